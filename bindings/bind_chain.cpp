@@ -1,0 +1,198 @@
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include "array_checks.hpp"
+#include "bindings.hpp"
+#include "mechbal/kdl_chain.hpp"
+#include "mechbal/serial_chain.hpp"
+
+namespace py = pybind11;
+
+namespace mechbal::pyb {
+
+namespace {
+
+Eigen::Isometry3d to_iso(const Eigen::Matrix4d& M) {
+  Eigen::Isometry3d T;
+  T.matrix() = M;
+  return T;
+}
+
+void check_rows(const Array& a, const char* name, pybind11::ssize_t n) {
+  require_shape(a, name, {-1, n});
+}
+
+}  // namespace
+
+void bind_chain(pybind11::module_& m) {
+  py::enum_<JointType>(m, "JointType")
+      .value("revolute", JointType::revolute)
+      .value("prismatic", JointType::prismatic);
+
+  py::class_<JointSpec>(m, "JointSpec", "One joint of a serial chain and the link it moves")
+      .def(py::init([](const std::string& name, JointType type, const Eigen::Matrix4d& origin,
+                       const Eigen::Vector3d& axis, double mass, const Eigen::Vector3d& com,
+                       const Eigen::Matrix3d& inertia) {
+             JointSpec j;
+             j.name = name;
+             j.type = type;
+             j.origin = to_iso(origin);
+             j.axis = axis;
+             j.link.mass = mass;
+             j.link.inertia_body = inertia;
+             j.com = com;
+             return j;
+           }),
+           py::arg("name"), py::arg("type"), py::arg("origin"), py::arg("axis"), py::arg("mass"),
+           py::arg("com"), py::arg("inertia"),
+           "origin: 4x4 transform previous link frame -> joint frame at q=0; axis in the joint "
+           "frame; com and inertia (about the centre of mass) in the link frame")
+      .def_readonly("name", &JointSpec::name)
+      .def_readonly("type", &JointSpec::type)
+      .def_property_readonly("origin", [](const JointSpec& j) { return Eigen::Matrix4d(j.origin.matrix()); })
+      .def_readonly("axis", &JointSpec::axis)
+      .def_property_readonly("mass", [](const JointSpec& j) { return j.link.mass; })
+      .def_readonly("com", &JointSpec::com)
+      .def_property_readonly("inertia", [](const JointSpec& j) { return j.link.inertia_body; });
+
+  py::class_<ChainModel>(m, "ChainModel", "Immutable, validated serial chain")
+      .def(py::init([](std::vector<JointSpec> joints, const Eigen::Vector3d& gravity,
+                       const Eigen::Matrix4d& base) {
+             return ChainModel(std::move(joints), gravity, to_iso(base));
+           }),
+           py::arg("joints"), py::arg("gravity") = Eigen::Vector3d(0.0, 0.0, -9.81),
+           py::arg("base") = Eigen::Matrix4d::Identity())
+      .def_property_readonly("dof", &ChainModel::dof)
+      .def_property_readonly("joints", &ChainModel::joints)
+      .def_property_readonly("gravity", &ChainModel::gravity)
+      .def_property_readonly("masses", [](const ChainModel& c) {
+        Eigen::VectorXd m(c.dof());
+        for (int i = 0; i < c.dof(); ++i) m(i) = c.bodies()[i].mass;
+        return m;
+      });
+
+  m.def(
+      "chain_kinematics",
+      [](const ChainModel& model, const Array& q, const Array& qd, const Array& qdd) {
+        const auto n = static_cast<pybind11::ssize_t>(model.dof());
+        check_rows(q, "q", n);
+        const auto N = q.shape(0);
+        require_shape(qd, "qd", {N, n});
+        require_shape(qdd, "qdd", {N, n});
+        Array com = make_array({N, n, 3}), vel = make_array({N, n, 3}),
+              acc = make_array({N, n, 3}), rot = make_array({N, n, 3, 3}),
+              w = make_array({N, n, 3}), al = make_array({N, n, 3}),
+              frames = make_array({N, n, 4, 4});
+        ChainWorkspace ws(model);
+        Status status = Status::ok;
+        using CVec = Eigen::Map<const Eigen::VectorXd>;
+        using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+        using RowMat4 = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>;
+        for (pybind11::ssize_t k = 0; k < N; ++k) {
+          const Status s = chain_kinematics(model, CVec(q.data(k, 0), n), CVec(qd.data(k, 0), n),
+                                            CVec(qdd.data(k, 0), n), ws);
+          status |= s;
+          for (pybind11::ssize_t i = 0; i < n; ++i) {
+            const BodyState& st = ws.states[static_cast<std::size_t>(i)];
+            const bool ok = s == Status::ok;
+            Eigen::Map<Eigen::Vector3d>(com.mutable_data(k, i, 0)) = ok ? st.com : Vec3::Zero();
+            Eigen::Map<Eigen::Vector3d>(vel.mutable_data(k, i, 0)) =
+                ok ? st.com_velocity : Vec3::Zero();
+            Eigen::Map<Eigen::Vector3d>(acc.mutable_data(k, i, 0)) =
+                ok ? st.com_acceleration : Vec3::Zero();
+            Eigen::Map<Eigen::Vector3d>(w.mutable_data(k, i, 0)) =
+                ok ? st.angular_velocity : Vec3::Zero();
+            Eigen::Map<Eigen::Vector3d>(al.mutable_data(k, i, 0)) =
+                ok ? st.angular_acceleration : Vec3::Zero();
+            Eigen::Map<RowMat3>(rot.mutable_data(k, i, 0, 0)) =
+                ok ? st.rotation : Mat3::Identity();
+            Eigen::Map<RowMat4>(frames.mutable_data(k, i, 0, 0)) =
+                ok ? ws.frames[static_cast<std::size_t>(i)].matrix() : Eigen::Matrix4d::Identity();
+          }
+        }
+        py::dict out;
+        out["com"] = com;
+        out["com_velocity"] = vel;
+        out["com_acceleration"] = acc;
+        out["rotation"] = rot;
+        out["angular_velocity"] = w;
+        out["angular_acceleration"] = al;
+        out["frames"] = frames;
+        out["status"] = status;
+        return out;
+      },
+      py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
+      "Every link's motion in the base frame for N joint states (q, qd, qdd each (N, dof)). "
+      "Returns a dict of arrays (N, dof, 3) / (N, dof, 3, 3) / frames (N, dof, 4, 4).");
+
+  py::class_<KdlChainDynamics>(m, "KdlChainDynamics",
+                               "Joint-space dynamics of a ChainModel through Orocos KDL")
+      .def(py::init<const ChainModel&>(), py::arg("model"))
+      .def_property_readonly("dof", &KdlChainDynamics::dof)
+      .def(
+          "inverse_dynamics",
+          [](KdlChainDynamics& d, const Array& q, const Array& qd, const Array& qdd) {
+            const auto n = static_cast<pybind11::ssize_t>(d.dof());
+            check_rows(q, "q", n);
+            const auto N = q.shape(0);
+            require_shape(qd, "qd", {N, n});
+            require_shape(qdd, "qdd", {N, n});
+            Array tau = make_array({N, n}), F = make_array({N, 3}), M = make_array({N, 3});
+            using CVec = Eigen::Map<const Eigen::VectorXd>;
+            Status status = Status::ok;
+            for (pybind11::ssize_t k = 0; k < N; ++k) {
+              Eigen::Map<Eigen::VectorXd> t(tau.mutable_data(k, 0), n);
+              Vec3 f, mo;
+              const Status s = d.inverse_dynamics(CVec(q.data(k, 0), n), CVec(qd.data(k, 0), n),
+                                                  CVec(qdd.data(k, 0), n), t, &f, &mo);
+              if (s != Status::ok) {
+                t.setZero();
+                f.setZero();
+                mo.setZero();
+              }
+              status |= s;
+              Eigen::Map<Eigen::Vector3d>(F.mutable_data(k, 0)) = f;
+              Eigen::Map<Eigen::Vector3d>(M.mutable_data(k, 0)) = mo;
+            }
+            py::dict out;
+            out["tau"] = tau;
+            out["support_force"] = F;
+            out["support_moment"] = M;
+            out["status"] = status;
+            return out;
+          },
+          py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          "Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, "
+          "support_moment about the base origin, (N, 3)) by KDL's ChainIdSolver_RNE.")
+      .def(
+          "mass_matrix",
+          [](KdlChainDynamics& d, const Eigen::VectorXd& q) {
+            if (q.size() != d.dof()) throw pybind11::value_error("q must have dof values");
+            Eigen::MatrixXd M(d.dof(), d.dof());
+            d.mass_matrix(q, M);
+            return M;
+          },
+          py::arg("q"))
+      .def(
+          "coriolis",
+          [](KdlChainDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+            if (q.size() != d.dof() || qd.size() != d.dof())
+              throw pybind11::value_error("q and qd must have dof values");
+            Eigen::VectorXd c(d.dof());
+            d.coriolis(q, qd, c);
+            return c;
+          },
+          py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques C(q, qd) qd")
+      .def(
+          "gravity",
+          [](KdlChainDynamics& d, const Eigen::VectorXd& q) {
+            if (q.size() != d.dof()) throw pybind11::value_error("q must have dof values");
+            Eigen::VectorXd g(d.dof());
+            d.gravity(q, g);
+            return g;
+          },
+          py::arg("q"), "Gravity torques G(q)");
+}
+
+}  // namespace mechbal::pyb

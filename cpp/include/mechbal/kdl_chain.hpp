@@ -1,0 +1,47 @@
+#pragma once
+/// \file kdl_chain.hpp
+/// Inverse dynamics of a serial chain through Orocos KDL, wrapped so that a tick allocates nothing.
+///
+/// KDL's `ChainIdSolver_RNE` gives joint torques; `ChainDynParam` the mass matrix, Coriolis and
+/// gravity terms. The wrench the chain transmits to its base is obtained from the same RNE pass by
+/// prepending six motionless virtual joints at the base origin (translations along x, y, z, then
+/// rotations about x, y, z): their generalised forces are exactly the support force and the support
+/// moment about O that the base exerts on the chain (gravity included).
+#include <Eigen/Core>
+#include <memory>
+
+#include "mechbal/serial_chain.hpp"
+#include "mechbal/status.hpp"
+
+namespace mechbal {
+
+class KdlChainDynamics {
+ public:
+  explicit KdlChainDynamics(const ChainModel& model);
+  ~KdlChainDynamics();
+  KdlChainDynamics(const KdlChainDynamics&) = delete;
+  KdlChainDynamics& operator=(const KdlChainDynamics&) = delete;
+
+  int dof() const noexcept { return dof_; }
+
+  /// tau = M(q) qdd + C(q, qd) qd + G(q). When `support_force`/`support_moment` are non-null
+  /// they receive the wrench the base exerts on the chain (moment about the base origin).
+  Status inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
+                          const Eigen::Ref<const Eigen::VectorXd>& qd,
+                          const Eigen::Ref<const Eigen::VectorXd>& qdd,
+                          Eigen::Ref<Eigen::VectorXd> tau, Vec3* support_force = nullptr,
+                          Vec3* support_moment = nullptr) noexcept;
+  Status mass_matrix(const Eigen::Ref<const Eigen::VectorXd>& q,
+                     Eigen::Ref<Eigen::MatrixXd> M) noexcept;
+  Status coriolis(const Eigen::Ref<const Eigen::VectorXd>& q,
+                  const Eigen::Ref<const Eigen::VectorXd>& qd,
+                  Eigen::Ref<Eigen::VectorXd> c) noexcept;
+  Status gravity(const Eigen::Ref<const Eigen::VectorXd>& q, Eigen::Ref<Eigen::VectorXd> g) noexcept;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int dof_;
+};
+
+}  // namespace mechbal

@@ -1,0 +1,9 @@
+#pragma once
+/// \file mechbal.hpp
+/// Umbrella header of the mechbal C++ core.
+#include "mechbal/kdl_chain.hpp"
+#include "mechbal/rigid_body.hpp"
+#include "mechbal/serial_chain.hpp"
+#include "mechbal/status.hpp"
+#include "mechbal/trajectory.hpp"
+#include "mechbal/version.hpp"

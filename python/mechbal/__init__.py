@@ -1,0 +1,20 @@
+"""mechbal: balancing of mechanisms and real-time control of balanced robots.
+
+The performance-critical algorithms live in the C++ core (``mechbal._core``); this package adds
+configuration (TOML -> validated models), offline sizing, batch simulation, reports and the
+``mechbal`` command line.
+"""
+from mechbal._core import (  # noqa: F401
+    ChainModel,
+    JointSpec,
+    JointType,
+    KdlChainDynamics,
+    RestToRestTrajectory,
+    Status,
+    TimeLaw,
+    chain_kinematics,
+    shaking_wrench,
+    validate_rigid_body,
+)
+from mechbal._core import __version__  # noqa: F401
+from mechbal.config import ConfigError, load_case  # noqa: F401

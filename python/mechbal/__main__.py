@@ -1,0 +1,5 @@
+import sys
+
+from mechbal.cli import main
+
+sys.exit(main())

@@ -1,0 +1,50 @@
+"""Built-in case studies: one TOML file each in this folder, run by the runner of its ``kind``.
+
+A runner is ``run(config: dict, out: Path) -> dict`` (the summary) registered with
+:func:`register`. ``mechbal cases`` lists the files; ``mechbal run NAME --out DIR`` runs one.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+from mechbal.config import CASES_DIR, ConfigError, load_case, read_toml
+
+Runner = Callable[[dict, Path], dict]
+_RUNNERS: dict[str, Runner] = {}
+
+#: the case ``mechbal demo`` runs
+DEFAULT_CASE = "arm2link"
+
+
+def register(kind: str) -> Callable[[Runner], Runner]:
+    def deco(fn: Runner) -> Runner:
+        _RUNNERS[kind] = fn
+        return fn
+
+    return deco
+
+
+def _load_runners() -> None:
+    # Importing the runner modules registers them.
+    from mechbal.cases import serial_chain  # noqa: F401
+
+
+def available() -> list[tuple[str, str, str]]:
+    """(name, kind, title) of every built-in case."""
+    out = []
+    for p in sorted(CASES_DIR.glob("*.toml")):
+        header = read_toml(p).get("case", {})
+        out.append((p.stem, header.get("kind", "?"), header.get("title", "")))
+    return out
+
+
+def run_case(name_or_path: str | Path, out: str | Path) -> dict:
+    _load_runners()
+    config = load_case(name_or_path)
+    kind = config["case"]["kind"]
+    if kind not in _RUNNERS:
+        raise ConfigError("case.kind", f"unknown kind (known: {', '.join(sorted(_RUNNERS))})", kind)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    return _RUNNERS[kind](config, out)
