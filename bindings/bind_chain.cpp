@@ -25,6 +25,8 @@ void check_rows(const Array& a, const char* name, pybind11::ssize_t n) {
 
 }  // namespace
 
+namespace {
+
 void bind_chain(pybind11::module_& m) {
   py::enum_<JointType>(m, "JointType")
       .value("revolute", JointType::revolute)
@@ -194,5 +196,9 @@ void bind_chain(pybind11::module_& m) {
           },
           py::arg("q"), "Gravity torques G(q)");
 }
+
+}  // namespace
+
+MECHBAL_REGISTER_BINDINGS(20, chain, bind_chain);
 
 }  // namespace mechbal::pyb

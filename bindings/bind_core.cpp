@@ -35,6 +35,8 @@ std::vector<RigidBody> make_bodies(const Array& mass, const Array& inertia) {
 
 }  // namespace
 
+namespace {
+
 void bind_core(pybind11::module_& m) {
   py::enum_<Status>(m, "Status", py::arithmetic(), "Bit flags returned by real-time algorithms")
       .value("ok", Status::ok)
@@ -106,5 +108,9 @@ all in the base frame. Returns a dict of (N,3) arrays: force (dP/dt), moment (dH
 linear_momentum, angular_momentum, and the OR of the statuses. Instants with non-finite input give
 zeros and set Status.non_finite_input.)doc");
 }
+
+}  // namespace
+
+MECHBAL_REGISTER_BINDINGS(0, core, bind_core);
 
 }  // namespace mechbal::pyb

@@ -9,6 +9,8 @@ namespace py = pybind11;
 
 namespace mechbal::pyb {
 
+namespace {
+
 void bind_trajectory(pybind11::module_& m) {
   py::enum_<TimeLaw>(m, "TimeLaw")
       .value("quintic", TimeLaw::quintic)
@@ -41,5 +43,9 @@ or minimum-energy cubic law (Arakelian et al. 2011, eqs 10-13).)doc")
            },
            py::arg("times"), "(q, qd, qdd), each (N, size), at the N given times");
 }
+
+}  // namespace
+
+MECHBAL_REGISTER_BINDINGS(10, trajectory, bind_trajectory);
 
 }  // namespace mechbal::pyb

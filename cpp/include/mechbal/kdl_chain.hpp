@@ -10,27 +10,36 @@
 #include <Eigen/Core>
 #include <memory>
 
+#include "mechbal/dynamics.hpp"
 #include "mechbal/serial_chain.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {
 
-class KdlChainDynamics {
+class KdlChainDynamics final : public InverseDynamics {
  public:
   explicit KdlChainDynamics(const ChainModel& model);
   ~KdlChainDynamics();
   KdlChainDynamics(const KdlChainDynamics&) = delete;
   KdlChainDynamics& operator=(const KdlChainDynamics&) = delete;
 
-  int dof() const noexcept { return dof_; }
+  int dof() const noexcept override { return dof_; }
+
+  /// InverseDynamics interface: joint torques only.
+  Status inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
+                          const Eigen::Ref<const Eigen::VectorXd>& qd,
+                          const Eigen::Ref<const Eigen::VectorXd>& qdd,
+                          Eigen::Ref<Eigen::VectorXd> tau) noexcept override {
+    return inverse_dynamics(q, qd, qdd, tau, nullptr, nullptr);
+  }
 
   /// tau = M(q) qdd + C(q, qd) qd + G(q). When `support_force`/`support_moment` are non-null
   /// they receive the wrench the base exerts on the chain (moment about the base origin).
   Status inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
                           const Eigen::Ref<const Eigen::VectorXd>& qd,
                           const Eigen::Ref<const Eigen::VectorXd>& qdd,
-                          Eigen::Ref<Eigen::VectorXd> tau, Vec3* support_force = nullptr,
-                          Vec3* support_moment = nullptr) noexcept;
+                          Eigen::Ref<Eigen::VectorXd> tau, Vec3* support_force,
+                          Vec3* support_moment) noexcept;
   Status mass_matrix(const Eigen::Ref<const Eigen::VectorXd>& q,
                      Eigen::Ref<Eigen::MatrixXd> M) noexcept;
   Status coriolis(const Eigen::Ref<const Eigen::VectorXd>& q,

@@ -1,6 +1,7 @@
 #pragma once
 /// \file mechbal.hpp
 /// Umbrella header of the mechbal C++ core.
+#include "mechbal/dynamics.hpp"
 #include "mechbal/kdl_chain.hpp"
 #include "mechbal/rigid_body.hpp"
 #include "mechbal/serial_chain.hpp"

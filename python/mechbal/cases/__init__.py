@@ -26,8 +26,13 @@ def register(kind: str) -> Callable[[Runner], Runner]:
 
 
 def _load_runners() -> None:
-    # Importing the runner modules registers them.
-    from mechbal.cases import serial_chain  # noqa: F401
+    # Importing every module of this package registers its runners (a new case kind is a new
+    # module here plus its TOML file: nothing else to edit).
+    import importlib
+    import pkgutil
+
+    for info in pkgutil.iter_modules(__path__):
+        importlib.import_module(f"{__name__}.{info.name}")
 
 
 def available() -> list[tuple[str, str, str]]:
