@@ -304,3 +304,16 @@ def test_case_bodies_files_follow_the_schema(arm2dof_run):
         assert np.max(np.abs(M[sl] - d["shaking_moment"][sl])) < 2e-3 * np.max(np.abs(d["shaking_moment"]))
     c = read_bodies(out / "bodies_C.npz")
     assert list(c["names"])[2:] == ["counterweight1", "counterweight2"]
+
+
+def test_case_config_errors_name_the_field(tmp_path):
+    from mechbal.cases import run_case
+    from mechbal.config import CASES_DIR, ConfigError
+
+    text = (CASES_DIR / "arm2dof.toml").read_text()
+    for old, new, field in (("m1 = 2.5", "m1 = -2.5", "arm.m1"),
+                            ("kp = [100.0, 100.0]", "kp = [100.0]", "controller.kp")):
+        bad = tmp_path / f"bad_{field}.toml"
+        bad.write_text(text.replace(old, new, 1))
+        with pytest.raises(ConfigError, match=field.replace(".", r"\.")):
+            run_case(bad, tmp_path / "out")
