@@ -1,0 +1,91 @@
+#include "mechbal/computed_torque.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace mechbal {
+
+namespace {
+
+void check_vector(const Eigen::VectorXd& v, const char* field, int n, bool allow_inf) {
+  std::ostringstream msg;
+  if (v.size() != n) {
+    msg << field << " must have " << n << " values (got " << v.size() << ")";
+    throw std::invalid_argument(msg.str());
+  }
+  for (int i = 0; i < n; ++i) {
+    const double x = v(i);
+    const bool ok = allow_inf ? (x > 0.0 && !std::isnan(x)) : (std::isfinite(x) && x > 0.0);
+    if (!ok) {
+      msg << field << "[" << i << "] must be " << (allow_inf ? "> 0" : "finite and > 0")
+          << " (got " << x << ")";
+      throw std::invalid_argument(msg.str());
+    }
+  }
+}
+
+}  // namespace
+
+ComputedTorque::ComputedTorque(InverseDynamics& model, const Eigen::VectorXd& kp,
+                               const Eigen::VectorXd& kd, const Eigen::VectorXd& torque_limit)
+    : model_(model), n_(model.dof()), kp_(kp), kd_(kd) {
+  if (n_ <= 0) throw std::invalid_argument("computed_torque.model must have at least one joint");
+  check_vector(kp, "computed_torque.kp", n_, false);
+  check_vector(kd, "computed_torque.kd", n_, false);
+  if (torque_limit.size() == 0) {
+    limit_ = Eigen::VectorXd::Constant(n_, std::numeric_limits<double>::infinity());
+  } else {
+    check_vector(torque_limit, "computed_torque.torque_limit", n_, true);
+    limit_ = torque_limit;
+  }
+  v_ = Eigen::VectorXd::Zero(n_);
+  raw_ = Eigen::VectorXd::Zero(n_);
+  last_ = Eigen::VectorXd::Zero(n_);
+}
+
+Status ComputedTorque::step(const Eigen::Ref<const Eigen::VectorXd>& q,
+                            const Eigen::Ref<const Eigen::VectorXd>& qd,
+                            const Eigen::Ref<const Eigen::VectorXd>& q_des,
+                            const Eigen::Ref<const Eigen::VectorXd>& qd_des,
+                            const Eigen::Ref<const Eigen::VectorXd>& qdd_des,
+                            Eigen::Ref<Eigen::VectorXd> tau) noexcept {
+  if (q.size() != n_ || qd.size() != n_ || q_des.size() != n_ || qd_des.size() != n_ ||
+      qdd_des.size() != n_ || tau.size() != n_)
+    return Status::bad_size;
+  if (!q.allFinite() || !qd.allFinite() || !q_des.allFinite() || !qd_des.allFinite() ||
+      !qdd_des.allFinite()) {
+    tau = last_;
+    return Status::non_finite_input;
+  }
+  // eq 4: v = qdd_d + Kp e + Kd edot (diagonal gains); computed into raw_ first so that v_ keeps
+  // the last good value if the model fails.
+  raw_ = qdd_des + kp_.cwiseProduct(q_des - q) + kd_.cwiseProduct(qd_des - qd);
+  if (!raw_.allFinite()) {  // finite inputs can still overflow
+    tau = last_;
+    return Status::non_finite_input;
+  }
+  v_ = raw_;
+  // eq 2: tau = A_hat v + C_hat qd + Q_hat = inverse dynamics of the model at (q, qd, v)
+  const Status s = model_.inverse_dynamics(q, qd, v_, raw_);
+  if (s != Status::ok || !raw_.allFinite()) {
+    tau = last_;
+    return s != Status::ok ? s : Status::non_finite_input;
+  }
+  Status status = Status::ok;
+  for (int i = 0; i < n_; ++i) {
+    if (raw_(i) > limit_(i)) {
+      raw_(i) = limit_(i);
+      status = Status::saturated;
+    } else if (raw_(i) < -limit_(i)) {
+      raw_(i) = -limit_(i);
+      status = Status::saturated;
+    }
+  }
+  last_ = raw_;
+  tau = last_;
+  return status;
+}
+
+}  // namespace mechbal
