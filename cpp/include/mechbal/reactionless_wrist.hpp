@@ -72,6 +72,8 @@ void validate_wrist_config(const ReactionlessWristConfig& config);
 
 /// What one tick commands: angles q_n (the position set-point for this tick), the rates and
 /// accelerations at t_n (feed-forward), the angles for the next tick, cond(N(q_n)).
+/// When the rate limit saturates, the acceleration feed-forward is zero (the unsaturated formula
+/// no longer describes the commanded motion).
 struct WristCommand {
   Vec3 angles = Vec3::Zero();
   Vec3 rates = Vec3::Zero();
