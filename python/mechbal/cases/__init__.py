@@ -14,7 +14,7 @@ Runner = Callable[[dict, Path], dict]
 _RUNNERS: dict[str, Runner] = {}
 
 #: the case ``mechbal demo`` runs
-DEFAULT_CASE = "arm2link"
+DEFAULT_CASE = "paminsa"
 
 
 def register(kind: str) -> Callable[[Runner], Runner]:

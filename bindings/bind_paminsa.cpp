@@ -1,0 +1,277 @@
+// pybind11 glue for the PAMINSA model and the reactionless wrist (no logic: conversions only).
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <cstdint>
+
+#include "array_checks.hpp"
+#include "bindings.hpp"
+#include "mechbal/paminsa.hpp"
+#include "mechbal/reactionless_wrist.hpp"
+
+namespace py = pybind11;
+
+namespace mechbal::pyb {
+
+namespace {
+
+constexpr py::ssize_t kBodies = static_cast<py::ssize_t>(PaminsaBodyIndex::count);
+
+struct BatchArrays {
+  Array com, vel, acc, rot, w, wd, F, M, D, Dd, q, qd, qdd, cond;
+  py::array_t<std::uint32_t> status;
+  explicit BatchArrays(py::ssize_t N)
+      : com(make_array({N, kBodies, 3})), vel(make_array({N, kBodies, 3})),
+        acc(make_array({N, kBodies, 3})), rot(make_array({N, kBodies, 3, 3})),
+        w(make_array({N, kBodies, 3})), wd(make_array({N, kBodies, 3})), F(make_array({N, 3})),
+        M(make_array({N, 3})), D(make_array({N, 3})), Dd(make_array({N, 3})),
+        q(make_array({N, 3})), qd(make_array({N, 3})), qdd(make_array({N, 3})),
+        cond(make_array({N})), status(std::vector<py::ssize_t>{N}) {}
+  PaminsaBatchOutput view() {
+    PaminsaBatchOutput o;
+    o.com = com.mutable_data();
+    o.com_velocity = vel.mutable_data();
+    o.com_acceleration = acc.mutable_data();
+    o.rotation = rot.mutable_data();
+    o.angular_velocity = w.mutable_data();
+    o.angular_acceleration = wd.mutable_data();
+    o.force = F.mutable_data();
+    o.moment = M.mutable_data();
+    o.D = D.mutable_data();
+    o.D_dot = Dd.mutable_data();
+    o.wrist_angles = q.mutable_data();
+    o.wrist_rates = qd.mutable_data();
+    o.wrist_accelerations = qdd.mutable_data();
+    o.condition = cond.mutable_data();
+    o.status = status.mutable_data();
+    return o;
+  }
+  py::dict to_dict(Status all) {
+    py::dict d;
+    d["com"] = com;
+    d["com_velocity"] = vel;
+    d["com_acceleration"] = acc;
+    d["rotation"] = rot;
+    d["angular_velocity"] = w;
+    d["angular_acceleration"] = wd;
+    d["shaking_force"] = F;
+    d["shaking_moment"] = M;
+    d["D"] = D;
+    d["D_dot"] = Dd;
+    d["wrist_angles"] = q;
+    d["wrist_rates"] = qd;
+    d["wrist_accelerations"] = qdd;
+    d["condition"] = cond;
+    d["status_per_instant"] = status;
+    d["status"] = all;
+    return d;
+  }
+};
+
+void bind_paminsa(py::module_& m) {
+  py::class_<PaminsaCounterweights>(m, "PaminsaCounterweights",
+                                    "Counterweight masses [kg] of PAMINSA (Briot & Arakelian 2009, "
+                                    "eqs 11, 14-16): at_A (CP1), at_F (CP2), at_L (CP3), vertical")
+      .def(py::init<>())
+      .def_readwrite("at_A", &PaminsaCounterweights::at_A)
+      .def_readwrite("at_F", &PaminsaCounterweights::at_F)
+      .def_readwrite("at_L", &PaminsaCounterweights::at_L)
+      .def_readwrite("vertical", &PaminsaCounterweights::vertical);
+
+  py::class_<PaminsaParameters> pp(m, "PaminsaParameters",
+                                   "Every PAMINSA parameter (defaults: the paper's Sec. II.A and "
+                                   "the reconstruction choices A1-A11), SI units");
+  pp.def(py::init<>());
+#define MB_RW(field) pp.def_readwrite(#field, &PaminsaParameters::field)
+  MB_RW(k); MB_RW(a); MB_RW(b); MB_RW(c); MB_RW(d); MB_RW(e); MB_RW(f);
+  MB_RW(length_BG); MB_RW(length_AE); MB_RW(length_DF); MB_RW(length_CE); MB_RW(length_AF);
+  MB_RW(length_CJ); MB_RW(length_MS5); MB_RW(length_MO); MB_RW(platform_mass); MB_RW(link_mass);
+  MB_RW(link_inertia); MB_RW(wrist_inertia); MB_RW(nominal_platform); MB_RW(nominal_rho);
+  MB_RW(z_A); MB_RW(elbow); MB_RW(vertical_mass_at_centroid); MB_RW(vertical_mass_xy);
+  MB_RW(vertical_mass_z0); MB_RW(cp3_ratio); MB_RW(counterweights);
+#undef MB_RW
+
+  py::enum_<WristIntegrator>(m, "WristIntegrator")
+      .value("euler", WristIntegrator::euler)
+      .value("rk4", WristIntegrator::rk4);
+
+  py::class_<ReactionlessWristConfig>(m, "ReactionlessWristConfig")
+      .def(py::init([](double rate_hz, WristIntegrator integrator, double max_rate,
+                       double max_condition, double damping) {
+             ReactionlessWristConfig c;
+             c.rate_hz = rate_hz;
+             c.integrator = integrator;
+             c.max_rate = max_rate;
+             c.max_condition = max_condition;
+             c.damping = damping;
+             validate_wrist_config(c);
+             return c;
+           }),
+           py::arg("rate_hz") = 1000.0, py::arg("integrator") = WristIntegrator::euler,
+           py::arg("max_rate") = std::numeric_limits<double>::infinity(),
+           py::arg("max_condition") = 1e4, py::arg("damping") = 1e-2)
+      .def_readonly("rate_hz", &ReactionlessWristConfig::rate_hz)
+      .def_readonly("integrator", &ReactionlessWristConfig::integrator)
+      .def_readonly("max_rate", &ReactionlessWristConfig::max_rate)
+      .def_readonly("max_condition", &ReactionlessWristConfig::max_condition)
+      .def_readonly("damping", &ReactionlessWristConfig::damping);
+
+  m.def("wrist_momentum_matrix",
+        [](const Eigen::Matrix3d& J1, const Eigen::Matrix3d& J2, const Eigen::Matrix3d& J3,
+           const Eigen::Vector3d& q) { return wrist_momentum_matrix({J1, J2, J3}, q); },
+        py::arg("J1"), py::arg("J2"), py::arg("J3"), py::arg("angles"),
+        "N(q) of Briot & Arakelian 2009 eq 23 (corrected): wrist angular momentum = N qdot");
+  m.def("wrist_momentum_bias",
+        [](const Eigen::Matrix3d& J1, const Eigen::Matrix3d& J2, const Eigen::Matrix3d& J3,
+           const Eigen::Vector3d& q, const Eigen::Vector3d& qd) {
+          return wrist_momentum_bias({J1, J2, J3}, q, qd);
+        },
+        py::arg("J1"), py::arg("J2"), py::arg("J3"), py::arg("angles"), py::arg("rates"),
+        "d/dt(N qdot) - N qddot");
+
+  py::class_<WristCommand>(m, "WristCommand")
+      .def_readonly("angles", &WristCommand::angles)
+      .def_readonly("rates", &WristCommand::rates)
+      .def_readonly("accelerations", &WristCommand::accelerations)
+      .def_readonly("next_angles", &WristCommand::next_angles)
+      .def_readonly("condition_number", &WristCommand::condition_number)
+      .def_readonly("status", &WristCommand::status);
+
+  py::class_<ReactionlessWrist>(m, "ReactionlessWrist",
+                                "Reactionless z-x-z wrist controller (Briot & Arakelian 2009, "
+                                "eqs 23-26, corrected)")
+      .def(py::init([](const Eigen::Matrix3d& J1, const Eigen::Matrix3d& J2,
+                       const Eigen::Matrix3d& J3, const ReactionlessWristConfig& c,
+                       const Eigen::Vector3d& q0, const Eigen::Vector3d& H) {
+             return ReactionlessWrist({J1, J2, J3}, c, q0, H);
+           }),
+           py::arg("J1"), py::arg("J2"), py::arg("J3"), py::arg("config"),
+           py::arg("initial_angles"), py::arg("target_momentum"))
+      .def("step", &ReactionlessWrist::step, py::arg("D"), py::arg("D_dot"), py::arg("D_half"),
+           py::arg("D_next"))
+      .def("step_euler", &ReactionlessWrist::step_euler, py::arg("D"), py::arg("D_dot"))
+      .def("reset", &ReactionlessWrist::reset, py::arg("angles"), py::arg("target_momentum"))
+      .def_property_readonly("command", &ReactionlessWrist::command)
+      .def_property_readonly("angles", &ReactionlessWrist::angles)
+      .def_property_readonly("dt", &ReactionlessWrist::dt);
+
+  py::class_<PaminsaModel>(m, "PaminsaModel",
+                           "Immutable PAMINSA model (Briot & Arakelian 2009), validated")
+      .def(py::init<const PaminsaParameters&>(), py::arg("parameters"))
+      .def_property_readonly("parameters", &PaminsaModel::parameters)
+      .def_property_readonly("body_names",
+                             [](const PaminsaModel&) {
+                               std::vector<std::string> n;
+                               for (std::size_t i = 0; i < PaminsaBodyIndex::count; ++i)
+                                 n.emplace_back(PaminsaModel::body_name(i));
+                               return n;
+                             })
+      .def_property_readonly("masses",
+                             [](const PaminsaModel& mo) {
+                               Eigen::VectorXd v(kBodies);
+                               for (py::ssize_t i = 0; i < kBodies; ++i) v(i) = mo.bodies()[i].mass;
+                               return v;
+                             })
+      .def_property_readonly("inertia_body",
+                             [](const PaminsaModel& mo) {
+                               Array a = make_array({kBodies, 3, 3});
+                               for (py::ssize_t i = 0; i < kBodies; ++i)
+                                 Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
+                                     a.mutable_data(i, 0, 0)) = mo.bodies()[i].inertia_body;
+                               return a;
+                             })
+      .def_property_readonly("slider_lines", [](const PaminsaModel& mo) {
+        Eigen::Matrix<double, 3, 2, Eigen::RowMajor> x;
+        for (int i = 0; i < 3; ++i) x.row(i) = mo.slider_line()[i].transpose();
+        return x;
+      })
+      .def_property_readonly("guide_pivots", [](const PaminsaModel& mo) {
+        Eigen::Matrix<double, 3, 2, Eigen::RowMajor> x;
+        for (int i = 0; i < 3; ++i) x.row(i) = mo.guide_pivot()[i].transpose();
+        return x;
+      })
+      .def_property_readonly("vertical_mass_xy", &PaminsaModel::vertical_mass_xy)
+      .def("inverse_kinematics",
+           [](const PaminsaModel& mo, const Eigen::Vector3d& P) {
+             PaminsaActuators a;
+             const Status s = mo.inverse_kinematics(P, a);
+             py::dict d;
+             d["alpha1"] = a.alpha1;
+             d["alpha3"] = a.alpha3;
+             d["z_B"] = a.z_B;
+             d["alpha2"] = a.alpha2;
+             d["stroke"] = Eigen::Vector3d(a.stroke);
+             d["status"] = s;
+             return d;
+           },
+           py::arg("P"))
+      .def("forward_kinematics",
+           [](const PaminsaModel& mo, double a1, double a3, double zB) {
+             Eigen::Vector3d P = Eigen::Vector3d::Zero();
+             const Status s = mo.forward_kinematics(a1, a3, zB, P);
+             return py::make_tuple(P, s);
+           },
+           py::arg("alpha1"), py::arg("alpha3"), py::arg("z_B"))
+      .def("leg_points",
+           [](const PaminsaModel& mo, const Eigen::Vector3d& P) {
+             PaminsaWorkspace ws;
+             PlatformMotion pm;
+             pm.position = P;
+             const Status s = paminsa_mechanism_kinematics(mo, pm, ws);
+             Array a = make_array({3, 6, 3});
+             for (int i = 0; i < 3; ++i)
+               for (int n = 0; n < 6; ++n)
+                 Eigen::Map<Eigen::Vector3d>(a.mutable_data(i, n, 0)) = ws.leg_points[i][n];
+             return py::make_tuple(a, s);
+           },
+           py::arg("P"), "Base-frame points A, B, C, D, E, F of each leg (3, 6, 3) at pose P");
+
+  m.def("paminsa_kinematics",
+        [](const PaminsaModel& mo, const Array& P, const Array& Pd, const Array& Pdd,
+           const Array& q, const Array& qd, const Array& qdd) {
+          require_shape(P, "P", {-1, 3});
+          const auto N = P.shape(0);
+          require_shape(Pd, "Pd", {N, 3});
+          require_shape(Pdd, "Pdd", {N, 3});
+          require_shape(q, "q", {N, 3});
+          require_shape(qd, "qd", {N, 3});
+          require_shape(qdd, "qdd", {N, 3});
+          BatchArrays out(N);
+          const Status s = paminsa_kinematics_batch(mo, static_cast<std::size_t>(N), P.data(),
+                                                    Pd.data(), Pdd.data(), q.data(), qd.data(),
+                                                    qdd.data(), out.view());
+          return out.to_dict(s);
+        },
+        py::arg("model"), py::arg("P"), py::arg("Pd"), py::arg("Pdd"), py::arg("q"),
+        py::arg("qd"), py::arg("qdd"),
+        "Every body's motion (N, 38, ...), the shaking wrench about O and D, dD/dt (eq 19) for "
+        "platform motion and prescribed wrist motion, each (N, 3).");
+
+  m.def("paminsa_reactionless_run",
+        [](const PaminsaModel& mo, const ReactionlessWristConfig& c, const Eigen::Vector3d& q0,
+           const Array& P, const Array& Pd, const Array& Pdd) {
+          require_shape(P, "P_half", {-1, 3});
+          const auto J = P.shape(0);
+          if (J < 3 || J % 2 == 0)
+            throw py::value_error("P_half must have 2 * steps + 1 rows (steps >= 1), got " +
+                                  std::to_string(J));
+          require_shape(Pd, "Pd_half", {J, 3});
+          require_shape(Pdd, "Pdd_half", {J, 3});
+          const auto steps = (J - 1) / 2;
+          BatchArrays out(steps + 1);
+          const Status s = paminsa_reactionless_run(mo, c, q0, static_cast<std::size_t>(steps),
+                                                    P.data(), Pd.data(), Pdd.data(), out.view());
+          return out.to_dict(s);
+        },
+        py::arg("model"), py::arg("config"), py::arg("initial_wrist_angles"), py::arg("P_half"),
+        py::arg("Pd_half"), py::arg("Pdd_half"),
+        "Fully balanced run with the reactionless wrist ticking at config.rate_hz. Platform motion "
+        "sampled every dt/2 ((2 steps + 1, 3) each); outputs at the steps + 1 ticks.");
+}
+
+}  // namespace
+
+MECHBAL_REGISTER_BINDINGS(40, paminsa, bind_paminsa);
+
+}  // namespace mechbal::pyb

@@ -1,0 +1,127 @@
+#pragma once
+/// \file reactionless_wrist.hpp
+/// Reactionless z-x-z wrist: the real-time controller that cancels the shaking moment of a
+/// force-balanced manipulator by spinning its wrist (Briot & Arakelian 2009, eqs 19-26, re-derived).
+///
+/// The total angular momentum about O is H = D + H_wrist, where D (eq 19) is the angular momentum
+/// of everything except the wrist's rotation and H_wrist = N(q_w) qdot_w (eqs 22-23) that of the
+/// wrist links spinning about their common centre of mass. Keeping H equal to its initial value
+/// H_target makes the shaking moment dH/dt zero:
+///
+///     N(q_w) qdot_w = H_target - D(t)                       (eq 25, corrected)
+///     q_w(t + dt) = q_w(t) + dt qdot_w(t)                   (eq 26, explicit Euler), or RK4
+///     N qddot_w = -Ddot - d/dt(N) qdot_w                    (servo feed-forward)
+///
+/// Corrections to the paper's printed equations (derivation in /work/scratch/paminsa, re-checked
+/// here by the tests against the wrist links' angular momentum computed body by body):
+///  1. eq 23: N = [(I1+I2+I3) e_z | (I2+I3) x1 | I3 z2], with x1 = Rz(phi) e_x,
+///     z2 = Rz(phi) Rx(theta) e_z and base-frame I_k = R_k J_k R_k^T. The printed matrix omits I2, I3
+///     from the phi column, adds a rotation to an inertia ("I_w2 + I_w3 E3"), and orders the rates
+///     [theta phi psi]; here they are (phi, theta, psi) throughout.
+///  2. eq 21/25: H_target is the initial total angular momentum, not 0 (they agree from rest).
+///  3. det N = 0 at theta = 0 or pi (z-x-z gimbal lock), which includes the paper's start pose
+///     "orientation equal to zero": the controller then uses damped least squares and reports
+///     Status::singular.
+#include <Eigen/Geometry>
+#include <array>
+#include <limits>
+
+#include "mechbal/rigid_body.hpp"
+#include "mechbal/status.hpp"
+
+namespace mechbal {
+
+/// Body-frame inertia tensors of the three wrist links about their centres of mass (all at the
+/// wrist centre). Link k's body frame is its joint frame: R1 = Rz(phi), R2 = R1 Rx(theta),
+/// R3 = R2 Rz(psi).
+using WristInertias = std::array<Mat3, 3>;
+
+/// Rotation, angular velocity and angular acceleration (base frame) of each z-x-z wrist link:
+/// w1 = phid e_z, w2 = w1 + thetad x1, w3 = w2 + psid z2 and their derivatives.
+struct WristLinkMotion {
+  std::array<Mat3, 3> rotation;
+  std::array<Vec3, 3> angular_velocity;
+  std::array<Vec3, 3> angular_acceleration;
+};
+void wrist_link_motion(const Vec3& angles, const Vec3& rates, const Vec3& accelerations,
+                       WristLinkMotion& out) noexcept;
+
+/// N(q) of eq 23 (corrected): H_wrist = N(q) qdot with H_wrist = sum_k I_k w_k.
+Mat3 wrist_momentum_matrix(const WristInertias& inertia_body, const Vec3& angles) noexcept;
+
+/// d/dt(N qdot) - N qddot = sum_k [I_k wdot_k|_{qddot=0} + w_k x I_k w_k] (the Ndot qdot term).
+Vec3 wrist_momentum_bias(const WristInertias& inertia_body, const Vec3& angles,
+                         const Vec3& rates) noexcept;
+
+enum class WristIntegrator { euler, rk4 };
+
+struct ReactionlessWristConfig {
+  double rate_hz = 1000.0;  ///< tick rate [Hz]
+  WristIntegrator integrator = WristIntegrator::euler;
+  /// per-axis wrist rate limit [rad/s]: the rate vector is scaled down (direction kept) and the
+  /// tick reports Status::saturated
+  double max_rate = std::numeric_limits<double>::infinity();
+  /// cond(N) above which N counts as singular: damped least squares, Status::singular
+  double max_condition = 1e4;
+  /// damping of the damped least squares, relative to the largest singular value of N
+  double damping = 1e-2;
+};
+
+/// Throws std::invalid_argument naming the field.
+void validate_wrist_config(const ReactionlessWristConfig& config);
+
+/// What one tick commands: angles q_n (the position set-point for this tick), the rates and
+/// accelerations at t_n (feed-forward), the angles for the next tick, cond(N(q_n)).
+/// When the rate limit saturates, the acceleration feed-forward is zero (the unsaturated formula
+/// no longer describes the commanded motion).
+struct WristCommand {
+  Vec3 angles = Vec3::Zero();
+  Vec3 rates = Vec3::Zero();
+  Vec3 accelerations = Vec3::Zero();
+  Vec3 next_angles = Vec3::Zero();
+  double condition_number = 1.0;
+  Status status = Status::ok;
+};
+
+class ReactionlessWrist {
+ public:
+  /// Throws std::invalid_argument (naming the field) on a bad configuration, inertia or start.
+  ReactionlessWrist(const WristInertias& inertia_body, const ReactionlessWristConfig& config,
+                    const Vec3& initial_angles, const Vec3& target_momentum);
+
+  /// Restart from `angles` with a new target total angular momentum H_target. Non-finite input:
+  /// nothing changes, Status::non_finite_input.
+  Status reset(const Vec3& angles, const Vec3& target_momentum) noexcept;
+
+  /// One tick with the configured integrator. D_now = D(t_n), D_dot = dD/dt(t_n); RK4 also
+  /// needs D(t_n + dt/2) and D(t_n + dt) (from the planned trajectory); Euler ignores them.
+  /// Non-finite input: the angles are held, rates and accelerations are zero, the state does not
+  /// advance, Status::non_finite_input. Never writes NaN.
+  Status step(const Vec3& D_now, const Vec3& D_dot, const Vec3& D_half,
+              const Vec3& D_next) noexcept;
+  /// One explicit-Euler tick (eq 26), whatever the configured integrator.
+  Status step_euler(const Vec3& D_now, const Vec3& D_dot) noexcept;
+
+  const WristCommand& command() const noexcept { return command_; }
+  const Vec3& angles() const noexcept { return angles_; }  ///< state q_n for the next tick
+  const Vec3& target_momentum() const noexcept { return target_; }
+  const ReactionlessWristConfig& config() const noexcept { return config_; }
+  const WristInertias& inertia_body() const noexcept { return inertia_; }
+  double dt() const noexcept { return dt_; }
+
+  /// qdot = N(q)^-1 (H_target - D) with damping and the rate limit; condition number of N(q).
+  Status rates(const Vec3& angles, const Vec3& D, Vec3& rates, double& condition) const noexcept;
+
+ private:
+  Status solve(const Mat3& N, const Vec3& rhs, Vec3& x, double& condition) const noexcept;
+  Status tick(const Vec3& D_now, const Vec3& D_dot, const Vec3* D_half, const Vec3* D_next) noexcept;
+
+  WristInertias inertia_;
+  ReactionlessWristConfig config_;
+  double dt_;
+  Vec3 angles_;
+  Vec3 target_;
+  WristCommand command_;
+};
+
+}  // namespace mechbal
