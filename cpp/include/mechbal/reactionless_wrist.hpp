@@ -12,7 +12,7 @@
 ///     q_w(t + dt) = q_w(t) + dt qdot_w(t)                   (eq 26, explicit Euler), or RK4
 ///     N qddot_w = -Ddot - d/dt(N) qdot_w                    (servo feed-forward)
 ///
-/// Corrections to the paper's printed equations (derivation in /work/scratch/paminsa, re-checked
+/// Corrections to the paper's printed equations (derivation in docs/paminsa_derivation.md, re-checked
 /// here by the tests against the wrist links' angular momentum computed body by body):
 ///  1. eq 23: N = [(I1+I2+I3) e_z | (I2+I3) x1 | I3 z2], with x1 = Rz(phi) e_x,
 ///     z2 = Rz(phi) Rx(theta) e_z and base-frame I_k = R_k J_k R_k^T. The printed matrix omits I2, I3
