@@ -16,6 +16,19 @@ def _pyplot():
     return plt
 
 
+def _finish(plt, fig, legend_axis, path: str | Path, title: str) -> Path:
+    """Legend, title, layout, save as PNG (creating the folder), close."""
+    legend_axis.legend(fontsize=8)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def plot_wrench(path: str | Path, t: np.ndarray,
                 variants: Mapping[str, tuple[np.ndarray, np.ndarray]], title: str = "") -> Path:
     """Shaking force x, y, z (top row) and moment x, y, z (bottom row) for each variant."""
@@ -31,15 +44,7 @@ def plot_wrench(path: str | Path, t: np.ndarray,
         axes[1, k].set_xlabel("t [s]")
         for r in range(2):
             axes[r, k].grid(True, alpha=0.3)
-    axes[0, 0].legend(fontsize=8)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _finish(plt, fig, axes[0, 0], path, title)
 
 
 def plot_series(path: str | Path, t: np.ndarray, series: Mapping[str, np.ndarray],
@@ -57,15 +62,7 @@ def plot_series(path: str | Path, t: np.ndarray, series: Mapping[str, np.ndarray
         axes[0, k].set_xlabel("t [s]")
         axes[0, k].set_ylabel(ylabel)
         axes[0, k].grid(True, alpha=0.3)
-    axes[0, 0].legend(fontsize=8)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _finish(plt, fig, axes[0, 0], path, title)
 
 
 def table(rows: Sequence[Sequence[object]], header: Sequence[str]) -> str:
