@@ -10,6 +10,7 @@ from mechbal._core import (  # noqa: F401
     JointType,
     KdlChainDynamics,
     RestToRestTrajectory,
+    RneChainDynamics,
     Status,
     TimeLaw,
     chain_kinematics,
