@@ -8,7 +8,8 @@ PIP := $(PY) -m pip --disable-pip-version-check
 APT_PACKAGES := libeigen3-dev liborocos-kdl-dev libgtest-dev libbenchmark-dev g++ make python3-venv python3-dev
 CPP_BUILD := build/cpp
 JOBS ?= 2
-SOURCES := $(shell find cpp bindings python tests/cpp tests/consumer bench cmake -type f 2>/dev/null) \
+SOURCES := $(shell find cpp bindings python tests/cpp tests/consumer bench cmake -path bench/results -prune \
+             -o -type f -print 2>/dev/null) \
            CMakeLists.txt pyproject.toml
 
 .PHONY: demo test test-cpp test-python bench apt venv install clean help
@@ -62,8 +63,29 @@ test-cpp: $(CPP_BUILD)/build.ninja
 test-python: install
 	$(PY) -m pytest -q tests/python
 
-bench: install
-	@echo "benchmarks: see bench/README.md (not yet built)"
+# ---- benchmarks (never part of `make test`; own build dir so test and bench builds don't fight) --
+BENCH_BUILD := build/bench
+BENCH_RUN := $(BENCH_BUILD)/results
+BENCH_FLAGS ?= --benchmark_repetitions=7 --benchmark_min_time=0.05 \
+               --benchmark_report_aggregates_only=true --tail_samples=20000
+LOOP_SECONDS ?= 5
+
+$(BENCH_BUILD)/build.ninja: | $(VENV)/.stamp-venv
+	$(VENV)/bin/cmake -S . -B $(BENCH_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release \
+	  -DCMAKE_MAKE_PROGRAM=$(abspath $(VENV)/bin/ninja) -DMECHBAL_BUILD_TESTS=OFF \
+	  -DMECHBAL_BUILD_BENCH=ON
+
+bench: install $(BENCH_BUILD)/build.ninja
+	$(VENV)/bin/cmake --build $(BENCH_BUILD) -j $(JOBS)
+	@mkdir -p $(BENCH_RUN)
+	$(BENCH_BUILD)/bench/mechbal-bench $(BENCH_FLAGS) --tail_out=$(BENCH_RUN)/tail.json \
+	  --benchmark_out=$(BENCH_RUN)/gbench.json --benchmark_out_format=json
+	$(BENCH_BUILD)/bench/mechbal-loop --seconds $(LOOP_SECONDS) --rate 1000 --rt \
+	  --json $(BENCH_RUN)/loop.json
+	$(PY) bench/bench_python.py --out $(BENCH_RUN)/python.json
+	$(PY) bench/merge_results.py --gbench $(BENCH_RUN)/gbench.json --tail $(BENCH_RUN)/tail.json \
+	  --loop $(BENCH_RUN)/loop.json --python $(BENCH_RUN)/python.json \
+	  --out-json bench/results/latest.json --out-md bench/results/latest.md
 
 clean:
 	rm -rf build $(VENV) out

@@ -14,6 +14,7 @@ from mechbal._core import (  # noqa: F401
     ReactionlessWrist,
     ReactionlessWristConfig,
     RestToRestTrajectory,
+    RneChainDynamics,
     Status,
     TimeLaw,
     chain_kinematics,

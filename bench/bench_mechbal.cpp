@@ -1,0 +1,115 @@
+// mechbal's own real-time paths: shaking wrench of a body set, chain kinematics, recursive
+// Newton-Euler inverse dynamics, the computed-torque-equivalent tick and the CRBA mass matrix.
+#include <random>
+
+#include "bench_registry.hpp"
+#include "mechbal/rigid_body.hpp"
+#include "mechbal/rnea.hpp"
+#include "mechbal/serial_chain.hpp"
+#include "test_support.hpp"
+
+namespace mechbal::bench {
+namespace {
+
+struct BodySet {
+  std::vector<RigidBody> bodies;
+  std::vector<BodyState> states;
+  ShakingWrench out;
+};
+
+Tick shaking_wrench_case(int count) {
+  auto s = std::make_shared<BodySet>();
+  std::mt19937 rng(static_cast<unsigned>(count));
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < count; ++i) {
+    s->bodies.push_back(test::random_body(rng));
+    BodyState st;
+    st.com = Vec3(u(rng), u(rng), u(rng));
+    st.com_velocity = Vec3(u(rng), u(rng), u(rng));
+    st.com_acceleration = Vec3(u(rng), u(rng), u(rng));
+    st.rotation = Eigen::Quaterniond::UnitRandom().toRotationMatrix();
+    st.angular_velocity = Vec3(u(rng), u(rng), u(rng));
+    st.angular_acceleration = Vec3(u(rng), u(rng), u(rng));
+    s->states.push_back(st);
+  }
+  return [s] {
+    shaking_wrench(s->bodies.data(), s->states.data(), s->states.size(), s->out);
+    benchmark::DoNotOptimize(s->out);
+  };
+}
+
+struct ChainKin {
+  explicit ChainKin(int dof) : model(bench_chain(dof)), ws(model), x(bench_states(dof)) {}
+  ChainModel model;
+  ChainWorkspace ws;
+  JointStates x;
+  int k = 0;
+};
+
+Tick chain_kinematics_case(int dof) {
+  auto s = std::make_shared<ChainKin>(dof);
+  return [s] {
+    const int k = s->k = (s->k + 1) & (JointStates::count - 1);
+    chain_kinematics(s->model, s->x.q[k], s->x.qd[k], s->x.qdd[k], s->ws);
+    benchmark::DoNotOptimize(s->ws.states.data());
+    benchmark::ClobberMemory();
+  };
+}
+
+struct Rne {
+  explicit Rne(int dof)
+      : model(bench_chain(dof)), rne(model), x(bench_states(dof)), v(dof), tau(dof), M(dof, dof) {}
+  ChainModel model;
+  RneChainDynamics rne;
+  JointStates x;
+  Eigen::VectorXd v, tau;
+  Eigen::MatrixXd M;
+  int k = 0;
+};
+
+Tick id_case(int dof) {
+  auto s = std::make_shared<Rne>(dof);
+  return [s] {
+    const int k = s->k = (s->k + 1) & (JointStates::count - 1);
+    s->rne.inverse_dynamics(s->x.q[k], s->x.qd[k], s->x.qdd[k], s->tau);
+    benchmark::DoNotOptimize(s->tau.data());
+    benchmark::ClobberMemory();
+  };
+}
+
+// Computed torque (PD outer loop + inverse dynamics), reference = state k, measured = state k+1.
+Tick ct_case(int dof) {
+  auto s = std::make_shared<Rne>(dof);
+  return [s] {
+    const int k = s->k = (s->k + 1) & (JointStates::count - 1);
+    const int m = (k + 1) & (JointStates::count - 1);
+    s->v = s->x.qdd[k] + ct_kp * (s->x.q[k] - s->x.q[m]) + ct_kd * (s->x.qd[k] - s->x.qd[m]);
+    s->rne.inverse_dynamics(s->x.q[m], s->x.qd[m], s->v, s->tau);
+    benchmark::DoNotOptimize(s->tau.data());
+    benchmark::ClobberMemory();
+  };
+}
+
+Tick mass_case(int dof) {
+  auto s = std::make_shared<Rne>(dof);
+  return [s] {
+    const int k = s->k = (s->k + 1) & (JointStates::count - 1);
+    s->rne.mass_matrix(s->x.q[k], s->M);
+    benchmark::DoNotOptimize(s->M.data());
+    benchmark::ClobberMemory();
+  };
+}
+
+}  // namespace
+}  // namespace mechbal::bench
+
+using namespace mechbal::bench;
+MECHBAL_BENCH_CASE(shaking_wrench_10) { return shaking_wrench_case(10); }
+MECHBAL_BENCH_CASE(shaking_wrench_50) { return shaking_wrench_case(50); }
+MECHBAL_BENCH_CASE(chain_kinematics_6) { return chain_kinematics_case(6); }
+MECHBAL_BENCH_CASE(chain_kinematics_7) { return chain_kinematics_case(7); }
+MECHBAL_BENCH_CASE(id6_mechbal) { return id_case(6); }
+MECHBAL_BENCH_CASE(id7_mechbal) { return id_case(7); }
+MECHBAL_BENCH_CASE(ct6_mechbal) { return ct_case(6); }
+MECHBAL_BENCH_CASE(mass6_mechbal) { return mass_case(6); }
+MECHBAL_BENCH_CASE(mass7_mechbal) { return mass_case(7); }

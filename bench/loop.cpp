@@ -1,0 +1,202 @@
+// mechbal-loop: runs a control tick at a fixed rate with absolute deadlines
+// (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME)) and reports the tick computation time
+// (p50, p99, p99.9, max), the wake-up latency and the deadline misses (a tick that ends after the
+// next release time).
+//
+// Workload (issue 6, until ComputedTorque lands): the 6-joint computed-torque-equivalent tick =
+// trajectory evaluate (quintic rest-to-rest, back and forth) + PD outer loop inline +
+// RneChainDynamics inverse dynamics tau = ID(q, qd, v).
+//
+// Usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE]
+//   --rt: try SCHED_FIFO (priority 80) and mlockall(MCL_CURRENT | MCL_FUTURE); when not permitted
+//         (no CAP_SYS_NICE / RLIMIT_RTPRIO, RLIMIT_MEMLOCK) it says so and runs without.
+#include <sched.h>
+#include <sys/mman.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "mechbal/rnea.hpp"
+#include "mechbal/trajectory.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+constexpr long kNsPerSec = 1000000000L;
+
+long long to_ns(const timespec& t) { return static_cast<long long>(t.tv_sec) * kNsPerSec + t.tv_nsec; }
+timespec from_ns(long long ns) {
+  timespec t;
+  t.tv_sec = static_cast<time_t>(ns / kNsPerSec);
+  t.tv_nsec = static_cast<long>(ns % kNsPerSec);
+  return t;
+}
+long long now_ns() {
+  timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return to_ns(t);
+}
+
+double pct(std::vector<long long> v, double p) {
+  if (v.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return static_cast<double>(v[k]);
+}
+
+void usage() {
+  std::fprintf(stderr, "usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE]\n");
+}
+
+/// The 6-joint computed-torque-equivalent workload; tick() is noexcept and allocation-free.
+struct ComputedTorqueWorkload {
+  ComputedTorqueWorkload()
+      : model(make_chain()),
+        dynamics(model),
+        trajectory(Eigen::VectorXd::Constant(6, -0.8), Eigen::VectorXd::Constant(6, 0.9), 0.75,
+                   mechbal::TimeLaw::quintic),
+        q_ref(6), qd_ref(6), qdd_ref(6), q(6), qd(6), v(6), tau(6) {}
+
+  static mechbal::ChainModel make_chain() {
+    std::mt19937 rng(1006u);  // the same 6-joint chain as mechbal-bench's ct6 cases
+    return mechbal::test::random_chain(rng, "RRRRRR");
+  }
+
+  mechbal::Status tick(double t) noexcept {
+    // back and forth along the rest-to-rest trajectory
+    const double period = 2.0 * trajectory.duration();
+    double tt = std::fmod(t, period);
+    if (tt > trajectory.duration()) tt = period - tt;
+    mechbal::Status s = trajectory.evaluate(tt, q_ref, qd_ref, qdd_ref);
+    // "measured" state: the reference with a small deterministic tracking error
+    q = q_ref.array() + 1e-3 * std::sin(50.0 * t);
+    qd = qd_ref.array() - 1e-2 * std::cos(50.0 * t);
+    v = qdd_ref + kp * (q_ref - q) + kd * (qd_ref - qd);
+    s |= dynamics.inverse_dynamics(q, qd, v, tau);
+    return s;
+  }
+
+  static constexpr double kp = 100.0, kd = 20.0;
+  mechbal::ChainModel model;
+  mechbal::RneChainDynamics dynamics;
+  mechbal::RestToRestTrajectory trajectory;
+  Eigen::VectorXd q_ref, qd_ref, qdd_ref, q, qd, v, tau;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double seconds = 5.0, rate = 1000.0;
+  bool rt = false;
+  std::string json;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--seconds" && i + 1 < argc) {
+      seconds = std::atof(argv[++i]);
+    } else if (a == "--rate" && i + 1 < argc) {
+      rate = std::atof(argv[++i]);
+    } else if (a == "--rt") {
+      rt = true;
+    } else if (a == "--json" && i + 1 < argc) {
+      json = argv[++i];
+    } else if (a == "--help" || a == "-h") {
+      usage();
+      return 0;
+    } else {
+      std::fprintf(stderr, "mechbal-loop: unknown option '%s'\n", a.c_str());
+      usage();
+      return 2;
+    }
+  }
+  if (!(seconds > 0.0) || !(rate > 0.0) || rate > 100000.0) {
+    std::fprintf(stderr, "mechbal-loop: --seconds must be > 0 and --rate in (0, 100000], got %g, %g\n",
+                 seconds, rate);
+    return 2;
+  }
+  const long long period = static_cast<long long>(std::llround(1e9 / rate));
+  const auto ticks = static_cast<std::size_t>(std::llround(seconds * rate));
+
+  bool fifo = false, locked = false;
+  if (rt) {
+    sched_param sp{};
+    sp.sched_priority = 80;
+    if (sched_setscheduler(0, SCHED_FIFO, &sp) == 0) {
+      fifo = true;
+    } else {
+      std::fprintf(stderr,
+                   "mechbal-loop: SCHED_FIFO not permitted (%s): running with the default "
+                   "scheduler (needs CAP_SYS_NICE or an RLIMIT_RTPRIO >= 80)\n",
+                   std::strerror(errno));
+    }
+    if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
+      locked = true;
+    } else {
+      std::fprintf(stderr,
+                   "mechbal-loop: mlockall not permitted (%s): memory may page (needs "
+                   "CAP_IPC_LOCK or a large enough RLIMIT_MEMLOCK)\n",
+                   std::strerror(errno));
+    }
+  }
+
+  ComputedTorqueWorkload work;
+  std::vector<long long> compute(ticks), wake(ticks);  // allocated before the loop
+  for (int i = 0; i < 1000; ++i) work.tick(i * 1e-3);  // warm caches
+
+  std::size_t misses = 0, overruns = 0, bad_status = 0;
+  long long release = now_ns() + period;
+  for (std::size_t k = 0; k < ticks; ++k) {
+    const timespec ts = from_ns(release);
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+    }
+    const long long start = now_ns();
+    const mechbal::Status s = work.tick(static_cast<double>(k) / rate);
+    const long long end = now_ns();
+    if (s != mechbal::Status::ok) ++bad_status;
+    if (end - start > period) ++overruns;  // the computation alone did not fit in a period
+    wake[k] = start - release;
+    compute[k] = end - start;
+    const long long next = release + period;
+    if (end > next) {
+      ++misses;
+      // skip the releases already missed, keep the absolute grid
+      while (release + period < end) release += period;
+    }
+    release += period;
+  }
+
+  const double p50 = pct(compute, 0.5), p99 = pct(compute, 0.99), p999 = pct(compute, 0.999);
+  const double mx = static_cast<double>(*std::max_element(compute.begin(), compute.end()));
+  const double w50 = pct(wake, 0.5), w99 = pct(wake, 0.99), w999 = pct(wake, 0.999);
+  const double wmax = static_cast<double>(*std::max_element(wake.begin(), wake.end()));
+  std::printf("mechbal-loop: %zu ticks at %.0f Hz (%.1f s), workload ct6 = trajectory + PD + RNE\n",
+              ticks, rate, seconds);
+  std::printf("  SCHED_FIFO %s, mlockall %s\n", fifo ? "on" : "off", locked ? "on" : "off");
+  std::printf("  tick time   p50 %8.0f ns  p99 %8.0f ns  p99.9 %8.0f ns  max %8.0f ns\n", p50, p99,
+              p999, mx);
+  std::printf("  wake-up lat p50 %8.0f ns  p99 %8.0f ns  p99.9 %8.0f ns  max %8.0f ns\n", w50, w99,
+              w999, wmax);
+  std::printf("  deadline misses %zu / %zu (ticks ending after the next release; of which the "
+              "computation alone exceeded the period: %zu), non-ok status %zu\n",
+              misses, ticks, overruns, bad_status);
+  if (!json.empty()) {
+    std::ofstream out(json);
+    out << "{\"workload\": \"ct6: trajectory evaluate + inline PD + RneChainDynamics ID\", "
+        << "\"rate_hz\": " << rate << ", \"seconds\": " << seconds << ", \"ticks\": " << ticks
+        << ", \"sched_fifo\": " << (fifo ? "true" : "false")
+        << ", \"mlockall\": " << (locked ? "true" : "false") << ", \"p50_ns\": " << p50
+        << ", \"p99_ns\": " << p99 << ", \"p999_ns\": " << p999 << ", \"max_ns\": " << mx
+        << ", \"wakeup_p50_ns\": " << w50 << ", \"wakeup_p99_ns\": " << w99
+        << ", \"wakeup_p999_ns\": " << w999 << ", \"wakeup_max_ns\": " << wmax
+        << ", \"deadline_misses\": " << misses << ", \"compute_overruns\": " << overruns << ", \"non_ok_status\": " << bad_status << "}\n";
+  }
+  return 0;
+}

@@ -1,0 +1,167 @@
+"""Merge the outputs of one `make bench` run into bench/results/latest.json and latest.md.
+
+Inputs (all written by the same run): Google Benchmark JSON of mechbal-bench (repetitions with
+aggregates), mechbal-bench's per-call tail JSON (--tail_out), mechbal-loop JSON, bench_python JSON.
+
+Per case: median_ns = median over repetitions of Google Benchmark's per-iteration *CPU* time (the
+machine is shared, CPU time is what the tick costs; the wall-clock median is kept as
+median_wall_ns); p99_ns / p999_ns = percentiles of individually timed calls (wall clock, timer
+overhead subtracted); allocations_per_tick = heap allocations counted around 1000 ticks after
+warm-up (global operator new replaced in mechbal-bench).
+"""
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import json
+import os
+import platform
+import subprocess
+from pathlib import Path
+
+
+def machine():
+    model = platform.processor() or "unknown"
+    try:
+        out = subprocess.run(["lscpu"], capture_output=True, text=True, check=True).stdout
+        for line in out.splitlines():
+            if line.startswith("Model name:"):
+                model = line.split(":", 1)[1].strip()
+    except (OSError, subprocess.CalledProcessError):
+        pass
+    load = os.getloadavg() if hasattr(os, "getloadavg") else (float("nan"),) * 3
+    return {"cpu": model, "cores": os.cpu_count(), "load_average_1_5_15": list(load),
+            "kernel": platform.release(), "python": platform.python_version()}
+
+
+def gbench_medians(path):
+    data = json.loads(Path(path).read_text())
+    out = {}
+    for b in data["benchmarks"]:
+        if b.get("run_type") != "aggregate" or b.get("aggregate_name") != "median":
+            continue
+        scale = {"ns": 1.0, "us": 1e3, "ms": 1e6, "s": 1e9}[b.get("time_unit", "ns")]
+        out[b["run_name"]] = {"median_ns": b["cpu_time"] * scale,
+                              "median_wall_ns": b["real_time"] * scale,
+                              "repetitions": b.get("repetitions")}
+    return out, data.get("context", {})
+
+
+def ratio(cases, slow, fast):
+    if slow in cases and fast in cases and cases[fast]["median_ns"] > 0:
+        return cases[slow]["median_ns"] / cases[fast]["median_ns"]
+    return None
+
+
+def fmt(x, digits=0):
+    return "n/a" if x is None else f"{x:,.{digits}f}"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--gbench", required=True, type=Path)
+    ap.add_argument("--tail", required=True, type=Path)
+    ap.add_argument("--loop", required=True, type=Path)
+    ap.add_argument("--python", type=Path)
+    ap.add_argument("--out-json", required=True, type=Path)
+    ap.add_argument("--out-md", required=True, type=Path)
+    args = ap.parse_args(argv)
+
+    medians, context = gbench_medians(args.gbench)
+    tail = json.loads(args.tail.read_text())
+    cases = {}
+    for name, m in sorted(medians.items()):
+        t = tail["cases"].get(name, {})
+        cases[name] = {**m, "p50_call_ns": t.get("p50_ns"), "p99_ns": t.get("p99_ns"),
+                       "p999_ns": t.get("p999_ns"), "max_call_ns": t.get("max_ns"),
+                       "allocations_per_tick": t.get("allocations_per_tick")}
+    missing = [n for n in cases if cases[n]["p99_ns"] is None]
+    if missing:
+        raise SystemExit(f"no per-call timings for {missing}: run mechbal-bench with --tail_out")
+
+    loop = json.loads(args.loop.read_text())
+    py = json.loads(args.python.read_text()) if args.python and args.python.exists() else None
+
+    ratios = {
+        # ct6 = computed-torque-equivalent tick (inline PD + inverse dynamics) until ComputedTorque
+        # lands: the other library's time over mechbal's, same 6-joint chain, same run.
+        "kdl_over_mechbal_ct6": ratio(cases, "ct6_kdl_raw", "ct6_mechbal"),
+        "pinocchio_over_mechbal_ct6": ratio(cases, "ct6_pinocchio", "ct6_mechbal"),
+        "kdl_wrapper_over_mechbal_ct6": ratio(cases, "ct6_kdl_wrapper", "ct6_mechbal"),
+        # Pinocchio given the chain in joint-aligned frames (RZ joints): its best case
+        "pinocchio_aligned_over_mechbal_ct6": ratio(cases, "ct6_pinocchio_aligned", "ct6_mechbal"),
+    }
+    for dof in (6, 7):
+        ratios[f"kdl_over_mechbal_id{dof}"] = ratio(cases, f"id{dof}_kdl_raw", f"id{dof}_mechbal")
+        ratios[f"pinocchio_over_mechbal_id{dof}"] = ratio(cases, f"id{dof}_pinocchio",
+                                                          f"id{dof}_mechbal")
+        ratios[f"kdl_over_mechbal_mass{dof}"] = ratio(cases, f"mass{dof}_kdl_raw",
+                                                      f"mass{dof}_mechbal")
+        ratios[f"pinocchio_over_mechbal_mass{dof}"] = ratio(cases, f"mass{dof}_pinocchio",
+                                                            f"mass{dof}_mechbal")
+    if py:
+        ratios["numpy_over_mechbal_batch"] = py["batch"]["numpy_over_mechbal"]
+        for name, v in py["per_call"].items():
+            if name in cases:
+                v["binding_overhead_ns"] = v["median_ns"] - cases[name]["median_ns"]
+
+    result = {
+        "generated": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
+        "machine": {**machine(), "gbench_context": {k: context.get(k) for k in (
+            "num_cpus", "mhz_per_cpu", "cpu_scaling_enabled", "library_build_type")}},
+        "notes": {
+            "median_ns": "median over repetitions of Google Benchmark CPU time per tick",
+            "p99_ns": "99th percentile of individually timed ticks (wall clock, timer overhead "
+                      "subtracted)",
+            "ct6": "computed torque on the 6-joint chain = inline PD outer loop + inverse "
+                   "dynamics tau = ID(q, qd, v); mechbal's ComputedTorque class is not merged yet",
+            "pinocchio": "Pinocchio C++ built header-only with mechbal's compiler flags; "
+                         "*_pinocchio: JointModelRevoluteUnaligned (the chain as given); "
+                         "*_pinocchio_aligned: the same chain re-expressed in joint-aligned "
+                         "frames so that every joint is a JointModelRZ (Pinocchio's best case)",
+        },
+        "cases": cases,
+        "loop": loop,
+        "ratios": ratios,
+        "python": py,
+    }
+    args.out_json.parent.mkdir(parents=True, exist_ok=True)
+    args.out_json.write_text(json.dumps(result, indent=2) + "\n")
+
+    m = result["machine"]
+    md = [f"Measured {result['generated']} on {m['cpu']}, {m['cores']} cores "
+          f"(load average {m['load_average_1_5_15'][0]:.1f}: shared machine), kernel {m['kernel']}.",
+          "",
+          "| case | median [ns] | p99 [ns] | allocations / tick |",
+          "|---|---:|---:|---:|"]
+    for name, c in cases.items():
+        md.append(f"| {name} | {fmt(c['median_ns'])} | {fmt(c['p99_ns'])} | "
+                  f"{fmt(c['allocations_per_tick'], 2)} |")
+    md += ["", "| ratio (other / mechbal, same chain, same run) | value |", "|---|---:|"]
+    for k, v in ratios.items():
+        md.append(f"| {k} | {fmt(v, 2)} |")
+    md += ["", f"mechbal-loop: {loop['ticks']} ticks at {loop['rate_hz']:.0f} Hz "
+               f"(SCHED_FIFO {'on' if loop['sched_fifo'] else 'off'}, "
+               f"mlockall {'on' if loop['mlockall'] else 'off'}), workload {loop['workload']}",
+           "", "| loop | p50 | p99 | p99.9 | max | deadline misses (compute overruns) |", "|---|---:|---:|---:|---:|---:|",
+           f"| tick time [ns] | {fmt(loop['p50_ns'])} | {fmt(loop['p99_ns'])} | "
+           f"{fmt(loop['p999_ns'])} | {fmt(loop['max_ns'])} | {loop['deadline_misses']} "
+           f"({loop.get('compute_overruns', 'n/a')}) |",
+           f"| wake-up latency [ns] | {fmt(loop['wakeup_p50_ns'])} | {fmt(loop['wakeup_p99_ns'])} | "
+           f"{fmt(loop['wakeup_p999_ns'])} | {fmt(loop['wakeup_max_ns'])} | |"]
+    if py:
+        b = py["batch"]
+        md += ["", "| Python | value |", "|---|---:|"]
+        for name, v in py["per_call"].items():
+            md.append(f"| {name}: single-instant call through the bindings, median [ns] | "
+                      f"{fmt(v['median_ns'])} |")
+        md += [f"| shaking_wrench batch, {b['instants']:,} instants x {b['bodies']} bodies: "
+               f"mechbal [instants/s] | {fmt(b['mechbal_instants_per_s'])} |",
+               f"| same, pure numpy [instants/s] | {fmt(b['numpy_instants_per_s'])} |",
+               f"| numpy time / mechbal time | {fmt(b['numpy_over_mechbal'], 1)} |"]
+    args.out_md.write_text("\n".join(md) + "\n")
+    print("\n".join(md))
+
+
+if __name__ == "__main__":
+    main()
