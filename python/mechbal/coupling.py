@@ -125,6 +125,11 @@ def couple_symbolic(masses, velocities, gravities, A, independent, pdot_bias=Non
 # ---------------------------------------------------------------------------------------------
 # Serial-chain building blocks (numpy): joints, links as Newton-Euler subsystems, discs
 # ---------------------------------------------------------------------------------------------
+def _cross(a, b):
+    """3-vector cross product (np.cross is slow on single vectors)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
 def skew(w):
     return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
 
@@ -171,19 +176,19 @@ def chain_kinematics(joints, q, qd, base=np.zeros(3)):
         o = p + R @ jt.offset
         z = R @ jt.axis
         dp = o - p
-        v_n = v + np.cross(w, dp)
-        a_n = a + np.cross(al, dp) + np.cross(w, np.cross(w, dp))
+        v_n = v + _cross(w, dp)
+        a_n = a + _cross(al, dp) + _cross(w, _cross(w, dp))
         if jt.type == "R":
             R_n = R @ rotation(jt.axis, q[i])
-            al_n = al + np.cross(w, z * qd[i])
+            al_n = al + _cross(w, z * qd[i])
             w_n = w + z * qd[i]
             p_n = o
         else:
             R_n = R.copy()
             p_n = o + z * q[i]
-            v_n = v_n + np.cross(w, z * q[i]) + z * qd[i]
-            a_n = a_n + np.cross(al, z * q[i]) + np.cross(w, np.cross(w, z * q[i])) \
-                + 2.0 * np.cross(w, z * qd[i])
+            v_n = v_n + _cross(w, z * q[i]) + z * qd[i]
+            a_n = a_n + _cross(al, z * q[i]) + _cross(w, _cross(w, z * q[i])) \
+                + 2.0 * _cross(w, z * qd[i])
             w_n, al_n = w.copy(), al.copy()
         out.append(dict(R=R_n, p=p_n, z=z, o=o, w=w_n, al=al_n, v=v_n, a=a_n, type=jt.type))
         R, p, w, al, v, a = R_n, p_n, w_n, al_n, v_n, a_n
@@ -196,7 +201,7 @@ def point_jacobian(kin, i, r):
     for j in range(i + 1):
         if kin[j]["type"] == "R":
             Jw[:, j] = kin[j]["z"]
-            Jv[:, j] = np.cross(kin[j]["z"], r - kin[j]["o"])
+            Jv[:, j] = _cross(kin[j]["z"], r - kin[j]["o"])
         else:
             Jv[:, j] = kin[j]["z"]
     return Jv, Jw
@@ -205,7 +210,7 @@ def point_jacobian(kin, i, r):
 def point_bias(kin, i, r):
     k = kin[i]
     rho = r - k["p"]
-    return k["a"] + np.cross(k["al"], rho) + np.cross(k["w"], np.cross(k["w"], rho))
+    return k["a"] + _cross(k["al"], rho) + _cross(k["w"], _cross(k["w"], rho))
 
 
 def link_subsystem(link: Link, kin_i, gravity=GRAVITY) -> Subsystem:
@@ -214,7 +219,7 @@ def link_subsystem(link: Link, kin_i, gravity=GRAVITY) -> Subsystem:
     Iw = R @ link.inertia @ R.T
     w = kin_i["w"]
     return Subsystem(block_diag([link.mass * np.eye(3), Iw]),
-                     np.concatenate([np.zeros(3), np.cross(w, Iw @ w)]),
+                     np.concatenate([np.zeros(3), _cross(w, Iw @ w)]),
                      np.concatenate([-link.mass * np.asarray(gravity), np.zeros(3)]))
 
 
@@ -251,10 +256,10 @@ def disc_subsystem(disc: Disc, kin, q, qd):
     E = np.zeros((3, n))
     E[:, disc.joint] = disc.ratio * a_w
     Jd = Rd.T @ (Jw_c + E)
-    bias = Rd.T @ (c["al"] + np.cross(c["w"], disc.ratio * a_w * qd[disc.joint]))
+    bias = Rd.T @ (c["al"] + _cross(c["w"], disc.ratio * a_w * qd[disc.joint]))
     wB = Jd @ qd
     Jm = np.diag(disc.inertia)
-    return Subsystem(Jm, np.cross(wB, Jm @ wB), np.zeros(3)), Jd, bias
+    return Subsystem(Jm, _cross(wB, Jm @ wB), np.zeros(3)), Jd, bias
 
 
 def arm_with_discs(joints, links, discs, q, qd, gravity=GRAVITY) -> CoupledModel:

@@ -270,23 +270,26 @@ def fivebar_model(d: dict, q, qd) -> cp.CoupledModel:
                  cp.Link(d[f"md{i}"], np.array([0.0, d[f"cd{i}"], 0.0]), np.diag(d[f"inertia_d{i}"]))]
         legs.append((joints, links, base, d[f"b{i}"]))
 
+    def tip_jacobian(k):
+        joints, _, base, b = legs[k]
+        kin = cp.chain_kinematics(joints, qs[k], np.zeros(2), base)
+        tip = kin[1]["p"] + kin[1]["R"] @ np.array([0.0, b, 0.0])
+        return cp.point_jacobian(kin, 1, tip)[0][1:]
+
     def leg(k, qdl):
         joints, links, base, b = legs[k]
         model, kin = cp.arm_model(joints, links, qs[k], qdl, base)
         tip = kin[1]["p"] + kin[1]["R"] @ np.array([0.0, b, 0.0])
-        Jv, _ = cp.point_jacobian(kin, 1, tip)
         sub = cp.Subsystem(model.mass, model.velocity, model.gravity)
-        return sub, Jv[1:], cp.point_bias(kin, 1, tip)[1:]
+        return sub, cp.point_bias(kin, 1, tip)[1:]
 
-    s1, J1, _ = leg(0, np.zeros(2))
-    s2, J2, _ = leg(1, np.zeros(2))
     A = np.zeros((4, 6))
-    A[0:2, 0:2], A[0:2, 4:6] = -J1, np.eye(2)
-    A[2:4, 2:4], A[2:4, 4:6] = -J2, np.eye(2)
+    A[0:2, 0:2], A[0:2, 4:6] = -tip_jacobian(0), np.eye(2)
+    A[2:4, 2:4], A[2:4, 4:6] = -tip_jacobian(1), np.eye(2)
     indep = [0, 2]
-    full = cp.coupling_matrix(A, indep) @ np.asarray(qd, float)
-    s1, _, b1 = leg(0, full[0:2])
-    s2, _, b2 = leg(1, full[2:4])
+    full = cp.coupling_matrix(A, indep) @ np.asarray(qd, float)   # passive rates first (from C)
+    s1, b1 = leg(0, full[0:2])
+    s2, b2 = leg(1, full[2:4])
     sP = cp.Subsystem(d["mP"] * np.eye(2), np.zeros(2), np.array([0.0, d["mP"] * G]))
     return cp.couple([s1, s2, sP], A, indep, -np.concatenate([b1, b2]), qd)
 
