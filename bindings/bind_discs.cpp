@@ -1,0 +1,154 @@
+// pybind11 glue for serial arms with counter-rotating discs (Coutinho & Hess Coelho) and the
+// decoupled joint controller. Conversion only: no logic.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <string>
+#include <vector>
+
+#include "array_checks.hpp"
+#include "bindings.hpp"
+#include "mechbal/computed_torque.hpp"
+#include "mechbal/decoupled_control.hpp"
+#include "mechbal/disc_arm.hpp"
+
+namespace py = pybind11;
+
+namespace mechbal::pyb {
+
+namespace {
+
+using CVec = Eigen::Map<const Eigen::VectorXd>;
+
+void bind_discs(py::module_& m) {
+  py::class_<DiscSpec>(m, "DiscSpec",
+                       "Counter-rotating disc carried by a link, driven at ratio * qd[joint]")
+      .def(py::init([](const std::string& name, int carrier, int joint, const Eigen::Vector3d& axis,
+                       double ratio, const Eigen::Vector3d& inertia) {
+             DiscSpec d;
+             d.name = name;
+             d.carrier = carrier;
+             d.joint = joint;
+             d.axis = axis;
+             d.ratio = ratio;
+             d.inertia = inertia;
+             return d;
+           }),
+           py::arg("name"), py::arg("carrier"), py::arg("joint"), py::arg("axis"),
+           py::arg("ratio"), py::arg("inertia"),
+           "carrier/joint: 0-based indices; axis in the carrier frame; inertia: principal central "
+           "moments in the disc frame [kg m^2] (mass lumped into the carrier link)")
+      .def_readonly("name", &DiscSpec::name)
+      .def_readonly("carrier", &DiscSpec::carrier)
+      .def_readonly("joint", &DiscSpec::joint)
+      .def_readonly("axis", &DiscSpec::axis)
+      .def_readonly("ratio", &DiscSpec::ratio)
+      .def_readonly("inertia", &DiscSpec::inertia);
+
+  py::class_<DiscArmDynamics>(m, "DiscArmDynamics",
+                              "Serial arm + discs by the coupling-matrix method (A° = 1), "
+                              "evaluated per tick: M'(q), v'(q, qd), g'(q)")
+      .def(py::init<ChainModel, std::vector<DiscSpec>>(), py::arg("chain"), py::arg("discs"))
+      .def_property_readonly("dof", &DiscArmDynamics::dof)
+      .def_property_readonly("discs", &DiscArmDynamics::discs)
+      .def(
+          "evaluate",
+          [](DiscArmDynamics& d, const Array& q, const Array& qd) {
+            const auto n = static_cast<py::ssize_t>(d.dof());
+            require_shape(q, "q", {-1, n});
+            const auto N = q.shape(0);
+            require_shape(qd, "qd", {N, n});
+            Array M = make_array({N, n, n}), v = make_array({N, n}), g = make_array({N, n});
+            Eigen::MatrixXd Mk(n, n);
+            Eigen::VectorXd vk(n), gk(n);
+            Status status = Status::ok;
+            using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+            for (py::ssize_t k = 0; k < N; ++k) {
+              const Status s = d.evaluate(CVec(q.data(k, 0), n), CVec(qd.data(k, 0), n), Mk, vk, gk);
+              if (s != Status::ok) {
+                Mk.setZero();
+                vk.setZero();
+                gk.setZero();
+              }
+              status |= s;
+              Eigen::Map<RowMat>(M.mutable_data(k, 0, 0), n, n) = Mk;
+              Eigen::Map<Eigen::VectorXd>(v.mutable_data(k, 0), n) = vk;
+              Eigen::Map<Eigen::VectorXd>(g.mutable_data(k, 0), n) = gk;
+            }
+            py::dict out;
+            out["mass"] = M;
+            out["velocity"] = v;
+            out["gravity"] = g;
+            out["status"] = status;
+            return out;
+          },
+          py::arg("q"), py::arg("qd"),
+          "For N states (q, qd each (N, dof)): {'mass' (N, dof, dof), 'velocity' (N, dof), "
+          "'gravity' (N, dof), 'status'}")
+      .def(
+          "inverse_dynamics",
+          [](DiscArmDynamics& d, const Array& q, const Array& qd, const Array& qdd) {
+            const auto n = static_cast<py::ssize_t>(d.dof());
+            require_shape(q, "q", {-1, n});
+            const auto N = q.shape(0);
+            require_shape(qd, "qd", {N, n});
+            require_shape(qdd, "qdd", {N, n});
+            Array tau = make_array({N, n});
+            Status status = Status::ok;
+            for (py::ssize_t k = 0; k < N; ++k) {
+              Eigen::Map<Eigen::VectorXd> t(tau.mutable_data(k, 0), n);
+              const Status s = d.inverse_dynamics(CVec(q.data(k, 0), n), CVec(qd.data(k, 0), n),
+                                                  CVec(qdd.data(k, 0), n), t);
+              if (s != Status::ok) t.setZero();
+              status |= s;
+            }
+            py::dict out;
+            out["tau"] = tau;
+            out["status"] = status;
+            return out;
+          },
+          py::arg("q"), py::arg("qd"), py::arg("qdd"), "Joint torques (N, dof): {'tau', 'status'}");
+
+  // ComputedTorque is bound in bind_arm2dof.cpp; add the disc-arm back end to its constructors.
+  auto ct = py::reinterpret_borrow<py::class_<ComputedTorque>>(m.attr("ComputedTorque"));
+  ct.def(py::init([](DiscArmDynamics& model, const Eigen::VectorXd& kp, const Eigen::VectorXd& kd,
+                     const Eigen::VectorXd& limit) { return new ComputedTorque(model, kp, kd, limit); }),
+         py::arg("model"), py::arg("kp"), py::arg("kd"), py::arg("torque_limit") = Eigen::VectorXd(),
+         py::keep_alive<1, 2>());
+
+  py::class_<DecoupledJointController>(
+      m, "DecoupledJointController",
+      "tau_i = k_i (qdd_d + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho "
+      "eqs 15, 26, 36)")
+      .def(py::init<const Eigen::VectorXd&, const Eigen::VectorXd&, const Eigen::VectorXd&,
+                    const Eigen::VectorXd&>(),
+           py::arg("k"), py::arg("kp"), py::arg("kd"), py::arg("torque_limit") = Eigen::VectorXd())
+      .def_property_readonly("dof", &DecoupledJointController::dof)
+      .def_property_readonly("k", [](const DecoupledJointController& c) {
+        return Eigen::VectorXd(c.k());
+      })
+      .def_property_readonly("last_command", [](const DecoupledJointController& c) {
+        return Eigen::VectorXd(c.last_command());
+      })
+      .def(
+          "step",
+          [](DecoupledJointController& c, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+             const Eigen::VectorXd& q_des, const Eigen::VectorXd& qd_des,
+             const Eigen::VectorXd& qdd_des) {
+            Eigen::VectorXd tau = c.last_command();
+            const Status s = c.step(q, qd, q_des, qd_des, qdd_des, tau);
+            if (s == Status::bad_size)
+              throw py::value_error("q, qd, q_des, qd_des, qdd_des must each have dof values");
+            return py::make_tuple(tau, s);
+          },
+          py::arg("q"), py::arg("qd"), py::arg("q_des"), py::arg("qd_des"), py::arg("qdd_des"),
+          "One tick: (tau, status). Non-finite input returns the last command and a status.")
+      .def("reset", &DecoupledJointController::reset);
+}
+
+}  // namespace
+
+MECHBAL_REGISTER_BINDINGS(50, discs, bind_discs);
+
+}  // namespace mechbal::pyb
