@@ -1,7 +1,8 @@
 // The balancing controllers' real-time ticks: the reactionless wrist alone (build N, solve
 // N qdot_w = H_target - D, feed-forward, integrate; Euler and RK4) and the whole PAMINSA tick
 // (closed-form kinematics of the 35 mechanism bodies, D and dD/dt, the wrist step, the wrist
-// links' motion and the shaking wrench of all 38 bodies), both at 1 kHz.
+// links' motion and the shaking wrench of all 38 bodies), both at 1 kHz; and the PAMINSA
+// kinematics + shaking wrench of one instant with a prescribed wrist motion.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -151,6 +152,63 @@ Tick paminsa_case(WristIntegrator integrator) {
   };
 }
 
+// ---------------------------------------------------------------------------- PAMINSA wrench
+// Closed-form kinematics of all 38 bodies with a prescribed wrist motion + the shaking wrench
+// (what paminsa_kinematics_batch does per instant). Checked at setup against finite differences
+// of the total momenta (the wrench is their time derivative, Briot & Arakelian 2009, eqs 1-4).
+struct WrenchCase {
+  PaminsaModel model{PaminsaParameters{}};
+  PaminsaWorkspace ws;
+  ShakingWrench out;
+  std::vector<PlatformMotion> platform;
+  std::vector<WristMotion> wrist;
+  Status status = Status::ok;
+  int k = 0;
+};
+
+WristMotion wrist_at(double t) {
+  const Vec3 q0(0.4, 1.2, -0.5), amp(0.7, 0.5, 1.3), om(2.0, 3.0, 4.0);
+  WristMotion w;
+  for (int i = 0; i < 3; ++i) {
+    w.angles(i) = q0(i) + amp(i) * std::sin(om(i) * t);
+    w.rates(i) = amp(i) * om(i) * std::cos(om(i) * t);
+    w.accelerations(i) = -amp(i) * om(i) * om(i) * std::sin(om(i) * t);
+  }
+  return w;
+}
+
+Tick paminsa_wrench_case() {
+  auto s = std::make_shared<WrenchCase>();
+  for (int n = 0; n < kTicks; ++n) {
+    s->platform.push_back(platform_at(n * kDt));
+    s->wrist.push_back(wrist_at(n * kDt));
+  }
+  const auto wrench_at = [&](double t) {
+    PaminsaWorkspace ws;
+    ShakingWrench w;
+    if (paminsa_kinematics(s->model, platform_at(t), wrist_at(t), ws) != Status::ok ||
+        shaking_wrench(s->model.bodies().data(), ws.states.data(), PaminsaBodyIndex::count, w) !=
+            Status::ok)
+      fail("PAMINSA bench trajectory is not reachable", t);
+    return w;
+  };
+  const double t = 0.3, h = 1e-5;
+  const ShakingWrench a = wrench_at(t - h), b = wrench_at(t), c = wrench_at(t + h);
+  const Vec3 dH = (c.angular_momentum - a.angular_momentum) / (2 * h);
+  const double rel = (dH - b.moment).norm() / std::max(1.0, b.moment.norm());
+  if (!(rel < 1e-6)) fail("PAMINSA wrench: moment != dH/dt (relative)", rel);
+  return [s] {
+    const std::size_t k = static_cast<std::size_t>(s->k);
+    s->k = (s->k + 1) & (kTicks - 1);
+    s->status = paminsa_kinematics(s->model, s->platform[k], s->wrist[k], s->ws);
+    s->status |= shaking_wrench(s->model.bodies().data(), s->ws.states.data(),
+                                PaminsaBodyIndex::count, s->out);
+    benchmark::DoNotOptimize(s->status);
+    benchmark::DoNotOptimize(&s->out);
+    benchmark::ClobberMemory();
+  };
+}
+
 }  // namespace
 }  // namespace mechbal::bench
 
@@ -159,3 +217,4 @@ MECHBAL_BENCH_CASE(wrist_euler) { return wrist_case(mechbal::WristIntegrator::eu
 MECHBAL_BENCH_CASE(wrist_rk4) { return wrist_case(mechbal::WristIntegrator::rk4); }
 MECHBAL_BENCH_CASE(paminsa_tick_euler) { return paminsa_case(mechbal::WristIntegrator::euler); }
 MECHBAL_BENCH_CASE(paminsa_tick_rk4) { return paminsa_case(mechbal::WristIntegrator::rk4); }
+MECHBAL_BENCH_CASE(paminsa_wrench) { return paminsa_wrench_case(); }
