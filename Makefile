@@ -69,6 +69,7 @@ BENCH_RUN := $(BENCH_BUILD)/results
 BENCH_FLAGS ?= --benchmark_repetitions=7 --benchmark_min_time=0.05 \
                --benchmark_report_aggregates_only=true --tail_samples=20000
 LOOP_SECONDS ?= 5
+LOOP_PAMINSA_SECONDS ?= 2
 
 $(BENCH_BUILD)/build.ninja: | $(VENV)/.stamp-venv
 	$(VENV)/bin/cmake -S . -B $(BENCH_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release \
@@ -82,9 +83,11 @@ bench: install $(BENCH_BUILD)/build.ninja
 	  --benchmark_out=$(BENCH_RUN)/gbench.json --benchmark_out_format=json
 	$(BENCH_BUILD)/bench/mechbal-loop --seconds $(LOOP_SECONDS) --rate 1000 --rt \
 	  --json $(BENCH_RUN)/loop.json
+	$(BENCH_BUILD)/bench/mechbal-loop --seconds $(LOOP_PAMINSA_SECONDS) --rate 1000 --rt \
+	  --workload paminsa --json $(BENCH_RUN)/loop_paminsa.json
 	$(PY) bench/bench_python.py --out $(BENCH_RUN)/python.json
 	$(PY) bench/merge_results.py --gbench $(BENCH_RUN)/gbench.json --tail $(BENCH_RUN)/tail.json \
-	  --loop $(BENCH_RUN)/loop.json --python $(BENCH_RUN)/python.json \
+	  --loop $(BENCH_RUN)/loop.json --loop-paminsa $(BENCH_RUN)/loop_paminsa.json --python $(BENCH_RUN)/python.json \
 	  --out-json bench/results/latest.json --out-md bench/results/latest.md
 
 clean:

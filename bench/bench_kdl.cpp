@@ -1,5 +1,7 @@
 // Orocos KDL on the same chains: mechbal's KdlChainDynamics wrapper (RNE with six virtual base
-// joints for the support wrench) and raw KDL (ChainIdSolver_RNE, ChainDynParam on the plain chain).
+// joints for the support wrench; its ct cases run mechbal's ComputedTorque controller over it) and
+// raw KDL (ChainIdSolver_RNE, ChainDynParam on the plain chain; its ct cases compute the same
+// computed-torque law inline).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -9,6 +11,7 @@
 #include <kdl/jntarray.hpp>
 #include <kdl/jntspaceinertiamatrix.hpp>
 
+#include "bench_ct.hpp"
 #include "bench_registry.hpp"
 #include "mechbal/kdl_chain.hpp"
 #include "mechbal/rnea.hpp"
@@ -150,16 +153,14 @@ Tick wrapper_id_case(int dof) {
   };
 }
 
+// mechbal's ComputedTorque controller over the KdlChainDynamics back end (checked against the
+// inline law through mechbal's RNE).
 Tick wrapper_ct_case(int dof) {
-  auto s = std::make_shared<Wrapper>(dof);
-  return [s] {
-    const int k = s->k = (s->k + 1) & (JointStates::count - 1);
-    const int m = (k + 1) & (JointStates::count - 1);
-    s->v = s->x.qdd[k] + ct_kp * (s->x.q[k] - s->x.q[m]) + ct_kd * (s->x.qd[k] - s->x.qd[m]);
-    s->kdl.inverse_dynamics(s->x.q[m], s->x.qd[m], s->v, s->tau);
-    benchmark::DoNotOptimize(s->tau.data());
-    benchmark::ClobberMemory();
-  };
+  const ChainModel model = bench_chain(dof);
+  auto s = std::make_shared<Ct<KdlChainDynamics>>(dof, model);
+  RneChainDynamics reference(model);
+  check_ct("ComputedTorque<KdlChainDynamics>", *s, reference);
+  return ct_tick(s);
 }
 
 }  // namespace
@@ -169,8 +170,10 @@ using namespace mechbal::bench;
 MECHBAL_BENCH_CASE(id6_kdl_raw) { return raw_id_case(6); }
 MECHBAL_BENCH_CASE(id7_kdl_raw) { return raw_id_case(7); }
 MECHBAL_BENCH_CASE(ct6_kdl_raw) { return raw_ct_case(6); }
+MECHBAL_BENCH_CASE(ct7_kdl_raw) { return raw_ct_case(7); }
 MECHBAL_BENCH_CASE(mass6_kdl_raw) { return raw_mass_case(6); }
 MECHBAL_BENCH_CASE(mass7_kdl_raw) { return raw_mass_case(7); }
 MECHBAL_BENCH_CASE(id6_kdl_wrapper) { return wrapper_id_case(6); }
 MECHBAL_BENCH_CASE(id7_kdl_wrapper) { return wrapper_id_case(7); }
 MECHBAL_BENCH_CASE(ct6_kdl_wrapper) { return wrapper_ct_case(6); }
+MECHBAL_BENCH_CASE(ct7_kdl_wrapper) { return wrapper_ct_case(7); }

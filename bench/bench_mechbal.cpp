@@ -1,8 +1,13 @@
 // mechbal's own real-time paths: shaking wrench of a body set, chain kinematics, recursive
-// Newton-Euler inverse dynamics, the computed-torque-equivalent tick and the CRBA mass matrix.
+// Newton-Euler inverse dynamics, the computed-torque tick (the real ComputedTorque controller over
+// RneChainDynamics and over the closed-form Arm2DofDynamics) and the CRBA mass matrix.
+#include <cstdio>
+#include <cstdlib>
 #include <random>
 
+#include "bench_ct.hpp"
 #include "bench_registry.hpp"
+#include "mechbal/arm2dof.hpp"
 #include "mechbal/rigid_body.hpp"
 #include "mechbal/rnea.hpp"
 #include "mechbal/serial_chain.hpp"
@@ -77,8 +82,10 @@ Tick id_case(int dof) {
   };
 }
 
-// Computed torque (PD outer loop + inverse dynamics), reference = state k, measured = state k+1.
-Tick ct_case(int dof) {
+// The computed-torque law written inline (PD outer loop + inverse dynamics), as the KDL and
+// Pinocchio ct cases compute it: reference = state k, measured = state k+1. Kept as
+// ct6_mechbal_inline to show what the ComputedTorque class adds (checks, virtual call, clipping).
+Tick ct_inline_case(int dof) {
   auto s = std::make_shared<Rne>(dof);
   return [s] {
     const int k = s->k = (s->k + 1) & (JointStates::count - 1);
@@ -88,6 +95,24 @@ Tick ct_case(int dof) {
     benchmark::DoNotOptimize(s->tau.data());
     benchmark::ClobberMemory();
   };
+}
+
+Tick ct_case(int dof) {
+  const ChainModel model = bench_chain(dof);
+  auto s = std::make_shared<Ct<RneChainDynamics>>(dof, model);
+  RneChainDynamics reference(model);
+  check_ct("ComputedTorque<RneChainDynamics>", *s, reference);
+  return ct_tick(s);
+}
+
+// 2-DOF closed form (Arakelian et al. 2011, Sec. 4 parameters), checked against mechbal's RNE on
+// the equivalent serial chain (arm2dof_chain_model): an independent model of the same arm.
+Tick ct2_case() {
+  const Arm2DofParameters arm{};
+  auto s = std::make_shared<Ct<Arm2DofDynamics>>(2, arm);
+  RneChainDynamics reference(arm2dof_chain_model(arm));
+  check_ct("ComputedTorque<Arm2DofDynamics>", *s, reference);
+  return ct_tick(s);
 }
 
 Tick mass_case(int dof) {
@@ -111,5 +136,8 @@ MECHBAL_BENCH_CASE(chain_kinematics_7) { return chain_kinematics_case(7); }
 MECHBAL_BENCH_CASE(id6_mechbal) { return id_case(6); }
 MECHBAL_BENCH_CASE(id7_mechbal) { return id_case(7); }
 MECHBAL_BENCH_CASE(ct6_mechbal) { return ct_case(6); }
+MECHBAL_BENCH_CASE(ct7_mechbal) { return ct_case(7); }
+MECHBAL_BENCH_CASE(ct6_mechbal_inline) { return ct_inline_case(6); }
+MECHBAL_BENCH_CASE(ct2_closed_form) { return ct2_case(); }
 MECHBAL_BENCH_CASE(mass6_mechbal) { return mass_case(6); }
 MECHBAL_BENCH_CASE(mass7_mechbal) { return mass_case(7); }

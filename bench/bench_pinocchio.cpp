@@ -143,6 +143,7 @@ using namespace mechbal::bench;
 MECHBAL_BENCH_CASE(id6_pinocchio) { return id_case(6); }
 MECHBAL_BENCH_CASE(id7_pinocchio) { return id_case(7); }
 MECHBAL_BENCH_CASE(ct6_pinocchio) { return ct_case(6); }
+MECHBAL_BENCH_CASE(ct7_pinocchio) { return ct_case(7); }
 MECHBAL_BENCH_CASE(mass6_pinocchio) { return mass_case(6); }
 MECHBAL_BENCH_CASE(mass7_pinocchio) { return mass_case(7); }
 MECHBAL_BENCH_CASE(id6_pinocchio_aligned) { return id_case(6, true); }

@@ -3,10 +3,15 @@
 1. Per-call cost of a single-instant call through the bindings (arrays of one instant in, a dict of
    arrays out): RneChainDynamics.inverse_dynamics (6 joints), shaking_wrench (10 bodies). The
    binding overhead is this minus the C++ tick time of mechbal-bench (the merge script subtracts).
+   Also one controller tick through the bindings: ComputedTorque.step (6-joint RNE back end, and
+   the 2-DOF closed form), ReactionlessWrist.step (Euler, RK4).
 2. Batch throughput (instants per second) of mechbal.shaking_wrench over a 1e5-instant trajectory
    of 10 bodies against a pure-numpy implementation of the same formula (Briot & Arakelian 2009,
    eqs 1-4): F = sum m a_G; M_O = sum (m OG x a_G + I alpha + w x I w), I = R I_body R^T. The two
    are checked to agree (1e-9 relative) before anything is timed.
+3. Controllers in batch: paminsa_reactionless_run (RK4 wrist, 2000 ticks, also writing every
+   body's motion) and simulate_computed_torque (2-DOF closed loop, 2000 ticks), ticks per second.
+   These are sequential closed loops: there is no vectorised numpy equivalent to compare with.
 
 Usage: python bench/bench_python.py [--out FILE.json] [--instants N] [--quick]
 """
@@ -109,6 +114,28 @@ def main(argv=None):
     med, p99 = median_per_call_ns(lambda: mechbal.shaking_wrench(**one), calls)
     results["per_call"]["shaking_wrench_10"] = {"median_ns": med, "p99_ns": p99}
 
+    # controller ticks through the bindings (1-D numpy arrays in, (tau, status) / status out)
+    n = 6
+    ct = mechbal.ComputedTorque(rne, np.full(n, 100.0), np.full(n, 20.0))
+    q, qd, q_d, qd_d, qdd_d = (rng.uniform(-1, 1, n) for _ in range(5))
+    med, p99 = median_per_call_ns(lambda: ct.step(q, qd, q_d, qd_d, qdd_d), calls)
+    results["per_call"]["ct6_mechbal"] = {"median_ns": med, "p99_ns": p99}
+    arm = mechbal.Arm2DofDynamics(mechbal.Arm2DofParameters())
+    ct2 = mechbal.ComputedTorque(arm, np.full(2, 100.0), np.full(2, 20.0))
+    q2, qd2, q2_d, qd2_d, qdd2_d = (rng.uniform(-1, 1, 2) for _ in range(5))
+    med, p99 = median_per_call_ns(lambda: ct2.step(q2, qd2, q2_d, qd2_d, qdd2_d), calls)
+    results["per_call"]["ct2_closed_form"] = {"median_ns": med, "p99_ns": p99}
+    pam = mechbal.PaminsaModel(mechbal.PaminsaParameters())
+    J = pam.inertia_body[35:38]
+    for name, integ in (("wrist_euler", mechbal.WristIntegrator.euler),
+                        ("wrist_rk4", mechbal.WristIntegrator.rk4)):
+        wrist = mechbal.ReactionlessWrist(J[0], J[1], J[2],
+                                          mechbal.ReactionlessWristConfig(integrator=integ),
+                                          np.full(3, np.pi / 2), np.zeros(3))
+        D, Dd = np.array([0.05, -0.02, 0.01]), np.array([0.3, 0.1, -0.2])
+        med, p99 = median_per_call_ns(lambda: wrist.step(D, Dd, D, D), calls)
+        results["per_call"][name] = {"median_ns": med, "p99_ns": p99}
+
     # ---- 2. batch throughput against numpy ------------------------------------------------------
     data = random_bodies(rng, args.instants, args.bodies)
     mb = mechbal.shaking_wrench(**data)
@@ -133,6 +160,39 @@ def main(argv=None):
         "numpy_instants_per_s": args.instants / t_np,
         "numpy_over_mechbal": t_np / t_mb,
     }
+    # ---- 3. controllers in batch (sequential closed loops: no vectorised numpy equivalent) -------
+    # PAMINSA fully balanced run with the RK4 reactionless wrist, 1 kHz, platform motion sampled on
+    # the half-step grid; every instant also writes the motion of the 38 bodies to numpy arrays.
+    steps = 2000
+    tj = np.arange(2 * steps + 1) * 0.5e-3
+    P0, amp, om, ph = (np.array(v) for v in ((0.48, 0.05, 0.6775), (0.04, 0.12, 0.03),
+                                            (3.0, 2.0, 5.0), (0.3, 1.1, 0.7)))
+    a = om * tj[:, None] + ph
+    P, Pd, Pdd = P0 + amp * np.sin(a), amp * om * np.cos(a), -amp * om ** 2 * np.sin(a)
+    cfg = mechbal.ReactionlessWristConfig(integrator=mechbal.WristIntegrator.rk4)
+    q0 = np.full(3, np.pi / 2)
+    run = mechbal.paminsa_reactionless_run(pam, cfg, q0, P, Pd, Pdd)
+    if run["status"] != mechbal.Status.ok:
+        raise SystemExit(f"paminsa_reactionless_run status {run['status']}")
+    t_run = best_time(lambda: mechbal.paminsa_reactionless_run(pam, cfg, q0, P, Pd, Pdd), repeat)
+    results["batch_controllers"] = {
+        "paminsa_reactionless_run": {"ticks": steps + 1, "seconds": t_run,
+                                     "ticks_per_s": (steps + 1) / t_run,
+                                     "ns_per_tick": t_run / (steps + 1) * 1e9}}
+    # 2-DOF closed loop under ComputedTorque (RK4 plant, 1 kHz control), 2 s
+    traj = mechbal.RestToRestTrajectory(np.array([-0.5, 0.3]), np.array([1.0, -0.4]), 2.0,
+                                        mechbal.TimeLaw.quintic)
+    plant = mechbal.Arm2DofDynamics(mechbal.Arm2DofParameters())
+    sim = mechbal._core.simulate_computed_torque
+    log = sim(plant, ct2, traj, np.array([-0.5, 0.3]), np.zeros(2), 1e-3, 2.0)
+    if log["status"] != mechbal.Status.ok:
+        raise SystemExit(f"simulate_computed_torque status {log['status']}")
+    t_sim = best_time(lambda: sim(plant, ct2, traj, np.array([-0.5, 0.3]), np.zeros(2), 1e-3, 2.0),
+                      repeat)
+    ticks = len(log["t"])
+    results["batch_controllers"]["closed_loop_ct2"] = {
+        "ticks": ticks, "seconds": t_sim, "ticks_per_s": ticks / t_sim,
+        "ns_per_tick": t_sim / ticks * 1e9}
     text = json.dumps(results, indent=2)
     print(text)
     if args.out:

@@ -50,8 +50,9 @@ struct JointStates {
 };
 JointStates bench_states(int dof, unsigned seed = 7);
 
-/// Computed-torque outer loop, inlined identically for every library (until ComputedTorque
-/// lands, issue 6): v = qdd_ref + Kp (q_ref - q) + Kd (qd_ref - qd); tau = ID(q, qd, v).
+/// Computed-torque gains. mechbal's ct cases run the ComputedTorque controller (bench_ct.hpp); the
+/// KDL-raw and Pinocchio ct cases compute the same law inline with their own inverse dynamics:
+/// v = qdd_ref + Kp (q_ref - q) + Kd (qd_ref - qd); tau = ID(q, qd, v).
 constexpr double ct_kp = 100.0, ct_kd = 20.0;
 
 }  // namespace mechbal::bench

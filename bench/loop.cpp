@@ -3,11 +3,14 @@
 // (p50, p99, p99.9, max), the wake-up latency and the deadline misses (a tick that ends after the
 // next release time).
 //
-// Workload (issue 6, until ComputedTorque lands): the 6-joint computed-torque-equivalent tick =
-// trajectory evaluate (quintic rest-to-rest, back and forth) + PD outer loop inline +
-// RneChainDynamics inverse dynamics tau = ID(q, qd, v).
+// Workloads (--workload):
+//   ct6 (default): the real controller, ComputedTorque over RneChainDynamics on the 6-joint bench
+//     chain, tracking a quintic rest-to-rest trajectory (back and forth) evaluated every tick;
+//   paminsa: the whole PAMINSA tick (PaminsaController::tick: mechanism kinematics at t, t + dt/2,
+//     t + dt, D, the reactionless wrist with RK4, wrist kinematics, shaking wrench of 38 bodies),
+//     the platform following a smooth 3-D motion around the nominal pose.
 //
-// Usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE]
+// Usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE] [--workload ct6|paminsa]
 //   --rt: try SCHED_FIFO (priority 80) and mlockall(MCL_CURRENT | MCL_FUTURE); when not permitted
 //         (no CAP_SYS_NICE / RLIMIT_RTPRIO, RLIMIT_MEMLOCK) it says so and runs without.
 #include <sched.h>
@@ -25,6 +28,8 @@
 #include <string>
 #include <vector>
 
+#include "mechbal/computed_torque.hpp"
+#include "mechbal/paminsa.hpp"
 #include "mechbal/rnea.hpp"
 #include "mechbal/trajectory.hpp"
 #include "test_support.hpp"
@@ -54,17 +59,23 @@ double pct(std::vector<long long> v, double p) {
 }
 
 void usage() {
-  std::fprintf(stderr, "usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE]\n");
+  std::fprintf(stderr,
+               "usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE] "
+               "[--workload ct6|paminsa]\n");
 }
 
-/// The 6-joint computed-torque-equivalent workload; tick() is noexcept and allocation-free.
+/// The 6-joint computed-torque workload; tick() is noexcept and allocation-free.
 struct ComputedTorqueWorkload {
+  static constexpr const char* name = "ct6";
+  static constexpr const char* description =
+      "ct6: trajectory evaluate + ComputedTorque::step over RneChainDynamics (6 joints)";
   ComputedTorqueWorkload()
       : model(make_chain()),
         dynamics(model),
+        controller(dynamics, Eigen::VectorXd::Constant(6, kp), Eigen::VectorXd::Constant(6, kd)),
         trajectory(Eigen::VectorXd::Constant(6, -0.8), Eigen::VectorXd::Constant(6, 0.9), 0.75,
                    mechbal::TimeLaw::quintic),
-        q_ref(6), qd_ref(6), qdd_ref(6), q(6), qd(6), v(6), tau(6) {}
+        q_ref(6), qd_ref(6), qdd_ref(6), q(6), qd(6), tau(6) {}
 
   static mechbal::ChainModel make_chain() {
     std::mt19937 rng(1006u);  // the same 6-joint chain as mechbal-bench's ct6 cases
@@ -80,74 +91,64 @@ struct ComputedTorqueWorkload {
     // "measured" state: the reference with a small deterministic tracking error
     q = q_ref.array() + 1e-3 * std::sin(50.0 * t);
     qd = qd_ref.array() - 1e-2 * std::cos(50.0 * t);
-    v = qdd_ref + kp * (q_ref - q) + kd * (qd_ref - qd);
-    s |= dynamics.inverse_dynamics(q, qd, v, tau);
+    s |= controller.step(q, qd, q_ref, qd_ref, qdd_ref, tau);
     return s;
   }
 
   static constexpr double kp = 100.0, kd = 20.0;
   mechbal::ChainModel model;
   mechbal::RneChainDynamics dynamics;
+  mechbal::ComputedTorque controller;
   mechbal::RestToRestTrajectory trajectory;
-  Eigen::VectorXd q_ref, qd_ref, qdd_ref, q, qd, v, tau;
+  Eigen::VectorXd q_ref, qd_ref, qdd_ref, q, qd, tau;
+};
+
+/// The whole PAMINSA tick at 1 kHz with the RK4 wrist; tick() is noexcept and allocation-free.
+struct PaminsaWorkload {
+  static constexpr const char* name = "paminsa";
+  static constexpr const char* description =
+      "paminsa: PaminsaController::tick (kinematics at t, t+dt/2, t+dt + D + RK4 reactionless "
+      "wrist + shaking wrench of 38 bodies)";
+  explicit PaminsaWorkload(double rate)
+      : dt(1.0 / rate), controller(mechbal::PaminsaModel{mechbal::PaminsaParameters{}},
+                                    config(rate), start) {
+    mechbal::PlatformMotion rest = platform_at(0.0);
+    rest.velocity.setZero();
+    rest.acceleration.setZero();
+    controller.reset(rest, start);
+  }
+  static mechbal::ReactionlessWristConfig config(double rate) {
+    mechbal::ReactionlessWristConfig c;
+    c.rate_hz = rate;
+    c.integrator = mechbal::WristIntegrator::rk4;
+    return c;
+  }
+  // a smooth 3-D platform motion around the nominal pose (the PAMINSA tests' trajectory)
+  static mechbal::PlatformMotion platform_at(double t) noexcept {
+    const mechbal::Vec3 P0(0.48, 0.05, 0.6775), amp(0.04, 0.12, 0.03), om(3.0, 2.0, 5.0),
+        ph(0.3, 1.1, 0.7);
+    mechbal::PlatformMotion m;
+    for (int i = 0; i < 3; ++i) {
+      const double a = om(i) * t + ph(i);
+      m.position(i) = P0(i) + amp(i) * std::sin(a);
+      m.velocity(i) = amp(i) * om(i) * std::cos(a);
+      m.acceleration(i) = -amp(i) * om(i) * om(i) * std::sin(a);
+    }
+    return m;
+  }
+  mechbal::Status tick(double t) noexcept {
+    return controller.tick(platform_at(t), platform_at(t + dt / 2), platform_at(t + dt));
+  }
+  const mechbal::Vec3 start{M_PI / 2, M_PI / 2, M_PI / 2};
+  double dt;
+  mechbal::PaminsaController controller;
 };
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  double seconds = 5.0, rate = 1000.0;
-  bool rt = false;
-  std::string json;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--seconds" && i + 1 < argc) {
-      seconds = std::atof(argv[++i]);
-    } else if (a == "--rate" && i + 1 < argc) {
-      rate = std::atof(argv[++i]);
-    } else if (a == "--rt") {
-      rt = true;
-    } else if (a == "--json" && i + 1 < argc) {
-      json = argv[++i];
-    } else if (a == "--help" || a == "-h") {
-      usage();
-      return 0;
-    } else {
-      std::fprintf(stderr, "mechbal-loop: unknown option '%s'\n", a.c_str());
-      usage();
-      return 2;
-    }
-  }
-  if (!(seconds > 0.0) || !(rate > 0.0) || rate > 100000.0) {
-    std::fprintf(stderr, "mechbal-loop: --seconds must be > 0 and --rate in (0, 100000], got %g, %g\n",
-                 seconds, rate);
-    return 2;
-  }
-  const long long period = static_cast<long long>(std::llround(1e9 / rate));
-  const auto ticks = static_cast<std::size_t>(std::llround(seconds * rate));
-
-  bool fifo = false, locked = false;
-  if (rt) {
-    sched_param sp{};
-    sp.sched_priority = 80;
-    if (sched_setscheduler(0, SCHED_FIFO, &sp) == 0) {
-      fifo = true;
-    } else {
-      std::fprintf(stderr,
-                   "mechbal-loop: SCHED_FIFO not permitted (%s): running with the default "
-                   "scheduler (needs CAP_SYS_NICE or an RLIMIT_RTPRIO >= 80)\n",
-                   std::strerror(errno));
-    }
-    if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
-      locked = true;
-    } else {
-      std::fprintf(stderr,
-                   "mechbal-loop: mlockall not permitted (%s): memory may page (needs "
-                   "CAP_IPC_LOCK or a large enough RLIMIT_MEMLOCK)\n",
-                   std::strerror(errno));
-    }
-  }
-
-  ComputedTorqueWorkload work;
+template <class W>
+void run_loop(W& work, std::size_t ticks, long long period, double rate, double seconds, bool fifo,
+              bool locked, const std::string& json) {
   std::vector<long long> compute(ticks), wake(ticks);  // allocated before the loop
   for (int i = 0; i < 1000; ++i) work.tick(i * 1e-3);  // warm caches
 
@@ -177,8 +178,8 @@ int main(int argc, char** argv) {
   const double mx = static_cast<double>(*std::max_element(compute.begin(), compute.end()));
   const double w50 = pct(wake, 0.5), w99 = pct(wake, 0.99), w999 = pct(wake, 0.999);
   const double wmax = static_cast<double>(*std::max_element(wake.begin(), wake.end()));
-  std::printf("mechbal-loop: %zu ticks at %.0f Hz (%.1f s), workload ct6 = trajectory + PD + RNE\n",
-              ticks, rate, seconds);
+  std::printf("mechbal-loop: %zu ticks at %.0f Hz (%.1f s), workload %s\n", ticks, rate, seconds,
+              W::description);
   std::printf("  SCHED_FIFO %s, mlockall %s\n", fifo ? "on" : "off", locked ? "on" : "off");
   std::printf("  tick time   p50 %8.0f ns  p99 %8.0f ns  p99.9 %8.0f ns  max %8.0f ns\n", p50, p99,
               p999, mx);
@@ -189,7 +190,7 @@ int main(int argc, char** argv) {
               misses, ticks, overruns, bad_status);
   if (!json.empty()) {
     std::ofstream out(json);
-    out << "{\"workload\": \"ct6: trajectory evaluate + inline PD + RneChainDynamics ID\", "
+    out << "{\"workload\": \"" << W::description << "\", "
         << "\"rate_hz\": " << rate << ", \"seconds\": " << seconds << ", \"ticks\": " << ticks
         << ", \"sched_fifo\": " << (fifo ? "true" : "false")
         << ", \"mlockall\": " << (locked ? "true" : "false") << ", \"p50_ns\": " << p50
@@ -197,6 +198,75 @@ int main(int argc, char** argv) {
         << ", \"wakeup_p50_ns\": " << w50 << ", \"wakeup_p99_ns\": " << w99
         << ", \"wakeup_p999_ns\": " << w999 << ", \"wakeup_max_ns\": " << wmax
         << ", \"deadline_misses\": " << misses << ", \"compute_overruns\": " << overruns << ", \"non_ok_status\": " << bad_status << "}\n";
+  }
+}
+
+int main(int argc, char** argv) {
+  double seconds = 5.0, rate = 1000.0;
+  bool rt = false;
+  std::string json, workload = "ct6";
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--seconds" && i + 1 < argc) {
+      seconds = std::atof(argv[++i]);
+    } else if (a == "--rate" && i + 1 < argc) {
+      rate = std::atof(argv[++i]);
+    } else if (a == "--rt") {
+      rt = true;
+    } else if (a == "--workload" && i + 1 < argc) {
+      workload = argv[++i];
+    } else if (a == "--json" && i + 1 < argc) {
+      json = argv[++i];
+    } else if (a == "--help" || a == "-h") {
+      usage();
+      return 0;
+    } else {
+      std::fprintf(stderr, "mechbal-loop: unknown option '%s'\n", a.c_str());
+      usage();
+      return 2;
+    }
+  }
+  if (!(seconds > 0.0) || !(rate > 0.0) || rate > 100000.0) {
+    std::fprintf(stderr, "mechbal-loop: --seconds must be > 0 and --rate in (0, 100000], got %g, %g\n",
+                 seconds, rate);
+    return 2;
+  }
+  if (workload != "ct6" && workload != "paminsa") {
+    std::fprintf(stderr, "mechbal-loop: --workload must be ct6 or paminsa, got '%s'\n",
+                 workload.c_str());
+    return 2;
+  }
+  const long long period = static_cast<long long>(std::llround(1e9 / rate));
+  const auto ticks = static_cast<std::size_t>(std::llround(seconds * rate));
+
+  bool fifo = false, locked = false;
+  if (rt) {
+    sched_param sp{};
+    sp.sched_priority = 80;
+    if (sched_setscheduler(0, SCHED_FIFO, &sp) == 0) {
+      fifo = true;
+    } else {
+      std::fprintf(stderr,
+                   "mechbal-loop: SCHED_FIFO not permitted (%s): running with the default "
+                   "scheduler (needs CAP_SYS_NICE or an RLIMIT_RTPRIO >= 80)\n",
+                   std::strerror(errno));
+    }
+    if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
+      locked = true;
+    } else {
+      std::fprintf(stderr,
+                   "mechbal-loop: mlockall not permitted (%s): memory may page (needs "
+                   "CAP_IPC_LOCK or a large enough RLIMIT_MEMLOCK)\n",
+                   std::strerror(errno));
+    }
+  }
+
+  if (workload == "paminsa") {
+    PaminsaWorkload work(rate);
+    run_loop(work, ticks, period, rate, seconds, fifo, locked, json);
+  } else {
+    ComputedTorqueWorkload work;
+    run_loop(work, ticks, period, rate, seconds, fifo, locked, json);
   }
   return 0;
 }

@@ -62,6 +62,7 @@ def main(argv=None):
     ap.add_argument("--gbench", required=True, type=Path)
     ap.add_argument("--tail", required=True, type=Path)
     ap.add_argument("--loop", required=True, type=Path)
+    ap.add_argument("--loop-paminsa", type=Path, help="mechbal-loop --workload paminsa JSON")
     ap.add_argument("--python", type=Path)
     ap.add_argument("--out-json", required=True, type=Path)
     ap.add_argument("--out-md", required=True, type=Path)
@@ -80,16 +81,25 @@ def main(argv=None):
         raise SystemExit(f"no per-call timings for {missing}: run mechbal-bench with --tail_out")
 
     loop = json.loads(args.loop.read_text())
+    loop_paminsa = (json.loads(args.loop_paminsa.read_text())
+                    if args.loop_paminsa and args.loop_paminsa.exists() else None)
     py = json.loads(args.python.read_text()) if args.python and args.python.exists() else None
 
     ratios = {
-        # ct6 = computed-torque-equivalent tick (inline PD + inverse dynamics) until ComputedTorque
-        # lands: the other library's time over mechbal's, same 6-joint chain, same run.
+        # ct6 = one computed-torque tick on the 6-joint chain: mechbal = the ComputedTorque
+        # controller over RneChainDynamics; KDL raw / Pinocchio = the same law inline with their
+        # own inverse dynamics. The other library's time over mechbal's, same chain, same run.
         "kdl_over_mechbal_ct6": ratio(cases, "ct6_kdl_raw", "ct6_mechbal"),
         "pinocchio_over_mechbal_ct6": ratio(cases, "ct6_pinocchio", "ct6_mechbal"),
+        "kdl_over_mechbal_ct7": ratio(cases, "ct7_kdl_raw", "ct7_mechbal"),
+        "pinocchio_over_mechbal_ct7": ratio(cases, "ct7_pinocchio", "ct7_mechbal"),
+        # ComputedTorque over KdlChainDynamics vs over RneChainDynamics (same controller)
         "kdl_wrapper_over_mechbal_ct6": ratio(cases, "ct6_kdl_wrapper", "ct6_mechbal"),
+        "kdl_wrapper_over_mechbal_ct7": ratio(cases, "ct7_kdl_wrapper", "ct7_mechbal"),
         # Pinocchio given the chain in joint-aligned frames (RZ joints): its best case
         "pinocchio_aligned_over_mechbal_ct6": ratio(cases, "ct6_pinocchio_aligned", "ct6_mechbal"),
+        # what the ComputedTorque class costs over the inline law (checks, virtual call, clipping)
+        "mechbal_class_over_inline_ct6": ratio(cases, "ct6_mechbal", "ct6_mechbal_inline"),
     }
     for dof in (6, 7):
         ratios[f"kdl_over_mechbal_id{dof}"] = ratio(cases, f"id{dof}_kdl_raw", f"id{dof}_mechbal")
@@ -105,6 +115,33 @@ def main(argv=None):
             if name in cases:
                 v["binding_overhead_ns"] = v["median_ns"] - cases[name]["median_ns"]
 
+    def median(name):
+        return cases[name]["median_ns"] if name in cases else None
+
+    def check(value, ok):
+        return {"value": value, "met": None if value is None else bool(ok(value))}
+
+    allocs = {n: c["allocations_per_tick"] for n, c in cases.items()}
+    targets = {
+        "wrist_euler_median_ns <= 500": check(median("wrist_euler"), lambda v: v <= 500),
+        "wrist_rk4_median_ns <= 500": check(median("wrist_rk4"), lambda v: v <= 500),
+        "paminsa_tick_euler_median_ns <= 2000": check(median("paminsa_tick_euler"),
+                                                      lambda v: v <= 2000),
+        "paminsa_tick_rk4_median_ns <= 2000": check(median("paminsa_tick_rk4"),
+                                                    lambda v: v <= 2000),
+        "loop_ct6_p999_ns < 10000": check(loop["p999_ns"], lambda v: v < 10000),
+        "kdl_over_mechbal_ct6 >= 2": check(ratios["kdl_over_mechbal_ct6"], lambda v: v >= 2),
+        "mechbal_over_pinocchio_ct6 <= 1.2": check(
+            None if not ratios["pinocchio_over_mechbal_ct6"]
+            else 1.0 / ratios["pinocchio_over_mechbal_ct6"], lambda v: v <= 1.2),
+        "numpy_over_mechbal_batch >= 10": check(ratios.get("numpy_over_mechbal_batch"),
+                                                lambda v: v >= 10),
+        "allocations_per_tick == 0 (every case)": check(max(allocs.values()), lambda v: v == 0),
+    }
+    if loop_paminsa:
+        targets["loop_paminsa_p999_ns < 10000"] = check(loop_paminsa["p999_ns"],
+                                                        lambda v: v < 10000)
+
     result = {
         "generated": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
         "machine": {**machine(), "gbench_context": {k: context.get(k) for k in (
@@ -113,8 +150,17 @@ def main(argv=None):
             "median_ns": "median over repetitions of Google Benchmark CPU time per tick",
             "p99_ns": "99th percentile of individually timed ticks (wall clock, timer overhead "
                       "subtracted)",
-            "ct6": "computed torque on the 6-joint chain = inline PD outer loop + inverse "
-                   "dynamics tau = ID(q, qd, v); mechbal's ComputedTorque class is not merged yet",
+            "ct": "computed torque on the 6-/7-joint chain: *_mechbal and *_kdl_wrapper run the "
+                  "ComputedTorque controller (computed_torque.hpp) over RneChainDynamics / "
+                  "KdlChainDynamics; *_kdl_raw and *_pinocchio compute the same law inline, "
+                  "v = qdd_d + Kp (q_d - q) + Kd (qd_d - qd), tau = ID(q, qd, v); "
+                  "ct6_mechbal_inline is mechbal's RNE with the inline law; ct2_closed_form is "
+                  "ComputedTorque over the closed-form Arm2DofDynamics",
+            "wrist": "ReactionlessWrist::step on PAMINSA's wrist inertias with D(t) of the PAMINSA "
+                     "mechanism precomputed along a 3-D platform motion (1 kHz)",
+            "paminsa_tick": "PaminsaController::tick: mechanism kinematics (35 bodies) and D at "
+                            "t (and t + dt/2, t + dt for RK4), the wrist step, wrist kinematics, "
+                            "shaking wrench of the 38 bodies",
             "pinocchio": "Pinocchio C++ built header-only with mechbal's compiler flags; "
                          "*_pinocchio: JointModelRevoluteUnaligned (the chain as given); "
                          "*_pinocchio_aligned: the same chain re-expressed in joint-aligned "
@@ -122,7 +168,9 @@ def main(argv=None):
         },
         "cases": cases,
         "loop": loop,
+        "loop_paminsa": loop_paminsa,
         "ratios": ratios,
+        "targets": targets,
         "python": py,
     }
     args.out_json.parent.mkdir(parents=True, exist_ok=True)
@@ -149,6 +197,19 @@ def main(argv=None):
            f"({loop.get('compute_overruns', 'n/a')}) |",
            f"| wake-up latency [ns] | {fmt(loop['wakeup_p50_ns'])} | {fmt(loop['wakeup_p99_ns'])} | "
            f"{fmt(loop['wakeup_p999_ns'])} | {fmt(loop['wakeup_max_ns'])} | |"]
+    if loop_paminsa:
+        lp = loop_paminsa
+        md += ["", f"mechbal-loop --workload paminsa: {lp['ticks']} ticks at {lp['rate_hz']:.0f} Hz,"
+                   f" workload {lp['workload']}", "",
+               "| loop | p50 | p99 | p99.9 | max | deadline misses (compute overruns) |",
+               "|---|---:|---:|---:|---:|---:|",
+               f"| tick time [ns] | {fmt(lp['p50_ns'])} | {fmt(lp['p99_ns'])} | "
+               f"{fmt(lp['p999_ns'])} | {fmt(lp['max_ns'])} | {lp['deadline_misses']} "
+               f"({lp.get('compute_overruns', 'n/a')}) |"]
+    md += ["", "| target | value | met |", "|---|---:|---|"]
+    for k, v in targets.items():
+        met = "n/a" if v["met"] is None else ("yes" if v["met"] else "NO")
+        md.append(f"| {k} | {fmt(v['value'], 2)} | {met} |")
     if py:
         b = py["batch"]
         md += ["", "| Python | value |", "|---|---:|"]
@@ -159,6 +220,9 @@ def main(argv=None):
                f"mechbal [instants/s] | {fmt(b['mechbal_instants_per_s'])} |",
                f"| same, pure numpy [instants/s] | {fmt(b['numpy_instants_per_s'])} |",
                f"| numpy time / mechbal time | {fmt(b['numpy_over_mechbal'], 1)} |"]
+        for name, v in py.get("batch_controllers", {}).items():
+            md.append(f"| {name} batch, {v['ticks']:,} ticks: ticks/s (ns per tick) | "
+                      f"{fmt(v['ticks_per_s'])} ({fmt(v['ns_per_tick'])}) |")
     args.out_md.write_text("\n".join(md) + "\n")
     print("\n".join(md))
 

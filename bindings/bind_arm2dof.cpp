@@ -11,7 +11,7 @@
 #include "mechbal/arm2dof.hpp"
 #include "mechbal/closed_loop.hpp"
 #include "mechbal/computed_torque.hpp"
-#include "mechbal/kdl_chain.hpp"
+#include "mechbal/dynamics.hpp"
 
 namespace py = pybind11;
 
@@ -93,7 +93,7 @@ void bind_arm2dof(py::module_& m) {
         "The 2-DOF arm (counterweights merged into the links) as a ChainModel: x-z plane, joint "
         "axes along -y, gravity (0, 0, -g)");
 
-  py::class_<Arm2DofDynamics>(m, "Arm2DofDynamics",
+  py::class_<Arm2DofDynamics, InverseDynamics>(m, "Arm2DofDynamics",
                               "Closed-form dynamics of the 2-DOF arm, eqs 14-31 (corrected)")
       .def(py::init<const Arm2DofParameters&, const Arm2DofCounterweights&>(), py::arg("arm"),
            py::arg("counterweights") = Arm2DofCounterweights{})
@@ -138,18 +138,14 @@ void bind_arm2dof(py::module_& m) {
   py::class_<ComputedTorque>(m, "ComputedTorque",
                              "Computed-torque control, Arakelian et al. 2011 eqs 2-6, over any "
                              "inverse-dynamics back end (keeps the model alive)")
-      .def(py::init([](Arm2DofDynamics& model, const Eigen::VectorXd& kp,
+      .def(py::init([](InverseDynamics& model, const Eigen::VectorXd& kp,
                        const Eigen::VectorXd& kd, const Eigen::VectorXd& limit) {
              return new ComputedTorque(model, kp, kd, limit);
            }),
            py::arg("model"), py::arg("kp"), py::arg("kd"),
-           py::arg("torque_limit") = Eigen::VectorXd(), py::keep_alive<1, 2>())
-      .def(py::init([](KdlChainDynamics& model, const Eigen::VectorXd& kp,
-                       const Eigen::VectorXd& kd, const Eigen::VectorXd& limit) {
-             return new ComputedTorque(model, kp, kd, limit);
-           }),
-           py::arg("model"), py::arg("kp"), py::arg("kd"),
-           py::arg("torque_limit") = Eigen::VectorXd(), py::keep_alive<1, 2>())
+           py::arg("torque_limit") = Eigen::VectorXd(), py::keep_alive<1, 2>(),
+           "model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, "
+           "RneChainDynamics)")
       .def_property_readonly("dof", &ComputedTorque::dof)
       .def_property_readonly("last_command", &ComputedTorque::last_command)
       .def(

@@ -128,7 +128,7 @@ void bind_chain(pybind11::module_& m) {
       "Every link's motion in the base frame for N joint states (q, qd, qdd each (N, dof)). "
       "Returns a dict of arrays (N, dof, 3) / (N, dof, 3, 3) / frames (N, dof, 4, 4).");
 
-  py::class_<KdlChainDynamics>(m, "KdlChainDynamics",
+  py::class_<KdlChainDynamics, InverseDynamics>(m, "KdlChainDynamics",
                                "Joint-space dynamics of a ChainModel through Orocos KDL")
       .def(py::init<const ChainModel&>(), py::arg("model"))
       .def_property_readonly("dof", &KdlChainDynamics::dof)

@@ -22,7 +22,7 @@ Eigen::VectorXd one_state(const RneChainDynamics& d, const Eigen::VectorXd& v, c
 }
 
 void bind_rnea(py::module_& m) {
-  py::class_<RneChainDynamics>(
+  py::class_<RneChainDynamics, InverseDynamics>(
       m, "RneChainDynamics",
       "Joint-space dynamics of a ChainModel by mechbal's own recursive Newton-Euler (inverse "
       "dynamics, base support wrench) and composite rigid body algorithm (mass matrix)")

@@ -32,12 +32,6 @@ void require_mass(double v, const std::string& field) {
   if (!std::isfinite(v) || v < 0.0) fail(field, "must be finite and >= 0", v);
 }
 
-Mat3 rot_z(double a) noexcept {
-  const double c = std::cos(a), s = std::sin(a);
-  Mat3 R;
-  R << c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0;
-  return R;
-}
 
 inline double cross2(const Vec2& a, const Vec2& b) noexcept { return a(0) * b(1) - a(1) * b(0); }
 
@@ -45,16 +39,24 @@ inline double cross2(const Vec2& a, const Vec2& b) noexcept { return a(0) * b(1)
 struct Scalar3 {
   double v = 0.0, d = 0.0, dd = 0.0;
 };
+
+/// An angle by its cosine and sine (no atan2 in the tick: every use of an angle is through its
+/// cosine and sine, which the vector gives directly; issue 6), and its first and second derivative.
+struct Angle3 {
+  double c = 1.0, s = 0.0, d = 0.0, dd = 0.0;
+};
 struct Point2 {
   Vec2 p = Vec2::Zero(), v = Vec2::Zero(), a = Vec2::Zero();
 };
 
-/// Angle of a planar vector w(t): beta = atan2(w); betad = (w x wd)/|w|^2;
+/// Angle of a planar vector w(t): (cos beta, sin beta) = w/|w|; betad = (w x wd)/|w|^2;
 /// betadd = (w x wdd)/|w|^2 - 2 betad (w . wd)/|w|^2.
-Scalar3 angle_of(const Vec2& w, const Vec2& wd, const Vec2& wdd) noexcept {
+Angle3 angle_of(const Vec2& w, const Vec2& wd, const Vec2& wdd) noexcept {
   const double r2 = w.squaredNorm();
-  Scalar3 out;
-  out.v = std::atan2(w(1), w(0));
+  const double r = std::sqrt(r2);
+  Angle3 out;
+  out.c = w(0) / r;
+  out.s = w(1) / r;
   out.d = cross2(w, wd) / r2;
   out.dd = cross2(w, wdd) / r2 - 2.0 * out.d * w.dot(wd) / r2;
   return out;
@@ -72,7 +74,7 @@ Scalar3 norm_of(const Vec2& w, const Vec2& wd, const Vec2& wdd) noexcept {
 /// Leg plane frame: X = B_h + s u + z e_z with u = (cos beta, sin beta, 0), n = e_z x u.
 struct Plane {
   Vec3 origin, u, n;
-  Scalar3 beta;
+  Angle3 beta;
 };
 
 /// In-plane point (s, z) with rates relative to the turning plane -> base frame:
@@ -101,8 +103,8 @@ void pantograph_link(const Plane& pl, const Point2& p1, const Point2& p2, BodySt
   mid.v = 0.5 * (p1.v + p2.v);
   mid.a = 0.5 * (p1.a + p2.a);
   to_base(pl, mid, st.com, st.com_velocity, st.com_acceleration);
-  const Scalar3 g = angle_of(p2.p - p1.p, p2.v - p1.v, p2.a - p1.a);
-  const Vec3 ex = std::cos(g.v) * pl.u + std::sin(g.v) * Vec3::UnitZ();
+  const Angle3 g = angle_of(p2.p - p1.p, p2.v - p1.v, p2.a - p1.a);
+  const Vec3 ex = g.c * pl.u + g.s * Vec3::UnitZ();
   st.rotation.col(0) = ex;
   st.rotation.col(1) = pl.n;
   st.rotation.col(2) = ex.cross(pl.n);
@@ -281,7 +283,7 @@ Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMot
   // leg-plane data first (so that an unreachable pose leaves the workspace untouched)
   Plane plane[3];
   Point2 A[3], C[3], E[3];
-  Scalar3 alpha[3];
+  Angle3 alpha[3];
   Vec2 AhArr[3];
   for (int i = 0; i < 3; ++i) {
     const Vec2& Bh = model.slider_line()[i];
@@ -294,10 +296,10 @@ Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMot
     if (!(w.norm() > 1e-9)) return Status::singular;
     plane[i].beta = angle_of(w, Ahd, Ahdd);
     const Scalar3 rho = norm_of(w, Ahd, Ahdd);
-    const double b = plane[i].beta.v;
+    const double cb = plane[i].beta.c, sb = plane[i].beta.s;
     plane[i].origin = Vec3(Bh(0), Bh(1), 0.0);
-    plane[i].u = Vec3(std::cos(b), std::sin(b), 0.0);
-    plane[i].n = Vec3(-std::sin(b), std::cos(b), 0.0);
+    plane[i].u = Vec3(cb, sb, 0.0);
+    plane[i].n = Vec3(-sb, cb, 0.0);
     // in-plane (s, z): A = (rho, z_A), C = (-(k-1) rho, z_C)
     A[i].p = Vec2(rho.v, p.z_A);
     A[i].v = Vec2(rho.d, 0.0);
@@ -350,8 +352,8 @@ Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMot
     pantograph_link(pn, A[i], Fp, ws.states[Idx::leg(i, 3)]);    // link 4, A-F
 
     // link 5: turns about the vertical through M_i; COM S5 at l_MS5 along M_i -> A_i
-    const Scalar3& al = alpha[i];
-    const Vec3 g(std::cos(al.v), std::sin(al.v), 0.0), gp(-std::sin(al.v), std::cos(al.v), 0.0);
+    const Angle3& al = alpha[i];
+    const Vec3 g(al.c, al.s, 0.0), gp(-al.s, al.c, 0.0);
     const Vec3 M3(model.guide_pivot()[i](0), model.guide_pivot()[i](1), p.z_A);
     const auto on_guide = [&](double l, BodyState& st) noexcept {
       st.com = M3 + l * g;
@@ -360,7 +362,7 @@ Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMot
     };
     BodyState& l5 = ws.states[Idx::leg(i, 4)];
     on_guide(p.length_MS5, l5);
-    l5.rotation = rot_z(al.v);
+    l5.rotation << al.c, -al.s, 0.0, al.s, al.c, 0.0, 0.0, 0.0, 1.0;  // Rz(alpha)
     l5.angular_velocity = al.d * Vec3::UnitZ();
     l5.angular_acceleration = al.dd * Vec3::UnitZ();
 
@@ -386,8 +388,8 @@ Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMot
 
     // base-frame points A..F
     const Point2* pts[6] = {&A[i], &Bp, &C[i], &Dp, &E[i], &Fp};
-    Vec3 dummy_v, dummy_a;
-    for (int n = 0; n < 6; ++n) to_base(pn, *pts[n], ws.leg_points[i][n], dummy_v, dummy_a);
+    for (int n = 0; n < 6; ++n)  // positions only (to_base's rates are not needed here)
+      ws.leg_points[i][n] = pn.origin + pts[n]->p(0) * pn.u + pts[n]->p(1) * Vec3::UnitZ();
   }
 
   // vertical counter-mass of the supplementary system (A9): z = z0 - (z_P - z_P0)
@@ -442,6 +444,28 @@ Status paminsa_mechanism_momentum(const PaminsaModel& model, const PaminsaWorksp
 }
 
 // ------------------------------------------------------------------------------ controller
+namespace {
+
+/// D only (eq 19), without dD/dt: what the RK4 stages need at t + dt/2 and t + dt. Same sum as
+/// shaking_wrench's angular momentum, H = sum (m OG x v_G + R J R^T w), with R (J (R^T w))
+/// (three matrix-vector products instead of forming R J R^T).
+Status mechanism_angular_momentum(const PaminsaModel& model, const PaminsaWorkspace& ws,
+                                  Vec3& D) noexcept {
+  Vec3 H = Vec3::Zero();
+  for (std::size_t j = 0; j < Idx::mechanism_count; ++j) {
+    const RigidBody& b = model.bodies()[j];
+    const BodyState& st = ws.states[j];
+    H.noalias() += b.mass * st.com.cross(st.com_velocity);
+    if (b.inertia_body.isZero(0.0)) continue;  // point mass
+    H.noalias() += st.rotation * (b.inertia_body * (st.rotation.transpose() * st.angular_velocity));
+  }
+  if (!H.allFinite()) return Status::non_finite_input;
+  D = H;
+  return Status::ok;
+}
+
+}  // namespace
+
 PaminsaController::PaminsaController(const PaminsaModel& model,
                                      const ReactionlessWristConfig& config,
                                      const Vec3& initial_wrist_angles)
@@ -459,30 +483,39 @@ Status PaminsaController::reset(const PlatformMotion& initial, const Vec3& wrist
 Status PaminsaController::tick(const PlatformMotion& now, const PlatformMotion& half,
                                const PlatformMotion& next) noexcept {
   const bool rk4 = wrist_.config().integrator == WristIntegrator::rk4;
-  Vec3 D_half = Vec3::Zero(), D_next = Vec3::Zero(), unused;
+  Vec3 D_half = Vec3::Zero(), D_next = Vec3::Zero();
   Status s = Status::ok;
   if (rk4) {
     s = paminsa_mechanism_kinematics(model_, half, ws_);
-    if (s == Status::ok) s = paminsa_mechanism_momentum(model_, ws_, D_half, unused);
+    if (s == Status::ok) s = mechanism_angular_momentum(model_, ws_, D_half);
     if (s == Status::ok) s = paminsa_mechanism_kinematics(model_, next, ws_);
-    if (s == Status::ok) s = paminsa_mechanism_momentum(model_, ws_, D_next, unused);
+    if (s == Status::ok) s = mechanism_angular_momentum(model_, ws_, D_next);
   }
-  Vec3 D, D_dot;
+  // the 35 mechanism bodies' momenta and wrench once: D, dD/dt, and the wrench's first 35 terms
+  ShakingWrench mechanism;
   if (s == Status::ok) s = paminsa_mechanism_kinematics(model_, now, ws_);
-  if (s == Status::ok) s = paminsa_mechanism_momentum(model_, ws_, D, D_dot);
+  if (s == Status::ok)
+    s = shaking_wrench(model_.bodies().data(), ws_.states.data(), Idx::mechanism_count, mechanism);
   if (s != Status::ok) {
     // hold: the wrist sees a non-finite input and keeps its angles
     const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
     wrist_.step(nan, nan, nan, nan);
     return s | Status::non_finite_input;
   }
-  D_ = D;
-  D_dot_ = D_dot;
-  const Status ws = wrist_.step(D, D_dot, D_half, D_next);
+  D_ = mechanism.angular_momentum;  // eq 19
+  D_dot_ = mechanism.moment;
+  const Status ws = wrist_.step(D_, D_dot_, D_half, D_next);
   const WristCommand& c = wrist_.command();
   WristMotion wm{c.angles, c.rates, c.accelerations};
   paminsa_wrist_kinematics(model_, now, wm, ws_);
-  shaking_wrench(model_.bodies().data(), ws_.states.data(), Idx::count, wrench_);
+  // all 38 bodies = the mechanism's sums + the three wrist links' (not re-summed from scratch)
+  ShakingWrench wrist;
+  shaking_wrench(model_.bodies().data() + Idx::wrist(0), ws_.states.data() + Idx::wrist(0), 3,
+                 wrist);
+  wrench_.linear_momentum = mechanism.linear_momentum + wrist.linear_momentum;
+  wrench_.angular_momentum = mechanism.angular_momentum + wrist.angular_momentum;
+  wrench_.force = mechanism.force + wrist.force;
+  wrench_.moment = mechanism.moment + wrist.moment;
   return ws;
 }
 

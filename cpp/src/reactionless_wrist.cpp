@@ -1,9 +1,12 @@
 #include "mechbal/reactionless_wrist.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -24,6 +27,41 @@ Mat3 rot_z(double a) noexcept {
   R << c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0;
   return R;
 }
+
+/// The wrist at one set of angles: base-frame link inertias I_k = R_k J_k R_k^T and the axes
+/// x1 = R1 e_x, z2 = R2 e_z; N and the bias term are both built from them (once per tick).
+struct WristAt {
+  WristAt(const WristInertias& J, const Vec3& q) noexcept {
+    const Mat3 R1 = rot_z(q(0));
+    const Mat3 R2 = R1 * rot_x(q(1));
+    const Mat3 R3 = R2 * rot_z(q(2));
+    I[0] = R1 * J[0] * R1.transpose();
+    I[1] = R2 * J[1] * R2.transpose();
+    I[2] = R3 * J[2] * R3.transpose();
+    x1 = R1.col(0);
+    z2 = R2.col(2);
+  }
+  /// eq 23 (corrected): N = [(I1+I2+I3) e_z | (I2+I3) x1 | I3 z2]
+  Mat3 momentum_matrix() const noexcept {
+    Mat3 N;
+    N.col(0) = (I[0] + I[1] + I[2]).col(2);
+    N.col(1) = (I[1] + I[2]) * x1;
+    N.col(2) = I[2] * z2;
+    return N;
+  }
+  /// sum_k [I_k wdot_k|_{qddot=0} + w_k x I_k w_k]
+  Vec3 bias(const Vec3& qd) const noexcept {
+    const Vec3 w1 = qd(0) * Vec3::UnitZ();
+    const Vec3 w2 = w1 + qd(1) * x1;
+    const Vec3 w3 = w2 + qd(2) * z2;
+    const Vec3 a2 = qd(1) * w1.cross(x1);
+    const Vec3 a3 = a2 + qd(2) * w2.cross(z2);
+    const Vec3 Iw1 = I[0] * w1, Iw2 = I[1] * w2, Iw3 = I[2] * w3;
+    return w1.cross(Iw1) + I[1] * a2 + w2.cross(Iw2) + I[2] * a3 + w3.cross(Iw3);
+  }
+  std::array<Mat3, 3> I;
+  Vec3 x1, z2;
+};
 
 [[noreturn]] void fail(const char* field, const std::string& what, double value) {
   std::ostringstream msg;
@@ -52,17 +90,7 @@ void wrist_link_motion(const Vec3& q, const Vec3& qd, const Vec3& qdd,
 }
 
 Mat3 wrist_momentum_matrix(const WristInertias& J, const Vec3& q) noexcept {
-  const Mat3 R1 = rot_z(q(0));
-  const Mat3 R2 = R1 * rot_x(q(1));
-  const Mat3 R3 = R2 * rot_z(q(2));
-  const Mat3 I1 = R1 * J[0] * R1.transpose();
-  const Mat3 I2 = R2 * J[1] * R2.transpose();
-  const Mat3 I3 = R3 * J[2] * R3.transpose();
-  Mat3 N;
-  N.col(0) = (I1 + I2 + I3) * Vec3::UnitZ();
-  N.col(1) = (I2 + I3) * R1.col(0);
-  N.col(2) = I3 * R2.col(2);
-  return N;
+  return WristAt(J, q).momentum_matrix();
 }
 
 Vec3 wrist_momentum_bias(const WristInertias& J, const Vec3& q, const Vec3& qd) noexcept {
@@ -113,8 +141,29 @@ Status ReactionlessWrist::reset(const Vec3& angles, const Vec3& target_momentum)
   return Status::ok;
 }
 
-Status ReactionlessWrist::solve(const Mat3& N, const Vec3& rhs, Vec3& x,
-                                double& condition) const noexcept {
+Status ReactionlessWrist::solve(const Mat3& N, const Vec3& rhs, Vec3& x, double& condition,
+                                Mat3* inverse) const noexcept {
+  // Fast path (issue 6: a 3x3 JacobiSVD costs ~0.7 us, the whole tick budget): the singular values
+  // of N are the square roots of the eigenvalues of N^T N, which Eigen gives in closed form; when
+  // N is well conditioned the exact solve is the cofactor inverse. The eigenvalues of N^T N lose
+  // about cond^2 eps relative accuracy (1e-8 at cond = 1e4), enough to decide well-conditioned
+  // and to report cond(N); anything else (ill-conditioned, non-finite) takes the SVD below.
+  Eigen::SelfAdjointEigenSolver<Mat3> eig;
+  eig.computeDirect(N.transpose() * N);
+  const Vec3& lambda = eig.eigenvalues();  // ascending
+  if (lambda(0) > 0.0 && std::isfinite(lambda(2))) {
+    const double c = std::sqrt(lambda(2) / lambda(0));
+    if (c <= config_.max_condition) {
+      const Mat3 inv = N.inverse();
+      const Vec3 y = inv * rhs;
+      if (y.allFinite() && inv.allFinite()) {
+        if (inverse) *inverse = inv;
+        x = y;
+        condition = c;
+        return Status::ok;
+      }
+    }
+  }
   Eigen::JacobiSVD<Mat3> svd(N, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Vec3 s = svd.singularValues();  // descending
   const double smax = s(0);
@@ -142,7 +191,12 @@ Status ReactionlessWrist::solve(const Mat3& N, const Vec3& rhs, Vec3& x,
 
 Status ReactionlessWrist::rates(const Vec3& q, const Vec3& D, Vec3& qd,
                                 double& condition) const noexcept {
-  Status st = solve(wrist_momentum_matrix(inertia_, q), target_ - D, qd, condition);
+  return rates_with(wrist_momentum_matrix(inertia_, q), D, qd, condition);
+}
+
+Status ReactionlessWrist::rates_with(const Mat3& N, const Vec3& D, Vec3& qd, double& condition,
+                                     Mat3* inverse) const noexcept {
+  Status st = solve(N, target_ - D, qd, condition, inverse);
   const double peak = qd.cwiseAbs().maxCoeff();
   if (peak > config_.max_rate) {
     qd *= config_.max_rate / peak;  // keep the direction of the commanded rate vector
@@ -177,11 +231,19 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
 
   Vec3 k1;
   double cond = 1.0, unused = 1.0;
-  Status st = rates(angles_, D_now, k1, cond);
+  // N(q_n) and the link inertias are built once for k1 and the feed-forward; when N is well
+  // conditioned its inverse is reused for both (issue 6: the tick recomputed them)
+  const WristAt at(inertia_, angles_);
+  const Mat3 N = at.momentum_matrix();
+  Mat3 N_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by the fast path
+  Status st = rates_with(N, D_now, k1, cond, &N_inv);
   // feed-forward acceleration: N qdd = -Ddot - bias(q, qdot)
   Vec3 qdd;
-  st |= solve(wrist_momentum_matrix(inertia_, angles_),
-              -D_dot - wrist_momentum_bias(inertia_, angles_, k1), qdd, unused);
+  const Vec3 rhs = -D_dot - at.bias(k1);
+  if (N_inv.allFinite())
+    qdd = N_inv * rhs;  // well conditioned: the fast path's inverse
+  else
+    st |= solve(N, rhs, qdd, unused);
   Vec3 next;
   if (D_half != nullptr && D_next != nullptr) {
     Vec3 k2, k3, k4;

@@ -51,13 +51,17 @@ inline bool finite_state(const BodyState& s) noexcept {
 // Contribution of one body to P, H_O, dP/dt, dH_O/dt.
 inline void accumulate(const RigidBody& b, const Vec3& c, const Vec3& v, const Vec3& a,
                        const Mat3& R, const Vec3& w, const Vec3& alpha, ShakingWrench& out) noexcept {
-  const Mat3 I_world = R * b.inertia_body * R.transpose();
-  const Vec3 Iw = I_world * w;
   out.linear_momentum.noalias() += b.mass * v;
-  out.angular_momentum.noalias() += b.mass * c.cross(v) + Iw;
+  out.angular_momentum.noalias() += b.mass * c.cross(v);
   out.force.noalias() += b.mass * a;
   // d/dt(m c x v) = m c x a ; d/dt(I w) = I alpha + w x (I w)
-  out.moment.noalias() += b.mass * c.cross(a) + I_world * alpha + w.cross(Iw);
+  out.moment.noalias() += b.mass * c.cross(a);
+  if (b.inertia_body.isZero(0.0)) return;  // point mass (exactly): no rotational terms
+  // I = R J R^T applied as R (J (R^T x)): six matrix-vector products instead of forming I
+  const Vec3 Iw = R * (b.inertia_body * (R.transpose() * w));
+  const Vec3 Ialpha = R * (b.inertia_body * (R.transpose() * alpha));
+  out.angular_momentum.noalias() += Iw;
+  out.moment.noalias() += Ialpha + w.cross(Iw);
 }
 
 }  // namespace

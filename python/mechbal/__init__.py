@@ -5,7 +5,11 @@ configuration (TOML -> validated models), offline sizing, batch simulation, repo
 ``mechbal`` command line.
 """
 from mechbal._core import (  # noqa: F401
+    Arm2DofDynamics,
+    Arm2DofParameters,
     ChainModel,
+    ComputedTorque,
+    InverseDynamics,
     JointSpec,
     JointType,
     KdlChainDynamics,
@@ -17,6 +21,7 @@ from mechbal._core import (  # noqa: F401
     RneChainDynamics,
     Status,
     TimeLaw,
+    WristIntegrator,
     chain_kinematics,
     paminsa_kinematics,
     paminsa_reactionless_run,

@@ -113,7 +113,11 @@ class ReactionlessWrist {
   Status rates(const Vec3& angles, const Vec3& D, Vec3& rates, double& condition) const noexcept;
 
  private:
-  Status solve(const Mat3& N, const Vec3& rhs, Vec3& x, double& condition) const noexcept;
+  /// Status::ok with `inverse` (when given) set to N^-1 only on the well-conditioned fast path.
+  Status solve(const Mat3& N, const Vec3& rhs, Vec3& x, double& condition,
+               Mat3* inverse = nullptr) const noexcept;
+  Status rates_with(const Mat3& N, const Vec3& D, Vec3& rates, double& condition,
+                    Mat3* inverse = nullptr) const noexcept;
   Status tick(const Vec3& D_now, const Vec3& D_dot, const Vec3* D_half, const Vec3* D_next) noexcept;
 
   WristInertias inertia_;

@@ -1,0 +1,24 @@
+// pybind11 glue for the InverseDynamics interface (dynamics.hpp): bound as the common base class
+// of every joint-space dynamics back end (Arm2DofDynamics, KdlChainDynamics, RneChainDynamics), so
+// that controllers taking an InverseDynamics (ComputedTorque) accept any of them. No logic.
+#include "bindings.hpp"
+#include "mechbal/dynamics.hpp"
+
+namespace py = pybind11;
+
+namespace mechbal::pyb {
+
+namespace {
+
+void bind_dynamics(py::module_& m) {
+  py::class_<InverseDynamics>(m, "InverseDynamics",
+                              "Joint-space inverse dynamics back end (base class of "
+                              "Arm2DofDynamics, KdlChainDynamics, RneChainDynamics)")
+      .def_property_readonly("dof", &InverseDynamics::dof);
+}
+
+}  // namespace
+
+MECHBAL_REGISTER_BINDINGS(15, dynamics, bind_dynamics);
+
+}  // namespace mechbal::pyb
