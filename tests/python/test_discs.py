@@ -133,10 +133,25 @@ def _bodies_symbolic(kind):
     return sp, q, qd, bodies, P
 
 
+def _pythagoras(sp, e):
+    """Exact normal form of a polynomial in sin/cos: expand, then replace sin(a)^k (k >= 2) by
+    (1 - cos(a)^2) sin(a)^(k-2) until no such power is left (sin^2 + cos^2 = 1 is the only
+    relation; identical to trigsimp on these expressions, and ~100x faster)."""
+    e = sp.expand(e)
+    while True:
+        pows = [p for p in e.atoms(sp.Pow)
+                if isinstance(p.base, sp.sin) and p.exp.is_Integer and p.exp >= 2]
+        if not pows:
+            return e
+        e = sp.expand(e.xreplace({p: (1 - sp.cos(p.base.args[0]) ** 2)
+                                  * sp.sin(p.base.args[0]) ** (p.exp - 2) for p in pows}))
+
+
 @lru_cache(maxsize=None)
 def lagrange_torque(kind):
     """tau = d/dt dL/dqd - dL/dq from T = sum 1/2 m |r_G'|^2 + 1/2 w^T J w, with the body-frame
-    angular velocity w from [w]x = R^T dR/dt (simplified per body), and V = sum m g z_G."""
+    angular velocity w from [w]x = R^T dR/dt (reduced per body with sin^2 = 1 - cos^2), and
+    V = sum m g z_G."""
     sp, q, qd, bodies, P = _bodies_symbolic(kind)
     qdd = sp.symbols(f"qdd1:{len(q) + 1}")
     T = V = 0
@@ -146,7 +161,7 @@ def lagrange_torque(kind):
             T += m * (rd.T * rd)[0] / 2
             V += m * dz.G * rG[2]
         W = R.T * sum((R.diff(a) * b for a, b in zip(q, qd)), sp.zeros(3, 3))
-        w = [sp.trigsimp(sp.expand(x)) for x in (W[2, 1], W[0, 2], W[1, 0])]
+        w = [_pythagoras(sp, x) for x in (W[2, 1], W[0, 2], W[1, 0])]
         T += (Jx * w[0] ** 2 + Jy * w[1] ** 2 + Jz * w[2] ** 2) / 2
     tau = []
     for i in range(len(q)):
