@@ -369,6 +369,52 @@ def test_general_five_bar_is_not_decoupled_but_is_statically_balanced():
     assert m["offdiag_ratio"] > 0.1 and m["diag_variation"] > 0.1
 
 
+def test_cpp_five_bar_equals_the_python_coupling_model():
+    """mechbal._core.FiveBarDynamics (fixed-size CoupledProjection, 4x4 A° per tick) == the
+    Python coupling (mechbal.sizing.discs.fivebar_model), to 1e-12, on balanced, unbalanced,
+    perturbed parallelogram and general (d > 0, b_i free) five-bars."""
+    rng = np.random.default_rng(21)
+    p = params("fivebar")
+    general = dict(p, d=0.12, b1=0.32, b2=0.34)
+    designs = {"balanced": dz.design("fivebar", p, True),
+               "unbalanced": dz.design("fivebar", p, False),
+               "perturbed": _perturbed("fivebar", rng),
+               "general": dz.design("fivebar", general, True),
+               "general_unbalanced": dz.design("fivebar", general, False)}
+    worst = 0.0
+    for label, d in designs.items():
+        if label.startswith("general"):
+            q = np.stack([rng.uniform(0.2, 1.2, 40), rng.uniform(1.8, 2.8, 40)], 1)
+            qd = rng.uniform(-2, 2, q.shape)
+        else:
+            q, qd = dz.sample_states("fivebar", 40, rng)
+        r = dz.fivebar_dynamics(d).evaluate(q, qd)
+        assert r["status"] == _core.Status.ok and np.all(r["ok"]), label
+        for k in range(len(q)):
+            ref = dz.fivebar_model(d, q[k], qd[k])
+            s = np.max(np.abs(ref.mass))
+            for ours, theirs in ((r["mass"][k], ref.mass), (r["velocity"][k], ref.velocity),
+                                 (r["gravity"][k], ref.gravity)):
+                err = np.max(np.abs(ours - theirs)) / max(s, np.max(np.abs(theirs)))
+                worst = max(worst, err)
+                assert err < 1e-12, (label, k, err)
+
+
+def test_cpp_five_bar_singular_pose_gives_a_status_and_no_nan():
+    d = dz.design("fivebar", params("fivebar"), True)
+    dyn = dz.fivebar_dynamics(d)
+    q = np.array([[0.4, 0.4], [0.4, 0.4 + np.pi], [0.4, 1.4]])
+    r = dyn.evaluate(q, np.ones_like(q))
+    assert list(r["ok"]) == [False, False, True]
+    assert r["status"] == _core.Status.singular
+    assert np.all(np.isfinite(r["mass"])) and np.all(np.isfinite(r["velocity"]))
+    assert np.all(r["reciprocal_condition"][:2] < 1e-6) and r["reciprocal_condition"][2] > 1e-3
+    with pytest.raises(ValueError, match="singular"):
+        dz.evaluate("fivebar", d, q, np.ones_like(q))
+    with pytest.raises(ValueError, match="five_bar.a1"):
+        dz.fivebar_dynamics(dict(d, a1=-0.3))
+
+
 @pytest.mark.parametrize("kind", ["planar3r", "spatial3r", "scara"])
 def test_decoupled_controller_equals_computed_torque_on_the_balanced_model(kind):
     p = params(kind)
@@ -403,7 +449,7 @@ def test_discs_case_runs_and_writes_the_summary(kind, tmp_path):
     cfg = load_case(CASES[kind])
     cfg["sampling"]["configurations"] = 40
     cfg["sensitivity"]["errors_pct"] = [5.0]
-    cfg["trajectory"]["samples"] = 31
+    cfg["trajectory"]["samples"] = 201
     s = _RUNNERS["discs"](cfg, tmp_path)
     saved = json.loads((tmp_path / "summary.json").read_text())
     assert (tmp_path / "joint_torques.png").stat().st_size > 1000
@@ -419,6 +465,38 @@ def test_discs_case_runs_and_writes_the_summary(kind, tmp_path):
     if kind == "spatial3r":
         assert abs(saved["inertia_conditions"]["Jy2"] - s["inertia_conditions"]["Jy2"]) == 0
         assert {c["id"] for c in saved["corrections"]} >= {"C2", "C3", "C6", "C8"}
+    if kind == "fivebar":
+        assert "FiveBarDynamics" in saved["decoupled_control"]["computed_torque_backend"]
+    # bodies files: every link and disc, and the shaking wrench recomputed from the poses alone
+    from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
+
+    sw = saved["shaking_wrench_on_trajectory"]
+    n_links = {"fivebar": 5}.get(kind, 3)
+    n_discs = {"planar3r": 4, "spatial3r": 2, "scara": 2}.get(kind, 0)
+    for variant, nb in (("unbalanced", n_links), ("balanced", n_links + n_discs)):
+        b = read_bodies(tmp_path / f"bodies_{variant}.npz")
+        assert b["mass"].shape == (nb,) and b["com"].shape == (201, nb, 3)
+        assert list(b["names"]) == sw[variant]["bodies"]
+        F, M = shaking_wrench_by_finite_differences(b)
+        sl = slice(3, -3)
+        Fs = max(np.max(np.abs(b["shaking_force"])), 1e-3 * np.max(np.abs(b["shaking_moment"])))
+        Ms = np.max(np.abs(b["shaking_moment"]))
+        assert np.max(np.abs(F[sl] - b["shaking_force"][sl])) < 2e-3 * Fs, variant
+        assert np.max(np.abs(M[sl] - b["shaking_moment"][sl])) < 2e-3 * Ms, variant
+        assert sw[variant]["peak_shaking_force_N"] == pytest.approx(
+            np.max(np.linalg.norm(b["shaking_force"], axis=1)), rel=1e-12)
+        assert sw[variant]["peak_shaking_moment_Nm"] == pytest.approx(
+            np.max(np.linalg.norm(b["shaking_moment"], axis=1)), rel=1e-12)
+    if n_discs:  # the discs are there, massless (lumped into their carriers), spinning
+        b = read_bodies(tmp_path / "bodies_balanced.npz")
+        assert [str(x) for x in b["names"][n_links:]] == [f"disc{i + 4}" for i in range(n_discs)]
+        assert np.all(b["mass"][n_links:] == 0.0)
+        assert np.all(np.einsum("bii->bi", b["inertia_body"][n_links:]) > 0.0)
+        R = b["rotation"][:, n_links:]
+        assert np.allclose(np.einsum("nbji,nbjk->nbik", R, R), np.eye(3), atol=1e-12)
+    if kind in ("planar3r", "fivebar"):
+        # static balancing fixes the total centre of mass: no shaking force after, some before
+        assert sw["balanced"]["peak_shaking_force_N"] < 1e-9 * sw["unbalanced"]["peak_shaking_force_N"]
 
 
 def test_bad_configurations_are_refused_naming_the_field():
