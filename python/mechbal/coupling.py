@@ -18,10 +18,12 @@ spatial arm and the 5R. Disc subsystems carry the Euler term ``v_d = omega x J o
 paper's eq 20 writes ``v = 0`` (correction C5 in docs/discs_derivation.md), which is harmless for
 planar discs and after balancing but gives wrong Coriolis terms otherwise (eq 24's printed 1/4).
 
-The per-tick C++ evaluator of serial arms with discs is ``mechbal._core.DiscArmDynamics`` (the
-same projection with A° = 1); this module also builds the models the C++ core does not (the 5R
-five-bar, whose A° is a 4x4 matrix) and the two-stage model of the paper (arm model first, then
-discs coupled to it) used to cross-check the C++ single-stage form.
+The per-tick C++ evaluators are ``mechbal._core.DiscArmDynamics`` (serial arms with discs, the
+same projection with A° = 1) and ``mechbal._core.FiveBarDynamics`` (the 5R five-bar, A° a 4x4
+matrix, over the general fixed-size ``mechbal::CoupledProjection``); this module is their
+independent Python reference (mechbal.sizing.discs.fivebar_model) and builds the two-stage model
+of the paper (arm model first, then discs coupled to it) used to cross-check the C++ single-stage
+form.
 """
 from __future__ import annotations
 

@@ -16,7 +16,8 @@
 /// closed forms per mechanism, serves the planar 3R, the spatial 3R and the SCARA alike, balanced
 /// or not, and any perturbed as-built parameter set (sensitivity), with no new derivation to get
 /// wrong; the closed forms stay in Python and in the tests as an independent check.
-/// (The 5R five-bar has a non-identity A° and lives in Python: mechbal.coupling.)
+/// (The 5R five-bar has a non-identity 4x4 A°, solved per tick: mechbal::FiveBarDynamics over the
+/// general mechbal::CoupledProjection, five_bar.hpp and coupled_model.hpp.)
 ///
 /// Disc convention: disc d is carried by link `carrier`, spins about `axis` (unit, carrier frame)
 /// through the carrier's frame origin, at relative angle ratio * q[joint] (gears/belts). Its mass

@@ -294,6 +294,18 @@ def fivebar_model(d: dict, q, qd) -> cp.CoupledModel:
     return cp.couple([s1, s2, sP], A, indep, -np.concatenate([b1, b2]), qd)
 
 
+def fivebar_dynamics(d: dict):
+    """The C++ per-tick evaluator (mechbal._core.FiveBarDynamics) of a five-bar design; in-plane
+    inertias are the x components of ``inertia_*`` (as in ``fivebar_model``)."""
+    from mechbal import _core
+
+    keys = ("a1", "a2", "b1", "b2", "d", "mp1", "mp2", "md1", "md2", "mP", "cp1", "cp2", "cd1", "cd2")
+    fp = _core.FiveBarParameters(**{k: float(d[k]) for k in keys},
+                                 **{f"J{k}": float(d[f"inertia_{k}"][0]) for k in ("p1", "p2", "d1", "d2")},
+                                 gravity=G)
+    return _core.FiveBarDynamics(fp)
+
+
 # ---------------------------------------------------------------------------------------------
 # Evaluation over samples, metrics, sensitivity
 # ---------------------------------------------------------------------------------------------
@@ -313,12 +325,17 @@ def sample_states(kind: str, n: int, rng: np.random.Generator):
 
 
 def evaluate(kind: str, d: dict, q: np.ndarray, qd: np.ndarray):
-    """(M (N, n, n), v (N, n), g (N, n)) of design d at N states: C++ DiscArmDynamics for the
-    serial arms, the Python coupling for the 5R."""
+    """(M (N, n, n), v (N, n), g (N, n)) of design d at N states, per tick in C++:
+    DiscArmDynamics for the serial arms, FiveBarDynamics for the 5R (``fivebar_model`` is the
+    Python reference of the latter). A singular five-bar state raises ValueError."""
+    q, qd = np.asarray(q, float), np.asarray(qd, float)
     if kind == "fivebar":
-        out = [fivebar_model(d, a, b) for a, b in zip(q, qd)]
-        return (np.array([o.mass for o in out]), np.array([o.velocity for o in out]),
-                np.array([o.gravity for o in out]))
+        r = fivebar_dynamics(d).evaluate(q, qd)
+        if not np.all(r["ok"]):
+            bad = np.flatnonzero(~r["ok"])
+            raise ValueError(f"five-bar singular or not assembled at {len(bad)} states, first "
+                             f"q = {q[bad[0]].tolist()}")
+        return r["mass"], r["velocity"], r["gravity"]
     r = disc_arm_dynamics(kind, d).evaluate(np.asarray(q, float), np.asarray(qd, float))
     return r["mass"], r["velocity"], r["gravity"]
 
