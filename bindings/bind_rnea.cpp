@@ -2,6 +2,7 @@
 #include <pybind11/numpy.h>
 
 #include "array_checks.hpp"
+#include "batch_inverse_dynamics.hpp"
 #include "bindings.hpp"
 #include "mechbal/rnea.hpp"
 
@@ -10,8 +11,6 @@ namespace py = pybind11;
 namespace mechbal::pyb {
 
 namespace {
-
-using CVec = Eigen::Map<const Eigen::VectorXd>;
 
 Eigen::VectorXd one_state(const RneChainDynamics& d, const Eigen::VectorXd& v, const char* name) {
   if (v.size() != d.dof()) {
@@ -31,33 +30,7 @@ void bind_rnea(py::module_& m) {
       .def(
           "inverse_dynamics",
           [](RneChainDynamics& d, const Array& q, const Array& qd, const Array& qdd) {
-            const auto n = static_cast<py::ssize_t>(d.dof());
-            require_shape(q, "q", {-1, n});
-            const auto N = q.shape(0);
-            require_shape(qd, "qd", {N, n});
-            require_shape(qdd, "qdd", {N, n});
-            Array tau = make_array({N, n}), F = make_array({N, 3}), M = make_array({N, 3});
-            Status status = Status::ok;
-            for (py::ssize_t k = 0; k < N; ++k) {
-              Eigen::Map<Eigen::VectorXd> t(tau.mutable_data(k, 0), n);
-              Vec3 f, mo;
-              const Status s = d.inverse_dynamics(CVec(q.data(k, 0), n), CVec(qd.data(k, 0), n),
-                                                  CVec(qdd.data(k, 0), n), t, &f, &mo);
-              if (s != Status::ok) {
-                t.setZero();
-                f.setZero();
-                mo.setZero();
-              }
-              status |= s;
-              Eigen::Map<Eigen::Vector3d>(F.mutable_data(k, 0)) = f;
-              Eigen::Map<Eigen::Vector3d>(M.mutable_data(k, 0)) = mo;
-            }
-            py::dict out;
-            out["tau"] = tau;
-            out["support_force"] = F;
-            out["support_moment"] = M;
-            out["status"] = status;
-            return out;
+            return batch_inverse_dynamics(d, q, qd, qdd);
           },
           py::arg("q"), py::arg("qd"), py::arg("qdd"),
           "Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, "

@@ -1,4 +1,5 @@
 #include "mechbal/computed_torque.hpp"
+#include "mechbal/detail/saturation.hpp"
 
 #include <cmath>
 #include <limits>
@@ -73,16 +74,7 @@ Status ComputedTorque::step(const Eigen::Ref<const Eigen::VectorXd>& q,
     tau = last_;
     return s != Status::ok ? s : Status::non_finite_input;
   }
-  Status status = Status::ok;
-  for (int i = 0; i < n_; ++i) {
-    if (raw_(i) > limit_(i)) {
-      raw_(i) = limit_(i);
-      status = Status::saturated;
-    } else if (raw_(i) < -limit_(i)) {
-      raw_(i) = -limit_(i);
-      status = Status::saturated;
-    }
-  }
+  const Status status = detail::clip_to_limits(raw_, limit_, n_);
   last_ = raw_;
   tau = last_;
   return status;

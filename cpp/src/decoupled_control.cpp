@@ -1,4 +1,5 @@
 #include "mechbal/decoupled_control.hpp"
+#include "mechbal/detail/saturation.hpp"
 
 #include <cmath>
 #include <limits>
@@ -75,16 +76,7 @@ Status DecoupledJointController::step(const Eigen::Ref<const Eigen::VectorXd>& q
     tau = last_;
     return Status::non_finite_input;
   }
-  Status status = Status::ok;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (raw_(i) > limit_(i)) {
-      raw_(i) = limit_(i);
-      status = Status::saturated;
-    } else if (raw_(i) < -limit_(i)) {
-      raw_(i) = -limit_(i);
-      status = Status::saturated;
-    }
-  }
+  const Status status = detail::clip_to_limits(raw_, limit_, n);
   last_ = raw_;
   tau = last_;
   return status;
