@@ -35,11 +35,6 @@ void require_mass(double v, const std::string& field) {
 
 inline double cross2(const Vec2& a, const Vec2& b) noexcept { return a(0) * b(1) - a(1) * b(0); }
 
-/// Value, first and second time derivative of a planar quantity.
-struct Scalar3 {
-  double v = 0.0, d = 0.0, dd = 0.0;
-};
-
 /// An angle by its cosine and sine (no atan2 in the tick: every use of an angle is through its
 /// cosine and sine, which the vector gives directly; issue 6), and its first and second derivative.
 struct Angle3 {
@@ -53,21 +48,12 @@ struct Point2 {
 /// betadd = (w x wdd)/|w|^2 - 2 betad (w . wd)/|w|^2.
 Angle3 angle_of(const Vec2& w, const Vec2& wd, const Vec2& wdd) noexcept {
   const double r2 = w.squaredNorm();
-  const double r = std::sqrt(r2);
+  const double ir = 1.0 / std::sqrt(r2), ir2 = ir * ir;  // one division
   Angle3 out;
-  out.c = w(0) / r;
-  out.s = w(1) / r;
-  out.d = cross2(w, wd) / r2;
-  out.dd = cross2(w, wdd) / r2 - 2.0 * out.d * w.dot(wd) / r2;
-  return out;
-}
-
-/// |w| and derivatives: rhod = w.wd/rho, rhodd = (|wd|^2 + w.wdd - rhod^2)/rho.
-Scalar3 norm_of(const Vec2& w, const Vec2& wd, const Vec2& wdd) noexcept {
-  Scalar3 out;
-  out.v = w.norm();
-  out.d = w.dot(wd) / out.v;
-  out.dd = (wd.squaredNorm() + w.dot(wdd) - out.d * out.d) / out.v;
+  out.c = w(0) * ir;
+  out.s = w(1) * ir;
+  out.d = cross2(w, wd) * ir2;
+  out.dd = (cross2(w, wdd) - 2.0 * out.d * w.dot(wd)) * ir2;
   return out;
 }
 
@@ -271,65 +257,137 @@ Status PaminsaModel::forward_kinematics(double alpha1, double alpha3, double z_B
 }
 
 // ------------------------------------------------------------------------------ kinematics
-Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMotion& pm,
-                                    PaminsaWorkspace& ws) noexcept {
+namespace {
+
+/// What determines every body of one leg: its turning plane, the in-plane points A, C, E with their
+/// rates, and the guide angle alpha of link 5.
+struct LegSolution {
+  Plane plane;
+  Point2 A, C, E;
+  Angle3 alpha;
+};
+
+/// The closed-form leg geometry shared by the kinematics and the momentum paths. With
+/// Accel = false the second derivatives are not computed (left zero): the RK4 stages need D only.
+/// Non-finite input: Status::non_finite_input; unreachable: Status::singular.
+template <bool Accel>
+Status solve_legs(const PaminsaModel& model, const PlatformMotion& pm,
+                  std::array<LegSolution, 3>& legs) noexcept {
   if (!finite(pm)) return Status::non_finite_input;
   const PaminsaParameters& p = model.parameters();
   const double k = p.k;
+  const double ikm1 = 1.0 / (k - 1.0);
   const Vec3& P = pm.position;
   const Vec3& Pd = pm.velocity;
   const Vec3& Pdd = pm.acceleration;
-
-  // leg-plane data first (so that an unreachable pose leaves the workspace untouched)
-  Plane plane[3];
-  Point2 A[3], C[3], E[3];
-  Angle3 alpha[3];
-  Vec2 AhArr[3];
+  const Vec2 Ahd = -Pd.head<2>() * ikm1;
+  const Vec2 Ahdd = Accel ? Vec2(-Pdd.head<2>() * ikm1) : Vec2::Zero();
+  const double lAE2 = p.length_AE * p.length_AE, lCE2 = p.length_CE * p.length_CE;
   for (int i = 0; i < 3; ++i) {
+    LegSolution& L = legs[static_cast<std::size_t>(i)];
     const Vec2& Bh = model.slider_line()[i];
     const Vec3 Cb = P + model.platform_joint_offset()[i];
-    const Vec2 Ah = (k * Bh - Cb.head<2>()) / (k - 1.0);
-    const Vec2 Ahd = -Pd.head<2>() / (k - 1.0);
-    const Vec2 Ahdd = -Pdd.head<2>() / (k - 1.0);
-    AhArr[i] = Ah;
+    const Vec2 Ah = (k * Bh - Cb.head<2>()) * ikm1;
     const Vec2 w = Ah - Bh;
-    if (!(w.norm() > 1e-9)) return Status::singular;
-    plane[i].beta = angle_of(w, Ahd, Ahdd);
-    const Scalar3 rho = norm_of(w, Ahd, Ahdd);
-    const double cb = plane[i].beta.c, sb = plane[i].beta.s;
-    plane[i].origin = Vec3(Bh(0), Bh(1), 0.0);
-    plane[i].u = Vec3(cb, sb, 0.0);
-    plane[i].n = Vec3(-sb, cb, 0.0);
+    const double r2 = w.squaredNorm();
+    // beta = angle of w, rho = |w| (angle_of / norm_of, sharing |w|)
+    const double rho = std::sqrt(r2);
+    if (!(rho > 1e-9)) return Status::singular;
+    const double wwd = w.dot(Ahd);
+    Angle3& beta = L.plane.beta;
+    const double irho = 1.0 / rho, ir2 = irho * irho;
+    beta.c = w(0) * irho;
+    beta.s = w(1) * irho;
+    beta.d = cross2(w, Ahd) * ir2;
+    const double rhod = wwd * irho;
+    double rhodd = 0.0;
+    if (Accel) {
+      beta.dd = (cross2(w, Ahdd) - 2.0 * beta.d * wwd) * ir2;
+      rhodd = (Ahd.squaredNorm() + w.dot(Ahdd) - rhod * rhod) * irho;
+    } else {
+      beta.dd = 0.0;
+    }
+    L.plane.origin = Vec3(Bh(0), Bh(1), 0.0);
+    L.plane.u = Vec3(beta.c, beta.s, 0.0);
+    L.plane.n = Vec3(-beta.s, beta.c, 0.0);
     // in-plane (s, z): A = (rho, z_A), C = (-(k-1) rho, z_C)
-    A[i].p = Vec2(rho.v, p.z_A);
-    A[i].v = Vec2(rho.d, 0.0);
-    A[i].a = Vec2(rho.dd, 0.0);
-    C[i].p = Vec2(-(k - 1.0) * rho.v, Cb(2));
-    C[i].v = Vec2(-(k - 1.0) * rho.d, Pd(2));
-    C[i].a = Vec2(-(k - 1.0) * rho.dd, Pdd(2));
+    L.A.p = Vec2(rho, p.z_A);
+    L.A.v = Vec2(rhod, 0.0);
+    L.A.a = Vec2(rhodd, 0.0);
+    L.C.p = Vec2(-(k - 1.0) * rho, Cb(2));
+    L.C.v = Vec2(-(k - 1.0) * rhod, Pd(2));
+    L.C.a = Accel ? Vec2(-(k - 1.0) * rhodd, Pdd(2)) : Vec2::Zero();
     // elbow E: |E - A| = l_AE, |E - C| = l_CE (circle intersection, A6)
-    const Vec2 dv = C[i].p - A[i].p;
-    const double L = dv.norm();
-    if (!(L > 1e-9)) return Status::singular;
-    const Vec2 dh = dv / L;
-    const double along = (p.length_AE * p.length_AE - p.length_CE * p.length_CE + L * L) / (2.0 * L);
-    const double h2 = p.length_AE * p.length_AE - along * along;
+    const Vec2 dv = L.C.p - L.A.p;
+    const double LL = dv.norm();
+    if (!(LL > 1e-9)) return Status::singular;
+    const double iLL = 1.0 / LL;
+    const Vec2 dh = dv * iLL;
+    const double along = (lAE2 - lCE2 + LL * LL) * (0.5 * iLL);
+    const double h2 = lAE2 - along * along;
     if (!(h2 > 1e-12)) return Status::singular;
-    E[i].p = A[i].p + along * dh + p.elbow * std::sqrt(h2) * Vec2(dh(1), -dh(0));
+    L.E.p = L.A.p + along * dh + p.elbow * std::sqrt(h2) * Vec2(dh(1), -dh(0));
     // rates from the constraint rows (E-A).(Ed-Ad) = 0, (E-C).(Ed-Cd) = 0 and their derivative
-    Eigen::Matrix2d Jc;
-    Jc.row(0) = (E[i].p - A[i].p).transpose();
-    Jc.row(1) = (E[i].p - C[i].p).transpose();
-    const double det = Jc.determinant();
+    const Vec2 ea = L.E.p - L.A.p, ec = L.E.p - L.C.p;
+    const double det = ea(0) * ec(1) - ea(1) * ec(0);
     if (!(std::abs(det) > 1e-12)) return Status::singular;
-    const Eigen::Matrix2d Jinv = Jc.inverse();
-    E[i].v = Jinv * Vec2(Jc.row(0).dot(A[i].v), Jc.row(1).dot(C[i].v));
-    const Vec2 rA = E[i].v - A[i].v, rC = E[i].v - C[i].v;
-    E[i].a = Jinv * Vec2(Jc.row(0).dot(A[i].a) - rA.squaredNorm(),
-                         Jc.row(1).dot(C[i].a) - rC.squaredNorm());
-    alpha[i] = angle_of(Ah - model.guide_pivot()[i], Ahd, Ahdd);
+    // inverse of [ea^T; ec^T] = [ec(1) -ea(1); -ec(0) ea(0)] / det
+    const double idet = 1.0 / det;
+    const auto solve2 = [&](double r0, double r1) noexcept {
+      return Vec2((ec(1) * r0 - ea(1) * r1) * idet, (-ec(0) * r0 + ea(0) * r1) * idet);
+    };
+    L.E.v = solve2(ea.dot(L.A.v), ec.dot(L.C.v));
+    if (Accel) {
+      const Vec2 rA = L.E.v - L.A.v, rC = L.E.v - L.C.v;
+      L.E.a = solve2(ea.dot(L.A.a) - rA.squaredNorm(), ec.dot(L.C.a) - rC.squaredNorm());
+      L.alpha = angle_of(Ah - model.guide_pivot()[i], Ahd, Ahdd);
+    } else {
+      L.E.a.setZero();
+      // angle_of without the second derivative
+      const Vec2 g = Ah - model.guide_pivot()[i];
+      const double ign = 1.0 / std::sqrt(g.squaredNorm());
+      L.alpha.c = g(0) * ign;
+      L.alpha.s = g(1) * ign;
+      L.alpha.d = cross2(g, Ahd) * ign * ign;
+      L.alpha.dd = 0.0;
+    }
   }
+  return Status::ok;
+}
 
+/// In-plane points of a leg that carry mass: D = E + (C-E)/k, F = A + (C-E)/k,
+/// B = ((k-1) A + C)/k.
+struct LegPoints {
+  Point2 D, F, B;
+};
+inline LegPoints leg_points(const LegSolution& L, double k) noexcept {
+  const double ik = 1.0 / k;
+  return {affine(L.E, 1.0 - ik, L.C, ik, L.A, 0.0), affine(L.A, 1.0, L.C, ik, L.E, -ik),
+          affine(L.A, 1.0 - ik, L.C, ik, L.E, 0.0)};
+}
+
+void fill_states(const PaminsaModel& model, const PlatformMotion& pm,
+                 const std::array<LegSolution, 3>& legs, PaminsaWorkspace& ws) noexcept;
+
+}  // namespace
+
+Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMotion& pm,
+                                    PaminsaWorkspace& ws) noexcept {
+  std::array<LegSolution, 3> legs;
+  const Status s = solve_legs<true>(model, pm, legs);
+  if (s != Status::ok) return s;  // the workspace is untouched
+  fill_states(model, pm, legs, ws);
+  return Status::ok;
+}
+
+namespace {
+
+void fill_states(const PaminsaModel& model, const PlatformMotion& pm,
+                 const std::array<LegSolution, 3>& legs, PaminsaWorkspace& ws) noexcept {
+  const PaminsaParameters& p = model.parameters();
+  const Vec3& P = pm.position;
+  const Vec3& Pd = pm.velocity;
+  const Vec3& Pdd = pm.acceleration;
   // platform (translates only: yaw locked by the parallel legs, tilt by the pantographs)
   BodyState& pl = ws.states[Idx::platform];
   pl.com = P;
@@ -339,20 +397,18 @@ Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMot
   pl.angular_velocity.setZero();
   pl.angular_acceleration.setZero();
 
-  const double ik = 1.0 / k;
   for (int i = 0; i < 3; ++i) {
-    // D = E + (C-E)/k, F = A + (C-E)/k, B = ((k-1) A + C)/k
-    const Point2 Dp = affine(E[i], 1.0 - ik, C[i], ik, A[i], 0.0);
-    const Point2 Fp = affine(A[i], 1.0, C[i], ik, E[i], -ik);
-    const Point2 Bp = affine(A[i], 1.0 - ik, C[i], ik, E[i], 0.0);
-    const Plane& pn = plane[i];
-    pantograph_link(pn, E[i], C[i], ws.states[Idx::leg(i, 0)]);  // link 1, E-C
+    const LegSolution& L = legs[static_cast<std::size_t>(i)];
+    const LegPoints lp = leg_points(L, p.k);
+    const Point2 &Dp = lp.D, &Fp = lp.F, &Bp = lp.B;
+    const Plane& pn = L.plane;
+    pantograph_link(pn, L.E, L.C, ws.states[Idx::leg(i, 0)]);  // link 1, E-C
     pantograph_link(pn, Dp, Fp, ws.states[Idx::leg(i, 1)]);      // link 2, D-F
-    pantograph_link(pn, A[i], E[i], ws.states[Idx::leg(i, 2)]);  // link 3, A-E
-    pantograph_link(pn, A[i], Fp, ws.states[Idx::leg(i, 3)]);    // link 4, A-F
+    pantograph_link(pn, L.A, L.E, ws.states[Idx::leg(i, 2)]);  // link 3, A-E
+    pantograph_link(pn, L.A, Fp, ws.states[Idx::leg(i, 3)]);    // link 4, A-F
 
     // link 5: turns about the vertical through M_i; COM S5 at l_MS5 along M_i -> A_i
-    const Angle3& al = alpha[i];
+    const Angle3& al = L.alpha;
     const Vec3 g(al.c, al.s, 0.0), gp(-al.s, al.c, 0.0);
     const Vec3 M3(model.guide_pivot()[i](0), model.guide_pivot()[i](1), p.z_A);
     const auto on_guide = [&](double l, BodyState& st) noexcept {
@@ -378,7 +434,7 @@ Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMot
 
     point_body(pn, Bp, ws.states[Idx::leg(i, 6)]);  // link 7: slider at B (A4)
     point_body(pn, Fp, ws.states[Idx::leg(i, 7)]);  // link 8: point mass at F (A5)
-    point_body(pn, A[i], ws.states[Idx::cp1(i)]);   // CP1 at A_i
+    point_body(pn, L.A, ws.states[Idx::cp1(i)]);   // CP1 at A_i
     point_body(pn, Fp, ws.states[Idx::cp2(i)]);     // CP2 at F_i
     BodyState& l = ws.states[Idx::cp3(i)];          // CP3 at L_i: M_iL_i = r M_iS_5i
     on_guide(p.cp3_ratio * p.length_MS5, l);
@@ -387,7 +443,7 @@ Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMot
     l.angular_acceleration.setZero();
 
     // base-frame points A..F
-    const Point2* pts[6] = {&A[i], &Bp, &C[i], &Dp, &E[i], &Fp};
+    const Point2* pts[6] = {&L.A, &Bp, &L.C, &Dp, &L.E, &Fp};
     for (int n = 0; n < 6; ++n)  // positions only (to_base's rates are not needed here)
       ws.leg_points[i][n] = pn.origin + pts[n]->p(0) * pn.u + pts[n]->p(1) * Vec3::UnitZ();
   }
@@ -401,8 +457,9 @@ Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMot
   vm.rotation.setIdentity();
   vm.angular_velocity.setZero();
   vm.angular_acceleration.setZero();
-  return Status::ok;
 }
+
+}  // namespace
 
 Status paminsa_wrist_kinematics(const PaminsaModel&, const PlatformMotion& pm,
                                 const WristMotion& wm, PaminsaWorkspace& ws) noexcept {
@@ -432,6 +489,203 @@ Status paminsa_kinematics(const PaminsaModel& model, const PlatformMotion& pm,
   return paminsa_wrist_kinematics(model, pm, wm, ws);
 }
 
+namespace {
+
+/// Momenta of the 35 mechanism bodies straight from the leg solution, without forming any body's
+/// state (issue 6). Each leg's in-plane bodies move in the vertical plane X = O + s u + z e_z that
+/// turns about e_z at beta_dot (u = (cos b, sin b, 0), n = e_z x u, du/dt = bd n, dn/dt = -bd u):
+///   V = sd u + s bd n + zd e_z,  A = (sdd - s bd^2) u + (2 sd bd + s bdd) n + zdd e_z,
+///   (X - O) x V = s^2 bd e_z + (z sd - s zd) n - s z bd u,
+///   (X - O) x A = s a_n e_z + (z a_u - s zdd) n - z a_n u   (a_u, a_n: A's u and n parts),
+/// so a leg's point masses reduce to m-weighted sums of s, sd, zd, s^2, z sd - s zd, s z (and
+/// their rates), and its moment about O is O x (sum m A) + those sums. A pantograph link (body
+/// axes ex = cos g u + sin g e_z, n, ex x n = cos g e_z - sin g u; principal inertias Jx, Jy, Jz;
+/// w = bd e_z - gd n) has
+///   I w = bd sin g cos g (Jx - Jz) u - Jy gd n + bd (Jx sin^2 g + Jz cos^2 g) e_z = a_u u + a_n n + a_e e_z
+///   d(I w)/dt = (a_u' - a_n bd) u + (a_n' + a_u bd) n + a_e' e_z,
+/// the column (link 6, body X = e_z, w = bd e_z) has I w = Jx bd e_z, and the guide (link 5) and
+/// CP3 turn about the vertical through M_i: sum m (M + l g) x (l ad g_perp) = (sum m l) ad M x g_perp
+/// + (sum m l^2) ad e_z, plus Jz ad e_z. Exact (same quantities as shaking_wrench over the bodies'
+/// states; tests/cpp/test_paminsa.cpp checks it to 1e-12 on random models and motions).
+/// The inertias are the model's principal ones (link_inertia, diagonal by construction).
+struct PlaneSums {
+  double m = 0, s = 0, sd = 0, zd = 0, ss = 0, w = 0, sz = 0;   // momentum
+  double sdd = 0, zdd = 0, ssd = 0, x2 = 0, zsd = 0;             // rates
+  template <bool Accel>
+  void add(double mass, const Point2& pt) noexcept {
+    const double s_ = pt.p(0), z_ = pt.p(1), sd_ = pt.v(0), zd_ = pt.v(1);
+    const double ms = mass * s_;
+    s += ms;
+    sd += mass * sd_;
+    zd += mass * zd_;
+    ss += ms * s_;
+    w += mass * (z_ * sd_ - s_ * zd_);
+    sz += ms * z_;
+    if (Accel) {
+      sdd += mass * pt.a(0);
+      zdd += mass * pt.a(1);
+      ssd += ms * sd_;
+      x2 += mass * (z_ * pt.a(0) - s_ * pt.a(1));
+      zsd += mass * z_ * sd_;
+    }
+  }
+};
+
+inline Vec3 in_base(const Plane& pl, double cu, double cn, double cz) noexcept {
+  return Vec3(cu * pl.u(0) + cn * pl.n(0), cu * pl.u(1) + cn * pl.n(1), cz);
+}
+
+inline Point2 midpoint(const Point2& a, const Point2& b) noexcept {
+  Point2 o;
+  o.p = 0.5 * (a.p + b.p);
+  o.v = 0.5 * (a.v + b.v);
+  o.a = 0.5 * (a.a + b.a);
+  return o;
+}
+
+template <bool Accel>
+void mechanism_wrench_from_legs(const PaminsaModel& model, const PlatformMotion& pm,
+                                const std::array<LegSolution, 3>& legs,
+                                ShakingWrench& out) noexcept {
+  const PaminsaParameters& p = model.parameters();
+  const auto& bodies = model.bodies();
+  Vec3 lin = Vec3::Zero(), ang = Vec3::Zero(), force = Vec3::Zero(), moment = Vec3::Zero();
+  // platform and vertical counter-mass (point masses)
+  {
+    const double mp = bodies[Idx::platform].mass;
+    lin += mp * pm.velocity;
+    ang += mp * pm.position.cross(pm.velocity);
+    const double mv = bodies[Idx::vertical_mass].mass;
+    const Vec3 vc(model.vertical_mass_xy()(0), model.vertical_mass_xy()(1),
+                  p.vertical_mass_z0 - (pm.position(2) - p.nominal_platform(2)));
+    const double vz = -pm.velocity(2);
+    lin(2) += mv * vz;
+    ang += mv * Vec3(vc(1) * vz, -vc(0) * vz, 0.0);  // vc x (0, 0, vz)
+    if (Accel) {
+      force += mp * pm.acceleration;
+      moment += mp * pm.position.cross(pm.acceleration);
+      const double az = -pm.acceleration(2);
+      force(2) += mv * az;
+      moment += mv * Vec3(vc(1) * az, -vc(0) * az, 0.0);
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    const LegSolution& L = legs[static_cast<std::size_t>(i)];
+    const Plane& pl = L.plane;
+    const double bd = pl.beta.d, bdd = pl.beta.dd;
+    const LegPoints lp = leg_points(L, p.k);
+    const auto mass = [&](std::size_t j) noexcept { return bodies[Idx::leg(i, j)].mass; };
+    const auto J = [&](std::size_t j, int a) noexcept {
+      return bodies[Idx::leg(i, j)].inertia_body(a, a);
+    };
+
+    // in-plane point masses: links 1-4 at their midpoints, link 6 at B + l_BG/2 e_z, link 7 at B,
+    // link 8 and CP2 at F, CP1 at A
+    const Point2 mid[4] = {midpoint(L.E, L.C), midpoint(lp.D, lp.F), midpoint(L.A, L.E),
+                           midpoint(L.A, lp.F)};
+    PlaneSums S;
+    for (std::size_t j = 0; j < 4; ++j) S.add<Accel>(mass(j), mid[j]);
+    Point2 col = lp.B;
+    col.p(1) += 0.5 * p.length_BG;
+    S.add<Accel>(mass(5), col);
+    S.add<Accel>(mass(6), lp.B);
+    S.add<Accel>(mass(7) + bodies[Idx::cp2(i)].mass, lp.F);
+    S.add<Accel>(bodies[Idx::cp1(i)].mass, L.A);
+
+    // rotation of the pantograph links (u, n, e_z components) and of the column (e_z)
+    double hu = 0, hn = 0, hz = 0, mu = 0, mn = 0, mz = 0;
+    const Point2* ends[4][2] = {{&L.E, &L.C}, {&lp.D, &lp.F}, {&L.A, &L.E}, {&L.A, &lp.F}};
+    for (std::size_t j = 0; j < 4; ++j) {
+      const double Jx = J(j, 0), Jy = J(j, 1), Jz = J(j, 2);
+      const Vec2 dp = ends[j][1]->p - ends[j][0]->p, dv = ends[j][1]->v - ends[j][0]->v;
+      // cos g, sin g enter only as cos^2, sin^2, sin cos: no square root, one division
+      const double ir2 = 1.0 / dp.squaredNorm();
+      const double c2 = dp(0) * dp(0) * ir2, s2 = dp(1) * dp(1) * ir2, sc = dp(0) * dp(1) * ir2;
+      const double gd = cross2(dp, dv) * ir2;
+      const double jxz = Jx - Jz, jsc = Jx * s2 + Jz * c2;
+      const double au = bd * sc * jxz, an = -Jy * gd, ae = bd * jsc;
+      hu += au;
+      hn += an;
+      hz += ae;
+      if (Accel) {
+        const Vec2 da = ends[j][1]->a - ends[j][0]->a;
+        const double gdd = (cross2(dp, da) - 2.0 * gd * dp.dot(dv)) * ir2;
+        const double aud = jxz * (bdd * sc + bd * gd * (c2 - s2));
+        const double and_ = -Jy * gdd;
+        const double aed = bdd * jsc + 2.0 * bd * gd * sc * jxz;
+        mu += aud - an * bd;
+        mn += and_ + au * bd;
+        mz += aed;
+      }
+    }
+    hz += J(5, 0) * bd;  // column: body X = e_z
+    if (Accel) mz += J(5, 0) * bdd;
+
+    // leg totals: sum m V, sum m A, and the moments about the plane origin, then about O
+    const Vec3 Pleg = in_base(pl, S.sd, S.s * bd, S.zd);
+    const Vec3 Hrel = in_base(pl, -S.sz * bd + hu, S.w + hn, S.ss * bd + hz);
+    lin += Pleg;
+    ang += pl.origin.cross(Pleg) + Hrel;
+    if (Accel) {
+      const Vec3 Fleg = in_base(pl, S.sdd - bd * bd * S.s, 2.0 * bd * S.sd + bdd * S.s, S.zdd);
+      const Vec3 Mrel = in_base(pl, -(2.0 * bd * S.zsd + bdd * S.sz) + mu,
+                                S.x2 - bd * bd * S.sz + mn, 2.0 * bd * S.ssd + bdd * S.ss + mz);
+      force += Fleg;
+      moment += pl.origin.cross(Fleg) + Mrel;
+    }
+
+    // guide (link 5) and CP3 on it, turning about the vertical through M_i
+    const Angle3& al = L.alpha;
+    const double m5 = mass(4), m3 = bodies[Idx::cp3(i)].mass;
+    const double l5 = p.length_MS5, l3 = p.cp3_ratio * p.length_MS5;
+    const double first = m5 * l5 + m3 * l3, second = m5 * l5 * l5 + m3 * l3 * l3 + J(4, 2);
+    const Vec3 M3(model.guide_pivot()[i](0), model.guide_pivot()[i](1), p.z_A);
+    const Vec3 g(al.c, al.s, 0.0), gp(-al.s, al.c, 0.0);
+    const Vec3 Pg = first * al.d * gp;
+    lin += Pg;
+    ang += M3.cross(Pg);
+    ang(2) += second * al.d;
+    if (Accel) {
+      const Vec3 Fg = first * (al.dd * gp - al.d * al.d * g);
+      force += Fg;
+      moment += M3.cross(Fg);
+      moment(2) += second * al.dd;
+    }
+  }
+  out.linear_momentum = lin;
+  out.angular_momentum = ang;
+  out.force = force;
+  out.moment = moment;
+}
+
+}  // namespace
+
+Status paminsa_mechanism_wrench(const PaminsaModel& model, const PlatformMotion& platform,
+                                ShakingWrench& out) noexcept {
+  std::array<LegSolution, 3> legs;
+  const Status s = solve_legs<true>(model, platform, legs);
+  if (s != Status::ok) return s;
+  ShakingWrench w;
+  mechanism_wrench_from_legs<true>(model, platform, legs, w);
+  if (!w.linear_momentum.allFinite() || !w.angular_momentum.allFinite() || !w.force.allFinite() ||
+      !w.moment.allFinite())
+    return Status::non_finite_input;
+  out = w;
+  return Status::ok;
+}
+
+Status paminsa_mechanism_angular_momentum(const PaminsaModel& model, const PlatformMotion& platform,
+                                          Vec3& D) noexcept {
+  std::array<LegSolution, 3> legs;
+  const Status s = solve_legs<false>(model, platform, legs);
+  if (s != Status::ok) return s;
+  ShakingWrench w;
+  mechanism_wrench_from_legs<false>(model, platform, legs, w);
+  if (!w.angular_momentum.allFinite()) return Status::non_finite_input;
+  D = w.angular_momentum;
+  return Status::ok;
+}
+
 Status paminsa_mechanism_momentum(const PaminsaModel& model, const PaminsaWorkspace& ws, Vec3& D,
                                   Vec3& D_dot) noexcept {
   ShakingWrench sw;
@@ -444,28 +698,6 @@ Status paminsa_mechanism_momentum(const PaminsaModel& model, const PaminsaWorksp
 }
 
 // ------------------------------------------------------------------------------ controller
-namespace {
-
-/// D only (eq 19), without dD/dt: what the RK4 stages need at t + dt/2 and t + dt. Same sum as
-/// shaking_wrench's angular momentum, H = sum (m OG x v_G + R J R^T w), with R (J (R^T w))
-/// (three matrix-vector products instead of forming R J R^T).
-Status mechanism_angular_momentum(const PaminsaModel& model, const PaminsaWorkspace& ws,
-                                  Vec3& D) noexcept {
-  Vec3 H = Vec3::Zero();
-  for (std::size_t j = 0; j < Idx::mechanism_count; ++j) {
-    const RigidBody& b = model.bodies()[j];
-    const BodyState& st = ws.states[j];
-    H.noalias() += b.mass * st.com.cross(st.com_velocity);
-    if (b.inertia_body.isZero(0.0)) continue;  // point mass
-    H.noalias() += st.rotation * (b.inertia_body * (st.rotation.transpose() * st.angular_velocity));
-  }
-  if (!H.allFinite()) return Status::non_finite_input;
-  D = H;
-  return Status::ok;
-}
-
-}  // namespace
-
 PaminsaController::PaminsaController(const PaminsaModel& model,
                                      const ReactionlessWristConfig& config,
                                      const Vec3& initial_wrist_angles)
@@ -485,23 +717,28 @@ Status PaminsaController::tick(const PlatformMotion& now, const PlatformMotion& 
   const bool rk4 = wrist_.config().integrator == WristIntegrator::rk4;
   Vec3 D_half = Vec3::Zero(), D_next = Vec3::Zero();
   Status s = Status::ok;
-  if (rk4) {
-    s = paminsa_mechanism_kinematics(model_, half, ws_);
-    if (s == Status::ok) s = mechanism_angular_momentum(model_, ws_, D_half);
-    if (s == Status::ok) s = paminsa_mechanism_kinematics(model_, next, ws_);
-    if (s == Status::ok) s = mechanism_angular_momentum(model_, ws_, D_next);
+  if (rk4) {  // D only at the RK4 stages: leg geometry and rates, no body state, no accelerations
+    s = paminsa_mechanism_angular_momentum(model_, half, D_half);
+    if (s == Status::ok) s = paminsa_mechanism_angular_momentum(model_, next, D_next);
   }
-  // the 35 mechanism bodies' momenta and wrench once: D, dD/dt, and the wrench's first 35 terms
+  // now: the leg geometry once, for the workspace's 35 body states and for the mechanism's
+  // momenta and wrench in closed form (D, dD/dt, and the wrench's first 35 terms)
+  std::array<LegSolution, 3> legs;
   ShakingWrench mechanism;
-  if (s == Status::ok) s = paminsa_mechanism_kinematics(model_, now, ws_);
-  if (s == Status::ok)
-    s = shaking_wrench(model_.bodies().data(), ws_.states.data(), Idx::mechanism_count, mechanism);
+  if (s == Status::ok) s = solve_legs<true>(model_, now, legs);
+  if (s == Status::ok) {
+    mechanism_wrench_from_legs<true>(model_, now, legs, mechanism);
+    if (!mechanism.linear_momentum.allFinite() || !mechanism.angular_momentum.allFinite() ||
+        !mechanism.force.allFinite() || !mechanism.moment.allFinite())
+      s = Status::non_finite_input;
+  }
   if (s != Status::ok) {
     // hold: the wrist sees a non-finite input and keeps its angles
     const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
     wrist_.step(nan, nan, nan, nan);
     return s | Status::non_finite_input;
   }
+  fill_states(model_, now, legs, ws_);
   D_ = mechanism.angular_momentum;  // eq 19
   D_dot_ = mechanism.moment;
   const Status ws = wrist_.step(D_, D_dot_, D_half, D_next);

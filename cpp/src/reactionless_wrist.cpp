@@ -28,40 +28,77 @@ Mat3 rot_z(double a) noexcept {
   return R;
 }
 
-/// The wrist at one set of angles: base-frame link inertias I_k = R_k J_k R_k^T and the axes
-/// x1 = R1 e_x, z2 = R2 e_z; N and the bias term are both built from them (once per tick).
-struct WristAt {
-  WristAt(const WristInertias& J, const Vec3& q) noexcept {
-    const Mat3 R1 = rot_z(q(0));
-    const Mat3 R2 = R1 * rot_x(q(1));
-    const Mat3 R3 = R2 * rot_z(q(2));
-    I[0] = R1 * J[0] * R1.transpose();
-    I[1] = R2 * J[1] * R2.transpose();
-    I[2] = R3 * J[2] * R3.transpose();
-    x1 = R1.col(0);
-    z2 = R2.col(2);
+/// The wrist at one set of angles, in the frame of link 2 (issue 6: nothing is formed in the base
+/// frame). With R2 = Rz(phi) Rx(theta): x1 = R2 e_x, z2 = R2 e_z, R2^T e_z = (0, sin th, cos th),
+/// and the link inertias in frame 2 are I1 = Rx^T J1 Rx, I2 = J2, I3 = Rz(psi) J3 Rz(psi)^T, so
+///     N = R2 N2,  N2 = [I1 ez + (J2 + I3) ez | (J2 + I3) e_x | I3 e_z]   (ez = R2^T e_z)
+/// with I1 ez = Rx^T (J1 e_z). N x = b <=> N2 x = R2^T b, and cond(N) = cond(N2). J may be any
+/// 3x3 matrix (the formulas do not assume symmetry or diagonal inertias).
+struct WristFrame2 {
+  WristFrame2(const WristInertias& J, const Vec3& q) noexcept {
+    cphi = std::cos(q(0)); sphi = std::sin(q(0));
+    cth = std::cos(q(1)); sth = std::sin(q(1));
+    const double cps = std::cos(q(2)), sps = std::sin(q(2));
+    // I3 = Rz(psi) J3 Rz(psi)^T, written out (Rz mixes the first two rows / columns only)
+    const Mat3& J3 = J[2];
+    Mat3 T;  // Rz J3
+    T.row(0) = cps * J3.row(0) - sps * J3.row(1);
+    T.row(1) = sps * J3.row(0) + cps * J3.row(1);
+    T.row(2) = J3.row(2);
+    I3.col(0) = cps * T.col(0) - sps * T.col(1);
+    I3.col(1) = sps * T.col(0) + cps * T.col(1);
+    I3.col(2) = T.col(2);
+    // I1 ez = Rx^T (J1 e_z)
+    const Vec3 j1 = J[0].col(2);
+    I1ez = Vec3(j1(0), cth * j1(1) + sth * j1(2), -sth * j1(1) + cth * j1(2));
+    J2 = &J[1];
+    const Mat3 S = *J2 + I3;  // (I2 + I3) in frame 2
+    N2.col(0) = I1ez + sth * S.col(1) + cth * S.col(2);
+    N2.col(1) = S.col(0);
+    N2.col(2) = I3.col(2);
   }
-  /// eq 23 (corrected): N = [(I1+I2+I3) e_z | (I2+I3) x1 | I3 z2]
+  /// R2^T b = Rx(th)^T Rz(phi)^T b
+  Vec3 to_frame2(const Vec3& b) const noexcept {
+    const double x = cphi * b(0) + sphi * b(1), y = -sphi * b(0) + cphi * b(1);
+    return Vec3(x, cth * y + sth * b(2), -sth * y + cth * b(2));
+  }
+  /// R2 v
+  Vec3 to_base(const Vec3& v) const noexcept {
+    const double y = cth * v(1) - sth * v(2), z = sth * v(1) + cth * v(2);
+    return Vec3(cphi * v(0) - sphi * y, sphi * v(0) + cphi * y, z);
+  }
+  /// N of eq 23 (corrected), base frame
   Mat3 momentum_matrix() const noexcept {
     Mat3 N;
-    N.col(0) = (I[0] + I[1] + I[2]).col(2);
-    N.col(1) = (I[1] + I[2]) * x1;
-    N.col(2) = I[2] * z2;
+    for (int j = 0; j < 3; ++j) N.col(j) = to_base(N2.col(j));
     return N;
   }
-  /// sum_k [I_k wdot_k|_{qddot=0} + w_k x I_k w_k]
-  Vec3 bias(const Vec3& qd) const noexcept {
-    const Vec3 w1 = qd(0) * Vec3::UnitZ();
-    const Vec3 w2 = w1 + qd(1) * x1;
-    const Vec3 w3 = w2 + qd(2) * z2;
-    const Vec3 a2 = qd(1) * w1.cross(x1);
-    const Vec3 a3 = a2 + qd(2) * w2.cross(z2);
-    const Vec3 Iw1 = I[0] * w1, Iw2 = I[1] * w2, Iw3 = I[2] * w3;
-    return w1.cross(Iw1) + I[1] * a2 + w2.cross(Iw2) + I[2] * a3 + w3.cross(Iw3);
+  /// R2^T sum_k [I_k wdot_k|_{qddot=0} + w_k x I_k w_k], all in frame 2 (x1 = e_x, z2 = e_z)
+  Vec3 bias_frame2(const Vec3& qd) const noexcept {
+    const Vec3 ez(0.0, sth, cth);
+    const Vec3 w1 = qd(0) * ez;
+    const Vec3 w2 = w1 + qd(1) * Vec3::UnitX();
+    const Vec3 w3 = w2 + qd(2) * Vec3::UnitZ();
+    const Vec3 a2 = qd(1) * w1.cross(Vec3::UnitX());
+    const Vec3 a3 = a2 + qd(2) * w2.cross(Vec3::UnitZ());
+    const Vec3 Iw1 = qd(0) * I1ez, Iw2 = *J2 * w2, Iw3 = I3 * w3;
+    return w1.cross(Iw1) + *J2 * a2 + w2.cross(Iw2) + I3 * a3 + w3.cross(Iw3);
   }
-  std::array<Mat3, 3> I;
-  Vec3 x1, z2;
+  double cphi, sphi, cth, sth;
+  Mat3 I3, N2;
+  Vec3 I1ez;
+  const Mat3* J2;
 };
+
+/// Cofactor inverse of a 3x3 matrix and its determinant.
+inline Mat3 cofactor_inverse(const Mat3& A, double& det) noexcept {
+  Mat3 C;
+  C.col(0) = A.col(1).cross(A.col(2));
+  C.col(1) = A.col(2).cross(A.col(0));
+  C.col(2) = A.col(0).cross(A.col(1));
+  det = A.col(0).dot(C.col(0));
+  return C.transpose() / det;
+}
 
 [[noreturn]] void fail(const char* field, const std::string& what, double value) {
   std::ostringstream msg;
@@ -90,7 +127,7 @@ void wrist_link_motion(const Vec3& q, const Vec3& qd, const Vec3& qdd,
 }
 
 Mat3 wrist_momentum_matrix(const WristInertias& J, const Vec3& q) noexcept {
-  return WristAt(J, q).momentum_matrix();
+  return WristFrame2(J, q).momentum_matrix();
 }
 
 Vec3 wrist_momentum_bias(const WristInertias& J, const Vec3& q, const Vec3& qd) noexcept {
@@ -196,13 +233,42 @@ Status ReactionlessWrist::rates(const Vec3& q, const Vec3& D, Vec3& qd,
 
 Status ReactionlessWrist::rates_with(const Mat3& N, const Vec3& D, Vec3& qd, double& condition,
                                      Mat3* inverse) const noexcept {
-  Status st = solve(N, target_ - D, qd, condition, inverse);
+  const Status st = solve(N, target_ - D, qd, condition, inverse);
+  return st | limit_rate(qd);
+}
+
+Status ReactionlessWrist::limit_rate(Vec3& qd) const noexcept {
   const double peak = qd.cwiseAbs().maxCoeff();
   if (peak > config_.max_rate) {
     qd *= config_.max_rate / peak;  // keep the direction of the commanded rate vector
-    st |= Status::saturated;
+    return Status::saturated;
   }
-  return st;
+  return Status::ok;
+}
+
+Status ReactionlessWrist::stage_rates(const Vec3& q, const Vec3& D, Vec3& qd) const noexcept {
+  // An RK4 stage needs the rates only, not cond(N) (issue 6: the closed-form eigenvalues cost as
+  // much as the rest of the stage). The decision "well conditioned" must stay the one solve()
+  // makes (cond(N) <= max_condition, else damped least squares + Status::singular), so it is
+  // taken on an upper bound: cond_2(N) <= |N|_F |N^-1|_F. When the bound is within the limit,
+  // so is cond(N), and the fast solve is exactly solve()'s fast path (cofactor inverse); the
+  // bound exceeds cond(N) by at least 1 + 1/cond and at most a factor 3, far above the eigenvalue
+  // route's cond^2 eps rounding, so the decision is the same. Otherwise solve() decides.
+  const WristFrame2 at(inertia_, q);
+  const Vec3 rhs = at.to_frame2(target_ - D);
+  double det = 0.0;
+  const Mat3 inv = cofactor_inverse(at.N2, det);
+  const double bound2 = at.N2.squaredNorm() * inv.squaredNorm();
+  const double max_c = config_.max_condition;
+  Status st = Status::ok;
+  double unused = 1.0;
+  if (det != 0.0 && bound2 <= max_c * max_c && inv.allFinite()) {
+    qd = inv * rhs;
+    if (!qd.allFinite()) st = solve(at.N2, rhs, qd, unused);
+  } else {
+    st = solve(at.N2, rhs, qd, unused);
+  }
+  return st | limit_rate(qd);
 }
 
 Status ReactionlessWrist::step(const Vec3& D_now, const Vec3& D_dot, const Vec3& D_half,
@@ -231,25 +297,26 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
 
   Vec3 k1;
   double cond = 1.0, unused = 1.0;
-  // N(q_n) and the link inertias are built once for k1 and the feed-forward; when N is well
-  // conditioned its inverse is reused for both (issue 6: the tick recomputed them)
-  const WristAt at(inertia_, angles_);
-  const Mat3 N = at.momentum_matrix();
-  Mat3 N_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by the fast path
-  Status st = rates_with(N, D_now, k1, cond, &N_inv);
-  // feed-forward acceleration: N qdd = -Ddot - bias(q, qdot)
+  // N(q_n) is built once (in link 2's frame) for k1 and the feed-forward; cond(N(q_n)), the
+  // reported one, comes from solve()'s closed-form eigenvalues; when N is well conditioned its
+  // inverse is reused for both (issue 6)
+  const WristFrame2 at(inertia_, angles_);
+  Mat3 N2_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by the fast path
+  Status st = solve(at.N2, at.to_frame2(target_ - D_now), k1, cond, &N2_inv);
+  st |= limit_rate(k1);
+  // feed-forward acceleration: N qdd = -Ddot - bias(q, qdot)  <=>  N2 qdd = R2^T(-Ddot) - bias2
   Vec3 qdd;
-  const Vec3 rhs = -D_dot - at.bias(k1);
-  if (N_inv.allFinite())
-    qdd = N_inv * rhs;  // well conditioned: the fast path's inverse
+  const Vec3 rhs = at.to_frame2(-D_dot) - at.bias_frame2(k1);
+  if (N2_inv.allFinite())
+    qdd = N2_inv * rhs;  // well conditioned: the fast path's inverse
   else
-    st |= solve(N, rhs, qdd, unused);
+    st |= solve(at.N2, rhs, qdd, unused);
   Vec3 next;
   if (D_half != nullptr && D_next != nullptr) {
     Vec3 k2, k3, k4;
-    st |= rates(angles_ + 0.5 * dt_ * k1, *D_half, k2, unused);
-    st |= rates(angles_ + 0.5 * dt_ * k2, *D_half, k3, unused);
-    st |= rates(angles_ + dt_ * k3, *D_next, k4, unused);
+    st |= stage_rates(angles_ + 0.5 * dt_ * k1, *D_half, k2);
+    st |= stage_rates(angles_ + 0.5 * dt_ * k2, *D_half, k3);
+    st |= stage_rates(angles_ + dt_ * k3, *D_next, k4);
     next = angles_ + dt_ / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   } else {
     next = angles_ + dt_ * k1;  // eq 26

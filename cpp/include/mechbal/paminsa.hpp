@@ -151,6 +151,18 @@ Status paminsa_kinematics(const PaminsaModel& model, const PlatformMotion& platf
 Status paminsa_mechanism_momentum(const PaminsaModel& model, const PaminsaWorkspace& ws, Vec3& D,
                                   Vec3& D_dot) noexcept;
 
+/// The 35 mechanism bodies' momenta and their rates (linear momentum, D of eq 19, shaking force,
+/// dD/dt) in closed form from the platform motion, without forming the bodies' states (each leg is
+/// a planar linkage in a vertical plane turning about z; derivation in paminsa.cpp). Equals
+/// shaking_wrench over the states of paminsa_mechanism_kinematics (to rounding). Same statuses as
+/// paminsa_mechanism_kinematics; `out` is untouched unless Status::ok.
+Status paminsa_mechanism_wrench(const PaminsaModel& model, const PlatformMotion& platform,
+                                ShakingWrench& out) noexcept;
+/// D only (what the RK4 stages need): positions and rates, no accelerations (the platform's
+/// acceleration must still be finite).
+Status paminsa_mechanism_angular_momentum(const PaminsaModel& model,
+                                          const PlatformMotion& platform, Vec3& D) noexcept;
+
 /// One controller tick of the fully balanced PAMINSA: kinematics at t_n, D, the reactionless-wrist
 /// step, then every body's motion (with the wrist following the command) and the shaking wrench.
 class PaminsaController {

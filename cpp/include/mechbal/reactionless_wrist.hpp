@@ -118,6 +118,10 @@ class ReactionlessWrist {
                Mat3* inverse = nullptr) const noexcept;
   Status rates_with(const Mat3& N, const Vec3& D, Vec3& rates, double& condition,
                     Mat3* inverse = nullptr) const noexcept;
+  /// Status::saturated (and qd scaled down, direction kept) when a rate exceeds max_rate.
+  Status limit_rate(Vec3& qd) const noexcept;
+  /// The rates at an RK4 stage: same result and status as rates() without computing cond(N).
+  Status stage_rates(const Vec3& angles, const Vec3& D, Vec3& qd) const noexcept;
   Status tick(const Vec3& D_now, const Vec3& D_dot, const Vec3* D_half, const Vec3* D_next) noexcept;
 
   WristInertias inertia_;
