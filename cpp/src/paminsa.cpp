@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace mechbal {
 
@@ -65,15 +66,18 @@ struct Plane {
 
 /// In-plane point (s, z) with rates relative to the turning plane -> base frame:
 /// Xd = sd u + s bd n + zd e_z;  Xdd = (sdd - s bd^2) u + (2 sd bd + s bdd) n + zdd e_z.
-void to_base(const Plane& pl, const Point2& pt, Vec3& X, Vec3& Xd, Vec3& Xdd) noexcept {
-  const double bd = pl.beta.d, bdd = pl.beta.dd;
+/// (u, n, e_z components written out: u = (c, s, 0), n = (-s, c, 0))
+inline void to_base(const Plane& pl, const Point2& pt, Vec3& X, Vec3& Xd, Vec3& Xdd) noexcept {
+  const double bd = pl.beta.d, bdd = pl.beta.dd, c = pl.beta.c, sn = pl.beta.s;
   const double s = pt.p(0), z = pt.p(1), sd = pt.v(0), zd = pt.v(1), sdd = pt.a(0), zdd = pt.a(1);
-  X = pl.origin + s * pl.u + z * Vec3::UnitZ();
-  Xd = sd * pl.u + s * bd * pl.n + zd * Vec3::UnitZ();
-  Xdd = (sdd - s * bd * bd) * pl.u + (2.0 * sd * bd + s * bdd) * pl.n + zdd * Vec3::UnitZ();
+  X = Vec3(pl.origin(0) + s * c, pl.origin(1) + s * sn, pl.origin(2) + z);
+  const double vn = s * bd;
+  Xd = Vec3(sd * c - vn * sn, sd * sn + vn * c, zd);
+  const double au = sdd - s * bd * bd, an = 2.0 * sd * bd + s * bdd;
+  Xdd = Vec3(au * c - an * sn, au * sn + an * c, zdd);
 }
 
-void point_body(const Plane& pl, const Point2& pt, BodyState& st) noexcept {
+inline void point_body(const Plane& pl, const Point2& pt, BodyState& st) noexcept {
   to_base(pl, pt, st.com, st.com_velocity, st.com_acceleration);
   st.rotation.setIdentity();
   st.angular_velocity.setZero();
@@ -178,6 +182,38 @@ PaminsaModel::PaminsaModel(const PaminsaParameters& p) : p_(p) {
     bodies_[Idx::wrist(k)].inertia_body = wrist_[k];
     const std::string f = "wrist_inertia[" + std::to_string(k) + "]";
     validate_rigid_body(bodies_[Idx::wrist(k)], f.c_str());
+  }
+
+  // constant mass data of the closed-form momentum path (paminsa_mechanism_wrench): the in-plane
+  // masses at affine combinations c_j of (A, C, E), with ik = 1/k: D = (0, ik, 1-ik),
+  // F = (1, ik, -ik), B = (1-ik, ik, 0); link midpoints; link 6 at B + l_BG/2 e_z
+  {
+    const double ik = 1.0 / p.k;
+    const Vec3 cA(1.0, 0.0, 0.0), cC(0.0, 1.0, 0.0), cE(0.0, 0.0, 1.0);
+    const Vec3 cD(0.0, ik, 1.0 - ik), cF(1.0, ik, -ik), cB(1.0 - ik, ik, 0.0);
+    for (int i = 0; i < 3; ++i) {
+      PaminsaLegMass& lm = leg_mass_[static_cast<std::size_t>(i)];
+      const auto m = [&](std::size_t j) { return bodies_[Idx::leg(i, j)].mass; };
+      const std::pair<double, Vec3> points[] = {
+          {m(0), 0.5 * (cE + cC)}, {m(1), 0.5 * (cD + cF)}, {m(2), 0.5 * (cA + cE)},
+          {m(3), 0.5 * (cA + cF)}, {m(5), cB}, {m(6), cB},
+          {m(7) + bodies_[Idx::cp2(i)].mass, cF}, {bodies_[Idx::cp1(i)].mass, cA}};
+      lm.G.setZero();
+      lm.mu.setZero();
+      for (const auto& pt : points) {
+        lm.G += pt.first * pt.second * pt.second.transpose();
+        lm.mu += pt.first * pt.second;
+      }
+      lm.nu = m(5) * 0.5 * p.length_BG * cB;
+      const auto J = [&](std::size_t j) { return Vec3(bodies_[Idx::leg(i, j)].inertia_body.diagonal()); };
+      lm.J14 = J(0) + J(3);
+      lm.J23 = J(1) + J(2);
+      lm.J6x = J(5)(0);
+      const double l5 = p.length_MS5, l3 = p.cp3_ratio * p.length_MS5;
+      const double m3 = bodies_[Idx::cp3(i)].mass;
+      lm.guide_first = m(4) * l5 + m3 * l3;
+      lm.guide_second = m(4) * l5 * l5 + m3 * l3 * l3 + J(4)(2);
+    }
   }
 
   // layout (A8): joints J_i around P, legs pointing outward along u0, guides along g0
@@ -435,7 +471,7 @@ void fill_states(const PaminsaModel& model, const PlatformMotion& pm,
     point_body(pn, Bp, ws.states[Idx::leg(i, 6)]);  // link 7: slider at B (A4)
     point_body(pn, Fp, ws.states[Idx::leg(i, 7)]);  // link 8: point mass at F (A5)
     point_body(pn, L.A, ws.states[Idx::cp1(i)]);   // CP1 at A_i
-    point_body(pn, Fp, ws.states[Idx::cp2(i)]);     // CP2 at F_i
+    ws.states[Idx::cp2(i)] = ws.states[Idx::leg(i, 7)];  // CP2 at F_i, as link 8
     BodyState& l = ws.states[Idx::cp3(i)];          // CP3 at L_i: M_iL_i = r M_iS_5i
     on_guide(p.cp3_ratio * p.length_MS5, l);
     l.rotation.setIdentity();
@@ -498,7 +534,10 @@ namespace {
 ///   (X - O) x V = s^2 bd e_z + (z sd - s zd) n - s z bd u,
 ///   (X - O) x A = s a_n e_z + (z a_u - s zdd) n - z a_n u   (a_u, a_n: A's u and n parts),
 /// so a leg's point masses reduce to m-weighted sums of s, sd, zd, s^2, z sd - s zd, s z (and
-/// their rates), and its moment about O is O x (sum m A) + those sums. A pantograph link (body
+/// their rates), and its moment about O is O x (sum m A) + those sums. Every mass point is an
+/// affine combination x_j = sum_k c_jk y_k (+ a constant height for link 6) of y = (A, C, E), so
+/// those sums are bilinear forms y^T G y' with G = sum_j m_j c_j c_j^T precomputed per leg
+/// (PaminsaLegMass). A pantograph link (body
 /// axes ex = cos g u + sin g e_z, n, ex x n = cos g e_z - sin g u; principal inertias Jx, Jy, Jz;
 /// w = bd e_z - gd n) has
 ///   I w = bd sin g cos g (Jx - Jz) u - Jy gd n + bd (Jx sin^2 g + Jz cos^2 g) e_z = a_u u + a_n n + a_e e_z
@@ -508,39 +547,8 @@ namespace {
 /// + (sum m l^2) ad e_z, plus Jz ad e_z. Exact (same quantities as shaking_wrench over the bodies'
 /// states; tests/cpp/test_paminsa.cpp checks it to 1e-12 on random models and motions).
 /// The inertias are the model's principal ones (link_inertia, diagonal by construction).
-struct PlaneSums {
-  double m = 0, s = 0, sd = 0, zd = 0, ss = 0, w = 0, sz = 0;   // momentum
-  double sdd = 0, zdd = 0, ssd = 0, x2 = 0, zsd = 0;             // rates
-  template <bool Accel>
-  void add(double mass, const Point2& pt) noexcept {
-    const double s_ = pt.p(0), z_ = pt.p(1), sd_ = pt.v(0), zd_ = pt.v(1);
-    const double ms = mass * s_;
-    s += ms;
-    sd += mass * sd_;
-    zd += mass * zd_;
-    ss += ms * s_;
-    w += mass * (z_ * sd_ - s_ * zd_);
-    sz += ms * z_;
-    if (Accel) {
-      sdd += mass * pt.a(0);
-      zdd += mass * pt.a(1);
-      ssd += ms * sd_;
-      x2 += mass * (z_ * pt.a(0) - s_ * pt.a(1));
-      zsd += mass * z_ * sd_;
-    }
-  }
-};
-
 inline Vec3 in_base(const Plane& pl, double cu, double cn, double cz) noexcept {
   return Vec3(cu * pl.u(0) + cn * pl.n(0), cu * pl.u(1) + cn * pl.n(1), cz);
-}
-
-inline Point2 midpoint(const Point2& a, const Point2& b) noexcept {
-  Point2 o;
-  o.p = 0.5 * (a.p + b.p);
-  o.v = 0.5 * (a.v + b.v);
-  o.a = 0.5 * (a.a + b.a);
-  return o;
 }
 
 template <bool Accel>
@@ -571,85 +579,78 @@ void mechanism_wrench_from_legs(const PaminsaModel& model, const PlatformMotion&
   }
   for (int i = 0; i < 3; ++i) {
     const LegSolution& L = legs[static_cast<std::size_t>(i)];
+    const PaminsaLegMass& lm = model.leg_mass()[static_cast<std::size_t>(i)];
     const Plane& pl = L.plane;
     const double bd = pl.beta.d, bdd = pl.beta.dd;
-    const LegPoints lp = leg_points(L, p.k);
-    const auto mass = [&](std::size_t j) noexcept { return bodies[Idx::leg(i, j)].mass; };
-    const auto J = [&](std::size_t j, int a) noexcept {
-      return bodies[Idx::leg(i, j)].inertia_body(a, a);
-    };
 
-    // in-plane point masses: links 1-4 at their midpoints, link 6 at B + l_BG/2 e_z, link 7 at B,
-    // link 8 and CP2 at F, CP1 at A
-    const Point2 mid[4] = {midpoint(L.E, L.C), midpoint(lp.D, lp.F), midpoint(L.A, L.E),
-                           midpoint(L.A, lp.F)};
-    PlaneSums S;
-    for (std::size_t j = 0; j < 4; ++j) S.add<Accel>(mass(j), mid[j]);
-    Point2 col = lp.B;
-    col.p(1) += 0.5 * p.length_BG;
-    S.add<Accel>(mass(5), col);
-    S.add<Accel>(mass(6), lp.B);
-    S.add<Accel>(mass(7) + bodies[Idx::cp2(i)].mass, lp.F);
-    S.add<Accel>(bodies[Idx::cp1(i)].mass, L.A);
+    // in-plane point masses as bilinear forms in y = (A, C, E) (PaminsaLegMass)
+    const Vec3 s(L.A.p(0), L.C.p(0), L.E.p(0)), z(L.A.p(1), L.C.p(1), L.E.p(1));
+    const Vec3 sd(L.A.v(0), L.C.v(0), L.E.v(0)), zd(L.A.v(1), L.C.v(1), L.E.v(1));
+    const Vec3 Gs = lm.G * s, Gz = lm.G * z;
+    const double S = lm.mu.dot(s), Sd = lm.mu.dot(sd), Zd = lm.mu.dot(zd);
+    const double Q = s.dot(Gs);                                // sum m s^2
+    const double Pz = z.dot(Gs) + lm.nu.dot(s);                // sum m s z
+    const double W = sd.dot(Gz) - zd.dot(Gs) + lm.nu.dot(sd);  // sum m (z sd - s zd)
 
-    // rotation of the pantograph links (u, n, e_z components) and of the column (e_z)
+    // rotation of the pantograph links: 1 and 4 are parallel (F - A = (C - E)/k), so are 2 and 3
+    // (F - D = A - E); I w depends on the link angle g through cos^2, sin^2, sin cos and its rates
+    // only (the same for g + pi), so each parallel pair is one term with summed inertias
     double hu = 0, hn = 0, hz = 0, mu = 0, mn = 0, mz = 0;
-    const Point2* ends[4][2] = {{&L.E, &L.C}, {&lp.D, &lp.F}, {&L.A, &L.E}, {&L.A, &lp.F}};
-    for (std::size_t j = 0; j < 4; ++j) {
-      const double Jx = J(j, 0), Jy = J(j, 1), Jz = J(j, 2);
-      const Vec2 dp = ends[j][1]->p - ends[j][0]->p, dv = ends[j][1]->v - ends[j][0]->v;
-      // cos g, sin g enter only as cos^2, sin^2, sin cos: no square root, one division
-      const double ir2 = 1.0 / dp.squaredNorm();
+    const Vec2 dps[2] = {L.C.p - L.E.p, L.E.p - L.A.p};
+    const Vec2 dvs[2] = {L.C.v - L.E.v, L.E.v - L.A.v};
+    for (int j = 0; j < 2; ++j) {
+      const Vec3& J = j == 0 ? lm.J14 : lm.J23;
+      const Vec2 &dp = dps[j], &dv = dvs[j];
+      const double ir2 = 1.0 / dp.squaredNorm();  // no square root, one division
       const double c2 = dp(0) * dp(0) * ir2, s2 = dp(1) * dp(1) * ir2, sc = dp(0) * dp(1) * ir2;
       const double gd = cross2(dp, dv) * ir2;
-      const double jxz = Jx - Jz, jsc = Jx * s2 + Jz * c2;
-      const double au = bd * sc * jxz, an = -Jy * gd, ae = bd * jsc;
+      const double jxz = J(0) - J(2), jsc = J(0) * s2 + J(2) * c2;
+      const double au = bd * sc * jxz, an = -J(1) * gd, ae = bd * jsc;
       hu += au;
       hn += an;
       hz += ae;
       if (Accel) {
-        const Vec2 da = ends[j][1]->a - ends[j][0]->a;
+        const Vec2 da = j == 0 ? Vec2(L.C.a - L.E.a) : Vec2(L.E.a - L.A.a);
         const double gdd = (cross2(dp, da) - 2.0 * gd * dp.dot(dv)) * ir2;
-        const double aud = jxz * (bdd * sc + bd * gd * (c2 - s2));
-        const double and_ = -Jy * gdd;
-        const double aed = bdd * jsc + 2.0 * bd * gd * sc * jxz;
-        mu += aud - an * bd;
-        mn += and_ + au * bd;
-        mz += aed;
+        mu += jxz * (bdd * sc + bd * gd * (c2 - s2)) - an * bd;
+        mn += -J(1) * gdd + au * bd;
+        mz += bdd * jsc + 2.0 * bd * gd * sc * jxz;
       }
     }
-    hz += J(5, 0) * bd;  // column: body X = e_z
-    if (Accel) mz += J(5, 0) * bdd;
+    hz += lm.J6x * bd;  // column: body X = e_z
+    if (Accel) mz += lm.J6x * bdd;
 
     // leg totals: sum m V, sum m A, and the moments about the plane origin, then about O
-    const Vec3 Pleg = in_base(pl, S.sd, S.s * bd, S.zd);
-    const Vec3 Hrel = in_base(pl, -S.sz * bd + hu, S.w + hn, S.ss * bd + hz);
+    const Vec3 Pleg = in_base(pl, Sd, S * bd, Zd);
+    const Vec3 Hrel = in_base(pl, -Pz * bd + hu, W + hn, Q * bd + hz);
     lin += Pleg;
     ang += pl.origin.cross(Pleg) + Hrel;
     if (Accel) {
-      const Vec3 Fleg = in_base(pl, S.sdd - bd * bd * S.s, 2.0 * bd * S.sd + bdd * S.s, S.zdd);
-      const Vec3 Mrel = in_base(pl, -(2.0 * bd * S.zsd + bdd * S.sz) + mu,
-                                S.x2 - bd * bd * S.sz + mn, 2.0 * bd * S.ssd + bdd * S.ss + mz);
+      const Vec3 sdd(L.A.a(0), L.C.a(0), L.E.a(0)), zdd(L.A.a(1), L.C.a(1), L.E.a(1));
+      const double Sdd = lm.mu.dot(sdd), Zdd = lm.mu.dot(zdd);
+      const double X1 = sd.dot(Gs);                                   // sum m s sd
+      const double X2 = sdd.dot(Gz) - zdd.dot(Gs) + lm.nu.dot(sdd);  // sum m (z sdd - s zdd)
+      const double X3 = sd.dot(Gz) + lm.nu.dot(sd);                   // sum m z sd
+      const Vec3 Fleg = in_base(pl, Sdd - bd * bd * S, 2.0 * bd * Sd + bdd * S, Zdd);
+      const Vec3 Mrel = in_base(pl, -(2.0 * bd * X3 + bdd * Pz) + mu,
+                                X2 - bd * bd * Pz + mn, 2.0 * bd * X1 + bdd * Q + mz);
       force += Fleg;
       moment += pl.origin.cross(Fleg) + Mrel;
     }
 
     // guide (link 5) and CP3 on it, turning about the vertical through M_i
     const Angle3& al = L.alpha;
-    const double m5 = mass(4), m3 = bodies[Idx::cp3(i)].mass;
-    const double l5 = p.length_MS5, l3 = p.cp3_ratio * p.length_MS5;
-    const double first = m5 * l5 + m3 * l3, second = m5 * l5 * l5 + m3 * l3 * l3 + J(4, 2);
     const Vec3 M3(model.guide_pivot()[i](0), model.guide_pivot()[i](1), p.z_A);
     const Vec3 g(al.c, al.s, 0.0), gp(-al.s, al.c, 0.0);
-    const Vec3 Pg = first * al.d * gp;
+    const Vec3 Pg = lm.guide_first * al.d * gp;
     lin += Pg;
     ang += M3.cross(Pg);
-    ang(2) += second * al.d;
+    ang(2) += lm.guide_second * al.d;
     if (Accel) {
-      const Vec3 Fg = first * (al.dd * gp - al.d * al.d * g);
+      const Vec3 Fg = lm.guide_first * (al.dd * gp - al.d * al.d * g);
       force += Fg;
       moment += M3.cross(Fg);
-      moment(2) += second * al.dd;
+      moment(2) += lm.guide_second * al.dd;
     }
   }
   out.linear_momentum = lin;
