@@ -35,10 +35,13 @@ Mat3 rot_z(double a) noexcept {
 /// with I1 ez = Rx^T (J1 e_z). N x = b <=> N2 x = R2^T b, and cond(N) = cond(N2). J may be any
 /// 3x3 matrix (the formulas do not assume symmetry or diagonal inertias).
 struct WristFrame2 {
-  WristFrame2(const WristInertias& J, const Vec3& q) noexcept {
-    cphi = std::cos(q(0)); sphi = std::sin(q(0));
-    cth = std::cos(q(1)); sth = std::sin(q(1));
-    const double cps = std::cos(q(2)), sps = std::sin(q(2));
+  WristFrame2(const WristInertias& J, const Vec3& q) noexcept
+      : WristFrame2(J, q.array().cos().matrix(), q.array().sin().matrix()) {}
+  /// from the cosines and sines of the angles
+  WristFrame2(const WristInertias& J, const Vec3& cq, const Vec3& sq) noexcept {
+    cphi = cq(0); sphi = sq(0);
+    cth = cq(1); sth = sq(1);
+    const double cps = cq(2), sps = sq(2);
     // I3 = Rz(psi) J3 Rz(psi)^T, written out (Rz mixes the first two rows / columns only)
     const Mat3& J3 = J[2];
     Mat3 T;  // Rz J3
@@ -89,6 +92,24 @@ struct WristFrame2 {
   Vec3 I1ez;
   const Mat3* J2;
 };
+
+/// cos and sin of q0 + delta from those of q0 (the RK4 stages: |delta| = dt |qdot| / 2 or
+/// dt |qdot|, small): for |delta| <= 1/32 the angle-addition formulas with Taylor polynomials of
+/// sin delta, cos delta whose first omitted terms are below 1e-18 relative (exact to rounding,
+/// without the libm calls, issue 6); otherwise libm at q.
+inline void sincos_near(double c0, double s0, double delta, double q, double& c,
+                        double& s) noexcept {
+  if (std::abs(delta) <= 1.0 / 32.0) {
+    const double d2 = delta * delta;
+    const double sd = delta * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
+    const double cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0 * (1.0 - d2 / 56.0)));
+    c = c0 * cd - s0 * sd;
+    s = s0 * cd + c0 * sd;
+  } else {
+    c = std::cos(q);
+    s = std::sin(q);
+  }
+}
 
 /// Cofactor inverse of a 3x3 matrix and its determinant.
 inline Mat3 cofactor_inverse(const Mat3& A, double& det) noexcept {
@@ -246,7 +267,8 @@ Status ReactionlessWrist::limit_rate(Vec3& qd) const noexcept {
   return Status::ok;
 }
 
-Status ReactionlessWrist::stage_rates(const Vec3& q, const Vec3& D, Vec3& qd) const noexcept {
+Status ReactionlessWrist::stage_rates(const Vec3& delta, const Vec3& cos_n, const Vec3& sin_n,
+                                      const Vec3& D, Vec3& qd) const noexcept {
   // An RK4 stage needs the rates only, not cond(N) (issue 6: the closed-form eigenvalues cost as
   // much as the rest of the stage). The decision "well conditioned" must stay the one solve()
   // makes (cond(N) <= max_condition, else damped least squares + Status::singular), so it is
@@ -254,7 +276,10 @@ Status ReactionlessWrist::stage_rates(const Vec3& q, const Vec3& D, Vec3& qd) co
   // so is cond(N), and the fast solve is exactly solve()'s fast path (cofactor inverse); the
   // bound exceeds cond(N) by at least 1 + 1/cond and at most a factor 3, far above the eigenvalue
   // route's cond^2 eps rounding, so the decision is the same. Otherwise solve() decides.
-  const WristFrame2 at(inertia_, q);
+  const Vec3 q = angles_ + delta;
+  Vec3 cq, sq;
+  for (int i = 0; i < 3; ++i) sincos_near(cos_n(i), sin_n(i), delta(i), q(i), cq(i), sq(i));
+  const WristFrame2 at(inertia_, cq, sq);
   const Vec3 rhs = at.to_frame2(target_ - D);
   double det = 0.0;
   const Mat3 inv = cofactor_inverse(at.N2, det);
@@ -300,7 +325,8 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
   // N(q_n) is built once (in link 2's frame) for k1 and the feed-forward; cond(N(q_n)), the
   // reported one, comes from solve()'s closed-form eigenvalues; when N is well conditioned its
   // inverse is reused for both (issue 6)
-  const WristFrame2 at(inertia_, angles_);
+  const Vec3 cos_n = angles_.array().cos().matrix(), sin_n = angles_.array().sin().matrix();
+  const WristFrame2 at(inertia_, cos_n, sin_n);
   Mat3 N2_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by the fast path
   Status st = solve(at.N2, at.to_frame2(target_ - D_now), k1, cond, &N2_inv);
   st |= limit_rate(k1);
@@ -314,9 +340,9 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
   Vec3 next;
   if (D_half != nullptr && D_next != nullptr) {
     Vec3 k2, k3, k4;
-    st |= stage_rates(angles_ + 0.5 * dt_ * k1, *D_half, k2);
-    st |= stage_rates(angles_ + 0.5 * dt_ * k2, *D_half, k3);
-    st |= stage_rates(angles_ + dt_ * k3, *D_next, k4);
+    st |= stage_rates(0.5 * dt_ * k1, cos_n, sin_n, *D_half, k2);
+    st |= stage_rates(0.5 * dt_ * k2, cos_n, sin_n, *D_half, k3);
+    st |= stage_rates(dt_ * k3, cos_n, sin_n, *D_next, k4);
     next = angles_ + dt_ / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   } else {
     next = angles_ + dt_ * k1;  // eq 26

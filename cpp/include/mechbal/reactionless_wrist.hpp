@@ -120,8 +120,10 @@ class ReactionlessWrist {
                     Mat3* inverse = nullptr) const noexcept;
   /// Status::saturated (and qd scaled down, direction kept) when a rate exceeds max_rate.
   Status limit_rate(Vec3& qd) const noexcept;
-  /// The rates at an RK4 stage: same result and status as rates() without computing cond(N).
-  Status stage_rates(const Vec3& angles, const Vec3& D, Vec3& qd) const noexcept;
+  /// The rates at the RK4 stage angles_ + delta (cos_n, sin_n: of angles_): same result and
+  /// status as rates() without computing cond(N).
+  Status stage_rates(const Vec3& delta, const Vec3& cos_n, const Vec3& sin_n, const Vec3& D,
+                     Vec3& qd) const noexcept;
   Status tick(const Vec3& D_now, const Vec3& D_dot, const Vec3* D_half, const Vec3* D_next) noexcept;
 
   WristInertias inertia_;
