@@ -85,21 +85,23 @@ inline void point_body(const Plane& pl, const Point2& pt, BodyState& st) noexcep
 }
 
 /// Pantograph link p1 -> p2 (COM at its middle), body X along the link, Y = plane normal n.
-/// gamma = elevation of p1->p2 in the plane: R = [cos g u + sin g e_z, n, X x n],
-/// w = bd e_z - gd n, wd = bdd e_z - gdd n + gd bd u.
-void pantograph_link(const Plane& pl, const Point2& p1, const Point2& p2, BodyState& st) noexcept {
+/// gamma = elevation of p1->p2 in the plane (g: its cos, sin and rates): R = [cos g u + sin g e_z,
+/// n, X x n] with X x n = cos g e_z - sin g u, w = bd e_z - gd n, wd = bdd e_z - gdd n + gd bd u.
+void pantograph_link(const Plane& pl, const Point2& p1, const Point2& p2, const Angle3& g,
+                     BodyState& st) noexcept {
   Point2 mid;
   mid.p = 0.5 * (p1.p + p2.p);
   mid.v = 0.5 * (p1.v + p2.v);
   mid.a = 0.5 * (p1.a + p2.a);
   to_base(pl, mid, st.com, st.com_velocity, st.com_acceleration);
-  const Angle3 g = angle_of(p2.p - p1.p, p2.v - p1.v, p2.a - p1.a);
-  const Vec3 ex = g.c * pl.u + g.s * Vec3::UnitZ();
-  st.rotation.col(0) = ex;
-  st.rotation.col(1) = pl.n;
-  st.rotation.col(2) = ex.cross(pl.n);
-  st.angular_velocity = pl.beta.d * Vec3::UnitZ() - g.d * pl.n;
-  st.angular_acceleration = pl.beta.dd * Vec3::UnitZ() - g.dd * pl.n + g.d * pl.beta.d * pl.u;
+  const double cb = pl.beta.c, sb = pl.beta.s, bd = pl.beta.d, bdd = pl.beta.dd;
+  // columns: ex = (c cb, c sb, s), n = (-sb, cb, 0), ex x n = (-s cb, -s sb, c)
+  st.rotation << g.c * cb, -sb, -g.s * cb,  //
+      g.c * sb, cb, -g.s * sb,              //
+      g.s, 0.0, g.c;
+  st.angular_velocity = Vec3(g.d * sb, -g.d * cb, bd);
+  const double t = g.d * bd;
+  st.angular_acceleration = Vec3(g.dd * sb + t * cb, -g.dd * cb + t * sb, bdd);
 }
 
 inline Point2 affine(const Point2& x, double cx, const Point2& y, double cy, const Point2& z,
@@ -438,10 +440,17 @@ void fill_states(const PaminsaModel& model, const PlatformMotion& pm,
     const LegPoints lp = leg_points(L, p.k);
     const Point2 &Dp = lp.D, &Fp = lp.F, &Bp = lp.B;
     const Plane& pn = L.plane;
-    pantograph_link(pn, L.E, L.C, ws.states[Idx::leg(i, 0)]);  // link 1, E-C
-    pantograph_link(pn, Dp, Fp, ws.states[Idx::leg(i, 1)]);      // link 2, D-F
-    pantograph_link(pn, L.A, L.E, ws.states[Idx::leg(i, 2)]);  // link 3, A-E
-    pantograph_link(pn, L.A, Fp, ws.states[Idx::leg(i, 3)]);    // link 4, A-F
+    // A-E-D-F is a parallelogram: F - A = (C - E)/k and F - D = A - E, so links 4 and 1 have the
+    // same direction and link 2 is link 3 turned by pi (two angles per leg, not four)
+    const Angle3 gEC = angle_of(L.C.p - L.E.p, L.C.v - L.E.v, L.C.a - L.E.a);
+    const Angle3 gAE = angle_of(L.E.p - L.A.p, L.E.v - L.A.v, L.E.a - L.A.a);
+    Angle3 gDF = gAE;
+    gDF.c = -gAE.c;
+    gDF.s = -gAE.s;
+    pantograph_link(pn, L.E, L.C, gEC, ws.states[Idx::leg(i, 0)]);  // link 1, E-C
+    pantograph_link(pn, Dp, Fp, gDF, ws.states[Idx::leg(i, 1)]);    // link 2, D-F
+    pantograph_link(pn, L.A, L.E, gAE, ws.states[Idx::leg(i, 2)]);  // link 3, A-E
+    pantograph_link(pn, L.A, Fp, gEC, ws.states[Idx::leg(i, 3)]);   // link 4, A-F
 
     // link 5: turns about the vertical through M_i; COM S5 at l_MS5 along M_i -> A_i
     const Angle3& al = L.alpha;
@@ -743,9 +752,19 @@ Status PaminsaController::tick(const PlatformMotion& now, const PlatformMotion& 
   D_ = mechanism.angular_momentum;  // eq 19
   D_dot_ = mechanism.moment;
   const Status ws = wrist_.step(D_, D_dot_, D_half, D_next);
+  // the wrist links' motion (paminsa_wrist_kinematics, with the cos/sin the wrist computed)
   const WristCommand& c = wrist_.command();
-  WristMotion wm{c.angles, c.rates, c.accelerations};
-  paminsa_wrist_kinematics(model_, now, wm, ws_);
+  WristLinkMotion m;
+  wrist_link_motion(c.cos_angles, c.sin_angles, c.rates, c.accelerations, m);
+  for (int k = 0; k < 3; ++k) {
+    BodyState& st = ws_.states[Idx::wrist(k)];
+    st.com = now.position;
+    st.com_velocity = now.velocity;
+    st.com_acceleration = now.acceleration;
+    st.rotation = m.rotation[k];
+    st.angular_velocity = m.angular_velocity[k];
+    st.angular_acceleration = m.angular_acceleration[k];
+  }
   // all 38 bodies = the mechanism's sums + the three wrist links' (not re-summed from scratch)
   ShakingWrench wrist;
   shaking_wrench(model_.bodies().data() + Idx::wrist(0), ws_.states.data() + Idx::wrist(0), 3,

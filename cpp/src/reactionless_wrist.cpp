@@ -14,19 +14,16 @@ namespace mechbal {
 
 namespace {
 
-Mat3 rot_x(double a) noexcept {
-  const double c = std::cos(a), s = std::sin(a);
-  Mat3 R;
-  R << 1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c;
-  return R;
+/// cos / sin of each angle, written as scalar calls on the same argument so that the compiler
+/// pairs them into one sincos each
+inline void cos_sin(const Vec3& q, Vec3& c, Vec3& s) noexcept {
+  for (int i = 0; i < 3; ++i) {
+    c(i) = std::cos(q(i));
+    s(i) = std::sin(q(i));
+  }
 }
-
-Mat3 rot_z(double a) noexcept {
-  const double c = std::cos(a), s = std::sin(a);
-  Mat3 R;
-  R << c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0;
-  return R;
-}
+inline Vec3 cos_of(const Vec3& q) noexcept { return Vec3(std::cos(q(0)), std::cos(q(1)), std::cos(q(2))); }
+inline Vec3 sin_of(const Vec3& q) noexcept { return Vec3(std::sin(q(0)), std::sin(q(1)), std::sin(q(2))); }
 
 /// The wrist at one set of angles, in the frame of link 2 (issue 6: nothing is formed in the base
 /// frame). With R2 = Rz(phi) Rx(theta): x1 = R2 e_x, z2 = R2 e_z, R2^T e_z = (0, sin th, cos th),
@@ -36,7 +33,7 @@ Mat3 rot_z(double a) noexcept {
 /// 3x3 matrix (the formulas do not assume symmetry or diagonal inertias).
 struct WristFrame2 {
   WristFrame2(const WristInertias& J, const Vec3& q) noexcept
-      : WristFrame2(J, q.array().cos().matrix(), q.array().sin().matrix()) {}
+      : WristFrame2(J, cos_of(q), sin_of(q)) {}
   /// from the cosines and sines of the angles
   WristFrame2(const WristInertias& J, const Vec3& cq, const Vec3& sq) noexcept {
     cphi = cq(0); sphi = sq(0);
@@ -131,9 +128,19 @@ inline Mat3 cofactor_inverse(const Mat3& A, double& det) noexcept {
 
 void wrist_link_motion(const Vec3& q, const Vec3& qd, const Vec3& qdd,
                        WristLinkMotion& out) noexcept {
-  const Mat3 R1 = rot_z(q(0));
-  const Mat3 R2 = R1 * rot_x(q(1));
-  const Mat3 R3 = R2 * rot_z(q(2));
+  Vec3 c, s;
+  cos_sin(q, c, s);
+  wrist_link_motion(c, s, qd, qdd, out);
+}
+
+void wrist_link_motion(const Vec3& c, const Vec3& s, const Vec3& qd, const Vec3& qdd,
+                       WristLinkMotion& out) noexcept {
+  Mat3 R1, Rx, Rz3;
+  R1 << c(0), -s(0), 0.0, s(0), c(0), 0.0, 0.0, 0.0, 1.0;
+  Rx << 1.0, 0.0, 0.0, 0.0, c(1), -s(1), 0.0, s(1), c(1);
+  Rz3 << c(2), -s(2), 0.0, s(2), c(2), 0.0, 0.0, 0.0, 1.0;
+  const Mat3 R2 = R1 * Rx;
+  const Mat3 R3 = R2 * Rz3;
   const Vec3 x1 = R1.col(0), z2 = R2.col(2);
   const Vec3 w1 = qd(0) * Vec3::UnitZ();
   const Vec3 w2 = w1 + qd(1) * x1;
@@ -187,6 +194,7 @@ ReactionlessWrist::ReactionlessWrist(const WristInertias& inertia_body,
   angles_ = initial_angles;
   target_ = target_momentum;
   command_.angles = command_.next_angles = initial_angles;
+  cos_sin(initial_angles, command_.cos_angles, command_.sin_angles);
   command_.condition_number = 1.0;
 }
 
@@ -196,6 +204,7 @@ Status ReactionlessWrist::reset(const Vec3& angles, const Vec3& target_momentum)
   target_ = target_momentum;
   command_ = WristCommand{};
   command_.angles = command_.next_angles = angles;
+  cos_sin(angles, command_.cos_angles, command_.sin_angles);
   return Status::ok;
 }
 
@@ -313,6 +322,7 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
                       (D_next == nullptr || D_next->allFinite());
   const auto hold = [this](Status why) noexcept {
     command_.angles = command_.next_angles = angles_;
+    cos_sin(angles_, command_.cos_angles, command_.sin_angles);
     command_.rates.setZero();
     command_.accelerations.setZero();
     command_.status = why;
@@ -325,7 +335,8 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
   // N(q_n) is built once (in link 2's frame) for k1 and the feed-forward; cond(N(q_n)), the
   // reported one, comes from solve()'s closed-form eigenvalues; when N is well conditioned its
   // inverse is reused for both (issue 6)
-  const Vec3 cos_n = angles_.array().cos().matrix(), sin_n = angles_.array().sin().matrix();
+  Vec3 cos_n, sin_n;
+  cos_sin(angles_, cos_n, sin_n);
   const WristFrame2 at(inertia_, cos_n, sin_n);
   Mat3 N2_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by the fast path
   Status st = solve(at.N2, at.to_frame2(target_ - D_now), k1, cond, &N2_inv);
@@ -349,6 +360,8 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
   }
   if (!next.allFinite() || !k1.allFinite() || !qdd.allFinite()) return hold(Status::non_finite_input);
   command_.angles = angles_;
+  command_.cos_angles = cos_n;
+  command_.sin_angles = sin_n;
   command_.rates = k1;
   command_.accelerations = has(st, Status::saturated) ? Vec3::Zero() : qdd;
   command_.next_angles = next;

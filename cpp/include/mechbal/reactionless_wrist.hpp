@@ -45,6 +45,9 @@ struct WristLinkMotion {
 };
 void wrist_link_motion(const Vec3& angles, const Vec3& rates, const Vec3& accelerations,
                        WristLinkMotion& out) noexcept;
+/// The same from the cosines and sines of the angles (e.g. WristCommand::cos_angles/sin_angles).
+void wrist_link_motion(const Vec3& cos_angles, const Vec3& sin_angles, const Vec3& rates,
+                       const Vec3& accelerations, WristLinkMotion& out) noexcept;
 
 /// N(q) of eq 23 (corrected): H_wrist = N(q) qdot with H_wrist = sum_k I_k w_k.
 Mat3 wrist_momentum_matrix(const WristInertias& inertia_body, const Vec3& angles) noexcept;
@@ -79,6 +82,8 @@ struct WristCommand {
   Vec3 rates = Vec3::Zero();
   Vec3 accelerations = Vec3::Zero();
   Vec3 next_angles = Vec3::Zero();
+  /// cos and sin of `angles` (the tick needs them; the kinematics of the same tick can reuse them)
+  Vec3 cos_angles = Vec3::Ones(), sin_angles = Vec3::Zero();
   double condition_number = 1.0;
   Status status = Status::ok;
 };
