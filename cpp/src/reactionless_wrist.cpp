@@ -191,6 +191,9 @@ ReactionlessWrist::ReactionlessWrist(const WristInertias& inertia_body,
   if (!initial_angles.allFinite()) fail("initial_angles", "must be finite", initial_angles.sum());
   if (!target_momentum.allFinite()) fail("target_momentum", "must be finite", target_momentum.sum());
   dt_ = 1.0 / config.rate_hz;
+  diagonal_inertia_ = true;
+  for (const Mat3& J : inertia_)
+    diagonal_inertia_ = diagonal_inertia_ && (J - Mat3(J.diagonal().asDiagonal())).isZero(0.0);
   angles_ = initial_angles;
   target_ = target_momentum;
   command_.angles = command_.next_angles = initial_angles;
@@ -288,19 +291,38 @@ Status ReactionlessWrist::stage_rates(const Vec3& delta, const Vec3& cos_n, cons
   const Vec3 q = angles_ + delta;
   Vec3 cq, sq;
   for (int i = 0; i < 3; ++i) sincos_near(cos_n(i), sin_n(i), delta(i), q(i), cq(i), sq(i));
-  const WristFrame2 at(inertia_, cq, sq);
-  const Vec3 rhs = at.to_frame2(target_ - D);
+  Mat3 N2;
+  if (diagonal_inertia_) {
+    // J_k = diag(x_k, y_k, z_k) (PAMINSA's wrist): WristFrame2's N2 written out, with
+    // I3 = Rz(psi) J3 Rz(psi)^T = [x3 c^2 + y3 s^2, (x3 - y3) c s, 0; ..., x3 s^2 + y3 c^2, 0; 0, 0, z3]
+    // and I1 ez = (0, sin th z1, cos th z1):
+    // N2 = [sin th S01, S00, 0; sin th (z1 + S11), S01, 0; cos th (z1 + S22), 0, z3], S = J2 + I3
+    const double c = cq(2), s = sq(2), cth = cq(1), sth = sq(1);
+    const Mat3 &J1 = inertia_[0], &J2 = inertia_[1], &J3 = inertia_[2];
+    const double x3 = J3(0, 0), y3 = J3(1, 1), z3 = J3(2, 2), z1 = J1(2, 2);
+    const double S00 = J2(0, 0) + x3 * c * c + y3 * s * s, S01 = (x3 - y3) * c * s;
+    const double S11 = J2(1, 1) + x3 * s * s + y3 * c * c, S22 = J2(2, 2) + z3;
+    N2 << sth * S01, S00, 0.0,  //
+        sth * (z1 + S11), S01, 0.0,  //
+        cth * (z1 + S22), 0.0, z3;
+  } else {
+    N2 = WristFrame2(inertia_, cq, sq).N2;
+  }
+  // R2^T (H_target - D), R2 = Rz(phi) Rx(theta)
+  const Vec3 b = target_ - D;
+  const double bx = cq(0) * b(0) + sq(0) * b(1), by = -sq(0) * b(0) + cq(0) * b(1);
+  const Vec3 rhs(bx, cq(1) * by + sq(1) * b(2), -sq(1) * by + cq(1) * b(2));
   double det = 0.0;
-  const Mat3 inv = cofactor_inverse(at.N2, det);
-  const double bound2 = at.N2.squaredNorm() * inv.squaredNorm();
+  const Mat3 inv = cofactor_inverse(N2, det);
+  const double bound2 = N2.squaredNorm() * inv.squaredNorm();
   const double max_c = config_.max_condition;
   Status st = Status::ok;
   double unused = 1.0;
   if (det != 0.0 && bound2 <= max_c * max_c && inv.allFinite()) {
     qd = inv * rhs;
-    if (!qd.allFinite()) st = solve(at.N2, rhs, qd, unused);
+    if (!qd.allFinite()) st = solve(N2, rhs, qd, unused);
   } else {
-    st = solve(at.N2, rhs, qd, unused);
+    st = solve(N2, rhs, qd, unused);
   }
   return st | limit_rate(qd);
 }

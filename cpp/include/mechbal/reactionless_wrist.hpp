@@ -134,6 +134,7 @@ class ReactionlessWrist {
   WristInertias inertia_;
   ReactionlessWristConfig config_;
   double dt_;
+  bool diagonal_inertia_ = false;  ///< every J_k diagonal (exactly): the stages' N2 in closed form
   Vec3 angles_;
   Vec3 target_;
   WristCommand command_;
