@@ -34,23 +34,33 @@ inline Vec3 sin_of(const Vec3& q) noexcept { return Vec3(std::sin(q(0)), std::si
 struct WristFrame2 {
   WristFrame2(const WristInertias& J, const Vec3& q) noexcept
       : WristFrame2(J, cos_of(q), sin_of(q)) {}
-  /// from the cosines and sines of the angles
-  WristFrame2(const WristInertias& J, const Vec3& cq, const Vec3& sq) noexcept {
+  /// from the cosines and sines of the angles; `diagonal`: every J_k is diagonal (exactly)
+  WristFrame2(const WristInertias& J, const Vec3& cq, const Vec3& sq,
+              bool diagonal = false) noexcept {
     cphi = cq(0); sphi = sq(0);
     cth = cq(1); sth = sq(1);
     const double cps = cq(2), sps = sq(2);
-    // I3 = Rz(psi) J3 Rz(psi)^T, written out (Rz mixes the first two rows / columns only)
     const Mat3& J3 = J[2];
-    Mat3 T;  // Rz J3
-    T.row(0) = cps * J3.row(0) - sps * J3.row(1);
-    T.row(1) = sps * J3.row(0) + cps * J3.row(1);
-    T.row(2) = J3.row(2);
-    I3.col(0) = cps * T.col(0) - sps * T.col(1);
-    I3.col(1) = sps * T.col(0) + cps * T.col(1);
-    I3.col(2) = T.col(2);
-    // I1 ez = Rx^T (J1 e_z)
-    const Vec3 j1 = J[0].col(2);
-    I1ez = Vec3(j1(0), cth * j1(1) + sth * j1(2), -sth * j1(1) + cth * j1(2));
+    if (diagonal) {
+      // I3 = Rz J3 Rz^T = [x c^2 + y s^2, (x - y) c s, 0; ., x s^2 + y c^2, 0; 0, 0, z]
+      const double x = J3(0, 0), y = J3(1, 1), cs = (x - y) * cps * sps;
+      I3 << x * cps * cps + y * sps * sps, cs, 0.0,  //
+          cs, x * sps * sps + y * cps * cps, 0.0,     //
+          0.0, 0.0, J3(2, 2);
+      I1ez = Vec3(0.0, sth * J[0](2, 2), cth * J[0](2, 2));
+    } else {
+      // I3 = Rz(psi) J3 Rz(psi)^T, written out (Rz mixes the first two rows / columns only)
+      Mat3 T;  // Rz J3
+      T.row(0) = cps * J3.row(0) - sps * J3.row(1);
+      T.row(1) = sps * J3.row(0) + cps * J3.row(1);
+      T.row(2) = J3.row(2);
+      I3.col(0) = cps * T.col(0) - sps * T.col(1);
+      I3.col(1) = sps * T.col(0) + cps * T.col(1);
+      I3.col(2) = T.col(2);
+      // I1 ez = Rx^T (J1 e_z)
+      const Vec3 j1 = J[0].col(2);
+      I1ez = Vec3(j1(0), cth * j1(1) + sth * j1(2), -sth * j1(1) + cth * j1(2));
+    }
     J2 = &J[1];
     const Mat3 S = *J2 + I3;  // (I2 + I3) in frame 2
     N2.col(0) = I1ez + sth * S.col(1) + cth * S.col(2);
@@ -359,7 +369,7 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
   // inverse is reused for both (issue 6)
   Vec3 cos_n, sin_n;
   cos_sin(angles_, cos_n, sin_n);
-  const WristFrame2 at(inertia_, cos_n, sin_n);
+  const WristFrame2 at(inertia_, cos_n, sin_n, diagonal_inertia_);
   Mat3 N2_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by the fast path
   Status st = solve(at.N2, at.to_frame2(target_ - D_now), k1, cond, &N2_inv);
   st |= limit_rate(k1);
