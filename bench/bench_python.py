@@ -4,7 +4,7 @@
    arrays out): RneChainDynamics.inverse_dynamics (6 joints), shaking_wrench (10 bodies). The
    binding overhead is this minus the C++ tick time of mechbal-bench (the merge script subtracts).
    Also one controller tick through the bindings: ComputedTorque.step (6-joint RNE back end, and
-   the 2-DOF closed form), ReactionlessWrist.step (Euler, RK4).
+   the 2-DOF closed form), ReactionlessWrist.step (Euler, RK4), DecoupledJointController.step (3 joints).
 2. Batch throughput (instants per second) of mechbal.shaking_wrench over a 1e5-instant trajectory
    of 10 bodies against a pure-numpy implementation of the same formula (Briot & Arakelian 2009,
    eqs 1-4): F = sum m a_G; M_O = sum (m OG x a_G + I alpha + w x I w), I = R I_body R^T. The two
@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 import mechbal
+import mechbal._core
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "python"))
 from conftest import chain_from_specs, random_chain_specs  # noqa: E402
@@ -125,6 +126,12 @@ def main(argv=None):
     q2, qd2, q2_d, qd2_d, qdd2_d = (rng.uniform(-1, 1, 2) for _ in range(5))
     med, p99 = median_per_call_ns(lambda: ct2.step(q2, qd2, q2_d, qd2_d, qdd2_d), calls)
     results["per_call"]["ct2_closed_form"] = {"median_ns": med, "p99_ns": p99}
+    # decoupled joint control (3 joints; the C++ case decoupled_step3 uses the balanced 3R's k)
+    dc = mechbal._core.DecoupledJointController(np.array([0.9, 0.2, 0.01]), np.full(3, 100.0),
+                                          np.full(3, 20.0))
+    q3, qd3, q3_d, qd3_d, qdd3_d = (rng.uniform(-1, 1, 3) for _ in range(5))
+    med, p99 = median_per_call_ns(lambda: dc.step(q3, qd3, q3_d, qd3_d, qdd3_d), calls)
+    results["per_call"]["decoupled_step3"] = {"median_ns": med, "p99_ns": p99}
     pam = mechbal.PaminsaModel(mechbal.PaminsaParameters())
     J = pam.inertia_body[35:38]
     for name, integ in (("wrist_euler", mechbal.WristIntegrator.euler),

@@ -14,54 +14,119 @@ namespace mechbal {
 
 namespace {
 
-Mat3 rot_x(double a) noexcept {
-  const double c = std::cos(a), s = std::sin(a);
-  Mat3 R;
-  R << 1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c;
-  return R;
-}
-
-Mat3 rot_z(double a) noexcept {
-  const double c = std::cos(a), s = std::sin(a);
-  Mat3 R;
-  R << c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0;
-  return R;
-}
-
-/// The wrist at one set of angles: base-frame link inertias I_k = R_k J_k R_k^T and the axes
-/// x1 = R1 e_x, z2 = R2 e_z; N and the bias term are both built from them (once per tick).
-struct WristAt {
-  WristAt(const WristInertias& J, const Vec3& q) noexcept {
-    const Mat3 R1 = rot_z(q(0));
-    const Mat3 R2 = R1 * rot_x(q(1));
-    const Mat3 R3 = R2 * rot_z(q(2));
-    I[0] = R1 * J[0] * R1.transpose();
-    I[1] = R2 * J[1] * R2.transpose();
-    I[2] = R3 * J[2] * R3.transpose();
-    x1 = R1.col(0);
-    z2 = R2.col(2);
+/// cos / sin of each angle, written as scalar calls on the same argument so that the compiler
+/// pairs them into one sincos each
+inline void cos_sin(const Vec3& q, Vec3& c, Vec3& s) noexcept {
+  for (int i = 0; i < 3; ++i) {
+    c(i) = std::cos(q(i));
+    s(i) = std::sin(q(i));
   }
-  /// eq 23 (corrected): N = [(I1+I2+I3) e_z | (I2+I3) x1 | I3 z2]
+}
+inline Vec3 cos_of(const Vec3& q) noexcept { return Vec3(std::cos(q(0)), std::cos(q(1)), std::cos(q(2))); }
+inline Vec3 sin_of(const Vec3& q) noexcept { return Vec3(std::sin(q(0)), std::sin(q(1)), std::sin(q(2))); }
+
+/// The wrist at one set of angles, in the frame of link 2 (issue 6: nothing is formed in the base
+/// frame). With R2 = Rz(phi) Rx(theta): x1 = R2 e_x, z2 = R2 e_z, R2^T e_z = (0, sin th, cos th),
+/// and the link inertias in frame 2 are I1 = Rx^T J1 Rx, I2 = J2, I3 = Rz(psi) J3 Rz(psi)^T, so
+///     N = R2 N2,  N2 = [I1 ez + (J2 + I3) ez | (J2 + I3) e_x | I3 e_z]   (ez = R2^T e_z)
+/// with I1 ez = Rx^T (J1 e_z). N x = b <=> N2 x = R2^T b, and cond(N) = cond(N2). J may be any
+/// 3x3 matrix (the formulas do not assume symmetry or diagonal inertias).
+struct WristFrame2 {
+  WristFrame2(const WristInertias& J, const Vec3& q) noexcept
+      : WristFrame2(J, cos_of(q), sin_of(q)) {}
+  /// from the cosines and sines of the angles; `diagonal`: every J_k is diagonal (exactly)
+  WristFrame2(const WristInertias& J, const Vec3& cq, const Vec3& sq,
+              bool diagonal = false) noexcept {
+    cphi = cq(0); sphi = sq(0);
+    cth = cq(1); sth = sq(1);
+    const double cps = cq(2), sps = sq(2);
+    const Mat3& J3 = J[2];
+    if (diagonal) {
+      // I3 = Rz J3 Rz^T = [x c^2 + y s^2, (x - y) c s, 0; ., x s^2 + y c^2, 0; 0, 0, z]
+      const double x = J3(0, 0), y = J3(1, 1), cs = (x - y) * cps * sps;
+      I3 << x * cps * cps + y * sps * sps, cs, 0.0,  //
+          cs, x * sps * sps + y * cps * cps, 0.0,     //
+          0.0, 0.0, J3(2, 2);
+      I1ez = Vec3(0.0, sth * J[0](2, 2), cth * J[0](2, 2));
+    } else {
+      // I3 = Rz(psi) J3 Rz(psi)^T, written out (Rz mixes the first two rows / columns only)
+      Mat3 T;  // Rz J3
+      T.row(0) = cps * J3.row(0) - sps * J3.row(1);
+      T.row(1) = sps * J3.row(0) + cps * J3.row(1);
+      T.row(2) = J3.row(2);
+      I3.col(0) = cps * T.col(0) - sps * T.col(1);
+      I3.col(1) = sps * T.col(0) + cps * T.col(1);
+      I3.col(2) = T.col(2);
+      // I1 ez = Rx^T (J1 e_z)
+      const Vec3 j1 = J[0].col(2);
+      I1ez = Vec3(j1(0), cth * j1(1) + sth * j1(2), -sth * j1(1) + cth * j1(2));
+    }
+    J2 = &J[1];
+    const Mat3 S = *J2 + I3;  // (I2 + I3) in frame 2
+    N2.col(0) = I1ez + sth * S.col(1) + cth * S.col(2);
+    N2.col(1) = S.col(0);
+    N2.col(2) = I3.col(2);
+  }
+  /// R2^T b = Rx(th)^T Rz(phi)^T b
+  Vec3 to_frame2(const Vec3& b) const noexcept {
+    const double x = cphi * b(0) + sphi * b(1), y = -sphi * b(0) + cphi * b(1);
+    return Vec3(x, cth * y + sth * b(2), -sth * y + cth * b(2));
+  }
+  /// R2 v
+  Vec3 to_base(const Vec3& v) const noexcept {
+    const double y = cth * v(1) - sth * v(2), z = sth * v(1) + cth * v(2);
+    return Vec3(cphi * v(0) - sphi * y, sphi * v(0) + cphi * y, z);
+  }
+  /// N of eq 23 (corrected), base frame
   Mat3 momentum_matrix() const noexcept {
     Mat3 N;
-    N.col(0) = (I[0] + I[1] + I[2]).col(2);
-    N.col(1) = (I[1] + I[2]) * x1;
-    N.col(2) = I[2] * z2;
+    for (int j = 0; j < 3; ++j) N.col(j) = to_base(N2.col(j));
     return N;
   }
-  /// sum_k [I_k wdot_k|_{qddot=0} + w_k x I_k w_k]
-  Vec3 bias(const Vec3& qd) const noexcept {
-    const Vec3 w1 = qd(0) * Vec3::UnitZ();
-    const Vec3 w2 = w1 + qd(1) * x1;
-    const Vec3 w3 = w2 + qd(2) * z2;
-    const Vec3 a2 = qd(1) * w1.cross(x1);
-    const Vec3 a3 = a2 + qd(2) * w2.cross(z2);
-    const Vec3 Iw1 = I[0] * w1, Iw2 = I[1] * w2, Iw3 = I[2] * w3;
-    return w1.cross(Iw1) + I[1] * a2 + w2.cross(Iw2) + I[2] * a3 + w3.cross(Iw3);
+  /// R2^T sum_k [I_k wdot_k|_{qddot=0} + w_k x I_k w_k], all in frame 2 (x1 = e_x, z2 = e_z)
+  Vec3 bias_frame2(const Vec3& qd) const noexcept {
+    const Vec3 ez(0.0, sth, cth);
+    const Vec3 w1 = qd(0) * ez;
+    const Vec3 w2 = w1 + qd(1) * Vec3::UnitX();
+    const Vec3 w3 = w2 + qd(2) * Vec3::UnitZ();
+    const Vec3 a2 = qd(1) * w1.cross(Vec3::UnitX());
+    const Vec3 a3 = a2 + qd(2) * w2.cross(Vec3::UnitZ());
+    const Vec3 Iw1 = qd(0) * I1ez, Iw2 = *J2 * w2, Iw3 = I3 * w3;
+    return w1.cross(Iw1) + *J2 * a2 + w2.cross(Iw2) + I3 * a3 + w3.cross(Iw3);
   }
-  std::array<Mat3, 3> I;
-  Vec3 x1, z2;
+  double cphi, sphi, cth, sth;
+  Mat3 I3, N2;
+  Vec3 I1ez;
+  const Mat3* J2;
 };
+
+/// cos and sin of q0 + delta from those of q0 (the RK4 stages: |delta| = dt |qdot| / 2 or
+/// dt |qdot|, small): for |delta| <= 1/32 the angle-addition formulas with Taylor polynomials of
+/// sin delta, cos delta whose first omitted terms are below 1e-18 relative (exact to rounding,
+/// without the libm calls, issue 6); otherwise libm at q.
+inline void sincos_near(double c0, double s0, double delta, double q, double& c,
+                        double& s) noexcept {
+  if (std::abs(delta) <= 1.0 / 32.0) {
+    const double d2 = delta * delta;
+    const double sd = delta * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
+    const double cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0 * (1.0 - d2 / 56.0)));
+    c = c0 * cd - s0 * sd;
+    s = s0 * cd + c0 * sd;
+  } else {
+    c = std::cos(q);
+    s = std::sin(q);
+  }
+}
+
+/// Cofactor inverse of a 3x3 matrix and its determinant.
+inline Mat3 cofactor_inverse(const Mat3& A, double& det) noexcept {
+  Mat3 C;
+  C.col(0) = A.col(1).cross(A.col(2));
+  C.col(1) = A.col(2).cross(A.col(0));
+  C.col(2) = A.col(0).cross(A.col(1));
+  det = A.col(0).dot(C.col(0));
+  return C.transpose() / det;
+}
 
 [[noreturn]] void fail(const char* field, const std::string& what, double value) {
   std::ostringstream msg;
@@ -73,9 +138,19 @@ struct WristAt {
 
 void wrist_link_motion(const Vec3& q, const Vec3& qd, const Vec3& qdd,
                        WristLinkMotion& out) noexcept {
-  const Mat3 R1 = rot_z(q(0));
-  const Mat3 R2 = R1 * rot_x(q(1));
-  const Mat3 R3 = R2 * rot_z(q(2));
+  Vec3 c, s;
+  cos_sin(q, c, s);
+  wrist_link_motion(c, s, qd, qdd, out);
+}
+
+void wrist_link_motion(const Vec3& c, const Vec3& s, const Vec3& qd, const Vec3& qdd,
+                       WristLinkMotion& out) noexcept {
+  Mat3 R1, Rx, Rz3;
+  R1 << c(0), -s(0), 0.0, s(0), c(0), 0.0, 0.0, 0.0, 1.0;
+  Rx << 1.0, 0.0, 0.0, 0.0, c(1), -s(1), 0.0, s(1), c(1);
+  Rz3 << c(2), -s(2), 0.0, s(2), c(2), 0.0, 0.0, 0.0, 1.0;
+  const Mat3 R2 = R1 * Rx;
+  const Mat3 R3 = R2 * Rz3;
   const Vec3 x1 = R1.col(0), z2 = R2.col(2);
   const Vec3 w1 = qd(0) * Vec3::UnitZ();
   const Vec3 w2 = w1 + qd(1) * x1;
@@ -90,7 +165,7 @@ void wrist_link_motion(const Vec3& q, const Vec3& qd, const Vec3& qdd,
 }
 
 Mat3 wrist_momentum_matrix(const WristInertias& J, const Vec3& q) noexcept {
-  return WristAt(J, q).momentum_matrix();
+  return WristFrame2(J, q).momentum_matrix();
 }
 
 Vec3 wrist_momentum_bias(const WristInertias& J, const Vec3& q, const Vec3& qd) noexcept {
@@ -126,9 +201,13 @@ ReactionlessWrist::ReactionlessWrist(const WristInertias& inertia_body,
   if (!initial_angles.allFinite()) fail("initial_angles", "must be finite", initial_angles.sum());
   if (!target_momentum.allFinite()) fail("target_momentum", "must be finite", target_momentum.sum());
   dt_ = 1.0 / config.rate_hz;
+  diagonal_inertia_ = true;
+  for (const Mat3& J : inertia_)
+    diagonal_inertia_ = diagonal_inertia_ && (J - Mat3(J.diagonal().asDiagonal())).isZero(0.0);
   angles_ = initial_angles;
   target_ = target_momentum;
   command_.angles = command_.next_angles = initial_angles;
+  cos_sin(initial_angles, command_.cos_angles, command_.sin_angles);
   command_.condition_number = 1.0;
 }
 
@@ -138,6 +217,7 @@ Status ReactionlessWrist::reset(const Vec3& angles, const Vec3& target_momentum)
   target_ = target_momentum;
   command_ = WristCommand{};
   command_.angles = command_.next_angles = angles;
+  cos_sin(angles, command_.cos_angles, command_.sin_angles);
   return Status::ok;
 }
 
@@ -196,13 +276,65 @@ Status ReactionlessWrist::rates(const Vec3& q, const Vec3& D, Vec3& qd,
 
 Status ReactionlessWrist::rates_with(const Mat3& N, const Vec3& D, Vec3& qd, double& condition,
                                      Mat3* inverse) const noexcept {
-  Status st = solve(N, target_ - D, qd, condition, inverse);
+  const Status st = solve(N, target_ - D, qd, condition, inverse);
+  return st | limit_rate(qd);
+}
+
+Status ReactionlessWrist::limit_rate(Vec3& qd) const noexcept {
   const double peak = qd.cwiseAbs().maxCoeff();
   if (peak > config_.max_rate) {
     qd *= config_.max_rate / peak;  // keep the direction of the commanded rate vector
-    st |= Status::saturated;
+    return Status::saturated;
   }
-  return st;
+  return Status::ok;
+}
+
+Status ReactionlessWrist::stage_rates(const Vec3& delta, const Vec3& cos_n, const Vec3& sin_n,
+                                      const Vec3& D, Vec3& qd) const noexcept {
+  // An RK4 stage needs the rates only, not cond(N) (issue 6: the closed-form eigenvalues cost as
+  // much as the rest of the stage). The decision "well conditioned" must stay the one solve()
+  // makes (cond(N) <= max_condition, else damped least squares + Status::singular), so it is
+  // taken on an upper bound: cond_2(N) <= |N|_F |N^-1|_F. When the bound is within the limit,
+  // so is cond(N), and the fast solve is exactly solve()'s fast path (cofactor inverse); the
+  // bound exceeds cond(N) by at least 1 + 1/cond and at most a factor 3, far above the eigenvalue
+  // route's cond^2 eps rounding, so the decision is the same. Otherwise solve() decides.
+  const Vec3 q = angles_ + delta;
+  Vec3 cq, sq;
+  for (int i = 0; i < 3; ++i) sincos_near(cos_n(i), sin_n(i), delta(i), q(i), cq(i), sq(i));
+  Mat3 N2;
+  if (diagonal_inertia_) {
+    // J_k = diag(x_k, y_k, z_k) (PAMINSA's wrist): WristFrame2's N2 written out, with
+    // I3 = Rz(psi) J3 Rz(psi)^T = [x3 c^2 + y3 s^2, (x3 - y3) c s, 0; ..., x3 s^2 + y3 c^2, 0; 0, 0, z3]
+    // and I1 ez = (0, sin th z1, cos th z1):
+    // N2 = [sin th S01, S00, 0; sin th (z1 + S11), S01, 0; cos th (z1 + S22), 0, z3], S = J2 + I3
+    const double c = cq(2), s = sq(2), cth = cq(1), sth = sq(1);
+    const Mat3 &J1 = inertia_[0], &J2 = inertia_[1], &J3 = inertia_[2];
+    const double x3 = J3(0, 0), y3 = J3(1, 1), z3 = J3(2, 2), z1 = J1(2, 2);
+    const double S00 = J2(0, 0) + x3 * c * c + y3 * s * s, S01 = (x3 - y3) * c * s;
+    const double S11 = J2(1, 1) + x3 * s * s + y3 * c * c, S22 = J2(2, 2) + z3;
+    N2 << sth * S01, S00, 0.0,  //
+        sth * (z1 + S11), S01, 0.0,  //
+        cth * (z1 + S22), 0.0, z3;
+  } else {
+    N2 = WristFrame2(inertia_, cq, sq).N2;
+  }
+  // R2^T (H_target - D), R2 = Rz(phi) Rx(theta)
+  const Vec3 b = target_ - D;
+  const double bx = cq(0) * b(0) + sq(0) * b(1), by = -sq(0) * b(0) + cq(0) * b(1);
+  const Vec3 rhs(bx, cq(1) * by + sq(1) * b(2), -sq(1) * by + cq(1) * b(2));
+  double det = 0.0;
+  const Mat3 inv = cofactor_inverse(N2, det);
+  const double bound2 = N2.squaredNorm() * inv.squaredNorm();
+  const double max_c = config_.max_condition;
+  Status st = Status::ok;
+  double unused = 1.0;
+  if (det != 0.0 && bound2 <= max_c * max_c && inv.allFinite()) {
+    qd = inv * rhs;
+    if (!qd.allFinite()) st = solve(N2, rhs, qd, unused);
+  } else {
+    st = solve(N2, rhs, qd, unused);
+  }
+  return st | limit_rate(qd);
 }
 
 Status ReactionlessWrist::step(const Vec3& D_now, const Vec3& D_dot, const Vec3& D_half,
@@ -222,6 +354,7 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
                       (D_next == nullptr || D_next->allFinite());
   const auto hold = [this](Status why) noexcept {
     command_.angles = command_.next_angles = angles_;
+    cos_sin(angles_, command_.cos_angles, command_.sin_angles);
     command_.rates.setZero();
     command_.accelerations.setZero();
     command_.status = why;
@@ -231,31 +364,36 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
 
   Vec3 k1;
   double cond = 1.0, unused = 1.0;
-  // N(q_n) and the link inertias are built once for k1 and the feed-forward; when N is well
-  // conditioned its inverse is reused for both (issue 6: the tick recomputed them)
-  const WristAt at(inertia_, angles_);
-  const Mat3 N = at.momentum_matrix();
-  Mat3 N_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by the fast path
-  Status st = rates_with(N, D_now, k1, cond, &N_inv);
-  // feed-forward acceleration: N qdd = -Ddot - bias(q, qdot)
+  // N(q_n) is built once (in link 2's frame) for k1 and the feed-forward; cond(N(q_n)), the
+  // reported one, comes from solve()'s closed-form eigenvalues; when N is well conditioned its
+  // inverse is reused for both (issue 6)
+  Vec3 cos_n, sin_n;
+  cos_sin(angles_, cos_n, sin_n);
+  const WristFrame2 at(inertia_, cos_n, sin_n, diagonal_inertia_);
+  Mat3 N2_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by the fast path
+  Status st = solve(at.N2, at.to_frame2(target_ - D_now), k1, cond, &N2_inv);
+  st |= limit_rate(k1);
+  // feed-forward acceleration: N qdd = -Ddot - bias(q, qdot)  <=>  N2 qdd = R2^T(-Ddot) - bias2
   Vec3 qdd;
-  const Vec3 rhs = -D_dot - at.bias(k1);
-  if (N_inv.allFinite())
-    qdd = N_inv * rhs;  // well conditioned: the fast path's inverse
+  const Vec3 rhs = at.to_frame2(-D_dot) - at.bias_frame2(k1);
+  if (N2_inv.allFinite())
+    qdd = N2_inv * rhs;  // well conditioned: the fast path's inverse
   else
-    st |= solve(N, rhs, qdd, unused);
+    st |= solve(at.N2, rhs, qdd, unused);
   Vec3 next;
   if (D_half != nullptr && D_next != nullptr) {
     Vec3 k2, k3, k4;
-    st |= rates(angles_ + 0.5 * dt_ * k1, *D_half, k2, unused);
-    st |= rates(angles_ + 0.5 * dt_ * k2, *D_half, k3, unused);
-    st |= rates(angles_ + dt_ * k3, *D_next, k4, unused);
+    st |= stage_rates(0.5 * dt_ * k1, cos_n, sin_n, *D_half, k2);
+    st |= stage_rates(0.5 * dt_ * k2, cos_n, sin_n, *D_half, k3);
+    st |= stage_rates(dt_ * k3, cos_n, sin_n, *D_next, k4);
     next = angles_ + dt_ / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   } else {
     next = angles_ + dt_ * k1;  // eq 26
   }
   if (!next.allFinite() || !k1.allFinite() || !qdd.allFinite()) return hold(Status::non_finite_input);
   command_.angles = angles_;
+  command_.cos_angles = cos_n;
+  command_.sin_angles = sin_n;
   command_.rates = k1;
   command_.accelerations = has(st, Status::saturated) ? Vec3::Zero() : qdd;
   command_.next_angles = next;

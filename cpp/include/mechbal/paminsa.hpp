@@ -95,6 +95,18 @@ struct WristMotion {
   Vec3 angles = Vec3::Zero(), rates = Vec3::Zero(), accelerations = Vec3::Zero();
 };
 
+/// Constant mass data of one leg for the closed-form momentum path (derived at construction):
+/// the leg's in-plane masses sit at affine combinations c_j of its points (A, C, E), so their
+/// momenta are bilinear forms in (A, C, E) with G = sum m_j c_j c_j^T, mu = sum m_j c_j and
+/// nu = the column's (link 6) mass x height offset x c_B; J14 / J23: summed principal inertias of
+/// the parallel pantograph links 1, 4 and 2, 3; J6x: the column's inertia about its (vertical)
+/// axis; guide_first / guide_second: sum m l and sum m l^2 + J_zz of link 5 and CP3 on the guide.
+struct PaminsaLegMass {
+  Mat3 G = Mat3::Zero();
+  Vec3 mu = Vec3::Zero(), nu = Vec3::Zero(), J14 = Vec3::Zero(), J23 = Vec3::Zero();
+  double J6x = 0.0, guide_first = 0.0, guide_second = 0.0;
+};
+
 /// Immutable, validated PAMINSA model with its derived layout.
 class PaminsaModel {
  public:
@@ -105,6 +117,7 @@ class PaminsaModel {
   const std::array<RigidBody, PaminsaBodyIndex::count>& bodies() const noexcept { return bodies_; }
   static const char* body_name(std::size_t index) noexcept;
   const WristInertias& wrist_inertia() const noexcept { return wrist_; }
+  const std::array<PaminsaLegMass, 3>& leg_mass() const noexcept { return leg_mass_; }
 
   // derived layout (A8)
   const std::array<Vec3, 3>& platform_joint_offset() const noexcept { return c_off_; }  ///< C_i - P
@@ -122,6 +135,7 @@ class PaminsaModel {
   PaminsaParameters p_;
   std::array<RigidBody, PaminsaBodyIndex::count> bodies_;
   WristInertias wrist_;
+  std::array<PaminsaLegMass, 3> leg_mass_;
   std::array<Vec3, 3> c_off_;
   std::array<Eigen::Vector2d, 3> B_h_, M_h_, A0_h_;
   Eigen::Vector2d vcw_;
@@ -150,6 +164,18 @@ Status paminsa_kinematics(const PaminsaModel& model, const PlatformMotion& platf
 /// translation is in the platform mass) and dD/dt, from the workspace's mechanism bodies.
 Status paminsa_mechanism_momentum(const PaminsaModel& model, const PaminsaWorkspace& ws, Vec3& D,
                                   Vec3& D_dot) noexcept;
+
+/// The 35 mechanism bodies' momenta and their rates (linear momentum, D of eq 19, shaking force,
+/// dD/dt) in closed form from the platform motion, without forming the bodies' states (each leg is
+/// a planar linkage in a vertical plane turning about z; derivation in paminsa.cpp). Equals
+/// shaking_wrench over the states of paminsa_mechanism_kinematics (to rounding). Same statuses as
+/// paminsa_mechanism_kinematics; `out` is untouched unless Status::ok.
+Status paminsa_mechanism_wrench(const PaminsaModel& model, const PlatformMotion& platform,
+                                ShakingWrench& out) noexcept;
+/// D only (what the RK4 stages need): positions and rates, no accelerations (the platform's
+/// acceleration must still be finite).
+Status paminsa_mechanism_angular_momentum(const PaminsaModel& model,
+                                          const PlatformMotion& platform, Vec3& D) noexcept;
 
 /// One controller tick of the fully balanced PAMINSA: kinematics at t_n, D, the reactionless-wrist
 /// step, then every body's motion (with the wrist following the command) and the shaking wrench.

@@ -45,6 +45,9 @@ struct WristLinkMotion {
 };
 void wrist_link_motion(const Vec3& angles, const Vec3& rates, const Vec3& accelerations,
                        WristLinkMotion& out) noexcept;
+/// The same from the cosines and sines of the angles (e.g. WristCommand::cos_angles/sin_angles).
+void wrist_link_motion(const Vec3& cos_angles, const Vec3& sin_angles, const Vec3& rates,
+                       const Vec3& accelerations, WristLinkMotion& out) noexcept;
 
 /// N(q) of eq 23 (corrected): H_wrist = N(q) qdot with H_wrist = sum_k I_k w_k.
 Mat3 wrist_momentum_matrix(const WristInertias& inertia_body, const Vec3& angles) noexcept;
@@ -79,6 +82,8 @@ struct WristCommand {
   Vec3 rates = Vec3::Zero();
   Vec3 accelerations = Vec3::Zero();
   Vec3 next_angles = Vec3::Zero();
+  /// cos and sin of `angles` (the tick needs them; the kinematics of the same tick can reuse them)
+  Vec3 cos_angles = Vec3::Ones(), sin_angles = Vec3::Zero();
   double condition_number = 1.0;
   Status status = Status::ok;
 };
@@ -118,11 +123,18 @@ class ReactionlessWrist {
                Mat3* inverse = nullptr) const noexcept;
   Status rates_with(const Mat3& N, const Vec3& D, Vec3& rates, double& condition,
                     Mat3* inverse = nullptr) const noexcept;
+  /// Status::saturated (and qd scaled down, direction kept) when a rate exceeds max_rate.
+  Status limit_rate(Vec3& qd) const noexcept;
+  /// The rates at the RK4 stage angles_ + delta (cos_n, sin_n: of angles_): same result and
+  /// status as rates() without computing cond(N).
+  Status stage_rates(const Vec3& delta, const Vec3& cos_n, const Vec3& sin_n, const Vec3& D,
+                     Vec3& qd) const noexcept;
   Status tick(const Vec3& D_now, const Vec3& D_dot, const Vec3* D_half, const Vec3* D_next) noexcept;
 
   WristInertias inertia_;
   ReactionlessWristConfig config_;
   double dt_;
+  bool diagonal_inertia_ = false;  ///< every J_k diagonal (exactly): the stages' N2 in closed form
   Vec3 angles_;
   Vec3 target_;
   WristCommand command_;
