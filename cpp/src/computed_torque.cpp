@@ -1,5 +1,5 @@
 #include "mechbal/computed_torque.hpp"
-#include "mechbal/detail/saturation.hpp"
+#include "mechbal/detail/joint_control.hpp"
 
 #include <cmath>
 #include <limits>
@@ -8,37 +8,16 @@
 
 namespace mechbal {
 
-namespace {
-
-void check_vector(const Eigen::VectorXd& v, const char* field, int n, bool allow_inf) {
-  std::ostringstream msg;
-  if (v.size() != n) {
-    msg << field << " must have " << n << " values (got " << v.size() << ")";
-    throw std::invalid_argument(msg.str());
-  }
-  for (int i = 0; i < n; ++i) {
-    const double x = v(i);
-    const bool ok = allow_inf ? (x > 0.0 && !std::isnan(x)) : (std::isfinite(x) && x > 0.0);
-    if (!ok) {
-      msg << field << "[" << i << "] must be " << (allow_inf ? "> 0" : "finite and > 0")
-          << " (got " << x << ")";
-      throw std::invalid_argument(msg.str());
-    }
-  }
-}
-
-}  // namespace
-
 ComputedTorque::ComputedTorque(InverseDynamics& model, const Eigen::VectorXd& kp,
                                const Eigen::VectorXd& kd, const Eigen::VectorXd& torque_limit)
     : model_(model), n_(model.dof()), kp_(kp), kd_(kd) {
   if (n_ <= 0) throw std::invalid_argument("computed_torque.model must have at least one joint");
-  check_vector(kp, "computed_torque.kp", n_, false);
-  check_vector(kd, "computed_torque.kd", n_, false);
+  detail::check_positive_vector(kp, "computed_torque.kp", n_, false);
+  detail::check_positive_vector(kd, "computed_torque.kd", n_, false);
   if (torque_limit.size() == 0) {
     limit_ = Eigen::VectorXd::Constant(n_, std::numeric_limits<double>::infinity());
   } else {
-    check_vector(torque_limit, "computed_torque.torque_limit", n_, true);
+    detail::check_positive_vector(torque_limit, "computed_torque.torque_limit", n_, true);
     limit_ = torque_limit;
   }
   v_ = Eigen::VectorXd::Zero(n_);

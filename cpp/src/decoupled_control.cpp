@@ -1,5 +1,5 @@
 #include "mechbal/decoupled_control.hpp"
-#include "mechbal/detail/saturation.hpp"
+#include "mechbal/detail/joint_control.hpp"
 
 #include <cmath>
 #include <limits>
@@ -7,27 +7,6 @@
 #include <stdexcept>
 
 namespace mechbal {
-
-namespace {
-
-void check(const Eigen::VectorXd& v, const char* field, Eigen::Index n, bool allow_inf) {
-  std::ostringstream msg;
-  if (v.size() != n) {
-    msg << field << " must have " << n << " values (got " << v.size() << ")";
-    throw std::invalid_argument(msg.str());
-  }
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double x = v(i);
-    const bool ok = allow_inf ? (x > 0.0 && !std::isnan(x)) : (std::isfinite(x) && x > 0.0);
-    if (!ok) {
-      msg << field << "[" << i << "] must be " << (allow_inf ? "> 0" : "finite and > 0")
-          << " (got " << x << ")";
-      throw std::invalid_argument(msg.str());
-    }
-  }
-}
-
-}  // namespace
 
 DecoupledJointController::DecoupledJointController(const Eigen::VectorXd& k,
                                                    const Eigen::VectorXd& kp,
@@ -39,16 +18,16 @@ DecoupledJointController::DecoupledJointController(const Eigen::VectorXd& k,
     msg << "decoupled_control.k must have 1.." << max_dof << " values (got " << n << ")";
     throw std::invalid_argument(msg.str());
   }
-  check(k, "decoupled_control.k", n, false);
-  check(kp, "decoupled_control.kp", n, false);
-  check(kd, "decoupled_control.kd", n, false);
+  detail::check_positive_vector(k, "decoupled_control.k", n, false);
+  detail::check_positive_vector(kp, "decoupled_control.kp", n, false);
+  detail::check_positive_vector(kd, "decoupled_control.kd", n, false);
   k_ = k;
   kp_ = kp;
   kd_ = kd;
   if (torque_limit.size() == 0) {
     limit_ = VecN::Constant(n, std::numeric_limits<double>::infinity());
   } else {
-    check(torque_limit, "decoupled_control.torque_limit", n, true);
+    detail::check_positive_vector(torque_limit, "decoupled_control.torque_limit", n, true);
     limit_ = torque_limit;
   }
   raw_ = VecN::Zero(n);

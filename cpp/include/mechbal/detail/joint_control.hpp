@@ -1,11 +1,17 @@
 #pragma once
-/// \file detail/saturation.hpp
-/// Shared by the joint controllers: clip a command to symmetric per-joint limits.
+/// \file detail/joint_control.hpp
+/// Shared by the joint controllers (ComputedTorque, DecoupledJointController): construction-time
+/// checks of gain and limit vectors, and the real-time clipping of a command to per-joint limits.
 #include <Eigen/Core>
 
 #include "mechbal/status.hpp"
 
 namespace mechbal::detail {
+
+/// Construction time (throws): `v` must have `n` values, each > 0 and finite (or > 0, possibly
+/// +infinity, when `allow_inf`); the std::invalid_argument names `field`, the index and the value.
+void check_positive_vector(const Eigen::VectorXd& v, const char* field, Eigen::Index n,
+                           bool allow_inf);
 
 /// Clips x(i) to [-limit(i), limit(i)] for the first n entries (limits may be +infinity).
 /// Returns Status::saturated when any entry was clipped, Status::ok otherwise. noexcept, no
