@@ -8,6 +8,7 @@
 
 #include "array_checks.hpp"
 #include "bindings.hpp"
+#include "controller_step.hpp"
 #include "mechbal/arm2dof.hpp"
 #include "mechbal/closed_loop.hpp"
 #include "mechbal/computed_torque.hpp"
@@ -148,17 +149,7 @@ void bind_arm2dof(py::module_& m) {
            "RneChainDynamics)")
       .def_property_readonly("dof", &ComputedTorque::dof)
       .def_property_readonly("last_command", &ComputedTorque::last_command)
-      .def(
-          "step",
-          [](ComputedTorque& c, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-             const Eigen::VectorXd& q_des, const Eigen::VectorXd& qd_des,
-             const Eigen::VectorXd& qdd_des) {
-            Eigen::VectorXd tau = c.last_command();
-            const Status s = c.step(q, qd, q_des, qd_des, qdd_des, tau);
-            if (s == Status::bad_size)
-              throw py::value_error("q, qd, q_des, qd_des, qdd_des must each have dof values");
-            return py::make_tuple(tau, s);
-          },
+      .def("step", &controller_step<ComputedTorque>,
           py::arg("q"), py::arg("qd"), py::arg("q_des"), py::arg("qd_des"), py::arg("qdd_des"),
           "One tick: (tau, status). Non-finite input returns the last command and a status.")
       .def("reset", &ComputedTorque::reset);

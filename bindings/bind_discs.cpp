@@ -9,6 +9,7 @@
 
 #include "array_checks.hpp"
 #include "bindings.hpp"
+#include "controller_step.hpp"
 #include "mechbal/computed_torque.hpp"
 #include "mechbal/decoupled_control.hpp"
 #include "mechbal/disc_arm.hpp"
@@ -131,17 +132,7 @@ void bind_discs(py::module_& m) {
       .def_property_readonly("last_command", [](const DecoupledJointController& c) {
         return Eigen::VectorXd(c.last_command());
       })
-      .def(
-          "step",
-          [](DecoupledJointController& c, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-             const Eigen::VectorXd& q_des, const Eigen::VectorXd& qd_des,
-             const Eigen::VectorXd& qdd_des) {
-            Eigen::VectorXd tau = c.last_command();
-            const Status s = c.step(q, qd, q_des, qd_des, qdd_des, tau);
-            if (s == Status::bad_size)
-              throw py::value_error("q, qd, q_des, qd_des, qdd_des must each have dof values");
-            return py::make_tuple(tau, s);
-          },
+      .def("step", &controller_step<DecoupledJointController>,
           py::arg("q"), py::arg("qd"), py::arg("q_des"), py::arg("qd_des"), py::arg("qdd_des"),
           "One tick: (tau, status). Non-finite input returns the last command and a status.")
       .def("reset", &DecoupledJointController::reset);
