@@ -203,7 +203,7 @@ Status inverse_dynamics(const MechanismModel& model, MechanismData& data, const 
                         const ConstVector& v, const ConstVector& a) noexcept {
   if (Status s = check_state(model, data, &q, &v, &a); s != Status::ok) return s;
   detail::joint_state<true, true>(model, data, q, v, a);
-  detail::place(model, data);
+  detail::place<false>(model, data);
   detail::forward_pass<true, true, true, true>(model, data);
   detail::backward_pass(model, data, data.joint_torque);
   return Status::ok;
@@ -212,7 +212,7 @@ Status inverse_dynamics(const MechanismModel& model, MechanismData& data, const 
 Status gravity_torque(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
   if (Status s = check_state(model, data, &q); s != Status::ok) return s;
   detail::joint_state<false, false>(model, data, q, q, q);
-  detail::place(model, data);
+  detail::place<false>(model, data);
   detail::forward_pass<false, false, true, true>(model, data);
   detail::backward_pass(model, data, data.gravity_torque);
   return Status::ok;
@@ -222,7 +222,7 @@ Status bias_torque(const MechanismModel& model, MechanismData& data, const Const
                    const ConstVector& v) noexcept {
   if (Status s = check_state(model, data, &q, &v); s != Status::ok) return s;
   detail::joint_state<true, false>(model, data, q, v, v);
-  detail::place(model, data);
+  detail::place<false>(model, data);
   detail::forward_pass<true, false, true, true>(model, data);
   detail::backward_pass(model, data, data.bias_torque);
   return Status::ok;
@@ -233,7 +233,7 @@ Status bias_torque(const MechanismModel& model, MechanismData& data, const Const
 Status mass_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
   if (Status s = check_state(model, data, &q); s != Status::ok) return s;
   detail::joint_state<false, false>(model, data, q, q, q);
-  detail::place(model, data);
+  detail::place<false>(model, data);
   detail::composite_inertias(model, data);
   Eigen::MatrixXd& M = data.mass_matrix;
   M.setZero();

@@ -13,6 +13,7 @@ from mechbal._core import (  # noqa: F401
     JointSpec,
     JointType,
     KdlChainDynamics,
+    MechanismDynamics,
     PaminsaModel,
     PaminsaParameters,
     ReactionlessWrist,

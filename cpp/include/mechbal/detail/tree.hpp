@@ -58,7 +58,8 @@ inline void joint_state(const MechanismModel& model, MechanismData& data,
   }
 }
 
-/// Link placements relative to their parents and in O (L frames).
+/// Link placements relative to their parents and, with World (the default), in O (L frames).
+template <bool World = true>
 inline void place(const MechanismModel& model, MechanismData& data) noexcept {
   const int nl = model.num_links();
   for (int l = 1; l < nl; ++l) {
@@ -85,9 +86,11 @@ inline void place(const MechanismModel& model, MechanismData& data) noexcept {
         w.translation = c.translation;
         break;
     }
-    const auto& p = data.work[static_cast<std::size_t>(model.parent(l))];
-    w.world_rotation.noalias() = p.world_rotation * w.rotation;
-    w.world_position = p.world_position + p.world_rotation * w.translation;
+    if (World) {
+      const auto& p = data.work[static_cast<std::size_t>(model.parent(l))];
+      w.world_rotation.noalias() = p.world_rotation * w.rotation;
+      w.world_position = p.world_position + p.world_rotation * w.translation;
+    }
   }
 }
 
