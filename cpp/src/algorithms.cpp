@@ -279,24 +279,7 @@ Status frame_jacobian(const MechanismModel& model, MechanismData& data, const Co
   if (Status s = check_state(model, data, &q); s != Status::ok) return s;
   detail::joint_state<false, false>(model, data, q, q, q);
   detail::place(model, data);
-  const int fl = model.frame_link(frame);
-  const auto& F = data.work[static_cast<std::size_t>(fl)];
-  const Vec3 origin = F.world_position + F.world_rotation * (model.link_constants(fl).aligned.transpose() *
-                                                             model.frame(frame).placement.translation());
-  data.frame_jacobian.setZero();
-  for (int k = fl; k >= 1; k = model.parent(k)) {
-    const int c = model.coordinate(k);
-    if (c < 0) continue;
-    const auto& K = data.work[static_cast<std::size_t>(k)];
-    const Vec3 z = K.world_rotation.col(2);
-    const double r = model.coordinate_ratio(k);
-    if (model.joint_type(k) == JointType::revolute) {
-      data.frame_jacobian.col(c).head<3>() += r * z.cross(origin - K.world_position);
-      data.frame_jacobian.col(c).tail<3>() += r * z;
-    } else {
-      data.frame_jacobian.col(c).head<3>() += r * z;
-    }
-  }
+  detail::frame_jacobian_placed(model, data, frame, data.frame_jacobian);
   return Status::ok;
 }
 

@@ -308,7 +308,53 @@ MechanismModel::MechanismModel(MechanismDescription d) {
     c.inertia_origin += I + m * (com.squaredNorm() * Mat3::Identity() - com * com.transpose());
   }
 
-  serial_chain_ = nl > 1;
+  // ---- loops and actuation ----
+  std::vector<std::string> frame_name_list;
+  for (const auto& fr : frames_) frame_name_list.push_back(fr.name);
+  std::map<std::string, std::size_t> loop_names;
+  for (std::size_t i = 0; i < d.loops.size(); ++i) {
+    const LoopConstraint& lc = d.loops[i];
+    if (lc.name.empty()) throw std::invalid_argument(indexed_field("loops", i, lc.name, "name") + " must not be empty");
+    if (!loop_names.emplace(lc.name, i).second) {
+      throw std::invalid_argument(indexed_field("loops", i, lc.name, "name") + " is used by two loops");
+    }
+    const int fa = frame_index(lc.frame_a), fb = frame_index(lc.frame_b);
+    if (fa < 0) {
+      throw std::invalid_argument(indexed_field("loops", i, lc.name, "frame_a") + ": no frame named '" +
+                                  lc.frame_a + "'" + nearest(lc.frame_a, frame_name_list));
+    }
+    if (fb < 0) {
+      throw std::invalid_argument(indexed_field("loops", i, lc.name, "frame_b") + ": no frame named '" +
+                                  lc.frame_b + "'" + nearest(lc.frame_b, frame_name_list));
+    }
+    if (frame_link_[static_cast<std::size_t>(fa)] == frame_link_[static_cast<std::size_t>(fb)]) {
+      throw std::invalid_argument(indexed_field("loops", i, lc.name, "frame_b") +
+                                  ": both frames are on the same link, so the loop closes nothing");
+    }
+    loops_.push_back(lc);
+    loop_frames_.emplace_back(fa, fb);
+    loop_rows_.push_back(num_constraints_);
+    num_constraints_ += loop_equations(lc.type);
+  }
+  std::vector<bool> is_actuated(static_cast<std::size_t>(dof_), d.actuated.empty() && d.loops.empty());
+  for (std::size_t i = 0; i < d.actuated.size(); ++i) {
+    const auto& name = d.actuated[i];
+    auto it = std::find(coordinate_names_.begin(), coordinate_names_.end(), name);
+    if (it == coordinate_names_.end()) {
+      throw std::invalid_argument("actuated[" + std::to_string(i) + "]: '" + name +
+                                  "' is not a joint with a coordinate (a fixed or gear-coupled joint "
+                                  "cannot be actuated)" + nearest(name, coordinate_names_));
+    }
+    const auto k = static_cast<std::size_t>(it - coordinate_names_.begin());
+    if (is_actuated[k]) throw std::invalid_argument("actuated[" + std::to_string(i) + "]: '" + name + "' is named twice");
+    is_actuated[k] = true;
+  }
+  if (!d.loops.empty() && d.actuated.empty()) {
+    throw std::invalid_argument("actuated: a mechanism with loops must name its actuated joints");
+  }
+  for (int c = 0; c < dof_; ++c) (is_actuated[static_cast<std::size_t>(c)] ? actuated_ : passive_).push_back(c);
+
+  serial_chain_ = nl > 1 && loops_.empty();
   for (std::size_t l = 1; l < nl; ++l) {
     if (parent_[l] != static_cast<int>(l) - 1 || type_[l] == JointType::fixed || ratio_[l] != 1.0 ||
         offset_[l] != 0.0 || coordinate_[l] != static_cast<int>(l) - 1) {
@@ -390,6 +436,35 @@ MechanismData::MechanismData(const MechanismModel& model)
     w.composite_inertia = Mat3::Zero();
   }
   link_mass_matrix = Eigen::MatrixXd::Zero(num_links, num_links);
+  const int m = model.num_constraints(), na = model.num_actuated(), np = model.num_passive();
+  loop_residual = Eigen::VectorXd::Zero(m);
+  loop_jacobian = Eigen::MatrixXd::Zero(m, dof);
+  loop_bias = Eigen::VectorXd::Zero(m);
+  loop_projection = Eigen::MatrixXd::Zero(dof, na);
+  for (int i = 0; i < na; ++i) loop_projection(model.actuated_coordinates()[static_cast<std::size_t>(i)], i) = 1.0;
+  loop_acceleration_bias = Eigen::VectorXd::Zero(dof);
+  closed_position = Eigen::VectorXd::Zero(dof);
+  closed_velocity = Eigen::VectorXd::Zero(dof);
+  closed_acceleration = Eigen::VectorXd::Zero(dof);
+  actuated_force = Eigen::VectorXd::Zero(na);
+  actuated_gravity = Eigen::VectorXd::Zero(na);
+  actuated_acceleration = Eigen::VectorXd::Zero(na);
+  reduced_mass_matrix = Eigen::MatrixXd::Zero(na, na);
+  loop_frame_jacobian_a = Eigen::MatrixXd::Zero(6, dof);
+  loop_frame_jacobian_b = Eigen::MatrixXd::Zero(6, dof);
+  loop_passive_jacobian = Eigen::MatrixXd::Zero(m, np);
+  loop_actuated_jacobian = Eigen::MatrixXd::Zero(m, na);
+  loop_constraint_work = Eigen::VectorXd::Zero(m);
+  reduced_ldlt = Eigen::LDLT<Eigen::MatrixXd>(na);
+  reduced_ldlt.compute(Eigen::MatrixXd::Identity(na, na));
+  loop_normal = Eigen::MatrixXd::Identity(np, np);
+  loop_ldlt = Eigen::LDLT<Eigen::MatrixXd>(np);
+  loop_ldlt.compute(loop_normal);  // sizes every internal buffer once
+  loop_step = Eigen::VectorXd::Zero(np);
+  loop_trial = Eigen::VectorXd::Zero(dof);
+  loop_solution = Eigen::MatrixXd::Zero(np, na);
+  loop_reduced_work = Eigen::MatrixXd::Zero(dof, na);
+  loop_vector_work = Eigen::VectorXd::Zero(dof);
 }
 
 }  // namespace mechbal

@@ -3,6 +3,7 @@
 /// MechanismData: every buffer the algorithms over a MechanismModel need, allocated once from the
 /// model (Pinocchio's Data). Algorithms write their results here; nothing allocates afterwards.
 /// All world quantities are in the base frame O; moments and angular momenta are about O.
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <vector>
@@ -51,6 +52,33 @@ struct MechanismData {
   Eigen::MatrixXd torque_regressor;    ///< dof x 10 nb: tau = Y pi
   Eigen::MatrixXd gravity_regressor;   ///< dof x 10 nb: G(q) = Y pi
   Eigen::MatrixXd momentum_regressor;  ///< 6 x 10 nb: [P; H_O] = Y pi
+
+  // ---- closed loops (algorithm/loops.hpp); sizes: m constraints, n = dof, na actuated ----
+  Eigen::VectorXd loop_residual;           ///< closure equations Phi(q) (m)
+  Eigen::MatrixXd loop_jacobian;           ///< A = dPhi/dq (m x n)
+  Eigen::VectorXd loop_bias;               ///< gamma = dA/dt v: A a + gamma = 0 (m)
+  Eigen::MatrixXd loop_projection;         ///< C: v = C v# (n x na), C = [I; -(A°)^-1 A#] reordered
+  Eigen::VectorXd loop_acceleration_bias;  ///< c: a = C a# + c (n)
+  double loop_rcond = 1.0;         ///< reciprocal condition estimate of the passive Jacobian A°
+  int loop_iterations = 0;         ///< Newton iterations of the last position solve
+  double loop_residual_norm = 0.0; ///< max |Phi| after the last position solve [m or rad]
+  Eigen::VectorXd closed_position, closed_velocity, closed_acceleration;  ///< q, v, a (n)
+  Eigen::VectorXd actuated_force;          ///< tau# = C^T tau (na)
+  Eigen::VectorXd actuated_gravity;        ///< C^T G (na)
+  Eigen::VectorXd actuated_acceleration;   ///< a# of the forward dynamics (na)
+  Eigen::MatrixXd reduced_mass_matrix;     ///< C^T M C (na x na)
+  // scratch of the loop algorithms
+  Eigen::MatrixXd loop_frame_jacobian_a, loop_frame_jacobian_b;  ///< 6 x n
+  Eigen::MatrixXd loop_passive_jacobian;   ///< A° (m x np)
+  Eigen::MatrixXd loop_actuated_jacobian;  ///< A# (m x na)
+  Eigen::VectorXd loop_constraint_work;    ///< m
+  Eigen::LDLT<Eigen::MatrixXd> reduced_ldlt;  ///< of C^T M C (na x na)
+  Eigen::MatrixXd loop_normal;             ///< A°^T A° + damping (np x np)
+  Eigen::LDLT<Eigen::MatrixXd> loop_ldlt;
+  Eigen::VectorXd loop_step, loop_trial;   ///< np, n
+  Eigen::MatrixXd loop_solution;           ///< np x na
+  Eigen::MatrixXd loop_reduced_work;       ///< n x na
+  Eigen::VectorXd loop_vector_work;        ///< n
 
   // ---- internal buffers (per link, in the joint-aligned frames L_i of model.hpp) ----
   struct LinkWork {

@@ -69,6 +69,26 @@ struct Frame {
   Eigen::Isometry3d placement = Eigen::Isometry3d::Identity();  ///< in the link frame
 };
 
+/// Loop-closure constraint types between two frames A and B (loops.hpp for the equations):
+///  - point: the origins coincide (3 equations, a spherical closure);
+///  - planar_point: the origins coincide in the plane normal to A's z axis (2 equations);
+///  - axis: the origins coincide and the z axes are parallel (5 equations, a revolute closure);
+///  - weld: the frames coincide (6 equations).
+enum class LoopType { point, planar_point, axis, weld };
+
+/// Number of scalar closure equations of a loop type.
+constexpr int loop_equations(LoopType t) noexcept {
+  return t == LoopType::point ? 3 : t == LoopType::planar_point ? 2 : t == LoopType::axis ? 5 : 6;
+}
+
+/// A loop closure between two named frames (usually on two branches of the tree).
+struct LoopConstraint {
+  std::string name;
+  LoopType type = LoopType::point;
+  std::string frame_a;
+  std::string frame_b;
+};
+
 /// Everything a MechanismModel is built from (what the URDF and TOML readers produce).
 struct MechanismDescription {
   std::string root_name = "base";
@@ -76,6 +96,11 @@ struct MechanismDescription {
   std::vector<Body> bodies;
   std::vector<Frame> frames;
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);
+  /// Loop closures; with loops, `actuated` must name the actuated joints (the independent
+  /// coordinates q#); the other coordinates are passive and follow from the closure equations.
+  std::vector<LoopConstraint> loops;
+  /// Names of the actuated joints (coordinates). Empty without loops: every coordinate.
+  std::vector<std::string> actuated;
 };
 
 /// The validated, immutable model. Link 0 is the base; links 1..num_links()-1 are the joints'
@@ -131,8 +156,25 @@ class MechanismModel {
   int frame_index(const std::string& name) const noexcept;
   /// Total mass of all bodies (the base's included) [kg].
   double total_mass() const noexcept { return total_mass_; }
-  /// True when the tree is a single chain of joints with coordinates (no branch, fixed joint or gear).
+  /// True when the tree is a single chain of joints with coordinates (no branch, fixed joint or
+  /// gear) and has no loops.
   bool is_serial_chain() const noexcept { return serial_chain_; }
+
+  // ---- loops and actuation ----
+  int num_loops() const noexcept { return static_cast<int>(loops_.size()); }
+  bool is_closed() const noexcept { return !loops_.empty(); }
+  const LoopConstraint& loop(int i) const { return loops_.at(static_cast<std::size_t>(i)); }
+  int loop_frame_a(int i) const noexcept { return loop_frames_[static_cast<std::size_t>(i)].first; }
+  int loop_frame_b(int i) const noexcept { return loop_frames_[static_cast<std::size_t>(i)].second; }
+  /// First row of loop i in the stacked closure equations.
+  int loop_row(int i) const noexcept { return loop_rows_[static_cast<std::size_t>(i)]; }
+  /// Total number of scalar closure equations.
+  int num_constraints() const noexcept { return num_constraints_; }
+  /// Indices into q of the actuated (independent) and passive coordinates.
+  const std::vector<int>& actuated_coordinates() const noexcept { return actuated_; }
+  const std::vector<int>& passive_coordinates() const noexcept { return passive_; }
+  int num_actuated() const noexcept { return static_cast<int>(actuated_.size()); }
+  int num_passive() const noexcept { return static_cast<int>(passive_.size()); }
 
   /// Precomputed per-link constants the algorithms use (joint-aligned frames, lumped inertia).
   /// Implementation detail made public for the algorithm files; see model.cpp.
@@ -165,6 +207,11 @@ class MechanismModel {
   std::vector<Frame> frames_;
   std::vector<int> frame_link_;
   std::vector<LinkConstants> constants_;
+  std::vector<LoopConstraint> loops_;
+  std::vector<std::pair<int, int>> loop_frames_;
+  std::vector<int> loop_rows_;
+  int num_constraints_ = 0;
+  std::vector<int> actuated_, passive_;
   double total_mass_ = 0.0;
   bool serial_chain_ = false;
 };

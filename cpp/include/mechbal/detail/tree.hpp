@@ -215,4 +215,54 @@ inline void composite_inertias(const MechanismModel& model, MechanismData& data)
   }
 }
 
+/// World placement and motion of a named frame from placed links and a forward pass: origin
+/// position, rotation (frame -> O), origin velocity and classical acceleration, angular velocity
+/// and acceleration (whatever the forward pass computed; zeros without velocities).
+struct FrameMotion {
+  Vec3 position, velocity, acceleration, angular_velocity, angular_acceleration;
+  Mat3 rotation;
+};
+
+inline FrameMotion frame_motion(const MechanismModel& model, const MechanismData& data, int frame) noexcept {
+  const int l = model.frame_link(frame);
+  const auto& W = data.work[static_cast<std::size_t>(l)];
+  const Mat3 RF = W.world_rotation * model.link_constants(l).aligned.transpose();
+  const auto& T = model.frame(frame).placement;
+  FrameMotion m;
+  const Vec3 r = RF * T.translation();
+  m.position = W.world_position + r;
+  m.rotation = RF * T.linear();
+  m.angular_velocity = W.world_rotation * W.w;
+  m.angular_acceleration = W.world_rotation * W.alpha;
+  m.velocity = W.world_rotation * W.vel + m.angular_velocity.cross(r);
+  m.acceleration = W.world_rotation * W.acc + m.angular_acceleration.cross(r) +
+                   m.angular_velocity.cross(m.angular_velocity.cross(r));
+  return m;
+}
+
+/// Jacobian [v; w] (O axes) of the origin of `frame` into J (6 x dof), from placed links (world
+/// poses computed).
+template <typename Jac>
+inline void frame_jacobian_placed(const MechanismModel& model, const MechanismData& data, int frame,
+                                  Jac& J) noexcept {
+  const int fl = model.frame_link(frame);
+  const auto& F = data.work[static_cast<std::size_t>(fl)];
+  const Vec3 origin = F.world_position + F.world_rotation * (model.link_constants(fl).aligned.transpose() *
+                                                             model.frame(frame).placement.translation());
+  J.setZero();
+  for (int k = fl; k >= 1; k = model.parent(k)) {
+    const int c = model.coordinate(k);
+    if (c < 0) continue;
+    const auto& K = data.work[static_cast<std::size_t>(k)];
+    const Vec3 z = K.world_rotation.col(2);
+    const double r = model.coordinate_ratio(k);
+    if (model.joint_type(k) == JointType::revolute) {
+      J.col(c).template head<3>() += r * z.cross(origin - K.world_position);
+      J.col(c).template tail<3>() += r * z;
+    } else {
+      J.col(c).template head<3>() += r * z;
+    }
+  }
+}
+
 }  // namespace mechbal::detail

@@ -1,0 +1,79 @@
+#pragma once
+/// \file algorithm/loops.hpp
+/// Closed-loop mechanisms on the general model: loop-closure equations, the position solve, the
+/// velocity/acceleration projection of the coupling-matrix method and the projected dynamics.
+///
+/// Coutinho & Hess Coelho (the discs paper), generalised: with the closure equations Phi(q) = 0 and
+/// A = dPhi/dq split into the passive columns A° and the actuated columns A#, the velocities are
+/// v = C v# with C = [I; -(A°)^-1 A#] (rows reordered to q's order) and the accelerations
+/// a = C a# + c with c = [0; -(A°)^-1 gamma], gamma = dA/dt v. With more equations than passive
+/// coordinates (planar loops closed by spatial point constraints, redundant closures) (A°)^-1 is
+/// the least-squares inverse (A°^T A°)^-1 A°^T, exact for consistent constraints.
+/// The actuated forces are tau# = C^T tau(q, v, a) (virtual power), the reduced mass matrix
+/// C^T M C, the reduced gravity C^T G; every tree algorithm (shaking wrench, base reaction, ...)
+/// applies to the closed mechanism at the solved (q, v, a).
+///
+/// Closure equations of loop (A, B) with d = p_B - p_A (origins, in O):
+///   point: d (3); planar_point: [x_A . d, y_A . d] (2); axis: d and [z_A . x_B, z_A . y_B] (5);
+///   weld: d and the rotation vector of R_B R_A^T (6).
+/// Open mechanisms (no loops) give C = the selection of the actuated coordinates and c = 0, so
+/// the closed_* functions apply to every mechanism.
+///
+/// Real time: noexcept, allocation-free, bounded (LoopSolveOptions::max_iterations).
+#include <Eigen/Core>
+
+#include "mechbal/data.hpp"
+#include "mechbal/model.hpp"
+#include "mechbal/status.hpp"
+
+namespace mechbal {
+
+using ConstVector = Eigen::Ref<const Eigen::VectorXd>;
+
+struct LoopSolveOptions {
+  int max_iterations = 50;      ///< Newton iterations (each with at most 8 step halvings)
+  double tolerance = 1e-13;     ///< on max |Phi| [m, rad]
+  double max_step = 0.5;        ///< largest change of a passive coordinate per iteration [rad, m]
+  double singular_rcond = 1e-7; ///< reciprocal condition of A° under which Status::singular is set
+};
+
+/// data.loop_residual = Phi(q) and data.loop_jacobian = A(q) (and world poses of every link).
+Status loop_constraints(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept;
+
+/// Position solve: the passive coordinates of `q` (in/out; its actuated entries are replaced by
+/// `q_actuated`, its passive entries are the warm start) such that Phi(q) = 0, by damped Newton
+/// with step limiting and backtracking. Status::ok when converged; Status::singular is added when
+/// A° is near singular (rcond in data.loop_rcond); Status::solver_error when it does not converge
+/// within the iteration bound (the mechanism cannot be assembled there): `q` is then left
+/// unchanged. data.loop_iterations, data.loop_residual_norm report the solve.
+Status solve_loop_positions(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                            Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options = {}) noexcept;
+
+/// At a solved q: data.loop_projection (C), data.closed_velocity = C v#, data.loop_bias (gamma),
+/// data.loop_acceleration_bias (c), data.loop_rcond. Status::singular near a parallel singularity
+/// (rcond below options.singular_rcond, or actuated velocities that the loops cannot accept).
+Status loop_projection(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                       const ConstVector& v_actuated, const LoopSolveOptions& options = {}) noexcept;
+
+/// The whole motion from the actuated coordinates: solve positions (q in/out as above), project
+/// velocities and accelerations: data.closed_position, closed_velocity, closed_acceleration.
+Status closed_motion(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                     const ConstVector& v_actuated, const ConstVector& a_actuated, Eigen::Ref<Eigen::VectorXd> q,
+                     const LoopSolveOptions& options = {}) noexcept;
+
+/// Actuated forces of the closed mechanism for the motion: data.actuated_force = C^T tau(q, v, a)
+/// (after closed_motion with the same arguments; also fills data.joint_torque of the tree).
+Status closed_inverse_dynamics(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                               const ConstVector& v_actuated, const ConstVector& a_actuated,
+                               Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options = {}) noexcept;
+
+/// data.reduced_mass_matrix = C^T M C and data.actuated_gravity = C^T G at the solved q.
+Status closed_mass_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                          Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options = {}) noexcept;
+
+/// Forward dynamics: data.actuated_acceleration = a# with C^T M C a# = tau# - C^T (M c + b(q, v)).
+Status closed_forward_dynamics(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                               const ConstVector& v_actuated, const ConstVector& tau_actuated,
+                               Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options = {}) noexcept;
+
+}  // namespace mechbal
