@@ -29,4 +29,4 @@ from mechbal._core import (  # noqa: F401
     validate_rigid_body,
 )
 from mechbal._core import __version__  # noqa: F401
-from mechbal.config import ConfigError, load_case  # noqa: F401
+from mechbal.config import ConfigError, ConfigWarning, load_case  # noqa: F401

@@ -11,7 +11,8 @@ degrees of freedom, cross references of the general mechanism format) and warns
 
 :func:`json_schema` publishes the same models as JSON Schema for editors;
 ``python/mechbal/cases/mechbal.schema.json`` is its output for every kind
-(``python -m mechbal.schema --write`` regenerates it; a test keeps it current).
+(``python -m mechbal.schema > python/mechbal/cases/mechbal.schema.json`` regenerates it; a test
+keeps it current).
 """
 import difflib
 import json
@@ -59,7 +60,9 @@ Pos = Annotated[float, Field(gt=0, le=MAX_ABS, **_NUM)]
 Mass = Annotated[float, Field(ge=0, le=MAX_ABS, description="kg", **_NUM)]
 Length = Annotated[float, Field(ge=-MAX_ABS, le=MAX_ABS, description="m", **_NUM)]
 Angle = Annotated[float, Field(ge=-MAX_ABS, le=MAX_ABS, description="rad", **_NUM)]
-Duration = Annotated[float, Field(gt=0, le=1e6, description="s", **_NUM)]
+Duration = Annotated[float, Field(ge=1e-3, le=1e6, description="s", **_NUM)]
+#: a controller's tick rate: at most one second per tick
+Rate = Annotated[float, Field(ge=1, le=1e6, description="Hz", **_NUM)]
 Samples = Annotated[int, Field(ge=3, le=MAX_SAMPLES, strict=True)]
 Name = Annotated[str, Field(min_length=1, max_length=128, strict=True)]
 Title = Annotated[str, Field(max_length=1000, strict=True)]
@@ -337,7 +340,7 @@ class Arm2DofTrajectory(Table):
 class Arm2DofController(Table):
     kp: PosVec2 = Field(description="s^-2")
     kd: PosVec2 = Field(description="s^-1")
-    rate_hz: Pos = 1000.0
+    rate_hz: Rate = 1000.0
     duration: Duration = 2.0
     initial_error: Vec2 = [0.0, 0.0]
     perturbation: Annotated[float, Field(ge=0, le=0.9, **_NUM)] = 0.2
@@ -440,7 +443,7 @@ class PaminsaTrajectory(Table):
 
 class PaminsaWrist(Table):
     initial_angles: _vec(3, Angle, "rad, z-x-z (phi, theta, psi)")
-    rate_hz: Pos = 1000.0
+    rate_hz: Rate = 1000.0
     integrator: Literal["euler", "rk4"] = "rk4"
     max_rate: Pos = Field(1e3, description="rad/s per axis")
     max_condition: Annotated[float, Field(ge=1, le=MAX_ABS, **_NUM)] = 1e4
@@ -800,7 +803,16 @@ _TYPE_WORDS = {
 }
 
 
-def _message(err: dict, root: Any, prefix: str) -> tuple[str, str, bool, Any]:
+def _at(data: Any, loc: tuple) -> Any:
+    for x in loc:
+        try:
+            data = data[x]
+        except (KeyError, IndexError, TypeError):
+            return None
+    return data
+
+
+def _message(err: dict, root: Any, prefix: str, data: Any = None) -> tuple[str, str, bool, Any]:
     """(field, message, has_value, value) of one pydantic error."""
     loc, typ, ctx = tuple(err.get("loc", ())), err.get("type", ""), err.get("ctx") or {}
     value = err.get("input")
@@ -812,7 +824,14 @@ def _message(err: dict, root: Any, prefix: str) -> tuple[str, str, bool, Any]:
     if typ == "extra_forbidden":
         key = str(loc[-1]) if loc else "?"
         what = "unknown table" if isinstance(value, dict) else "unknown key"
-        return field, what + did_you_mean(key, _allowed_keys(root, loc[:-1])), False, None
+        allowed = _allowed_keys(root, loc[:-1])
+        table = _at(data, loc[:-1])
+        if isinstance(table, dict):  # the user meant a key that is not there yet
+            absent = [k for k in allowed if k not in table]
+            hint = did_you_mean(key, absent)
+            if "did you" in hint:
+                return field, what + hint, False, None
+        return field, what + did_you_mean(key, allowed), False, None
     if typ == "missing":
         return field, "is required", False, None
     if typ == "literal_error":
@@ -848,13 +867,13 @@ def _message(err: dict, root: Any, prefix: str) -> tuple[str, str, bool, Any]:
     return field, err.get("msg", "is invalid"), True, value
 
 
-def _errors_to_config_error(exc: ValidationError, root: Any, prefix: str = "") -> ConfigError:
+def _errors_to_config_error(exc: ValidationError, root: Any, prefix: str = "", data: Any = None) -> ConfigError:
     errors = exc.errors(include_url=False)
     # an unknown key first: it usually explains the rest (a misspelled required key is also missing)
     errors.sort(key=lambda e: e.get("type") != "extra_forbidden")
     problems = []
     for err in errors:
-        field, text, has_value, value = _message(err, root, prefix)
+        field, text, has_value, value = _message(err, root, prefix, data)
         line = f"{field}: {text}" if field else text
         if has_value:
             line += f" (got {short_repr(value)})"
@@ -876,23 +895,36 @@ def validate_table(model: type, data: Any, prefix: str = "") -> Any:
     try:
         return model.model_validate(data)
     except ValidationError as exc:
-        raise _errors_to_config_error(exc, model, prefix) from None
+        raise _errors_to_config_error(exc, model, prefix, data) from None
     except RecursionError:
         raise ConfigError(prefix or "case", "is nested too deeply", has_value=False) from None
 
 
 # ---- the whole file -----------------------------------------------------------------------------
 
+def _unknown_key_near(table: dict, wanted: str, allowed: list[str], prefix: str) -> None:
+    """A missing ``wanted`` key is most likely misspelled: name the unknown key nearest to it."""
+    unknown = [k for k in table if isinstance(k, str) and k not in allowed]
+    near = difflib.get_close_matches(wanted, unknown, n=1, cutoff=0.6)
+    if near:
+        what = "unknown table" if isinstance(table[near[0]], dict) else "unknown key"
+        raise ConfigError(_path((near[0],), prefix), f"{what} (did you mean {wanted!r}?)",
+                          has_value=False)
+
+
 def _model_for(config: Any) -> type:
     if not isinstance(config, dict):
         raise ConfigError("case file", "must be a TOML document (a table)", config)
     header = config.get("case")
     if header is None:
+        _unknown_key_near(config, "case", [], "")
         raise ConfigError("case", "is required", has_value=False)
     if not isinstance(header, dict):
         raise ConfigError("case", "must be a table", header)
+    header_keys = list(DiscsCaseHeader.model_fields)
     kind = header.get("kind")
     if kind is None:
+        _unknown_key_near(header, "kind", header_keys, "case")
         raise ConfigError("case.kind", "is required", has_value=False)
     if not isinstance(kind, str):
         raise ConfigError("case.kind", "must be a string", kind)
@@ -904,6 +936,7 @@ def _model_for(config: Any) -> type:
     if isinstance(model, dict):
         mech = header.get("mechanism")
         if mech is None:
+            _unknown_key_near(header, "mechanism", header_keys, "case")
             raise ConfigError("case.mechanism", f"is required for kind {kind!r} (one of "
                                                 f"{', '.join(model)})", has_value=False)
         if not isinstance(mech, str) or mech not in model:
@@ -1054,9 +1087,17 @@ class _TomlJsonSchema(GenerateJsonSchema):
 
     def default_schema(self, schema):
         out = super().default_schema(schema)
-        if out.get("default", 0) is None:
-            del out["default"]
+        if "default" in out:
+            out["default"] = _drop_none(out["default"])
+            if out["default"] is None:
+                del out["default"]
         return out
+
+
+def _drop_none(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {k: _drop_none(v) for k, v in x.items() if v is not None}
+    return x
 
 
 def _case_models(kind: str | None) -> list[type]:
@@ -1094,17 +1135,19 @@ def schema_text(kind: str | None = None) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m mechbal.schema [KIND] [--write]``: print (or write the shipped file of) the
-    JSON Schema."""
+    """``python -m mechbal.schema [KIND]``: print the JSON Schema (of every kind by default).
+    The shipped file is regenerated with
+    ``python -m mechbal.schema > python/mechbal/cases/mechbal.schema.json``."""
     args = list(sys.argv[1:] if argv is None else argv)
-    write = "--write" in args
-    args = [a for a in args if a != "--write"]
-    text = schema_text(args[0] if args else None)
-    if write:
-        SCHEMA_FILE.write_text(text)
-        print(f"wrote {SCHEMA_FILE}")
-    else:
-        sys.stdout.write(text)
+    if args and args[0] in ("-h", "--help"):
+        print(main.__doc__)
+        return 0
+    try:
+        text = schema_text(args[0] if args else None)
+    except ValueError as exc:
+        print(f"mechbal.schema: {exc}", file=sys.stderr)
+        return 2
+    sys.stdout.write(text)
     return 0
 
 
