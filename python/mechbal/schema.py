@@ -419,14 +419,20 @@ class PaminsaGeometry(Table):
     cp3_ratio: Num
 
 
+PaminsaLinkMasses = _vec(8, Mass, "kg, links 1..8")
+PaminsaLinkInertias = _vec(8, Vec3, "kg m^2, principal [J_XX, J_YY, J_ZZ] of links 1..8")
+PaminsaWristInertias = _vec(3, Vec3, "kg m^2, principal [J_XX, J_YY, J_ZZ] of wrist links 1..3")
+WristAngles = _vec(3, Angle, "rad, z-x-z (phi, theta, psi)")
+
+
 class PaminsaMasses(Table):
     platform: Mass
-    links: _vec(8, Mass, "kg, links 1..8")
+    links: PaminsaLinkMasses
 
 
 class PaminsaInertias(Table):
-    links: _vec(8, Vec3, "kg m^2, principal [J_XX, J_YY, J_ZZ] of links 1..8")
-    wrist: _vec(3, Vec3, "kg m^2, principal [J_XX, J_YY, J_ZZ] of wrist links 1..3")
+    links: PaminsaLinkInertias
+    wrist: PaminsaWristInertias
 
 
 class PaminsaCounterweights(Table):
@@ -442,7 +448,7 @@ class PaminsaTrajectory(Table):
 
 
 class PaminsaWrist(Table):
-    initial_angles: _vec(3, Angle, "rad, z-x-z (phi, theta, psi)")
+    initial_angles: WristAngles
     rate_hz: Rate = 1000.0
     integrator: Literal["euler", "rk4"] = "rk4"
     max_rate: Pos = Field(1e3, description="rad/s per axis")
