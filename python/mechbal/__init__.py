@@ -30,6 +30,6 @@ from mechbal._core import (  # noqa: F401
     validate_rigid_body,
 )
 from mechbal._core import __version__  # noqa: F401
-from mechbal.config import ConfigError, load_case  # noqa: F401
+from mechbal.config import ConfigError, ConfigWarning, load_case  # noqa: F401
 from mechbal._core import Body, Frame, Joint, MechanismDescription, MechanismModel  # noqa: F401,E402
 from mechbal.mechanism import Mechanism  # noqa: F401,E402

@@ -1,8 +1,11 @@
 """Configuration: TOML files -> validated models.
 
-Every error is a :class:`ConfigError` naming the offending field by its dotted path (for example
+The schema of every case file is in :mod:`mechbal.schema` (pydantic models, strict: unknown keys
+are errors); :func:`mechbal.schema.validate_case` checks a whole file before anything runs. Every
+error is a :class:`ConfigError` naming the offending field by its dotted path (for example
 ``mechanism.joints[1].link.mass``) and the value found, and nothing is half-built: models are only
-constructed once every field has been read and checked.
+constructed once every field has been read and checked. The helpers here (``number``, ``vector``,
+...) remain for code that checks values outside case files.
 """
 from __future__ import annotations
 
@@ -21,17 +24,8 @@ else:  # pragma: no cover
 CASES_DIR = Path(__file__).resolve().parent / "cases"
 
 
-class ConfigError(ValueError):
-    """A configuration value is missing, of the wrong type or out of range."""
-
-    def __init__(self, field: str, message: str, value: Any = None, *, has_value: bool = True):
-        self.field = field
-        self.value = value
-        text = f"{field}: {message}"
-        if has_value:
-            text += f" (got {value!r})"
-        super().__init__(text)
-
+from mechbal.errors import ConfigError, ConfigWarning, short_repr  # noqa: F401 (re-exported)
+from mechbal.spec import rotation_rpy  # noqa: F401 (re-exported)
 
 _MISSING = object()
 
@@ -92,39 +86,19 @@ def vector(value: Any, field: str, size: int | None = None) -> np.ndarray:
 def inertia(value: Any, field: str) -> np.ndarray:
     """An inertia tensor about the centre of mass [kg m^2]: a 3x3 list, three principal moments
     [Ixx, Iyy, Izz], or six values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]. Must be symmetric positive
-    semi-definite and satisfy the triangle inequality of a physical body."""
-    if isinstance(value, (list, tuple)) and len(value) == 3 and all(
-            isinstance(r, (list, tuple)) for r in value):
-        rows = [vector(r, f"{field}[{i}]", 3) for i, r in enumerate(value)]
-        I = np.array(rows)
-    elif isinstance(value, (list, tuple)) and len(value) in (3, 6):
-        v = vector(value, field)
-        I = np.diag(v[:3])
-        if len(v) == 6:
-            I[0, 1] = I[1, 0] = v[3]
-            I[0, 2] = I[2, 0] = v[4]
-            I[1, 2] = I[2, 1] = v[5]
-    else:
-        raise ConfigError(field, "must be a 3x3 matrix, [Ixx, Iyy, Izz] or "
-                                 "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]", value)
-    from mechbal._core import validate_rigid_body
+    semi-definite and satisfy the triangle inequality of a physical body
+    (:func:`mechbal.schema.inertia_matrix`)."""
+    from pydantic_core import PydanticCustomError
+
+    from mechbal.schema import inertia_matrix
 
     try:
-        validate_rigid_body(1.0, I, field)
-    except ValueError as exc:
-        msg = str(exc).replace(f"{field}.inertia ", "")
-        raise ConfigError(field, msg, value) from None
-    return I
-
-
-def rotation_rpy(rpy: np.ndarray) -> np.ndarray:
-    """Rotation matrix from roll-pitch-yaw (fixed axes x, then y, then z): Rz(y) Ry(p) Rx(r)."""
-    r, p, y = rpy
-    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
-    Rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
-    Ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
-    Rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
-    return Rz @ Ry @ Rx
+        return inertia_matrix(value)
+    except PydanticCustomError as exc:
+        ctx = exc.context or {}
+        v = ctx.get("value")
+        raise ConfigError(field + ctx.get("sub", ""), ctx.get("message", exc.message()),
+                          value if v is None else v) from None
 
 
 def transform(value: Any, field: str) -> np.ndarray:
@@ -176,98 +150,100 @@ def load_case(name_or_path: str | Path) -> dict:
 
 # ---- serial chains ----------------------------------------------------------------------------
 
-def _dh_origin(table: Mapping[str, Any], field: str, modified: bool) -> tuple[np.ndarray, np.ndarray]:
-    """(origin, X) from DH parameters. Modified (Craig): origin = Rx(alpha) Tx(a) Tz(d) Rz(theta),
-    X = I. Standard: the joint rotates before Tz(d) Tx(a) Rx(alpha), which we carry as X into the
-    next joint's origin (the link's own frame is the frame right after the joint)."""
-    a = number(require(table, "a", field), f"{field}.a")
-    alpha = number(require(table, "alpha", field), f"{field}.alpha")
-    d = number(require(table, "d", field, 0.0), f"{field}.d")
-    theta = number(require(table, "theta", field, 0.0), f"{field}.theta")
+def chain_model(spec, field: str = "mechanism"):
+    """A :class:`mechbal.ChainModel` from a :class:`mechbal.spec.MechanismSpec` that is a serial
+    chain: moving joints one after the other, no gear coupling. Fixed joints are folded into the
+    next joint's placement, and every body is merged into the one rigid body of the moving link
+    that carries it (mass, centre of mass and inertia about it: exact for dynamics and momentum).
+    Bodies on the base do not move and are left out. A tree or a gear coupling needs the general
+    mechanism model: ConfigError naming it."""
+    from mechbal._core import ChainModel, JointSpec, JointType
 
-    def rx(t):
+    from mechbal.spec import BASE
+
+    by_name = {j.name: j for j in spec.joints}
+
+    def moving_ancestor(name: str):
+        """(the moving joint whose link carries the link of ``name``, or base; the transform
+        from the link frame of ``name`` to that link's frame)."""
         T = np.eye(4)
-        T[:3, :3] = rotation_rpy([t, 0, 0])
-        return T
+        while name != BASE and by_name[name].type == "fixed":
+            T = by_name[name].placement @ T
+            name = by_name[name].parent
+        return name, T
 
-    def rz(t):
-        T = np.eye(4)
-        T[:3, :3] = rotation_rpy([0, 0, t])
-        return T
+    moving = [j for j in spec.joints if j.type != "fixed"]
+    if not moving:
+        raise ConfigError(f"{field}.joints", "needs at least one moving joint", has_value=False)
+    origins = []
+    for k, j in enumerate(moving):
+        if j.mimic is not None:
+            raise ConfigError(f"{field}.joints", f"joint {j.name!r} is gear-coupled (mimic of "
+                              f"{j.mimic[0]!r}): this runner takes serial chains; gear couplings "
+                              f"need the general mechanism model", has_value=False)
+        ancestor, T = moving_ancestor(j.parent)
+        expected = moving[k - 1].name if k > 0 else BASE
+        if ancestor != expected:
+            raise ConfigError(f"{field}.joints", f"joint {j.name!r} branches from {ancestor!r}, not "
+                              f"from {expected!r}: this runner takes serial chains; trees need the "
+                              f"general mechanism model", has_value=False)
+        origins.append(T @ j.placement)
+    parts: dict[str, list] = {j.name: [] for j in moving}
+    for b in spec.bodies:
+        ancestor, T = moving_ancestor(b.link)
+        if ancestor == BASE:
+            continue  # does not move: no momentum, no torque
+        R = T[:3, :3]
+        parts[ancestor].append((b.mass, R @ b.com + T[:3, 3], R @ b.inertia @ R.T))
+    specs = []
+    for j, origin in zip(moving, origins):
+        mass, com, inertia = _merge_bodies(parts[j.name])
+        specs.append(JointSpec(j.name, JointType.revolute if j.type == "revolute" else JointType.prismatic,
+                               origin, j.axis, mass, com, inertia))
+    return ChainModel(specs, spec.gravity, np.eye(4))
 
-    def tr(x, y, z):
-        T = np.eye(4)
-        T[:3, 3] = [x, y, z]
-        return T
 
-    if modified:
-        return rx(alpha) @ tr(a, 0, 0) @ tr(0, 0, d) @ rz(theta), np.eye(4)
-    return rz(theta), tr(0, 0, d) @ tr(a, 0, 0) @ rx(alpha)
+def _merge_bodies(parts):
+    """(mass, com, inertia about com) of rigid bodies on one link (same frame)."""
+    if not parts:
+        return 0.0, np.zeros(3), np.zeros((3, 3))
+    if len(parts) == 1:
+        return parts[0]
+    mass = sum(m for m, _, _ in parts)
+    com = sum(m * c for m, c, _ in parts) / mass if mass > 0 else np.zeros(3)
+    inertia = np.zeros((3, 3))
+    for m, c, I in parts:
+        d = c - com
+        inertia += I + m * (d @ d * np.eye(3) - np.outer(d, d))
+    return float(mass), com, 0.5 * (inertia + inertia.T)
 
 
 def chain_from_config(table: Mapping[str, Any], field: str = "mechanism"):
-    """Build a :class:`mechbal.ChainModel` from a ``[mechanism]`` table.
-
-    Each ``[[mechanism.joints]]`` has ``name``, ``type`` (revolute | prismatic), ``axis`` (default
+    """Build a :class:`mechbal.ChainModel` from a ``[mechanism]`` table (the format of
+    :mod:`mechbal.spec`: each ``[[mechanism.joints]]`` has ``name``, ``type``, ``axis`` (default
     [0, 0, 1], in the joint frame) and one of ``origin = {xyz, rpy}``, ``mdh = {a, alpha, d,
-    theta}`` (modified DH) or ``dh = {...}`` (standard DH), and ``link = {mass, com, inertia}`` with
-    com and inertia (about the centre of mass) in the link frame (for ``dh``: in the standard DH
-    frame of the link, converted here).
-    """
-    from mechbal._core import ChainModel, JointSpec, JointType
+    theta}`` (modified DH) or ``dh = {...}`` (standard DH), and ``link = {mass, com, inertia}``
+    with com and inertia (about the centre of mass) in the link frame (for ``dh``: in the standard
+    DH frame of the link, converted here)). The table must describe a serial chain."""
+    from mechbal.spec import mechanism_spec
 
-    gravity = vector(require(table, "gravity", field, [0.0, 0.0, -9.81]), f"{field}.gravity", 3)
-    base = transform(require(table, "base", field, {}), f"{field}.base")
-    joints_raw = require(table, "joints", field)
-    if not isinstance(joints_raw, list) or not joints_raw:
-        raise ConfigError(f"{field}.joints", "must be a non-empty array of tables", joints_raw)
-    specs = []
-    carry = np.eye(4)  # standard DH: constant transform after the previous joint
-    for i, jt in enumerate(joints_raw):
-        jf = f"{field}.joints[{i}]"
-        if not isinstance(jt, Mapping):
-            raise ConfigError(jf, "must be a table", jt)
-        name = string(require(jt, "name", jf, f"joint{i + 1}"), f"{jf}.name")
-        jtype = string(require(jt, "type", jf, "revolute"), f"{jf}.type", ("revolute", "prismatic"))
-        kinds = [k for k in ("origin", "mdh", "dh") if k in jt]
-        if len(kinds) > 1:
-            raise ConfigError(jf, "give only one of origin, mdh, dh", sorted(kinds))
-        kind = kinds[0] if kinds else "origin"
-        X = np.eye(4)
-        if kind == "origin":
-            origin = transform(jt.get("origin", {}), f"{jf}.origin")
-            axis = vector(require(jt, "axis", jf, [0.0, 0.0, 1.0]), f"{jf}.axis", 3)
-        else:
-            origin, X = _dh_origin(require(jt, kind, jf), f"{jf}.{kind}", modified=(kind == "mdh"))
-            if "axis" in jt:
-                raise ConfigError(f"{jf}.axis", "DH joints move along/about z; drop axis", jt["axis"])
-            axis = np.array([0.0, 0.0, 1.0])
-        if np.linalg.norm(axis) < 1e-12:
-            raise ConfigError(f"{jf}.axis", "must be a non-zero vector", list(axis))
-        link = require(jt, "link", jf)
-        lf = f"{jf}.link"
-        mass = number(require(link, "mass", lf), f"{lf}.mass", minimum=0.0)
-        com = vector(require(link, "com", lf, [0.0, 0.0, 0.0]), f"{lf}.com", 3)
-        I = inertia(require(link, "inertia", lf), f"{lf}.inertia")
-        if kind == "dh":  # com/inertia given in the DH frame = link frame * X
-            com = X[:3, :3] @ com + X[:3, 3]
-            I = X[:3, :3] @ I @ X[:3, :3].T
-        specs.append(JointSpec(name, JointType.revolute if jtype == "revolute" else JointType.prismatic,
-                               carry @ origin, axis, mass, com, I))
-        carry = X
-    return ChainModel(specs, gravity, base)
+    return chain_model(mechanism_spec(table, field), field)
 
 
-def trajectory_from_config(table: Mapping[str, Any], dof: int, field: str = "trajectory"):
+def trajectory_from_config(table: Any, dof: int, field: str = "trajectory"):
     """A :class:`mechbal.RestToRestTrajectory` and the sample times from a ``[trajectory]`` table
-    with ``law`` (quintic | cubic), ``start``, ``end`` (``dof`` values), ``duration`` [s] and
-    ``samples`` (number of instants, >= 3)."""
+    (a dict or a validated :class:`mechbal.schema.ChainTrajectory`) with ``law`` (quintic |
+    cubic), ``start``, ``end`` (``dof`` values), ``duration`` [s] and ``samples`` (number of
+    instants, 3 .. 1e6)."""
     from mechbal._core import RestToRestTrajectory, TimeLaw
 
-    law = string(require(table, "law", field, "quintic"), f"{field}.law", ("quintic", "cubic"))
-    start = vector(require(table, "start", field), f"{field}.start", dof)
-    end = vector(require(table, "end", field), f"{field}.end", dof)
-    duration = number(require(table, "duration", field), f"{field}.duration", positive=True)
-    samples = integer(require(table, "samples", field, 501), f"{field}.samples", minimum=3)
-    traj = RestToRestTrajectory(start, end, duration, getattr(TimeLaw, law))
-    return traj, np.linspace(0.0, duration, samples)
+    from mechbal.schema import ChainTrajectory, validate_table
+
+    tr = table if isinstance(table, ChainTrajectory) else validate_table(ChainTrajectory, table, field)
+    for key in ("start", "end"):
+        v = getattr(tr, key)
+        if len(v) != dof:
+            raise ConfigError(f"{field}.{key}", f"must have {dof} values", v)
+    traj = RestToRestTrajectory(np.array(tr.start, float), np.array(tr.end, float), tr.duration,
+                                getattr(TimeLaw, tr.law))
+    return traj, np.linspace(0.0, tr.duration, tr.samples)

@@ -86,8 +86,11 @@ def test_com_wrong_length():
 
 def test_unknown_joint_type():
     cfg = copy.deepcopy(BASE["mechanism"])
-    cfg["joints"][0]["type"] = "spherical"
-    expect_error(lambda: chain_from_config(cfg), "mechanism.joints[0].type", "'spherical'")
+    cfg["joints"][0]["type"] = "helical"
+    expect_error(lambda: chain_from_config(cfg), "mechanism.joints[0].type", "'helical'")
+    cfg["joints"][0]["type"] = "revolut"
+    e = expect_error(lambda: chain_from_config(cfg), "mechanism.joints[0].type", "'revolut'")
+    assert "did you mean 'revolute'?" in str(e)
 
 
 def test_zero_axis():

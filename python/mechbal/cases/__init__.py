@@ -1,7 +1,9 @@
 """Built-in case studies: one TOML file each in this folder, run by the runner of its ``kind``.
 
-A runner is ``run(config: dict, out: Path) -> dict`` (the summary) registered with
-:func:`register`. ``mechbal cases`` lists the files; ``mechbal run NAME --out DIR`` runs one.
+A runner is ``run(config, out: Path) -> dict`` (the summary) registered with
+:func:`register`; ``config`` is the case validated by :func:`mechbal.schema.validate_case` (a
+runner also accepts the raw dict of a TOML file and validates it itself). ``mechbal cases`` lists
+the files; ``mechbal run NAME --out DIR`` runs one.
 """
 from __future__ import annotations
 
@@ -9,6 +11,7 @@ from pathlib import Path
 from typing import Callable
 
 from mechbal.config import CASES_DIR, ConfigError, load_case, read_toml
+from mechbal.schema import validate_case
 
 Runner = Callable[[dict, Path], dict]
 _RUNNERS: dict[str, Runner] = {}
@@ -46,8 +49,8 @@ def available() -> list[tuple[str, str, str]]:
 
 def run_case(name_or_path: str | Path, out: str | Path) -> dict:
     _load_runners()
-    config = load_case(name_or_path)
-    kind = config["case"]["kind"]
+    config = validate_case(load_case(name_or_path))  # the whole file, before anything runs
+    kind = config.case.kind
     if kind not in _RUNNERS:
         raise ConfigError("case.kind", f"unknown kind (known: {', '.join(sorted(_RUNNERS))})", kind)
     out = Path(out)

@@ -17,21 +17,15 @@ import numpy as np
 
 from mechbal import _core, report
 from mechbal.cases import register
-from mechbal.config import ConfigError, integer, number, require, vector
+from mechbal.schema import Arm2DofArm, validate_case, validate_table
 from mechbal.export import write_bodies, write_summary
 from mechbal.sizing import rms_counterweights as rc
 
 
 def arm_from_config(table) -> "_core.Arm2DofParameters":
-    f = "arm"
-    vals = {k: number(require(table, k, f), f"{f}.{k}", minimum=0.0)
-            for k in ("m1", "m2", "l1", "i_s1", "i_s2")}
-    for k in ("m1", "m2", "l1"):
-        number(vals[k], f"{f}.{k}", positive=True)
-    vals["l_s1"] = number(require(table, "l_s1", f), f"{f}.l_s1")
-    vals["l_s2"] = number(require(table, "l_s2", f), f"{f}.l_s2")
-    vals["g"] = number(require(table, "g", f, 9.81), f"{f}.g", minimum=0.0)
-    return _core.Arm2DofParameters(**vals)
+    """The arm of an ``[arm]`` table (a dict or a validated :class:`mechbal.schema.Arm2DofArm`)."""
+    arm = table if isinstance(table, Arm2DofArm) else validate_table(Arm2DofArm, table, "arm")
+    return _core.Arm2DofParameters(**arm.model_dump())
 
 
 def _rms(tau):
@@ -78,17 +72,12 @@ def _closed_loop(arm, cw, cfg, traj, start):
     """Computed torque on the true arm (RK4 at the controller rate): exact model (every RK4 stage
     and 1 kHz zero-order hold), +-p % corners on m1, m2, I_S1, I_S2 of the true arm, and the
     exact model under torque limits."""
-    f = "controller"
-    kp = vector(require(cfg, "kp", f), f"{f}.kp", 2)
-    kd = vector(require(cfg, "kd", f), f"{f}.kd", 2)
-    for k, v in (("kp", kp), ("kd", kd)):
-        if np.any(v <= 0):
-            raise ConfigError(f"{f}.{k}", "must be > 0", v.tolist())
-    dt = 1.0 / number(require(cfg, "rate_hz", f, 1000.0), f"{f}.rate_hz", positive=True)
-    duration = number(require(cfg, "duration", f, 2.0), f"{f}.duration", positive=True)
-    e0 = vector(require(cfg, "initial_error", f, [0.0, 0.0]), f"{f}.initial_error", 2)
-    p = number(require(cfg, "perturbation", f, 0.2), f"{f}.perturbation", minimum=0.0, maximum=0.9)
-    limit = vector(require(cfg, "torque_limit", f, [np.inf, np.inf]), f"{f}.torque_limit", 2)
+    kp, kd = np.array(cfg.kp, float), np.array(cfg.kd, float)
+    dt = 1.0 / cfg.rate_hz
+    duration = cfg.duration
+    e0 = np.array(cfg.initial_error, float)
+    p = cfg.perturbation
+    limit = np.array(cfg.torque_limit if cfg.torque_limit is not None else [np.inf, np.inf], float)
     q0 = np.asarray(start) - e0
     cwc = cw if cw is not None else _core.Arm2DofCounterweights()
     plant = _core.Arm2DofDynamics(arm, cwc)
@@ -142,19 +131,16 @@ def _closed_loop(arm, cw, cfg, traj, start):
 
 
 @register("arm2dof")
-def run(config: dict, out: Path) -> dict:
-    arm = arm_from_config(require(config, "arm", ""))
-    cwt = require(config, "counterweights", "")
-    m_cw1 = number(require(cwt, "m_cw1", "counterweights"), "counterweights.m_cw1", positive=True)
-    m_cw2 = number(require(cwt, "m_cw2", "counterweights"), "counterweights.m_cw2", positive=True)
-    paper_r = vector(require(cwt, "paper_r_cw", "counterweights", [np.nan, np.nan]),
-                     "counterweights.paper_r_cw", 2) if "paper_r_cw" in cwt else np.full(2, np.nan)
-    tt = require(config, "trajectory", "")
-    start = vector(require(tt, "start", "trajectory"), "trajectory.start", 2)
-    end = vector(require(tt, "end", "trajectory"), "trajectory.end", 2)
-    T = number(require(tt, "duration", "trajectory"), "trajectory.duration", positive=True)
-    N = integer(require(tt, "samples", "trajectory", 1001), "trajectory.samples", minimum=3)
-    paper = config.get("paper", {})
+def run(config, out: Path) -> dict:
+    case = validate_case(config, warn=False)
+    arm = arm_from_config(case.arm)
+    cwt = case.counterweights
+    m_cw1, m_cw2 = cwt.m_cw1, cwt.m_cw2
+    paper_r = np.array(cwt.paper_r_cw, float) if cwt.paper_r_cw is not None else np.full(2, np.nan)
+    tt = case.trajectory
+    start, end = np.array(tt.start, float), np.array(tt.end, float)
+    T, N = tt.duration, tt.samples
+    paper = case.paper.model_dump()
     t = np.linspace(0.0, T, N)
     laws = {"A": _core.TimeLaw.quintic, "B": _core.TimeLaw.cubic}
     trajs = {k: _core.RestToRestTrajectory(start, end, T, law) for k, law in laws.items()}
@@ -186,8 +172,8 @@ def run(config: dict, out: Path) -> dict:
 
     # ---- closed loop on the arm of run C (and, for comparison, the bare arm of run B) ----
     traj_B = _core.RestToRestTrajectory(start, end, T, _core.TimeLaw.cubic)
-    cl = _closed_loop(arm, cw["C"], require(config, "controller", ""), traj_B, start)
-    cl_bare = _closed_loop(arm, None, require(config, "controller", ""), traj_B, start)
+    cl = _closed_loop(arm, cw["C"], case.controller, traj_B, start)
+    cl_bare = _closed_loop(arm, None, case.controller, traj_B, start)
 
     # ---- files ----
     for k in ("A", "B", "C"):
@@ -247,7 +233,7 @@ def run(config: dict, out: Path) -> dict:
             f"matches with the joints swapped. At our optimum: RMS {rC[0]:.1f}/{rC[1]:.1f} %, "
             f"peak {pC[0]:.1f}/{pC[1]:.1f} %.")
     summary = {
-        "case": config["case"]["name"], "kind": "arm2dof",
+        "case": case.case.name, "kind": "arm2dof",
         "source": "Arakelian, Le Baron & Mottu 2011, Mechatronics 21:310-314",
         "samples": N, "duration_s": T,
         "r_cw_m": [res.r_cw1, res.r_cw2],

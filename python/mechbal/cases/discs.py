@@ -16,7 +16,8 @@ import numpy as np
 
 from mechbal import _core, report
 from mechbal.cases import register
-from mechbal.config import ConfigError, inertia, integer, number, require, string, vector
+from mechbal.config import ConfigError, inertia
+from mechbal.schema import inertia_matrix, validate_case
 from mechbal.export import write_bodies, write_summary
 from mechbal.sizing import discs as dz
 
@@ -48,22 +49,17 @@ def _principal(I: np.ndarray, field: str) -> np.ndarray:
     return np.diag(I).copy()
 
 
-def parameters_from_config(kind: str, config: dict) -> dict:
-    """Flat parameter dict (the names of docs/discs_derivation.md) from a case file; every value
-    checked, errors name the field."""
+def parameters_from_config(kind: str, config) -> dict:
+    """Flat parameter dict (the names of docs/discs_derivation.md) from a case (validated, or a
+    dict validated here); errors name the field."""
+    case = validate_case(config, warn=False)
+    if case.case.mechanism != kind:
+        raise ConfigError("case.mechanism", f"must be {kind!r} here", case.case.mechanism)
     spec = _SPEC[kind]
-    pt, it = require(config, "parameters", ""), require(config, "inertia", "")
-    ut = require(config, "unbalanced", "")
-    p = {}
-    for k in spec["params"]:
-        if k in ("d", "mP1_share"):
-            p[k] = number(require(pt, k, "parameters"), f"parameters.{k}", minimum=0.0)
-        else:
-            p[k] = number(require(pt, k, "parameters"), f"parameters.{k}", positive=True)
-    if kind == "fivebar" and p["mP1_share"] > p["mP"]:
-        raise ConfigError("parameters.mP1_share", f"must be <= mP = {p['mP']}", p["mP1_share"])
+    pt, it, ut = case.parameters, case.inertia, case.unbalanced
+    p = {k: getattr(pt, k) for k in spec["params"]}
     for b in spec["bodies"]:
-        J = _principal(inertia(require(it, b, "inertia"), f"inertia.{b}"), f"inertia.{b}")
+        J = _principal(inertia_matrix(getattr(it, b)), f"inertia.{b}")
         if kind == "fivebar":
             key = _FIVEBAR_KEYS[b]
             p[f"J{key}"] = J[0]
@@ -72,10 +68,10 @@ def parameters_from_config(kind: str, config: dict) -> dict:
             i = b[-1]
             p[f"Jx{i}"], p[f"Jy{i}"], p[f"Jz{i}"] = J
     for k in spec["unbalanced"]:
-        p[f"{k}_unbal"] = number(require(ut, k, "unbalanced"), f"unbalanced.{k}")
+        p[f"{k}_unbal"] = getattr(ut, k)
     for b in ("link1", "link2", "link3"):
-        if b in ut and kind != "fivebar":
-            J = _principal(inertia(ut[b], f"unbalanced.{b}"), f"unbalanced.{b}")
+        if kind != "fivebar" and getattr(ut, b) is not None:
+            J = _principal(inertia_matrix(getattr(ut, b)), f"unbalanced.{b}")
             i = b[-1]
             p[f"Jx{i}_unbal"], p[f"Jy{i}_unbal"], p[f"Jz{i}_unbal"] = J
     if kind == "spatial3r":  # the inertia conditions of eq 25 must give a physical body
@@ -94,8 +90,7 @@ def _torques(kind, d, q, qd, qdd):
 def _controller_check(kind, p, cfg, q_des, qd_des, qdd_des, n):
     """DecoupledJointController vs ComputedTorque over the balanced model, on the trajectory with
     an offset actual state (so the PD terms act)."""
-    kp = vector(require(cfg, "kp", "controller"), "controller.kp", n)
-    kd = vector(require(cfg, "kd", "controller"), "controller.kd", n)
+    kp, kd = np.array(cfg.kp, float), np.array(cfg.kd, float)
     k = np.asarray(dz.BALANCE[kind](p)["k"])
     dc = _core.DecoupledJointController(k, kp, kd)
     rng = np.random.default_rng(0)
@@ -234,40 +229,38 @@ def _write_bodies(path, t, b, q, qd, qdd):
 
 
 @register("discs")
-def run(config: dict, out: Path) -> dict:
-    kind = string(require(config["case"], "mechanism", "case"), "case.mechanism", dz.MECHANISMS)
+def run(config, out: Path) -> dict:
+    case = validate_case(config, warn=False)
+    kind = case.case.mechanism
     n = _SPEC[kind]["n"]
-    p = parameters_from_config(kind, config)
+    p = parameters_from_config(kind, case)
     bal = dz.BALANCE[kind](p)
-    if kind == "fivebar" and not dz.is_parallelogram(p):
+    if kind == "fivebar" and not dz.is_parallelogram(p):  # the schema checks it too
         raise ConfigError("parameters", "a general 5R cannot be made constant-diagonal (C11): "
                           "use the parallelogram d = 0, b1 = a2, b2 = a1",
                           {k: p[k] for k in ("d", "a1", "a2", "b1", "b2")})
+    params = list(case.sensitivity.parameters)
+    known = dz.design(kind, p, True)
+    for i, name in enumerate(params):
+        if name not in known:
+            from mechbal.schema import did_you_mean
 
-    st = require(config, "sampling", "", {})
-    N = integer(require(st, "configurations", "sampling", 1000), "sampling.configurations", minimum=10)
-    seed = integer(require(st, "seed", "sampling", 0), "sampling.seed", minimum=0)
+            raise ConfigError(f"sensitivity.parameters[{i}]", "unknown parameter"
+                              + did_you_mean(name, sorted(k for k, v in known.items()
+                                                          if np.ndim(v) == 0)), name)
+    errors = np.array(case.sensitivity.errors_pct, float) / 100.0
+
+    N, seed = case.sampling.configurations, case.sampling.seed
     q, qd = dz.sample_states(kind, N, np.random.default_rng(seed))
     before = dz.metrics(*dz.evaluate(kind, dz.design(kind, p, False), q, qd))
     after = dz.metrics(*dz.evaluate(kind, dz.design(kind, p, True), q, qd), bal["k"])
 
-    sens_cfg = require(config, "sensitivity", "", {})
-    params = require(sens_cfg, "parameters", "sensitivity", [])
-    if not isinstance(params, list) or not all(isinstance(x, str) for x in params):
-        raise ConfigError("sensitivity.parameters", "must be a list of names", params)
-    errors = vector(require(sens_cfg, "errors_pct", "sensitivity", [1.0, 5.0, 10.0]),
-                    "sensitivity.errors_pct") / 100.0
     Ns = min(N, 200)
-    try:
-        sens = dz.sensitivity(kind, p, params, errors, q[:Ns], qd[:Ns])
-    except KeyError as exc:
-        raise ConfigError("sensitivity.parameters", "unknown parameter", exc.args[0]) from None
+    sens = dz.sensitivity(kind, p, params, errors, q[:Ns], qd[:Ns])
 
-    tt = require(config, "trajectory", "")
-    start = vector(require(tt, "start", "trajectory"), "trajectory.start", n)
-    end = vector(require(tt, "end", "trajectory"), "trajectory.end", n)
-    T = number(require(tt, "duration", "trajectory"), "trajectory.duration", positive=True)
-    Nt = integer(require(tt, "samples", "trajectory", 301), "trajectory.samples", minimum=3)
+    tt = case.trajectory
+    start, end = np.array(tt.start, float), np.array(tt.end, float)
+    T, Nt = tt.duration, tt.samples
     t = np.linspace(0.0, T, Nt)
     qt, qdt, qddt = _core.RestToRestTrajectory(start, end, T, _core.TimeLaw.quintic).evaluate_batch(t)
     tau_u = _torques(kind, dz.design(kind, p, False), qt, qdt, qddt)
@@ -279,8 +272,8 @@ def run(config: dict, out: Path) -> dict:
     report.plot_series(out / "joint_torques.png", t,
                        {"unbalanced": tau_u, "balanced": tau_b, "k_i q''_i": tau_k},
                        labels, "torque [N m]",
-                       title=f"{config['case']['name']}: joint torques, unbalanced vs balanced")
-    control = _controller_check(kind, p, require(config, "controller", ""), qt, qdt, qddt, n)
+                       title=f"{case.case.name}: joint torques, unbalanced vs balanced")
+    control = _controller_check(kind, p, case.controller, qt, qdt, qddt, n)
 
     # ---- every link and disc as a body along the trajectory: the shaking wrench ----
     wrench = {}
@@ -301,7 +294,7 @@ def run(config: dict, out: Path) -> dict:
     if "K_cross" in bal:
         balancing["K_cross"] = bal["K_cross"]
     summary = {
-        "case": config["case"]["name"], "kind": "discs", "mechanism": kind,
+        "case": case.case.name, "kind": "discs", "mechanism": kind,
         "source": "Coutinho & Hess Coelho, A new approach for designing dynamic balanced serial "
                   "mechanisms (derivation: docs/discs_derivation.md)",
         "balancing": balancing,

@@ -19,7 +19,8 @@ import numpy as np
 
 from mechbal import report
 from mechbal.cases import register
-from mechbal.config import ConfigError, integer, number, require, string, vector
+from mechbal.config import ConfigError
+from mechbal.schema import validate_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences, write_bodies, write_summary
 from mechbal.sizing import paminsa_counterweights as sizing
 
@@ -28,69 +29,48 @@ _GEOMETRY_SCALARS = ("k", "a", "b", "c", "d", "e", "f", "length_BG", "length_AE"
                      "z_A", "elbow", "vertical_mass_z0", "cp3_ratio")
 
 
-def parameters_from_config(config: dict):
+def parameters_from_config(config):
     """mechbal.PaminsaParameters (without counterweights) from the [geometry], [masses],
-    [inertias] tables; ConfigError names the field. The C++ model validates the rest
-    (ValueError naming the field)."""
+    [inertias] tables of a case (validated, or a dict validated here); ConfigError names the
+    field. The C++ model validates the rest (ValueError naming the field)."""
     from mechbal._core import PaminsaParameters
 
+    case = validate_case(config, warn=False)
     p = PaminsaParameters()
-    g = require(config, "geometry", "")
+    g = case.geometry
     for key in _GEOMETRY_SCALARS:
-        setattr(p, key, number(require(g, key, "geometry"), f"geometry.{key}"))
-    p.nominal_platform = vector(require(g, "nominal_platform", "geometry"), "geometry.nominal_platform", 3)
-    vxy = require(g, "vertical_mass_xy", "geometry", "centroid")
-    if isinstance(vxy, str):
-        string(vxy, "geometry.vertical_mass_xy", ("centroid",))
+        setattr(p, key, getattr(g, key))
+    p.nominal_platform = np.array(g.nominal_platform, float)
+    if isinstance(g.vertical_mass_xy, str):  # "centroid"
         p.vertical_mass_at_centroid = True
     else:
         p.vertical_mass_at_centroid = False
-        p.vertical_mass_xy = vector(vxy, "geometry.vertical_mass_xy", 2)
-    m = require(config, "masses", "")
-    p.platform_mass = number(require(m, "platform", "masses"), "masses.platform", minimum=0.0)
-    links = vector(require(m, "links", "masses"), "masses.links", 8)
-    for i, x in enumerate(links):
-        number(x, f"masses.links[{i}]", minimum=0.0)
-    p.link_mass = list(links)
-    inert = require(config, "inertias", "")
-    li = require(inert, "links", "inertias")
-    if not isinstance(li, list) or len(li) != 8:
-        raise ConfigError("inertias.links", "must be 8 lists [J_XX, J_YY, J_ZZ]", li)
-    p.link_inertia = [vector(v, f"inertias.links[{i}]", 3) for i, v in enumerate(li)]
-    wi = require(inert, "wrist", "inertias")
-    if not isinstance(wi, list) or len(wi) != 3:
-        raise ConfigError("inertias.wrist", "must be 3 lists [J_XX, J_YY, J_ZZ]", wi)
-    p.wrist_inertia = [vector(v, f"inertias.wrist[{i}]", 3) for i, v in enumerate(wi)]
+        p.vertical_mass_xy = np.array(g.vertical_mass_xy, float)
+    p.platform_mass = case.masses.platform
+    p.link_mass = [float(x) for x in case.masses.links]
+    p.link_inertia = [np.array(v, float) for v in case.inertias.links]
+    p.wrist_inertia = [np.array(v, float) for v in case.inertias.wrist]
     return p
 
 
-def wrist_config_from_config(config: dict, integrator: str | None = None):
+def wrist_config_from_config(config, integrator: str | None = None):
     from mechbal._core import ReactionlessWristConfig, WristIntegrator
 
-    w = require(config, "wrist", "")
-    integ = integrator or string(require(w, "integrator", "wrist", "rk4"), "wrist.integrator", ("euler", "rk4"))
+    w = validate_case(config, warn=False).wrist
     try:
         return ReactionlessWristConfig(
-            rate_hz=number(require(w, "rate_hz", "wrist", 1000.0), "wrist.rate_hz", positive=True),
-            integrator=getattr(WristIntegrator, integ),
-            max_rate=number(require(w, "max_rate", "wrist", 1e3), "wrist.max_rate", positive=True),
-            max_condition=number(require(w, "max_condition", "wrist", 1e4), "wrist.max_condition", minimum=1.0),
-            damping=number(require(w, "damping", "wrist", 1e-2), "wrist.damping", positive=True))
+            rate_hz=w.rate_hz, integrator=getattr(WristIntegrator, integrator or w.integrator),
+            max_rate=w.max_rate, max_condition=w.max_condition, damping=w.damping)
     except ValueError as exc:
-        if isinstance(exc, ConfigError):
-            raise
-        raise ConfigError("wrist", str(exc), w) from None
+        raise ConfigError("wrist", str(exc), w.model_dump()) from None
 
 
-def trajectory_from_config(config: dict):
+def trajectory_from_config(config):
     from mechbal._core import RestToRestTrajectory, TimeLaw
 
-    tr = require(config, "trajectory", "")
-    law = string(require(tr, "law", "trajectory", "quintic"), "trajectory.law", ("quintic", "cubic"))
-    return RestToRestTrajectory(vector(require(tr, "start", "trajectory"), "trajectory.start", 3),
-                                vector(require(tr, "end", "trajectory"), "trajectory.end", 3),
-                                number(require(tr, "duration", "trajectory"), "trajectory.duration", positive=True),
-                                getattr(TimeLaw, law))
+    tr = validate_case(config, warn=False).trajectory
+    return RestToRestTrajectory(np.array(tr.start, float), np.array(tr.end, float), tr.duration,
+                                getattr(TimeLaw, tr.law))
 
 
 def identification_trajectories(cycle, nominal):
@@ -133,19 +113,16 @@ def moment_about(M, F, point):
 
 
 @register("paminsa")
-def run(config: dict, out: Path) -> dict:
+def run(config, out: Path) -> dict:
     from mechbal._core import PaminsaModel, paminsa_kinematics, paminsa_reactionless_run
 
+    config = validate_case(config, warn=False)
     params = parameters_from_config(config)
     cycle = trajectory_from_config(config)
-    wcfg = require(config, "wrist", "")
-    q0 = vector(require(wcfg, "initial_angles", "wrist"), "wrist.initial_angles", 3)
-    primary = string(require(wcfg, "integrator", "wrist", "rk4"), "wrist.integrator", ("euler", "rk4"))
-    cws = require(config, "counterweights", "")
-    use = string(require(cws, "use", "counterweights", "closed_form"), "counterweights.use",
-                 ("closed_form", "least_squares", "paper_reported"))
-    ls_samples = integer(require(cws, "least_squares_samples", "counterweights", 40),
-                         "counterweights.least_squares_samples", minimum=5)
+    q0 = np.array(config.wrist.initial_angles, float)
+    primary = config.wrist.integrator
+    use = config.counterweights.use
+    ls_samples = config.counterweights.least_squares_samples
 
     # ---- counterweights: closed forms, literal printed equations, least squares
     closed = sizing.closed_form(params)
@@ -202,7 +179,7 @@ def run(config: dict, out: Path) -> dict:
     ratio_c = float(np.abs(Mf_c[:, 2]).max() / np.abs(Mu_c[:, 2]).max())
 
     # ---- plots (Fig. 4, Fig. 5, cond N)
-    title = config["case"].get("title", "PAMINSA")
+    title = config.case.title or "PAMINSA"
     report.plot_wrench(out / "shaking_wrench.png", t,
                        {"unbalanced": (F_unbal, M_unbal), "force-balanced": (fbal["shaking_force"], M_fb),
                         f"fully balanced ({primary})": (bal[primary]["shaking_force"], bal[primary]["shaking_moment"])},
@@ -217,7 +194,7 @@ def run(config: dict, out: Path) -> dict:
     cond = bal[primary]["condition"]
     m_reported = np.linalg.norm(rep["shaking_force"], axis=1).max()
     summary = {
-        "case": config["case"]["name"],
+        "case": config.case.name,
         "kind": "paminsa",
         "paper": "Briot & Arakelian 2009, AIM, PAMINSA complete shaking force and moment balancing",
         "duration_s": float(cycle.duration),

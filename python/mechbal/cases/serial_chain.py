@@ -1,5 +1,6 @@
-"""Runner for ``kind = "serial_chain"``: a chain from its TOML description moving along a
-rest-to-rest trajectory; shaking force and moment, base reaction and joint torques."""
+"""Runner for ``kind = "serial_chain"`` (and its alias ``kind = "mechanism"``): a chain from its
+TOML description (:mod:`mechbal.spec`) moving along a rest-to-rest trajectory; shaking force and
+moment, base reaction and joint torques."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -8,27 +9,30 @@ import numpy as np
 
 from mechbal import report
 from mechbal.cases import register
-from mechbal.config import chain_from_config, require, trajectory_from_config
+from mechbal.config import chain_model, trajectory_from_config
 from mechbal.export import write_bodies, write_summary
+from mechbal.schema import validate_case
 from mechbal.simulate import run_chain
 
 
+@register("mechanism")
 @register("serial_chain")
-def run(config: dict, out: Path) -> dict:
-    model = chain_from_config(require(config, "mechanism", ""))
-    traj, t = trajectory_from_config(require(config, "trajectory", ""), model.dof)
+def run(config, out: Path) -> dict:
+    case = validate_case(config, warn=False)
+    model = chain_model(case.spec)
+    traj, t = trajectory_from_config(case.trajectory, model.dof)
     r = run_chain(model, traj, t)
     F, M = r.wrench["force"], r.wrench["moment"]
     write_bodies(out / "bodies_nominal.npz", t=t, names=r.names, mass=r.mass,
                  inertia_body=r.inertia_body, com=r.bodies["com"], rotation=r.bodies["rotation"],
                  shaking_force=F, shaking_moment=M, q=r.q, qd=r.qd, qdd=r.qdd, torque=r.torque)
     report.plot_wrench(out / "shaking_wrench.png", t, {"nominal": (F, M)},
-                       title=config["case"].get("title", config["case"]["name"]))
+                       title=case.case.title or case.case.name)
     report.plot_series(out / "joint_torques.png", t, {"KDL RNE": r.torque}, r.names, "torque",
                        title="joint torques")
     summary = {
-        "case": config["case"]["name"],
-        "kind": "serial_chain",
+        "case": case.case.name,
+        "kind": case.case.kind,
         "dof": model.dof,
         "duration_s": float(traj.duration),
         "samples": int(len(t)),
