@@ -15,6 +15,7 @@
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/jacobian.hpp"
 #include "mechbal/algorithm/kinematics.hpp"
+#include "mechbal/algorithm/loops.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/regressor.hpp"
@@ -241,20 +242,43 @@ void bind_mechanism(py::module_& m) {
       .def_readonly("link", &Frame::link)
       .def_property_readonly("placement", [](const Frame& f) { return Eigen::Matrix4d(f.placement.matrix()); });
 
+  py::enum_<LoopType>(m, "LoopType", "Loop-closure types (algorithm/loops.hpp)")
+      .value("point", LoopType::point)
+      .value("planar_point", LoopType::planar_point)
+      .value("axis", LoopType::axis)
+      .value("weld", LoopType::weld);
+
+  py::class_<LoopConstraint>(m, "LoopConstraint", "A loop closure between two named frames")
+      .def(py::init([](const std::string& name, LoopType type, const std::string& a, const std::string& b) {
+             return LoopConstraint{name, type, a, b};
+           }),
+           py::arg("name"), py::arg("type"), py::arg("frame_a"), py::arg("frame_b"))
+      .def_readonly("name", &LoopConstraint::name)
+      .def_readonly("type", &LoopConstraint::type)
+      .def_readonly("frame_a", &LoopConstraint::frame_a)
+      .def_readonly("frame_b", &LoopConstraint::frame_b);
+
   py::class_<MechanismDescription>(m, "MechanismDescription",
-                                   "Joints, bodies, frames and gravity: what a MechanismModel is built from")
+                                   "Joints, bodies, frames, gravity and loop closures: what a MechanismModel "
+                                   "is built from")
       .def(py::init([](std::vector<Joint> joints, std::vector<Body> bodies, std::vector<Frame> frames,
-                       const Eigen::Vector3d& gravity, const std::string& root_name) {
+                       const Eigen::Vector3d& gravity, const std::string& root_name,
+                       std::vector<LoopConstraint> loops, std::vector<std::string> actuated) {
              MechanismDescription d;
              d.joints = std::move(joints);
              d.bodies = std::move(bodies);
              d.frames = std::move(frames);
              d.gravity = gravity;
              d.root_name = root_name;
+             d.loops = std::move(loops);
+             d.actuated = std::move(actuated);
              return d;
            }),
            py::arg("joints"), py::arg("bodies") = std::vector<Body>{}, py::arg("frames") = std::vector<Frame>{},
-           py::arg("gravity") = Eigen::Vector3d(0.0, 0.0, -9.81), py::arg("root_name") = "base")
+           py::arg("gravity") = Eigen::Vector3d(0.0, 0.0, -9.81), py::arg("root_name") = "base",
+           py::arg("loops") = std::vector<LoopConstraint>{}, py::arg("actuated") = std::vector<std::string>{})
+      .def_readonly("loops", &MechanismDescription::loops)
+      .def_readonly("actuated", &MechanismDescription::actuated)
       .def_readonly("joints", &MechanismDescription::joints)
       .def_readonly("bodies", &MechanismDescription::bodies)
       .def_readonly("frames", &MechanismDescription::frames)
@@ -282,6 +306,10 @@ void bind_mechanism(py::module_& m) {
       .def_property_readonly("description", &MechanismModel::description)
       .def_property_readonly("coordinate_names", &MechanismModel::coordinate_names)
       .def_property_readonly("is_serial_chain", &MechanismModel::is_serial_chain)
+      .def_property_readonly("is_closed", &MechanismModel::is_closed)
+      .def_property_readonly("num_constraints", &MechanismModel::num_constraints)
+      .def_property_readonly("actuated_coordinates", &MechanismModel::actuated_coordinates)
+      .def_property_readonly("passive_coordinates", &MechanismModel::passive_coordinates)
       .def_property_readonly("link_names",
                              [](const MechanismModel& mo) {
                                std::vector<std::string> n;
@@ -323,6 +351,129 @@ void bind_mechanism(py::module_& m) {
       .def(py::pickle(
           [](const MechanismModel& mo) { return py::make_tuple(mo.description()); },
           [](const py::tuple& t) { return MechanismModel(t[0].cast<MechanismDescription>()); }));
+
+  // ---- closed loops: actuated (N, na) in; q0 (dof,) the warm start of the first instant ----
+  m.def(
+      "mechanism_closed_motion",
+      [](const MechanismModel& mo, const Array& qa, const Array& va, const Array& aa, const Array& q0,
+         int max_iterations, double tolerance, double singular_rcond, bool dynamics) {
+        const auto na = static_cast<py::ssize_t>(mo.num_actuated());
+        const auto n = static_cast<py::ssize_t>(mo.dof());
+        require_shape(qa, "q_actuated", {-1, na});
+        const auto N = qa.shape(0);
+        require_shape(va, "v_actuated", {N, na});
+        require_shape(aa, "a_actuated", {N, na});
+        require_shape(q0, "q_guess", {n});
+        if (max_iterations < 1 || max_iterations > 1000) {
+          throw py::value_error("max_iterations must be in 1..1000, got " + std::to_string(max_iterations));
+        }
+        LoopSolveOptions opt;
+        opt.max_iterations = max_iterations;
+        opt.tolerance = tolerance;
+        opt.singular_rcond = singular_rcond;
+        Array Q = make_array({N, n}), V = make_array({N, n}), A = make_array({N, n}), F = make_array({N, na});
+        py::array_t<double> rcond(N), residual(N);
+        py::array_t<std::int32_t> iterations(N);
+        StatusArray status(N);
+        {
+          MechanismData d(mo);
+          Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(q0.data(), n);
+          auto st = status.mutable_unchecked<1>();
+          auto rc = rcond.mutable_unchecked<1>();
+          auto rs = residual.mutable_unchecked<1>();
+          auto it = iterations.mutable_unchecked<1>();
+          py::gil_scoped_release release;
+          for (py::ssize_t k = 0; k < N; ++k) {
+            const CVec qk(row(qa, k), na), vk(row(va, k), na), ak(row(aa, k), na);
+            Status s = dynamics ? closed_inverse_dynamics(mo, d, qk, vk, ak, q, opt)
+                                : closed_motion(mo, d, qk, vk, ak, q, opt);
+            const bool solved = !has(s, Status::solver_error) && !has(s, Status::bad_size) &&
+                                !has(s, Status::non_finite_input);
+            bool finite = solved && d.closed_velocity.allFinite() && d.closed_acceleration.allFinite() &&
+                          (!dynamics || d.actuated_force.allFinite());
+            if (solved && !finite) s |= Status::out_of_range;
+            st(k) = static_cast<std::uint32_t>(s);
+            rc(k) = d.loop_rcond;
+            rs(k) = d.loop_residual_norm;
+            it(k) = d.loop_iterations;
+            double* qo = Q.mutable_data(k);
+            double* vo = V.mutable_data(k);
+            double* ao = A.mutable_data(k);
+            for (py::ssize_t i = 0; i < n; ++i) {
+              qo[i] = solved ? q(i) : 0.0;
+              vo[i] = finite ? d.closed_velocity(i) : 0.0;
+              ao[i] = finite ? d.closed_acceleration(i) : 0.0;
+            }
+            double* fo = F.mutable_data(k);
+            for (py::ssize_t i = 0; i < na; ++i) fo[i] = finite && dynamics ? d.actuated_force(i) : 0.0;
+          }
+        }
+        py::dict out;
+        out["q"] = Q;
+        out["v"] = V;
+        out["a"] = A;
+        if (dynamics) out["actuated_force"] = F;
+        out["rcond"] = rcond;
+        out["residual"] = residual;
+        out["iterations"] = iterations;
+        out["status"] = status;
+        return out;
+      },
+      py::arg("model"), py::arg("q_actuated"), py::arg("v_actuated"), py::arg("a_actuated"), py::arg("q_guess"),
+      py::arg("max_iterations") = 50, py::arg("tolerance") = 1e-13, py::arg("singular_rcond") = 1e-7,
+      py::arg("dynamics") = false,
+      "Solve the loops along a motion of the actuated coordinates (each instant warm-starts the next): "
+      "full q, v, a (N, dof), rcond of A°, residual, iterations and status per instant; with "
+      "dynamics=True also the actuated forces C^T tau (N, na).");
+
+  m.def(
+      "mechanism_closed_mass_matrix",
+      [](const MechanismModel& mo, const Array& qa, const Array& q0) {
+        const auto na = static_cast<py::ssize_t>(mo.num_actuated());
+        const auto n = static_cast<py::ssize_t>(mo.dof());
+        require_shape(qa, "q_actuated", {-1, na});
+        require_shape(q0, "q_guess", {n});
+        const auto N = qa.shape(0);
+        Array Mr = make_array({N, na, na}), G = make_array({N, na});
+        StatusArray status(N);
+        MechanismData d(mo);
+        Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(q0.data(), n);
+        auto st = status.mutable_unchecked<1>();
+        for (py::ssize_t k = 0; k < N; ++k) {
+          Status s = closed_mass_matrix(mo, d, CVec(row(qa, k), na), q);
+          const bool ok = !has(s, Status::solver_error) && !has(s, Status::bad_size) &&
+                          !has(s, Status::non_finite_input) && d.reduced_mass_matrix.allFinite();
+          st(k) = static_cast<std::uint32_t>(s);
+          put(Mr, k, d.reduced_mass_matrix, ok);
+          put(G, k, d.actuated_gravity, ok);
+        }
+        py::dict out;
+        out["reduced_mass_matrix"] = Mr;
+        out["actuated_gravity"] = G;
+        out["status"] = status;
+        return out;
+      },
+      py::arg("model"), py::arg("q_actuated"), py::arg("q_guess"));
+
+  m.def(
+      "mechanism_closed_forward_dynamics",
+      [](const MechanismModel& mo, const Eigen::VectorXd& qa, const Eigen::VectorXd& va, const Eigen::VectorXd& tau,
+         const Eigen::VectorXd& q0) {
+        const auto na = mo.num_actuated();
+        if (qa.size() != na || va.size() != na || tau.size() != na || q0.size() != mo.dof()) {
+          throw py::value_error("q_actuated, v_actuated, tau_actuated must have " + std::to_string(na) +
+                                " values and q_guess " + std::to_string(mo.dof()));
+        }
+        MechanismData d(mo);
+        Eigen::VectorXd q = q0;
+        const Status s = closed_forward_dynamics(mo, d, qa, va, tau, q);
+        py::dict out;
+        out["a_actuated"] = Eigen::VectorXd(d.actuated_acceleration);
+        out["q"] = q;
+        out["status"] = static_cast<std::uint32_t>(s);
+        return out;
+      },
+      py::arg("model"), py::arg("q_actuated"), py::arg("v_actuated"), py::arg("tau_actuated"), py::arg("q_guess"));
 
   m.def("chain_description", &chain_description, py::arg("chain"),
         "A serial ChainModel as a general MechanismDescription (base folded into the first joint)");

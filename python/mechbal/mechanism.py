@@ -23,7 +23,7 @@ import numpy as np
 
 from mechbal import _core
 
-__all__ = ["Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion"]
+__all__ = ["Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion"]
 
 
 @dataclass(frozen=True)
@@ -75,6 +75,22 @@ class BodyMotion:
     status: np.ndarray
 
 
+@dataclass(frozen=True)
+class ClosedMotion:
+    """Solved motion of a closed mechanism: full ``q``, ``v``, ``a`` (.., dof), the reciprocal
+    condition ``rcond`` of the passive Jacobian A°, the closure ``residual`` (max |Phi|),
+    Newton ``iterations``, ``status`` and, when asked, ``actuated_force`` (.., na)."""
+
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    rcond: np.ndarray
+    residual: np.ndarray
+    iterations: np.ndarray
+    status: np.ndarray
+    actuated_force: np.ndarray | None = None
+
+
 def _status_text(code: int) -> str:
     names = [s.name for s in _core.Status.__members__.values() if int(s) and int(code) & int(s)]
     return " | ".join(names) or "ok"
@@ -124,15 +140,44 @@ class Mechanism:
     def from_toml(cls, path: str | Path) -> "Mechanism":
         """Read the ``[mechanism]`` table of a TOML case file (serial chains, trees, extra bodies,
         gear couplings, frames; see the README's "Describing a mechanism")."""
-        from mechbal.config import ConfigError, case_path, chain_from_config, read_toml
+        from mechbal.config import ConfigError, case_path, read_toml
+        from mechbal.spec import mechanism_spec
 
         path = case_path(path)
         config = read_toml(path)
         if "mechanism" not in config:
             raise ConfigError("mechanism", "is required", has_value=False)
-        chain = chain_from_config(config["mechanism"])
-        model = _core.MechanismModel(_core.chain_description(chain))
-        return cls(model, name=path.stem, source=str(path))
+        return cls.from_spec(mechanism_spec(config["mechanism"]), name=path.stem, source=str(path))
+
+    @classmethod
+    def from_spec(cls, spec, name: str = "mechanism", source: str | None = None) -> "Mechanism":
+        """From a :class:`mechbal.spec.MechanismSpec` (what the TOML reader produces)."""
+        from mechbal.config import ConfigError
+
+        types = {"revolute": _core.JointType.revolute, "prismatic": _core.JointType.prismatic,
+                 "fixed": _core.JointType.fixed}
+        loop_types = {"point": _core.LoopType.point, "planar_point": _core.LoopType.planar_point,
+                      "axis": _core.LoopType.axis, "weld": _core.LoopType.weld}
+        joints = []
+        for j in spec.joints:
+            kw = {}
+            if j.mimic is not None:
+                kw = dict(mimic_joint=j.mimic[0], mimic_ratio=float(j.mimic[1]), mimic_offset=float(j.mimic[2]))
+            joints.append(_core.Joint(j.name, types[j.type], j.parent, np.asarray(j.placement, float),
+                                      np.asarray(j.axis, float), float(j.lower), float(j.upper),
+                                      float(j.velocity), float(j.effort), **kw))
+        bodies = [_core.Body(b.name, b.link, float(b.mass), np.asarray(b.com, float),
+                             np.asarray(b.inertia, float), b.kind) for b in spec.bodies]
+        frames = [_core.Frame(f.name, f.link, np.asarray(f.placement, float)) for f in spec.frames]
+        loops = [_core.LoopConstraint(lp.name, loop_types[lp.type], lp.frame_a, lp.frame_b)
+                 for lp in getattr(spec, "loops", [])]
+        desc = _core.MechanismDescription(joints, bodies, frames, np.asarray(spec.gravity, float), "base",
+                                          loops, list(getattr(spec, "actuated", [])))
+        try:
+            model = _core.MechanismModel(desc)
+        except ValueError as exc:
+            raise ConfigError("mechanism", str(exc), has_value=False) from None
+        return cls(model, name=name, source=source)
 
     # ---- structure ---------------------------------------------------------------------------
     @property
@@ -170,6 +215,22 @@ class Mechanism:
     @property
     def bodies(self):
         return list(self.model.bodies)
+
+    @property
+    def is_closed(self) -> bool:
+        """True when the mechanism has loop closures."""
+        return bool(self.model.is_closed)
+
+    @property
+    def actuated_names(self) -> list[str]:
+        """Actuated joints: the independent coordinates q# of the closed-loop methods."""
+        names = self.joint_names
+        return [names[i] for i in self.model.actuated_coordinates]
+
+    @property
+    def passive_names(self) -> list[str]:
+        names = self.joint_names
+        return [names[i] for i in self.model.passive_coordinates]
 
     def __repr__(self) -> str:
         return (f"<Mechanism {self.name!r}: {self.dof} dof, {len(self.link_names) - 1} joints, "
@@ -329,6 +390,59 @@ class Mechanism:
             Io = I + m * (c @ c * np.eye(3) - np.outer(c, c))
             out.append([m, *(m * c), Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]])
         return np.array(out, dtype=float).reshape(-1)
+
+    # ---- closed loops --------------------------------------------------------------------------
+    def closed_motion(self, q_actuated, v_actuated=None, a_actuated=None, *, q_guess=None,
+                      max_iterations: int = 50, tolerance: float = 1e-13, singular_rcond: float = 1e-7,
+                      with_forces: bool = False) -> "ClosedMotion":
+        """Solve the loop closures along a motion of the actuated joints (1-D: one instant; 2-D:
+        (N, na) in time order, each instant warm-starting the next from ``q_guess`` (default: zeros)).
+        Returns the full q, v, a (the coupling-matrix method: v = C v#, a = C a# + c), the reciprocal
+        condition of the passive Jacobian, the closure residual, Newton iterations, statuses
+        (``singular`` near a parallel singularity; ``solver_error`` where the mechanism cannot be
+        assembled: that instant's q, v, a are zeros), and with ``with_forces`` the actuated forces
+        tau# = C^T tau [N m or N]."""
+        qa = np.asarray(q_actuated, dtype=float)
+        va = np.zeros_like(qa) if v_actuated is None else v_actuated
+        aa = np.zeros_like(qa) if a_actuated is None else a_actuated
+        na = len(self.model.actuated_coordinates)
+        single = qa.ndim == 1
+        arrays = []
+        for name, x in (("q_actuated", qa), ("v_actuated", va), ("a_actuated", aa)):
+            x = np.asarray(x)
+            if x.dtype.kind not in "biuf":
+                raise TypeError(f"{name} must be a real numeric array, got dtype {x.dtype}")
+            x = np.ascontiguousarray(x, dtype=float).reshape(1, -1) if single else np.ascontiguousarray(x, float)
+            if x.ndim != 2 or x.shape[1] != na or x.shape[0] != (1 if single else qa.shape[0]):
+                raise ValueError(f"{name} must have shape ({na},) or (N, {na}) like q_actuated, got "
+                                 f"{np.asarray(x).shape}")
+            arrays.append(x)
+        guess = np.zeros(self.dof) if q_guess is None else np.ascontiguousarray(q_guess, dtype=float)
+        r = _core.mechanism_closed_motion(self.model, *arrays, guess, max_iterations, tolerance,
+                                          singular_rcond, with_forces)
+        out = {k: np.asarray(v) for k, v in r.items()}
+        if single:
+            out = {k: v[0] for k, v in out.items()}
+        return ClosedMotion(q=out["q"], v=out["v"], a=out["a"], rcond=out["rcond"], residual=out["residual"],
+                            iterations=out["iterations"], status=out["status"],
+                            actuated_force=out.get("actuated_force"))
+
+    def actuated_forces(self, q_actuated, v_actuated, a_actuated, **kw) -> np.ndarray:
+        """Actuated forces tau# = C^T tau(q, v, a) of the closed mechanism [N m or N]; for one
+        instant raises ValueError when the loops cannot be solved there."""
+        m = self.closed_motion(q_actuated, v_actuated, a_actuated, with_forces=True, **kw)
+        if np.ndim(m.status) == 0 and (int(m.status) & ~int(_core.Status.singular)):
+            raise ValueError(f"{self.name}: the loops cannot be solved here ({_status_text(int(m.status))})")
+        return m.actuated_force
+
+    def reduced_mass_matrix(self, q_actuated, *, q_guess=None) -> tuple[np.ndarray, np.ndarray]:
+        """(C^T M C, C^T G): mass matrix and gravity forces in the actuated coordinates."""
+        qa = np.atleast_2d(np.asarray(q_actuated, dtype=float))
+        guess = np.zeros(self.dof) if q_guess is None else np.asarray(q_guess, dtype=float)
+        r = _core.mechanism_closed_mass_matrix(self.model, np.ascontiguousarray(qa), guess)
+        if np.ndim(q_actuated) == 1:
+            return r["reduced_mass_matrix"][0], r["actuated_gravity"][0]
+        return r["reduced_mass_matrix"], r["actuated_gravity"]
 
     def _frame(self, frame: str) -> int:
         i = self.model.frame_index(frame)

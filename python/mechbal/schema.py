@@ -272,13 +272,26 @@ class Frame(Table):
     origin: Origin = Origin()
 
 
+class Loop(Table):
+    """``[[mechanism.loops]]``: a loop closure between two named frames."""
+    name: Name
+    type: Literal["point", "planar_point", "axis", "weld"] = Field(
+        "point", description="point (3 equations), planar_point (2, in the plane normal to frame_a's z), "
+                             "axis (5: points coincide, z axes parallel), weld (6)")
+    frame_a: Name = Field(description="a frame of [[mechanism.frames]]")
+    frame_b: Name = Field(description="a frame of [[mechanism.frames]], on another branch")
+
+
 class Mechanism(Table):
-    """``[mechanism]``: a tree of joints with bodies, gears and frames."""
+    """``[mechanism]``: a tree of joints with bodies, gears, frames and loop closures."""
     gravity: Vec3 = Field([0.0, 0.0, -9.81], description="m/s^2, in O")
     base: Optional[Origin] = Field(None, description="placement of the root joints' base frame in O")
     joints: Annotated[list[Joint], Field(min_length=1, max_length=MAX_JOINTS)]
     bodies: Annotated[list[Body], Field(max_length=MAX_BODIES)] = []
     frames: Annotated[list[Frame], Field(max_length=MAX_FRAMES)] = []
+    loops: Annotated[list[Loop], Field(max_length=MAX_FRAMES)] = []
+    actuated: Annotated[list[Name], Field(max_length=MAX_JOINTS,
+                                          description="actuated joints (required with loops)")] = []
 
 
 class ChainTrajectory(Table):

@@ -116,11 +116,24 @@ class FrameSpec:
 
 
 @dataclass(frozen=True, eq=False)
+class LoopSpec:
+    """A loop closure between frames ``frame_a`` and ``frame_b``: ``type`` point (3 equations),
+    planar_point (2), axis (5) or weld (6); see ``cpp/include/mechbal/algorithm/loops.hpp``."""
+    name: str
+    type: str
+    frame_a: str
+    frame_b: str
+
+
+@dataclass(frozen=True, eq=False)
 class MechanismSpec:
     gravity: np.ndarray
     joints: list[JointSpec]
     bodies: list[BodySpec] = field(default_factory=list)
     frames: list[FrameSpec] = field(default_factory=list)
+    loops: list[LoopSpec] = field(default_factory=list)
+    #: actuated joints (the independent coordinates q#); empty without loops means every joint
+    actuated: list[str] = field(default_factory=list)
 
     def joint(self, name: str) -> JointSpec:
         for j in self.joints:
@@ -324,4 +337,28 @@ def mechanism_spec(mechanism: Any, field: str = "mechanism") -> MechanismSpec:
         frames.append(FrameSpec(fr.name, link,
                                 frame_of_link(link) @ transform_xyz_rpy(fr.origin.xyz, fr.origin.rpy)))
 
-    return MechanismSpec(np.array(m.gravity, dtype=float), joints, bodies, frames)
+    loops: list[LoopSpec] = []
+    loop_field: dict[str, str] = {}
+    for l_i, lp in enumerate(m.loops):
+        f = f"{field}.loops[{l_i}]"
+        if lp.name in loop_field:
+            raise ConfigError(f"{f}.name", f"duplicate loop name: also {loop_field[lp.name]}", lp.name)
+        loop_field[lp.name] = f
+        for key in ("frame_a", "frame_b"):
+            name = getattr(lp, key)
+            if name not in frame_field:
+                raise ConfigError(f"{f}.{key}", "no such frame (define it in [[mechanism.frames]])"
+                                  + _hint(name, list(frame_field)), name)
+        loops.append(LoopSpec(lp.name, lp.type, lp.frame_a, lp.frame_b))
+    independent = [j.name for j in joints if j.type != "fixed" and j.mimic is None]
+    for a_i, name in enumerate(m.actuated):
+        if name not in independent:
+            raise ConfigError(f"{field}.actuated[{a_i}]", "not a joint with its own coordinate"
+                              + _hint(name, independent), name)
+    if len(set(m.actuated)) != len(m.actuated):
+        raise ConfigError(f"{field}.actuated", "names a joint twice", list(m.actuated))
+    if loops and not m.actuated:
+        raise ConfigError(f"{field}.actuated", "a mechanism with loops must name its actuated joints",
+                          has_value=False)
+    return MechanismSpec(np.array(m.gravity, dtype=float), joints, bodies, frames, loops,
+                         list(m.actuated))
