@@ -2,6 +2,11 @@
 
 A runner is ``run(config: dict, out: Path) -> dict`` (the summary) registered with
 :func:`register`. ``mechbal cases`` lists the files; ``mechbal run NAME --out DIR`` runs one.
+
+:func:`run_case` checks the output path and reads the case before any computation, then runs the
+runner into a temporary folder next to ``DIR`` that replaces ``DIR`` only when the run is complete
+(:mod:`mechbal.output`): ``DIR`` holds a whole run or none. A runner writes only into the folder
+it is given and may call :func:`mechbal.progress.stage` at each stage of its work.
 """
 from __future__ import annotations
 
@@ -12,14 +17,19 @@ from mechbal.config import CASES_DIR, ConfigError, load_case, read_toml
 
 Runner = Callable[[dict, Path], dict]
 _RUNNERS: dict[str, Runner] = {}
+_STAGES: dict[str, int] = {}
 
 #: the case ``mechbal demo`` runs
 DEFAULT_CASE = "paminsa"
 
 
-def register(kind: str) -> Callable[[Runner], Runner]:
+def register(kind: str, stages: int | None = None) -> Callable[[Runner], Runner]:
+    """Register ``fn`` as the runner of ``kind``; ``stages``: how many times it calls
+    :func:`mechbal.progress.stage` (the length of its progress bar), if known."""
     def deco(fn: Runner) -> Runner:
         _RUNNERS[kind] = fn
+        if stages is not None:
+            _STAGES[kind] = stages
         return fn
 
     return deco
@@ -45,11 +55,20 @@ def available() -> list[tuple[str, str, str]]:
 
 
 def run_case(name_or_path: str | Path, out: str | Path) -> dict:
+    """Run a built-in case (by name) or a case file into the folder ``out``; returns the summary.
+
+    Raises :class:`mechbal.output.OutputError` (bad ``out``) and :class:`ConfigError` before any
+    computation; whatever a runner raises leaves ``out`` as it was."""
+    from mechbal import progress
+    from mechbal.output import check_output_dir, staged_output
+
+    check_output_dir(out)
     _load_runners()
     config = load_case(name_or_path)
     kind = config["case"]["kind"]
     if kind not in _RUNNERS:
         raise ConfigError("case.kind", f"unknown kind (known: {', '.join(sorted(_RUNNERS))})", kind)
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    return _RUNNERS[kind](config, out)
+    with staged_output(out) as tmp, progress.run_bar(config["case"]["name"], _STAGES.get(kind)):
+        summary = _RUNNERS[kind](config, tmp)
+        progress.finish()
+    return summary
