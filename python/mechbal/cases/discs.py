@@ -278,8 +278,12 @@ def run(config: dict, out: Path) -> dict:
         labels[2] = "joint 3 (force [N])"
     report.plot_series(out / "joint_torques.png", t,
                        {"unbalanced": tau_u, "balanced": tau_b, "k_i q''_i": tau_k},
-                       labels, "torque [N m]",
-                       title=f"{config['case']['name']}: joint torques, unbalanced vs balanced")
+                       labels, ["force [N]" if "force" in lab else "torque [N m]" for lab in labels],
+                       title=f"{config['case']['name']}: joint torques, unbalanced vs balanced",
+                       caption="Joint torques along the rest-to-rest trajectory: unbalanced arm, "
+                               "arm balanced by counterweights and counter-rotating discs, and "
+                               "the decoupled model k_i q''_i, which the balanced torque equals "
+                               "(dashed over solid).")
     control = _controller_check(kind, p, require(config, "controller", ""), qt, qdt, qddt, n)
 
     # ---- every link and disc as a body along the trajectory: the shaking wrench ----
