@@ -2,7 +2,8 @@
 
 A bar appears when standard error is a terminal, ``--quiet`` was not given (``configure(quiet=
 True)``) and ``MECHBAL_PROGRESS`` is not ``0``; it shows up only after half a second, so short work
-prints nothing. ``MECHBAL_PROGRESS=1`` forces bars on (for a terminal that does not say it is one).
+prints nothing (``MECHBAL_PROGRESS_DELAY`` seconds). ``MECHBAL_PROGRESS=1`` forces bars on (for a
+terminal that does not say it is one).
 
 - :func:`run_bar` / :func:`stage`: one bar per case run, advanced by the runner at each stage
   ("sizing counterweights", "simulating", "plots", ...);
@@ -39,10 +40,29 @@ def enabled() -> bool:
         return False
 
 
+def _delay() -> float:
+    """Seconds before a bar shows (``MECHBAL_PROGRESS_DELAY``, default 0.5)."""
+    try:
+        return max(0.0, float(os.environ.get("MECHBAL_PROGRESS_DELAY", "0.5")))
+    except ValueError:
+        return 0.5
+
+
 def _tqdm(**kwargs):
+    import shutil
+
     from tqdm import tqdm
 
-    return tqdm(file=sys.stderr, dynamic_ncols=True, leave=False, delay=0.5, **kwargs)
+    try:
+        width = os.get_terminal_size(sys.stderr.fileno()).columns
+    except (OSError, ValueError, AttributeError):
+        width = 0
+    # a terminal that reports no size (a fresh pseudo-terminal) gets $COLUMNS x $LINES or 80 x 24
+    # (tqdm hides bars below a screen height of 0)
+    fallback = shutil.get_terminal_size()
+    size = (dict(dynamic_ncols=True) if width > 0
+            else dict(ncols=fallback.columns, nrows=fallback.lines))
+    return tqdm(file=sys.stderr, leave=False, delay=_delay(), **size, **kwargs)
 
 
 def track(iterable: Iterable[T], desc: str, total: int | None = None) -> Iterator[T]:
@@ -72,8 +92,8 @@ def run_bar(desc: str, total: int | None = None) -> Iterator[None]:
         yield
         return
     _bar = _tqdm(desc=desc, total=total, unit="stage",
-                 bar_format="{desc}: {n_fmt}/{total_fmt} stages |{bar:20}| {elapsed} {postfix}"
-                 if total else "{desc}: {n_fmt} stages, {elapsed} {postfix}")
+                 bar_format="{desc}: {n_fmt}/{total_fmt} stages |{bar:20}| {elapsed}{postfix}"
+                 if total else "{desc}: {n_fmt} stages, {elapsed}{postfix}")
     try:
         yield
     finally:
@@ -97,6 +117,7 @@ def finish() -> None:
     if _bar is not None and getattr(_bar, "_mechbal_started", False):
         _bar.update(1)
         _bar._mechbal_started = False
+        _bar.set_postfix_str("done", refresh=True)
 
 
 __all__ = ["configure", "enabled", "finish", "run_bar", "stage", "track"]

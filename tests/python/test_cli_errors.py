@@ -277,3 +277,67 @@ def test_init_serial_template_runs(tmp_path, capsys):
 def test_init_linkage_says_it_is_not_available(capsys):
     assert main(["init", "linkage"]) == 2
     one_line_error(capsys, 2, "not available yet", "init serial")
+
+
+# ---- progress ---------------------------------------------------------------------------------
+
+def _run_in_terminal(args, env_extra):
+    """Run mechbal under a pseudo-terminal (stdout and stderr a tty); return its output."""
+    import pty
+
+    env = dict(os.environ, MECHBAL_PROGRESS_DELAY="0", **env_extra)
+    env.pop("MECHBAL_PROGRESS", None)
+    pid, fd = pty.fork()
+    if pid == 0:  # child
+        os.execve(sys.executable, [sys.executable, "-m", "mechbal", *args], env)
+    import fcntl
+    import struct
+    import termios
+
+    fcntl.ioctl(fd, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))  # 24 x 100 terminal
+    chunks = []
+    while True:
+        try:
+            data = os.read(fd, 65536)
+        except OSError:
+            break
+        if not data:
+            break
+        chunks.append(data)
+    _, status = os.waitpid(pid, 0)
+    return os.waitstatus_to_exitcode(status), b"".join(chunks).decode(errors="replace")
+
+
+@pytest.mark.parametrize("case, stages", [("arm2link", 3), ("discs-3r", 5)])
+def test_progress_bar_on_a_terminal(tmp_path, case, stages):
+    code, text = _run_in_terminal(["run", case, "--out", str(tmp_path / "o")], {})
+    assert code == 0, text
+    assert f"/{stages} stages" in text and f"{stages}/{stages} stages" in text, text
+    assert "summary" in text  # the last stage's label
+
+
+def test_no_progress_bar_with_quiet_on_a_terminal(tmp_path):
+    code, text = _run_in_terminal(["run", "arm2link", "--out", str(tmp_path / "o"), "--quiet"], {})
+    assert code == 0 and "stages" not in text and text.strip() == "", text
+
+
+def test_no_progress_bar_when_not_on_a_terminal(tmp_path):
+    env = dict(os.environ, MECHBAL_PROGRESS_DELAY="0")
+    env.pop("MECHBAL_PROGRESS", None)
+    r = subprocess.run([sys.executable, "-m", "mechbal", "run", "arm2link", "--out",
+                        str(tmp_path / "o")], capture_output=True, text=True, env=env)
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    assert "peak shaking force" in r.stdout  # the tables still go to stdout
+
+
+def test_progress_track_is_transparent(monkeypatch):
+    from mechbal import progress
+
+    monkeypatch.setenv("MECHBAL_PROGRESS", "1")
+    monkeypatch.setenv("MECHBAL_PROGRESS_DELAY", "0")
+    assert list(progress.track(iter(range(5)), "x", total=5)) == list(range(5))
+    progress.configure(quiet=True)
+    try:
+        assert not progress.enabled()
+    finally:
+        progress.configure(quiet=False)

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import _core, report
+from mechbal import _core, progress, report
 from mechbal.cases import register
 from mechbal.config import ConfigError, integer, number, require, vector
 from mechbal.export import write_bodies, write_summary
@@ -107,7 +107,7 @@ def _closed_loop(arm, cw, cfg, traj, start):
     dev = lambda log: float(np.max(np.abs(log["q_des"] - log["q"] - e_eq6)))  # noqa: E731
     err = lambda log: float(np.max(np.abs(log["q_des"] - log["q"])))  # noqa: E731
     worst, worst_on_track = None, None
-    for s in itertools.product((1 - p, 1 + p), repeat=4):
+    for s in progress.track(list(itertools.product((1 - p, 1 + p), repeat=4)), "perturbed models"):
         true_arm = _core.Arm2DofParameters(arm.m1 * s[0], arm.m2 * s[1], arm.l1, arm.l_s1,
                                            arm.l_s2, arm.i_s1 * s[2], arm.i_s2 * s[3], arm.g)
         true_plant = _core.Arm2DofDynamics(true_arm, cwc)
@@ -141,7 +141,7 @@ def _closed_loop(arm, cw, cfg, traj, start):
         })
 
 
-@register("arm2dof")
+@register("arm2dof", stages=4)
 def run(config: dict, out: Path) -> dict:
     arm = arm_from_config(require(config, "arm", ""))
     cwt = require(config, "counterweights", "")
@@ -161,6 +161,7 @@ def run(config: dict, out: Path) -> dict:
     motion = {k: tr.evaluate_batch(t) for k, tr in trajs.items()}
 
     # ---- sizing (eqs 39-59) and its numerical check ----
+    progress.stage("RMS-optimal counterweights and torques")
     res = rc.rms_optimal_radii(arm, m_cw1, m_cw2, *motion["B"])
     r_num = rc.rms_optimal_radii_numerical(arm, m_cw1, m_cw2, *motion["B"])
     r_static = rc.static_balancing_radii(arm, m_cw1, m_cw2)
@@ -184,12 +185,14 @@ def run(config: dict, out: Path) -> dict:
         tk = _core.KdlChainDynamics(chain).inverse_dynamics(*motion[law])["tau"]
         kdl_dev = max(kdl_dev, float(np.max(np.abs(tk - tau[k])) / np.max(np.abs(tau[k]))))
 
+    progress.stage("computed-torque closed loops")
     # ---- closed loop on the arm of run C (and, for comparison, the bare arm of run B) ----
     traj_B = _core.RestToRestTrajectory(start, end, T, _core.TimeLaw.cubic)
     cl = _closed_loop(arm, cw["C"], require(config, "controller", ""), traj_B, start)
     cl_bare = _closed_loop(arm, None, require(config, "controller", ""), traj_B, start)
 
     # ---- files ----
+    progress.stage("bodies files and plots")
     for k in ("A", "B", "C"):
         law, c = runs[k]
         b = _bodies(arm, c, *motion[law])
@@ -221,6 +224,7 @@ def run(config: dict, out: Path) -> dict:
                        caption="Torque commanded by computed torque at 1 kHz (zero-order hold) "
                                "with the exact model and with the worst +-20 % model.")
 
+    progress.stage("summary")
     rB, pB = red("B")
     rC, pC = red("C")
     rS, pS = red("B_static_cw")

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import _core, report
+from mechbal import _core, progress, report
 from mechbal.cases import register
 from mechbal.config import ConfigError, inertia, integer, number, require, string, vector
 from mechbal.export import write_bodies, write_summary
@@ -101,7 +101,8 @@ def _controller_check(kind, p, cfg, q_des, qd_des, qdd_des, n):
     rng = np.random.default_rng(0)
     q = q_des + rng.uniform(-0.05, 0.05, q_des.shape)
     qd = qd_des + rng.uniform(-0.1, 0.1, qd_des.shape)
-    tau_dc = np.array([dc.step(*x)[0] for x in zip(q, qd, q_des, qd_des, qdd_des)])
+    tau_dc = np.array([dc.step(*x)[0] for x in progress.track(
+        zip(q, qd, q_des, qd_des, qdd_des), "decoupled control ticks", total=len(q))])
     bal = dz.design(kind, p, True)
     if kind == "fivebar":
         ct = _core.ComputedTorque(dz.fivebar_dynamics(bal), kp, kd)
@@ -109,7 +110,8 @@ def _controller_check(kind, p, cfg, q_des, qd_des, qdd_des, n):
     else:
         ct = _core.ComputedTorque(dz.disc_arm_dynamics(kind, bal), kp, kd)
         backend = "mechbal.ComputedTorque over DiscArmDynamics"
-    steps = [ct.step(*x) for x in zip(q, qd, q_des, qd_des, qdd_des)]
+    steps = [ct.step(*x) for x in progress.track(
+        zip(q, qd, q_des, qd_des, qdd_des), "computed torque ticks", total=len(q))]
     if any(s != _core.Status.ok for _, s in steps):
         raise RuntimeError(f"computed torque failed on the trajectory: {[s for _, s in steps]}")
     tau_ct = np.array([t for t, _ in steps])
@@ -233,7 +235,7 @@ def _write_bodies(path, t, b, q, qd, qdd):
     return w["force"], w["moment"]
 
 
-@register("discs")
+@register("discs", stages=5)
 def run(config: dict, out: Path) -> dict:
     kind = string(require(config["case"], "mechanism", "case"), "case.mechanism", dz.MECHANISMS)
     n = _SPEC[kind]["n"]
@@ -247,6 +249,7 @@ def run(config: dict, out: Path) -> dict:
     st = require(config, "sampling", "", {})
     N = integer(require(st, "configurations", "sampling", 1000), "sampling.configurations", minimum=10)
     seed = integer(require(st, "seed", "sampling", 0), "sampling.seed", minimum=0)
+    progress.stage("mass matrix over sampled configurations")
     q, qd = dz.sample_states(kind, N, np.random.default_rng(seed))
     before = dz.metrics(*dz.evaluate(kind, dz.design(kind, p, False), q, qd))
     after = dz.metrics(*dz.evaluate(kind, dz.design(kind, p, True), q, qd), bal["k"])
@@ -259,6 +262,7 @@ def run(config: dict, out: Path) -> dict:
                     "sensitivity.errors_pct") / 100.0
     Ns = min(N, 200)
     try:
+        progress.stage("sensitivity to parameter errors")
         sens = dz.sensitivity(kind, p, params, errors, q[:Ns], qd[:Ns])
     except KeyError as exc:
         raise ConfigError("sensitivity.parameters", "unknown parameter", exc.args[0]) from None
@@ -270,6 +274,7 @@ def run(config: dict, out: Path) -> dict:
     Nt = integer(require(tt, "samples", "trajectory", 301), "trajectory.samples", minimum=3)
     t = np.linspace(0.0, T, Nt)
     qt, qdt, qddt = _core.RestToRestTrajectory(start, end, T, _core.TimeLaw.quintic).evaluate_batch(t)
+    progress.stage("trajectory torques, decoupled and computed-torque control")
     tau_u = _torques(kind, dz.design(kind, p, False), qt, qdt, qddt)
     tau_b = _torques(kind, dz.design(kind, p, True), qt, qdt, qddt)
     tau_k = qddt * np.asarray(bal["k"])
@@ -287,6 +292,7 @@ def run(config: dict, out: Path) -> dict:
     control = _controller_check(kind, p, require(config, "controller", ""), qt, qdt, qddt, n)
 
     # ---- every link and disc as a body along the trajectory: the shaking wrench ----
+    progress.stage("bodies files (shaking wrench)")
     wrench = {}
     for variant, balanced in (("unbalanced", False), ("balanced", True)):
         b = _disc_bodies(kind, dz.design(kind, p, balanced), qt, qdt, qddt)
@@ -304,6 +310,7 @@ def run(config: dict, out: Path) -> dict:
         balancing["inertia_conditions"] = bal["inertia_conditions"]
     if "K_cross" in bal:
         balancing["K_cross"] = bal["K_cross"]
+    progress.stage("summary")
     summary = {
         "case": config["case"]["name"], "kind": "discs", "mechanism": kind,
         "source": "Coutinho & Hess Coelho, A new approach for designing dynamic balanced serial "

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import report
+from mechbal import progress, report
 from mechbal.cases import register
 from mechbal.config import ConfigError, integer, number, require, string, vector
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences, write_bodies, write_summary
@@ -154,7 +154,7 @@ def moment_about(M, F, point):
     return M - np.cross(np.asarray(point, float)[None, :], F)
 
 
-@register("paminsa")
+@register("paminsa", stages=5)
 def run(config: dict, out: Path) -> dict:
     from mechbal._core import PaminsaModel, paminsa_kinematics, paminsa_reactionless_run
 
@@ -169,6 +169,7 @@ def run(config: dict, out: Path) -> dict:
     ls_samples = integer(require(cws, "least_squares_samples", "counterweights", 40),
                          "counterweights.least_squares_samples", minimum=5)
 
+    progress.stage("sizing counterweights (closed form, least squares)")
     # ---- counterweights: closed forms, literal printed equations, least squares
     closed = sizing.closed_form(params)
     printed = sizing.paper_printed(params)
@@ -183,6 +184,7 @@ def run(config: dict, out: Path) -> dict:
     model_reported = PaminsaModel(reported.apply(params))
 
     # ---- motion
+    progress.stage("kinematics and reactionless wrist (Euler, RK4)")
     cfg = {name: wrist_config_from_config(config, name) for name in ("euler", "rk4")}
     rate = cfg[primary].rate_hz
     t, Ph, Pdh, Pddh = half_step_samples(cycle, rate)
@@ -195,6 +197,7 @@ def run(config: dict, out: Path) -> dict:
     bal = {name: paminsa_reactionless_run(model_bal, c, q0, Ph, Pdh, Pddh) for name, c in cfg.items()}
 
     # ---- export
+    progress.stage("bodies files (wrench of the stored poses)")
     _export(out / "bodies_unbalanced.npz", t, model_unbal, unbal, P=P, Pd=Pd, Pdd=Pdd)
     _export(out / "bodies_force_balanced.npz", t, model_bal, fbal, P=P, Pd=Pd, Pdd=Pdd)
     posed = {}
@@ -211,6 +214,7 @@ def run(config: dict, out: Path) -> dict:
         if name == primary:
             _export(out / "bodies_balanced.npz", t, model_bal, stored, integrator=np.array(name), **extra)
 
+    progress.stage("checks from the exported poses, plots")
     # ---- the balanced moment recomputed from the exported poses alone (central differences)
     inner = slice(2, -2)
     F_unbal, M_unbal = unbal["shaking_force"], unbal["shaking_moment"]
@@ -253,6 +257,7 @@ def run(config: dict, out: Path) -> dict:
                                "along the run; the wrist is far from its z-x-z singularity.")
 
     # ---- summary
+    progress.stage("summary")
     rates = {n: report.peak_abs(r["wrist_rates"]) for n, r in bal.items()}
     cond = bal[primary]["condition"]
     m_reported = np.linalg.norm(rep["shaking_force"], axis=1).max()

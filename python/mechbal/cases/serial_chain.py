@@ -6,19 +6,21 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import report
+from mechbal import progress, report
 from mechbal.cases import register
 from mechbal.config import chain_from_config, require, trajectory_from_config
 from mechbal.export import write_bodies, write_summary
 from mechbal.simulate import run_chain
 
 
-@register("serial_chain")
+@register("serial_chain", stages=3)
 def run(config: dict, out: Path) -> dict:
     model = chain_from_config(require(config, "mechanism", ""))
     traj, t = trajectory_from_config(require(config, "trajectory", ""), model.dof)
+    progress.stage("kinematics, shaking wrench, inverse dynamics")
     r = run_chain(model, traj, t)
     F, M = r.wrench["force"], r.wrench["moment"]
+    progress.stage("bodies file and plots")
     # the wrench the base exerts on the chain (KDL, gravity included, moment about O)
     R_F, R_M = r.support_force, r.support_moment
     write_bodies(out / "bodies_nominal.npz", t=t, names=r.names, mass=r.mass,
@@ -46,6 +48,7 @@ def run(config: dict, out: Path) -> dict:
                        caption="Actuator torque (revolute) or force (prismatic) of each joint "
                                "along the trajectory, gravity included (KDL recursive "
                                "Newton-Euler).")
+    progress.stage("summary")
     summary = {
         "case": config["case"]["name"],
         "kind": "serial_chain",
