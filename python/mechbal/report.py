@@ -79,6 +79,7 @@ def plot_wrench(path: str | Path, t: np.ndarray,
         axes[1, k].set_ylabel("moment [N m]")
         for r in range(2):
             axes[r, k].set_xlabel("t [s]")
+            axes[r, k].xaxis.set_tick_params(labelbottom=True)
             axes[r, k].grid(True, alpha=0.3)
     return _finish(plt, fig, axes.ravel(), path, title, caption)
 
