@@ -31,7 +31,8 @@ namespace {
 void bind_chain(pybind11::module_& m) {
   py::enum_<JointType>(m, "JointType")
       .value("revolute", JointType::revolute)
-      .value("prismatic", JointType::prismatic);
+      .value("prismatic", JointType::prismatic)
+      .value("fixed", JointType::fixed);
 
   py::class_<JointSpec>(m, "JointSpec", "One joint of a serial chain and the link it moves")
       .def(py::init([](const std::string& name, JointType type, const Eigen::Matrix4d& origin,

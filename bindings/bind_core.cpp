@@ -44,7 +44,8 @@ void bind_core(pybind11::module_& m) {
       .value("singular", Status::singular)
       .value("saturated", Status::saturated)
       .value("bad_size", Status::bad_size)
-      .value("solver_error", Status::solver_error);
+      .value("solver_error", Status::solver_error)
+      .value("out_of_range", Status::out_of_range);
 
   m.def(
       "validate_rigid_body",

@@ -12,7 +12,7 @@ namespace mechbal::pyb {
 
 namespace {
 
-Eigen::VectorXd one_state(const RneChainDynamics& d, const Eigen::VectorXd& v, const char* name) {
+Eigen::VectorXd one_state(const MechanismDynamics& d, const Eigen::VectorXd& v, const char* name) {
   if (v.size() != d.dof()) {
     throw py::value_error(std::string(name) + " must have " + std::to_string(d.dof()) +
                           " values, got " + std::to_string(v.size()));
@@ -21,15 +21,16 @@ Eigen::VectorXd one_state(const RneChainDynamics& d, const Eigen::VectorXd& v, c
 }
 
 void bind_rnea(py::module_& m) {
-  py::class_<RneChainDynamics, InverseDynamics>(
-      m, "RneChainDynamics",
-      "Joint-space dynamics of a ChainModel by mechbal's own recursive Newton-Euler (inverse "
-      "dynamics, base support wrench) and composite rigid body algorithm (mass matrix)")
-      .def(py::init<const ChainModel&>(), py::arg("model"))
-      .def_property_readonly("dof", &RneChainDynamics::dof)
+  py::class_<MechanismDynamics, InverseDynamics>(
+      m, "MechanismDynamics",
+      "Joint-space dynamics of a MechanismModel (recursive Newton-Euler inverse dynamics with the "
+      "base support wrench, composite rigid body mass matrix): the InverseDynamics back end of the "
+      "general model, for ComputedTorque and the simulators")
+      .def(py::init<MechanismModel>(), py::arg("model"))
+      .def_property_readonly("dof", &MechanismDynamics::dof)
       .def(
           "inverse_dynamics",
-          [](RneChainDynamics& d, const Array& q, const Array& qd, const Array& qdd) {
+          [](MechanismDynamics& d, const Array& q, const Array& qd, const Array& qdd) {
             return batch_inverse_dynamics(d, q, qd, qdd);
           },
           py::arg("q"), py::arg("qd"), py::arg("qdd"),
@@ -38,7 +39,7 @@ void bind_rnea(py::module_& m) {
           "non-finite input give zeros and set their flag in `status`.")
       .def(
           "mass_matrix",
-          [](RneChainDynamics& d, const Eigen::VectorXd& q) {
+          [](MechanismDynamics& d, const Eigen::VectorXd& q) {
             one_state(d, q, "q");
             Eigen::MatrixXd M(d.dof(), d.dof());
             if (d.mass_matrix(q, M) != Status::ok) throw py::value_error("q must be finite");
@@ -47,7 +48,7 @@ void bind_rnea(py::module_& m) {
           py::arg("q"), "Mass matrix M(q) (dof, dof) by the composite rigid body algorithm")
       .def(
           "gravity",
-          [](RneChainDynamics& d, const Eigen::VectorXd& q) {
+          [](MechanismDynamics& d, const Eigen::VectorXd& q) {
             one_state(d, q, "q");
             Eigen::VectorXd g(d.dof());
             if (d.gravity(q, g) != Status::ok) throw py::value_error("q must be finite");
@@ -56,7 +57,7 @@ void bind_rnea(py::module_& m) {
           py::arg("q"), "Gravity torques G(q)")
       .def(
           "bias",
-          [](RneChainDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+          [](MechanismDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
             one_state(d, q, "q");
             one_state(d, qd, "qd");
             Eigen::VectorXd b(d.dof());
@@ -66,7 +67,7 @@ void bind_rnea(py::module_& m) {
           py::arg("q"), py::arg("qd"), "Bias torques C(q, qd) qd + G(q)")
       .def(
           "coriolis",
-          [](RneChainDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+          [](MechanismDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
             one_state(d, q, "q");
             one_state(d, qd, "qd");
             Eigen::VectorXd c(d.dof());
@@ -74,6 +75,11 @@ void bind_rnea(py::module_& m) {
             return c;
           },
           py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques C(q, qd) qd");
+
+  py::class_<RneChainDynamics, MechanismDynamics>(
+      m, "RneChainDynamics",
+      "MechanismDynamics of a serial ChainModel (the chain as a general mechanism)")
+      .def(py::init<const ChainModel&>(), py::arg("model"));
 }
 
 }  // namespace

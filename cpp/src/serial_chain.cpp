@@ -24,6 +24,11 @@ ChainModel::ChainModel(std::vector<JointSpec> joints, const Vec3& gravity,
   if (!base_.matrix().allFinite()) throw std::invalid_argument("base must be finite");
   for (std::size_t i = 0; i < joints_.size(); ++i) {
     JointSpec& j = joints_[i];
+    if (j.type != JointType::revolute && j.type != JointType::prismatic) {
+      throw std::invalid_argument(joint_field(i, j, "type") +
+                                  " must be revolute or prismatic in a serial chain (use "
+                                  "MechanismModel for fixed joints)");
+    }
     const double n = j.axis.norm();
     if (!j.axis.allFinite() || n < 1e-12) {
       std::ostringstream m;
@@ -103,6 +108,25 @@ Eigen::Isometry3d modified_dh_origin(double a, double alpha, double d, double th
   T.translate(Vec3(0.0, 0.0, d));
   T.rotate(Eigen::AngleAxisd(theta, Vec3::UnitZ()));
   return T;
+}
+
+MechanismDescription chain_description(const ChainModel& model) {
+  MechanismDescription d;
+  d.gravity = model.gravity();
+  std::string parent = d.root_name;
+  for (int i = 0; i < model.dof(); ++i) {
+    const JointSpec& js = model.joints()[static_cast<std::size_t>(i)];
+    Joint j;
+    j.name = js.name.empty() ? "joint" + std::to_string(i + 1) : js.name;
+    j.type = js.type;
+    j.parent = parent;
+    j.placement = i == 0 ? model.base() * js.origin : js.origin;
+    j.axis = js.axis;
+    d.joints.push_back(j);
+    d.bodies.push_back(Body{j.name, "link", j.name, js.link.mass, js.com, js.link.inertia_body});
+    parent = j.name;
+  }
+  return d;
 }
 
 }  // namespace mechbal

@@ -13,6 +13,7 @@ from mechbal._core import (  # noqa: F401
     JointSpec,
     JointType,
     KdlChainDynamics,
+    MechanismDynamics,
     PaminsaModel,
     PaminsaParameters,
     ReactionlessWrist,
@@ -30,3 +31,5 @@ from mechbal._core import (  # noqa: F401
 )
 from mechbal._core import __version__  # noqa: F401
 from mechbal.config import ConfigError, load_case  # noqa: F401
+from mechbal._core import Body, Frame, Joint, MechanismDescription, MechanismModel  # noqa: F401,E402
+from mechbal.mechanism import Mechanism  # noqa: F401,E402

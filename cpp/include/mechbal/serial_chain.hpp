@@ -14,12 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "mechbal/joint_type.hpp"
+#include "mechbal/model.hpp"
 #include "mechbal/rigid_body.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {
-
-enum class JointType { revolute, prismatic };
 
 struct JointSpec {
   std::string name;
@@ -66,6 +66,11 @@ Status chain_kinematics(const ChainModel& model, const Eigen::Ref<const Eigen::V
                         const Eigen::Ref<const Eigen::VectorXd>& qd,
                         const Eigen::Ref<const Eigen::VectorXd>& qdd,
                         ChainWorkspace& ws) noexcept;
+
+/// The chain as a general MechanismDescription: joint i named as in the chain (or "joint<i>"),
+/// parent the previous joint, the base transform folded into the first placement, each link's
+/// inertia a body of kind "link" named after its joint. Not real-time.
+MechanismDescription chain_description(const ChainModel& model);
 
 /// Modified (Craig 1989) DH origin: Rx(alpha) Tx(a) Tz(d) Rz(theta).
 Eigen::Isometry3d modified_dh_origin(double a, double alpha, double d, double theta);

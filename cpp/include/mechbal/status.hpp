@@ -13,6 +13,8 @@ enum class Status : std::uint32_t {
   saturated = 1u << 2,         ///< an output hit its configured limit and was clipped
   bad_size = 1u << 3,          ///< an input had the wrong dimension: output left untouched
   solver_error = 1u << 4,      ///< an underlying solver (e.g. KDL) reported an error
+  out_of_range = 1u << 5,      ///< finite input outside its documented range, or a result that
+                               ///< overflowed: output held (real time) or zeroed (batch)
 };
 
 constexpr Status operator|(Status a, Status b) noexcept {

@@ -1,0 +1,74 @@
+#pragma once
+/// \file data.hpp
+/// MechanismData: every buffer the algorithms over a MechanismModel need, allocated once from the
+/// model (Pinocchio's Data). Algorithms write their results here; nothing allocates afterwards.
+/// All world quantities are in the base frame O; moments and angular momenta are about O.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "mechbal/model.hpp"
+#include "mechbal/rigid_body.hpp"
+
+namespace mechbal {
+
+struct MechanismData {
+  explicit MechanismData(const MechanismModel& model);
+
+  int dof;         ///< of the model this data was built for (checked by every algorithm)
+  int num_links;
+  int num_bodies;
+  int num_frames;
+
+  // ---- joint positions (every link's joint, gear couplings applied) ----
+  std::vector<double> joint_position, joint_velocity, joint_acceleration;
+
+  // ---- forward kinematics: link frames F_i in O (index 0 = base) ----
+  std::vector<Mat3> link_rotation;               ///< F_i -> O
+  std::vector<Vec3> link_position;               ///< origin of F_i in O
+  std::vector<Vec3> link_angular_velocity;       ///< in O
+  std::vector<Vec3> link_velocity;               ///< of F_i's origin, in O
+  std::vector<Vec3> link_angular_acceleration;   ///< in O
+  std::vector<Vec3> link_acceleration;           ///< of F_i's origin, in O (gravity excluded)
+  std::vector<BodyState> body_states;            ///< every body's motion (com, rotation, ...), in O
+  std::vector<RigidBody> body_inertias;          ///< mass and inertia about com, body = link axes
+  std::vector<Eigen::Isometry3d> frame_placements;  ///< named frames in O
+
+  // ---- results ----
+  double mass = 0.0;                   ///< total mass [kg]
+  Vec3 center_of_mass = Vec3::Zero();  ///< in O [m]
+  ShakingWrench shaking;   ///< momenta about O and their rates (shaking force and moment)
+  BaseReaction base_reaction;  ///< wrench the base exerts on the mechanism (gravity included)
+  Eigen::VectorXd joint_torque;    ///< inverse dynamics [N m or N], size dof
+  Eigen::VectorXd gravity_torque;  ///< G(q)
+  Eigen::VectorXd bias_torque;     ///< C(q, v) v + G(q)
+  Eigen::MatrixXd mass_matrix;     ///< M(q), dof x dof, symmetric
+  Eigen::MatrixXd momentum_matrix;  ///< 6 x dof: [P; H_O] = A(q) v (linear first)
+  Eigen::MatrixXd frame_jacobian;   ///< 6 x dof: [v; w] of a frame's origin, O axes
+  /// Regressors over each body's 10 inertial parameters, body b in columns 10b..10b+9:
+  /// [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] with c and I (about the link frame
+  /// origin) in the frame of the body's link (Pinocchio's ordering).
+  Eigen::MatrixXd torque_regressor;    ///< dof x 10 nb: tau = Y pi
+  Eigen::MatrixXd gravity_regressor;   ///< dof x 10 nb: G(q) = Y pi
+  Eigen::MatrixXd momentum_regressor;  ///< 6 x 10 nb: [P; H_O] = Y pi
+
+  // ---- internal buffers (per link, in the joint-aligned frames L_i of model.hpp) ----
+  struct LinkWork {
+    Mat3 rotation;     ///< L_i relative to L_parent at the current q
+    Vec3 translation;  ///< origin of L_i in L_parent
+    Vec3 w, alpha, acc;    ///< angular velocity, angular acceleration, origin acceleration (in L_i)
+    Vec3 vel;              ///< origin velocity (in L_i)
+    Vec3 force, moment;    ///< wrench from the parent on link i (moment about L_i's origin)
+    Mat3 world_rotation;   ///< L_i -> O
+    Vec3 world_position;   ///< origin of L_i in O
+    double composite_mass;
+    Vec3 composite_first_moment;
+    Mat3 composite_inertia;
+  };
+  std::vector<LinkWork> work;
+  Eigen::MatrixXd link_mass_matrix;  ///< per-link joint-space mass matrix (num_links^2)
+  Eigen::MatrixXd link_regressor;           ///< dof x 10 scratch: one link's torque regressor
+  Eigen::MatrixXd link_momentum_regressor;  ///< 6 x 10 scratch: one link's momentum regressor
+};
+
+}  // namespace mechbal

@@ -1,0 +1,218 @@
+#pragma once
+/// \file detail/tree.hpp
+/// Internal passes over a MechanismModel shared by the algorithm files: input checks, joint
+/// positions through the gear couplings, placement of every link, the recursive Newton-Euler
+/// forward pass and the composite-inertia backward pass. Everything here works in the
+/// joint-aligned link frames L_i of model.hpp (the joint moves about / along local z).
+/// noexcept and allocation-free.
+#include <Eigen/Core>
+#include <cmath>
+
+#include "mechbal/data.hpp"
+#include "mechbal/model.hpp"
+#include "mechbal/status.hpp"
+
+namespace mechbal::detail {
+
+/// w x e_z without the multiplications by zero.
+inline Vec3 cross_ez(const Vec3& w) noexcept { return Vec3(w.y(), -w.x(), 0.0); }
+
+inline bool data_matches(const MechanismModel& model, const MechanismData& data) noexcept {
+  return data.dof == model.dof() && data.num_links == model.num_links() &&
+         data.num_bodies == model.num_bodies() && data.num_frames == model.num_frames() &&
+         static_cast<int>(data.work.size()) == model.num_links();
+}
+
+/// Sizes and finiteness of up to three state vectors (null = not used).
+inline Status check_state(const MechanismModel& model, const MechanismData& data,
+                          const Eigen::Ref<const Eigen::VectorXd>* q,
+                          const Eigen::Ref<const Eigen::VectorXd>* v = nullptr,
+                          const Eigen::Ref<const Eigen::VectorXd>* a = nullptr) noexcept {
+  if (!data_matches(model, data)) return Status::bad_size;
+  const Eigen::Index n = model.dof();
+  if ((q && q->size() != n) || (v && v->size() != n) || (a && a->size() != n)) return Status::bad_size;
+  if ((q && !q->allFinite()) || (v && !v->allFinite()) || (a && !a->allFinite())) {
+    return Status::non_finite_input;
+  }
+  return Status::ok;
+}
+
+/// Joint position, velocity, acceleration of every link from the independent coordinates.
+template <bool Velocity, bool Acceleration>
+inline void joint_state(const MechanismModel& model, MechanismData& data,
+                        const Eigen::Ref<const Eigen::VectorXd>& q,
+                        const Eigen::Ref<const Eigen::VectorXd>& v,
+                        const Eigen::Ref<const Eigen::VectorXd>& a) noexcept {
+  const int nl = model.num_links();
+  for (int l = 1; l < nl; ++l) {
+    const auto k = static_cast<std::size_t>(l);
+    const int c = model.coordinate(l);
+    if (c < 0) {
+      data.joint_position[k] = data.joint_velocity[k] = data.joint_acceleration[k] = 0.0;
+      continue;
+    }
+    const double r = model.coordinate_ratio(l);
+    data.joint_position[k] = r * q(c) + model.coordinate_offset(l);
+    data.joint_velocity[k] = Velocity ? r * v(c) : 0.0;
+    data.joint_acceleration[k] = Acceleration ? r * a(c) : 0.0;
+  }
+}
+
+/// Link placements relative to their parents and, with World (the default), in O (L frames).
+template <bool World = true>
+inline void place(const MechanismModel& model, MechanismData& data) noexcept {
+  const int nl = model.num_links();
+  for (int l = 1; l < nl; ++l) {
+    const auto k = static_cast<std::size_t>(l);
+    const auto& c = model.link_constants(l);
+    auto& w = data.work[k];
+    switch (model.joint_type(l)) {
+      case JointType::revolute: {
+        // C_R Rz(q): only the first two columns change
+        const double qk = data.joint_position[k];
+        const double cs = std::cos(qk), sn = std::sin(qk);
+        w.rotation.col(0) = cs * c.rotation.col(0) + sn * c.rotation.col(1);
+        w.rotation.col(1) = cs * c.rotation.col(1) - sn * c.rotation.col(0);
+        w.rotation.col(2) = c.rotation.col(2);
+        w.translation = c.translation;
+        break;
+      }
+      case JointType::prismatic:
+        w.rotation = c.rotation;
+        w.translation = c.translation + c.rotation.col(2) * data.joint_position[k];
+        break;
+      case JointType::fixed:
+        w.rotation = c.rotation;
+        w.translation = c.translation;
+        break;
+    }
+    if (World) {
+      const auto& p = data.work[static_cast<std::size_t>(model.parent(l))];
+      w.world_rotation.noalias() = p.world_rotation * w.rotation;
+      w.world_position = p.world_position + p.world_rotation * w.translation;
+    }
+  }
+}
+
+/// Forward pass: velocity, acceleration of every link in its own L frame and, when Forces, the
+/// net wrench each link needs (force, moment about its origin). Gravity enters as an upward
+/// acceleration -g of the base (Luh et al.), so with Gravity the wrenches include the weights.
+template <bool Velocity, bool Acceleration, bool Gravity, bool Forces>
+inline void forward_pass(const MechanismModel& model, MechanismData& data) noexcept {
+  auto& base = data.work[0];
+  base.w.setZero();
+  base.alpha.setZero();
+  base.vel.setZero();
+  if (Gravity) {
+    base.acc = -model.gravity();
+  } else {
+    base.acc.setZero();
+  }
+  const int nl = model.num_links();
+  for (int l = 1; l < nl; ++l) {
+    const auto k = static_cast<std::size_t>(l);
+    const auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
+    auto& W = data.work[k];
+    const Vec3& p = W.translation;
+    const Mat3& R = W.rotation;
+    Vec3 a_lin = P.acc;
+    if (Velocity || Acceleration) a_lin += P.alpha.cross(p);
+    if (Velocity) a_lin += P.w.cross(P.w.cross(p));
+    W.acc.noalias() = R.transpose() * a_lin;
+    if (Velocity) {
+      W.w.noalias() = R.transpose() * P.w;
+      W.vel.noalias() = R.transpose() * (P.vel + P.w.cross(p));
+    } else {
+      W.w.setZero();
+      W.vel.setZero();
+    }
+    if (Velocity || Acceleration) {
+      W.alpha.noalias() = R.transpose() * P.alpha;
+    } else {
+      W.alpha.setZero();
+    }
+    const double qd = Velocity ? data.joint_velocity[k] : 0.0;
+    const double qdd = Acceleration ? data.joint_acceleration[k] : 0.0;
+    switch (model.joint_type(l)) {
+      case JointType::revolute:
+        if (Velocity) {
+          W.alpha += cross_ez(W.w) * qd;
+          W.w.z() += qd;
+        }
+        if (Acceleration) W.alpha.z() += qdd;
+        break;
+      case JointType::prismatic:
+        if (Velocity) {
+          W.acc += cross_ez(W.w) * (2.0 * qd);
+          W.vel.z() += qd;
+        }
+        if (Acceleration) W.acc.z() += qdd;
+        break;
+      case JointType::fixed:
+        break;
+    }
+    if (Forces) {
+      const auto& c = model.link_constants(l);
+      const Vec3& h = c.first_moment;
+      W.force = c.mass * W.acc + W.alpha.cross(h);
+      W.moment.noalias() = c.inertia_origin * W.alpha;
+      W.moment += h.cross(W.acc);
+      if (Velocity) {
+        W.force += W.w.cross(W.w.cross(h));
+        W.moment += W.w.cross(c.inertia_origin * W.w);
+      }
+    }
+  }
+}
+
+/// Backward pass: wrench transmitted by each joint (accumulated into work[l].force/moment; the
+/// base's entry receives the wrench the base exerts on the moving links, in O), projected on the
+/// joint axes and through the gear couplings into `tau` (size dof).
+template <typename Tau>
+inline void backward_pass(const MechanismModel& model, MechanismData& data, Tau& tau) noexcept {
+  data.work[0].force.setZero();
+  data.work[0].moment.setZero();
+  tau.setZero();
+  for (int l = model.num_links() - 1; l >= 1; --l) {
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    const int c = model.coordinate(l);
+    if (c >= 0) {
+      const double t = model.joint_type(l) == JointType::revolute ? W.moment.z() : W.force.z();
+      tau(c) += model.coordinate_ratio(l) * t;
+    }
+    auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
+    const Vec3 f = W.rotation * W.force;
+    P.force += f;
+    P.moment += W.rotation * W.moment + W.translation.cross(f);
+  }
+}
+
+/// Composite mass, first moment and inertia about each link's origin (in L_i) of the subtree
+/// rooted at every link (CRBA's backward pass; Featherstone 2008, alg. 6.2).
+inline void composite_inertias(const MechanismModel& model, MechanismData& data) noexcept {
+  const int nl = model.num_links();
+  for (int l = 0; l < nl; ++l) {
+    const auto& c = model.link_constants(l);
+    auto& W = data.work[static_cast<std::size_t>(l)];
+    W.composite_mass = c.mass;
+    W.composite_first_moment = c.first_moment;
+    W.composite_inertia = c.inertia_origin;
+  }
+  for (int l = nl - 1; l >= 1; --l) {
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
+    // I_O' = R I R^T + m ((p.p) 1 - p p^T) + 2 (p.h) 1 - h p^T - p h^T with h = R h_child.
+    const double m = W.composite_mass;
+    const Vec3& p = W.translation;
+    const Vec3 h = W.rotation * W.composite_first_moment;
+    Mat3 I = W.rotation * W.composite_inertia * W.rotation.transpose();
+    const Mat3 hp = h * p.transpose();
+    I += (m * p.squaredNorm() + 2.0 * p.dot(h)) * Mat3::Identity() - m * p * p.transpose() - hp -
+         hp.transpose();
+    P.composite_mass += m;
+    P.composite_first_moment += h + m * p;
+    P.composite_inertia += I;
+  }
+}
+
+}  // namespace mechbal::detail

@@ -1,0 +1,427 @@
+// The algorithms over a MechanismModel (one public header each in mechbal/algorithm/).
+#include "mechbal/algorithm/center_of_mass.hpp"
+#include "mechbal/algorithm/inverse_dynamics.hpp"
+#include "mechbal/algorithm/jacobian.hpp"
+#include "mechbal/algorithm/kinematics.hpp"
+#include "mechbal/algorithm/mass_matrix.hpp"
+#include "mechbal/algorithm/momentum.hpp"
+#include "mechbal/algorithm/regressor.hpp"
+#include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/detail/tree.hpp"
+
+namespace mechbal {
+
+namespace {
+
+using detail::check_state;
+
+/// World quantities of links, bodies and frames from the L-frame work buffers.
+void world_kinematics(const MechanismModel& model, MechanismData& data) noexcept {
+  const int nl = model.num_links();
+  for (int l = 0; l < nl; ++l) {
+    const auto k = static_cast<std::size_t>(l);
+    const auto& W = data.work[k];
+    const Mat3& R = W.world_rotation;
+    data.link_rotation[k].noalias() = R * model.link_constants(l).aligned.transpose();
+    data.link_position[k] = W.world_position;
+    data.link_angular_velocity[k].noalias() = R * W.w;
+    data.link_velocity[k].noalias() = R * W.vel;
+    data.link_angular_acceleration[k].noalias() = R * W.alpha;
+    data.link_acceleration[k].noalias() = R * W.acc;
+  }
+  for (int b = 0; b < model.num_bodies(); ++b) {
+    const auto k = static_cast<std::size_t>(model.body_link(b));
+    BodyState& s = data.body_states[static_cast<std::size_t>(b)];
+    const Mat3& R = data.link_rotation[k];
+    const Vec3& w = data.link_angular_velocity[k];
+    const Vec3& al = data.link_angular_acceleration[k];
+    const Vec3 r = R * model.bodies()[static_cast<std::size_t>(b)].com;
+    s.com = data.link_position[k] + r;
+    s.com_velocity = data.link_velocity[k] + w.cross(r);
+    s.com_acceleration = data.link_acceleration[k] + al.cross(r) + w.cross(w.cross(r));
+    s.rotation = R;
+    s.angular_velocity = w;
+    s.angular_acceleration = al;
+  }
+  for (int f = 0; f < model.num_frames(); ++f) {
+    const auto k = static_cast<std::size_t>(model.frame_link(f));
+    Eigen::Isometry3d T;
+    T.linear() = data.link_rotation[k];
+    T.translation() = data.link_position[k];
+    T.makeAffine();
+    data.frame_placements[static_cast<std::size_t>(f)] = T * model.frame(f).placement;
+  }
+}
+
+/// Sum of m c over all links (the base's bodies included), in O.
+Vec3 mass_moment(const MechanismModel& model, const MechanismData& data) noexcept {
+  Vec3 mc = Vec3::Zero();
+  for (int l = 0; l < model.num_links(); ++l) {
+    const auto& c = model.link_constants(l);
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    mc += c.mass * W.world_position + W.world_rotation * c.first_moment;
+  }
+  return mc;
+}
+
+/// Momenta about O of all links, from a forward pass with velocities.
+void sum_momenta(const MechanismModel& model, MechanismData& data) noexcept {
+  Vec3 P = Vec3::Zero(), H = Vec3::Zero();
+  for (int l = 1; l < model.num_links(); ++l) {
+    const auto& c = model.link_constants(l);
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    const Vec3 p_local = c.mass * W.vel + W.w.cross(c.first_moment);
+    const Vec3 h_local = c.inertia_origin * W.w + c.first_moment.cross(W.vel);
+    const Vec3 p_world = W.world_rotation * p_local;
+    P += p_world;
+    H += W.world_rotation * h_local + W.world_position.cross(p_world);
+  }
+  data.shaking.linear_momentum = P;
+  data.shaking.angular_momentum = H;
+}
+
+/// Rates of the momenta about O: the sum of every link's Newton-Euler wrench (moment about its
+/// origin n_o, so about O: n_o + p x f).
+void sum_wrenches(const MechanismModel& model, MechanismData& data) noexcept {
+  Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+  for (int l = 1; l < model.num_links(); ++l) {
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    const Vec3 f = W.world_rotation * W.force;
+    F += f;
+    M += W.world_rotation * W.moment + W.world_position.cross(f);
+  }
+  data.shaking.force = F;
+  data.shaking.moment = M;
+}
+
+}  // namespace
+
+// ---- kinematics ---------------------------------------------------------------------------------
+
+Status forward_kinematics(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place(model, data);
+  detail::forward_pass<false, false, false, false>(model, data);
+  world_kinematics(model, data);
+  return Status::ok;
+}
+
+Status forward_kinematics(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                          const ConstVector& v) noexcept {
+  if (Status s = check_state(model, data, &q, &v); s != Status::ok) return s;
+  detail::joint_state<true, false>(model, data, q, v, v);
+  detail::place(model, data);
+  detail::forward_pass<true, false, false, false>(model, data);
+  world_kinematics(model, data);
+  return Status::ok;
+}
+
+Status forward_kinematics(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                          const ConstVector& v, const ConstVector& a) noexcept {
+  if (Status s = check_state(model, data, &q, &v, &a); s != Status::ok) return s;
+  detail::joint_state<true, true>(model, data, q, v, a);
+  detail::place(model, data);
+  detail::forward_pass<true, true, false, false>(model, data);
+  world_kinematics(model, data);
+  return Status::ok;
+}
+
+Status center_of_mass(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place(model, data);
+  data.mass = model.total_mass();
+  data.center_of_mass = data.mass > 0.0 ? Vec3(mass_moment(model, data) / data.mass) : Vec3::Zero();
+  return Status::ok;
+}
+
+// ---- momentum and shaking wrench ----------------------------------------------------------------
+
+Status momentum(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                const ConstVector& v) noexcept {
+  if (Status s = check_state(model, data, &q, &v); s != Status::ok) return s;
+  detail::joint_state<true, false>(model, data, q, v, v);
+  detail::place(model, data);
+  detail::forward_pass<true, false, false, false>(model, data);
+  sum_momenta(model, data);
+  return Status::ok;
+}
+
+Status momentum_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place(model, data);
+  detail::composite_inertias(model, data);
+  data.momentum_matrix.setZero();
+  for (int l = 1; l < model.num_links(); ++l) {
+    const int c = model.coordinate(l);
+    if (c < 0) continue;
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    Vec3 P, L;  // momentum of the subtree under a unit joint rate, in L_l (L about its origin)
+    if (model.joint_type(l) == JointType::revolute) {
+      P = -detail::cross_ez(W.composite_first_moment);
+      L = W.composite_inertia.col(2);
+    } else {
+      P = Vec3(0.0, 0.0, W.composite_mass);
+      L = detail::cross_ez(W.composite_first_moment);
+    }
+    const double r = model.coordinate_ratio(l);
+    const Vec3 Pw = W.world_rotation * P;
+    data.momentum_matrix.col(c).head<3>() += r * Pw;
+    data.momentum_matrix.col(c).tail<3>() += r * (W.world_rotation * L + W.world_position.cross(Pw));
+  }
+  return Status::ok;
+}
+
+Status shaking_wrench(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                      const ConstVector& v, const ConstVector& a) noexcept {
+  if (Status s = check_state(model, data, &q, &v, &a); s != Status::ok) return s;
+  detail::joint_state<true, true>(model, data, q, v, a);
+  detail::place(model, data);
+  detail::forward_pass<true, true, false, true>(model, data);
+  sum_momenta(model, data);
+  sum_wrenches(model, data);
+  return Status::ok;
+}
+
+Status base_reaction(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                     const ConstVector& v, const ConstVector& a) noexcept {
+  if (Status s = shaking_wrench(model, data, q, v, a); s != Status::ok) return s;
+  const Vec3 mc = mass_moment(model, data);
+  const Vec3& g = model.gravity();
+  data.mass = model.total_mass();
+  data.center_of_mass = data.mass > 0.0 ? Vec3(mc / data.mass) : Vec3::Zero();
+  data.base_reaction.force = data.shaking.force - data.mass * g;
+  data.base_reaction.moment = data.shaking.moment - mc.cross(g);
+  return Status::ok;
+}
+
+// ---- inverse dynamics ---------------------------------------------------------------------------
+
+Status inverse_dynamics(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                        const ConstVector& v, const ConstVector& a) noexcept {
+  if (Status s = check_state(model, data, &q, &v, &a); s != Status::ok) return s;
+  detail::joint_state<true, true>(model, data, q, v, a);
+  detail::place<false>(model, data);
+  detail::forward_pass<true, true, true, true>(model, data);
+  detail::backward_pass(model, data, data.joint_torque);
+  return Status::ok;
+}
+
+Status gravity_torque(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place<false>(model, data);
+  detail::forward_pass<false, false, true, true>(model, data);
+  detail::backward_pass(model, data, data.gravity_torque);
+  return Status::ok;
+}
+
+Status bias_torque(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                   const ConstVector& v) noexcept {
+  if (Status s = check_state(model, data, &q, &v); s != Status::ok) return s;
+  detail::joint_state<true, false>(model, data, q, v, v);
+  detail::place<false>(model, data);
+  detail::forward_pass<true, false, true, true>(model, data);
+  detail::backward_pass(model, data, data.bias_torque);
+  return Status::ok;
+}
+
+// ---- mass matrix --------------------------------------------------------------------------------
+
+Status mass_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place<false>(model, data);
+  detail::composite_inertias(model, data);
+  Eigen::MatrixXd& M = data.mass_matrix;
+  M.setZero();
+  for (int l = 1; l < model.num_links(); ++l) {
+    const int cl = model.coordinate(l);
+    if (cl < 0) continue;
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    const double rl = model.coordinate_ratio(l);
+    Vec3 L, P;  // momentum of composite l under a unit rate of joint l, about L_l's origin
+    double diag;
+    if (model.joint_type(l) == JointType::revolute) {
+      L = W.composite_inertia.col(2);
+      P = -detail::cross_ez(W.composite_first_moment);
+      diag = L.z();
+    } else {
+      L = detail::cross_ez(W.composite_first_moment);
+      P = Vec3(0.0, 0.0, W.composite_mass);
+      diag = P.z();
+    }
+    M(cl, cl) += rl * rl * diag;
+    // carry it to every ancestor: M(j, l) = S_j . (momentum about j's origin)
+    int k = l;
+    for (int j = model.parent(l); j >= 1; k = j, j = model.parent(j)) {
+      const auto& K = data.work[static_cast<std::size_t>(k)];
+      P = K.rotation * P;
+      L = K.rotation * L + K.translation.cross(P);
+      const int cj = model.coordinate(j);
+      if (cj < 0) continue;
+      const double value = rl * model.coordinate_ratio(j) *
+                           (model.joint_type(j) == JointType::revolute ? L.z() : P.z());
+      M(cl, cj) += value;
+      M(cj, cl) += value;
+    }
+  }
+  return Status::ok;
+}
+
+// ---- Jacobians ----------------------------------------------------------------------------------
+
+Status frame_jacobian(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                      int frame) noexcept {
+  if (frame < 0 || frame >= model.num_frames()) return Status::bad_size;
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place(model, data);
+  const int fl = model.frame_link(frame);
+  const auto& F = data.work[static_cast<std::size_t>(fl)];
+  const Vec3 origin = F.world_position + F.world_rotation * (model.link_constants(fl).aligned.transpose() *
+                                                             model.frame(frame).placement.translation());
+  data.frame_jacobian.setZero();
+  for (int k = fl; k >= 1; k = model.parent(k)) {
+    const int c = model.coordinate(k);
+    if (c < 0) continue;
+    const auto& K = data.work[static_cast<std::size_t>(k)];
+    const Vec3 z = K.world_rotation.col(2);
+    const double r = model.coordinate_ratio(k);
+    if (model.joint_type(k) == JointType::revolute) {
+      data.frame_jacobian.col(c).head<3>() += r * z.cross(origin - K.world_position);
+      data.frame_jacobian.col(c).tail<3>() += r * z;
+    } else {
+      data.frame_jacobian.col(c).head<3>() += r * z;
+    }
+  }
+  return Status::ok;
+}
+
+// ---- regressors ---------------------------------------------------------------------------------
+
+namespace {
+
+/// E_p x for the symmetric basis matrices of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz].
+inline Vec3 inertia_basis_times(int p, const Vec3& x) noexcept {
+  switch (p) {
+    case 0: return Vec3(x.x(), 0.0, 0.0);
+    case 1: return Vec3(x.y(), x.x(), 0.0);
+    case 2: return Vec3(0.0, x.y(), 0.0);
+    case 3: return Vec3(x.z(), 0.0, x.x());
+    case 4: return Vec3(0.0, x.z(), x.y());
+    default: return Vec3(0.0, 0.0, x.z());
+  }
+}
+
+/// Torque regressor of one link's inertial parameters (in F_l, about its origin) into
+/// data.link_regressor (dof x 10), from a forward pass (with gravity when wanted).
+void link_torque_regressor(const MechanismModel& model, MechanismData& data, int l) noexcept {
+  const auto& W = data.work[static_cast<std::size_t>(l)];
+  const Mat3& A = model.link_constants(l).aligned;
+  const Vec3 w = A * W.w, al = A * W.alpha, acc = A * W.acc;  // in F_l
+  const Mat3 RF = W.world_rotation * A.transpose();
+  const Vec3& p = W.world_position;
+  Eigen::Matrix<double, 6, 10> Y;  // wrench in O (force; moment about O) per parameter
+  Y.setZero();
+  Vec3 f, n;
+  for (int col = 0; col < 10; ++col) {
+    if (col == 0) {
+      f = acc;
+      n.setZero();
+    } else if (col < 4) {
+      const Vec3 e = Vec3::Unit(col - 1);
+      f = al.cross(e) + w.cross(w.cross(e));
+      n = e.cross(acc);
+    } else {
+      f.setZero();
+      n = inertia_basis_times(col - 4, al) + w.cross(inertia_basis_times(col - 4, w));
+    }
+    const Vec3 fw = RF * f;
+    Y.block<3, 1>(0, col) = fw;
+    Y.block<3, 1>(3, col) = RF * n + p.cross(fw);
+  }
+  data.link_regressor.setZero();
+  for (int k = l; k >= 1; k = model.parent(k)) {
+    const int c = model.coordinate(k);
+    if (c < 0) continue;
+    const auto& K = data.work[static_cast<std::size_t>(k)];
+    const Vec3 z = K.world_rotation.col(2);
+    const double r = model.coordinate_ratio(k);
+    if (model.joint_type(k) == JointType::revolute) {
+      // z . (n_O - p_k x f) = z . n_O - (p_k x f) . z = z . n_O - (z x p_k) . f
+      const Vec3 zxp = z.cross(K.world_position);
+      for (int col = 0; col < 10; ++col) {
+        data.link_regressor(c, col) += r * (z.dot(Y.block<3, 1>(3, col)) - zxp.dot(Y.block<3, 1>(0, col)));
+      }
+    } else {
+      for (int col = 0; col < 10; ++col) data.link_regressor(c, col) += r * z.dot(Y.block<3, 1>(0, col));
+    }
+  }
+}
+
+template <bool Velocity, bool Acceleration>
+void fill_torque_regressor(const MechanismModel& model, MechanismData& data, Eigen::MatrixXd& out) noexcept {
+  detail::place(model, data);
+  detail::forward_pass<Velocity, Acceleration, true, false>(model, data);
+  for (int b = 0; b < model.num_bodies(); ++b) {
+    const int l = model.body_link(b);
+    if (l == 0) {
+      out.middleCols<10>(10 * b).setZero();
+      continue;
+    }
+    link_torque_regressor(model, data, l);
+    out.middleCols<10>(10 * b) = data.link_regressor;
+  }
+}
+
+}  // namespace
+
+Status torque_regressor(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                        const ConstVector& v, const ConstVector& a) noexcept {
+  if (Status s = check_state(model, data, &q, &v, &a); s != Status::ok) return s;
+  detail::joint_state<true, true>(model, data, q, v, a);
+  fill_torque_regressor<true, true>(model, data, data.torque_regressor);
+  return Status::ok;
+}
+
+Status gravity_regressor(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  fill_torque_regressor<false, false>(model, data, data.gravity_regressor);
+  return Status::ok;
+}
+
+Status momentum_regressor(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                          const ConstVector& v) noexcept {
+  if (Status s = check_state(model, data, &q, &v); s != Status::ok) return s;
+  detail::joint_state<true, false>(model, data, q, v, v);
+  detail::place(model, data);
+  detail::forward_pass<true, false, false, false>(model, data);
+  for (int b = 0; b < model.num_bodies(); ++b) {
+    auto Y = data.momentum_regressor.middleCols<10>(10 * b);
+    const int l = model.body_link(b);
+    Y.setZero();
+    if (l == 0) continue;
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    const Mat3 RF = W.world_rotation * model.link_constants(l).aligned.transpose();
+    const Vec3& p = W.world_position;
+    const Vec3 w = W.world_rotation * W.w, vel = W.world_rotation * W.vel;
+    const Vec3 w_local = RF.transpose() * w;
+    // P = m v + w x R h;  H_O = p x P + (R h) x v + R I (R^T w)
+    Y.block<3, 1>(0, 0) = vel;
+    Y.block<3, 1>(3, 0) = p.cross(vel);
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 e = RF.col(k);
+      const Vec3 P = w.cross(e);
+      Y.block<3, 1>(0, 1 + k) = P;
+      Y.block<3, 1>(3, 1 + k) = p.cross(P) + e.cross(vel);
+    }
+    for (int k = 0; k < 6; ++k) Y.block<3, 1>(3, 4 + k) = RF * inertia_basis_times(k, w_local);
+  }
+  return Status::ok;
+}
+
+}  // namespace mechbal

@@ -1,0 +1,210 @@
+// The general mechanism model (model.hpp, data.hpp, algorithm/*.hpp): against KDL on serial
+// chains (an independent engine), against the per-body shaking wrench of rigid_body.hpp, against
+// its own invariants on random trees, and the real-time contract (no allocation, statuses).
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "alloc_counter.hpp"
+#include "mechbal/algorithm/center_of_mass.hpp"
+#include "mechbal/algorithm/inverse_dynamics.hpp"
+#include "mechbal/algorithm/jacobian.hpp"
+#include "mechbal/algorithm/kinematics.hpp"
+#include "mechbal/algorithm/mass_matrix.hpp"
+#include "mechbal/algorithm/momentum.hpp"
+#include "mechbal/algorithm/regressor.hpp"
+#include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/kdl_chain.hpp"
+#include "test_support.hpp"
+
+using namespace mechbal;
+
+namespace {
+
+/// A random tree: each joint's parent is a random earlier link; types from `types` (R, P, F);
+/// 1-3 bodies per link; a gear coupling on the last joint when `gear`; a frame on every link.
+MechanismModel random_tree(std::mt19937& rng, const std::string& types, bool gear = false) {
+  MechanismDescription d;
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  std::vector<std::string> links{d.root_name};
+  for (std::size_t i = 0; i < types.size(); ++i) {
+    Joint j;
+    j.name = "j" + std::to_string(i + 1);
+    j.type = types[i] == 'P' ? JointType::prismatic : types[i] == 'F' ? JointType::fixed : JointType::revolute;
+    j.parent = links[std::uniform_int_distribution<std::size_t>(0, links.size() - 1)(rng)];
+    j.placement = test::random_pose(rng);
+    j.axis = Vec3(u(rng), u(rng), u(rng)).normalized();
+    d.joints.push_back(j);
+    const int nb = 1 + static_cast<int>(std::uniform_int_distribution<int>(0, 2)(rng));
+    for (int b = 0; b < nb; ++b) {
+      const RigidBody rb = test::random_body(rng);
+      d.bodies.push_back(Body{j.name + "_b" + std::to_string(b), "link", j.name, rb.mass,
+                              Vec3(u(rng), u(rng), u(rng)), rb.inertia_body});
+    }
+    d.frames.push_back(Frame{j.name + "_tool", j.name, test::random_pose(rng)});
+    links.push_back(j.name);
+  }
+  if (gear) {
+    for (auto it = d.joints.rbegin(); it != d.joints.rend(); ++it) {
+      if (it->type == JointType::fixed) continue;
+      for (const auto& m : d.joints) {
+        if (m.name != it->name && m.type != JointType::fixed) {
+          it->mimic_joint = m.name;
+          it->mimic_ratio = -1.7;
+          it->mimic_offset = 0.3;
+          break;
+        }
+      }
+      break;
+    }
+  }
+  return MechanismModel(d);
+}
+
+double rel(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+}
+
+}  // namespace
+
+TEST(Mechanism, ChainMatchesKdl) {
+  std::mt19937 rng(21);
+  for (const char* types : {"RRRRRR", "RPRRPR", "R", "PP"}) {
+    const ChainModel chain = test::random_chain(rng, types);
+    const MechanismModel model(chain_description(chain));
+    ASSERT_TRUE(model.is_serial_chain());
+    MechanismData data(model);
+    KdlChainDynamics kdl(chain);
+    const int n = model.dof();
+    for (int k = 0; k < 5; ++k) {
+      const Eigen::VectorXd q = test::random_vector(rng, n, 2.0), v = test::random_vector(rng, n, 1.0),
+                            a = test::random_vector(rng, n, 1.0);
+      Eigen::VectorXd tau(n);
+      Vec3 F, M;
+      ASSERT_EQ(kdl.inverse_dynamics(q, v, a, tau, &F, &M), Status::ok);
+      ASSERT_EQ(inverse_dynamics(model, data, q, v, a), Status::ok);
+      EXPECT_LT(rel(data.joint_torque, tau), 1e-10) << types;
+      Eigen::MatrixXd Mk(n, n);
+      ASSERT_EQ(kdl.mass_matrix(q, Mk), Status::ok);
+      ASSERT_EQ(mass_matrix(model, data, q), Status::ok);
+      EXPECT_LT(rel(data.mass_matrix, Mk), 1e-10) << types;
+      // KDL's base support wrench is the base reaction of the moving links
+      ASSERT_EQ(base_reaction(model, data, q, v, a), Status::ok);
+      EXPECT_LT(rel(data.base_reaction.force, F), 1e-10);
+      EXPECT_LT(rel(data.base_reaction.moment, M), 1e-10);
+    }
+  }
+}
+
+TEST(Mechanism, ShakingWrenchEqualsTheSumOverBodies) {
+  std::mt19937 rng(22);
+  for (int trial = 0; trial < 10; ++trial) {
+    const MechanismModel model = random_tree(rng, "RRPFRRF", trial % 2 == 1);
+    MechanismData data(model);
+    const int n = model.dof();
+    const Eigen::VectorXd q = test::random_vector(rng, n, 2.0), v = test::random_vector(rng, n, 1.0),
+                          a = test::random_vector(rng, n, 1.0);
+    ASSERT_EQ(forward_kinematics(model, data, q, v, a), Status::ok);
+    ShakingWrench per_body;
+    ASSERT_EQ(shaking_wrench(data.body_inertias.data(), data.body_states.data(), data.body_states.size(), per_body),
+              Status::ok);
+    ASSERT_EQ(shaking_wrench(model, data, q, v, a), Status::ok);
+    EXPECT_LT(rel(data.shaking.force, per_body.force), 1e-12);
+    EXPECT_LT(rel(data.shaking.moment, per_body.moment), 1e-12);
+    EXPECT_LT(rel(data.shaking.linear_momentum, per_body.linear_momentum), 1e-12);
+    EXPECT_LT(rel(data.shaking.angular_momentum, per_body.angular_momentum), 1e-12);
+  }
+}
+
+TEST(Mechanism, VirtualPowerAndMomentumMatrix) {
+  // tau . v = dT/dt + dV/dt with T = v^T M v / 2: checks the dynamics against the mass matrix along
+  // a motion by finite differences of the energy; and A(q) v equals the momenta.
+  std::mt19937 rng(23);
+  for (int trial = 0; trial < 10; ++trial) {
+    const MechanismModel model = random_tree(rng, "RRPRFR", trial % 2 == 0);
+    MechanismData data(model);
+    const int n = model.dof();
+    const Eigen::VectorXd q0 = test::random_vector(rng, n, 2.0), v0 = test::random_vector(rng, n, 1.0),
+                          a0 = test::random_vector(rng, n, 1.0);
+    auto energy = [&](double t) {
+      const Eigen::VectorXd q = q0 + v0 * t + 0.5 * a0 * t * t, v = v0 + a0 * t;
+      mass_matrix(model, data, q);
+      center_of_mass(model, data, q);
+      return 0.5 * v.dot(data.mass_matrix * v) - data.mass * model.gravity().dot(data.center_of_mass);
+    };
+    const double h = 1e-5;
+    const double power = (energy(h) - energy(-h)) / (2 * h);
+    ASSERT_EQ(inverse_dynamics(model, data, q0, v0, a0), Status::ok);
+    EXPECT_NEAR(data.joint_torque.dot(v0), power, 1e-6 * std::max(1.0, std::abs(power)));
+    ASSERT_EQ(momentum_matrix(model, data, q0), Status::ok);
+    const Eigen::Matrix<double, 6, 1> h6 = data.momentum_matrix * v0;
+    ASSERT_EQ(momentum(model, data, q0, v0), Status::ok);
+    EXPECT_LT(rel(h6.head<3>(), data.shaking.linear_momentum), 1e-12);
+    EXPECT_LT(rel(h6.tail<3>(), data.shaking.angular_momentum), 1e-12);
+  }
+}
+
+TEST(Mechanism, AlgorithmsAllocateNothing) {
+  std::mt19937 rng(24);
+  const MechanismModel model = random_tree(rng, "RRPFRRRF", true);
+  MechanismData data(model);
+  const int n = model.dof();
+  const Eigen::VectorXd q = test::random_vector(rng, n, 2.0), v = test::random_vector(rng, n, 1.0),
+                        a = test::random_vector(rng, n, 1.0);
+  test::AllocationScope scope;
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(forward_kinematics(model, data, q, v, a), Status::ok);
+    EXPECT_EQ(center_of_mass(model, data, q), Status::ok);
+    EXPECT_EQ(momentum(model, data, q, v), Status::ok);
+    EXPECT_EQ(momentum_matrix(model, data, q), Status::ok);
+    EXPECT_EQ(shaking_wrench(model, data, q, v, a), Status::ok);
+    EXPECT_EQ(base_reaction(model, data, q, v, a), Status::ok);
+    EXPECT_EQ(inverse_dynamics(model, data, q, v, a), Status::ok);
+    EXPECT_EQ(gravity_torque(model, data, q), Status::ok);
+    EXPECT_EQ(bias_torque(model, data, q, v), Status::ok);
+    EXPECT_EQ(mass_matrix(model, data, q), Status::ok);
+    EXPECT_EQ(frame_jacobian(model, data, q, 0), Status::ok);
+    EXPECT_EQ(torque_regressor(model, data, q, v, a), Status::ok);
+    EXPECT_EQ(gravity_regressor(model, data, q), Status::ok);
+    EXPECT_EQ(momentum_regressor(model, data, q, v), Status::ok);
+  }
+  EXPECT_EQ(scope.count(), 0u);
+}
+
+TEST(Mechanism, BadInputGivesAStatusAndWritesNothing) {
+  std::mt19937 rng(25);
+  const MechanismModel model = random_tree(rng, "RRR");
+  const MechanismModel other = random_tree(rng, "RRRR");
+  MechanismData data(model), wrong(other);
+  const Eigen::VectorXd q = Eigen::VectorXd::Constant(3, 0.1);
+  Eigen::VectorXd nan = q;
+  nan(1) = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_EQ(inverse_dynamics(model, data, q, q, q), Status::ok);
+  const Eigen::VectorXd before = data.joint_torque;
+  EXPECT_EQ(inverse_dynamics(model, data, nan, q, q), Status::non_finite_input);
+  EXPECT_EQ(inverse_dynamics(model, data, q, Eigen::VectorXd::Zero(2), q), Status::bad_size);
+  EXPECT_EQ(inverse_dynamics(model, wrong, q, q, q), Status::bad_size);
+  EXPECT_EQ(frame_jacobian(model, data, q, 7), Status::bad_size);
+  EXPECT_EQ(data.joint_torque, before);
+}
+
+TEST(Mechanism, ConstructionErrorsNameTheField) {
+  MechanismDescription d;
+  Joint a;
+  a.name = "shoulder";
+  a.parent = "base";
+  Joint b;
+  b.name = "elbow";
+  b.parent = "sholder";
+  d.joints = {a, b};
+  try {
+    MechanismModel m(d);
+    FAIL() << "accepted an unknown parent";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "joints[1] (elbow).parent: no link named 'sholder' (did you mean 'shoulder'?)");
+  }
+  d.joints[1].parent = "shoulder";
+  d.joints[1].lower = 1.0;
+  d.joints[1].upper = -1.0;
+  EXPECT_THROW(MechanismModel{d}, std::invalid_argument);
+}
