@@ -1,6 +1,6 @@
-// A consumer of the installed core that includes only the umbrella header and uses every
-// controller (ComputedTorque over each inverse-dynamics back end, DecoupledJointController,
-// ReactionlessWrist, PaminsaController) plus the rigid-body algorithms. Exit code 0 when every
+// A consumer of the installed core that includes only the umbrella header and uses the general
+// model (MechanismModel, MechanismData, its algorithms) and every controller (ComputedTorque over
+// each inverse-dynamics back end, DecoupledJointController, ReactionlessWrist, PaminsaController). Exit code 0 when every
 // result is what it must be; each failure prints one line.
 #include <mechbal/mechbal.hpp>
 
@@ -91,6 +91,43 @@ int main() {
   discs[0].inertia = mechbal::Vec3(0.01, 0.005, 0.005);
   mechbal::DiscArmDynamics disc_arm(arm, discs);
   computed_torque_over(disc_arm, "DiscArmDynamics");
+
+  // the general model: the same arm as a MechanismModel, its algorithms and a controller over it
+  {
+    mechbal::MechanismDescription d;
+    for (int i = 0; i < 2; ++i) {
+      mechbal::Joint j;
+      j.name = i == 0 ? "shoulder" : "elbow";
+      j.parent = i == 0 ? "base" : "shoulder";
+      j.axis = mechbal::Vec3(0.0, -1.0, 0.0);
+      if (i == 1) j.placement.translation() = mechbal::Vec3(0.5, 0.0, 0.0);
+      d.joints.push_back(j);
+      mechbal::Body b;
+      b.name = j.name + "_link";
+      b.link = j.name;
+      b.mass = i == 0 ? 4.0 : 2.0;
+      b.com = mechbal::Vec3(0.2, 0.0, 0.0);
+      b.inertia = mechbal::Vec3(0.004, 0.09, 0.09).asDiagonal();
+      d.bodies.push_back(b);
+    }
+    const mechbal::MechanismModel model(d);
+    mechbal::MechanismData data(model);
+    const Eigen::VectorXd q = Eigen::VectorXd::Constant(2, 0.3), v = Eigen::VectorXd::Ones(2),
+                          a = Eigen::VectorXd::Constant(2, -0.5);
+    mechbal::Status st = mechbal::inverse_dynamics(model, data, q, v, a);
+    st |= mechbal::shaking_wrench(model, data, q, v, a);
+    st |= mechbal::base_reaction(model, data, q, v, a);
+    // R = dP/dt - m g: the base reaction is the shaking force plus the weight
+    const double weight_gap =
+        (data.base_reaction.force - data.shaking.force + data.mass * model.gravity()).norm();
+    std::printf("MechanismModel: %d dof, %s, tau = (%.4f, %.4f) N m, |R - (F - m g)| = %.1e N\n",
+                model.dof(), mechbal::status_name(st), data.joint_torque(0), data.joint_torque(1),
+                weight_gap);
+    check(st == mechbal::Status::ok && weight_gap < 1e-9 && data.joint_torque.allFinite(),
+          "MechanismModel algorithms");
+    mechbal::MechanismDynamics dynamics(model);
+    computed_torque_over(dynamics, "MechanismDynamics");
+  }
 
   // decoupled joint control: tau = k (qdd_d + kp e + kd e')
   {

@@ -1,12 +1,26 @@
 #pragma once
 /// \file mechbal.hpp
 /// Umbrella header of the mechbal C++ core: includes every public header in
-/// cpp/include/mechbal/ (the ctest `install_and_consume` fails when one is missing here).
+/// cpp/include/mechbal/ and cpp/include/mechbal/algorithm/ (the ctest `install_and_consume` fails
+/// when one is missing here; detail/ is private).
 ///
-/// Model and algorithms
+/// The general mechanism model and its algorithms (one header each)
 #include "mechbal/status.hpp"
 #include "mechbal/version.hpp"
 #include "mechbal/rigid_body.hpp"
+#include "mechbal/joint_type.hpp"
+#include "mechbal/model.hpp"
+#include "mechbal/data.hpp"
+#include "mechbal/algorithm/center_of_mass.hpp"
+#include "mechbal/algorithm/inverse_dynamics.hpp"
+#include "mechbal/algorithm/jacobian.hpp"
+#include "mechbal/algorithm/kinematics.hpp"
+#include "mechbal/algorithm/mass_matrix.hpp"
+#include "mechbal/algorithm/momentum.hpp"
+#include "mechbal/algorithm/regressor.hpp"
+#include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/mechanism_dynamics.hpp"
+/// Serial chains, trajectories, dynamics back ends
 #include "mechbal/serial_chain.hpp"
 #include "mechbal/trajectory.hpp"
 #include "mechbal/dynamics.hpp"
