@@ -1,58 +1,99 @@
 # Two commands on a fresh Debian machine: `make demo` and `make test`. Each installs what is
-# missing (Debian packages, a virtual environment, the package), then runs.
+# missing (Debian packages, a virtual environment, the package), then runs. `make demo` installs
+# only what the demo needs (the core's build dependencies and the runtime Python packages);
+# `make test` adds the test packages (GoogleTest, Google Benchmark, pytest, Pinocchio, sympy).
 SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 PIP := $(PY) -m pip --disable-pip-version-check
-APT_PACKAGES := libeigen3-dev liborocos-kdl-dev libgtest-dev libbenchmark-dev g++ make python3-venv python3-dev
+APT_PACKAGES := libeigen3-dev liborocos-kdl-dev g++ make python3-venv python3-dev
+APT_TEST_PACKAGES := libgtest-dev libbenchmark-dev
 CPP_BUILD := build/cpp
 JOBS ?= 2
 SOURCES := $(shell find cpp bindings python tests/cpp tests/consumer bench cmake -path bench/results -prune \
              -o -type f -print 2>/dev/null) \
            CMakeLists.txt pyproject.toml
+# pip install of a list from pyproject.toml (one source of truth), read by the venv's Python when
+# the recipe runs: $(call pip_list,runtime) for `dependencies`, $(call pip_list,test) for an extra
+define pip_list
+deps=(); while IFS= read -r d; do deps+=("$$d"); done < <($(PY) -c "import sys; \
+tomllib = __import__('tomllib') if sys.version_info >= (3, 11) else __import__('pip._vendor.tomli', fromlist=['loads']); \
+p = tomllib.load(open('pyproject.toml', 'rb'))['project']; \
+print('\n'.join(p['dependencies'] if sys.argv[1] == 'runtime' else p['optional-dependencies'][sys.argv[1]]))" $(1)) \
+  && [ $${#deps[@]} -gt 0 ] && echo "    $${deps[*]}" && $(PIP) install -q --progress-bar off "$${deps[@]}"
+endef
+say = @printf '\n==> %s\n' $(1)
 
-.PHONY: demo test test-cpp test-python bench apt venv install clean help
+.PHONY: demo test test-cpp test-python bench apt apt-test venv install install-test clean help
 
 help:
 	@echo "make demo   - install what is missing, then run 'mechbal demo' (output in out/demo)"
 	@echo "make test   - install what is missing, then run the C++ tests (ctest) and pytest"
 	@echo "make bench  - build and run the benchmarks"
 	@echo "make clean  - remove build outputs and the virtual environment"
+	@echo "JOBS=N      - parallel compile jobs (default 2)"
 
 demo: install
+	$(call say,"Running the default case study: .venv/bin/mechbal demo --out out/demo")
 	$(VENV)/bin/mechbal demo --out out/demo
 
 test: test-cpp test-python
 
 # ---- setup ------------------------------------------------------------------------------------
-apt: $(VENV)/.stamp-apt
-$(VENV)/.stamp-apt:
-	@missing=""; for p in $(APT_PACKAGES); do \
+define apt_install
+	@missing=""; for p in $(1); do \
 	  dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
 	if [ -n "$$missing" ]; then \
-	  echo "Installing Debian packages:$$missing"; \
+	  printf '\n==> Installing Debian packages:%s\n' "$$missing"; \
 	  SUDO=""; [ "$$(id -u)" -ne 0 ] && SUDO="sudo"; \
 	  $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
 	  $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing \
 	    </dev/null || { echo "apt-get failed: install$$missing by hand"; exit 1; }; \
 	fi
+endef
+
+apt: $(VENV)/.stamp-apt
+$(VENV)/.stamp-apt:
+	$(call apt_install,$(APT_PACKAGES))
 	@mkdir -p $(VENV) && touch $@
+
+apt-test: $(VENV)/.stamp-apt-test
+$(VENV)/.stamp-apt-test: | $(VENV)/.stamp-apt
+	$(call apt_install,$(APT_TEST_PACKAGES))
+	@touch $@
 
 venv: $(VENV)/.stamp-venv
 $(VENV)/.stamp-venv: pyproject.toml | $(VENV)/.stamp-apt
+	$(call say,"Creating $(VENV) with the build tools (pip, scikit-build-core, pybind11, cmake, ninja)")
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PIP) install -q --upgrade pip
-	$(PIP) install -q "scikit-build-core>=0.10" "pybind11>=2.10" cmake ninja
+	$(PIP) install -q --progress-bar off "scikit-build-core>=0.10" "pybind11>=2.10" cmake ninja
+	$(call say,"Installing the runtime Python packages")
+	@$(call pip_list,runtime)
 	@touch $@
 
+# The build shows each compile step ([k/n] from ninja, through pip -v) and keeps the whole log.
 install: $(VENV)/.stamp-install
 $(VENV)/.stamp-install: $(SOURCES) | $(VENV)/.stamp-venv
-	$(PIP) install -q --no-build-isolation ".[test]"
+	$(call say,"Building the C++ core and its Python module with $(JOBS) jobs (log: build/pip-install.log)")
+	@mkdir -p build; set -o pipefail; start=$$(date +%s); \
+	CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PIP) install -v --no-build-isolation . 2>&1 \
+	  | tee build/pip-install.log \
+	  | grep --line-buffered -E '^ *\[[0-9]+/[0-9]+\] |^\*\*\* |^ *Successfully installed' \
+	  | sed -u -e 's/^ *//' -e 's/^/    /' \
+	  || { echo "pip install failed; the end of build/pip-install.log:"; tail -40 build/pip-install.log; exit 1; }; \
+	echo "    built and installed in $$(( $$(date +%s) - start )) s"
+	@touch $@
+
+install-test: $(VENV)/.stamp-install-test
+$(VENV)/.stamp-install-test: pyproject.toml | $(VENV)/.stamp-install $(VENV)/.stamp-apt-test
+	$(call say,"Installing the test packages")
+	@$(call pip_list,test)
 	@touch $@
 
 # ---- tests ------------------------------------------------------------------------------------
-$(CPP_BUILD)/build.ninja: | $(VENV)/.stamp-venv
+$(CPP_BUILD)/build.ninja: | $(VENV)/.stamp-venv $(VENV)/.stamp-apt-test
 	$(VENV)/bin/cmake -S . -B $(CPP_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release \
 	  -DCMAKE_MAKE_PROGRAM=$(abspath $(VENV)/bin/ninja) -DMECHBAL_BUILD_TESTS=ON
 
@@ -60,7 +101,7 @@ test-cpp: $(CPP_BUILD)/build.ninja
 	$(VENV)/bin/cmake --build $(CPP_BUILD) -j $(JOBS)
 	$(VENV)/bin/ctest --test-dir $(CPP_BUILD) --output-on-failure -j $(JOBS)
 
-test-python: install
+test-python: install $(VENV)/.stamp-install-test
 	$(PY) -m pytest -q tests/python
 
 # ---- benchmarks (never part of `make test`; own build dir so test and bench builds don't fight) --
@@ -76,7 +117,7 @@ $(BENCH_BUILD)/build.ninja: | $(VENV)/.stamp-venv
 	  -DCMAKE_MAKE_PROGRAM=$(abspath $(VENV)/bin/ninja) -DMECHBAL_BUILD_TESTS=OFF \
 	  -DMECHBAL_BUILD_BENCH=ON
 
-bench: install $(BENCH_BUILD)/build.ninja
+bench: install $(VENV)/.stamp-apt-test $(BENCH_BUILD)/build.ninja
 	$(VENV)/bin/cmake --build $(BENCH_BUILD) -j $(JOBS)
 	@mkdir -p $(BENCH_RUN)
 	$(BENCH_BUILD)/bench/mechbal-bench $(BENCH_FLAGS) --tail_out=$(BENCH_RUN)/tail.json \

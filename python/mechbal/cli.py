@@ -1,12 +1,34 @@
-"""The ``mechbal`` command line."""
+"""The ``mechbal`` command line.
+
+Exit codes: 0 success; 2 a user's mistake (bad case file or value, bad output folder, bad
+arguments), reported as one line ``mechbal: error: ...`` naming the field or path; 3 an internal
+error (a bug in mechbal), reported as one line with a request to report it (set
+``MECHBAL_DEBUG=1`` for the traceback); 130 interrupted. No traceback is ever shown otherwise.
+"""
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
+import json
+import os
+import stat
 import sys
 from pathlib import Path
 
 from mechbal.config import ConfigError
 
+#: refuse case files larger than this (a case is a few kB; anything huge is a mistake)
+MAX_CASE_BYTES = 4 * 1024 * 1024
+ISSUES_HINT = ("this is a bug in mechbal: please report it with the command line and the case "
+               "file (MECHBAL_DEBUG=1 shows the traceback)")
+
+
+class UserError(Exception):
+    """A mistake in what the user gave (exit code 2)."""
+
+
+# ---- commands ---------------------------------------------------------------------------------
 
 def _cmd_cases(args) -> int:
     from mechbal.cases import DEFAULT_CASE, available
@@ -17,12 +39,65 @@ def _cmd_cases(args) -> int:
     return 0
 
 
+def check_case_file(name_or_path: str) -> Path:
+    """Path of the case after the checks that the TOML reader does not do: a regular file, not a
+    folder, of reasonable size, UTF-8 text, valid TOML of reasonable nesting (raises
+    :class:`ConfigError` naming the path)."""
+    from mechbal.config import case_path, tomllib
+
+    path = case_path(name_or_path)  # ConfigError for an unknown built-in name or a missing file
+    try:
+        st = path.stat()
+    except OSError as exc:
+        raise ConfigError("case", f"cannot be read: {exc.strerror}", str(path)) from None
+    if stat.S_ISDIR(st.st_mode):
+        raise ConfigError("case", "is a folder, not a case file", str(path))
+    if not stat.S_ISREG(st.st_mode):
+        raise ConfigError("case", "is not a regular file (a device, pipe or socket)", str(path))
+    if st.st_size > MAX_CASE_BYTES:
+        raise ConfigError("case", f"is {st.st_size} bytes, more than a case file can be "
+                                  f"({MAX_CASE_BYTES} bytes)", str(path))
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ConfigError("case", f"cannot be read: {exc.strerror}", str(path)) from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise ConfigError(str(path), f"is not UTF-8 text (byte 0x{raw[exc.start]:02x} on line "
+                                     f"{line}): save it as UTF-8", has_value=False) from None
+    try:
+        tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(str(path), f"is not valid TOML: {exc}", has_value=False) from None
+    except RecursionError:
+        raise ConfigError(str(path), "nests arrays or tables too deeply to be a case file",
+                          has_value=False) from None
+    return path
+
+
 def _cmd_run(args) -> int:
     from mechbal.cases import run_case
+    from mechbal.output import check_output_dir
 
     out = Path(args.out)
-    run_case(args.case, out)
-    print(f"wrote {out}/summary.json and the plots and bodies files beside it")
+    check_output_dir(out)           # before anything else: a bad --out fails in the first second
+    check_case_file(args.case)
+    buffer = io.StringIO()
+    with contextlib.redirect_stdout(buffer):  # the runner's tables, printed after its bar closes
+        summary = run_case(args.case, out)
+    if not args.quiet:
+        sys.stdout.write(buffer.getvalue())
+    notes = summary.get("non_finite_values") if isinstance(summary, dict) else None
+    if not notes:  # what is on disk is what counts
+        with contextlib.suppress(OSError, ValueError):
+            notes = json.loads((out / "summary.json").read_text()).get("non_finite_values")
+    if notes:
+        print(f"mechbal: warning: {len(notes)} non-finite value(s) written as null in "
+              f"{out}/summary.json (listed under non_finite_values)", file=sys.stderr)
+    if not args.quiet:
+        print(f"wrote {out}/summary.json and the plots and bodies files beside it")
     return 0
 
 
@@ -30,42 +105,114 @@ def _cmd_demo(args) -> int:
     from mechbal.cases import DEFAULT_CASE
 
     args.case = DEFAULT_CASE
-    print(f"mechbal demo: running the default case '{DEFAULT_CASE}'")
+    if not args.quiet:
+        print(f"mechbal demo: running the default case '{DEFAULT_CASE}'")
     return _cmd_run(args)
 
 
+def _cmd_init(args) -> int:
+    from mechbal import templates
+
+    if args.kind == "linkage":
+        raise UserError(templates.LINKAGE_NOT_YET)
+    sys.stdout.write(templates.SERIAL)
+    return 0
+
+
+# ---- parser and main --------------------------------------------------------------------------
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line and exit code 2, as for every other user mistake
+        self.print_usage(sys.stderr)
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    from mechbal import __version__
+
+    p = _Parser(
         prog="mechbal",
         description="Balancing of mechanisms: shaking force and moment, counterweights, springs, "
-                    "counter-rotating discs, and real-time controllers of balanced robots.")
-    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+                    "counter-rotating discs, and real-time controllers of balanced robots.",
+        epilog="Exit codes: 0 ok, 2 a mistake in the input (one line names the field or path), "
+               "3 an internal error (please report it).")
+    p.add_argument("--version", action="version", version=f"mechbal {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     s = sub.add_parser("cases", help="list the built-in case studies")
     s.set_defaults(func=_cmd_cases)
+    quiet = dict(action="store_true",
+                 help="no progress bar and no tables: only warnings and errors (on stderr)")
     s = sub.add_parser("run", help="run a case study (built-in name or TOML file)",
                        description="Run a case study and write DIR/summary.json, PNG plots and "
-                                   "DIR/bodies_<variant>.npz for every simulated variant.")
+                                   "DIR/bodies_<variant>.npz for every simulated variant. DIR "
+                                   "receives a whole run or nothing: the run is written next to "
+                                   "it and moved into place when complete, replacing a previous "
+                                   "run.")
     s.add_argument("case", help="built-in case name (see 'mechbal cases') or path to a TOML file")
     s.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    s.add_argument("-q", "--quiet", **quiet)
     s.set_defaults(func=_cmd_run)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")
     s.add_argument("--out", default="out/demo", metavar="DIR", help="output folder")
+    s.add_argument("-q", "--quiet", **quiet)
     s.set_defaults(func=_cmd_demo)
+    s = sub.add_parser("init", help="print a commented case template: mechbal init serial > my.toml",
+                       description="Print a commented case file to standard output, to edit and "
+                                   "run with 'mechbal run my.toml'.")
+    s.add_argument("kind", choices=("serial", "linkage"),
+                   help="serial: a serial chain (joints, links, trajectory); linkage: a closed "
+                        "loop (four-bar with a counterweight), not available yet")
+    s.set_defaults(func=_cmd_init)
     return p
 
 
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text or type(exc).__name__
+
+
 def main(argv: list[str] | None = None) -> int:
+    from mechbal import progress
+    from mechbal.output import OutputError
+
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    progress.configure(quiet=getattr(args, "quiet", False))
+    debug = os.environ.get("MECHBAL_DEBUG", "") not in ("", "0")
     try:
         return args.func(args)
-    except ConfigError as exc:
-        print(f"mechbal: configuration error: {exc}", file=sys.stderr)
+    except (ConfigError, OutputError, UserError) as exc:
+        if debug:
+            raise
+        print(f"mechbal: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except MemoryError:
+        if debug:
+            raise
+        print("mechbal: error: out of memory: the case asks for too many samples or "
+              "configurations (reduce trajectory.samples or the like)", file=sys.stderr)
+        return 2
+    except (ValueError, RuntimeError, OverflowError, ArithmeticError) as exc:
+        # raised by the core's validation (std::invalid_argument names the field) or by a runner
+        # on values it cannot use: a mistake in the case, not in mechbal
+        if debug:
+            raise
+        kind = "" if type(exc) in (ValueError, RuntimeError) else f"{type(exc).__name__}: "
+        print(f"mechbal: error: {kind}{_one_line(exc)}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("mechbal: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # noqa: BLE001 - the last line of defence: no traceback
+        if debug:
+            raise
+        print(f"mechbal: internal error: {type(exc).__name__}: {_one_line(exc)}; {ISSUES_HINT}",
+              file=sys.stderr)
+        return 3
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -6,10 +6,14 @@ the body frame, ``com`` (N,B,3) and ``rotation`` (N,B,3,3) (body -> base) in the
 mechbal's own ``shaking_force`` (N,3) and ``shaking_moment`` (N,3) about the base origin O.
 From these arrays alone the shaking wrench can be recomputed by finite differences
 (:func:`shaking_wrench_by_finite_differences`).
+
+``summary.json`` is strict JSON (:func:`write_summary`): non-finite numbers are written as null and
+listed under ``non_finite_values``.
 """
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
@@ -79,24 +83,53 @@ def shaking_wrench_by_finite_differences(data: Mapping[str, np.ndarray]) -> tupl
     return _derivative(P, data["t"]), _derivative(H, data["t"])
 
 
-def _jsonable(x: Any) -> Any:
+def _jsonable(x: Any, path: str = "", notes: list | None = None) -> Any:
+    """Plain JSON types; a non-finite float becomes None and, when ``notes`` is given, a note
+    ``{"field": dotted path, "value": "NaN" | "Infinity" | "-Infinity"}`` is appended."""
     if isinstance(x, Mapping):
-        return {str(k): _jsonable(v) for k, v in x.items()}
+        return {str(k): _jsonable(v, f"{path}.{k}" if path else str(k), notes) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
+        return [_jsonable(v, f"{path}[{i}]", notes) for i, v in enumerate(x)]
     if isinstance(x, np.ndarray):
-        return _jsonable(x.tolist())
-    if isinstance(x, (np.floating, float)):
-        return float(x)
+        return _jsonable(x.tolist(), path, notes)
+    if isinstance(x, (np.bool_, bool)):
+        return bool(x)
     if isinstance(x, (np.integer,)):
         return int(x)
-    if isinstance(x, np.bool_):
-        return bool(x)
-    return x
+    if isinstance(x, (np.floating, float)):
+        v = float(x)
+        if not math.isfinite(v):
+            if notes is not None:
+                notes.append({"field": path, "value": "NaN" if v != v else
+                              ("Infinity" if v > 0 else "-Infinity")})
+            return None
+        return v
+    if isinstance(x, (str, int)) or x is None:
+        return x
+    if isinstance(x, Path):
+        return str(x)
+    raise TypeError(f"{path or 'summary'}: cannot be written to JSON ({type(x).__name__})")
+
+
+def to_json(summary: Mapping[str, Any]) -> tuple[str, list[dict]]:
+    """Strict JSON text of ``summary`` (RFC 8259: no NaN or Infinity) and the notes on the
+    non-finite values it replaced by null."""
+    notes: list[dict] = []
+    data = _jsonable(summary, "", notes)
+    if notes:
+        data["non_finite_values"] = notes
+    return json.dumps(data, indent=2, sort_keys=False, allow_nan=False) + "\n", notes
 
 
 def write_summary(path: str | Path, summary: Mapping[str, Any]) -> Path:
+    """Write ``summary`` as strict JSON. A non-finite number (NaN, +-inf: e.g. a paper value the
+    case does not give) is written as ``null`` and listed under ``non_finite_values`` with its
+    dotted field, both in the file and (when ``summary`` is a dict) in ``summary`` itself, so that
+    the caller can warn."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(_jsonable(summary), indent=2, sort_keys=False) + "\n")
+    text, notes = to_json(summary)
+    path.write_text(text)
+    if notes and isinstance(summary, dict):
+        summary["non_finite_values"] = notes
     return path

@@ -16,12 +16,43 @@ def _pyplot():
     return plt
 
 
-def _finish(plt, fig, legend_axis, path: str | Path, title: str) -> Path:
-    """Legend, title, layout, save as PNG (creating the folder), close."""
-    legend_axis.legend(fontsize=8)
+#: successive series: solid, then dashed, dotted, dash-dot, each thinner and drawn above the
+#: previous one, so that coinciding lines all stay visible (a dashed line over a solid one)
+_STYLES = [dict(linestyle="-", linewidth=2.6), dict(linestyle="--", linewidth=1.9),
+           dict(linestyle=":", linewidth=1.9), dict(linestyle="-.", linewidth=1.3),
+           dict(linestyle=(0, (5, 1, 1, 1)), linewidth=1.1)]
+
+
+def _style(i: int) -> dict:
+    return dict(_STYLES[i % len(_STYLES)], zorder=2 + i)
+
+
+def grid_shape(panels: int) -> tuple[int, int]:
+    """(rows, columns) of a grid of ``panels`` panels: one column up to 1, two up to 4, three
+    beyond (a 6-joint plot is 2 x 3, a 12-joint plot 4 x 3)."""
+    cols = 1 if panels <= 1 else 2 if panels <= 4 else 3
+    return -(-panels // cols), cols
+
+
+def _finish(plt, fig, axes, path: str | Path, title: str, caption: str) -> Path:
+    """One legend for the figure (above the panels), title, caption (below), save as PNG."""
+    import textwrap
+
+    handles, labels = axes[0].get_legend_handles_labels()
+    top = 0.96 if title else 0.995
     if title:
-        fig.suptitle(title)
-    fig.tight_layout()
+        fig.suptitle(title, y=0.995, va="top", fontsize=12)
+    if len(labels) > 1 or labels and not labels[0].startswith("_"):
+        fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, top),
+                   ncol=min(len(labels), 4), fontsize=9, frameon=False)
+        top -= 0.035 * (1 + (len(labels) - 1) // 4) * (6.5 / fig.get_figheight())
+    bottom = 0.0
+    if caption:
+        width = int(fig.get_figwidth() * 17)
+        text = "\n".join(textwrap.wrap(caption, width))
+        fig.text(0.01, 0.005, text, ha="left", va="bottom", fontsize=8.5, color="0.25")
+        bottom = (0.03 + 0.022 * text.count("\n")) * (6.5 / fig.get_figheight())
+    fig.tight_layout(rect=(0.0, bottom, 1.0, top))
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
@@ -30,39 +61,59 @@ def _finish(plt, fig, legend_axis, path: str | Path, title: str) -> Path:
 
 
 def plot_wrench(path: str | Path, t: np.ndarray,
-                variants: Mapping[str, tuple[np.ndarray, np.ndarray]], title: str = "") -> Path:
-    """Shaking force x, y, z (top row) and moment x, y, z (bottom row) for each variant."""
+                variants: Mapping[str, tuple[np.ndarray, np.ndarray]], title: str = "",
+                caption: str = "", force: str = "shaking force",
+                moment: str = "shaking moment") -> Path:
+    """Force x, y, z (top row) [N] and moment x, y, z (bottom row) [N m], one line per variant
+    (successive variants dashed, dotted, ... over the previous ones)."""
     plt = _pyplot()
-    fig, axes = plt.subplots(2, 3, figsize=(13, 6.5), sharex=True)
-    for name, (F, M) in variants.items():
-        for k, axis in enumerate("xyz"):
-            axes[0, k].plot(t, F[:, k], label=name)
-            axes[1, k].plot(t, M[:, k], label=name)
+    fig, axes = plt.subplots(2, 3, figsize=(13, 6.8), sharex=True)
+    for i, (name, (F, M)) in enumerate(variants.items()):
+        for k in range(3):
+            axes[0, k].plot(t, F[:, k], label=name, **_style(i))
+            axes[1, k].plot(t, M[:, k], label=name, **_style(i))
     for k, axis in enumerate("xyz"):
-        axes[0, k].set_title(f"shaking force {axis} [N]")
-        axes[1, k].set_title(f"shaking moment {axis} [N m]")
-        axes[1, k].set_xlabel("t [s]")
+        axes[0, k].set_title(f"{force} {axis}", fontsize=10)
+        axes[1, k].set_title(f"{moment} {axis}", fontsize=10)
+        axes[0, k].set_ylabel("force [N]")
+        axes[1, k].set_ylabel("moment [N m]")
         for r in range(2):
+            axes[r, k].set_xlabel("t [s]")
+            axes[r, k].xaxis.set_tick_params(labelbottom=True)
             axes[r, k].grid(True, alpha=0.3)
-    return _finish(plt, fig, axes[0, 0], path, title)
+    return _finish(plt, fig, axes.ravel(), path, title, caption)
 
 
 def plot_series(path: str | Path, t: np.ndarray, series: Mapping[str, np.ndarray],
-                labels: Sequence[str], ylabel: str, title: str = "") -> Path:
-    """One subplot per column (e.g. per joint), one line per named series."""
+                labels: Sequence[str], ylabel: str | Sequence[str], title: str = "",
+                caption: str = "") -> Path:
+    """One panel per column (e.g. per joint) in a grid (:func:`grid_shape`), one line per named
+    series; ``ylabel`` with its unit, one for all panels or one per panel."""
     plt = _pyplot()
-    cols = len(labels)
-    fig, axes = plt.subplots(1, cols, figsize=(4.5 * cols, 3.6), squeeze=False)
-    for name, y in series.items():
+    n = len(labels)
+    ylabels = [ylabel] * n if isinstance(ylabel, str) else list(ylabel)
+    if len(ylabels) != n:
+        raise ValueError(f"ylabel: {len(ylabels)} labels for {n} panels")
+    rows, cols = grid_shape(n)
+    width = 6.5 if cols == 1 else 4.6 * cols
+    fig, axes = plt.subplots(rows, cols, figsize=(width, 2.9 * rows + 1.3), squeeze=False,
+                             sharex=True)
+    flat = axes.ravel()
+    for i, (name, y) in enumerate(series.items()):
         y = np.asarray(y).reshape(len(t), -1)
-        for k in range(cols):
-            axes[0, k].plot(t, y[:, k], label=name)
+        if y.shape[1] != n:
+            raise ValueError(f"series {name!r} has {y.shape[1]} columns for {n} panels")
+        for k in range(n):
+            flat[k].plot(t, y[:, k], label=name, **_style(i))
     for k, lab in enumerate(labels):
-        axes[0, k].set_title(lab)
-        axes[0, k].set_xlabel("t [s]")
-        axes[0, k].set_ylabel(ylabel)
-        axes[0, k].grid(True, alpha=0.3)
-    return _finish(plt, fig, axes[0, 0], path, title)
+        flat[k].set_title(lab, fontsize=10)
+        flat[k].set_xlabel("t [s]")
+        flat[k].set_ylabel(ylabels[k])
+        flat[k].grid(True, alpha=0.3)
+        flat[k].xaxis.set_tick_params(labelbottom=True)
+    for ax in flat[n:]:
+        ax.set_visible(False)
+    return _finish(plt, fig, flat[:n], path, title, caption)
 
 
 def table(rows: Sequence[Sequence[object]], header: Sequence[str]) -> str:

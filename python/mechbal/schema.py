@@ -295,12 +295,16 @@ class Mechanism(Table):
 
 
 class ChainTrajectory(Table):
-    """``[trajectory]``: rest-to-rest motion of the independent joints."""
+    """``[trajectory]``: rest-to-rest motion of the actuated joints (every independent joint of an
+    open mechanism)."""
     law: Literal["quintic", "cubic"] = "quintic"
-    start: JointValues = Field(description="one value per independent joint (rad or m)")
-    end: JointValues = Field(description="one value per independent joint (rad or m)")
+    start: JointValues = Field(description="one value per actuated joint (rad or m)")
+    end: JointValues = Field(description="one value per actuated joint (rad or m)")
     duration: Duration
     samples: Samples = 501
+    initial_guess: Optional[JointValues] = Field(
+        None, description="closed mechanisms: every joint coordinate near the assembly at start "
+                          "(picks the assembly mode of the loops), rad or m")
 
 
 class SerialChainCaseHeader(CaseHeader):

@@ -4,6 +4,12 @@ A runner is ``run(config, out: Path) -> dict`` (the summary) registered with
 :func:`register`; ``config`` is the case validated by :func:`mechbal.schema.validate_case` (a
 runner also accepts the raw dict of a TOML file and validates it itself). ``mechbal cases`` lists
 the files; ``mechbal run NAME --out DIR`` runs one.
+
+
+:func:`run_case` checks the output path and reads the case before any computation, then runs the
+runner into a temporary folder next to ``DIR`` that replaces ``DIR`` only when the run is complete
+(:mod:`mechbal.output`): ``DIR`` holds a whole run or none. A runner writes only into the folder
+it is given and may call :func:`mechbal.progress.stage` at each stage of its work.
 """
 from __future__ import annotations
 
@@ -15,14 +21,19 @@ from mechbal.schema import validate_case
 
 Runner = Callable[[dict, Path], dict]
 _RUNNERS: dict[str, Runner] = {}
+_STAGES: dict[str, int] = {}
 
 #: the case ``mechbal demo`` runs
 DEFAULT_CASE = "paminsa"
 
 
-def register(kind: str) -> Callable[[Runner], Runner]:
+def register(kind: str, stages: int | None = None) -> Callable[[Runner], Runner]:
+    """Register ``fn`` as the runner of ``kind``; ``stages``: how many times it calls
+    :func:`mechbal.progress.stage` (the length of its progress bar), if known."""
     def deco(fn: Runner) -> Runner:
         _RUNNERS[kind] = fn
+        if stages is not None:
+            _STAGES[kind] = stages
         return fn
 
     return deco
@@ -48,11 +59,20 @@ def available() -> list[tuple[str, str, str]]:
 
 
 def run_case(name_or_path: str | Path, out: str | Path) -> dict:
+    """Run a built-in case (by name) or a case file into the folder ``out``; returns the summary.
+
+    Raises :class:`mechbal.output.OutputError` (bad ``out``) and :class:`ConfigError` before any
+    computation; whatever a runner raises leaves ``out`` as it was."""
+    from mechbal import progress
+    from mechbal.output import check_output_dir, staged_output
+
+    check_output_dir(out)
     _load_runners()
     config = validate_case(load_case(name_or_path))  # the whole file, before anything runs
     kind = config.case.kind
     if kind not in _RUNNERS:
         raise ConfigError("case.kind", f"unknown kind (known: {', '.join(sorted(_RUNNERS))})", kind)
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    return _RUNNERS[kind](config, out)
+    with staged_output(out) as tmp, progress.run_bar(config.case.name, _STAGES.get(kind)):
+        summary = _RUNNERS[kind](config, tmp)
+        progress.finish()
+    return summary

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import _core, report
+from mechbal import _core, progress, report
 from mechbal.cases import register
 from mechbal.config import ConfigError, inertia
 from mechbal.schema import inertia_matrix, validate_case
@@ -96,7 +96,8 @@ def _controller_check(kind, p, cfg, q_des, qd_des, qdd_des, n):
     rng = np.random.default_rng(0)
     q = q_des + rng.uniform(-0.05, 0.05, q_des.shape)
     qd = qd_des + rng.uniform(-0.1, 0.1, qd_des.shape)
-    tau_dc = np.array([dc.step(*x)[0] for x in zip(q, qd, q_des, qd_des, qdd_des)])
+    tau_dc = np.array([dc.step(*x)[0] for x in progress.track(
+        zip(q, qd, q_des, qd_des, qdd_des), "decoupled control ticks", total=len(q))])
     bal = dz.design(kind, p, True)
     if kind == "fivebar":
         ct = _core.ComputedTorque(dz.fivebar_dynamics(bal), kp, kd)
@@ -104,7 +105,8 @@ def _controller_check(kind, p, cfg, q_des, qd_des, qdd_des, n):
     else:
         ct = _core.ComputedTorque(dz.disc_arm_dynamics(kind, bal), kp, kd)
         backend = "mechbal.ComputedTorque over DiscArmDynamics"
-    steps = [ct.step(*x) for x in zip(q, qd, q_des, qd_des, qdd_des)]
+    steps = [ct.step(*x) for x in progress.track(
+        zip(q, qd, q_des, qd_des, qdd_des), "computed torque ticks", total=len(q))]
     if any(s != _core.Status.ok for _, s in steps):
         raise RuntimeError(f"computed torque failed on the trajectory: {[s for _, s in steps]}")
     tau_ct = np.array([t for t, _ in steps])
@@ -228,7 +230,7 @@ def _write_bodies(path, t, b, q, qd, qdd):
     return w["force"], w["moment"]
 
 
-@register("discs")
+@register("discs", stages=5)
 def run(config, out: Path) -> dict:
     case = validate_case(config, warn=False)
     kind = case.case.mechanism
@@ -251,11 +253,13 @@ def run(config, out: Path) -> dict:
     errors = np.array(case.sensitivity.errors_pct, float) / 100.0
 
     N, seed = case.sampling.configurations, case.sampling.seed
+    progress.stage("mass matrix over sampled configurations")
     q, qd = dz.sample_states(kind, N, np.random.default_rng(seed))
     before = dz.metrics(*dz.evaluate(kind, dz.design(kind, p, False), q, qd))
     after = dz.metrics(*dz.evaluate(kind, dz.design(kind, p, True), q, qd), bal["k"])
 
     Ns = min(N, 200)
+    progress.stage("sensitivity to parameter errors")
     sens = dz.sensitivity(kind, p, params, errors, q[:Ns], qd[:Ns])
 
     tt = case.trajectory
@@ -263,6 +267,7 @@ def run(config, out: Path) -> dict:
     T, Nt = tt.duration, tt.samples
     t = np.linspace(0.0, T, Nt)
     qt, qdt, qddt = _core.RestToRestTrajectory(start, end, T, _core.TimeLaw.quintic).evaluate_batch(t)
+    progress.stage("trajectory torques, decoupled and computed-torque control")
     tau_u = _torques(kind, dz.design(kind, p, False), qt, qdt, qddt)
     tau_b = _torques(kind, dz.design(kind, p, True), qt, qdt, qddt)
     tau_k = qddt * np.asarray(bal["k"])
@@ -271,11 +276,16 @@ def run(config, out: Path) -> dict:
         labels[2] = "joint 3 (force [N])"
     report.plot_series(out / "joint_torques.png", t,
                        {"unbalanced": tau_u, "balanced": tau_b, "k_i q''_i": tau_k},
-                       labels, "torque [N m]",
-                       title=f"{case.case.name}: joint torques, unbalanced vs balanced")
+                       labels, ["force [N]" if "force" in lab else "torque [N m]" for lab in labels],
+                       title=f"{case.case.name}: joint torques, unbalanced vs balanced",
+                       caption="Joint torques along the rest-to-rest trajectory: unbalanced arm, "
+                               "arm balanced by counterweights and counter-rotating discs, and "
+                               "the decoupled model k_i q''_i, which the balanced torque equals "
+                               "(dashed over solid).")
     control = _controller_check(kind, p, case.controller, qt, qdt, qddt, n)
 
     # ---- every link and disc as a body along the trajectory: the shaking wrench ----
+    progress.stage("bodies files (shaking wrench)")
     wrench = {}
     for variant, balanced in (("unbalanced", False), ("balanced", True)):
         b = _disc_bodies(kind, dz.design(kind, p, balanced), qt, qdt, qddt)
@@ -293,6 +303,7 @@ def run(config, out: Path) -> dict:
         balancing["inertia_conditions"] = bal["inertia_conditions"]
     if "K_cross" in bal:
         balancing["K_cross"] = bal["K_cross"]
+    progress.stage("summary")
     summary = {
         "case": case.case.name, "kind": "discs", "mechanism": kind,
         "source": "Coutinho & Hess Coelho, A new approach for designing dynamic balanced serial "

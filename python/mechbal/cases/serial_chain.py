@@ -1,56 +1,117 @@
-"""Runner for ``kind = "serial_chain"`` (and its alias ``kind = "mechanism"``): a chain from its
-TOML description (:mod:`mechbal.spec`) moving along a rest-to-rest trajectory; shaking force and
-moment, base reaction and joint torques."""
+"""Runner for ``kind = "mechanism"`` (alias ``kind = "serial_chain"``): any mechanism of the
+general model (:mod:`mechbal.spec`: chains, trees, extra bodies, gear couplings, loop closures)
+moving along a rest-to-rest trajectory of its actuated joints; shaking force and moment, base
+reaction with gravity, actuator torques and, for closed mechanisms, the loop solve's conditioning."""
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from mechbal import report
+from mechbal import _core, progress, report
 from mechbal.cases import register
-from mechbal.config import chain_model, trajectory_from_config
+from mechbal.config import ConfigError, trajectory_from_config
 from mechbal.export import write_bodies, write_summary
+from mechbal.mechanism import Mechanism
 from mechbal.schema import validate_case
-from mechbal.simulate import run_chain
 
 
-@register("mechanism")
-@register("serial_chain")
+def mechanism_motion(mech: Mechanism, traj, t, q_guess=None):
+    """(q, v, a, torque, extra) of a mechanism along a trajectory of its actuated joints: for an
+    open mechanism the trajectory drives every coordinate and torque is the inverse dynamics; for a
+    closed one the loops are solved instant by instant and torque is the actuated force C^T tau."""
+    qa, va, aa = traj.evaluate_batch(t)
+    if not mech.is_closed:
+        return qa, va, aa, mech.inverse_dynamics(qa, va, aa), {}
+    m = mech.closed_motion(qa, va, aa, q_guess=q_guess, with_forces=True)
+    bad = (m.status & ~np.uint32(int(_core.Status.singular))) != 0
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        raise ConfigError("trajectory", f"the loops cannot be assembled at t = {t[k]:.4g} s (closure "
+                                        f"residual {m.residual[k]:.3g}); check the geometry, the "
+                                        "trajectory and trajectory.initial_guess", has_value=False)
+    singular = (m.status & np.uint32(int(_core.Status.singular))) != 0
+    extra = {"min_rcond": float(np.min(m.rcond)), "singular_instants": int(np.sum(singular)),
+             "max_closure_residual": float(np.max(m.residual)),
+             "max_newton_iterations": int(np.max(m.iterations))}
+    return m.q, m.v, m.a, m.actuated_force, extra
+
+
+@register("mechanism", stages=3)
+@register("serial_chain", stages=3)
 def run(config, out: Path) -> dict:
     case = validate_case(config, warn=False)
-    model = chain_model(case.spec)
-    traj, t = trajectory_from_config(case.trajectory, model.dof)
-    r = run_chain(model, traj, t)
-    F, M = r.wrench["force"], r.wrench["moment"]
-    write_bodies(out / "bodies_nominal.npz", t=t, names=r.names, mass=r.mass,
-                 inertia_body=r.inertia_body, com=r.bodies["com"], rotation=r.bodies["rotation"],
-                 shaking_force=F, shaking_moment=M, q=r.q, qd=r.qd, qdd=r.qdd, torque=r.torque)
-    report.plot_wrench(out / "shaking_wrench.png", t, {"nominal": (F, M)},
-                       title=case.case.title or case.case.name)
-    report.plot_series(out / "joint_torques.png", t, {"KDL RNE": r.torque}, r.names, "torque",
-                       title="joint torques")
+    mech = Mechanism.from_spec(case.spec, name=case.case.name)
+    names = mech.actuated_names
+    traj, t = trajectory_from_config(case.trajectory, len(names))
+    guess = getattr(case.trajectory, "initial_guess", None)
+    if guess is not None and len(guess) != mech.dof:
+        raise ConfigError("trajectory.initial_guess", f"must have {mech.dof} values (every joint with a "
+                          f"coordinate: {', '.join(mech.joint_names)})", list(guess))
+    progress.stage("kinematics, loop solve, shaking wrench, inverse dynamics")
+    q, v, a, torque, extra = mechanism_motion(mech, traj, t, None if guess is None else np.array(guess, float))
+    sw = mech.shaking_wrench(q, v, a)
+    br = mech.base_reaction(q, v, a)
+    motion = mech.body_motion(q, v, a)
+    F, M = sw.shaking_force, sw.shaking_moment
+    R_F, R_M = br.base_reaction_force, br.base_reaction_moment
+
+    progress.stage("bodies file and plots")
+    bodies = mech.bodies
+    write_bodies(out / "bodies_nominal.npz", t=t, names=mech.body_names,
+                 mass=np.array([b.mass for b in bodies]),
+                 inertia_body=np.array([b.inertia for b in bodies]).reshape(-1, 3, 3),
+                 com=motion.com, rotation=motion.rotation, shaking_force=F, shaking_moment=M,
+                 q=q, qd=v, qdd=a, torque=torque, base_reaction_force=R_F, base_reaction_moment=R_M)
+    title = case.case.title or case.case.name
+    report.plot_wrench(out / "shaking_wrench.png", t, {"nominal": (F, M)}, title=title,
+                       caption="Shaking force dP/dt and shaking moment dH_O/dt (about the base origin "
+                               "O, inertial part only: no gravity) of all bodies along the trajectory.")
+    report.plot_wrench(out / "base_reaction.png", t, {"with gravity": (R_F, R_M),
+                                                      "shaking wrench (no gravity)": (F, M)},
+                       title=f"{title}: base reaction", force="base reaction force",
+                       moment="base reaction moment",
+                       caption="Wrench the base exerts on the mechanism (gravity included, moment "
+                               "about O) against the shaking wrench (inertial only): they differ "
+                               "by the weight, -m g and -(m c) x g.")
+    types = {j.name: j.type for j in mech.model.description.joints}
+    kinds = ["prismatic" if types[n] == _core.JointType.prismatic else "revolute" for n in names]
+    report.plot_series(out / "joint_torques.png", t, {"general model": torque},
+                       [f"{n} ({k})" for n, k in zip(names, kinds)],
+                       ["torque [N m]" if k == "revolute" else "force [N]" for k in kinds],
+                       title=f"{title}: actuator torques",
+                       caption="Actuator torque (revolute) or force (prismatic) of each actuated "
+                               "joint along the trajectory, gravity included"
+                               + (" (C^T tau of the closed mechanism)." if mech.is_closed else "."))
+    progress.stage("summary")
     summary = {
         "case": case.case.name,
         "kind": case.case.kind,
-        "dof": model.dof,
+        "dof": mech.dof,
+        "actuated": names,
+        "closed": mech.is_closed,
         "duration_s": float(traj.duration),
         "samples": int(len(t)),
         "law": traj.law.name,
         "variants": ["nominal"],
         "peak_shaking_force_N": {"nominal": report.peak_abs(F)},
         "peak_shaking_moment_Nm": {"nominal": report.peak_abs(M)},
-        "peak_joint_torque": {"nominal": report.peak_abs(r.torque)},
-        "rms_joint_torque": {"nominal": np.sqrt(np.mean(r.torque ** 2, axis=0))},
-        "total_mass_kg": float(np.sum(r.mass)),
-        "files": ["bodies_nominal.npz", "shaking_wrench.png", "joint_torques.png"],
+        "peak_joint_torque": {"nominal": report.peak_abs(torque)},
+        "rms_joint_torque": {"nominal": np.sqrt(np.mean(torque ** 2, axis=0))},
+        "peak_base_reaction_force_N": {"nominal": report.peak_abs(R_F)},
+        "peak_base_reaction_moment_Nm": {"nominal": report.peak_abs(R_M)},
+        "base_reaction": "wrench the base exerts on the mechanism, gravity included, moment about O",
+        "total_mass_kg": mech.total_mass,
+        "files": ["bodies_nominal.npz", "shaking_wrench.png", "base_reaction.png", "joint_torques.png"],
     }
+    if extra:
+        summary["loops"] = extra
     write_summary(out / "summary.json", summary)
     print(report.table(
         [["peak shaking force [N]", *report.peak_abs(F)],
          ["peak shaking moment about O [N m]", *report.peak_abs(M)]],
         ["quantity", "x", "y", "z"]))
-    print(report.table([["peak torque", *report.peak_abs(r.torque)],
-                        ["RMS torque", *np.sqrt(np.mean(r.torque ** 2, axis=0))]],
-                       ["joint torque [N m or N]", *r.names]))
+    print(report.table([["peak torque", *report.peak_abs(torque)],
+                        ["RMS torque", *np.sqrt(np.mean(torque ** 2, axis=0))]],
+                       ["actuator torque [N m or N]", *names]))
     return summary

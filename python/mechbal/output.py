@@ -1,0 +1,122 @@
+"""Output folders that hold a whole run or none.
+
+A run is written into a temporary folder next to ``DIR`` (``.DIR.partial-XXXX``, same file system)
+and moved into place only when the runner has finished: a failed run leaves no file behind and an
+old run in ``DIR`` intact; a successful run replaces an old one whole (no file of the old run stays
+beside the new ones). The output path is checked before any computation:
+
+- ``DIR`` must not be an existing file, nor below one;
+- an existing ``DIR`` must be empty or hold a previous mechbal run (a ``summary.json``): mechbal
+  never replaces a folder of other files (``--out ~`` is refused, not emptied);
+- the folder that will hold ``DIR`` must be writable (checked by creating the temporary folder).
+
+Every refusal is an :class:`OutputError` whose message names the path and the reason.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Iterator
+
+#: a folder holding this file is taken to be a previous mechbal run (safe to replace)
+RUN_MARKER = "summary.json"
+
+
+class OutputError(OSError):
+    """The output path cannot hold a run (a file, not writable, a folder of other files)."""
+
+    def __init__(self, path: str | Path, reason: str):
+        self.path = str(path)
+        self.reason = reason
+        super().__init__(f"--out {path}: {reason}")
+
+    def __str__(self) -> str:  # OSError's own str() would print errno fields
+        return f"--out {self.path}: {self.reason}"
+
+
+def _reason(exc: OSError) -> str:
+    return exc.strerror or str(exc)
+
+
+def check_output_dir(out: str | Path) -> Path:
+    """Absolute ``DIR`` after every check that needs no write (raises :class:`OutputError`)."""
+    given = out
+    out = Path(os.path.abspath(os.path.expanduser(str(out))))
+    if out.exists() or out.is_symlink():
+        if not out.is_dir():
+            raise OutputError(given, "exists and is not a folder (give a folder path)")
+        try:
+            entries = [p.name for p in out.iterdir()]
+        except OSError as exc:
+            raise OutputError(given, f"cannot be read: {_reason(exc)}") from None
+        if entries and RUN_MARKER not in entries:
+            raise OutputError(given, f"is a folder of other files (no {RUN_MARKER} of a previous "
+                                     "run): give a new or empty folder")
+        if out.parent == out:
+            raise OutputError(given, "is the root folder")
+    # the nearest existing ancestor must be a writable folder
+    parent = out.parent
+    while not parent.exists():
+        if parent.is_symlink():
+            raise OutputError(given, f"{parent} is a broken link")
+        parent = parent.parent
+    if not parent.is_dir():
+        raise OutputError(given, f"{parent} is a file, not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(given, f"cannot write in {parent} (permission denied)")
+    return out
+
+
+@contextlib.contextmanager
+def staged_output(out: str | Path) -> Iterator[Path]:
+    """Yield a fresh temporary folder next to ``out``; when the block ends without an exception,
+    move it to ``out`` (replacing a previous run), otherwise delete it. All checks happen before
+    the block runs."""
+    given = out
+    out = check_output_dir(out)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; DIR gets the usual mode
+    except OSError as exc:
+        raise OutputError(given, f"cannot create a folder in {out.parent}: {_reason(exc)}") from None
+    try:
+        yield tmp
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    try:
+        _replace(tmp, out)
+    except OSError as exc:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise OutputError(given, f"cannot move the finished run into place: {_reason(exc)}") from None
+
+
+def _replace(tmp: Path, out: Path) -> None:
+    """Move ``tmp`` to ``out``; an old ``out`` is renamed aside first and deleted after, and put
+    back if the move fails. Renames within one folder: no copy, no partial state visible under
+    ``out``."""
+    if not (out.exists() or out.is_symlink()):
+        os.rename(tmp, out)
+        return
+    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
+    old.rmdir()
+    os.rename(out, old)
+    try:
+        os.rename(tmp, out)
+    except OSError:
+        with contextlib.suppress(OSError):
+            os.rename(old, out)
+        raise
+    if old.is_symlink():
+        old.unlink()
+    else:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+__all__ = ["OutputError", "RUN_MARKER", "check_output_dir", "staged_output"]
