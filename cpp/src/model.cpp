@@ -74,7 +74,15 @@ std::string nearest(const std::string& name, const std::vector<std::string>& kno
       best = k;
     }
   }
-  if (best.empty() || best_d > std::max<std::size_t>(2, name.size() / 3)) return "";
+  // a near miss, or one name inside the other ('crank' for 'crank_joint')
+  bool contains = false;
+  for (const auto& k : known) {
+    if (!name.empty() && (k.find(name) != std::string::npos || name.find(k) != std::string::npos)) {
+      if (!contains || k.size() < best.size()) best = k;
+      contains = true;
+    }
+  }
+  if (best.empty() || (!contains && best_d > std::max<std::size_t>(2, name.size() / 3))) return "";
   return " (did you mean '" + best + "'?)";
 }
 

@@ -31,5 +31,6 @@ from mechbal._core import (  # noqa: F401
 )
 from mechbal._core import __version__  # noqa: F401
 from mechbal.config import ConfigError, ConfigWarning, load_case  # noqa: F401
-from mechbal._core import Body, Frame, Joint, MechanismDescription, MechanismModel  # noqa: F401,E402
+from mechbal._core import (  # noqa: F401,E402
+    Body, Frame, Joint, LoopConstraint, LoopType, MechanismDescription, MechanismModel)
 from mechbal.mechanism import Mechanism  # noqa: F401,E402

@@ -114,11 +114,15 @@ class Mechanism:
     @classmethod
     def from_description(cls, joints: Sequence["_core.Joint"], bodies: Sequence["_core.Body"] = (),
                          frames: Sequence["_core.Frame"] = (), gravity=(0.0, 0.0, -9.81),
-                         root_name: str = "base", name: str = "mechanism") -> "Mechanism":
+                         root_name: str = "base", name: str = "mechanism",
+                         loops: Sequence["_core.LoopConstraint"] = (),
+                         actuated: Sequence[str] = ()) -> "Mechanism":
         """From C++ description objects (:class:`mechbal.Joint`, :class:`mechbal.Body`,
-        :class:`mechbal.Frame`). Raises ValueError naming the field on bad input."""
+        :class:`mechbal.Frame`, :class:`mechbal.LoopConstraint`) and the names of the actuated
+        joints (required with loops). Raises ValueError naming the field on bad input."""
         desc = _core.MechanismDescription(list(joints), list(bodies), list(frames),
-                                          np.asarray(gravity, dtype=float), root_name)
+                                          np.asarray(gravity, dtype=float), root_name, list(loops),
+                                          list(actuated))
         return cls(_core.MechanismModel(desc), name=name)
 
     @classmethod

@@ -15,6 +15,7 @@
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/jacobian.hpp"
 #include "mechbal/algorithm/kinematics.hpp"
+#include "mechbal/algorithm/loops.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/regressor.hpp"
