@@ -989,7 +989,7 @@ def validate_case(config: Any, *, warn: bool = True):
 def _cross_checks(case: Any) -> None:
     if isinstance(case, SerialChainCase):
         spec = case.spec  # cross references of the mechanism (ConfigError naming the field)
-        names = spec.independent_joints
+        names = list(spec.actuated) if spec.loops else spec.independent_joints
         if not names:
             raise ConfigError("mechanism.joints", "needs at least one moving joint that is not a mimic",
                               has_value=False)
@@ -997,7 +997,8 @@ def _cross_checks(case: Any) -> None:
             v = getattr(case.trajectory, key)
             if len(v) != len(names):
                 raise ConfigError(f"trajectory.{key}", f"must have {len(names)} values (one per "
-                                                       f"independent joint: {', '.join(names)})", v)
+                                                       f"{'actuated' if spec.loops else 'independent'} "
+                                                       f"joint: {', '.join(names)})", v)
         n_bodies = max(1, len(spec.bodies))
         if case.trajectory.samples * n_bodies > MAX_SAMPLE_BODIES:
             raise ConfigError("trajectory.samples", f"must be <= {MAX_SAMPLE_BODIES // n_bodies} for "

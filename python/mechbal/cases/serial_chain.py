@@ -69,7 +69,7 @@ def run(config, out: Path) -> dict:
                                "O, inertial part only: no gravity) of all bodies along the trajectory.")
     report.plot_wrench(out / "base_reaction.png", t, {"with gravity": (R_F, R_M),
                                                       "shaking wrench (no gravity)": (F, M)},
-                       title=f"{title}: base reaction", force="base reaction force",
+                       title=f"{case.case.name}: base reaction", force="base reaction force",
                        moment="base reaction moment",
                        caption="Wrench the base exerts on the mechanism (gravity included, moment "
                                "about O) against the shaking wrench (inertial only): they differ "
@@ -79,7 +79,7 @@ def run(config, out: Path) -> dict:
     report.plot_series(out / "joint_torques.png", t, {"general model": torque},
                        [f"{n} ({k})" for n, k in zip(names, kinds)],
                        ["torque [N m]" if k == "revolute" else "force [N]" for k in kinds],
-                       title=f"{title}: actuator torques",
+                       title=f"{case.case.name}: actuator torques",
                        caption="Actuator torque (revolute) or force (prismatic) of each actuated "
                                "joint along the trajectory, gravity included"
                                + (" (C^T tau of the closed mechanism)." if mech.is_closed else "."))
