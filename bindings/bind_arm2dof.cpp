@@ -94,7 +94,7 @@ void bind_arm2dof(py::module_& m) {
         "The 2-DOF arm (counterweights merged into the links) as a ChainModel: x-z plane, joint "
         "axes along -y, gravity (0, 0, -g)");
 
-  py::class_<Arm2DofDynamics, InverseDynamics>(m, "Arm2DofDynamics",
+  py::class_<Arm2DofDynamics, InverseDynamics, ForwardDynamics>(m, "Arm2DofDynamics",
                               "Closed-form dynamics of the 2-DOF arm, eqs 14-31 (corrected)")
       .def(py::init<const Arm2DofParameters&, const Arm2DofCounterweights&>(), py::arg("arm"),
            py::arg("counterweights") = Arm2DofCounterweights{})
@@ -156,7 +156,7 @@ void bind_arm2dof(py::module_& m) {
 
   m.def(
       "simulate_computed_torque",
-      [](Arm2DofDynamics& plant, ComputedTorque& controller, const RestToRestTrajectory& desired,
+      [](ForwardDynamics& plant, ComputedTorque& controller, const RestToRestTrajectory& desired,
          const Eigen::VectorXd& q0, const Eigen::VectorXd& qd0, double dt, double duration,
          const std::string& sampling) {
         ClosedLoopOptions opt;

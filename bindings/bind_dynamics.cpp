@@ -15,6 +15,9 @@ void bind_dynamics(py::module_& m) {
                               "Joint-space inverse dynamics back end (base class of "
                               "Arm2DofDynamics, KdlChainDynamics, RneChainDynamics)")
       .def_property_readonly("dof", &InverseDynamics::dof);
+  py::class_<ForwardDynamics>(m, "ForwardDynamics",
+                              "Forward dynamics of a plant for closed-loop simulation (base class of "
+                              "Arm2DofDynamics and MechanismDynamics)");
 }
 
 }  // namespace

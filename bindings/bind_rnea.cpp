@@ -12,6 +12,11 @@ namespace mechbal::pyb {
 
 namespace {
 
+std::string failure_text(Status s) {
+  return std::string("rejected (") + status_name(s) + "): the state must be finite and, for a closed "
+         "mechanism, the loops must close near the previous pose";
+}
+
 Eigen::VectorXd one_state(const MechanismDynamics& d, const Eigen::VectorXd& v, const char* name) {
   if (v.size() != d.dof()) {
     throw py::value_error(std::string(name) + " must have " + std::to_string(d.dof()) +
@@ -21,12 +26,37 @@ Eigen::VectorXd one_state(const MechanismDynamics& d, const Eigen::VectorXd& v, 
 }
 
 void bind_rnea(py::module_& m) {
-  py::class_<MechanismDynamics, InverseDynamics>(
+  py::class_<MechanismDynamics, InverseDynamics, ForwardDynamics>(
       m, "MechanismDynamics",
       "Joint-space dynamics of a MechanismModel (recursive Newton-Euler inverse dynamics with the "
       "base support wrench, composite rigid body mass matrix): the InverseDynamics back end of the "
       "general model, for ComputedTorque and the simulators")
-      .def(py::init<MechanismModel>(), py::arg("model"))
+      .def(py::init([](const MechanismModel& model, const Eigen::VectorXd& q_guess) {
+             try {
+               return new MechanismDynamics(model, q_guess);
+             } catch (const std::invalid_argument& e) {
+               throw py::value_error(e.what());
+             }
+           }),
+           py::arg("model"), py::arg("q_guess") = Eigen::VectorXd(),
+           "Dynamics in the actuated coordinates (loops solved each call, warm-started from q_guess, "
+           "the full coordinates near the assembly)")
+      .def(
+          "forward_dynamics",
+          [](MechanismDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau) {
+            one_state(d, q, "q");
+            one_state(d, qd, "qd");
+            one_state(d, tau, "tau");
+            Eigen::VectorXd a(d.dof());
+            const Status s = d.forward_dynamics(q, qd, tau, a);
+            if (s != Status::ok) {
+              throw py::value_error(std::string("forward dynamics failed: ") + status_name(s));
+            }
+            return a;
+          },
+          py::arg("q"), py::arg("qd"), py::arg("tau"), "Accelerations a = M^-1 (tau - b) (actuated coordinates)")
+      .def_property_readonly("solved_position",
+                             [](const MechanismDynamics& d) { return Eigen::VectorXd(d.solved_position()); })
       .def_property_readonly("dof", &MechanismDynamics::dof)
       .def(
           "inverse_dynamics",
@@ -42,7 +72,7 @@ void bind_rnea(py::module_& m) {
           [](MechanismDynamics& d, const Eigen::VectorXd& q) {
             one_state(d, q, "q");
             Eigen::MatrixXd M(d.dof(), d.dof());
-            if (d.mass_matrix(q, M) != Status::ok) throw py::value_error("q must be finite");
+            if (const Status s = d.mass_matrix(q, M); s != Status::ok) throw py::value_error(failure_text(s));
             return M;
           },
           py::arg("q"), "Mass matrix M(q) (dof, dof) by the composite rigid body algorithm")
@@ -51,7 +81,7 @@ void bind_rnea(py::module_& m) {
           [](MechanismDynamics& d, const Eigen::VectorXd& q) {
             one_state(d, q, "q");
             Eigen::VectorXd g(d.dof());
-            if (d.gravity(q, g) != Status::ok) throw py::value_error("q must be finite");
+            if (const Status s = d.gravity(q, g); s != Status::ok) throw py::value_error(failure_text(s));
             return g;
           },
           py::arg("q"), "Gravity torques G(q)")
@@ -61,7 +91,7 @@ void bind_rnea(py::module_& m) {
             one_state(d, q, "q");
             one_state(d, qd, "qd");
             Eigen::VectorXd b(d.dof());
-            if (d.bias(q, qd, b) != Status::ok) throw py::value_error("q and qd must be finite");
+            if (const Status s = d.bias(q, qd, b); s != Status::ok) throw py::value_error(failure_text(s));
             return b;
           },
           py::arg("q"), py::arg("qd"), "Bias torques C(q, qd) qd + G(q)")
@@ -71,7 +101,7 @@ void bind_rnea(py::module_& m) {
             one_state(d, q, "q");
             one_state(d, qd, "qd");
             Eigen::VectorXd c(d.dof());
-            if (d.coriolis(q, qd, c) != Status::ok) throw py::value_error("q and qd must be finite");
+            if (const Status s = d.coriolis(q, qd, c); s != Status::ok) throw py::value_error(failure_text(s));
             return c;
           },
           py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques C(q, qd) qd");

@@ -79,18 +79,6 @@ Arm2DofLumped arm2dof_lumped(const Arm2DofParameters& arm,
 ChainModel arm2dof_chain_model(const Arm2DofParameters& arm,
                                const Arm2DofCounterweights& cw = Arm2DofCounterweights{});
 
-/// Forward-dynamics interface of a plant for closed-loop simulation: qdd = M^-1 (tau - C qd - G).
-class ForwardDynamics {
- public:
-  virtual ~ForwardDynamics() = default;
-  virtual int dof() const noexcept = 0;
-  /// Real-time: noexcept, allocation-free; sizes must equal dof() (else bad_size, qdd untouched);
-  /// non-finite input -> non_finite_input, qdd untouched; singular mass matrix -> singular.
-  virtual Status forward_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
-                                  const Eigen::Ref<const Eigen::VectorXd>& qd,
-                                  const Eigen::Ref<const Eigen::VectorXd>& tau,
-                                  Eigen::Ref<Eigen::VectorXd> qdd) noexcept = 0;
-};
 
 /// Closed-form 2-DOF dynamics, eq 1: tau = A(q) qdd + C(q, qd) qd + Q(q) (eqs 14-31 corrected).
 /// Immutable after construction; every method is noexcept and allocation-free.
