@@ -44,7 +44,11 @@ void bind_core(pybind11::module_& m) {
       .value("singular", Status::singular)
       .value("saturated", Status::saturated)
       .value("bad_size", Status::bad_size)
-      .value("solver_error", Status::solver_error);
+      .value("solver_error", Status::solver_error)
+      .value("out_of_range", Status::out_of_range);
+
+  m.def("status_name", [](std::uint32_t s) { return std::string(status_name(static_cast<Status>(s))); },
+        py::arg("status"), "Name of a Status value ('multiple' for a combination of flags)");
 
   m.def(
       "validate_rigid_body",

@@ -96,26 +96,40 @@ void bind_paminsa(py::module_& m) {
       .value("euler", WristIntegrator::euler)
       .value("rk4", WristIntegrator::rk4);
 
-  py::class_<ReactionlessWristConfig>(m, "ReactionlessWristConfig")
+  py::class_<ReactionlessWristConfig>(m, "ReactionlessWristConfig",
+                                      "Reactionless wrist tick: rate, integrator, limits (every "
+                                      "limit finite) and damping; validated on construction")
       .def(py::init([](double rate_hz, WristIntegrator integrator, double max_rate,
-                       double max_condition, double damping) {
+                       double max_condition, double damping, double max_acceleration,
+                       double max_momentum, double max_moment) {
              ReactionlessWristConfig c;
              c.rate_hz = rate_hz;
              c.integrator = integrator;
              c.max_rate = max_rate;
              c.max_condition = max_condition;
              c.damping = damping;
+             c.max_acceleration = max_acceleration;
+             c.max_momentum = max_momentum;
+             c.max_moment = max_moment;
              validate_wrist_config(c);
              return c;
            }),
-           py::arg("rate_hz") = 1000.0, py::arg("integrator") = WristIntegrator::euler,
-           py::arg("max_rate") = std::numeric_limits<double>::infinity(),
-           py::arg("max_condition") = 1e4, py::arg("damping") = 1e-2)
+           py::arg("rate_hz") = ReactionlessWristConfig{}.rate_hz,
+           py::arg("integrator") = WristIntegrator::euler,
+           py::arg("max_rate") = ReactionlessWristConfig{}.max_rate,
+           py::arg("max_condition") = ReactionlessWristConfig{}.max_condition,
+           py::arg("damping") = ReactionlessWristConfig{}.damping,
+           py::arg("max_acceleration") = ReactionlessWristConfig{}.max_acceleration,
+           py::arg("max_momentum") = ReactionlessWristConfig{}.max_momentum,
+           py::arg("max_moment") = ReactionlessWristConfig{}.max_moment)
       .def_readonly("rate_hz", &ReactionlessWristConfig::rate_hz)
       .def_readonly("integrator", &ReactionlessWristConfig::integrator)
       .def_readonly("max_rate", &ReactionlessWristConfig::max_rate)
       .def_readonly("max_condition", &ReactionlessWristConfig::max_condition)
-      .def_readonly("damping", &ReactionlessWristConfig::damping);
+      .def_readonly("damping", &ReactionlessWristConfig::damping)
+      .def_readonly("max_acceleration", &ReactionlessWristConfig::max_acceleration)
+      .def_readonly("max_momentum", &ReactionlessWristConfig::max_momentum)
+      .def_readonly("max_moment", &ReactionlessWristConfig::max_moment);
 
   m.def("wrist_momentum_matrix",
         [](const Eigen::Matrix3d& J1, const Eigen::Matrix3d& J2, const Eigen::Matrix3d& J3,

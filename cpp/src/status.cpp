@@ -11,6 +11,7 @@ const char* status_name(Status s) noexcept {
     case Status::saturated: return "saturated";
     case Status::bad_size: return "bad_size";
     case Status::solver_error: return "solver_error";
+    case Status::out_of_range: return "out_of_range";
   }
   return "multiple";
 }
