@@ -43,12 +43,10 @@ DiscArmDynamics::DiscArmDynamics(ChainModel chain, std::vector<DiscSpec> discs)
       v << "must be finite (got " << s.ratio << ")";
       fail(d, "ratio", v.str());
     }
-    const double norm = s.axis.norm();
-    if (!s.axis.allFinite() || !(norm > 1e-12)) {
-      v << "must be a finite non-zero vector (got " << s.axis.transpose() << ")";
+    if (!normalize_axis(s.axis)) {
+      v << "must be a finite vector of norm >= 1e-12 (got " << s.axis.transpose() << ")";
       fail(d, "axis", v.str());
     }
-    s.axis /= norm;
     RigidBody rb;
     rb.inertia_body = s.inertia.asDiagonal();
     const std::string field = "discs[" + std::to_string(d) + "]";
@@ -133,6 +131,7 @@ Status DiscArmDynamics::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q,
     return Status::bad_size;
   if (!q.allFinite() || !qd.allFinite()) return Status::non_finite_input;
   compute(q, qd);
+  if (!M_.allFinite() || !v_.allFinite() || !g_.allFinite()) return Status::out_of_range;
   mass = M_;
   velocity_terms = v_;
   gravity_terms = g_;
@@ -148,8 +147,9 @@ Status DiscArmDynamics::inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>
     return Status::bad_size;
   if (!q.allFinite() || !qd.allFinite() || !qdd.allFinite()) return Status::non_finite_input;
   compute(q, qd);
-  tau.noalias() = M_ * qdd;
-  tau += v_ + g_;
+  const VecN t = M_ * qdd + v_ + g_;
+  if (!t.allFinite()) return Status::out_of_range;  // finite input that overflowed; tau untouched
+  tau = t;
   return Status::ok;
 }
 

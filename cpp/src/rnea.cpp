@@ -23,6 +23,21 @@ Mat3 aligned_with_z(const Vec3& axis) {
   return A;
 }
 
+/// Status::ok when `out` is finite, else zeroes it and returns Status::out_of_range (finite input
+/// that overflowed: never report ok with a non-finite output).
+template <typename Derived>
+inline Status finite_or_zero(Eigen::MatrixBase<Derived>&& out) noexcept {
+  if (out.allFinite()) return Status::ok;
+  out.setZero();
+  return Status::out_of_range;
+}
+template <typename Derived>
+inline Status finite_or_zero(Eigen::MatrixBase<Derived>& out) noexcept {
+  if (out.allFinite()) return Status::ok;
+  out.setZero();
+  return Status::out_of_range;
+}
+
 /// w x e_z and h x e_z without the multiplications by zero.
 inline Vec3 cross_ez(const Vec3& w) { return Vec3(w.y(), -w.x(), 0.0); }
 
@@ -146,13 +161,16 @@ Status RneChainDynamics::inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd
   if (!q.allFinite() || !qd.allFinite() || !qdd.allFinite()) return Status::non_finite_input;
   place(q);
   rne<true, true, true>(qd, qdd, tau);
-  if (support_force || support_moment) {
-    // link 1's frame is placed directly in the world frame
-    const State& s = states_[0];
-    const Vec3 F = s.rotation * s.force;
-    if (support_force) *support_force = F;
-    if (support_moment) *support_moment = s.rotation * s.moment + s.translation.cross(F);
+  // link 1's frame is placed directly in the world frame
+  const State& s = states_[0];
+  const Vec3 F = s.rotation * s.force;
+  const Vec3 Mo = s.rotation * s.moment + s.translation.cross(F);
+  if (!tau.allFinite() || !F.allFinite() || !Mo.allFinite()) {
+    tau.setZero();  // finite input that overflowed
+    return Status::out_of_range;
   }
+  if (support_force) *support_force = F;
+  if (support_moment) *support_moment = Mo;
   return Status::ok;
 }
 
@@ -162,7 +180,7 @@ Status RneChainDynamics::gravity(const Eigen::Ref<const Eigen::VectorXd>& q,
   if (!q.allFinite()) return Status::non_finite_input;
   place(q);
   rne<false, false, true>(q, q, g);
-  return Status::ok;
+  return finite_or_zero(g);
 }
 
 Status RneChainDynamics::bias(const Eigen::Ref<const Eigen::VectorXd>& q,
@@ -172,7 +190,7 @@ Status RneChainDynamics::bias(const Eigen::Ref<const Eigen::VectorXd>& q,
   if (!q.allFinite() || !qd.allFinite()) return Status::non_finite_input;
   place(q);
   rne<true, false, true>(qd, qd, b);
-  return Status::ok;
+  return finite_or_zero(b);
 }
 
 Status RneChainDynamics::coriolis(const Eigen::Ref<const Eigen::VectorXd>& q,
@@ -182,7 +200,7 @@ Status RneChainDynamics::coriolis(const Eigen::Ref<const Eigen::VectorXd>& q,
   if (!q.allFinite() || !qd.allFinite()) return Status::non_finite_input;
   place(q);
   rne<true, false, false>(qd, qd, c);
-  return Status::ok;
+  return finite_or_zero(c);
 }
 
 Status RneChainDynamics::mass_matrix(const Eigen::Ref<const Eigen::VectorXd>& q,
@@ -232,7 +250,7 @@ Status RneChainDynamics::mass_matrix(const Eigen::Ref<const Eigen::VectorXd>& q,
       M(j, i) = M(i, j) = links_[static_cast<std::size_t>(j)].revolute ? L.z() : P.z();
     }
   }
-  return Status::ok;
+  return finite_or_zero(M);
 }
 
 }  // namespace mechbal

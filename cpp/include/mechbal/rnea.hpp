@@ -47,7 +47,8 @@ class RneChainDynamics final : public InverseDynamics {
   /// As above; when `support_force`/`support_moment` are non-null they receive the wrench the base
   /// exerts on the chain (moment about the base origin, world frame, gravity included), as
   /// KdlChainDynamics does. Real-time: noexcept, allocation-free. Wrong sizes: Status::bad_size;
-  /// non-finite input: Status::non_finite_input; outputs untouched in both cases.
+  /// non-finite input: Status::non_finite_input; outputs untouched in both cases. Finite input
+  /// whose result overflows (every query of this class): Status::out_of_range, outputs zero.
   Status inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
                           const Eigen::Ref<const Eigen::VectorXd>& qd,
                           const Eigen::Ref<const Eigen::VectorXd>& qdd,
