@@ -4,6 +4,7 @@
 #include "mechbal/decoupled_control.hpp"
 #include "mechbal/disc_arm.hpp"
 #include "mechbal/dynamics.hpp"
+#include "mechbal/joint_limits.hpp"
 #include "mechbal/kdl_chain.hpp"
 #include "mechbal/rigid_body.hpp"
 #include "mechbal/serial_chain.hpp"
