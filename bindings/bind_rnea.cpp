@@ -12,12 +12,8 @@ namespace mechbal::pyb {
 
 namespace {
 
-Eigen::VectorXd one_state(const RneChainDynamics& d, const Eigen::VectorXd& v, const char* name) {
-  if (v.size() != d.dof()) {
-    throw py::value_error(std::string(name) + " must have " + std::to_string(d.dof()) +
-                          " values, got " + std::to_string(v.size()));
-  }
-  return v;
+Eigen::VectorXd one_state(const RneChainDynamics& d, const Array& v, const char* name) {
+  return vector_arg(v, name, d.dof(), false, "one value per joint");
 }
 
 void bind_rnea(py::module_& m) {
@@ -38,39 +34,37 @@ void bind_rnea(py::module_& m) {
           "non-finite input give zeros and set their flag in `status`.")
       .def(
           "mass_matrix",
-          [](RneChainDynamics& d, const Eigen::VectorXd& q) {
-            one_state(d, q, "q");
-            Eigen::MatrixXd M(d.dof(), d.dof());
-            if (d.mass_matrix(q, M) != Status::ok) throw py::value_error("q must be finite");
+          [](RneChainDynamics& d, const Array& q) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q");
+            Eigen::MatrixXd M = Eigen::MatrixXd::Zero(d.dof(), d.dof());
+            raise_unless_ok(d.mass_matrix(q_, M), "RneChainDynamics.mass_matrix");
             return M;
           },
           py::arg("q"), "Mass matrix M(q) (dof, dof) by the composite rigid body algorithm")
       .def(
           "gravity",
-          [](RneChainDynamics& d, const Eigen::VectorXd& q) {
-            one_state(d, q, "q");
-            Eigen::VectorXd g(d.dof());
-            if (d.gravity(q, g) != Status::ok) throw py::value_error("q must be finite");
+          [](RneChainDynamics& d, const Array& q) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q");
+            Eigen::VectorXd g = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.gravity(q_, g), "RneChainDynamics.gravity");
             return g;
           },
           py::arg("q"), "Gravity torques G(q)")
       .def(
           "bias",
-          [](RneChainDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-            one_state(d, q, "q");
-            one_state(d, qd, "qd");
-            Eigen::VectorXd b(d.dof());
-            if (d.bias(q, qd, b) != Status::ok) throw py::value_error("q and qd must be finite");
+          [](RneChainDynamics& d, const Array& q, const Array& qd) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "qd");
+            Eigen::VectorXd b = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.bias(q_, qd_, b), "RneChainDynamics.bias");
             return b;
           },
           py::arg("q"), py::arg("qd"), "Bias torques C(q, qd) qd + G(q)")
       .def(
           "coriolis",
-          [](RneChainDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-            one_state(d, q, "q");
-            one_state(d, qd, "qd");
-            Eigen::VectorXd c(d.dof());
-            if (d.coriolis(q, qd, c) != Status::ok) throw py::value_error("q and qd must be finite");
+          [](RneChainDynamics& d, const Array& q, const Array& qd) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "qd");
+            Eigen::VectorXd c = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.coriolis(q_, qd_, c), "RneChainDynamics.coriolis");
             return c;
           },
           py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques C(q, qd) qd");

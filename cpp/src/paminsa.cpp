@@ -270,10 +270,15 @@ Status PaminsaModel::inverse_kinematics(const Vec3& P, PaminsaActuators& out) co
     alpha[i] = std::atan2(v(1), v(0));
     out.stroke(i) = v.norm();
   }
+  const double z_B = p_.z_A + (P(2) - p_.length_CJ - p_.z_A) / k;  // z_C - z_A = k (z_B - z_A)
+  if (!out.stroke.allFinite() || !std::isfinite(z_B)) {  // finite P that overflowed
+    out = PaminsaActuators{};
+    return Status::out_of_range;
+  }
   out.alpha1 = alpha[0];
   out.alpha2 = alpha[1];
   out.alpha3 = alpha[2];
-  out.z_B = p_.z_A + (P(2) - p_.length_CJ - p_.z_A) / k;  // vertical model: z_C - z_A = k (z_B - z_A)
+  out.z_B = z_B;
   return Status::ok;
 }
 

@@ -126,7 +126,8 @@ class PaminsaModel {
   const std::array<Eigen::Vector2d, 3>& nominal_A() const noexcept { return A0_h_; }
   const Eigen::Vector2d& vertical_mass_xy() const noexcept { return vcw_; }
 
-  /// Closed-form inverse kinematics P -> actuators. Non-finite P: Status::non_finite_input.
+  /// Closed-form inverse kinematics P -> actuators. Non-finite P: Status::non_finite_input; a P
+  /// whose strokes overflow: Status::out_of_range and `out` zeroed.
   Status inverse_kinematics(const Vec3& P, PaminsaActuators& out) const noexcept;
   /// Closed-form forward solve (alpha1, alpha3, z_B) -> P. Parallel guides: Status::singular.
   Status forward_kinematics(double alpha1, double alpha3, double z_B, Vec3& P) const noexcept;
