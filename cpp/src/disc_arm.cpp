@@ -58,11 +58,13 @@ DiscArmDynamics::DiscArmDynamics(ChainModel chain, std::vector<DiscSpec> discs)
   g_ = VecN::Zero(n);
 }
 
-void DiscArmDynamics::compute(const Eigen::Ref<const Eigen::VectorXd>& q,
-                              const Eigen::Ref<const Eigen::VectorXd>& qd) noexcept {
+Status DiscArmDynamics::compute(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                const Eigen::Ref<const Eigen::VectorXd>& qd) noexcept {
   const int n = chain_.dof();
-  // Bias accelerations (dJ/dt qd) are the accelerations at qdd = 0.
-  chain_kinematics(chain_, q, qd, zero_, ws_);
+  // Bias accelerations (dJ/dt qd) are the accelerations at qdd = 0. The link motion overflowing
+  // (out_of_range) leaves the workspace at rest: nothing below would mean anything.
+  const Status kinematics = chain_kinematics(chain_, q, qd, zero_, ws_);
+  if (kinematics != Status::ok) return kinematics;
   M_.setZero();
   v_.setZero();
   g_.setZero();
@@ -118,6 +120,7 @@ void DiscArmDynamics::compute(const Eigen::Ref<const Eigen::VectorXd>& q,
     const Vec3 h = Jm.cwiseProduct(bias) + wb.cross(Jm.cwiseProduct(wb));
     v_.noalias() += Jd.transpose() * h;
   }
+  return Status::ok;
 }
 
 Status DiscArmDynamics::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q,
@@ -130,7 +133,7 @@ Status DiscArmDynamics::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q,
       velocity_terms.size() != n || gravity_terms.size() != n)
     return Status::bad_size;
   if (!q.allFinite() || !qd.allFinite()) return Status::non_finite_input;
-  compute(q, qd);
+  if (const Status s = compute(q, qd); s != Status::ok) return s;
   if (!M_.allFinite() || !v_.allFinite() || !g_.allFinite()) return Status::out_of_range;
   mass = M_;
   velocity_terms = v_;
@@ -146,7 +149,7 @@ Status DiscArmDynamics::inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>
   if (q.size() != n || qd.size() != n || qdd.size() != n || tau.size() != n)
     return Status::bad_size;
   if (!q.allFinite() || !qd.allFinite() || !qdd.allFinite()) return Status::non_finite_input;
-  compute(q, qd);
+  if (const Status s = compute(q, qd); s != Status::ok) return s;
   const VecN t = M_ * qdd + v_ + g_;
   if (!t.allFinite()) return Status::out_of_range;  // finite input that overflowed; tau untouched
   tau = t;
