@@ -280,9 +280,13 @@ Status ReactionlessWrist::solve(const Mat3& N, const Vec3& rhs, Vec3& x, double&
   Mat3 A = NtN;
   A.diagonal().array() += config_.damping * config_.damping * lambda(2);
   double det = 0.0;
-  const Mat3 A_inv = cofactor_inverse(A, det);
-  x = A_inv * (N.transpose() * rhs);
-  if (!x.allFinite()) x.setZero();
+  const Mat3 pinv = cofactor_inverse(A, det) * N.transpose();  // damped pseudo-inverse
+  x = pinv * rhs;
+  if (!x.allFinite()) {
+    x.setZero();
+  } else if (inverse && pinv.allFinite()) {
+    *inverse = pinv;
+  }
   return Status::singular;
 }
 
@@ -392,19 +396,19 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
   Vec3 k1;
   double cond = 1.0, unused = 1.0;
   // N(q_n) is built once (in link 2's frame) for k1 and the feed-forward; cond(N(q_n)), the
-  // reported one, comes from solve()'s closed-form eigenvalues; when N is well conditioned its
-  // inverse is reused for both (issue 6)
+  // reported one, comes from solve()'s closed-form eigenvalues; the operator of k1's solve (N's
+  // inverse, or its damped pseudo-inverse at the singularity) is reused for both (issue 6, 14)
   Vec3 cos_n, sin_n;
   cos_sin(angles_, cos_n, sin_n);
   const WristFrame2 at(inertia_, cos_n, sin_n, diagonal_inertia_);
-  Mat3 N2_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by the fast path
+  Mat3 N2_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by solve()
   Status st = solve(at.N2, at.to_frame2(target_ - D_now), k1, cond, &N2_inv);
   st |= limit_rate(k1);
   // feed-forward acceleration: N qdd = -Ddot - bias(q, qdot)  <=>  N2 qdd = R2^T(-Ddot) - bias2
   Vec3 qdd;
   const Vec3 rhs = at.to_frame2(-D_dot) - at.bias_frame2(k1);
   if (N2_inv.allFinite())
-    qdd = N2_inv * rhs;  // well conditioned: the fast path's inverse
+    qdd = N2_inv * rhs;  // same operator, same status as solving again
   else
     st |= solve(at.N2, rhs, qdd, unused);
   Vec3 next;

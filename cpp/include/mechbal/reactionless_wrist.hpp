@@ -144,7 +144,9 @@ class ReactionlessWrist {
   Status rates(const Vec3& angles, const Vec3& D, Vec3& rates, double& condition) const noexcept;
 
  private:
-  /// Status::ok with `inverse` (when given) set to N^-1 only on the well-conditioned fast path.
+  /// `inverse` (when given) receives the operator applied to rhs: N^-1 (Status::ok) or the damped
+  /// pseudo-inverse (N^T N + lambda^2 1)^-1 N^T (Status::singular); left untouched when N is zero
+  /// or not finite.
   Status solve(const Mat3& N, const Vec3& rhs, Vec3& x, double& condition,
                Mat3* inverse = nullptr) const noexcept;
   Status rates_with(const Mat3& N, const Vec3& D, Vec3& rates, double& condition,
