@@ -12,17 +12,8 @@ namespace mechbal::pyb {
 
 namespace {
 
-std::string failure_text(Status s) {
-  return std::string("rejected (") + status_name(s) + "): the state must be finite and, for a closed "
-         "mechanism, the loops must close near the previous pose";
-}
-
-Eigen::VectorXd one_state(const MechanismDynamics& d, const Eigen::VectorXd& v, const char* name) {
-  if (v.size() != d.dof()) {
-    throw py::value_error(std::string(name) + " must have " + std::to_string(d.dof()) +
-                          " values, got " + std::to_string(v.size()));
-  }
-  return v;
+Eigen::VectorXd one_state(const MechanismDynamics& d, const Array& v, const char* name) {
+  return vector_arg(v, name, d.dof(), false, "one value per joint");
 }
 
 void bind_rnea(py::module_& m) {
@@ -43,15 +34,11 @@ void bind_rnea(py::module_& m) {
            "the full coordinates near the assembly)")
       .def(
           "forward_dynamics",
-          [](MechanismDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau) {
-            one_state(d, q, "q");
-            one_state(d, qd, "qd");
-            one_state(d, tau, "tau");
-            Eigen::VectorXd a(d.dof());
-            const Status s = d.forward_dynamics(q, qd, tau, a);
-            if (s != Status::ok) {
-              throw py::value_error(std::string("forward dynamics failed: ") + status_name(s));
-            }
+          [](MechanismDynamics& d, const Array& q, const Array& qd, const Array& tau) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "qd"),
+                                  tau_ = one_state(d, tau, "tau");
+            Eigen::VectorXd a = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.forward_dynamics(q_, qd_, tau_, a), "MechanismDynamics.forward_dynamics");
             return a;
           },
           py::arg("q"), py::arg("qd"), py::arg("tau"), "Accelerations a = M^-1 (tau - b) (actuated coordinates)")
@@ -69,39 +56,37 @@ void bind_rnea(py::module_& m) {
           "non-finite input give zeros and set their flag in `status`.")
       .def(
           "mass_matrix",
-          [](MechanismDynamics& d, const Eigen::VectorXd& q) {
-            one_state(d, q, "q");
-            Eigen::MatrixXd M(d.dof(), d.dof());
-            if (const Status s = d.mass_matrix(q, M); s != Status::ok) throw py::value_error(failure_text(s));
+          [](MechanismDynamics& d, const Array& q) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q");
+            Eigen::MatrixXd M = Eigen::MatrixXd::Zero(d.dof(), d.dof());
+            raise_unless_ok(d.mass_matrix(q_, M), "MechanismDynamics.mass_matrix");
             return M;
           },
           py::arg("q"), "Mass matrix M(q) (dof, dof) by the composite rigid body algorithm")
       .def(
           "gravity",
-          [](MechanismDynamics& d, const Eigen::VectorXd& q) {
-            one_state(d, q, "q");
-            Eigen::VectorXd g(d.dof());
-            if (const Status s = d.gravity(q, g); s != Status::ok) throw py::value_error(failure_text(s));
+          [](MechanismDynamics& d, const Array& q) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q");
+            Eigen::VectorXd g = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.gravity(q_, g), "MechanismDynamics.gravity");
             return g;
           },
           py::arg("q"), "Gravity torques G(q)")
       .def(
           "bias",
-          [](MechanismDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-            one_state(d, q, "q");
-            one_state(d, qd, "qd");
-            Eigen::VectorXd b(d.dof());
-            if (const Status s = d.bias(q, qd, b); s != Status::ok) throw py::value_error(failure_text(s));
+          [](MechanismDynamics& d, const Array& q, const Array& qd) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "qd");
+            Eigen::VectorXd b = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.bias(q_, qd_, b), "MechanismDynamics.bias");
             return b;
           },
           py::arg("q"), py::arg("qd"), "Bias torques C(q, qd) qd + G(q)")
       .def(
           "coriolis",
-          [](MechanismDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-            one_state(d, q, "q");
-            one_state(d, qd, "qd");
-            Eigen::VectorXd c(d.dof());
-            if (const Status s = d.coriolis(q, qd, c); s != Status::ok) throw py::value_error(failure_text(s));
+          [](MechanismDynamics& d, const Array& q, const Array& qd) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "qd");
+            Eigen::VectorXd c = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.coriolis(q_, qd_, c), "MechanismDynamics.coriolis");
             return c;
           },
           py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques C(q, qd) qd");

@@ -109,6 +109,7 @@ Status KdlChainDynamics::inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd
   if (m.rne.CartToJnt(m.q_full, m.qd_full, m.qdd_full, m.f_ext, m.tau_full) < 0) {
     return Status::solver_error;
   }
+  if (!m.tau_full.data.allFinite()) return Status::out_of_range;  // outputs untouched
   tau = m.tau_full.data.tail(dof_);
   if (support_force) *support_force = m.tau_full.data.segment<3>(0);
   if (support_moment) *support_moment = m.tau_full.data.segment<3>(3);
@@ -121,6 +122,7 @@ Status KdlChainDynamics::mass_matrix(const Eigen::Ref<const Eigen::VectorXd>& q,
   if (!q.allFinite()) return Status::non_finite_input;
   impl_->q.data = q;
   if (impl_->dyn.JntToMass(impl_->q, impl_->M) < 0) return Status::solver_error;
+  if (!impl_->M.data.allFinite()) return Status::out_of_range;
   M = impl_->M.data;
   return Status::ok;
 }
@@ -133,6 +135,7 @@ Status KdlChainDynamics::coriolis(const Eigen::Ref<const Eigen::VectorXd>& q,
   impl_->q.data = q;
   impl_->qd.data = qd;
   if (impl_->dyn.JntToCoriolis(impl_->q, impl_->qd, impl_->out) < 0) return Status::solver_error;
+  if (!impl_->out.data.allFinite()) return Status::out_of_range;
   c = impl_->out.data;
   return Status::ok;
 }
@@ -143,6 +146,7 @@ Status KdlChainDynamics::gravity(const Eigen::Ref<const Eigen::VectorXd>& q,
   if (!q.allFinite()) return Status::non_finite_input;
   impl_->q.data = q;
   if (impl_->dyn.JntToGravity(impl_->q, impl_->out) < 0) return Status::solver_error;
+  if (!impl_->out.data.allFinite()) return Status::out_of_range;
   g = impl_->out.data;
   return Status::ok;
 }

@@ -41,12 +41,18 @@ Status MechanismDynamics::inverse_dynamics(const Eigen::Ref<const Eigen::VectorX
   if (model_->is_closed()) {
     s = closed_inverse_dynamics(*model_, data_, q, qd, qdd, q_, options_);
     if (failed(s)) return s;
-    tau = data_.actuated_force;
+    if (!data_.actuated_force.allFinite()) s |= Status::out_of_range;
   } else {
     s = mechbal::inverse_dynamics(*model_, data_, q, qd, qdd);
-    if (s != Status::ok) return s;
-    tau = data_.joint_torque;
+    if (s != Status::ok && s != Status::out_of_range) return s;
   }
+  if (has(s, Status::out_of_range)) {  // a finite input that overflowed: zeros, never garbage
+    tau.setZero();
+    if (support_force) support_force->setZero();
+    if (support_moment) support_moment->setZero();
+    return s;
+  }
+  tau = model_->is_closed() ? data_.actuated_force : data_.joint_torque;
   // the base's entry of the backward pass holds the wrench on the root links, in O, about O
   if (support_force) *support_force = data_.work[0].force;
   if (support_moment) *support_moment = data_.work[0].moment;

@@ -72,7 +72,7 @@ class DiscArmDynamics final : public InverseDynamics {
                           Eigen::Ref<Eigen::VectorXd> tau) noexcept override;
 
  private:
-  void compute(const Eigen::Ref<const Eigen::VectorXd>& q,
+  Status compute(const Eigen::Ref<const Eigen::VectorXd>& q,
                const Eigen::Ref<const Eigen::VectorXd>& qd) noexcept;
 
   ChainModel chain_;

@@ -35,6 +35,9 @@ class KdlChainDynamics final : public InverseDynamics {
 
   /// tau = M(q) qdd + C(q, qd) qd + G(q). When `support_force`/`support_moment` are non-null
   /// they receive the wrench the base exerts on the chain (moment about the base origin).
+  /// Every query: wrong sizes Status::bad_size, non-finite input Status::non_finite_input, KDL
+  /// failure Status::solver_error, a result that overflowed Status::out_of_range; the outputs are
+  /// untouched unless Status::ok.
   Status inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
                           const Eigen::Ref<const Eigen::VectorXd>& qd,
                           const Eigen::Ref<const Eigen::VectorXd>& qdd,

@@ -31,6 +31,7 @@
 /// Controllers and closed-loop simulation
 #include "mechbal/computed_torque.hpp"
 #include "mechbal/decoupled_control.hpp"
+#include "mechbal/joint_limits.hpp"
 #include "mechbal/reactionless_wrist.hpp"
 #include "mechbal/closed_loop.hpp"
 /// Fast paths of the papers' mechanisms
