@@ -7,6 +7,10 @@
 /// prepending six motionless virtual joints at the base origin (translations along x, y, z, then
 /// rotations about x, y, z): their generalised forces are exactly the support force and the support
 /// moment about O that the base exerts on the chain (gravity included).
+///
+/// Built from a ChainModel, or from the general MechanismModel when that is a serial chain
+/// (`model.is_serial_chain()`): KDL is then an independent engine beside MechanismDynamics on the
+/// same description, and its check (tests/cpp/test_kdl_general.cpp).
 #include <Eigen/Core>
 #include <memory>
 
@@ -19,6 +23,13 @@ namespace mechbal {
 class KdlChainDynamics final : public InverseDynamics {
  public:
   explicit KdlChainDynamics(const ChainModel& model);
+  /// From the general model when it is a serial chain: joint k moves link k + 1 whose parent is
+  /// link k, every joint revolute or prismatic with its own coordinate (no fixed joint, no gear
+  /// coupling). The bodies on each link are lumped into one rigid body (same mass, first moment
+  /// and inertia); bodies on the base do not move and are left out, as in MechanismDynamics'
+  /// support wrench. Throws std::invalid_argument naming the link or joint that makes the model
+  /// not a chain ("KdlChainDynamics: joint 'wrist' is fixed ..."). Not real-time.
+  explicit KdlChainDynamics(const MechanismModel& model);
   ~KdlChainDynamics();
   KdlChainDynamics(const KdlChainDynamics&) = delete;
   KdlChainDynamics& operator=(const KdlChainDynamics&) = delete;
