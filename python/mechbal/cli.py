@@ -21,7 +21,7 @@ def _cmd_run(args) -> int:
     from mechbal.cases import run_case
 
     out = Path(args.out)
-    run_case(args.case, out)
+    run_case(args.case, out, duration=getattr(args, "duration", None), samples=getattr(args, "samples", None))
     print(f"wrote {out}/summary.json and the plots and bodies files beside it")
     return 0
 
@@ -45,8 +45,12 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("run", help="run a case study (built-in name or TOML file)",
                        description="Run a case study and write DIR/summary.json, PNG plots and "
                                    "DIR/bodies_<variant>.npz for every simulated variant.")
-    s.add_argument("case", help="built-in case name (see 'mechbal cases') or path to a TOML file")
+    s.add_argument("case", help="built-in case name (see 'mechbal cases') or path to a TOML or URDF file")
     s.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    s.add_argument("--duration", type=float, metavar="S",
+                   help="URDF files: duration of the default trajectory [s] (default: 2)")
+    s.add_argument("--samples", type=int, metavar="N",
+                   help="URDF files: number of instants of the default trajectory (default: 501)")
     s.set_defaults(func=_cmd_run)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")

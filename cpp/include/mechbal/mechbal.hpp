@@ -9,4 +9,5 @@
 #include "mechbal/serial_chain.hpp"
 #include "mechbal/status.hpp"
 #include "mechbal/trajectory.hpp"
+#include "mechbal/urdf.hpp"
 #include "mechbal/version.hpp"

@@ -44,9 +44,21 @@ def available() -> list[tuple[str, str, str]]:
     return out
 
 
-def run_case(name_or_path: str | Path, out: str | Path) -> dict:
+def run_case(name_or_path: str | Path, out: str | Path, **trajectory) -> dict:
+    """Run a built-in case, a TOML case file or a URDF file (``trajectory``: ``duration`` and
+    ``samples`` of a URDF file's default trajectory, see :mod:`mechbal.cases.urdf_robot`)."""
     _load_runners()
-    config = load_case(name_or_path)
+    trajectory = {k: v for k, v in trajectory.items() if v is not None}
+    if str(name_or_path).lower().endswith(".urdf"):
+        from mechbal.cases.urdf_robot import urdf_case
+
+        config = urdf_case(name_or_path, **trajectory)
+    elif trajectory:
+        raise ConfigError(", ".join(f"--{k}" for k in trajectory),
+                          "only applies to URDF files (a TOML case has its [trajectory] table)",
+                          has_value=False)
+    else:
+        config = load_case(name_or_path)
     kind = config["case"]["kind"]
     if kind not in _RUNNERS:
         raise ConfigError("case.kind", f"unknown kind (known: {', '.join(sorted(_RUNNERS))})", kind)
