@@ -203,7 +203,7 @@ Status inverse_dynamics(const MechanismModel& model, MechanismData& data, const 
                         const ConstVector& v, const ConstVector& a) noexcept {
   if (Status s = check_state(model, data, &q, &v, &a); s != Status::ok) return s;
   detail::joint_state<true, true>(model, data, q, v, a);
-  detail::place(model, data);
+  detail::place<false>(model, data);
   detail::forward_pass<true, true, true, true>(model, data);
   detail::backward_pass(model, data, data.joint_torque);
   return Status::ok;
@@ -212,7 +212,7 @@ Status inverse_dynamics(const MechanismModel& model, MechanismData& data, const 
 Status gravity_torque(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
   if (Status s = check_state(model, data, &q); s != Status::ok) return s;
   detail::joint_state<false, false>(model, data, q, q, q);
-  detail::place(model, data);
+  detail::place<false>(model, data);
   detail::forward_pass<false, false, true, true>(model, data);
   detail::backward_pass(model, data, data.gravity_torque);
   return Status::ok;
@@ -222,7 +222,7 @@ Status bias_torque(const MechanismModel& model, MechanismData& data, const Const
                    const ConstVector& v) noexcept {
   if (Status s = check_state(model, data, &q, &v); s != Status::ok) return s;
   detail::joint_state<true, false>(model, data, q, v, v);
-  detail::place(model, data);
+  detail::place<false>(model, data);
   detail::forward_pass<true, false, true, true>(model, data);
   detail::backward_pass(model, data, data.bias_torque);
   return Status::ok;
@@ -233,7 +233,7 @@ Status bias_torque(const MechanismModel& model, MechanismData& data, const Const
 Status mass_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
   if (Status s = check_state(model, data, &q); s != Status::ok) return s;
   detail::joint_state<false, false>(model, data, q, q, q);
-  detail::place(model, data);
+  detail::place<false>(model, data);
   detail::composite_inertias(model, data);
   Eigen::MatrixXd& M = data.mass_matrix;
   M.setZero();
@@ -257,10 +257,11 @@ Status mass_matrix(const MechanismModel& model, MechanismData& data, const Const
     // carry it to every ancestor: M(j, l) = S_j . (momentum about j's origin)
     int k = l;
     for (int j = model.parent(l); j >= 1; k = j, j = model.parent(j)) {
+      const int cj = model.coordinate(j);
+      if (cj < 0 && model.parent(j) == 0) break;  // a link welded to the base: nothing above
       const auto& K = data.work[static_cast<std::size_t>(k)];
       P = K.rotation * P;
       L = K.rotation * L + K.translation.cross(P);
-      const int cj = model.coordinate(j);
       if (cj < 0) continue;
       const double value = rl * model.coordinate_ratio(j) *
                            (model.joint_type(j) == JointType::revolute ? L.z() : P.z());
