@@ -276,10 +276,11 @@ Status mass_matrix(const MechanismModel& model, MechanismData& data, const Const
     // carry it to every ancestor: M(j, l) = S_j . (momentum about j's origin)
     int k = l;
     for (int j = model.parent(l); j >= 1; k = j, j = model.parent(j)) {
+      const int cj = model.coordinate(j);
+      if (cj < 0 && model.parent(j) == 0) break;  // a link welded to the base: nothing above
       const auto& K = data.work[static_cast<std::size_t>(k)];
       P = K.rotation * P;
       L = K.rotation * L + K.translation.cross(P);
-      const int cj = model.coordinate(j);
       if (cj < 0) continue;
       const double value = rl * model.coordinate_ratio(j) *
                            (model.joint_type(j) == JointType::revolute ? L.z() : P.z());

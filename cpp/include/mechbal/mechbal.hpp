@@ -6,6 +6,7 @@
 ///
 /// The general mechanism model and its algorithms (one header each)
 #include "mechbal/status.hpp"
+#include "mechbal/urdf.hpp"
 #include "mechbal/version.hpp"
 #include "mechbal/rigid_body.hpp"
 #include "mechbal/joint_type.hpp"
