@@ -460,5 +460,5 @@ def test_run_flags_are_for_urdf_files_only(tmp_path, capsys):
     assert "--samples: only applies to URDF files" in capsys.readouterr().err
     path = tmp_path / "two.urdf"
     path.write_text(_GOOD)
-    assert main(["run", str(path), "--out", str(tmp_path), "--samples", "2"]) == 2
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--samples", "2"]) == 2
     assert "trajectory.samples (--samples)" in capsys.readouterr().err

@@ -15,10 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import _core, report
+from mechbal import _core
 from mechbal.cases import register
 from mechbal.config import ConfigError, integer, number, require
-from mechbal.export import write_bodies, write_summary
 from mechbal.mechanism import Mechanism
 
 KIND = "urdf"
@@ -53,8 +52,10 @@ def default_motion(mech: Mechanism) -> tuple[np.ndarray, np.ndarray]:
     return start, end
 
 
-@register(KIND)
+@register(KIND, stages=3)
 def run(config: dict, out: Path) -> dict:
+    from mechbal.cases.serial_chain import run_mechanism
+
     path = Path(require(require(config, "urdf", ""), "path", "urdf"))
     table = require(config, "trajectory", "")
     duration = number(require(table, "duration", "trajectory"), "trajectory.duration (--duration)",
@@ -67,58 +68,7 @@ def run(config: dict, out: Path) -> dict:
     start, end = default_motion(mech)
     traj = _core.RestToRestTrajectory(start, end, duration, _core.TimeLaw.quintic)
     t = np.linspace(0.0, duration, samples)
-    q, qd, qdd = (np.ascontiguousarray(x) for x in traj.evaluate_batch(t))
-
-    motion = mech.body_motion(q, qd, qdd)
-    wrench = mech.shaking_wrench(q, qd, qdd)
-    reaction = mech.base_reaction(q, qd, qdd)
-    torque = mech.inverse_dynamics(q, qd, qdd)
-    for what, status in (("kinematics", motion.status), ("shaking wrench", wrench.status),
-                         ("base reaction", reaction.status)):
-        if np.any(status != 0):
-            raise ConfigError(f"URDF file '{path}'", f"{what} failed at {int(np.sum(status != 0))} "
-                              "instants (non-finite results)", has_value=False)
-    F, M = wrench.shaking_force, wrench.shaking_moment
-    bodies = mech.bodies
-    mass = np.array([b.mass for b in bodies], float)
-    inertia_body = np.array([b.inertia for b in bodies], float).reshape(len(bodies), 3, 3)
-    write_bodies(out / "bodies_nominal.npz", t=t, names=mech.body_names, mass=mass,
-                 inertia_body=inertia_body, com=motion.com, rotation=motion.rotation,
-                 shaking_force=F, shaking_moment=M, q=q, qd=qd, qdd=qdd, torque=torque,
-                 base_reaction_force=reaction.base_reaction_force,
-                 base_reaction_moment=reaction.base_reaction_moment)
-    title = config["case"].get("title", config["case"]["name"])
-    report.plot_wrench(out / "shaking_wrench.png", t, {"nominal": (F, M)}, title=title)
-    report.plot_series(out / "joint_torques.png", t, {"inverse dynamics": torque}, mech.joint_names,
-                       "torque", title="joint torques")
-    rms = np.sqrt(np.mean(torque ** 2, axis=0))
-    summary = {
-        "case": config["case"]["name"],
-        "kind": KIND,
-        "urdf": str(path),
-        "dof": mech.dof,
-        "joint_names": mech.joint_names,
-        "body_names": mech.body_names,
-        "duration_s": float(duration),
-        "samples": int(samples),
-        "law": "quintic",
-        "start": start,
-        "end": end,
-        "variants": ["nominal"],
-        "peak_shaking_force_N": {"nominal": report.peak_abs(F)},
-        "peak_shaking_moment_Nm": {"nominal": report.peak_abs(M)},
-        "peak_base_reaction_force_N": {"nominal": report.peak_abs(reaction.base_reaction_force)},
-        "peak_base_reaction_moment_Nm": {"nominal": report.peak_abs(reaction.base_reaction_moment)},
-        "peak_joint_torque": {"nominal": report.peak_abs(torque)},
-        "rms_joint_torque": {"nominal": rms},
-        "total_mass_kg": mech.total_mass,
-        "files": ["bodies_nominal.npz", "shaking_wrench.png", "joint_torques.png"],
-    }
-    write_summary(out / "summary.json", summary)
-    print(report.table(
-        [["peak shaking force [N]", *report.peak_abs(F)],
-         ["peak shaking moment about O [N m]", *report.peak_abs(M)]],
-        ["quantity", "x", "y", "z"]))
-    print(report.table([["peak torque", *report.peak_abs(torque)], ["RMS torque", *rms]],
-                       ["joint torque [N m or N]", *mech.joint_names]))
-    return summary
+    return run_mechanism(mech, traj, t, out, name=config["case"]["name"], kind=KIND,
+                         title=config["case"].get("title", config["case"]["name"]),
+                         summary_extra={"urdf": str(path), "joint_names": mech.joint_names,
+                                        "body_names": mech.body_names, "start": start, "end": end})
