@@ -178,7 +178,7 @@ void bind_arm2dof(py::module_& m) {
            },
            py::arg("q"));
 
-  py::class_<ComputedTorque>(m, "ComputedTorque",
+  py::class_<ComputedTorque, JointController>(m, "ComputedTorque",
                              "Computed-torque control, Arakelian et al. 2011 eqs 2-6, over any "
                              "inverse-dynamics back end (keeps the model alive)")
       .def(py::init(&make_computed_torque<InverseDynamics>), py::arg("model"), py::arg("kp"),
@@ -197,8 +197,8 @@ void bind_arm2dof(py::module_& m) {
       .def("reset", &ComputedTorque::reset);
 
   m.def(
-      "simulate_computed_torque",
-      [](ForwardDynamics& plant, ComputedTorque& controller, const RestToRestTrajectory& desired,
+      "simulate_closed_loop",
+      [](ForwardDynamics& plant, JointController& controller, const RestToRestTrajectory& desired,
          const Array& q0_arg, const Array& qd0_arg, double dt, double duration,
          const std::string& sampling) {
         const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "qd0", -1);
@@ -215,14 +215,16 @@ void bind_arm2dof(py::module_& m) {
         ClosedLoopLog log;
         {
           py::gil_scoped_release release;
-          log = simulate_computed_torque(plant, controller, desired, q0, qd0, opt);
+          log = simulate_closed_loop(plant, controller, desired, q0, qd0, opt);
         }
         return log_to_dict(log);
       },
       py::arg("plant"), py::arg("controller"), py::arg("desired"), py::arg("q0"), py::arg("qd0"),
       py::arg("dt") = 1e-3, py::arg("duration") = 1.0, py::arg("sampling") = "zero_order_hold",
-      "RK4 closed loop of `plant` under `controller` tracking `desired`; returns a dict of arrays "
+      "RK4 closed loop of `plant` (any ForwardDynamics: Arm2DofDynamics, MechanismDynamics of any "
+      "mechanism) under `controller` (any JointController) tracking `desired`; returns a dict of arrays "
       "t (N+1,), q, qd, q_des, qd_des, tau (N+1, dof), status, saturated_ticks, steps_completed.");
+  m.attr("simulate_computed_torque") = m.attr("simulate_closed_loop");
 
   m.def(
       "pd_error_analytic",

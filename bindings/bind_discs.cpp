@@ -125,7 +125,7 @@ void bind_discs(py::module_& m) {
          py::arg("kd"), py::arg("torque_limit") = py::none(), MECHBAL_JOINT_RANGE_ARGS,
          py::keep_alive<1, 2>());
 
-  py::class_<DecoupledJointController>(
+  py::class_<DecoupledJointController, JointController>(
       m, "DecoupledJointController",
       "tau_i = k_i (qdd_d + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho "
       "eqs 15, 26, 36)")

@@ -11,11 +11,12 @@
 
 #include "mechbal/dynamics.hpp"
 #include "mechbal/joint_limits.hpp"
+#include "mechbal/joint_controller.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {
 
-class ComputedTorque {
+class ComputedTorque : public JointController {
  public:
   /// kp, kd: diagonal gains (dof() values each, finite and > 0). torque_limit: empty (every joint
   /// at default_torque_limit) or dof() values > 0 (+infinity means default_torque_limit): the
@@ -26,7 +27,7 @@ class ComputedTorque {
                  const Eigen::VectorXd& torque_limit = Eigen::VectorXd(),
                  const JointInputRange& range = JointInputRange{});
 
-  int dof() const noexcept { return n_; }
+  int dof() const noexcept override { return n_; }
   const Eigen::VectorXd& kp() const noexcept { return kp_; }
   const Eigen::VectorXd& kd() const noexcept { return kd_; }
   const Eigen::VectorXd& torque_limit() const noexcept { return limit_; }
@@ -43,7 +44,7 @@ class ComputedTorque {
               const Eigen::Ref<const Eigen::VectorXd>& q_des,
               const Eigen::Ref<const Eigen::VectorXd>& qd_des,
               const Eigen::Ref<const Eigen::VectorXd>& qdd_des,
-              Eigen::Ref<Eigen::VectorXd> tau) noexcept;
+              Eigen::Ref<Eigen::VectorXd> tau) noexcept override;
 
   /// The last command returned (held on bad input).
   const Eigen::VectorXd& last_command() const noexcept { return last_; }

@@ -10,11 +10,12 @@
 #include <Eigen/Core>
 
 #include "mechbal/joint_limits.hpp"
+#include "mechbal/joint_controller.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {
 
-class DecoupledJointController {
+class DecoupledJointController : public JointController {
  public:
   static constexpr int max_dof = 8;
   using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_dof, 1>;
@@ -29,7 +30,7 @@ class DecoupledJointController {
                            const Eigen::VectorXd& torque_limit = Eigen::VectorXd(),
                            const JointInputRange& range = JointInputRange{});
 
-  int dof() const noexcept { return static_cast<int>(k_.size()); }
+  int dof() const noexcept override { return static_cast<int>(k_.size()); }
   const VecN& k() const noexcept { return k_; }
   const VecN& kp() const noexcept { return kp_; }
   const VecN& kd() const noexcept { return kd_; }
@@ -45,7 +46,7 @@ class DecoupledJointController {
               const Eigen::Ref<const Eigen::VectorXd>& q_des,
               const Eigen::Ref<const Eigen::VectorXd>& qd_des,
               const Eigen::Ref<const Eigen::VectorXd>& qdd_des,
-              Eigen::Ref<Eigen::VectorXd> tau) noexcept;
+              Eigen::Ref<Eigen::VectorXd> tau) noexcept override;
 
   const VecN& last_command() const noexcept { return last_; }
   void reset() noexcept { last_.setZero(); }

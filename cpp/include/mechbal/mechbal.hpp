@@ -30,6 +30,7 @@
 #include "mechbal/kdl_chain.hpp"
 #include "mechbal/coupled_model.hpp"
 /// Controllers and closed-loop simulation
+#include "mechbal/joint_controller.hpp"
 #include "mechbal/computed_torque.hpp"
 #include "mechbal/decoupled_control.hpp"
 #include "mechbal/joint_limits.hpp"
