@@ -57,6 +57,44 @@ class SpringSlot:
     anchor_b_bounds: Any = None
 
 
+@dataclass(frozen=True)
+class DiscSlot:
+    """A counter-rotating disc a method may add (shaking-moment balancing, Coutinho & Hess
+    Coelho): an axle on link ``carrier`` through ``position`` [m] along ``axis`` (carrier frame),
+    the disc turning relative to the carrier by ``ratio`` times the rate of coordinate ``joint``
+    (a gear train; ratio 1: the disc turns with the next link). Its mass is part of the
+    carrier's; it adds its axial ``inertia`` J_a [kg m^2] about the axle and
+    ``transverse_inertia`` (None: J_a / 2, a thin disc). ``ratio`` and ``inertia`` None are
+    chosen by the method (inertia within ``inertia_min``..``inertia_max``; a chosen ratio
+    outside ``ratio_min``..``ratio_max`` is reported)."""
+
+    name: str
+    carrier: str
+    joint: str
+    axis: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    ratio: float | None = None
+    inertia: float | None = None
+    transverse_inertia: float | None = None
+    inertia_min: float = 0.0
+    inertia_max: float = math.inf
+    ratio_min: float = -math.inf
+    ratio_max: float = math.inf
+
+
+@dataclass(frozen=True)
+class InertiaSlot:
+    """Central principal inertias of an existing body that a method may choose (``components``
+    among ``"Ixx", "Iyy", "Izz"``, about the body's centre of mass in its link's axes, each >=
+    ``minimum``): e.g. the cross-bar of the spatial arm's link 2 (corrected eq 25 of the discs
+    paper)."""
+
+    name: str
+    body: str
+    components: tuple[str, ...] = ("Iyy",)
+    minimum: float = 0.0
+
+
 @dataclass
 class BalanceResult:
     """What a balancing method returns.
