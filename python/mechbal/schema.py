@@ -705,6 +705,11 @@ class OrthoglideSpring(Table):
     rate: Optional[Pos] = Field(None, description="N/m; absent: sized for static balance")
 
 
+class JointValue(Table):
+    joint: Name
+    value: Num = Field(description="rad or m")
+
+
 class OrthoglideRoles(Table):
     """``[roles]``: which frame, bodies and springs of the mechanism are the paper's P, m_p, m_s2,
     distal and proximal springs, and the warm start of the loop solve."""
@@ -713,8 +718,8 @@ class OrthoglideRoles(Table):
     vertical_slider_body: Name = Field(description="body m_s2")
     distal_spring: Name
     proximal_spring: Name
-    initial_guess: dict[Name, Num] = Field({}, description="joint -> coordinate (rad or m) near "
-                                                              "the assembly mode; others start at 0")
+    initial_guess: Annotated[list[JointValue], Field(max_length=MAX_JOINTS)] = Field(
+        [], description="coordinates near the assembly mode (the loop solve's warm start); others start at 0")
 
 
 class OrthoglideWorkspace(Table):
@@ -1146,11 +1151,11 @@ def _orthoglide_cross_checks(case: "OrthoglideCase") -> None:
         if getattr(r, key) not in allowed:
             raise ConfigError(f"roles.{key}", f"unknown name{did_you_mean(getattr(r, key), allowed)}",
                               getattr(r, key))
-    for name in r.initial_guess:
-        if name not in spec.independent_joints:
-            raise ConfigError(f"roles.initial_guess.{name}", "not a joint with a coordinate"
-                                                              f"{did_you_mean(name, spec.independent_joints)}",
-                              has_value=False)
+    for i, jv in enumerate(r.initial_guess):
+        if jv.joint not in spec.independent_joints:
+            raise ConfigError(f"roles.initial_guess[{i}].joint", "not a joint with a coordinate"
+                                                                 f"{did_you_mean(jv.joint, spec.independent_joints)}",
+                              jv.joint)
     c = case.catalogue.counts
     if c[0] > c[1]:
         raise ConfigError("catalogue.counts", "must be [from, to] with from <= to", c)

@@ -108,8 +108,8 @@ class Orthoglide:
                                         name=case.case.name)
         names = self.mech.joint_names
         self.q_guess = np.zeros(self.mech.dof)
-        for k, x in case.roles.initial_guess.items():
-            self.q_guess[names.index(k)] = x
+        for jv in case.roles.initial_guess:
+            self.q_guess[names.index(jv.joint)] = jv.value
         self.tool = case.roles.tool_frame
         missing = [f for f in POINT_FRAMES if f not in self.mech.frame_names]
         if missing:
@@ -190,7 +190,7 @@ class Orthoglide:
         residual = float(np.max(np.abs(A @ K + G)))
         return {n: float(k) for (n, *_), k in zip(self.spring_specs, K)}, residual, int(rank)
 
-    def dynamics(self, path: paper.Path, springs: list[Spring]) -> dict:
+    def dynamics(self, path: paper.PlatformPath, springs: list[Spring]) -> dict:
         """Motor forces along a path and the terms of the virtual power balance."""
         m, C, rho, rho_d, rho_dd = self.solve(path.p, path.v, path.a)
         tau = np.einsum("nda,nd->na", C, self.mech.inverse_dynamics(m.q, m.v, m.a))   # gravity included

@@ -35,7 +35,7 @@ import numpy as np
 
 __all__ = ["linear_delta_ik", "distal_rate", "proximal_rate", "LumpedModel", "lumped_model",
            "potential_energy", "inverse_dynamics", "CatalogueSpring", "SpringCluster", "load_catalogue",
-           "select_springs", "rest_to_rest", "Path", "helix_path", "cube_path", "machining_path",
+           "select_springs", "rest_to_rest", "PlatformPath", "helix_path", "cube_path", "machining_path",
            "PAPER_TABLE1", "PAPER_TABLE2", "PAPER_TABLE4", "PAPER_TABLE5", "PAPER_TABLE6"]
 
 # ---- the paper's published numbers (for comparison only) ----------------------------------------
@@ -469,7 +469,7 @@ def rest_to_rest(distance: float, v_max: float, a_max: float):
 
 
 @dataclass
-class Path:
+class PlatformPath:
     """A sampled trajectory of the platform point P: ``t`` (N,), ``p``, ``v``, ``a`` (N, 3) and
     the cutting force on the tool ``f_cut`` (N, 3) [N]; ``cutting`` (N,) bool."""
 
@@ -483,7 +483,7 @@ class Path:
     info: dict = field(default_factory=dict)
 
 
-def _sample(segments, dt: float, name: str, info=None) -> Path:
+def _sample(segments, dt: float, name: str, info=None) -> PlatformPath:
     """Concatenate segments (duration, fn(t_local) -> p, v, a, f, cutting) on one time grid."""
     durations = np.array([d for d, _ in segments])
     starts = np.concatenate([[0.0], np.cumsum(durations)])
@@ -497,7 +497,7 @@ def _sample(segments, dt: float, name: str, info=None) -> Path:
         m = idx == i
         if np.any(m):
             p[m], v[m], a[m], f[m], cutting[m] = fn(t[m] - starts[i])
-    return Path(name, t, p, v, a, f, cutting, dict(info or {}))
+    return PlatformPath(name, t, p, v, a, f, cutting, dict(info or {}))
 
 
 def _line(p0, p1, v_max, a_axis, force: Callable | None = None):
@@ -517,7 +517,7 @@ def _line(p0, p1, v_max, a_axis, force: Callable | None = None):
 
 
 def helix_path(center, edge: float, radius: float, speed: float, vertical_ratio: float, acceleration: float,
-               dt: float, name: str = "A") -> Path:
+               dt: float, name: str = "A") -> PlatformPath:
     """Path A: P on a helix of ``radius`` about the vertical through ``center``, from the bottom to
     the top face of the workspace cube, tangential (horizontal) speed ``speed`` and vertical speed
     ``vertical_ratio * speed``, constant between smooth start and stop ramps of ``acceleration``
@@ -546,7 +546,7 @@ CUBE_TOUR = ["000", "100", "101", "001", "000", "010", "110", "111", "011", "010
              "011", "001", "110", "100"]
 
 
-def cube_path(center, edge: float, speed: float, a_axis: float, dt: float, name: str = "B") -> Path:
+def cube_path(center, edge: float, speed: float, a_axis: float, dt: float, name: str = "B") -> PlatformPath:
     """Path B: rest-to-rest moves along the edges and the space diagonals of the workspace cube
     (:data:`CUBE_TOUR`), speed <= ``speed``, acceleration <= ``a_axis`` on each axis."""
     c = np.asarray(center, float)
@@ -576,7 +576,7 @@ def cutting_force(operation: str, feed: float, force: float) -> Callable:
 
 
 def machining_path(center, operation: str, feed: float, force: float, pockets, holes, drill_depth: float,
-                   approach_height: float, rapid_speed: float, a_axis: float, dt: float, name: str) -> Path:
+                   approach_height: float, rapid_speed: float, a_axis: float, dt: float, name: str) -> PlatformPath:
     """Paths C-F: from C, rapid moves (``rapid_speed``, ``a_axis``) to each pocket (or hole), the
     machining at the feed ``feed`` with the cutting force of :func:`cutting_force`, rapid moves
     back to C. A pocket is a contour pass of its rectangle (corner (x, y, z) relative to C, size
