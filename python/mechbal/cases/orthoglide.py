@@ -485,7 +485,7 @@ def run(config, out: Path) -> dict:
         report.plot_series(out / f"motor_forces_{name}.png", pth.t,
                            {"unbalanced (Un)": ru["motor_force"], "balanced (SB)": rs["motor_force"]},
                            ["x motor", "y motor (vertical)", "z motor"], "force [N]",
-                           title=f"{title}: Path {name}",
+                           title=f"{case.case.name}: motor forces, Path {name}",
                            caption="Motor force of each slider along the path, unbalanced (springs removed) and "
                                    "statically balanced by the distal and proximal springs (Table 4).")
         files.append(f"motor_forces_{name}.png")
@@ -504,7 +504,8 @@ def run(config, out: Path) -> dict:
             axes[i, 0].set_xlabel("t [s]")
             axes[i, 0].grid(True, alpha=0.3)
         fname = f"machining_{ax}.png"
-        report._finish(plt, fig, axes.ravel(), out / fname, f"{title}: {ax}-axis motor force (Fig. {6 if ax == 'y' else 7})",
+        report._finish(plt, fig, axes.ravel(), out / fname,
+                       f"{case.case.name}: {ax}-axis motor force, machining (Fig. {6 if ax == 'y' else 7})",
                        f"Motor force along the {ax} axis in the machining tasks, unbalanced vs balanced; cutting "
                        "forces proportional to the feed velocity (Table 3).")
         files.append(fname)
