@@ -56,7 +56,10 @@ class BalanceResult:
     the result is not exact (``"rank 4 < 6 unknowns: ..."``, ``"bound: cw1.mass_max"``,
     ``"impossible: ..."``), empty when the balance is exact; ``metrics``: before/after peak and
     RMS values (gravity torque, actuator torque, shaking force and moment) where computed;
-    ``balanced``: the balanced :class:`mechbal.Mechanism`."""
+    ``balanced``: the balanced :class:`mechbal.Mechanism`; ``active_bounds``: every bound the
+    design sits on (``"cw1.max_radius"``, ``"mass_budget"``), whether or not it limited the
+    balance (when it did, it is also in ``limited_by``); ``undetermined``: combinations of the
+    unknowns that the condition does not determine (the null space of the linear problem)."""
 
     method: str
     design: dict[str, dict[str, Any]]
@@ -68,6 +71,8 @@ class BalanceResult:
     limited_by: list[str] = field(default_factory=list)
     metrics: dict[str, Any] = field(default_factory=dict)
     balanced: Any = None
+    active_bounds: list[str] = field(default_factory=list)
+    undetermined: list[str] = field(default_factory=list)
 
     @property
     def exact(self) -> bool:
@@ -89,4 +94,5 @@ class BalanceResult:
         return plain({"method": self.method, "design": self.design, "residual": self.residual,
                       "residual_before": self.residual_before, "residual_units": self.residual_units,
                       "rank": self.rank, "unknowns": self.unknowns, "limited_by": self.limited_by,
-                      "exact": self.exact, "metrics": self.metrics})
+                      "exact": self.exact, "active_bounds": self.active_bounds,
+                      "undetermined": self.undetermined, "metrics": self.metrics})
