@@ -577,12 +577,23 @@ def _slot_design(s: Slot, m: float, p: np.ndarray, active: Sequence[str]) -> dic
            "mass_moment": m * p,
            "frame": f"the frame link '{s.link}' is described in" + ("" if np.allclose(s.T, np.eye(4))
                                                                     else " (its DH frame)"),
-           "bounds": {"mass_min": s.mass_min, "mass_max": s.mass_max, "max_radius": s.max_radius,
-                      "center": s.center, "direction": s.direction},
+           "bounds": {"mass_min": s.mass_min, "mass_max": _or_none(s.mass_max),
+                      "max_radius": _or_none(s.max_radius), "center": s.center, "direction": s.direction},
            "active_bounds": [a.split(".", 1)[1] for a in active if a.startswith(s.name + ".")]}
     if s.direction is not None:
         out["signed_distance"] = float(s.direction @ (p - s.center))
     return out
+
+
+def _or_none(x: float):
+    """An unbounded bound is absent (None in summary.json), not infinity."""
+    return float(x) if math.isfinite(x) else None
+
+
+def reduction_pct(before, after):
+    """100 (1 - after / before) per entry; None where before is 0 (nothing to reduce)."""
+    b, a = np.atleast_1d(np.asarray(before, float)), np.atleast_1d(np.asarray(after, float))
+    return [None if bi == 0 else 100.0 * (1.0 - ai / bi) for bi, ai in zip(b, a)]
 
 
 def balanced_mechanism(mech, placed) -> Any:

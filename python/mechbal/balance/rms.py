@@ -384,8 +384,8 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples, *, objectiv
         "objective": objective, "coupling": coupling, "samples": int(len(q)),
         "rms_torque_before": rms_b, "rms_torque_after": rms_a,
         "peak_torque_before": pk_b, "peak_torque_after": pk_a,
-        "rms_reduction_pct": 100.0 * (1.0 - rms_a / np.where(rms_b > 0, rms_b, np.nan)),
-        "peak_reduction_pct": 100.0 * (1.0 - pk_a / np.where(pk_b > 0, pk_b, np.nan)),
+        "rms_reduction_pct": common.reduction_pct(rms_b, rms_a),
+        "peak_reduction_pct": common.reduction_pct(pk_b, pk_a),
         "added_mass": float(sum(m for _, m, _ in placed)),
     }
     return BalanceResult(method="rms", design=design_out, residual=float(np.sqrt(np.mean(tau_after ** 2))),
