@@ -444,7 +444,7 @@ class _Design:
         return cons
 
 
-def _slsqp(fun, starts, cons, violation, tol, maxiter=1000):
+def _slsqp(fun, starts, cons, violation, tol, maxiter=1000, ftol=1e-16):
     """Best SLSQP result over the starts (feasible first, then the least objective); trust-constr
     when SLSQP finds nothing feasible."""
     from scipy.optimize import minimize
@@ -453,7 +453,7 @@ def _slsqp(fun, starts, cons, violation, tol, maxiter=1000):
     for start in starts:
         for method in ("SLSQP",):
             r = minimize(fun, start, jac=True, method=method, constraints=cons,
-                         options=dict(ftol=1e-16, maxiter=maxiter))
+                         options=dict(ftol=ftol, maxiter=maxiter))
             key = (violation(r.x) > tol, float(fun(r.x)[0]))
             if best is None or key < best_key:
                 best, best_key = r.x, key
@@ -530,15 +530,19 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
         y = to_y(z)
     stage = "least squares within the bounds"
     if dsg.violation(y, mscale) > tol:
-        # stage 2b: no least-squares solution meets the bounds: constrained least squares
-        bs = max(float(by @ by), 1e-300)
+        # stage 2b: no least-squares solution meets the bounds: constrained least squares, on the
+        # triangular factor (|A y + b|^2 = |R y + Q^T b|^2 + const: ny x ny, whatever the rows)
+        Qf, Rf = np.linalg.qr(Ay)
+        cf = Qf.T @ by
+        bs = max(float(cf @ cf), 1e-300)
 
         def g(yy):
-            r = Ay @ yy + by
-            return float(r @ r) / bs, 2.0 * (Ay.T @ r) / bs
+            r = Rf @ yy + cf
+            return float(r @ r) / bs, 2.0 * (Rf.T @ r) / bs
 
         starts = [y, np.zeros(ny)]
-        y = _slsqp(g, starts, dsg.scipy(lambda yy: yy, np.eye(ny)), lambda yy: dsg.violation(yy, mscale), tol)
+        y = _slsqp(g, starts, dsg.scipy(lambda yy: yy, np.eye(ny)), lambda yy: dsg.violation(yy, mscale), tol,
+                   ftol=1e-13)
         stage = "constrained least squares (the bounds exclude every least-squares solution)"
     x = dsg.x(y)
     residual = rms(y)
