@@ -7,7 +7,7 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 PIP := $(PY) -m pip --disable-pip-version-check
-APT_PACKAGES := libeigen3-dev liborocos-kdl-dev g++ make python3-venv python3-dev
+APT_PACKAGES := libeigen3-dev liborocos-kdl-dev liburdfdom-dev g++ make python3-venv python3-dev
 APT_TEST_PACKAGES := libgtest-dev libbenchmark-dev
 CPP_BUILD := build/cpp
 JOBS ?= 2
@@ -25,11 +25,12 @@ print('\n'.join(p['dependencies'] if sys.argv[1] == 'runtime' else p['optional-d
 endef
 say = @printf '\n==> %s\n' $(1)
 
-.PHONY: demo test test-cpp test-python bench apt apt-test venv install install-test clean help
+.PHONY: demo test test-cpp test-python test-sanitize bench apt apt-test venv install install-test clean help
 
 help:
 	@echo "make demo   - install what is missing, then run 'mechbal demo' (output in out/demo)"
 	@echo "make test   - install what is missing, then run the C++ tests (ctest) and pytest"
+	@echo "make test-sanitize - the C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 	@echo "make bench  - build and run the benchmarks"
 	@echo "make clean  - remove build outputs and the virtual environment"
 	@echo "JOBS=N      - parallel compile jobs (default 2)"
@@ -103,6 +104,22 @@ test-cpp: $(CPP_BUILD)/build.ninja
 
 test-python: install $(VENV)/.stamp-install-test
 	$(PY) -m pytest -q tests/python
+
+# ---- sanitizers: the C++ tests built with ASan + UBSan in their own build dir (Debug, so Eigen's
+# assertions are on; -O1 keeps the run short). Any report fails the run. The consumer test
+# (install + find_package from a plain build) is not instrumented and is left to `make test`.
+SAN_BUILD := build/sanitize
+SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+$(SAN_BUILD)/build.ninja: | $(VENV)/.stamp-venv
+	$(VENV)/bin/cmake -S . -B $(SAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Debug \
+	  -DCMAKE_MAKE_PROGRAM=$(abspath $(VENV)/bin/ninja) -DMECHBAL_BUILD_TESTS=ON \
+	  -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" -DCMAKE_CXX_FLAGS="$(SAN_FLAGS)" \
+	  -DCMAKE_EXE_LINKER_FLAGS="$(SAN_FLAGS)"
+
+test-sanitize: $(SAN_BUILD)/build.ninja
+	$(VENV)/bin/cmake --build $(SAN_BUILD) -j $(JOBS)
+	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  $(VENV)/bin/ctest --test-dir $(SAN_BUILD) --output-on-failure -j $(JOBS) -E install_and_consume
 
 # ---- benchmarks (never part of `make test`; own build dir so test and bench builds don't fight) --
 BENCH_BUILD := build/bench

@@ -1,17 +1,82 @@
 #pragma once
-// Shape checks at the binding boundary: errors name the argument and the shape received.
+// Checked conversion of array arguments at the binding boundary (issue 14: nothing garbage leaves
+// a binding). Every array argument is a mechbal::pyb::Array: a numpy array, list, tuple or scalar
+// of real numbers (integer or float) becomes a C-contiguous float64 array; complex numbers,
+// strings, bytes, booleans, objects and ragged sequences are refused with a TypeError naming the
+// argument, at its first use (require_shape, vector_arg, ...), instead of pybind11's forcecast,
+// which dropped imaginary parts and parsed strings as numbers. Shape errors name the argument, the
+// expected and the received shape.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <Eigen/Core>
 #include <initializer_list>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include "mechbal/status.hpp"
 
 namespace mechbal::pyb {
 
-using Array = pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>;
+/// Output arrays (and the storage of Array): float64, C order.
+using OutArray = pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>;
 
-inline std::string shape_of(const Array& a) {
+/// An array argument after the checked conversion. `refused` is empty when the argument was real
+/// numbers; otherwise it says what was received and the array is empty.
+class Array : public OutArray {
+ public:
+  using OutArray::OutArray;
+  Array() = default;
+  explicit Array(const OutArray& a) : OutArray(a) {}
+  std::string refused;
+};
+
+namespace detail {
+
+inline std::string describe_dtype(const pybind11::dtype& dt) {
+  switch (dt.kind()) {
+    case 'c': return "complex values";
+    case 'b': return "booleans";
+    case 'U':
+    case 'S': return "strings";
+    case 'O': return "Python objects";
+    case 'M':
+    case 'm': return "dates or time deltas";
+    default: return "values of dtype " + pybind11::str(dt).cast<std::string>();
+  }
+}
+
+}  // namespace detail
+
+/// The checked conversion (also usable on any handle).
+inline Array to_real_array(pybind11::handle src) {
+  namespace py = pybind11;
+  py::array a;
+  if (py::isinstance<py::array>(src)) {
+    a = py::reinterpret_borrow<py::array>(src);
+  } else {
+    // leaked on purpose: a static py::object would be destroyed after the interpreter
+    static py::object* asarray =
+        new py::object(py::module_::import("numpy").attr("asarray"));
+    try {
+      a = py::reinterpret_steal<py::array>((*asarray)(src).release());
+    } catch (py::error_already_set& e) {
+      Array out;
+      out.refused = "a sequence that is not an array of numbers (" + std::string(e.what()) + ")";
+      return out;
+    }
+  }
+  const char kind = a.dtype().kind();
+  if (kind != 'i' && kind != 'u' && kind != 'f') {
+    Array out;
+    out.refused = detail::describe_dtype(a.dtype());
+    return out;
+  }
+  return Array(OutArray::ensure(a));
+}
+
+inline std::string shape_of(const pybind11::array& a) {
   std::ostringstream s;
   s << "(";
   for (pybind11::ssize_t i = 0; i < a.ndim(); ++i) s << (i ? ", " : "") << a.shape(i);
@@ -19,8 +84,20 @@ inline std::string shape_of(const Array& a) {
   return s.str();
 }
 
-/// Requires `a` to have exactly `shape`; -1 matches any extent. Throws ValueError naming `name`.
-inline void require_shape(const Array& a, const char* name, std::initializer_list<pybind11::ssize_t> shape) {
+/// TypeError naming `name` when the argument was not real numbers.
+inline void require_real(const Array& a, const char* name) {
+  if (!a.refused.empty())
+    throw pybind11::type_error(std::string(name) +
+                               " must be an array of real numbers (int or float), got " +
+                               a.refused);
+}
+
+/// Requires real numbers and exactly `shape`; -1 matches any extent. ValueError naming `name`,
+/// the expected and the received shape (and `context`, e.g. "one value per joint", when given).
+inline void require_shape(const Array& a, const char* name,
+                          std::initializer_list<pybind11::ssize_t> shape,
+                          const char* context = nullptr) {
+  require_real(a, name);
   bool ok = a.ndim() == static_cast<pybind11::ssize_t>(shape.size());
   if (ok) {
     pybind11::ssize_t i = 0;
@@ -37,13 +114,89 @@ inline void require_shape(const Array& a, const char* name, std::initializer_lis
       msg << (first ? "" : ", ") << (s < 0 ? std::string("*") : std::to_string(s));
       first = false;
     }
-    msg << (shape.size() == 1 ? ",)" : ")") << ", got " << shape_of(a);
+    msg << (shape.size() == 1 ? ",)" : ")");
+    if (context) msg << " (" << context << ")";
+    msg << ", got " << shape_of(a);
     throw pybind11::value_error(msg.str());
   }
 }
 
-inline Array make_array(std::initializer_list<pybind11::ssize_t> shape) {
-  return Array(std::vector<pybind11::ssize_t>(shape));
+/// ValueError naming `name` when any value is NaN or infinite (functions with no status).
+inline void require_finite(const Array& a, const char* name) {
+  const double* p = a.data();
+  for (pybind11::ssize_t i = 0; i < a.size(); ++i)
+    if (!std::isfinite(p[i]))
+      throw pybind11::value_error(std::string(name) + " must be finite, got " +
+                                  std::to_string(p[i]));
+}
+
+/// A vector argument of n values (n < 0: any length), optionally required finite.
+inline Eigen::VectorXd vector_arg(const Array& a, const char* name, pybind11::ssize_t n,
+                                  bool finite = false, const char* context = nullptr) {
+  require_shape(a, name, {n}, context);
+  if (finite) require_finite(a, name);
+  return Eigen::Map<const Eigen::VectorXd>(a.data(), a.shape(0));
+}
+
+template <int N>
+inline Eigen::Matrix<double, N, 1> fixed_vector(const Array& a, const char* name,
+                                                bool finite = false) {
+  require_shape(a, name, {N});
+  if (finite) require_finite(a, name);
+  return Eigen::Map<const Eigen::Matrix<double, N, 1>>(a.data());
+}
+
+/// A (rows, cols) matrix argument (row-major numpy to Eigen), optionally required finite.
+template <int R, int C>
+inline Eigen::Matrix<double, R, C> fixed_matrix(const Array& a, const char* name,
+                                                bool finite = false) {
+  require_shape(a, name, {R, C});
+  if (finite) require_finite(a, name);
+  return Eigen::Map<const Eigen::Matrix<double, R, C, (C == 1 ? Eigen::ColMajor : Eigen::RowMajor)>>(
+      a.data());
+}
+
+/// ValueError for a per-sample function with no status in its Python signature: names the
+/// function and the reason (the Status).
+inline void raise_unless_ok(Status s, const char* what) {
+  if (s == Status::ok) return;
+  std::string why;
+  if (has(s, Status::non_finite_input)) why = "an input is NaN or infinite";
+  else if (has(s, Status::out_of_range)) why = "the result overflowed (input out of range)";
+  else if (has(s, Status::singular)) why = "singular configuration";
+  else if (has(s, Status::solver_error)) why = "the solver failed";
+  else if (has(s, Status::bad_size)) why = "wrong sizes";
+  else why = status_name(s);
+  throw pybind11::value_error(std::string(what) + ": " + why + " (status " + status_name(s) + ")");
+}
+
+inline OutArray make_array(std::initializer_list<pybind11::ssize_t> shape) {
+  return OutArray(std::vector<pybind11::ssize_t>(shape));
+}
+
+/// Per-instant status array (N,) of a batch function (uint32 bit flags of mechbal.Status).
+inline pybind11::array_t<std::uint32_t> make_status_array(pybind11::ssize_t N) {
+  pybind11::array_t<std::uint32_t> s(std::vector<pybind11::ssize_t>{N});
+  if (N > 0) std::fill(s.mutable_data(), s.mutable_data() + N, 0u);
+  return s;
 }
 
 }  // namespace mechbal::pyb
+
+namespace pybind11::detail {
+
+/// Every mechbal::pyb::Array argument goes through the checked conversion; loading never fails,
+/// refusals are reported (naming the argument) where the binding first uses the argument.
+template <>
+struct type_caster<mechbal::pyb::Array> {
+  PYBIND11_TYPE_CASTER(mechbal::pyb::Array, const_name("numpy.ndarray[numpy.float64]"));
+  bool load(handle src, bool) {
+    value = mechbal::pyb::to_real_array(src);
+    return true;
+  }
+  static handle cast(const mechbal::pyb::Array& a, return_value_policy, handle) {
+    return a.inc_ref();
+  }
+};
+
+}  // namespace pybind11::detail

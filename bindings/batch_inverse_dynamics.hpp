@@ -1,6 +1,8 @@
 #pragma once
 // Batch inverse dynamics with the base support wrench, shared by every chain back end that offers
 // inverse_dynamics(q, qd, qdd, tau, &support_force, &support_moment) (KDL, mechbal's RNE).
+// Instants with bad input or an overflowing result give zeros and their flags in
+// status_per_instant (N,); status is the OR.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -19,7 +21,8 @@ pybind11::dict batch_inverse_dynamics(Dynamics& d, const Array& q, const Array& 
   const auto N = q.shape(0);
   require_shape(qd, "qd", {N, n});
   require_shape(qdd, "qdd", {N, n});
-  Array tau = make_array({N, n}), F = make_array({N, 3}), M = make_array({N, 3});
+  OutArray tau = make_array({N, n}), F = make_array({N, 3}), M = make_array({N, 3});
+  auto per_instant = make_status_array(N);
   using CVec = Eigen::Map<const Eigen::VectorXd>;
   Status status = Status::ok;
   for (pybind11::ssize_t k = 0; k < N; ++k) {
@@ -33,6 +36,7 @@ pybind11::dict batch_inverse_dynamics(Dynamics& d, const Array& q, const Array& 
       mo.setZero();
     }
     status |= s;
+    per_instant.mutable_at(k) = static_cast<std::uint32_t>(s);
     Eigen::Map<Eigen::Vector3d>(F.mutable_data(k, 0)) = f;
     Eigen::Map<Eigen::Vector3d>(M.mutable_data(k, 0)) = mo;
   }
@@ -41,6 +45,7 @@ pybind11::dict batch_inverse_dynamics(Dynamics& d, const Array& q, const Array& 
   out["support_force"] = F;
   out["support_moment"] = M;
   out["status"] = status;
+  out["status_per_instant"] = per_instant;
   return out;
 }
 

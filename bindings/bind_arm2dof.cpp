@@ -4,7 +4,9 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "array_checks.hpp"
 #include "bindings.hpp"
@@ -30,18 +32,32 @@ py::dict batch3(const Array& a, const char* na, const Array& b, const char* nb, 
   const auto N = a.shape(0);
   require_shape(b, nb, {N, 2});
   require_shape(c, nc, {N, 2});
-  Array out = make_array({N, 2});
+  OutArray out = make_array({N, 2});
+  auto per_instant = make_status_array(N);
   Status status = Status::ok;
   for (py::ssize_t k = 0; k < N; ++k) {
     Eigen::Map<Eigen::VectorXd> o(out.mutable_data(k, 0), 2);
     const Status s = f(CVec(a.data(k, 0), 2), CVec(b.data(k, 0), 2), CVec(c.data(k, 0), 2), o);
     if (s != Status::ok) o.setZero();
     status |= s;
+    per_instant.mutable_at(k) = static_cast<std::uint32_t>(s);
   }
   py::dict d;
   d[out_name] = out;
   d["status"] = status;
+  d["status_per_instant"] = per_instant;
   return d;
+}
+
+template <typename T>
+T finite_result(const T& value, const char* what) {
+  bool finite;
+  if constexpr (std::is_arithmetic_v<T>) finite = std::isfinite(value);
+  else finite = value.allFinite();
+  if (!finite)
+    throw py::value_error(std::string("Arm2DofDynamics.") + what +
+                          ": the result overflowed (input out of range)");
+  return value;
 }
 
 py::dict log_to_dict(const ClosedLoopLog& log) {
@@ -94,7 +110,7 @@ void bind_arm2dof(py::module_& m) {
         "The 2-DOF arm (counterweights merged into the links) as a ChainModel: x-z plane, joint "
         "axes along -y, gravity (0, 0, -g)");
 
-  py::class_<Arm2DofDynamics, InverseDynamics>(m, "Arm2DofDynamics",
+  py::class_<Arm2DofDynamics, InverseDynamics, ForwardDynamics>(m, "Arm2DofDynamics",
                               "Closed-form dynamics of the 2-DOF arm, eqs 14-31 (corrected)")
       .def(py::init<const Arm2DofParameters&, const Arm2DofCounterweights&>(), py::arg("arm"),
            py::arg("counterweights") = Arm2DofCounterweights{})
@@ -130,23 +146,49 @@ void bind_arm2dof(py::module_& m) {
                           });
           },
           py::arg("q"), py::arg("qd"), py::arg("tau"), "Accelerations (N, 2): {'qdd', 'status'}")
-      .def("mass_matrix", &Arm2DofDynamics::mass_matrix, py::arg("q"))
-      .def("coriolis_matrix", &Arm2DofDynamics::coriolis_matrix, py::arg("q"), py::arg("qd"))
-      .def("gravity", &Arm2DofDynamics::gravity, py::arg("q"))
-      .def("kinetic_energy", &Arm2DofDynamics::kinetic_energy, py::arg("q"), py::arg("qd"))
-      .def("potential_energy", &Arm2DofDynamics::potential_energy, py::arg("q"));
+      // no status in these signatures: NaN input or an overflowing result is a ValueError
+      .def("mass_matrix",
+           [](const Arm2DofDynamics& d, const Array& q) {
+             return finite_result(d.mass_matrix(fixed_vector<2>(q, "q", true)), "mass_matrix");
+           },
+           py::arg("q"), "A(q) (2, 2), eqs 14-19 (corrected)")
+      .def("coriolis_matrix",
+           [](const Arm2DofDynamics& d, const Array& q, const Array& qd) {
+             return finite_result(d.coriolis_matrix(fixed_vector<2>(q, "q", true),
+                                                    fixed_vector<2>(qd, "qd", true)),
+                                  "coriolis_matrix");
+           },
+           py::arg("q"), py::arg("qd"), "C(q, qd) (2, 2), Christoffel form")
+      .def("gravity",
+           [](const Arm2DofDynamics& d, const Array& q) {
+             return finite_result(d.gravity(fixed_vector<2>(q, "q", true)), "gravity");
+           },
+           py::arg("q"), "Q(q) (2,), eqs 21-22")
+      .def("kinetic_energy",
+           [](const Arm2DofDynamics& d, const Array& q, const Array& qd) {
+             return finite_result(d.kinetic_energy(fixed_vector<2>(q, "q", true),
+                                                   fixed_vector<2>(qd, "qd", true)),
+                                  "kinetic_energy");
+           },
+           py::arg("q"), py::arg("qd"))
+      .def("potential_energy",
+           [](const Arm2DofDynamics& d, const Array& q) {
+             return finite_result(d.potential_energy(fixed_vector<2>(q, "q", true)),
+                                  "potential_energy");
+           },
+           py::arg("q"));
 
-  py::class_<ComputedTorque>(m, "ComputedTorque",
+  py::class_<ComputedTorque, JointController>(m, "ComputedTorque",
                              "Computed-torque control, Arakelian et al. 2011 eqs 2-6, over any "
                              "inverse-dynamics back end (keeps the model alive)")
-      .def(py::init([](InverseDynamics& model, const Eigen::VectorXd& kp,
-                       const Eigen::VectorXd& kd, const Eigen::VectorXd& limit) {
-             return new ComputedTorque(model, kp, kd, limit);
-           }),
-           py::arg("model"), py::arg("kp"), py::arg("kd"),
-           py::arg("torque_limit") = Eigen::VectorXd(), py::keep_alive<1, 2>(),
+      .def(py::init(&make_computed_torque<InverseDynamics>), py::arg("model"), py::arg("kp"),
+           py::arg("kd"), py::arg("torque_limit") = py::none(), MECHBAL_JOINT_RANGE_ARGS,
+           py::keep_alive<1, 2>(),
            "model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, "
-           "RneChainDynamics)")
+           "RneChainDynamics). torque_limit: one value per joint (default and +inf: "
+           "mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the "
+           "input range of a tick (beyond it: the held command and Status.out_of_range)")
+      .def_property_readonly("torque_limit", &ComputedTorque::torque_limit)
       .def_property_readonly("dof", &ComputedTorque::dof)
       .def_property_readonly("last_command", &ComputedTorque::last_command)
       .def("step", &controller_step<ComputedTorque>,
@@ -155,10 +197,11 @@ void bind_arm2dof(py::module_& m) {
       .def("reset", &ComputedTorque::reset);
 
   m.def(
-      "simulate_computed_torque",
-      [](Arm2DofDynamics& plant, ComputedTorque& controller, const RestToRestTrajectory& desired,
-         const Eigen::VectorXd& q0, const Eigen::VectorXd& qd0, double dt, double duration,
+      "simulate_closed_loop",
+      [](ForwardDynamics& plant, JointController& controller, const RestToRestTrajectory& desired,
+         const Array& q0_arg, const Array& qd0_arg, double dt, double duration,
          const std::string& sampling) {
+        const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "qd0", -1);
         ClosedLoopOptions opt;
         opt.dt = dt;
         opt.duration = duration;
@@ -172,18 +215,21 @@ void bind_arm2dof(py::module_& m) {
         ClosedLoopLog log;
         {
           py::gil_scoped_release release;
-          log = simulate_computed_torque(plant, controller, desired, q0, qd0, opt);
+          log = simulate_closed_loop(plant, controller, desired, q0, qd0, opt);
         }
         return log_to_dict(log);
       },
       py::arg("plant"), py::arg("controller"), py::arg("desired"), py::arg("q0"), py::arg("qd0"),
       py::arg("dt") = 1e-3, py::arg("duration") = 1.0, py::arg("sampling") = "zero_order_hold",
-      "RK4 closed loop of `plant` under `controller` tracking `desired`; returns a dict of arrays "
+      "RK4 closed loop of `plant` (any ForwardDynamics: Arm2DofDynamics, MechanismDynamics of any "
+      "mechanism) under `controller` (any JointController) tracking `desired`; returns a dict of arrays "
       "t (N+1,), q, qd, q_des, qd_des, tau (N+1, dof), status, saturated_ticks, steps_completed.");
+  m.attr("simulate_computed_torque") = m.attr("simulate_closed_loop");
 
   m.def(
       "pd_error_analytic",
-      [](double e0, double ed0, double kp, double kd, const Eigen::VectorXd& t) {
+      [](double e0, double ed0, double kp, double kd, const Array& t_arg) {
+        const Eigen::VectorXd t = vector_arg(t_arg, "t", -1);
         Eigen::VectorXd e(t.size());
         for (Eigen::Index i = 0; i < t.size(); ++i) e(i) = pd_error_analytic(e0, ed0, kp, kd, t(i));
         return e;

@@ -35,17 +35,16 @@ void bind_chain(pybind11::module_& m) {
       .value("fixed", JointType::fixed);
 
   py::class_<JointSpec>(m, "JointSpec", "One joint of a serial chain and the link it moves")
-      .def(py::init([](const std::string& name, JointType type, const Eigen::Matrix4d& origin,
-                       const Eigen::Vector3d& axis, double mass, const Eigen::Vector3d& com,
-                       const Eigen::Matrix3d& inertia) {
+      .def(py::init([](const std::string& name, JointType type, const Array& origin,
+                       const Array& axis, double mass, const Array& com, const Array& inertia) {
              JointSpec j;
              j.name = name;
              j.type = type;
-             j.origin = to_iso(origin);
-             j.axis = axis;
+             j.origin = to_iso(fixed_matrix<4, 4>(origin, "origin"));
+             j.axis = fixed_vector<3>(axis, "axis");
              j.link.mass = mass;
-             j.link.inertia_body = inertia;
-             j.com = com;
+             j.link.inertia_body = fixed_matrix<3, 3>(inertia, "inertia");
+             j.com = fixed_vector<3>(com, "com");
              return j;
            }),
            py::arg("name"), py::arg("type"), py::arg("origin"), py::arg("axis"), py::arg("mass"),
@@ -61,12 +60,17 @@ void bind_chain(pybind11::module_& m) {
       .def_property_readonly("inertia", [](const JointSpec& j) { return j.link.inertia_body; });
 
   py::class_<ChainModel>(m, "ChainModel", "Immutable, validated serial chain")
-      .def(py::init([](std::vector<JointSpec> joints, const Eigen::Vector3d& gravity,
-                       const Eigen::Matrix4d& base) {
-             return ChainModel(std::move(joints), gravity, to_iso(base));
+      .def(py::init([](std::vector<JointSpec> joints, const py::object& gravity,
+                       const py::object& base) {
+             const Vec3 g = gravity.is_none() ? Vec3(0.0, 0.0, -9.81)
+                                              : fixed_vector<3>(to_real_array(gravity), "gravity");
+             const Eigen::Matrix4d B = base.is_none()
+                                           ? Eigen::Matrix4d::Identity()
+                                           : fixed_matrix<4, 4>(to_real_array(base), "base");
+             return ChainModel(std::move(joints), g, to_iso(B));
            }),
-           py::arg("joints"), py::arg("gravity") = Eigen::Vector3d(0.0, 0.0, -9.81),
-           py::arg("base") = Eigen::Matrix4d::Identity())
+           py::arg("joints"), py::arg("gravity") = py::none(), py::arg("base") = py::none(),
+           "gravity: (3,) [m/s^2], default (0, 0, -9.81); base: 4x4 transform, default identity")
       .def_property_readonly("dof", &ChainModel::dof)
       .def_property_readonly("joints", &ChainModel::joints)
       .def_property_readonly("gravity", &ChainModel::gravity)
@@ -84,10 +88,11 @@ void bind_chain(pybind11::module_& m) {
         const auto N = q.shape(0);
         require_shape(qd, "qd", {N, n});
         require_shape(qdd, "qdd", {N, n});
-        Array com = make_array({N, n, 3}), vel = make_array({N, n, 3}),
-              acc = make_array({N, n, 3}), rot = make_array({N, n, 3, 3}),
-              w = make_array({N, n, 3}), al = make_array({N, n, 3}),
-              frames = make_array({N, n, 4, 4});
+        OutArray com = make_array({N, n, 3}), vel = make_array({N, n, 3}),
+                 acc = make_array({N, n, 3}), rot = make_array({N, n, 3, 3}),
+                 w = make_array({N, n, 3}), al = make_array({N, n, 3}),
+                 frames = make_array({N, n, 4, 4});
+        auto per_instant = make_status_array(N);
         ChainWorkspace ws(model);
         Status status = Status::ok;
         using CVec = Eigen::Map<const Eigen::VectorXd>;
@@ -97,6 +102,7 @@ void bind_chain(pybind11::module_& m) {
           const Status s = chain_kinematics(model, CVec(q.data(k, 0), n), CVec(qd.data(k, 0), n),
                                             CVec(qdd.data(k, 0), n), ws);
           status |= s;
+          per_instant.mutable_at(k) = static_cast<std::uint32_t>(s);
           for (pybind11::ssize_t i = 0; i < n; ++i) {
             const BodyState& st = ws.states[static_cast<std::size_t>(i)];
             const bool ok = s == Status::ok;
@@ -124,15 +130,28 @@ void bind_chain(pybind11::module_& m) {
         out["angular_acceleration"] = al;
         out["frames"] = frames;
         out["status"] = status;
+        out["status_per_instant"] = per_instant;
         return out;
       },
       py::arg("model"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
       "Every link's motion in the base frame for N joint states (q, qd, qdd each (N, dof)). "
-      "Returns a dict of arrays (N, dof, 3) / (N, dof, 3, 3) / frames (N, dof, 4, 4).");
+      "Returns a dict of arrays (N, dof, 3) / (N, dof, 3, 3) / frames (N, dof, 4, 4), "
+      "status_per_instant (N,) and their OR, status; a failed instant (non-finite input, or motion "
+      "that overflows: out_of_range) gives identity poses and zero motion.");
 
   py::class_<KdlChainDynamics, InverseDynamics>(m, "KdlChainDynamics",
                                "Joint-space dynamics of a ChainModel through Orocos KDL")
       .def(py::init<const ChainModel&>(), py::arg("model"))
+      .def(py::init([](const MechanismModel& model) {
+             try {
+               return std::make_unique<KdlChainDynamics>(model);
+             } catch (const std::invalid_argument& e) {
+               throw py::value_error(e.what());
+             }
+           }),
+           py::arg("model"),
+           "From the general MechanismModel when it is a serial chain (bodies lumped per link); "
+           "ValueError naming the link or joint otherwise")
       .def_property_readonly("dof", &KdlChainDynamics::dof)
       .def(
           "inverse_dynamics",
@@ -144,29 +163,29 @@ void bind_chain(pybind11::module_& m) {
           "support_moment about the base origin, (N, 3)) by KDL's ChainIdSolver_RNE.")
       .def(
           "mass_matrix",
-          [](KdlChainDynamics& d, const Eigen::VectorXd& q) {
-            if (q.size() != d.dof()) throw pybind11::value_error("q must have dof values");
-            Eigen::MatrixXd M(d.dof(), d.dof());
-            d.mass_matrix(q, M);
+          [](KdlChainDynamics& d, const Array& q) {
+            const Eigen::VectorXd q_ = vector_arg(q, "q", d.dof(), false, "one value per joint");
+            Eigen::MatrixXd M = Eigen::MatrixXd::Zero(d.dof(), d.dof());
+            raise_unless_ok(d.mass_matrix(q_, M), "KdlChainDynamics.mass_matrix");
             return M;
           },
-          py::arg("q"))
+          py::arg("q"), "Mass matrix M(q) (dof, dof); ValueError for non-finite or overflowing q")
       .def(
           "coriolis",
-          [](KdlChainDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-            if (q.size() != d.dof() || qd.size() != d.dof())
-              throw pybind11::value_error("q and qd must have dof values");
-            Eigen::VectorXd c(d.dof());
-            d.coriolis(q, qd, c);
+          [](KdlChainDynamics& d, const Array& q, const Array& qd) {
+            const Eigen::VectorXd q_ = vector_arg(q, "q", d.dof(), false, "one value per joint");
+            const Eigen::VectorXd qd_ = vector_arg(qd, "qd", d.dof(), false, "one value per joint");
+            Eigen::VectorXd c = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.coriolis(q_, qd_, c), "KdlChainDynamics.coriolis");
             return c;
           },
           py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques C(q, qd) qd")
       .def(
           "gravity",
-          [](KdlChainDynamics& d, const Eigen::VectorXd& q) {
-            if (q.size() != d.dof()) throw pybind11::value_error("q must have dof values");
-            Eigen::VectorXd g(d.dof());
-            d.gravity(q, g);
+          [](KdlChainDynamics& d, const Array& q) {
+            const Eigen::VectorXd q_ = vector_arg(q, "q", d.dof(), false, "one value per joint");
+            Eigen::VectorXd g = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.gravity(q_, g), "KdlChainDynamics.gravity");
             return g;
           },
           py::arg("q"), "Gravity torques G(q)");

@@ -47,12 +47,15 @@ void bind_core(pybind11::module_& m) {
       .value("solver_error", Status::solver_error)
       .value("out_of_range", Status::out_of_range);
 
+  m.def("status_name", [](std::uint32_t s) { return std::string(status_name(static_cast<Status>(s))); },
+        py::arg("status"), "Name of a Status value ('multiple' for a combination of flags)");
+
   m.def(
       "validate_rigid_body",
-      [](double mass, const Eigen::Matrix3d& inertia, const std::string& field) {
+      [](double mass, const Array& inertia, const std::string& field) {
         RigidBody b;
         b.mass = mass;
-        b.inertia_body = inertia;
+        b.inertia_body = fixed_matrix<3, 3>(inertia, "inertia_body");
         validate_rigid_body(b, field.c_str());
       },
       py::arg("mass"), py::arg("inertia_body"), py::arg("field") = "body",
@@ -77,8 +80,9 @@ void bind_core(pybind11::module_& m) {
         require_shape(rotation, "rotation", {N, B, 3, 3});
         require_shape(angular_velocity, "angular_velocity", {N, B, 3});
         require_shape(angular_acceleration, "angular_acceleration", {N, B, 3});
-        Array F = make_array({N, 3}), M = make_array({N, 3}), P = make_array({N, 3}),
-              H = make_array({N, 3});
+        OutArray F = make_array({N, 3}), M = make_array({N, 3}), P = make_array({N, 3}),
+                 H = make_array({N, 3});
+        auto per_instant = make_status_array(N);
         BodyTrajectoryView view{static_cast<std::size_t>(N), static_cast<std::size_t>(B),
                                 com.data(), com_velocity.data(), com_acceleration.data(),
                                 rotation.data(), angular_velocity.data(),
@@ -87,7 +91,7 @@ void bind_core(pybind11::module_& m) {
         {
           py::gil_scoped_release release;
           s = shaking_wrench_batch(bodies.data(), view, F.mutable_data(), M.mutable_data(),
-                                   P.mutable_data(), H.mutable_data());
+                                   P.mutable_data(), H.mutable_data(), per_instant.mutable_data());
         }
         py::dict out;
         out["force"] = F;
@@ -95,6 +99,7 @@ void bind_core(pybind11::module_& m) {
         out["linear_momentum"] = P;
         out["angular_momentum"] = H;
         out["status"] = s;
+        out["status_per_instant"] = per_instant;
         return out;
       },
       py::arg("mass"), py::arg("inertia_body"), py::arg("com"), py::arg("com_velocity"),
@@ -106,8 +111,8 @@ eqs 1-4), in one C++ call.
 mass (B,), inertia_body (B,3,3) about each centre of mass in the body frame; com, com_velocity,
 com_acceleration, angular_velocity, angular_acceleration (N,B,3) and rotation (N,B,3,3) body->base,
 all in the base frame. Returns a dict of (N,3) arrays: force (dP/dt), moment (dH_O/dt),
-linear_momentum, angular_momentum, and the OR of the statuses. Instants with non-finite input give
-zeros and set Status.non_finite_input.)doc");
+linear_momentum, angular_momentum; status_per_instant (N,) and their OR, status. Instants with
+non-finite input (non_finite_input) or an overflowing wrench (out_of_range) give zeros.)doc");
 }
 
 }  // namespace

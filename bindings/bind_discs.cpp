@@ -25,15 +25,15 @@ using CVec = Eigen::Map<const Eigen::VectorXd>;
 void bind_discs(py::module_& m) {
   py::class_<DiscSpec>(m, "DiscSpec",
                        "Counter-rotating disc carried by a link, driven at ratio * qd[joint]")
-      .def(py::init([](const std::string& name, int carrier, int joint, const Eigen::Vector3d& axis,
-                       double ratio, const Eigen::Vector3d& inertia) {
+      .def(py::init([](const std::string& name, int carrier, int joint, const Array& axis,
+                       double ratio, const Array& inertia) {
              DiscSpec d;
              d.name = name;
              d.carrier = carrier;
              d.joint = joint;
-             d.axis = axis;
+             d.axis = fixed_vector<3>(axis, "axis");
              d.ratio = ratio;
-             d.inertia = inertia;
+             d.inertia = fixed_vector<3>(inertia, "inertia");
              return d;
            }),
            py::arg("name"), py::arg("carrier"), py::arg("joint"), py::arg("axis"),
@@ -60,7 +60,8 @@ void bind_discs(py::module_& m) {
             require_shape(q, "q", {-1, n});
             const auto N = q.shape(0);
             require_shape(qd, "qd", {N, n});
-            Array M = make_array({N, n, n}), v = make_array({N, n}), g = make_array({N, n});
+            OutArray M = make_array({N, n, n}), v = make_array({N, n}), g = make_array({N, n});
+            auto per_instant = make_status_array(N);
             Eigen::MatrixXd Mk(n, n);
             Eigen::VectorXd vk(n), gk(n);
             Status status = Status::ok;
@@ -73,6 +74,7 @@ void bind_discs(py::module_& m) {
                 gk.setZero();
               }
               status |= s;
+              per_instant.mutable_at(k) = static_cast<std::uint32_t>(s);
               Eigen::Map<RowMat>(M.mutable_data(k, 0, 0), n, n) = Mk;
               Eigen::Map<Eigen::VectorXd>(v.mutable_data(k, 0), n) = vk;
               Eigen::Map<Eigen::VectorXd>(g.mutable_data(k, 0), n) = gk;
@@ -82,11 +84,13 @@ void bind_discs(py::module_& m) {
             out["velocity"] = v;
             out["gravity"] = g;
             out["status"] = status;
+            out["status_per_instant"] = per_instant;
             return out;
           },
           py::arg("q"), py::arg("qd"),
           "For N states (q, qd each (N, dof)): {'mass' (N, dof, dof), 'velocity' (N, dof), "
-          "'gravity' (N, dof), 'status'}")
+          "'gravity' (N, dof), 'status_per_instant' (N,), 'status' (OR)}; failed states give "
+          "zeros")
       .def(
           "inverse_dynamics",
           [](DiscArmDynamics& d, const Array& q, const Array& qd, const Array& qdd) {
@@ -95,7 +99,8 @@ void bind_discs(py::module_& m) {
             const auto N = q.shape(0);
             require_shape(qd, "qd", {N, n});
             require_shape(qdd, "qdd", {N, n});
-            Array tau = make_array({N, n});
+            OutArray tau = make_array({N, n});
+            auto per_instant = make_status_array(N);
             Status status = Status::ok;
             for (py::ssize_t k = 0; k < N; ++k) {
               Eigen::Map<Eigen::VectorXd> t(tau.mutable_data(k, 0), n);
@@ -103,28 +108,46 @@ void bind_discs(py::module_& m) {
                                                   CVec(qdd.data(k, 0), n), t);
               if (s != Status::ok) t.setZero();
               status |= s;
+              per_instant.mutable_at(k) = static_cast<std::uint32_t>(s);
             }
             py::dict out;
             out["tau"] = tau;
             out["status"] = status;
+            out["status_per_instant"] = per_instant;
             return out;
           },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"), "Joint torques (N, dof): {'tau', 'status'}");
+          py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          "Joint torques (N, dof): {'tau', 'status_per_instant' (N,), 'status' (OR)}");
 
   // ComputedTorque is bound in bind_arm2dof.cpp; add the disc-arm back end to its constructors.
   auto ct = py::reinterpret_borrow<py::class_<ComputedTorque>>(m.attr("ComputedTorque"));
-  ct.def(py::init([](DiscArmDynamics& model, const Eigen::VectorXd& kp, const Eigen::VectorXd& kd,
-                     const Eigen::VectorXd& limit) { return new ComputedTorque(model, kp, kd, limit); }),
-         py::arg("model"), py::arg("kp"), py::arg("kd"), py::arg("torque_limit") = Eigen::VectorXd(),
+  ct.def(py::init(&make_computed_torque<DiscArmDynamics>), py::arg("model"), py::arg("kp"),
+         py::arg("kd"), py::arg("torque_limit") = py::none(), MECHBAL_JOINT_RANGE_ARGS,
          py::keep_alive<1, 2>());
 
-  py::class_<DecoupledJointController>(
+  py::class_<DecoupledJointController, JointController>(
       m, "DecoupledJointController",
       "tau_i = k_i (qdd_d + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho "
       "eqs 15, 26, 36)")
-      .def(py::init<const Eigen::VectorXd&, const Eigen::VectorXd&, const Eigen::VectorXd&,
-                    const Eigen::VectorXd&>(),
-           py::arg("k"), py::arg("kp"), py::arg("kd"), py::arg("torque_limit") = Eigen::VectorXd())
+      .def(py::init([](const Array& k, const Array& kp, const Array& kd,
+                       const py::object& torque_limit, double max_position, double max_speed,
+                       double max_acceleration) {
+             const Eigen::VectorXd limit =
+                 torque_limit.is_none()
+                     ? Eigen::VectorXd()
+                     : vector_arg(to_real_array(torque_limit), "torque_limit", -1);
+             return DecoupledJointController(
+                 vector_arg(k, "k", -1), vector_arg(kp, "kp", -1), vector_arg(kd, "kd", -1), limit,
+                 joint_input_range(max_position, max_speed, max_acceleration));
+           }),
+           py::arg("k"), py::arg("kp"), py::arg("kd"), py::arg("torque_limit") = py::none(),
+           MECHBAL_JOINT_RANGE_ARGS,
+           "k, kp, kd: one value per joint; torque_limit: one per joint (default and +inf: mechbal "
+           "default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range "
+           "of a tick (beyond it: the held command and Status.out_of_range)")
+      .def_property_readonly("torque_limit", [](const DecoupledJointController& c) {
+        return Eigen::VectorXd(c.torque_limit());
+      })
       .def_property_readonly("dof", &DecoupledJointController::dof)
       .def_property_readonly("k", [](const DecoupledJointController& c) {
         return Eigen::VectorXd(c.k());

@@ -3,6 +3,7 @@
 // that controllers taking an InverseDynamics (ComputedTorque) accept any of them. No logic.
 #include "bindings.hpp"
 #include "mechbal/dynamics.hpp"
+#include "mechbal/joint_controller.hpp"
 
 namespace py = pybind11;
 
@@ -15,6 +16,13 @@ void bind_dynamics(py::module_& m) {
                               "Joint-space inverse dynamics back end (base class of "
                               "Arm2DofDynamics, KdlChainDynamics, RneChainDynamics)")
       .def_property_readonly("dof", &InverseDynamics::dof);
+  py::class_<ForwardDynamics>(m, "ForwardDynamics",
+                              "Forward dynamics of a plant for closed-loop simulation (base class of "
+                              "Arm2DofDynamics and MechanismDynamics)");
+  py::class_<JointController>(m, "JointController",
+                              "Joint-space tracking controller (base class of ComputedTorque and "
+                              "DecoupledJointController)")
+      .def_property_readonly("dof", &JointController::dof);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include "array_checks.hpp"
 #include "bindings.hpp"
+#include "controller_step.hpp"
 #include "mechbal/computed_torque.hpp"
 #include "mechbal/five_bar.hpp"
 
@@ -69,15 +70,17 @@ void bind_five_bar(py::module_& m) {
             require_shape(q, "q", {-1, 2});
             const auto N = q.shape(0);
             require_shape(qd, "qd", {N, 2});
-            Array M = make_array({N, 2, 2}), v = make_array({N, 2}), g = make_array({N, 2}),
-                  rc = make_array({N});
+            OutArray M = make_array({N, 2, 2}), v = make_array({N, 2}), g = make_array({N, 2}),
+                     rc = make_array({N});
             py::array_t<bool> ok(N);
+            auto per_instant = make_status_array(N);
             Status status = Status::ok;
             for (py::ssize_t k = 0; k < N; ++k) {
               Eigen::Matrix2d Mk = Eigen::Matrix2d::Zero();
               V2 vk = V2::Zero(), gk = V2::Zero();
               const Status s = f.evaluate(row2(q, k), row2(qd, k), Mk, vk, gk);
               status |= s;
+              per_instant.mutable_at(k) = static_cast<std::uint32_t>(s);
               ok.mutable_at(k) = s == Status::ok;
               rc.mutable_at(k) = f.reciprocal_condition();
               for (int i = 0; i < 2; ++i) {
@@ -93,11 +96,13 @@ void bind_five_bar(py::module_& m) {
             out["ok"] = ok;
             out["reciprocal_condition"] = rc;
             out["status"] = status;
+            out["status_per_instant"] = per_instant;
             return out;
           },
           py::arg("q"), py::arg("qd"),
           "For N states (q, qd each (N, 2)): {'mass' (N, 2, 2), 'velocity', 'gravity' (N, 2), "
-          "'ok' (N,), 'reciprocal_condition' (N,), 'status' (OR)}; failed states give zeros")
+          "'ok' (N,), 'reciprocal_condition' (N,), 'status_per_instant' (N,), 'status' (OR)}; "
+          "failed states give zeros")
       .def(
           "inverse_dynamics",
           [](FiveBarDynamics& f, const Array& q, const Array& qd, const Array& qdd) {
@@ -105,22 +110,26 @@ void bind_five_bar(py::module_& m) {
             const auto N = q.shape(0);
             require_shape(qd, "qd", {N, 2});
             require_shape(qdd, "qdd", {N, 2});
-            Array tau = make_array({N, 2});
+            OutArray tau = make_array({N, 2});
+            auto per_instant = make_status_array(N);
             Status status = Status::ok;
             for (py::ssize_t k = 0; k < N; ++k) {
               Eigen::VectorXd t = Eigen::VectorXd::Zero(2);
               const Status s = f.inverse_dynamics(row2(q, k), row2(qd, k), row2(qdd, k), t);
               if (s != Status::ok) t.setZero();
               status |= s;
+              per_instant.mutable_at(k) = static_cast<std::uint32_t>(s);
               tau.mutable_at(k, 0) = t(0);
               tau.mutable_at(k, 1) = t(1);
             }
             py::dict out;
             out["tau"] = tau;
             out["status"] = status;
+            out["status_per_instant"] = per_instant;
             return out;
           },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"), "Joint torques (N, 2): {'tau', 'status'}")
+          py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          "Joint torques (N, 2): {'tau', 'status_per_instant' (N,), 'status' (OR)}")
       .def(
           "motion",
           [](FiveBarDynamics& f, const Array& q, const Array& qd, const Array& qdd) {
@@ -128,12 +137,16 @@ void bind_five_bar(py::module_& m) {
             const auto N = q.shape(0);
             require_shape(qd, "qd", {N, 2});
             require_shape(qdd, "qdd", {N, 2});
-            Array ang = make_array({N, 4}), rate = make_array({N, 4}), acc = make_array({N, 4}),
-                  P = make_array({N, 2}), vP = make_array({N, 2}), aP = make_array({N, 2});
+            OutArray ang = make_array({N, 4}), rate = make_array({N, 4}), acc = make_array({N, 4}),
+                     P = make_array({N, 2}), vP = make_array({N, 2}), aP = make_array({N, 2});
+            auto per_instant = make_status_array(N);
             Status status = Status::ok;
             for (py::ssize_t k = 0; k < N; ++k) {
-              FiveBarMotion mo;
-              status |= f.motion(row2(q, k), row2(qd, k), row2(qdd, k), mo);
+              FiveBarMotion mo;  // zeros, left so by a failed instant
+              const Status s = f.motion(row2(q, k), row2(qd, k), row2(qdd, k), mo);
+              if (s != Status::ok) mo = FiveBarMotion{};
+              status |= s;
+              per_instant.mutable_at(k) = static_cast<std::uint32_t>(s);
               for (int i = 0; i < 4; ++i) {
                 ang.mutable_at(k, i) = mo.angles(i);
                 rate.mutable_at(k, i) = mo.rates(i);
@@ -153,16 +166,17 @@ void bind_five_bar(py::module_& m) {
             out["end_effector_velocity"] = vP;
             out["end_effector_acceleration"] = aP;
             out["status"] = status;
+            out["status_per_instant"] = per_instant;
             return out;
           },
           py::arg("q"), py::arg("qd"), py::arg("qdd"),
           "Joint angles/rates/accelerations (N, 4) in the order (theta1, theta12, theta2, "
-          "theta22) and the end effector (y, z) position/velocity/acceleration (N, 2)");
+          "theta22) and the end effector (y, z) position/velocity/acceleration (N, 2); "
+          "status_per_instant (N,) and their OR, status; failed instants give zeros");
 
   auto ct = py::reinterpret_borrow<py::class_<ComputedTorque>>(m.attr("ComputedTorque"));
-  ct.def(py::init([](FiveBarDynamics& model, const Eigen::VectorXd& kp, const Eigen::VectorXd& kd,
-                     const Eigen::VectorXd& limit) { return new ComputedTorque(model, kp, kd, limit); }),
-         py::arg("model"), py::arg("kp"), py::arg("kd"), py::arg("torque_limit") = Eigen::VectorXd(),
+  ct.def(py::init(&make_computed_torque<FiveBarDynamics>), py::arg("model"), py::arg("kp"),
+         py::arg("kd"), py::arg("torque_limit") = py::none(), MECHBAL_JOINT_RANGE_ARGS,
          py::keep_alive<1, 2>());
 }
 

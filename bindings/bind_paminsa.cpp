@@ -19,7 +19,7 @@ namespace {
 constexpr py::ssize_t kBodies = static_cast<py::ssize_t>(PaminsaBodyIndex::count);
 
 struct BatchArrays {
-  Array com, vel, acc, rot, w, wd, F, M, D, Dd, q, qd, qdd, cond;
+  OutArray com, vel, acc, rot, w, wd, F, M, D, Dd, q, qd, qdd, cond;
   py::array_t<std::uint32_t> status;
   explicit BatchArrays(py::ssize_t N)
       : com(make_array({N, kBodies, 3})), vel(make_array({N, kBodies, 3})),
@@ -69,6 +69,11 @@ struct BatchArrays {
   }
 };
 
+WristInertias inertias(const Array& J1, const Array& J2, const Array& J3) {
+  return {fixed_matrix<3, 3>(J1, "J1", true), fixed_matrix<3, 3>(J2, "J2", true),
+          fixed_matrix<3, 3>(J3, "J3", true)};
+}
+
 void bind_paminsa(py::module_& m) {
   py::class_<PaminsaCounterweights>(m, "PaminsaCounterweights",
                                     "Counterweight masses [kg] of PAMINSA (Briot & Arakelian 2009, "
@@ -96,36 +101,56 @@ void bind_paminsa(py::module_& m) {
       .value("euler", WristIntegrator::euler)
       .value("rk4", WristIntegrator::rk4);
 
-  py::class_<ReactionlessWristConfig>(m, "ReactionlessWristConfig")
+  py::class_<ReactionlessWristConfig>(m, "ReactionlessWristConfig",
+                                      "Reactionless wrist tick: rate, integrator, limits (every "
+                                      "limit finite) and damping; validated on construction")
       .def(py::init([](double rate_hz, WristIntegrator integrator, double max_rate,
-                       double max_condition, double damping) {
+                       double max_condition, double damping, double max_acceleration,
+                       double max_momentum, double max_moment) {
              ReactionlessWristConfig c;
              c.rate_hz = rate_hz;
              c.integrator = integrator;
              c.max_rate = max_rate;
              c.max_condition = max_condition;
              c.damping = damping;
+             c.max_acceleration = max_acceleration;
+             c.max_momentum = max_momentum;
+             c.max_moment = max_moment;
              validate_wrist_config(c);
              return c;
            }),
-           py::arg("rate_hz") = 1000.0, py::arg("integrator") = WristIntegrator::euler,
-           py::arg("max_rate") = std::numeric_limits<double>::infinity(),
-           py::arg("max_condition") = 1e4, py::arg("damping") = 1e-2)
+           py::arg("rate_hz") = ReactionlessWristConfig{}.rate_hz,
+           py::arg("integrator") = WristIntegrator::euler,
+           py::arg("max_rate") = ReactionlessWristConfig{}.max_rate,
+           py::arg("max_condition") = ReactionlessWristConfig{}.max_condition,
+           py::arg("damping") = ReactionlessWristConfig{}.damping,
+           py::arg("max_acceleration") = ReactionlessWristConfig{}.max_acceleration,
+           py::arg("max_momentum") = ReactionlessWristConfig{}.max_momentum,
+           py::arg("max_moment") = ReactionlessWristConfig{}.max_moment)
       .def_readonly("rate_hz", &ReactionlessWristConfig::rate_hz)
       .def_readonly("integrator", &ReactionlessWristConfig::integrator)
       .def_readonly("max_rate", &ReactionlessWristConfig::max_rate)
       .def_readonly("max_condition", &ReactionlessWristConfig::max_condition)
-      .def_readonly("damping", &ReactionlessWristConfig::damping);
+      .def_readonly("damping", &ReactionlessWristConfig::damping)
+      .def_readonly("max_acceleration", &ReactionlessWristConfig::max_acceleration)
+      .def_readonly("max_momentum", &ReactionlessWristConfig::max_momentum)
+      .def_readonly("max_moment", &ReactionlessWristConfig::max_moment);
 
+  // no status in these signatures: NaN input or an overflowing result is a ValueError
   m.def("wrist_momentum_matrix",
-        [](const Eigen::Matrix3d& J1, const Eigen::Matrix3d& J2, const Eigen::Matrix3d& J3,
-           const Eigen::Vector3d& q) { return wrist_momentum_matrix({J1, J2, J3}, q); },
+        [](const Array& J1, const Array& J2, const Array& J3, const Array& q) {
+          const Mat3 N = wrist_momentum_matrix(inertias(J1, J2, J3), fixed_vector<3>(q, "angles", true));
+          if (!N.allFinite()) throw py::value_error("wrist_momentum_matrix: the result overflowed");
+          return N;
+        },
         py::arg("J1"), py::arg("J2"), py::arg("J3"), py::arg("angles"),
         "N(q) of Briot & Arakelian 2009 eq 23 (corrected): wrist angular momentum = N qdot");
   m.def("wrist_momentum_bias",
-        [](const Eigen::Matrix3d& J1, const Eigen::Matrix3d& J2, const Eigen::Matrix3d& J3,
-           const Eigen::Vector3d& q, const Eigen::Vector3d& qd) {
-          return wrist_momentum_bias({J1, J2, J3}, q, qd);
+        [](const Array& J1, const Array& J2, const Array& J3, const Array& q, const Array& qd) {
+          const Vec3 b = wrist_momentum_bias(inertias(J1, J2, J3), fixed_vector<3>(q, "angles", true),
+                                             fixed_vector<3>(qd, "rates", true));
+          if (!b.allFinite()) throw py::value_error("wrist_momentum_bias: the result overflowed");
+          return b;
         },
         py::arg("J1"), py::arg("J2"), py::arg("J3"), py::arg("angles"), py::arg("rates"),
         "d/dt(N qdot) - N qddot");
@@ -141,17 +166,32 @@ void bind_paminsa(py::module_& m) {
   py::class_<ReactionlessWrist>(m, "ReactionlessWrist",
                                 "Reactionless z-x-z wrist controller (Briot & Arakelian 2009, "
                                 "eqs 23-26, corrected)")
-      .def(py::init([](const Eigen::Matrix3d& J1, const Eigen::Matrix3d& J2,
-                       const Eigen::Matrix3d& J3, const ReactionlessWristConfig& c,
-                       const Eigen::Vector3d& q0, const Eigen::Vector3d& H) {
-             return ReactionlessWrist({J1, J2, J3}, c, q0, H);
+      .def(py::init([](const Array& J1, const Array& J2, const Array& J3,
+                       const ReactionlessWristConfig& c, const Array& q0, const Array& H) {
+             return ReactionlessWrist(inertias(J1, J2, J3), c, fixed_vector<3>(q0, "initial_angles"),
+                                      fixed_vector<3>(H, "target_momentum"));
            }),
            py::arg("J1"), py::arg("J2"), py::arg("J3"), py::arg("config"),
            py::arg("initial_angles"), py::arg("target_momentum"))
-      .def("step", &ReactionlessWrist::step, py::arg("D"), py::arg("D_dot"), py::arg("D_half"),
-           py::arg("D_next"))
-      .def("step_euler", &ReactionlessWrist::step_euler, py::arg("D"), py::arg("D_dot"))
-      .def("reset", &ReactionlessWrist::reset, py::arg("angles"), py::arg("target_momentum"))
+      // the tick takes NaN (and returns Status.non_finite_input with the held command)
+      .def("step",
+           [](ReactionlessWrist& w, const Array& D, const Array& Dd, const Array& Dh,
+              const Array& Dn) {
+             return w.step(fixed_vector<3>(D, "D"), fixed_vector<3>(Dd, "D_dot"),
+                           fixed_vector<3>(Dh, "D_half"), fixed_vector<3>(Dn, "D_next"));
+           },
+           py::arg("D"), py::arg("D_dot"), py::arg("D_half"), py::arg("D_next"),
+           "One tick (configured integrator). Returns the Status; the command is in .command")
+      .def("step_euler",
+           [](ReactionlessWrist& w, const Array& D, const Array& Dd) {
+             return w.step_euler(fixed_vector<3>(D, "D"), fixed_vector<3>(Dd, "D_dot"));
+           },
+           py::arg("D"), py::arg("D_dot"))
+      .def("reset",
+           [](ReactionlessWrist& w, const Array& q, const Array& H) {
+             return w.reset(fixed_vector<3>(q, "angles"), fixed_vector<3>(H, "target_momentum"));
+           },
+           py::arg("angles"), py::arg("target_momentum"))
       .def_property_readonly("command", &ReactionlessWrist::command)
       .def_property_readonly("angles", &ReactionlessWrist::angles)
       .def_property_readonly("dt", &ReactionlessWrist::dt);
@@ -193,9 +233,10 @@ void bind_paminsa(py::module_& m) {
       })
       .def_property_readonly("vertical_mass_xy", &PaminsaModel::vertical_mass_xy)
       .def("inverse_kinematics",
-           [](const PaminsaModel& mo, const Eigen::Vector3d& P) {
+           [](const PaminsaModel& mo, const Array& P) {
              PaminsaActuators a;
-             const Status s = mo.inverse_kinematics(P, a);
+             const Status s = mo.inverse_kinematics(fixed_vector<3>(P, "P"), a);
+             if (s != Status::ok) a = PaminsaActuators{};  // zeros with the status
              py::dict d;
              d["alpha1"] = a.alpha1;
              d["alpha3"] = a.alpha3;
@@ -214,18 +255,21 @@ void bind_paminsa(py::module_& m) {
            },
            py::arg("alpha1"), py::arg("alpha3"), py::arg("z_B"))
       .def("leg_points",
-           [](const PaminsaModel& mo, const Eigen::Vector3d& P) {
+           [](const PaminsaModel& mo, const Array& P) {
              PaminsaWorkspace ws;
              PlatformMotion pm;
-             pm.position = P;
+             pm.position = fixed_vector<3>(P, "P");
              const Status s = paminsa_mechanism_kinematics(mo, pm, ws);
-             Array a = make_array({3, 6, 3});
+             OutArray a = make_array({3, 6, 3});
              for (int i = 0; i < 3; ++i)
-               for (int n = 0; n < 6; ++n)
-                 Eigen::Map<Eigen::Vector3d>(a.mutable_data(i, n, 0)) = ws.leg_points[i][n];
+               for (int n = 0; n < 6; ++n)  // zeros when the pose failed (issue 14: was stack garbage)
+                 Eigen::Map<Eigen::Vector3d>(a.mutable_data(i, n, 0)) =
+                     s == Status::ok ? ws.leg_points[i][n] : Vec3::Zero();
              return py::make_tuple(a, s);
            },
-           py::arg("P"), "Base-frame points A, B, C, D, E, F of each leg (3, 6, 3) at pose P");
+           py::arg("P"),
+           "(points, status): base-frame points A, B, C, D, E, F of each leg (3, 6, 3) at pose P; "
+           "zeros and the status when P is not finite, unreachable or overflows");
 
   m.def("paminsa_kinematics",
         [](const PaminsaModel& mo, const Array& P, const Array& Pd, const Array& Pdd,
@@ -249,8 +293,9 @@ void bind_paminsa(py::module_& m) {
         "platform motion and prescribed wrist motion, each (N, 3).");
 
   m.def("paminsa_reactionless_run",
-        [](const PaminsaModel& mo, const ReactionlessWristConfig& c, const Eigen::Vector3d& q0,
+        [](const PaminsaModel& mo, const ReactionlessWristConfig& c, const Array& q0_arg,
            const Array& P, const Array& Pd, const Array& Pdd) {
+          const Vec3 q0 = fixed_vector<3>(q0_arg, "initial_wrist_angles");
           require_shape(P, "P_half", {-1, 3});
           const auto J = P.shape(0);
           if (J < 3 || J % 2 == 0)

@@ -12,21 +12,38 @@ namespace mechbal::pyb {
 
 namespace {
 
-Eigen::VectorXd one_state(const MechanismDynamics& d, const Eigen::VectorXd& v, const char* name) {
-  if (v.size() != d.dof()) {
-    throw py::value_error(std::string(name) + " must have " + std::to_string(d.dof()) +
-                          " values, got " + std::to_string(v.size()));
-  }
-  return v;
+Eigen::VectorXd one_state(const MechanismDynamics& d, const Array& v, const char* name) {
+  return vector_arg(v, name, d.dof(), false, "one value per joint");
 }
 
 void bind_rnea(py::module_& m) {
-  py::class_<MechanismDynamics, InverseDynamics>(
+  py::class_<MechanismDynamics, InverseDynamics, ForwardDynamics>(
       m, "MechanismDynamics",
       "Joint-space dynamics of a MechanismModel (recursive Newton-Euler inverse dynamics with the "
       "base support wrench, composite rigid body mass matrix): the InverseDynamics back end of the "
       "general model, for ComputedTorque and the simulators")
-      .def(py::init<MechanismModel>(), py::arg("model"))
+      .def(py::init([](const MechanismModel& model, const Eigen::VectorXd& q_guess) {
+             try {
+               return new MechanismDynamics(model, q_guess);
+             } catch (const std::invalid_argument& e) {
+               throw py::value_error(e.what());
+             }
+           }),
+           py::arg("model"), py::arg("q_guess") = Eigen::VectorXd(),
+           "Dynamics in the actuated coordinates (loops solved each call, warm-started from q_guess, "
+           "the full coordinates near the assembly)")
+      .def(
+          "forward_dynamics",
+          [](MechanismDynamics& d, const Array& q, const Array& qd, const Array& tau) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "qd"),
+                                  tau_ = one_state(d, tau, "tau");
+            Eigen::VectorXd a = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.forward_dynamics(q_, qd_, tau_, a), "MechanismDynamics.forward_dynamics");
+            return a;
+          },
+          py::arg("q"), py::arg("qd"), py::arg("tau"), "Accelerations a = M^-1 (tau - b) (actuated coordinates)")
+      .def_property_readonly("solved_position",
+                             [](const MechanismDynamics& d) { return Eigen::VectorXd(d.solved_position()); })
       .def_property_readonly("dof", &MechanismDynamics::dof)
       .def(
           "inverse_dynamics",
@@ -39,39 +56,37 @@ void bind_rnea(py::module_& m) {
           "non-finite input give zeros and set their flag in `status`.")
       .def(
           "mass_matrix",
-          [](MechanismDynamics& d, const Eigen::VectorXd& q) {
-            one_state(d, q, "q");
-            Eigen::MatrixXd M(d.dof(), d.dof());
-            if (d.mass_matrix(q, M) != Status::ok) throw py::value_error("q must be finite");
+          [](MechanismDynamics& d, const Array& q) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q");
+            Eigen::MatrixXd M = Eigen::MatrixXd::Zero(d.dof(), d.dof());
+            raise_unless_ok(d.mass_matrix(q_, M), "MechanismDynamics.mass_matrix");
             return M;
           },
           py::arg("q"), "Mass matrix M(q) (dof, dof) by the composite rigid body algorithm")
       .def(
           "gravity",
-          [](MechanismDynamics& d, const Eigen::VectorXd& q) {
-            one_state(d, q, "q");
-            Eigen::VectorXd g(d.dof());
-            if (d.gravity(q, g) != Status::ok) throw py::value_error("q must be finite");
+          [](MechanismDynamics& d, const Array& q) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q");
+            Eigen::VectorXd g = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.gravity(q_, g), "MechanismDynamics.gravity");
             return g;
           },
           py::arg("q"), "Gravity torques G(q)")
       .def(
           "bias",
-          [](MechanismDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-            one_state(d, q, "q");
-            one_state(d, qd, "qd");
-            Eigen::VectorXd b(d.dof());
-            if (d.bias(q, qd, b) != Status::ok) throw py::value_error("q and qd must be finite");
+          [](MechanismDynamics& d, const Array& q, const Array& qd) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "qd");
+            Eigen::VectorXd b = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.bias(q_, qd_, b), "MechanismDynamics.bias");
             return b;
           },
           py::arg("q"), py::arg("qd"), "Bias torques C(q, qd) qd + G(q)")
       .def(
           "coriolis",
-          [](MechanismDynamics& d, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-            one_state(d, q, "q");
-            one_state(d, qd, "qd");
-            Eigen::VectorXd c(d.dof());
-            if (d.coriolis(q, qd, c) != Status::ok) throw py::value_error("q and qd must be finite");
+          [](MechanismDynamics& d, const Array& q, const Array& qd) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "qd");
+            Eigen::VectorXd c = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.coriolis(q_, qd_, c), "MechanismDynamics.coriolis");
             return c;
           },
           py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques C(q, qd) qd");

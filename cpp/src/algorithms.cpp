@@ -15,6 +15,13 @@ namespace {
 
 using detail::check_state;
 
+/// ok when every value of the result is finite; a finite input whose result overflowed gives
+/// Status::out_of_range (DESIGN.md: never ok with a non-finite output).
+template <typename... T>
+Status finite_result(const T&... results) noexcept {
+  return (results.allFinite() && ...) ? Status::ok : Status::out_of_range;
+}
+
 /// World quantities of links, bodies and frames from the L-frame work buffers.
 void world_kinematics(const MechanismModel& model, MechanismData& data) noexcept {
   const int nl = model.num_links();
@@ -51,6 +58,17 @@ void world_kinematics(const MechanismModel& model, MechanismData& data) noexcept
     T.makeAffine();
     data.frame_placements[static_cast<std::size_t>(f)] = T * model.frame(f).placement;
   }
+}
+
+bool kinematics_finite(const MechanismData& data) noexcept {
+  for (std::size_t l = 0; l < data.link_position.size(); ++l) {
+    if (!data.link_position[l].allFinite() || !data.link_rotation[l].allFinite() ||
+        !data.link_velocity[l].allFinite() || !data.link_angular_velocity[l].allFinite() ||
+        !data.link_acceleration[l].allFinite() || !data.link_angular_acceleration[l].allFinite()) {
+      return false;
+    }
+  }
+  return true;
 }
 
 /// Sum of m c over all links (the base's bodies included), in O.
@@ -104,7 +122,7 @@ Status forward_kinematics(const MechanismModel& model, MechanismData& data, cons
   detail::place(model, data);
   detail::forward_pass<false, false, false, false>(model, data);
   world_kinematics(model, data);
-  return Status::ok;
+  return kinematics_finite(data) ? Status::ok : Status::out_of_range;
 }
 
 Status forward_kinematics(const MechanismModel& model, MechanismData& data, const ConstVector& q,
@@ -114,7 +132,7 @@ Status forward_kinematics(const MechanismModel& model, MechanismData& data, cons
   detail::place(model, data);
   detail::forward_pass<true, false, false, false>(model, data);
   world_kinematics(model, data);
-  return Status::ok;
+  return kinematics_finite(data) ? Status::ok : Status::out_of_range;
 }
 
 Status forward_kinematics(const MechanismModel& model, MechanismData& data, const ConstVector& q,
@@ -124,7 +142,7 @@ Status forward_kinematics(const MechanismModel& model, MechanismData& data, cons
   detail::place(model, data);
   detail::forward_pass<true, true, false, false>(model, data);
   world_kinematics(model, data);
-  return Status::ok;
+  return kinematics_finite(data) ? Status::ok : Status::out_of_range;
 }
 
 Status center_of_mass(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
@@ -133,7 +151,7 @@ Status center_of_mass(const MechanismModel& model, MechanismData& data, const Co
   detail::place(model, data);
   data.mass = model.total_mass();
   data.center_of_mass = data.mass > 0.0 ? Vec3(mass_moment(model, data) / data.mass) : Vec3::Zero();
-  return Status::ok;
+  return finite_result(data.center_of_mass);
 }
 
 // ---- momentum and shaking wrench ----------------------------------------------------------------
@@ -145,7 +163,7 @@ Status momentum(const MechanismModel& model, MechanismData& data, const ConstVec
   detail::place(model, data);
   detail::forward_pass<true, false, false, false>(model, data);
   sum_momenta(model, data);
-  return Status::ok;
+  return finite_result(data.shaking.linear_momentum, data.shaking.angular_momentum);
 }
 
 Status momentum_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
@@ -171,7 +189,7 @@ Status momentum_matrix(const MechanismModel& model, MechanismData& data, const C
     data.momentum_matrix.col(c).head<3>() += r * Pw;
     data.momentum_matrix.col(c).tail<3>() += r * (W.world_rotation * L + W.world_position.cross(Pw));
   }
-  return Status::ok;
+  return finite_result(data.momentum_matrix);
 }
 
 Status shaking_wrench(const MechanismModel& model, MechanismData& data, const ConstVector& q,
@@ -182,7 +200,8 @@ Status shaking_wrench(const MechanismModel& model, MechanismData& data, const Co
   detail::forward_pass<true, true, false, true>(model, data);
   sum_momenta(model, data);
   sum_wrenches(model, data);
-  return Status::ok;
+  return finite_result(data.shaking.linear_momentum, data.shaking.angular_momentum, data.shaking.force,
+                       data.shaking.moment);
 }
 
 Status base_reaction(const MechanismModel& model, MechanismData& data, const ConstVector& q,
@@ -194,7 +213,7 @@ Status base_reaction(const MechanismModel& model, MechanismData& data, const Con
   data.center_of_mass = data.mass > 0.0 ? Vec3(mc / data.mass) : Vec3::Zero();
   data.base_reaction.force = data.shaking.force - data.mass * g;
   data.base_reaction.moment = data.shaking.moment - mc.cross(g);
-  return Status::ok;
+  return finite_result(data.base_reaction.force, data.base_reaction.moment);
 }
 
 // ---- inverse dynamics ---------------------------------------------------------------------------
@@ -206,7 +225,7 @@ Status inverse_dynamics(const MechanismModel& model, MechanismData& data, const 
   detail::place<false>(model, data);
   detail::forward_pass<true, true, true, true>(model, data);
   detail::backward_pass(model, data, data.joint_torque);
-  return Status::ok;
+  return finite_result(data.joint_torque);
 }
 
 Status gravity_torque(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
@@ -215,7 +234,7 @@ Status gravity_torque(const MechanismModel& model, MechanismData& data, const Co
   detail::place<false>(model, data);
   detail::forward_pass<false, false, true, true>(model, data);
   detail::backward_pass(model, data, data.gravity_torque);
-  return Status::ok;
+  return finite_result(data.gravity_torque);
 }
 
 Status bias_torque(const MechanismModel& model, MechanismData& data, const ConstVector& q,
@@ -225,7 +244,7 @@ Status bias_torque(const MechanismModel& model, MechanismData& data, const Const
   detail::place<false>(model, data);
   detail::forward_pass<true, false, true, true>(model, data);
   detail::backward_pass(model, data, data.bias_torque);
-  return Status::ok;
+  return finite_result(data.bias_torque);
 }
 
 // ---- mass matrix --------------------------------------------------------------------------------
@@ -257,10 +276,11 @@ Status mass_matrix(const MechanismModel& model, MechanismData& data, const Const
     // carry it to every ancestor: M(j, l) = S_j . (momentum about j's origin)
     int k = l;
     for (int j = model.parent(l); j >= 1; k = j, j = model.parent(j)) {
+      const int cj = model.coordinate(j);
+      if (cj < 0 && model.parent(j) == 0) break;  // a link welded to the base: nothing above
       const auto& K = data.work[static_cast<std::size_t>(k)];
       P = K.rotation * P;
       L = K.rotation * L + K.translation.cross(P);
-      const int cj = model.coordinate(j);
       if (cj < 0) continue;
       const double value = rl * model.coordinate_ratio(j) *
                            (model.joint_type(j) == JointType::revolute ? L.z() : P.z());
@@ -268,7 +288,7 @@ Status mass_matrix(const MechanismModel& model, MechanismData& data, const Const
       M(cj, cl) += value;
     }
   }
-  return Status::ok;
+  return finite_result(M);
 }
 
 // ---- Jacobians ----------------------------------------------------------------------------------
@@ -280,7 +300,7 @@ Status frame_jacobian(const MechanismModel& model, MechanismData& data, const Co
   detail::joint_state<false, false>(model, data, q, q, q);
   detail::place(model, data);
   detail::frame_jacobian_placed(model, data, frame, data.frame_jacobian);
-  return Status::ok;
+  return finite_result(data.frame_jacobian);
 }
 
 // ---- regressors ---------------------------------------------------------------------------------
@@ -367,14 +387,14 @@ Status torque_regressor(const MechanismModel& model, MechanismData& data, const 
   if (Status s = check_state(model, data, &q, &v, &a); s != Status::ok) return s;
   detail::joint_state<true, true>(model, data, q, v, a);
   fill_torque_regressor<true, true>(model, data, data.torque_regressor);
-  return Status::ok;
+  return finite_result(data.torque_regressor);
 }
 
 Status gravity_regressor(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
   if (Status s = check_state(model, data, &q); s != Status::ok) return s;
   detail::joint_state<false, false>(model, data, q, q, q);
   fill_torque_regressor<false, false>(model, data, data.gravity_regressor);
-  return Status::ok;
+  return finite_result(data.gravity_regressor);
 }
 
 Status momentum_regressor(const MechanismModel& model, MechanismData& data, const ConstVector& q,
@@ -404,7 +424,7 @@ Status momentum_regressor(const MechanismModel& model, MechanismData& data, cons
     }
     for (int k = 0; k < 6; ++k) Y.block<3, 1>(3, 4 + k) = RF * inertia_basis_times(k, w_local);
   }
-  return Status::ok;
+  return finite_result(data.momentum_regressor);
 }
 
 }  // namespace mechbal

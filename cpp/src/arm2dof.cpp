@@ -166,7 +166,9 @@ Status Arm2DofDynamics::inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>
   if (q.size() != 2 || qd.size() != 2 || qdd.size() != 2 || tau.size() != 2)
     return Status::bad_size;
   if (!all_finite2(q) || !all_finite2(qd) || !all_finite2(qdd)) return Status::non_finite_input;
-  tau = torque(Vec2(q(0), q(1)), Vec2(qd(0), qd(1)), Vec2(qdd(0), qdd(1)));
+  const Vec2 t = torque(Vec2(q(0), q(1)), Vec2(qd(0), qd(1)), Vec2(qdd(0), qdd(1)));
+  if (!t.allFinite()) return Status::out_of_range;  // finite input that overflowed; tau untouched
+  tau = t;
   return Status::ok;
 }
 
@@ -177,7 +179,9 @@ Status Arm2DofDynamics::forward_dynamics(const Eigen::Ref<const Eigen::VectorXd>
   if (q.size() != 2 || qd.size() != 2 || tau.size() != 2 || qdd.size() != 2)
     return Status::bad_size;
   if (!all_finite2(q) || !all_finite2(qd) || !all_finite2(tau)) return Status::non_finite_input;
-  qdd = acceleration(Vec2(q(0), q(1)), Vec2(qd(0), qd(1)), Vec2(tau(0), tau(1)));
+  const Vec2 a = acceleration(Vec2(q(0), q(1)), Vec2(qd(0), qd(1)), Vec2(tau(0), tau(1)));
+  if (!a.allFinite()) return Status::out_of_range;  // qdd untouched
+  qdd = a;
   return Status::ok;
 }
 

@@ -31,6 +31,12 @@ ClosedLoopLog simulate_computed_torque(ForwardDynamics& plant, ComputedTorque& c
                                        const RestToRestTrajectory& desired,
                                        const Eigen::VectorXd& q0, const Eigen::VectorXd& qd0,
                                        const ClosedLoopOptions& options) {
+  return simulate_closed_loop(plant, controller, desired, q0, qd0, options);
+}
+
+ClosedLoopLog simulate_closed_loop(ForwardDynamics& plant, JointController& controller,
+                                   const RestToRestTrajectory& desired, const Eigen::VectorXd& q0,
+                                   const Eigen::VectorXd& qd0, const ClosedLoopOptions& options) {
   const int n = plant.dof();
   std::ostringstream msg;
   if (controller.dof() != n || desired.size() != n) {

@@ -11,7 +11,9 @@ namespace mechbal {
 DecoupledJointController::DecoupledJointController(const Eigen::VectorXd& k,
                                                    const Eigen::VectorXd& kp,
                                                    const Eigen::VectorXd& kd,
-                                                   const Eigen::VectorXd& torque_limit) {
+                                                   const Eigen::VectorXd& torque_limit,
+                                                   const JointInputRange& range)
+    : range_(range) {
   const Eigen::Index n = k.size();
   if (n < 1 || n > max_dof) {
     std::ostringstream msg;
@@ -24,12 +26,10 @@ DecoupledJointController::DecoupledJointController(const Eigen::VectorXd& k,
   k_ = k;
   kp_ = kp;
   kd_ = kd;
-  if (torque_limit.size() == 0) {
-    limit_ = VecN::Constant(n, std::numeric_limits<double>::infinity());
-  } else {
-    detail::check_positive_vector(torque_limit, "decoupled_control.torque_limit", n, true);
-    limit_ = torque_limit;
-  }
+  Eigen::VectorXd limit;
+  detail::check_torque_limit(torque_limit, "decoupled_control.torque_limit", n, limit);
+  limit_ = limit;
+  validate_joint_input_range(range, "decoupled_control");
   raw_ = VecN::Zero(n);
   last_ = VecN::Zero(n);
 }
@@ -49,11 +49,15 @@ Status DecoupledJointController::step(const Eigen::Ref<const Eigen::VectorXd>& q
     tau = last_;
     return Status::non_finite_input;
   }
+  if (!within(range_, q, qd, q_des, qd_des, qdd_des)) {
+    tau = last_;
+    return Status::out_of_range;
+  }
   // eqs 15, 26, 36 with the computed-torque outer loop: tau_i = k_i (qdd_d + Kp e + Kd e').
   raw_ = k_.cwiseProduct(qdd_des + kp_.cwiseProduct(q_des - q) + kd_.cwiseProduct(qd_des - qd));
-  if (!raw_.allFinite()) {
+  if (!raw_.allFinite()) {  // finite inputs can still overflow (large gains)
     tau = last_;
-    return Status::non_finite_input;
+    return Status::out_of_range;
   }
   const Status status = detail::clip_to_limits(raw_, limit_, n);
   last_ = raw_;

@@ -43,12 +43,10 @@ DiscArmDynamics::DiscArmDynamics(ChainModel chain, std::vector<DiscSpec> discs)
       v << "must be finite (got " << s.ratio << ")";
       fail(d, "ratio", v.str());
     }
-    const double norm = s.axis.norm();
-    if (!s.axis.allFinite() || !(norm > 1e-12)) {
-      v << "must be a finite non-zero vector (got " << s.axis.transpose() << ")";
+    if (!normalize_axis(s.axis)) {
+      v << "must be a finite vector of norm >= 1e-12 (got " << s.axis.transpose() << ")";
       fail(d, "axis", v.str());
     }
-    s.axis /= norm;
     RigidBody rb;
     rb.inertia_body = s.inertia.asDiagonal();
     const std::string field = "discs[" + std::to_string(d) + "]";
@@ -60,11 +58,13 @@ DiscArmDynamics::DiscArmDynamics(ChainModel chain, std::vector<DiscSpec> discs)
   g_ = VecN::Zero(n);
 }
 
-void DiscArmDynamics::compute(const Eigen::Ref<const Eigen::VectorXd>& q,
-                              const Eigen::Ref<const Eigen::VectorXd>& qd) noexcept {
+Status DiscArmDynamics::compute(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                const Eigen::Ref<const Eigen::VectorXd>& qd) noexcept {
   const int n = chain_.dof();
-  // Bias accelerations (dJ/dt qd) are the accelerations at qdd = 0.
-  chain_kinematics(chain_, q, qd, zero_, ws_);
+  // Bias accelerations (dJ/dt qd) are the accelerations at qdd = 0. The link motion overflowing
+  // (out_of_range) leaves the workspace at rest: nothing below would mean anything.
+  const Status kinematics = chain_kinematics(chain_, q, qd, zero_, ws_);
+  if (kinematics != Status::ok) return kinematics;
   M_.setZero();
   v_.setZero();
   g_.setZero();
@@ -120,6 +120,7 @@ void DiscArmDynamics::compute(const Eigen::Ref<const Eigen::VectorXd>& q,
     const Vec3 h = Jm.cwiseProduct(bias) + wb.cross(Jm.cwiseProduct(wb));
     v_.noalias() += Jd.transpose() * h;
   }
+  return Status::ok;
 }
 
 Status DiscArmDynamics::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q,
@@ -132,7 +133,8 @@ Status DiscArmDynamics::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q,
       velocity_terms.size() != n || gravity_terms.size() != n)
     return Status::bad_size;
   if (!q.allFinite() || !qd.allFinite()) return Status::non_finite_input;
-  compute(q, qd);
+  if (const Status s = compute(q, qd); s != Status::ok) return s;
+  if (!M_.allFinite() || !v_.allFinite() || !g_.allFinite()) return Status::out_of_range;
   mass = M_;
   velocity_terms = v_;
   gravity_terms = g_;
@@ -147,9 +149,10 @@ Status DiscArmDynamics::inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>
   if (q.size() != n || qd.size() != n || qdd.size() != n || tau.size() != n)
     return Status::bad_size;
   if (!q.allFinite() || !qd.allFinite() || !qdd.allFinite()) return Status::non_finite_input;
-  compute(q, qd);
-  tau.noalias() = M_ * qdd;
-  tau += v_ + g_;
+  if (const Status s = compute(q, qd); s != Status::ok) return s;
+  const VecN t = M_ * qdd + v_ + g_;
+  if (!t.allFinite()) return Status::out_of_range;  // finite input that overflowed; tau untouched
+  tau = t;
   return Status::ok;
 }
 

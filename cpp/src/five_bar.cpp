@@ -142,7 +142,7 @@ Status FiveBarDynamics::compute(const Eigen::Vector2d& q, const Eigen::Vector2d&
   proj_.project();
   if (!proj_.reduced_mass.allFinite() || !proj_.reduced_velocity.allFinite() ||
       !proj_.reduced_gravity.allFinite())
-    return Status::singular;
+    return Status::out_of_range;  // A° passed the singularity test: finite input that overflowed
   return Status::ok;
 }
 
@@ -164,6 +164,7 @@ Status FiveBarDynamics::motion(const Eigen::Vector2d& q, const Eigen::Vector2d& 
   if (s != Status::ok) return s;
   const Projection::VecP p = proj_.rates(qd);
   const Projection::VecP a = proj_.accelerations(qdd);
+  if (!p.allFinite() || !a.allFinite()) return Status::out_of_range;  // out untouched
   out.angles = angles_;
   out.rates = rates_;
   out.accelerations = {a(0), a(2), a(1), a(3)};
@@ -182,8 +183,10 @@ Status FiveBarDynamics::inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>
   if (!qdd.allFinite()) return Status::non_finite_input;
   const Status s = compute(Eigen::Vector2d(q), Eigen::Vector2d(qd));
   if (s != Status::ok) return s;
-  tau.noalias() = proj_.reduced_mass * qdd;
-  tau += proj_.reduced_velocity + proj_.reduced_gravity;
+  const Eigen::Vector2d t = proj_.reduced_mass * Eigen::Vector2d(qdd) + proj_.reduced_velocity +
+                            proj_.reduced_gravity;
+  if (!t.allFinite()) return Status::out_of_range;  // finite input that overflowed; tau untouched
+  tau = t;
   return Status::ok;
 }
 

@@ -6,10 +6,71 @@
 #include <kdl/jntarray.hpp>
 #include <kdl/jntspaceinertiamatrix.hpp>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace mechbal {
 
 namespace {
+
+[[noreturn]] void not_a_chain(const std::string& why) {
+  throw std::invalid_argument("KdlChainDynamics: the model is not a serial chain: " + why);
+}
+
+// The general model as a ChainModel (joint k moves link k + 1), bodies lumped per link.
+ChainModel chain_of(const MechanismModel& model) {
+  const int nl = model.num_links();
+  if (nl < 2) not_a_chain("it has no joint");
+  if (!model.is_serial_chain()) {
+    // name the first link that breaks the chain
+    const auto& joints = model.description().joints;  // depth-first: joint l - 1 moves link l
+    for (int l = 1; l < nl; ++l) {
+      const Joint& j = joints[static_cast<std::size_t>(l - 1)];
+      if (model.parent(l) != l - 1) {
+        not_a_chain("link '" + j.name + "' hangs from '" + model.link_name(model.parent(l)) +
+                    "', not from '" + model.link_name(l - 1) + "' (a tree with branches)");
+      }
+      if (model.joint_type(l) == JointType::fixed) {
+        not_a_chain("joint '" + j.name + "' is fixed (fold its bodies into '" +
+                    model.link_name(l - 1) + "' to use KDL)");
+      }
+      if (!j.mimic_joint.empty()) {
+        not_a_chain("joint '" + j.name + "' is gear-coupled to '" + j.mimic_joint +
+                    "' (no coordinate of its own)");
+      }
+    }
+    not_a_chain("its coordinates are not one per joint in link order");
+  }
+  std::vector<JointSpec> specs(static_cast<std::size_t>(nl - 1));
+  std::vector<double> mass(static_cast<std::size_t>(nl), 0.0);
+  std::vector<Vec3> first_moment(static_cast<std::size_t>(nl), Vec3::Zero());
+  for (int b = 0; b < model.num_bodies(); ++b) {
+    const auto l = static_cast<std::size_t>(model.body_link(b));
+    mass[l] += model.body(b).mass;
+    first_moment[l] += model.body(b).mass * model.body(b).com;
+  }
+  for (int l = 1; l < nl; ++l) {
+    JointSpec& s = specs[static_cast<std::size_t>(l - 1)];
+    s.name = model.link_name(l);
+    s.type = model.joint_type(l);
+    s.origin = model.placement(l);
+    s.axis = model.axis(l);
+    const auto k = static_cast<std::size_t>(l);
+    s.link.mass = mass[k];
+    s.com = mass[k] > 0.0 ? Vec3(first_moment[k] / mass[k]) : Vec3::Zero();
+    s.link.inertia_body.setZero();
+  }
+  for (int b = 0; b < model.num_bodies(); ++b) {
+    const int l = model.body_link(b);
+    if (l == 0) continue;
+    JointSpec& s = specs[static_cast<std::size_t>(l - 1)];
+    const Body& body = model.body(b);
+    const Vec3 d = body.com - s.com;  // parallel axes to the lumped centre of mass
+    s.link.inertia_body += body.inertia + body.mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
+  }
+  for (JointSpec& s : specs) s.link.inertia_body = 0.5 * (s.link.inertia_body + s.link.inertia_body.transpose()).eval();
+  return ChainModel(std::move(specs), model.gravity());
+}
 
 KDL::Frame to_kdl(const Eigen::Isometry3d& T) {
   const Mat3 R = T.linear();
@@ -88,6 +149,8 @@ struct KdlChainDynamics::Impl {
 KdlChainDynamics::KdlChainDynamics(const ChainModel& model)
     : impl_(std::make_unique<Impl>(model)), dof_(model.dof()) {}
 
+KdlChainDynamics::KdlChainDynamics(const MechanismModel& model) : KdlChainDynamics(chain_of(model)) {}
+
 KdlChainDynamics::~KdlChainDynamics() = default;
 
 Status KdlChainDynamics::inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
@@ -109,6 +172,7 @@ Status KdlChainDynamics::inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd
   if (m.rne.CartToJnt(m.q_full, m.qd_full, m.qdd_full, m.f_ext, m.tau_full) < 0) {
     return Status::solver_error;
   }
+  if (!m.tau_full.data.allFinite()) return Status::out_of_range;  // outputs untouched
   tau = m.tau_full.data.tail(dof_);
   if (support_force) *support_force = m.tau_full.data.segment<3>(0);
   if (support_moment) *support_moment = m.tau_full.data.segment<3>(3);
@@ -121,6 +185,7 @@ Status KdlChainDynamics::mass_matrix(const Eigen::Ref<const Eigen::VectorXd>& q,
   if (!q.allFinite()) return Status::non_finite_input;
   impl_->q.data = q;
   if (impl_->dyn.JntToMass(impl_->q, impl_->M) < 0) return Status::solver_error;
+  if (!impl_->M.data.allFinite()) return Status::out_of_range;
   M = impl_->M.data;
   return Status::ok;
 }
@@ -133,6 +198,7 @@ Status KdlChainDynamics::coriolis(const Eigen::Ref<const Eigen::VectorXd>& q,
   impl_->q.data = q;
   impl_->qd.data = qd;
   if (impl_->dyn.JntToCoriolis(impl_->q, impl_->qd, impl_->out) < 0) return Status::solver_error;
+  if (!impl_->out.data.allFinite()) return Status::out_of_range;
   c = impl_->out.data;
   return Status::ok;
 }
@@ -143,6 +209,7 @@ Status KdlChainDynamics::gravity(const Eigen::Ref<const Eigen::VectorXd>& q,
   if (!q.allFinite()) return Status::non_finite_input;
   impl_->q.data = q;
   if (impl_->dyn.JntToGravity(impl_->q, impl_->out) < 0) return Status::solver_error;
+  if (!impl_->out.data.allFinite()) return Status::out_of_range;
   g = impl_->out.data;
   return Status::ok;
 }

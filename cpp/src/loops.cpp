@@ -284,8 +284,9 @@ Status closed_inverse_dynamics(const MechanismModel& model, MechanismData& data,
   if (has(status, Status::solver_error) || has(status, Status::bad_size) || has(status, Status::non_finite_input)) {
     return status;
   }
-  inverse_dynamics(model, data, data.closed_position, data.closed_velocity, data.closed_acceleration);
+  status |= inverse_dynamics(model, data, data.closed_position, data.closed_velocity, data.closed_acceleration);
   data.actuated_force.noalias() = data.loop_projection.transpose() * data.joint_torque;
+  if (!data.actuated_force.allFinite()) status |= Status::out_of_range;
   return status;
 }
 

@@ -270,10 +270,15 @@ Status PaminsaModel::inverse_kinematics(const Vec3& P, PaminsaActuators& out) co
     alpha[i] = std::atan2(v(1), v(0));
     out.stroke(i) = v.norm();
   }
+  const double z_B = p_.z_A + (P(2) - p_.length_CJ - p_.z_A) / k;  // z_C - z_A = k (z_B - z_A)
+  if (!out.stroke.allFinite() || !std::isfinite(z_B)) {  // finite P that overflowed
+    out = PaminsaActuators{};
+    return Status::out_of_range;
+  }
   out.alpha1 = alpha[0];
   out.alpha2 = alpha[1];
   out.alpha3 = alpha[2];
-  out.z_B = p_.z_A + (P(2) - p_.length_CJ - p_.z_A) / k;  // vertical model: z_C - z_A = k (z_B - z_A)
+  out.z_B = z_B;
   return Status::ok;
 }
 
@@ -375,15 +380,19 @@ Status solve_legs(const PaminsaModel& model, const PlatformMotion& pm,
       return Vec2((ec(1) * r0 - ea(1) * r1) * idet, (-ec(0) * r0 + ea(0) * r1) * idet);
     };
     L.E.v = solve2(ea.dot(L.A.v), ec.dot(L.C.v));
+    // guide direction alpha = angle of M_i -> A_i: undefined with A_i on the pivot M_i (issue 14:
+    // angle_of a zero vector gave NaN with Status::ok)
+    const Vec2 g = Ah - model.guide_pivot()[i];
+    const double g2 = g.squaredNorm();
+    if (!(g2 > 1e-18)) return Status::singular;
     if (Accel) {
       const Vec2 rA = L.E.v - L.A.v, rC = L.E.v - L.C.v;
       L.E.a = solve2(ea.dot(L.A.a) - rA.squaredNorm(), ec.dot(L.C.a) - rC.squaredNorm());
-      L.alpha = angle_of(Ah - model.guide_pivot()[i], Ahd, Ahdd);
+      L.alpha = angle_of(g, Ahd, Ahdd);
     } else {
       L.E.a.setZero();
       // angle_of without the second derivative
-      const Vec2 g = Ah - model.guide_pivot()[i];
-      const double ign = 1.0 / std::sqrt(g.squaredNorm());
+      const double ign = 1.0 / std::sqrt(g2);
       L.alpha.c = g(0) * ign;
       L.alpha.s = g(1) * ign;
       L.alpha.d = cross2(g, Ahd) * ign * ign;
@@ -415,6 +424,15 @@ Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMot
   const Status s = solve_legs<true>(model, pm, legs);
   if (s != Status::ok) return s;  // the workspace is untouched
   fill_states(model, pm, legs, ws);
+  for (std::size_t b = 0; b < Idx::mechanism_count; ++b) {
+    const BodyState& st = ws.states[b];
+    if (!(st.com.allFinite() && st.com_velocity.allFinite() && st.com_acceleration.allFinite() &&
+          st.rotation.allFinite() && st.angular_velocity.allFinite() &&
+          st.angular_acceleration.allFinite())) {
+      ws = PaminsaWorkspace{};  // finite input overflowed: never leave non-finite states behind
+      return Status::out_of_range;
+    }
+  }
   return Status::ok;
 }
 
@@ -679,7 +697,7 @@ Status paminsa_mechanism_wrench(const PaminsaModel& model, const PlatformMotion&
   mechanism_wrench_from_legs<true>(model, platform, legs, w);
   if (!w.linear_momentum.allFinite() || !w.angular_momentum.allFinite() || !w.force.allFinite() ||
       !w.moment.allFinite())
-    return Status::non_finite_input;
+    return Status::out_of_range;  // finite input (solve_legs checked) that overflowed
   out = w;
   return Status::ok;
 }
@@ -691,7 +709,7 @@ Status paminsa_mechanism_angular_momentum(const PaminsaModel& model, const Platf
   if (s != Status::ok) return s;
   ShakingWrench w;
   mechanism_wrench_from_legs<false>(model, platform, legs, w);
-  if (!w.angular_momentum.allFinite()) return Status::non_finite_input;
+  if (!w.angular_momentum.allFinite()) return Status::out_of_range;
   D = w.angular_momentum;
   return Status::ok;
 }
@@ -710,16 +728,36 @@ Status paminsa_mechanism_momentum(const PaminsaModel& model, const PaminsaWorksp
 // ------------------------------------------------------------------------------ controller
 PaminsaController::PaminsaController(const PaminsaModel& model,
                                      const ReactionlessWristConfig& config,
-                                     const Vec3& initial_wrist_angles)
-    : model_(model), wrist_(model.wrist_inertia(), config, initial_wrist_angles, Vec3::Zero()) {}
+                                     const Vec3& initial_wrist_angles, const PlatformLimits& limits)
+    : model_(model),
+      limits_(limits),
+      wrist_(model.wrist_inertia(), config, initial_wrist_angles, Vec3::Zero()) {
+  if (!std::isfinite(limits.max_speed) || limits.max_speed <= 0.0)
+    fail("platform_limits.max_speed", "must be finite and > 0", limits.max_speed);
+  if (!std::isfinite(limits.max_acceleration) || limits.max_acceleration <= 0.0)
+    fail("platform_limits.max_acceleration", "must be finite and > 0", limits.max_acceleration);
+}
+
+bool PaminsaController::in_range(const PlatformMotion& m) const noexcept {
+  return m.velocity.cwiseAbs().maxCoeff() <= limits_.max_speed &&
+         m.acceleration.cwiseAbs().maxCoeff() <= limits_.max_acceleration;
+}
 
 Status PaminsaController::reset(const PlatformMotion& initial, const Vec3& wrist_angles) noexcept {
-  Status s = paminsa_mechanism_kinematics(model_, initial, ws_);
+  // everything is computed aside and committed only when the wrist accepts the reset (issue 14:
+  // the workspace was written before the checks)
+  if (!finite(initial) || !wrist_angles.allFinite()) return Status::non_finite_input;
+  if (!in_range(initial)) return Status::out_of_range;
+  PaminsaWorkspace ws;
+  Status s = paminsa_mechanism_kinematics(model_, initial, ws);
   if (s != Status::ok) return s;
   Vec3 D, Dd;
-  s = paminsa_mechanism_momentum(model_, ws_, D, Dd);
+  s = paminsa_mechanism_momentum(model_, ws, D, Dd);
   if (s != Status::ok) return s;
-  return wrist_.reset(wrist_angles, D);  // wrist at rest: H_target = D(t0)
+  s = wrist_.reset(wrist_angles, D);  // wrist at rest: H_target = D(t0)
+  if (s != Status::ok) return s;
+  ws_ = ws;
+  return Status::ok;
 }
 
 Status PaminsaController::tick(const PlatformMotion& now, const PlatformMotion& half,
@@ -727,7 +765,11 @@ Status PaminsaController::tick(const PlatformMotion& now, const PlatformMotion& 
   const bool rk4 = wrist_.config().integrator == WristIntegrator::rk4;
   Vec3 D_half = Vec3::Zero(), D_next = Vec3::Zero();
   Status s = Status::ok;
-  if (rk4) {  // D only at the RK4 stages: leg geometry and rates, no body state, no accelerations
+  if (!finite(now) || (rk4 && (!finite(half) || !finite(next))))
+    s = Status::non_finite_input;
+  else if (!in_range(now) || (rk4 && (!in_range(half) || !in_range(next))))
+    s = Status::out_of_range;
+  if (rk4 && s == Status::ok) {  // D only at the RK4 stages: leg geometry and rates, no body state, no accelerations
     s = paminsa_mechanism_angular_momentum(model_, half, D_half);
     if (s == Status::ok) s = paminsa_mechanism_angular_momentum(model_, next, D_next);
   }
@@ -740,13 +782,11 @@ Status PaminsaController::tick(const PlatformMotion& now, const PlatformMotion& 
     mechanism_wrench_from_legs<true>(model_, now, legs, mechanism);
     if (!mechanism.linear_momentum.allFinite() || !mechanism.angular_momentum.allFinite() ||
         !mechanism.force.allFinite() || !mechanism.moment.allFinite())
-      s = Status::non_finite_input;
+      s = Status::out_of_range;
   }
   if (s != Status::ok) {
-    // hold: the wrist sees a non-finite input and keeps its angles
-    const Vec3 nan = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-    wrist_.step(nan, nan, nan, nan);
-    return s | Status::non_finite_input;
+    // hold: the wrist keeps its angles (zero rates), the workspace and wrench keep the last tick's
+    return wrist_.hold(s);
   }
   fill_states(model_, now, legs, ws_);
   D_ = mechanism.angular_momentum;  // eq 19
@@ -824,8 +864,16 @@ Status paminsa_kinematics_batch(const PaminsaModel& model, std::size_t instants,
     Status s = paminsa_kinematics(model, pm, wm, ws);
     ShakingWrench sw;
     Vec3 D = Vec3::Zero(), Dd = Vec3::Zero();
-    if (s == Status::ok) s = shaking_wrench(model.bodies().data(), ws.states.data(), Idx::count, sw);
-    if (s == Status::ok) s = paminsa_mechanism_momentum(model, ws, D, Dd);
+    // the inputs are finite here (paminsa_kinematics checked them): a non-finite body state or
+    // wrench is an overflow of finite input
+    if (s == Status::ok) {
+      s = shaking_wrench(model.bodies().data(), ws.states.data(), Idx::count, sw);
+      if (s == Status::non_finite_input) s = Status::out_of_range;
+    }
+    if (s == Status::ok) {
+      s = paminsa_mechanism_momentum(model, ws, D, Dd);
+      if (s == Status::non_finite_input) s = Status::out_of_range;
+    }
     if (s != Status::ok) {
       ws = PaminsaWorkspace{};  // never NaN out: identity poses, zero motion
       sw = ShakingWrench{};

@@ -3,7 +3,6 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -181,8 +180,16 @@ Vec3 wrist_momentum_bias(const WristInertias& J, const Vec3& q, const Vec3& qd) 
 }
 
 void validate_wrist_config(const ReactionlessWristConfig& c) {
-  if (!std::isfinite(c.rate_hz) || c.rate_hz <= 0.0) fail("rate_hz", "must be finite and > 0", c.rate_hz);
-  if (std::isnan(c.max_rate) || c.max_rate <= 0.0) fail("max_rate", "must be > 0 (may be inf)", c.max_rate);
+  // [1, 1e6] Hz: dt = 1/rate_hz finite and a step that is a control tick (issue 14: 5e-324 Hz gave
+  // an infinite step)
+  if (!(c.rate_hz >= 1.0 && c.rate_hz <= 1e6)) fail("rate_hz", "must be in [1, 1e6] Hz", c.rate_hz);
+  if (!std::isfinite(c.max_rate) || c.max_rate <= 0.0) fail("max_rate", "must be finite and > 0", c.max_rate);
+  if (!std::isfinite(c.max_acceleration) || c.max_acceleration <= 0.0)
+    fail("max_acceleration", "must be finite and > 0", c.max_acceleration);
+  if (!std::isfinite(c.max_momentum) || c.max_momentum <= 0.0)
+    fail("max_momentum", "must be finite and > 0", c.max_momentum);
+  if (!std::isfinite(c.max_moment) || c.max_moment <= 0.0)
+    fail("max_moment", "must be finite and > 0", c.max_moment);
   if (!std::isfinite(c.max_condition) || c.max_condition <= 1.0)
     fail("max_condition", "must be finite and > 1", c.max_condition);
   if (!std::isfinite(c.damping) || c.damping <= 0.0 || c.damping >= 1.0)
@@ -198,8 +205,11 @@ ReactionlessWrist::ReactionlessWrist(const WristInertias& inertia_body,
   validate_wrist_config(config);
   static const char* names[3] = {"wrist_inertia[0]", "wrist_inertia[1]", "wrist_inertia[2]"};
   for (int k = 0; k < 3; ++k) validate_rigid_body(RigidBody{0.0, inertia_body[k]}, names[k]);
-  if (!initial_angles.allFinite()) fail("initial_angles", "must be finite", initial_angles.sum());
-  if (!target_momentum.allFinite()) fail("target_momentum", "must be finite", target_momentum.sum());
+  if (!initial_angles.allFinite() || initial_angles.cwiseAbs().maxCoeff() > max_angle)
+    fail("initial_angles", "must be finite and within +-1e6 rad", initial_angles.cwiseAbs().maxCoeff());
+  if (!target_momentum.allFinite() || target_momentum.cwiseAbs().maxCoeff() > config.max_momentum)
+    fail("target_momentum", "must be finite and within +-max_momentum",
+         target_momentum.cwiseAbs().maxCoeff());
   dt_ = 1.0 / config.rate_hz;
   diagonal_inertia_ = true;
   for (const Mat3& J : inertia_)
@@ -213,6 +223,9 @@ ReactionlessWrist::ReactionlessWrist(const WristInertias& inertia_body,
 
 Status ReactionlessWrist::reset(const Vec3& angles, const Vec3& target_momentum) noexcept {
   if (!angles.allFinite() || !target_momentum.allFinite()) return Status::non_finite_input;
+  if (angles.cwiseAbs().maxCoeff() > max_angle ||
+      target_momentum.cwiseAbs().maxCoeff() > config_.max_momentum)
+    return Status::out_of_range;
   angles_ = angles;
   target_ = target_momentum;
   command_ = WristCommand{};
@@ -227,46 +240,54 @@ Status ReactionlessWrist::solve(const Mat3& N, const Vec3& rhs, Vec3& x, double&
   // of N are the square roots of the eigenvalues of N^T N, which Eigen gives in closed form; when
   // N is well conditioned the exact solve is the cofactor inverse. The eigenvalues of N^T N lose
   // about cond^2 eps relative accuracy (1e-8 at cond = 1e4), enough to decide well-conditioned
-  // and to report cond(N); anything else (ill-conditioned, non-finite) takes the SVD below.
+  // and to report cond(N).
+  const Mat3 NtN = N.transpose() * N;
   Eigen::SelfAdjointEigenSolver<Mat3> eig;
-  eig.computeDirect(N.transpose() * N);
+  eig.computeDirect(NtN);
   const Vec3& lambda = eig.eigenvalues();  // ascending
-  if (lambda(0) > 0.0 && std::isfinite(lambda(2))) {
-    const double c = std::sqrt(lambda(2) / lambda(0));
-    if (c <= config_.max_condition) {
-      const Mat3 inv = N.inverse();
-      const Vec3 y = inv * rhs;
-      if (y.allFinite() && inv.allFinite()) {
-        if (inverse) *inverse = inv;
-        x = y;
-        condition = c;
-        return Status::ok;
-      }
-    }
-  }
-  Eigen::JacobiSVD<Mat3> svd(N, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Vec3 s = svd.singularValues();  // descending
-  const double smax = s(0);
-  if (!(smax > 0.0) || !std::isfinite(smax)) {
-    x.setZero();
-    condition = std::numeric_limits<double>::max();
+  constexpr double huge = std::numeric_limits<double>::max();
+  if (!std::isfinite(lambda(2)) || !(lambda(2) > 0.0) || !NtN.allFinite()) {
+    x.setZero();  // N zero, overflowing or not finite: no solution worth returning
+    condition = huge;
     return Status::singular;
   }
-  condition = s(2) > smax / std::numeric_limits<double>::max() ? smax / s(2)
-                                                                 : std::numeric_limits<double>::max();
-  const Vec3 b = svd.matrixU().transpose() * rhs;
-  Vec3 y;
-  Status st = Status::ok;
-  if (condition > config_.max_condition) {
-    // damped least squares: minimises |N x - rhs|^2 + lambda^2 |x|^2
-    const double lambda = config_.damping * smax;
-    for (int i = 0; i < 3; ++i) y(i) = s(i) * b(i) / (s(i) * s(i) + lambda * lambda);
-    st = Status::singular;
-  } else {
-    for (int i = 0; i < 3; ++i) y(i) = b(i) / s(i);
+  const double c = lambda(0) > 0.0 ? std::sqrt(lambda(2) / lambda(0)) : huge;
+  if (c <= config_.max_condition) {
+    const Mat3 inv = N.inverse();
+    const Vec3 y = inv * rhs;
+    if (y.allFinite() && inv.allFinite()) {
+      if (inverse) *inverse = inv;
+      x = y;
+      condition = c;
+      return Status::ok;
+    }
   }
-  x = svd.matrixV() * y;
-  return st;
+  // reported cond(N) of a singular N: sigma_min from |det N| = s1 s2 s3 (relative error ~ cond eps)
+  // rather than from the smallest eigenvalue of N^T N (~ cond^2 eps, 1e-4 at cond = 1e6)
+  {
+    const double det_N = N.col(0).dot(N.col(1).cross(N.col(2)));
+    const double s1 = std::sqrt(lambda(2)), s2 = std::sqrt(std::max(lambda(1), 0.0));
+    const double s3 = s2 > 0.0 ? std::abs(det_N) / (s1 * s2) : 0.0;
+    condition = s3 > s1 / huge ? s1 / s3 : huge;
+    if (!std::isfinite(condition)) condition = huge;
+  }
+  // Singular (issue 14: the former JacobiSVD fallback cost 4-5 us, ten times the tick budget):
+  // damped least squares, x minimises |N x - rhs|^2 + lambda^2 |x|^2 with lambda = damping
+  // sigma_max(N), i.e. the 3x3 normal equations (N^T N + lambda^2 1) x = N^T rhs. Their matrix is
+  // symmetric positive definite with cond <= 1 + 1/damping^2 (1e4 + 1 by default) whatever N is,
+  // so the cofactor inverse is accurate; the solution equals the SVD form
+  // sum_i s_i (u_i . rhs) / (s_i^2 + lambda^2) v_i to rounding.
+  Mat3 A = NtN;
+  A.diagonal().array() += config_.damping * config_.damping * lambda(2);
+  double det = 0.0;
+  const Mat3 pinv = cofactor_inverse(A, det) * N.transpose();  // damped pseudo-inverse
+  x = pinv * rhs;
+  if (!x.allFinite()) {
+    x.setZero();
+  } else if (inverse && pinv.allFinite()) {
+    *inverse = pinv;
+  }
+  return Status::singular;
 }
 
 Status ReactionlessWrist::rates(const Vec3& q, const Vec3& D, Vec3& qd,
@@ -278,6 +299,23 @@ Status ReactionlessWrist::rates_with(const Mat3& N, const Vec3& D, Vec3& qd, dou
                                      Mat3* inverse) const noexcept {
   const Status st = solve(N, target_ - D, qd, condition, inverse);
   return st | limit_rate(qd);
+}
+
+Status ReactionlessWrist::hold(Status why) noexcept {
+  command_.angles = command_.next_angles = angles_;
+  cos_sin(angles_, command_.cos_angles, command_.sin_angles);
+  command_.rates.setZero();
+  command_.accelerations.setZero();
+  command_.status = why;
+  return why;
+}
+
+bool ReactionlessWrist::in_range(const Vec3& D_now, const Vec3& D_dot, const Vec3* D_half,
+                                 const Vec3* D_next) const noexcept {
+  const double H = config_.max_momentum;
+  return D_now.cwiseAbs().maxCoeff() <= H && D_dot.cwiseAbs().maxCoeff() <= config_.max_moment &&
+         (D_half == nullptr || D_half->cwiseAbs().maxCoeff() <= H) &&
+         (D_next == nullptr || D_next->cwiseAbs().maxCoeff() <= H);
 }
 
 Status ReactionlessWrist::limit_rate(Vec3& qd) const noexcept {
@@ -352,32 +390,25 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
   const bool finite = D_now.allFinite() && D_dot.allFinite() &&
                       (D_half == nullptr || D_half->allFinite()) &&
                       (D_next == nullptr || D_next->allFinite());
-  const auto hold = [this](Status why) noexcept {
-    command_.angles = command_.next_angles = angles_;
-    cos_sin(angles_, command_.cos_angles, command_.sin_angles);
-    command_.rates.setZero();
-    command_.accelerations.setZero();
-    command_.status = why;
-    return why;
-  };
   if (!finite) return hold(Status::non_finite_input);
+  if (!in_range(D_now, D_dot, D_half, D_next)) return hold(Status::out_of_range);
 
   Vec3 k1;
   double cond = 1.0, unused = 1.0;
   // N(q_n) is built once (in link 2's frame) for k1 and the feed-forward; cond(N(q_n)), the
-  // reported one, comes from solve()'s closed-form eigenvalues; when N is well conditioned its
-  // inverse is reused for both (issue 6)
+  // reported one, comes from solve()'s closed-form eigenvalues; the operator of k1's solve (N's
+  // inverse, or its damped pseudo-inverse at the singularity) is reused for both (issue 6, 14)
   Vec3 cos_n, sin_n;
   cos_sin(angles_, cos_n, sin_n);
   const WristFrame2 at(inertia_, cos_n, sin_n, diagonal_inertia_);
-  Mat3 N2_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by the fast path
+  Mat3 N2_inv = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());  // set by solve()
   Status st = solve(at.N2, at.to_frame2(target_ - D_now), k1, cond, &N2_inv);
   st |= limit_rate(k1);
   // feed-forward acceleration: N qdd = -Ddot - bias(q, qdot)  <=>  N2 qdd = R2^T(-Ddot) - bias2
   Vec3 qdd;
   const Vec3 rhs = at.to_frame2(-D_dot) - at.bias_frame2(k1);
   if (N2_inv.allFinite())
-    qdd = N2_inv * rhs;  // well conditioned: the fast path's inverse
+    qdd = N2_inv * rhs;  // same operator, same status as solving again
   else
     st |= solve(at.N2, rhs, qdd, unused);
   Vec3 next;
@@ -390,12 +421,25 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
   } else {
     next = angles_ + dt_ * k1;  // eq 26
   }
-  if (!next.allFinite() || !k1.allFinite() || !qdd.allFinite()) return hold(Status::non_finite_input);
+  // finite, in-range input cannot overflow here (the rates are clipped), but the tick must never
+  // emit a non-finite command or leave the angle range whatever happens
+  if (!next.allFinite() || !k1.allFinite() || !qdd.allFinite() ||
+      next.cwiseAbs().maxCoeff() > max_angle)
+    return hold(Status::out_of_range);
+  if (has(st, Status::saturated)) {
+    qdd.setZero();  // the unsaturated formula no longer describes the commanded motion
+  } else {
+    const double peak = qdd.cwiseAbs().maxCoeff();
+    if (peak > config_.max_acceleration) {
+      qdd *= config_.max_acceleration / peak;  // direction kept
+      st |= Status::saturated;
+    }
+  }
   command_.angles = angles_;
   command_.cos_angles = cos_n;
   command_.sin_angles = sin_n;
   command_.rates = k1;
-  command_.accelerations = has(st, Status::saturated) ? Vec3::Zero() : qdd;
+  command_.accelerations = qdd;
   command_.next_angles = next;
   command_.condition_number = cond;
   command_.status = st;

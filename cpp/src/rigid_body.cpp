@@ -48,6 +48,11 @@ inline bool finite_state(const BodyState& s) noexcept {
          s.angular_acceleration.allFinite();
 }
 
+inline bool finite_wrench(const ShakingWrench& w) noexcept {
+  return w.linear_momentum.allFinite() && w.angular_momentum.allFinite() && w.force.allFinite() &&
+         w.moment.allFinite();
+}
+
 // Contribution of one body to P, H_O, dP/dt, dH_O/dt.
 inline void accumulate(const RigidBody& b, const Vec3& c, const Vec3& v, const Vec3& a,
                        const Mat3& R, const Vec3& w, const Vec3& alpha, ShakingWrench& out) noexcept {
@@ -78,6 +83,10 @@ Status shaking_wrench(const RigidBody* bodies, const BodyState* states, std::siz
     accumulate(bodies[j], s.com, s.com_velocity, s.com_acceleration, s.rotation,
                s.angular_velocity, s.angular_acceleration, out);
   }
+  if (!finite_wrench(out)) {  // finite input that overflowed
+    out = ShakingWrench{};
+    return Status::out_of_range;
+  }
   return Status::ok;
 }
 
@@ -93,16 +102,20 @@ Status base_reaction(const RigidBody* bodies, const BodyState* states, std::size
   }
   out.force = inertial.force - weight_force;
   out.moment = inertial.moment - weight_moment;
-  if (!out.force.allFinite() || !out.moment.allFinite() || !gravity.allFinite()) {
+  if (!gravity.allFinite() || !finite_wrench(inertial)) {
     out = BaseReaction{};
     return Status::non_finite_input;
+  }
+  if (!out.force.allFinite() || !out.moment.allFinite()) {
+    out = BaseReaction{};
+    return Status::out_of_range;
   }
   return Status::ok;
 }
 
 Status shaking_wrench_batch(const RigidBody* bodies, const BodyTrajectoryView& m, double* force,
                             double* moment, double* linear_momentum,
-                            double* angular_momentum) noexcept {
+                            double* angular_momentum, std::uint32_t* status_per_instant) noexcept {
   using CVec3 = Eigen::Map<const Vec3>;
   // rotation is stored row-major (numpy C order): map as the transpose of a column-major 3x3.
   using CMat3Row = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>;
@@ -123,10 +136,15 @@ Status shaking_wrench_batch(const RigidBody* bodies, const BodyTrajectoryView& m
       }
       accumulate(bodies[j], c, v, a, R, w, al, out);
     }
+    Status s = Status::ok;
     if (!finite) {
-      out = ShakingWrench{};
-      status |= Status::non_finite_input;
+      s = Status::non_finite_input;
+    } else if (!finite_wrench(out)) {
+      s = Status::out_of_range;  // finite input that overflowed
     }
+    if (s != Status::ok) out = ShakingWrench{};
+    status |= s;
+    if (status_per_instant) status_per_instant[k] = static_cast<std::uint32_t>(s);
     if (force) Eigen::Map<Vec3>(force + 3 * k) = out.force;
     if (moment) Eigen::Map<Vec3>(moment + 3 * k) = out.moment;
     if (linear_momentum) Eigen::Map<Vec3>(linear_momentum + 3 * k) = out.linear_momentum;

@@ -29,14 +29,12 @@ ChainModel::ChainModel(std::vector<JointSpec> joints, const Vec3& gravity,
                                   " must be revolute or prismatic in a serial chain (use "
                                   "MechanismModel for fixed joints)");
     }
-    const double n = j.axis.norm();
-    if (!j.axis.allFinite() || n < 1e-12) {
+    if (!normalize_axis(j.axis)) {
       std::ostringstream m;
-      m << joint_field(i, j, "axis") << " must be a finite non-zero vector, got ["
+      m << joint_field(i, j, "axis") << " must be a finite vector of norm >= 1e-12, got ["
         << j.axis.transpose() << "]";
       throw std::invalid_argument(m.str());
     }
-    j.axis /= n;
     if (!j.origin.matrix().allFinite()) {
       throw std::invalid_argument(joint_field(i, j, "origin") + " must be finite");
     }
@@ -48,6 +46,19 @@ ChainModel::ChainModel(std::vector<JointSpec> joints, const Vec3& gravity,
     validate_rigid_body(j.link, joint_field(i, j, "link").c_str());
     bodies_.push_back(j.link);
   }
+}
+
+bool normalize_axis(Vec3& axis) noexcept {
+  // scale by the largest component first: |axis| itself overflows for components near 1e155
+  // and above (issue 14: an axis of 1e300 was normalised to zero)
+  if (!axis.allFinite()) return false;
+  const double peak = axis.cwiseAbs().maxCoeff();
+  if (!(peak > 0.0)) return false;
+  const Vec3 scaled = axis / peak;  // largest component exactly +-1
+  const double n = scaled.norm();   // in [1, sqrt 3]
+  if (!(peak * n >= 1e-12)) return false;
+  axis = scaled / n;
+  return true;
 }
 
 ChainWorkspace::ChainWorkspace(const ChainModel& model)
@@ -97,6 +108,22 @@ Status chain_kinematics(const ChainModel& model, const Eigen::Ref<const Eigen::V
     st.angular_acceleration = alpha;
     st.com_velocity = v_o + w.cross(rc);
     st.com_acceleration = a_o + alpha.cross(rc) + w.cross(w.cross(rc));
+  }
+  // finite input can still overflow (a speed of 1e200 squared): never report ok with a
+  // non-finite state, never leave one behind
+  bool finite = true;
+  for (int i = 0; i < n && finite; ++i) {
+    const BodyState& st = ws.states[static_cast<std::size_t>(i)];
+    finite = ws.frames[static_cast<std::size_t>(i)].matrix().allFinite() &&
+             st.com_velocity.allFinite() && st.com_acceleration.allFinite() &&
+             st.angular_velocity.allFinite() && st.angular_acceleration.allFinite();
+  }
+  if (!finite) {
+    for (int i = 0; i < n; ++i) {
+      ws.frames[static_cast<std::size_t>(i)] = Eigen::Isometry3d::Identity();
+      ws.states[static_cast<std::size_t>(i)] = BodyState{};
+    }
+    return Status::out_of_range;
   }
   return Status::ok;
 }

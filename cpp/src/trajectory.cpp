@@ -41,6 +41,14 @@ RestToRestTrajectory::RestToRestTrajectory(const Eigen::VectorXd& start, const E
     msg << "trajectory.duration must be a finite number > 0, got " << duration;
     throw std::invalid_argument(msg.str());
   }
+  // the peak acceleration (at most 6 |end - start| / T^2, cubic law) must be finite, so that no
+  // evaluate() can overflow (issue 14: a duration of 5e-324 gave infinite rates)
+  const double stroke = start.size() ? (end - start).cwiseAbs().maxCoeff() : 0.0;
+  if (!std::isfinite(stroke) || !std::isfinite(6.0 * stroke / duration / duration)) {
+    msg << "trajectory.duration " << duration << " is too short for a stroke of " << stroke
+        << ": the accelerations overflow";
+    throw std::invalid_argument(msg.str());
+  }
 }
 
 Status RestToRestTrajectory::evaluate(double t, Eigen::Ref<Eigen::VectorXd> q,

@@ -67,6 +67,8 @@ def check_case_file(name_or_path: str) -> Path:
         line = raw[:exc.start].count(b"\n") + 1
         raise ConfigError(str(path), f"is not UTF-8 text (byte 0x{raw[exc.start]:02x} on line "
                                      f"{line}): save it as UTF-8", has_value=False) from None
+    if path.suffix.lower() == ".urdf":
+        return path  # XML: the URDF reader checks it
     try:
         tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -86,7 +88,8 @@ def _cmd_run(args) -> int:
     check_case_file(args.case)
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer):  # the runner's tables, printed after its bar closes
-        summary = run_case(args.case, out)
+        summary = run_case(args.case, out, duration=getattr(args, "duration", None),
+                           samples=getattr(args, "samples", None))
     if not args.quiet:
         sys.stdout.write(buffer.getvalue())
     notes = summary.get("non_finite_values") if isinstance(summary, dict) else None
@@ -173,8 +176,12 @@ def build_parser() -> argparse.ArgumentParser:
                                    "receives a whole run or nothing: the run is written next to "
                                    "it and moved into place when complete, replacing a previous "
                                    "run.")
-    s.add_argument("case", help="built-in case name (see 'mechbal cases') or path to a TOML file")
+    s.add_argument("case", help="built-in case name (see 'mechbal cases') or path to a TOML or URDF file")
     s.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    s.add_argument("--duration", type=float, metavar="S",
+                   help="URDF files: duration of the default trajectory [s] (default: 2)")
+    s.add_argument("--samples", type=int, metavar="N",
+                   help="URDF files: number of instants of the default trajectory (default: 501)")
     s.add_argument("-q", "--quiet", **quiet)
     s.set_defaults(func=_cmd_run)
     s = sub.add_parser("balance", help="balance a mechanism by a method (static, force, moment, springs, rms)",

@@ -18,9 +18,12 @@ spatial arm and the 5R. Disc subsystems carry the Euler term ``v_d = omega x J o
 paper's eq 20 writes ``v = 0`` (correction C5 in docs/discs_derivation.md), which is harmless for
 planar discs and after balancing but gives wrong Coriolis terms otherwise (eq 24's printed 1/4).
 
-The per-tick C++ evaluators are ``mechbal._core.DiscArmDynamics`` (serial arms with discs, the
-same projection with A° = 1) and ``mechbal._core.FiveBarDynamics`` (the 5R five-bar, A° a 4x4
-matrix, over the general fixed-size ``mechbal::CoupledProjection``); this module is their
+The serial arms with discs are data on the general model (``mechbal.papers.discs``: each disc a
+gear-coupled joint, evaluated by MechanismDynamics, whose projection tau = G^T tau_joint is this
+one with A° = 1). The per-tick C++ evaluators of the paper's form are
+``mechbal._core.DiscArmDynamics`` (serial arms with discs, A° = 1, a cross-check) and
+``mechbal._core.FiveBarDynamics`` (the 5R five-bar, A° a 4x4 matrix, over the general fixed-size
+``mechbal::CoupledProjection``); this module is their
 independent Python reference (mechbal.sizing.discs.fivebar_model) and builds the two-stage model
 of the paper (arm model first, then discs coupled to it) used to cross-check the C++ single-stage
 form.

@@ -130,18 +130,38 @@ class Mechanism:
 
     @classmethod
     def from_urdf(cls, path: str | Path) -> "Mechanism":
-        """Read a URDF file (links with inertials, revolute / continuous / prismatic / fixed joints,
-        ``mimic`` as gear couplings, limits) through urdfdom in C++."""
+        """Read a URDF file through urdfdom in C++ (the same reader an embedded controller uses):
+        links with inertials become bodies named after the links, revolute / continuous /
+        prismatic / fixed joints keep their names (continuous = revolute without position
+        limits, one coordinate), ``mimic`` becomes a gear coupling, limits are kept, and every
+        URDF link is a named frame (see ``cpp/include/mechbal/urdf.hpp`` for the mapping).
+        Raises :class:`mechbal.config.ConfigError` (a ValueError) naming the URDF element."""
         from mechbal.config import ConfigError
 
         path = Path(path)
+        field = f"URDF file '{path}'"
         if not path.is_file():
-            raise ConfigError("urdf", "file not found", str(path))
+            raise ConfigError(field, "not found", has_value=False)
         try:
             model = _core.mechanism_from_urdf(str(path))
         except ValueError as exc:
-            raise ConfigError(str(path), str(exc), has_value=False) from None
+            message = str(exc)
+            if message.startswith(field + ": "):
+                message = message[len(field) + 2:]
+            raise ConfigError(field, message, has_value=False) from None
         return cls(model, name=path.stem, source=str(path))
+
+    @classmethod
+    def from_urdf_string(cls, xml: str, name: str = "urdf") -> "Mechanism":
+        """As :meth:`from_urdf`, from a URDF document held in a string."""
+        from mechbal.config import ConfigError
+
+        try:
+            model = _core.mechanism_from_urdf_string(xml)
+        except ValueError as exc:
+            field, _, message = str(exc).partition(": ")  # the C++ message names its element first
+            raise ConfigError(field, message, has_value=False) from None
+        return cls(model, name=name)
 
     @classmethod
     def from_toml(cls, path: str | Path) -> "Mechanism":

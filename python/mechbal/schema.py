@@ -777,7 +777,10 @@ def _path(loc: tuple, prefix: str = "") -> str:
         if isinstance(x, int):
             out += f"[{x}]"
         else:
-            out += f".{x}" if out else str(x)
+            x = str(x)
+            if not x.isprintable() or any(c in x for c in ".[]\"' "):
+                x = repr(x)  # a key with a newline or a dot stays one readable line
+            out += f".{x}" if out else x
     return out
 
 

@@ -191,5 +191,13 @@ int main() {
   }
 
   std::printf("%d failure(s)\n", failures);
+  // a URDF read through urdfdom, linked through the installed CMake package
+  const mechbal::MechanismModel urdf_arm = mechbal::model_from_urdf_string(
+      "<robot name='arm'><link name='base'/><link name='arm'><inertial><mass value='1'/>"
+      "<inertia ixx='0.01' ixy='0' ixz='0' iyy='0.01' iyz='0' izz='0.01'/></inertial></link>"
+      "<joint name='shoulder' type='continuous'><parent link='base'/><child link='arm'/></joint>"
+      "</robot>");
+  std::printf("URDF: %d coordinate(s), %d body(ies)\n", urdf_arm.dof(), urdf_arm.num_bodies());
+  check(urdf_arm.dof() == 1 && urdf_arm.num_bodies() == 1, "model_from_urdf_string");
   return failures == 0 ? 0 : 1;
 }

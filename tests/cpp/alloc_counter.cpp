@@ -1,5 +1,8 @@
 #include "alloc_counter.hpp"
 
+// The replacement operators allocate with malloc / aligned_alloc and free with free, which
+// AddressSanitizer intercepts: the counting tests run unchanged under `make test-sanitize`.
+
 #include <cstdlib>
 #include <new>
 

@@ -1,8 +1,15 @@
 // Real-time contract: the single-instant functions allocate nothing (DESIGN.md).
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "alloc_counter.hpp"
+#include "mechbal/arm2dof.hpp"
+#include "mechbal/computed_torque.hpp"
+#include "mechbal/decoupled_control.hpp"
 #include "mechbal/kdl_chain.hpp"
+#include "mechbal/paminsa.hpp"
+#include "mechbal/rnea.hpp"
 #include "mechbal/rigid_body.hpp"
 #include "mechbal/serial_chain.hpp"
 #include "mechbal/trajectory.hpp"
@@ -53,6 +60,60 @@ TEST(Allocations, SingleInstantFunctionsAllocateNothing) {
     EXPECT_EQ(kdl.mass_matrix(qt, M), Status::ok);
     EXPECT_EQ(kdl.coriolis(qt, qdt, c), Status::ok);
     EXPECT_EQ(kdl.gravity(qt, g), Status::ok);
+  }
+  EXPECT_EQ(scope.count(), 0u);
+}
+
+// Issue 14: the paths that reject input (out_of_range holds, overflow checks) and the wrist's
+// closed-form damped least squares at the singularity are reachable from a tick: no allocation.
+TEST(Allocations, RejectionAndSingularPathsAllocateNothing) {
+  std::mt19937 rng(8);
+  const ChainModel model = test::random_chain(rng, "RRPR");
+  const int n = model.dof();
+  ChainWorkspace ws(model);
+  KdlChainDynamics kdl(model);
+  RneChainDynamics rne(model);
+  Arm2DofDynamics arm(Arm2DofParameters{});
+  ComputedTorque ct(arm, Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20));
+  DecoupledJointController dc(Eigen::Vector2d(1, 2), Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20));
+  const PaminsaModel paminsa(PaminsaParameters{});
+  ReactionlessWristConfig rk4;
+  rk4.integrator = WristIntegrator::rk4;
+  PaminsaController pc(paminsa, rk4, Vec3(M_PI / 2, M_PI / 2, M_PI / 2));
+  ReactionlessWrist singular_wrist(paminsa.wrist_inertia(), rk4, Vec3::Zero(), Vec3::Zero());
+  PlatformMotion rest;
+  rest.position = paminsa.parameters().nominal_platform;
+  ASSERT_EQ(pc.reset(rest, Vec3(M_PI / 2, M_PI / 2, M_PI / 2)), Status::ok);
+  PlatformMotion fast = rest, far = rest;
+  fast.velocity = Vec3(50.0, 0.0, 0.0);  // beyond PlatformLimits::max_speed
+  far.position = Vec3(5.0, 5.0, 0.6);    // unreachable
+  const Eigen::VectorXd q = Eigen::VectorXd::Constant(n, 0.3), huge = Eigen::VectorXd::Constant(n, 1e200);
+  Eigen::VectorXd tau(n), c(n), tau2(2);
+  Eigen::MatrixXd M(n, n);
+  const Eigen::Vector2d z2 = Eigen::Vector2d::Zero(), absurd(1e6, 0.0);
+  ShakingWrench sw;
+  Vec3 F, Mo;
+  kdl.inverse_dynamics(q, q, q, tau, &F, &Mo);  // warm up
+  kdl.coriolis(q, q, c);
+
+  test::AllocationScope scope;
+  for (int tick = 0; tick < 50; ++tick) {
+    EXPECT_EQ(chain_kinematics(model, q, huge, q, ws), Status::out_of_range);
+    EXPECT_EQ(shaking_wrench(model.bodies().data(), ws.states.data(), ws.states.size(), sw), Status::ok);
+    EXPECT_EQ(rne.inverse_dynamics(q, huge, q, tau, &F, &Mo), Status::out_of_range);
+    EXPECT_EQ(rne.mass_matrix(q, M), Status::ok);
+    EXPECT_EQ(kdl.inverse_dynamics(q, huge, q, tau, &F, &Mo), Status::out_of_range);
+    EXPECT_EQ(kdl.coriolis(q, huge, c), Status::out_of_range);
+    EXPECT_EQ(ct.step(z2, z2, absurd, z2, z2, tau2), Status::out_of_range);
+    EXPECT_EQ(dc.step(z2, absurd, z2, z2, z2, tau2), Status::out_of_range);
+    EXPECT_TRUE(has(singular_wrist.step(Vec3(1.0, 0.5, 0.2), Vec3::Zero(), Vec3(1.0, 0.5, 0.2),
+                                        Vec3(1.0, 0.5, 0.2)),
+                    Status::singular));
+    singular_wrist.reset(Vec3::Zero(), Vec3::Zero());
+    EXPECT_EQ(singular_wrist.step(Vec3::Constant(1e5), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()),
+              Status::out_of_range);
+    EXPECT_EQ(pc.tick(fast, fast, fast), Status::out_of_range);
+    EXPECT_EQ(pc.tick(far, far, far), Status::singular);
   }
   EXPECT_EQ(scope.count(), 0u);
 }

@@ -357,6 +357,8 @@ TEST(ReactionlessWrist, FastSolveAgreesWithTheSvd) {
   const WristInertias& J = model.wrist_inertia();
   ReactionlessWristConfig c;
   c.max_condition = 1e4;
+  c.max_rate = 1e9;  // the solve, not the limits
+  c.max_acceleration = 1e12;
   std::mt19937 rng(42);
   std::uniform_real_distribution<double> u(-3.0, 3.0);
   int singular = 0, regular = 0;
@@ -374,6 +376,16 @@ TEST(ReactionlessWrist, FastSolveAgreesWithTheSvd) {
     if (cond > c.max_condition) {
       ++singular;
       EXPECT_TRUE(has(st, Status::singular));
+      // the closed-form damped least squares (normal equations) equals the SVD form
+      // sum_i s_i (u_i . b) / (s_i^2 + lambda^2) v_i, lambda = damping s_max
+      const double lambda = c.damping * s(0);
+      const Vec3 b = svd.matrixU().transpose() * (-D);
+      Vec3 y;
+      for (int i = 0; i < 3; ++i) y(i) = s(i) * b(i) / (s(i) * s(i) + lambda * lambda);
+      const Vec3 dls = svd.matrixV() * y;
+      EXPECT_LT((w.command().rates - dls).norm(), 1e-9 * (1.0 + dls.norm()));
+      // the reported cond(N) of a singular N is accurate too (from |det N|, not eigenvalues)
+      if (cond < 1e10) EXPECT_NEAR(w.command().condition_number / cond, 1.0, 1e-5);
       continue;
     }
     ++regular;

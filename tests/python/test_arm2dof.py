@@ -280,6 +280,7 @@ def test_case_reproduces_the_paper_or_records_why_not(arm2dof_run):
     assert np.all(np.array(s["rms_torque_Nm"]["C"]) < np.array(s["rms_torque_Nm"]["C_paper_radii"]))
     assert any("0.147" in d for d in s["discrepancies"])
     assert s["kdl_vs_closed_form_max_rel_dev"] < 1e-9
+    assert s["general_model_vs_closed_form_max_rel_dev"] < 1e-12
     cl = s["closed_loop"]
     dev = cl["with_initial_error"]["max_deviation_from_eq6_rad"]
     assert dev["exact_every_rk4_stage"] < 1e-6

@@ -252,12 +252,18 @@ def test_unbalanced_arm_links_match_pinocchio_and_kdl(kind):
 
 @pytest.mark.parametrize("kind", ["planar3r", "spatial3r", "scara"])
 def test_paper_two_stage_coupling_equals_the_cpp_single_stage_evaluator(kind):
-    """Arm model (M#, v#, g#) first, then discs (the paper's procedure, Python) == the C++
-    DiscArmDynamics, on a perturbed design with non-axisymmetric discs."""
+    """Arm model (M#, v#, g#) first, then discs (the paper's procedure, Python) == the general
+    model (dz.evaluate: discs as gear couplings) and the C++ DiscArmDynamics, on a perturbed
+    design with non-axisymmetric discs."""
     rng = np.random.default_rng(8)
     d = _perturbed(kind, rng)
     q, qd = dz.sample_states(kind, 20, rng)
     M, v, g = dz.evaluate(kind, d, q, qd)
+    fast = dz.disc_arm_dynamics(kind, d).evaluate(q, qd)
+    torque_scale = max(np.max(np.abs(fast["velocity"])), np.max(np.abs(fast["gravity"])))
+    assert np.max(np.abs(M - fast["mass"])) < 1e-12 * np.max(np.abs(fast["mass"]))
+    assert np.max(np.abs(v - fast["velocity"])) < 1e-12 * torque_scale
+    assert np.max(np.abs(g - fast["gravity"])) < 1e-12 * torque_scale
     joints, links, discs = dz.serial_structure(kind, d)
     for k in range(len(q)):
         ref = cp.arm_with_discs(joints, links, discs, q[k], qd[k])

@@ -58,7 +58,7 @@ def test_rnea_bad_input_names_the_argument():
     rne = mechbal.RneChainDynamics(chain_from_specs(random_chain_specs(rng, "RRR")))
     with pytest.raises(ValueError, match="qd"):
         rne.inverse_dynamics(np.zeros((2, 3)), np.zeros((2, 4)), np.zeros((2, 3)))
-    with pytest.raises(ValueError, match="q must have 3"):
+    with pytest.raises(ValueError, match=r"q must have shape \(3,\).*got \(2,\)"):
         rne.mass_matrix(np.zeros(2))
     out = rne.inverse_dynamics(np.array([[0.0, np.nan, 0.0]]), np.zeros((1, 3)), np.zeros((1, 3)))
     assert out["status"] == mechbal.Status.non_finite_input
@@ -90,5 +90,7 @@ def test_computed_torque_over_rne_agrees_with_kdl(types, seed):
         assert _rel(tau_rne, tau_kdl) < 1e-9
         assert _rel(tau_rne, law) < 1e-9
         assert np.linalg.norm(tau_rne) > 1.0  # not a trivially zero command
-    with pytest.raises(ValueError, match="dof values"):
+    with pytest.raises(ValueError, match=rf"q must have shape \({n},\) \(the controller has {n} joints\), got \({n + 1},\)"):
         ct_rne.step(np.zeros(n + 1), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n))
+    with pytest.raises(ValueError, match=rf"qdd_des must have shape \({n},\)"):
+        ct_rne.step(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n, 1)))

@@ -20,6 +20,10 @@
 ///   Q1  = g (s1 + M2 l1) cos q1 + g s2 cos(q1 + q2),  Q2 = g s2 cos(q1 + q2)
 /// which are eqs 14-22 (bare arm) and 23-31 (counterweight torques, added linearly).
 ///
+/// A fast path of the general model: the same arm with links and counterweights as separate bodies
+/// is `mechbal.papers.arm2dof_mechanism`; tests/python/test_papers.py checks torques, mass matrix
+/// and gravity against MechanismDynamics to 1e-12 relative along the paper's trajectories.
+///
 /// Corrections to the printed paper (proofs: tests/python/test_arm2dof.py, sympy Lagrangian):
 ///  - eqs 14 and 23: the term -k32 theta2dot^2 must read -k32 theta2dot^2 sin(theta2);
 ///  - eq 16 / text: "l_A" is I_A, the inertia of link 1 about A; eq 18: 1/2 (I_S2 + m2 l_S2^2)
@@ -79,18 +83,6 @@ Arm2DofLumped arm2dof_lumped(const Arm2DofParameters& arm,
 ChainModel arm2dof_chain_model(const Arm2DofParameters& arm,
                                const Arm2DofCounterweights& cw = Arm2DofCounterweights{});
 
-/// Forward-dynamics interface of a plant for closed-loop simulation: qdd = M^-1 (tau - C qd - G).
-class ForwardDynamics {
- public:
-  virtual ~ForwardDynamics() = default;
-  virtual int dof() const noexcept = 0;
-  /// Real-time: noexcept, allocation-free; sizes must equal dof() (else bad_size, qdd untouched);
-  /// non-finite input -> non_finite_input, qdd untouched; singular mass matrix -> singular.
-  virtual Status forward_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
-                                  const Eigen::Ref<const Eigen::VectorXd>& qd,
-                                  const Eigen::Ref<const Eigen::VectorXd>& tau,
-                                  Eigen::Ref<Eigen::VectorXd> qdd) noexcept = 0;
-};
 
 /// Closed-form 2-DOF dynamics, eq 1: tau = A(q) qdd + C(q, qd) qd + Q(q) (eqs 14-31 corrected).
 /// Immutable after construction; every method is noexcept and allocation-free.

@@ -19,6 +19,8 @@
 
 #include "mechbal/arm2dof.hpp"
 #include "mechbal/computed_torque.hpp"
+#include "mechbal/dynamics.hpp"
+#include "mechbal/joint_controller.hpp"
 #include "mechbal/status.hpp"
 #include "mechbal/trajectory.hpp"
 
@@ -42,9 +44,16 @@ struct ClosedLoopLog {
   int steps_completed = 0;     ///< < steps when the plant failed (then later rows repeat the last state)
 };
 
-/// Simulates `plant` driven by `controller` (whose model may differ from the plant) tracking
-/// `desired`, from the initial state (q0, qd0). Throws std::invalid_argument naming the field on
-/// bad sizes or options.
+/// Simulates `plant` (any ForwardDynamics: Arm2DofDynamics, MechanismDynamics of any mechanism,
+/// closed loops included) driven by `controller` (any JointController: ComputedTorque over any
+/// model, which may differ from the plant, or DecoupledJointController) tracking `desired`, from
+/// the initial state (q0, qd0). Throws std::invalid_argument naming the field on bad sizes or
+/// options.
+ClosedLoopLog simulate_closed_loop(ForwardDynamics& plant, JointController& controller,
+                                   const RestToRestTrajectory& desired, const Eigen::VectorXd& q0,
+                                   const Eigen::VectorXd& qd0, const ClosedLoopOptions& options);
+
+/// simulate_closed_loop with a ComputedTorque controller (Arakelian et al. 2011's closed loop).
 ClosedLoopLog simulate_computed_torque(ForwardDynamics& plant, ComputedTorque& controller,
                                        const RestToRestTrajectory& desired,
                                        const Eigen::VectorXd& q0, const Eigen::VectorXd& qd0,

@@ -10,35 +10,41 @@
 #include <Eigen/Core>
 
 #include "mechbal/dynamics.hpp"
+#include "mechbal/joint_limits.hpp"
+#include "mechbal/joint_controller.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {
 
-class ComputedTorque {
+class ComputedTorque : public JointController {
  public:
-  /// kp, kd: diagonal gains (dof() values each, finite and > 0). torque_limit: empty (no limit)
-  /// or dof() values > 0 (may be +infinity): the command is clipped to [-limit, limit] and the
-  /// step returns Status::saturated. Throws std::invalid_argument naming the field on bad values.
-  /// The model must outlive the controller.
+  /// kp, kd: diagonal gains (dof() values each, finite and > 0). torque_limit: empty (every joint
+  /// at default_torque_limit) or dof() values > 0 (+infinity means default_torque_limit): the
+  /// command is clipped to [-limit, limit] and the step returns Status::saturated. range: the
+  /// input range of a tick. Throws std::invalid_argument naming the field on bad values. The model
+  /// must outlive the controller.
   ComputedTorque(InverseDynamics& model, const Eigen::VectorXd& kp, const Eigen::VectorXd& kd,
-                 const Eigen::VectorXd& torque_limit = Eigen::VectorXd());
+                 const Eigen::VectorXd& torque_limit = Eigen::VectorXd(),
+                 const JointInputRange& range = JointInputRange{});
 
-  int dof() const noexcept { return n_; }
+  int dof() const noexcept override { return n_; }
   const Eigen::VectorXd& kp() const noexcept { return kp_; }
   const Eigen::VectorXd& kd() const noexcept { return kd_; }
   const Eigen::VectorXd& torque_limit() const noexcept { return limit_; }
+  const JointInputRange& input_range() const noexcept { return range_; }
 
   /// One control tick. Real-time: noexcept, allocation-free, bounded.
-  /// Wrong sizes: Status::bad_size, tau untouched. Non-finite input, model failure or a non-finite
-  /// model output: the status says why and tau receives the last safe command (zero before the
-  /// first good tick); the controller's state is unchanged. Otherwise tau is the (clipped)
-  /// computed torque, remembered as the last safe command.
+  /// Wrong sizes: Status::bad_size, tau untouched. Non-finite input (non_finite_input), input
+  /// outside input_range() or an overflowing command (out_of_range), or a model failure (the
+  /// model's status): tau receives the last safe command (zero before the first good tick) and
+  /// the controller's state is unchanged. Otherwise tau is the computed torque clipped to
+  /// torque_limit() (finite), remembered as the last safe command.
   Status step(const Eigen::Ref<const Eigen::VectorXd>& q,
               const Eigen::Ref<const Eigen::VectorXd>& qd,
               const Eigen::Ref<const Eigen::VectorXd>& q_des,
               const Eigen::Ref<const Eigen::VectorXd>& qd_des,
               const Eigen::Ref<const Eigen::VectorXd>& qdd_des,
-              Eigen::Ref<Eigen::VectorXd> tau) noexcept;
+              Eigen::Ref<Eigen::VectorXd> tau) noexcept override;
 
   /// The last command returned (held on bad input).
   const Eigen::VectorXd& last_command() const noexcept { return last_; }
@@ -51,6 +57,7 @@ class ComputedTorque {
   InverseDynamics& model_;
   int n_;
   Eigen::VectorXd kp_, kd_, limit_;
+  JointInputRange range_;
   Eigen::VectorXd v_, raw_, last_;
 };
 

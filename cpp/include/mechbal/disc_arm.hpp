@@ -19,6 +19,14 @@
 /// (The 5R five-bar has a non-identity 4x4 A°, solved per tick: mechbal::FiveBarDynamics over the
 /// general mechbal::CoupledProjection, five_bar.hpp and coupled_model.hpp.)
 ///
+/// Since the general model (model.hpp) has gear couplings, these arms are data on it: each disc a
+/// link on a revolute joint whose angle is `ratio * q[joint]` (mimic), built by
+/// `mechbal.papers.discs` and evaluated by MechanismDynamics, which is what the Python runner and
+/// sizing now use. This evaluator agrees with it to ~1e-15 (tests/python/test_papers.py) and is
+/// not a fast path: its inverse dynamics costs about twice MechanismDynamics' on the same arm. It
+/// stays for its remaining users (bench_decoupled.cpp, tests/cpp/test_discs.cpp, the bindings)
+/// until they move to MechanismDynamics.
+///
 /// Disc convention: disc d is carried by link `carrier`, spins about `axis` (unit, carrier frame)
 /// through the carrier's frame origin, at relative angle ratio * q[joint] (gears/belts). Its mass
 /// is lumped into the carrier link; the disc subsystem carries only its central inertia
@@ -72,7 +80,7 @@ class DiscArmDynamics final : public InverseDynamics {
                           Eigen::Ref<Eigen::VectorXd> tau) noexcept override;
 
  private:
-  void compute(const Eigen::Ref<const Eigen::VectorXd>& q,
+  Status compute(const Eigen::Ref<const Eigen::VectorXd>& q,
                const Eigen::Ref<const Eigen::VectorXd>& qd) noexcept;
 
   ChainModel chain_;

@@ -22,4 +22,17 @@ class InverseDynamics {
                                   Eigen::Ref<Eigen::VectorXd> tau) noexcept = 0;
 };
 
+/// Forward-dynamics interface of a plant for closed-loop simulation: qdd = M^-1 (tau - C qd - G).
+class ForwardDynamics {
+ public:
+  virtual ~ForwardDynamics() = default;
+  virtual int dof() const noexcept = 0;
+  /// Real-time: noexcept, allocation-free; sizes must equal dof() (else bad_size, qdd untouched);
+  /// non-finite input -> non_finite_input, qdd untouched; singular mass matrix -> singular.
+  virtual Status forward_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                  const Eigen::Ref<const Eigen::VectorXd>& qd,
+                                  const Eigen::Ref<const Eigen::VectorXd>& tau,
+                                  Eigen::Ref<Eigen::VectorXd> qdd) noexcept = 0;
+};
+
 }  // namespace mechbal

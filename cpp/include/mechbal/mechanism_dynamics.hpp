@@ -1,12 +1,22 @@
 #pragma once
 /// \file mechanism_dynamics.hpp
-/// MechanismDynamics: the InverseDynamics back end of the general model, so the controllers
-/// (ComputedTorque, DecoupledJointController) and simulators drive any MechanismModel. It owns an
-/// immutable copy of the model (shared, never a reference to something that can change underneath,
-/// unlike KDL's solvers) and its MechanismData; every call is noexcept and allocation-free.
+/// MechanismDynamics: the InverseDynamics and ForwardDynamics back end of the general model, so the
+/// controllers (ComputedTorque, DecoupledJointController) and the closed-loop simulator
+/// (closed_loop.hpp) drive any MechanismModel, closed loops included.
+///
+/// Coordinates are the actuated ones (model.actuated_coordinates(); every coordinate of an open
+/// mechanism). For a closed mechanism each call solves the loops (algorithm/loops.hpp), warm-started
+/// from the previous call's passive coordinates, and works with the projected dynamics:
+/// tau# = C^T tau(q, v, a), M# = C^T M C. An open mechanism takes the tree algorithms directly.
+///
+/// It owns an immutable copy of the model (shared, never a reference to something that can change
+/// underneath, unlike KDL's solvers) and its MechanismData; every call is noexcept and
+/// allocation-free.
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <memory>
 
+#include "mechbal/algorithm/loops.hpp"
 #include "mechbal/data.hpp"
 #include "mechbal/dynamics.hpp"
 #include "mechbal/model.hpp"
@@ -15,17 +25,28 @@
 
 namespace mechbal {
 
-class MechanismDynamics : public InverseDynamics {
+class MechanismDynamics : public InverseDynamics, public ForwardDynamics {
  public:
-  explicit MechanismDynamics(MechanismModel model);
-  explicit MechanismDynamics(std::shared_ptr<const MechanismModel> model);
+  /// `q_guess` (model.dof() values, default zeros): the full coordinates near the assembly the
+  /// loops start from (the assembly mode). Throws std::invalid_argument when an open mechanism has
+  /// passive (unactuated) coordinates, which this back end cannot drive, or q_guess has the wrong
+  /// size.
+  explicit MechanismDynamics(MechanismModel model, const Eigen::VectorXd& q_guess = Eigen::VectorXd());
+  explicit MechanismDynamics(std::shared_ptr<const MechanismModel> model,
+                             const Eigen::VectorXd& q_guess = Eigen::VectorXd());
 
-  int dof() const noexcept override { return model_->dof(); }
+  /// Number of actuated coordinates.
+  int dof() const noexcept override { return model_->num_actuated(); }
   const MechanismModel& model() const noexcept { return *model_; }
   MechanismData& data() noexcept { return data_; }
+  /// Full coordinates of the last solved pose (the warm start of the next call).
+  const Eigen::VectorXd& solved_position() const noexcept { return q_; }
+  LoopSolveOptions& loop_options() noexcept { return options_; }
 
-  /// tau = M(q) qdd + C(q, qd) qd + G(q). Sizes must equal dof() (Status::bad_size), input finite
-  /// (Status::non_finite_input), tau untouched otherwise.
+  /// tau# = M#(q#) a# + b#(q#, v#) (gravity included). Sizes must equal dof() (Status::bad_size),
+  /// input finite (Status::non_finite_input), tau untouched otherwise; a closed mechanism that
+  /// cannot be assembled gives Status::solver_error (tau untouched); near a parallel singularity
+  /// Status::singular with the computed tau.
   Status inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
                           const Eigen::Ref<const Eigen::VectorXd>& qd,
                           const Eigen::Ref<const Eigen::VectorXd>& qdd,
@@ -39,18 +60,34 @@ class MechanismDynamics : public InverseDynamics {
                           const Eigen::Ref<const Eigen::VectorXd>& qdd,
                           Eigen::Ref<Eigen::VectorXd> tau, Vec3* support_force,
                           Vec3* support_moment) noexcept;
+  /// a# = M#^-1 (tau# - b#). Status::singular when M# is not positive definite (qdd untouched).
+  Status forward_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
+                          const Eigen::Ref<const Eigen::VectorXd>& qd,
+                          const Eigen::Ref<const Eigen::VectorXd>& tau,
+                          Eigen::Ref<Eigen::VectorXd> qdd) noexcept override;
+  /// M#(q#) (dof x dof).
   Status mass_matrix(const Eigen::Ref<const Eigen::VectorXd>& q, Eigen::Ref<Eigen::MatrixXd> M) noexcept;
+  /// G#(q#).
   Status gravity(const Eigen::Ref<const Eigen::VectorXd>& q, Eigen::Ref<Eigen::VectorXd> g) noexcept;
-  /// C(q, qd) qd + G(q).
+  /// b#(q#, v#) = C#(q#, v#) v# + G#(q#).
   Status bias(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& qd,
               Eigen::Ref<Eigen::VectorXd> b) noexcept;
-  /// C(q, qd) qd alone (no gravity).
+  /// C#(q#, v#) v# alone (no gravity).
   Status coriolis(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& qd,
                   Eigen::Ref<Eigen::VectorXd> c) noexcept;
 
  private:
+  static bool failed(Status s) noexcept {
+    return has(s, Status::solver_error) || has(s, Status::bad_size) || has(s, Status::non_finite_input);
+  }
+
   std::shared_ptr<const MechanismModel> model_;
   MechanismData data_;
+  Eigen::VectorXd q_;       ///< full coordinates: warm start and last solved pose
+  Eigen::VectorXd zero_;    ///< dof() zeros
+  Eigen::VectorXd work_;    ///< dof()
+  Eigen::LDLT<Eigen::MatrixXd> ldlt_;
+  LoopSolveOptions options_;
 };
 
 }  // namespace mechbal

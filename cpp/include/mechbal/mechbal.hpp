@@ -6,6 +6,7 @@
 ///
 /// The general mechanism model and its algorithms (one header each)
 #include "mechbal/status.hpp"
+#include "mechbal/urdf.hpp"
 #include "mechbal/version.hpp"
 #include "mechbal/rigid_body.hpp"
 #include "mechbal/joint_type.hpp"
@@ -29,8 +30,10 @@
 #include "mechbal/kdl_chain.hpp"
 #include "mechbal/coupled_model.hpp"
 /// Controllers and closed-loop simulation
+#include "mechbal/joint_controller.hpp"
 #include "mechbal/computed_torque.hpp"
 #include "mechbal/decoupled_control.hpp"
+#include "mechbal/joint_limits.hpp"
 #include "mechbal/reactionless_wrist.hpp"
 #include "mechbal/closed_loop.hpp"
 /// Fast paths of the papers' mechanisms

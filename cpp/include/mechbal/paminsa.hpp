@@ -126,7 +126,8 @@ class PaminsaModel {
   const std::array<Eigen::Vector2d, 3>& nominal_A() const noexcept { return A0_h_; }
   const Eigen::Vector2d& vertical_mass_xy() const noexcept { return vcw_; }
 
-  /// Closed-form inverse kinematics P -> actuators. Non-finite P: Status::non_finite_input.
+  /// Closed-form inverse kinematics P -> actuators. Non-finite P: Status::non_finite_input; a P
+  /// whose strokes overflow: Status::out_of_range and `out` zeroed.
   Status inverse_kinematics(const Vec3& P, PaminsaActuators& out) const noexcept;
   /// Closed-form forward solve (alpha1, alpha3, z_B) -> P. Parallel guides: Status::singular.
   Status forward_kinematics(double alpha1, double alpha3, double z_B, Vec3& P) const noexcept;
@@ -150,7 +151,8 @@ struct PaminsaWorkspace {
 
 /// Motion of the 35 mechanism bodies (all but the wrist). Non-finite input:
 /// Status::non_finite_input and the workspace is untouched; an unreachable pose (pantograph
-/// cannot close): Status::singular and the workspace is untouched.
+/// cannot close, or A_i on its guide pivot M_i): Status::singular and the workspace is untouched;
+/// finite input whose motion overflows: Status::out_of_range and the workspace is reset to rest.
 Status paminsa_mechanism_kinematics(const PaminsaModel& model, const PlatformMotion& platform,
                                     PaminsaWorkspace& ws) noexcept;
 /// Motion of the three wrist links (COMs at P).
@@ -177,19 +179,34 @@ Status paminsa_mechanism_wrench(const PaminsaModel& model, const PlatformMotion&
 Status paminsa_mechanism_angular_momentum(const PaminsaModel& model,
                                           const PlatformMotion& platform, Vec3& D) noexcept;
 
+/// Input range of the platform motion a PaminsaController tick accepts (per component, finite).
+/// The position range is the reachable workspace (an unreachable pose is Status::singular).
+struct PlatformLimits {
+  double max_speed = 10.0;           ///< |Pdot| per component [m/s]
+  double max_acceleration = 1000.0;  ///< |Pddot| per component [m/s^2] (~100 g)
+};
+
 /// One controller tick of the fully balanced PAMINSA: kinematics at t_n, D, the reactionless-wrist
 /// step, then every body's motion (with the wrist following the command) and the shaking wrench.
 class PaminsaController {
  public:
+  /// Throws std::invalid_argument naming the field on a bad configuration or limit.
   PaminsaController(const PaminsaModel& model, const ReactionlessWristConfig& config,
-                    const Vec3& initial_wrist_angles);
+                    const Vec3& initial_wrist_angles, const PlatformLimits& limits = {});
 
-  /// Restart at rest-state `initial` (wrist at rest): H_target = D(initial).
+  /// Restart at rest-state `initial` (wrist at rest): H_target = D(initial). On any failure
+  /// (non-finite, out of range, unreachable, wrist refusal) nothing changes and the status says
+  /// why.
   Status reset(const PlatformMotion& initial, const Vec3& wrist_angles) noexcept;
   /// One tick: platform motion at t_n, t_n + dt/2 and t_n + dt (the last two from the planned
-  /// trajectory; the Euler integrator ignores them). Non-finite input holds the wrist.
+  /// trajectory; the Euler integrator ignores them). Bad input holds the wrist (zero rates, same
+  /// angles) and keeps the workspace and wrench of the last good tick: non-finite input
+  /// Status::non_finite_input; a speed or acceleration beyond limits() (or an overflowing
+  /// result) Status::out_of_range; an unreachable pose Status::singular. The wrist's own statuses
+  /// (singular, saturated, out_of_range) pass through.
   Status tick(const PlatformMotion& now, const PlatformMotion& half,
               const PlatformMotion& next) noexcept;
+  const PlatformLimits& limits() const noexcept { return limits_; }
 
   const PaminsaModel& model() const noexcept { return model_; }
   const PaminsaWorkspace& workspace() const noexcept { return ws_; }
@@ -199,7 +216,10 @@ class PaminsaController {
   const Vec3& D_dot() const noexcept { return D_dot_; }
 
  private:
+  bool in_range(const PlatformMotion& m) const noexcept;
+
   PaminsaModel model_;
+  PlatformLimits limits_;
   PaminsaWorkspace ws_;
   ReactionlessWrist wrist_;
   ShakingWrench wrench_;

@@ -21,7 +21,9 @@
 ///  2. eq 21/25: H_target is the initial total angular momentum, not 0 (they agree from rest).
 ///  3. det N = 0 at theta = 0 or pi (z-x-z gimbal lock), which includes the paper's start pose
 ///     "orientation equal to zero": the controller then uses damped least squares and reports
-///     Status::singular.
+///     Status::singular. The damped solve is a closed-form 3x3 (the normal equations
+///     (N^T N + lambda^2 1) x = N^T b, cond <= 1 + 1/damping^2), so a singular tick costs about
+///     what a regular one does (bench/README.md).
 #include <Eigen/Geometry>
 #include <array>
 #include <limits>
@@ -58,12 +60,23 @@ Vec3 wrist_momentum_bias(const WristInertias& inertia_body, const Vec3& angles,
 
 enum class WristIntegrator { euler, rk4 };
 
+/// Configuration and input ranges of the wrist tick. Every limit is finite (issue 14: nothing
+/// absurd passes as ok): an input outside its range gives Status::out_of_range and the held
+/// command, an output above its limit is clipped with Status::saturated.
 struct ReactionlessWristConfig {
-  double rate_hz = 1000.0;  ///< tick rate [Hz]
+  double rate_hz = 1000.0;  ///< tick rate [Hz], in [1, 1e6]
   WristIntegrator integrator = WristIntegrator::euler;
-  /// per-axis wrist rate limit [rad/s]: the rate vector is scaled down (direction kept) and the
-  /// tick reports Status::saturated
-  double max_rate = std::numeric_limits<double>::infinity();
+  /// per-axis wrist rate limit [rad/s], finite: the rate vector is scaled down (direction kept)
+  /// and the tick reports Status::saturated (100 rad/s ~ 950 rpm: above any wrist joint)
+  double max_rate = 100.0;
+  /// per-axis limit of the acceleration feed-forward [rad/s^2], finite: scaled down (direction
+  /// kept), Status::saturated
+  double max_acceleration = 1e4;
+  /// input range of D(t) (every component) and of the target momentum [kg m^2/s]: beyond it the
+  /// tick holds, Status::out_of_range (1e4: e.g. 100 kg at 10 m/s, 10 m from O)
+  double max_momentum = 1e4;
+  /// input range of dD/dt (every component) [N m]: beyond it the tick holds, Status::out_of_range
+  double max_moment = 1e5;
   /// cond(N) above which N counts as singular: damped least squares, Status::singular
   double max_condition = 1e4;
   /// damping of the damped least squares, relative to the largest singular value of N
@@ -94,18 +107,31 @@ class ReactionlessWrist {
   ReactionlessWrist(const WristInertias& inertia_body, const ReactionlessWristConfig& config,
                     const Vec3& initial_angles, const Vec3& target_momentum);
 
+  /// Angles are kept within [-max_angle, max_angle] rad (double resolution there: 1e-10 rad): a
+  /// start or reset beyond it is refused, a tick that would leave it holds (Status::out_of_range).
+  static constexpr double max_angle = 1e6;
+
   /// Restart from `angles` with a new target total angular momentum H_target. Non-finite input:
-  /// nothing changes, Status::non_finite_input.
+  /// nothing changes, Status::non_finite_input; angles beyond max_angle or a target beyond
+  /// config().max_momentum: nothing changes, Status::out_of_range.
   Status reset(const Vec3& angles, const Vec3& target_momentum) noexcept;
 
   /// One tick with the configured integrator. D_now = D(t_n), D_dot = dD/dt(t_n); RK4 also
   /// needs D(t_n + dt/2) and D(t_n + dt) (from the planned trajectory); Euler ignores them.
   /// Non-finite input: the angles are held, rates and accelerations are zero, the state does not
-  /// advance, Status::non_finite_input. Never writes NaN.
+  /// advance, Status::non_finite_input. A D beyond config().max_momentum or a D_dot beyond
+  /// config().max_moment (any component), or a step that would overflow or leave max_angle: the
+  /// same hold with Status::out_of_range. Never writes NaN; |rates| <= max_rate and
+  /// |accelerations| <= max_acceleration per axis whatever the input.
   Status step(const Vec3& D_now, const Vec3& D_dot, const Vec3& D_half,
               const Vec3& D_next) noexcept;
   /// One explicit-Euler tick (eq 26), whatever the configured integrator.
   Status step_euler(const Vec3& D_now, const Vec3& D_dot) noexcept;
+
+  /// Hold: the command keeps the current angles with zero rates and accelerations, the state does
+  /// not advance; returns `why` (also stored in command().status). For callers that detect bad
+  /// input upstream of the wrist (PaminsaController).
+  Status hold(Status why) noexcept;
 
   const WristCommand& command() const noexcept { return command_; }
   const Vec3& angles() const noexcept { return angles_; }  ///< state q_n for the next tick
@@ -118,13 +144,18 @@ class ReactionlessWrist {
   Status rates(const Vec3& angles, const Vec3& D, Vec3& rates, double& condition) const noexcept;
 
  private:
-  /// Status::ok with `inverse` (when given) set to N^-1 only on the well-conditioned fast path.
+  /// `inverse` (when given) receives the operator applied to rhs: N^-1 (Status::ok) or the damped
+  /// pseudo-inverse (N^T N + lambda^2 1)^-1 N^T (Status::singular); left untouched when N is zero
+  /// or not finite.
   Status solve(const Mat3& N, const Vec3& rhs, Vec3& x, double& condition,
                Mat3* inverse = nullptr) const noexcept;
   Status rates_with(const Mat3& N, const Vec3& D, Vec3& rates, double& condition,
                     Mat3* inverse = nullptr) const noexcept;
   /// Status::saturated (and qd scaled down, direction kept) when a rate exceeds max_rate.
   Status limit_rate(Vec3& qd) const noexcept;
+  /// D, D_dot (and the RK4 samples) within max_momentum / max_moment.
+  bool in_range(const Vec3& D_now, const Vec3& D_dot, const Vec3* D_half,
+                const Vec3* D_next) const noexcept;
   /// The rates at the RK4 stage angles_ + delta (cos_n, sin_n: of angles_): same result and
   /// status as rates() without computing cond(N).
   Status stage_rates(const Vec3& delta, const Vec3& cos_n, const Vec3& sin_n, const Vec3& D,

@@ -9,6 +9,7 @@
 /// (dI/dt w = w x (I w) because dI/dt = [w]x I - I [w]x and [w]x w = 0.)
 #include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 
 #include "mechbal/status.hpp"
 
@@ -50,7 +51,8 @@ struct ShakingWrench {
 void validate_rigid_body(const RigidBody& body, const char* field);
 
 /// Momenta, shaking force and shaking moment about O of `count` bodies at one instant.
-/// Allocation-free and noexcept. Non-finite input gives Status::non_finite_input and a zero wrench.
+/// Allocation-free and noexcept. Non-finite input gives Status::non_finite_input and a zero wrench;
+/// finite input whose sums overflow gives Status::out_of_range and a zero wrench.
 Status shaking_wrench(const RigidBody* bodies, const BodyState* states, std::size_t count,
                       ShakingWrench& out) noexcept;
 
@@ -66,8 +68,9 @@ Status base_reaction(const RigidBody* bodies, const BodyState* states, std::size
 
 /// Batch over `instants` instants for `count` bodies, struct-of-arrays, C-contiguous row-major:
 /// com, com_velocity, com_acceleration, angular_velocity, angular_acceleration: (N, B, 3);
-/// rotation: (N, B, 3, 3) body->base. Outputs (N, 3) each; any may be null.
-/// Returns the OR of the per-instant statuses.
+/// rotation: (N, B, 3, 3) body->base. Outputs (N, 3) each, and the status of each instant (N,);
+/// any may be null. An instant with non-finite input (non_finite_input) or an overflowing wrench
+/// (out_of_range) gets zeros. Returns the OR of the per-instant statuses.
 struct BodyTrajectoryView {
   std::size_t instants = 0;
   std::size_t count = 0;
@@ -80,6 +83,7 @@ struct BodyTrajectoryView {
 };
 Status shaking_wrench_batch(const RigidBody* bodies, const BodyTrajectoryView& motion,
                             double* force, double* moment, double* linear_momentum,
-                            double* angular_momentum) noexcept;
+                            double* angular_momentum,
+                            std::uint32_t* status_per_instant = nullptr) noexcept;
 
 }  // namespace mechbal

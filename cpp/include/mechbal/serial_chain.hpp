@@ -61,7 +61,9 @@ struct ChainWorkspace {
 
 /// Forward position/velocity/acceleration kinematics of every link (closed-form recursion).
 /// Allocation-free, noexcept. Sizes must equal model.dof() (else Status::bad_size, nothing
-/// written); non-finite input gives Status::non_finite_input and leaves the workspace untouched.
+/// written); non-finite input gives Status::non_finite_input and leaves the workspace untouched;
+/// finite input whose motion overflows gives Status::out_of_range and resets the workspace to
+/// rest (identity frames, zero motion).
 Status chain_kinematics(const ChainModel& model, const Eigen::Ref<const Eigen::VectorXd>& q,
                         const Eigen::Ref<const Eigen::VectorXd>& qd,
                         const Eigen::Ref<const Eigen::VectorXd>& qdd,
@@ -71,6 +73,10 @@ Status chain_kinematics(const ChainModel& model, const Eigen::Ref<const Eigen::V
 /// parent the previous joint, the base transform folded into the first placement, each link's
 /// inertia a body of kind "link" named after its joint. Not real-time.
 MechanismDescription chain_description(const ChainModel& model);
+
+/// Scales `axis` to unit length without overflow (by its largest component first). False, axis
+/// untouched, when it is not finite or its norm is below 1e-12.
+bool normalize_axis(Vec3& axis) noexcept;
 
 /// Modified (Craig 1989) DH origin: Rx(alpha) Tx(a) Tz(d) Rz(theta).
 Eigen::Isometry3d modified_dh_origin(double a, double alpha, double d, double theta);

@@ -13,8 +13,11 @@ enum class Status : std::uint32_t {
   saturated = 1u << 2,         ///< an output hit its configured limit and was clipped
   bad_size = 1u << 3,          ///< an input had the wrong dimension: output left untouched
   solver_error = 1u << 4,      ///< an underlying solver (e.g. KDL) reported an error
-  out_of_range = 1u << 5,      ///< finite input outside its documented range, or a result that
-                               ///< overflowed: output held (real time) or zeroed (batch)
+  /// an input was finite but outside its documented range or configured limit (e.g. a wrist
+  /// momentum above ReactionlessWristConfig::max_momentum, a joint speed above max_speed), or a
+  /// finite input overflowed to a non-finite result: output holds the last safe value (a batch
+  /// instant gets zeros)
+  out_of_range = 1u << 5,
 };
 
 constexpr Status operator|(Status a, Status b) noexcept {

@@ -58,8 +58,10 @@ def available() -> list[tuple[str, str, str]]:
     return out
 
 
-def run_case(name_or_path: str | Path, out: str | Path) -> dict:
-    """Run a built-in case (by name) or a case file into the folder ``out``; returns the summary.
+def run_case(name_or_path: str | Path, out: str | Path, **trajectory) -> dict:
+    """Run a built-in case (by name), a TOML case file or a URDF file into the folder ``out``;
+    returns the summary. ``trajectory``: ``duration`` and ``samples`` of a URDF file's default
+    trajectory (see :mod:`mechbal.cases.urdf_robot`).
 
     Raises :class:`mechbal.output.OutputError` (bad ``out``) and :class:`ConfigError` before any
     computation; whatever a runner raises leaves ``out`` as it was."""
@@ -70,11 +72,21 @@ def run_case(name_or_path: str | Path, out: str | Path) -> dict:
     _load_runners()
     from mechbal.schema import CASE_MODELS
 
-    raw = load_case(name_or_path)
+    trajectory = {k: v for k, v in trajectory.items() if v is not None}
+    if str(name_or_path).lower().endswith(".urdf"):
+        from mechbal.cases.urdf_robot import urdf_case
+
+        raw = urdf_case(name_or_path, **trajectory)
+    elif trajectory:
+        raise ConfigError(", ".join(f"--{k}" for k in trajectory),
+                          "only applies to URDF files (a TOML case has its [trajectory] table)",
+                          has_value=False)
+    else:
+        raw = load_case(name_or_path)
     header = raw.get("case") if isinstance(raw, dict) else None
     kind = header.get("kind") if isinstance(header, dict) else None
     if isinstance(kind, str) and kind in _RUNNERS and kind not in CASE_MODELS:
-        # a runner registered without a schema (a plugin or a test) validates its own file
+        # a runner registered without a schema (a URDF robot, a plugin, a test) validates its input
         config, name = raw, raw["case"]["name"]
     else:
         config = validate_case(raw)  # the whole file, before anything runs

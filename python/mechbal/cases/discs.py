@@ -103,8 +103,8 @@ def _controller_check(kind, p, cfg, q_des, qd_des, qdd_des, n):
         ct = _core.ComputedTorque(dz.fivebar_dynamics(bal), kp, kd)
         backend = "mechbal.ComputedTorque over FiveBarDynamics (C++, 4x4 A° per tick)"
     else:
-        ct = _core.ComputedTorque(dz.disc_arm_dynamics(kind, bal), kp, kd)
-        backend = "mechbal.ComputedTorque over DiscArmDynamics"
+        ct = _core.ComputedTorque(_core.MechanismDynamics(dz.disc_mechanism(kind, bal).model), kp, kd)
+        backend = "mechbal.ComputedTorque over MechanismDynamics (the general model, discs as gear couplings)"
     steps = [ct.step(*x) for x in progress.track(
         zip(q, qd, q_des, qd_des, qdd_des), "computed torque ticks", total=len(q))]
     if any(s != _core.Status.ok for _, s in steps):

@@ -42,34 +42,48 @@ def mechanism_motion(mech: Mechanism, traj, t, q_guess=None):
 def run(config, out: Path) -> dict:
     case = validate_case(config, warn=False)
     mech = Mechanism.from_spec(case.spec, name=case.case.name)
-    names = mech.actuated_names
-    traj, t = trajectory_from_config(case.trajectory, len(names))
+    traj, t = trajectory_from_config(case.trajectory, len(mech.actuated_names))
     guess = getattr(case.trajectory, "initial_guess", None)
     if guess is not None and len(guess) != mech.dof:
         raise ConfigError("trajectory.initial_guess", f"must have {mech.dof} values (every joint with a "
                           f"coordinate: {', '.join(mech.joint_names)})", list(guess))
+    return run_mechanism(mech, traj, t, out, name=case.case.name, kind=case.case.kind,
+                         title=case.case.title or case.case.name,
+                         q_guess=None if guess is None else np.array(guess, float))
+
+
+def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, title: str,
+                  q_guess=None, summary_extra: dict | None = None) -> dict:
+    """The run every mechanism gets (TOML case or URDF file): motion along ``traj`` at ``t``
+    (loops solved for closed mechanisms), shaking wrench, base reaction, actuator torques;
+    writes bodies_nominal.npz, the plots and summary.json into ``out``; returns the summary."""
+    names = mech.actuated_names
     progress.stage("kinematics, loop solve, shaking wrench, inverse dynamics")
-    q, v, a, torque, extra = mechanism_motion(mech, traj, t, None if guess is None else np.array(guess, float))
+    q, v, a, torque, extra = mechanism_motion(mech, traj, t, q_guess)
     sw = mech.shaking_wrench(q, v, a)
     br = mech.base_reaction(q, v, a)
     motion = mech.body_motion(q, v, a)
+    for what, status in (("kinematics", motion.status), ("shaking wrench", sw.status),
+                         ("base reaction", br.status)):
+        if np.any(status != 0):
+            raise ConfigError("trajectory", f"{what} failed at {int(np.sum(status != 0))} instants "
+                                            "(non-finite results)", has_value=False)
     F, M = sw.shaking_force, sw.shaking_moment
     R_F, R_M = br.base_reaction_force, br.base_reaction_moment
 
     progress.stage("bodies file and plots")
     bodies = mech.bodies
     write_bodies(out / "bodies_nominal.npz", t=t, names=mech.body_names,
-                 mass=np.array([b.mass for b in bodies]),
-                 inertia_body=np.array([b.inertia for b in bodies]).reshape(-1, 3, 3),
+                 mass=np.array([b.mass for b in bodies], float),
+                 inertia_body=np.array([b.inertia for b in bodies], float).reshape(-1, 3, 3),
                  com=motion.com, rotation=motion.rotation, shaking_force=F, shaking_moment=M,
                  q=q, qd=v, qdd=a, torque=torque, base_reaction_force=R_F, base_reaction_moment=R_M)
-    title = case.case.title or case.case.name
     report.plot_wrench(out / "shaking_wrench.png", t, {"nominal": (F, M)}, title=title,
                        caption="Shaking force dP/dt and shaking moment dH_O/dt (about the base origin "
                                "O, inertial part only: no gravity) of all bodies along the trajectory.")
     report.plot_wrench(out / "base_reaction.png", t, {"with gravity": (R_F, R_M),
                                                       "shaking wrench (no gravity)": (F, M)},
-                       title=f"{case.case.name}: base reaction", force="base reaction force",
+                       title=f"{name}: base reaction", force="base reaction force",
                        moment="base reaction moment",
                        caption="Wrench the base exerts on the mechanism (gravity included, moment "
                                "about O) against the shaking wrench (inertial only): they differ "
@@ -79,14 +93,15 @@ def run(config, out: Path) -> dict:
     report.plot_series(out / "joint_torques.png", t, {"general model": torque},
                        [f"{n} ({k})" for n, k in zip(names, kinds)],
                        ["torque [N m]" if k == "revolute" else "force [N]" for k in kinds],
-                       title=f"{case.case.name}: actuator torques",
+                       title=f"{name}: actuator torques",
                        caption="Actuator torque (revolute) or force (prismatic) of each actuated "
                                "joint along the trajectory, gravity included"
                                + (" (C^T tau of the closed mechanism)." if mech.is_closed else "."))
     progress.stage("summary")
+    rms = np.sqrt(np.mean(torque ** 2, axis=0))
     summary = {
-        "case": case.case.name,
-        "kind": case.case.kind,
+        "case": name,
+        "kind": kind,
         "dof": mech.dof,
         "actuated": names,
         "closed": mech.is_closed,
@@ -97,7 +112,7 @@ def run(config, out: Path) -> dict:
         "peak_shaking_force_N": {"nominal": report.peak_abs(F)},
         "peak_shaking_moment_Nm": {"nominal": report.peak_abs(M)},
         "peak_joint_torque": {"nominal": report.peak_abs(torque)},
-        "rms_joint_torque": {"nominal": np.sqrt(np.mean(torque ** 2, axis=0))},
+        "rms_joint_torque": {"nominal": rms},
         "peak_base_reaction_force_N": {"nominal": report.peak_abs(R_F)},
         "peak_base_reaction_moment_Nm": {"nominal": report.peak_abs(R_M)},
         "base_reaction": "wrench the base exerts on the mechanism, gravity included, moment about O",
@@ -106,12 +121,12 @@ def run(config, out: Path) -> dict:
     }
     if extra:
         summary["loops"] = extra
+    summary.update(summary_extra or {})
     write_summary(out / "summary.json", summary)
     print(report.table(
         [["peak shaking force [N]", *report.peak_abs(F)],
          ["peak shaking moment about O [N m]", *report.peak_abs(M)]],
         ["quantity", "x", "y", "z"]))
-    print(report.table([["peak torque", *report.peak_abs(torque)],
-                        ["RMS torque", *np.sqrt(np.mean(torque ** 2, axis=0))]],
+    print(report.table([["peak torque", *report.peak_abs(torque)], ["RMS torque", *rms]],
                        ["actuator torque [N m or N]", *names]))
     return summary

@@ -221,8 +221,18 @@ def chain_model(joints, links):
     return _core.ChainModel(specs)
 
 
+def disc_mechanism(kind: str, d: dict):
+    """A serial design on the general model: mechbal.Mechanism with each disc a gear-coupled
+    joint (mechbal.papers.discs.disc_design_mechanism). What :func:`evaluate` and the runner use."""
+    from mechbal.papers.discs import disc_design_mechanism
+
+    return disc_design_mechanism(kind, d)
+
+
 def disc_arm_dynamics(kind: str, d: dict):
-    """The C++ per-tick evaluator (mechbal._core.DiscArmDynamics) of a serial design."""
+    """The C++ coupling-matrix evaluator (mechbal._core.DiscArmDynamics) of a serial design: the
+    paper's projection M' = C^T M# C, kept as a cross-check of the general model (it is not
+    faster than mechbal.MechanismDynamics)."""
     from mechbal import _core
 
     joints, links, discs = serial_structure(kind, d)
@@ -325,9 +335,10 @@ def sample_states(kind: str, n: int, rng: np.random.Generator):
 
 
 def evaluate(kind: str, d: dict, q: np.ndarray, qd: np.ndarray):
-    """(M (N, n, n), v (N, n), g (N, n)) of design d at N states, per tick in C++:
-    DiscArmDynamics for the serial arms, FiveBarDynamics for the 5R (``fivebar_model`` is the
-    Python reference of the latter). A singular five-bar state raises ValueError."""
+    """(M (N, n, n), v (N, n), g (N, n)) of design d at N states, in C++: the general model for
+    the serial arms (:func:`disc_mechanism`: CRBA mass matrix, v = bias - gravity torque),
+    FiveBarDynamics for the 5R (a closed loop; ``fivebar_model`` is its Python reference). A
+    singular five-bar state raises ValueError."""
     q, qd = np.asarray(q, float), np.asarray(qd, float)
     if kind == "fivebar":
         r = fivebar_dynamics(d).evaluate(q, qd)
@@ -336,8 +347,9 @@ def evaluate(kind: str, d: dict, q: np.ndarray, qd: np.ndarray):
             raise ValueError(f"five-bar singular or not assembled at {len(bad)} states, first "
                              f"q = {q[bad[0]].tolist()}")
         return r["mass"], r["velocity"], r["gravity"]
-    r = disc_arm_dynamics(kind, d).evaluate(np.asarray(q, float), np.asarray(qd, float))
-    return r["mass"], r["velocity"], r["gravity"]
+    mech = disc_mechanism(kind, d)
+    M, g = mech.mass_matrix(q), mech.gravity_torque(q)
+    return M, mech.bias_torque(q, qd) - g, g
 
 
 def metrics(M, v, g, k=None) -> dict:

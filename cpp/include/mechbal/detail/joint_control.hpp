@@ -4,6 +4,7 @@
 /// checks of gain and limit vectors, and the real-time clipping of a command to per-joint limits.
 #include <Eigen/Core>
 
+#include "mechbal/joint_limits.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal::detail {
@@ -12,6 +13,12 @@ namespace mechbal::detail {
 /// +infinity, when `allow_inf`); the std::invalid_argument names `field`, the index and the value.
 void check_positive_vector(const Eigen::VectorXd& v, const char* field, Eigen::Index n,
                            bool allow_inf);
+
+/// Construction time (throws): the torque limit of n joints into `out`: empty gives
+/// default_torque_limit for every joint, +infinity entries are replaced by it, other entries must
+/// be finite and > 0.
+void check_torque_limit(const Eigen::VectorXd& limit, const char* field, Eigen::Index n,
+                        Eigen::VectorXd& out);
 
 /// Clips x(i) to [-limit(i), limit(i)] for the first n entries (limits may be +infinity).
 /// Returns Status::saturated when any entry was clipped, Status::ok otherwise. noexcept, no

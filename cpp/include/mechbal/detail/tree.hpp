@@ -58,7 +58,9 @@ inline void joint_state(const MechanismModel& model, MechanismData& data,
   }
 }
 
-/// Link placements relative to their parents and, with World (the default), in O (L frames).
+/// Link placements relative to their parents and, with World, in O (L frames). The passes that
+/// work in the links' own frames only (inverse dynamics, gravity, bias, mass matrix) skip World:
+/// work[].world_* are then left as they were.
 template <bool World = true>
 inline void place(const MechanismModel& model, MechanismData& data) noexcept {
   const int nl = model.num_links();
@@ -92,6 +94,19 @@ inline void place(const MechanismModel& model, MechanismData& data) noexcept {
       w.world_position = p.world_position + p.world_rotation * w.translation;
     }
   }
+}
+
+/// R S R^T of a symmetric S, computing the upper triangle only (45 multiplications, not 54).
+inline Mat3 rotate_symmetric(const Mat3& R, const Mat3& S) noexcept {
+  const Mat3 RS = R * S;
+  Mat3 out;
+  out(0, 0) = RS.row(0).dot(R.row(0));
+  out(0, 1) = out(1, 0) = RS.row(0).dot(R.row(1));
+  out(0, 2) = out(2, 0) = RS.row(0).dot(R.row(2));
+  out(1, 1) = RS.row(1).dot(R.row(1));
+  out(1, 2) = out(2, 1) = RS.row(1).dot(R.row(2));
+  out(2, 2) = RS.row(2).dot(R.row(2));
+  return out;
 }
 
 /// Forward pass: velocity, acceleration of every link in its own L frame and, when Forces, the
@@ -188,7 +203,10 @@ inline void backward_pass(const MechanismModel& model, MechanismData& data, Tau&
 }
 
 /// Composite mass, first moment and inertia about each link's origin (in L_i) of the subtree
-/// rooted at every link (CRBA's backward pass; Featherstone 2008, alg. 6.2).
+/// rooted at every moving link (CRBA's backward pass; Featherstone 2008, alg. 6.2). The base's
+/// entry (link 0) keeps only its own bodies: nothing above the joints uses the whole tree's
+/// composite, and not carrying subtrees onto the base saves a transform per base child. Massless
+/// subtrees (a tool frame's link) are not transformed either: they add nothing.
 inline void composite_inertias(const MechanismModel& model, MechanismData& data) noexcept {
   const int nl = model.num_links();
   for (int l = 0; l < nl; ++l) {
@@ -199,19 +217,35 @@ inline void composite_inertias(const MechanismModel& model, MechanismData& data)
     W.composite_inertia = c.inertia_origin;
   }
   for (int l = nl - 1; l >= 1; --l) {
+    const int parent = model.parent(l);
+    if (parent == 0) continue;
     const auto& W = data.work[static_cast<std::size_t>(l)];
-    auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
-    // I_O' = R I R^T + m ((p.p) 1 - p p^T) + 2 (p.h) 1 - h p^T - p h^T with h = R h_child.
+    // massless: m = 0 and a zero inertia (positive semi-definite with zero trace)
+    if (W.composite_mass == 0.0 && W.composite_inertia.trace() == 0.0) continue;
+    auto& P = data.work[static_cast<std::size_t>(parent)];
+    // I_O' = R I R^T + m ((p.p) 1 - p p^T) + 2 (p.h) 1 - h p^T - p h^T with h = R h_child,
+    // on the six distinct entries of the symmetric result.
     const double m = W.composite_mass;
     const Vec3& p = W.translation;
     const Vec3 h = W.rotation * W.composite_first_moment;
-    Mat3 I = W.rotation * W.composite_inertia * W.rotation.transpose();
-    const Mat3 hp = h * p.transpose();
-    I += (m * p.squaredNorm() + 2.0 * p.dot(h)) * Mat3::Identity() - m * p * p.transpose() - hp -
-         hp.transpose();
+    const Mat3 I = rotate_symmetric(W.rotation, W.composite_inertia);
+    const double diagonal = m * p.squaredNorm() + 2.0 * p.dot(h);
+    const Vec3 mp_h = m * p + h;  // m p_r p_c + h_r p_c + p_r h_c = (m p + h)_r p_c + p_r h_c
+    Mat3& C = P.composite_inertia;
+    C(0, 0) += I(0, 0) + diagonal - (mp_h.x() * p.x() + p.x() * h.x());
+    C(1, 1) += I(1, 1) + diagonal - (mp_h.y() * p.y() + p.y() * h.y());
+    C(2, 2) += I(2, 2) + diagonal - (mp_h.z() * p.z() + p.z() * h.z());
+    const double c01 = I(0, 1) - (mp_h.x() * p.y() + p.x() * h.y());
+    const double c02 = I(0, 2) - (mp_h.x() * p.z() + p.x() * h.z());
+    const double c12 = I(1, 2) - (mp_h.y() * p.z() + p.y() * h.z());
+    C(0, 1) += c01;
+    C(1, 0) += c01;
+    C(0, 2) += c02;
+    C(2, 0) += c02;
+    C(1, 2) += c12;
+    C(2, 1) += c12;
     P.composite_mass += m;
-    P.composite_first_moment += h + m * p;
-    P.composite_inertia += I;
+    P.composite_first_moment += mp_h;
   }
 }
 

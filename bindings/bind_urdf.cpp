@@ -1,0 +1,50 @@
+// pybind11 glue of the URDF reader (mechbal/urdf.hpp): a URDF file or document as a validated
+// MechanismModel (or its description). Errors (std::invalid_argument naming the URDF element and
+// the value) become ValueError. Python's mechbal.Mechanism.from_urdf wraps these.
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "bindings.hpp"
+#include "mechbal/urdf.hpp"
+
+namespace py = pybind11;
+
+namespace mechbal::pyb {
+
+namespace {
+
+template <typename Fn>
+auto value_errors(Fn fn) -> decltype(fn()) {
+  try {
+    return fn();
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+}
+
+void bind_urdf(py::module_& m) {
+  m.def(
+      "mechanism_from_urdf",
+      [](const std::string& path) { return value_errors([&] { return model_from_urdf_file(path); }); },
+      py::arg("path"),
+      "The MechanismModel of a URDF file (urdfdom): links with inertials as bodies, revolute / "
+      "continuous / prismatic / fixed joints, mimic as gear couplings, limits, a frame per link. "
+      "ValueError names the URDF element and the value.");
+  m.def(
+      "mechanism_from_urdf_string",
+      [](const std::string& xml) { return value_errors([&] { return model_from_urdf_string(xml); }); },
+      py::arg("xml"), "The MechanismModel of a URDF document given as a string.");
+  m.def(
+      "urdf_description",
+      [](const std::string& path) { return value_errors([&] { return urdf_description_from_file(path); }); },
+      py::arg("path"), "The MechanismDescription of a URDF file (before validation by the model).");
+}
+
+}  // namespace
+
+MECHBAL_REGISTER_BINDINGS(35, urdf, bind_urdf);
+
+}  // namespace mechbal::pyb

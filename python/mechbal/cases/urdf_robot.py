@@ -1,0 +1,74 @@
+"""Runner for a URDF file (``mechbal run robot.urdf --out DIR``): the robot read by the C++ URDF
+reader as a general :class:`mechbal.Mechanism`, moved along a default rest-to-rest trajectory;
+shaking force and moment about O, base reaction and joint torques (inverse dynamics), written as
+every case writes them (summary.json, PNG plots, bodies_nominal.npz).
+
+Default trajectory: a quintic rest-to-rest motion over ``duration`` seconds (2 s) sampled at
+``samples`` instants (501). Every joint starts at 0 (clipped into its limits) and moves towards its
+upper limit by half the room left, at most 0.5 rad (revolute) or 0.1 m (prismatic); a joint with
+no room above moves towards its lower limit the same way; an unlimited (continuous) joint moves
+by 0.5 rad.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from mechbal import _core
+from mechbal.cases import register
+from mechbal.config import ConfigError, integer, number, require
+from mechbal.mechanism import Mechanism
+
+KIND = "urdf"
+DEFAULT_DURATION = 2.0
+DEFAULT_SAMPLES = 501
+#: largest default motion of one joint: revolute [rad], prismatic [m]
+MAX_STEP = {_core.JointType.revolute: 0.5, _core.JointType.prismatic: 0.1}
+
+
+def urdf_case(path: str | Path, duration: float | None = None, samples: int | None = None) -> dict:
+    """The case configuration of a URDF file (what a TOML case file would hold)."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"URDF file '{path}'", "not found", has_value=False)
+    trajectory = {"duration": DEFAULT_DURATION if duration is None else duration,
+                  "samples": DEFAULT_SAMPLES if samples is None else samples}
+    return {"case": {"name": path.stem, "kind": KIND, "title": f"{path.name} (URDF)"},
+            "urdf": {"path": str(path)}, "trajectory": trajectory}
+
+
+def default_motion(mech: Mechanism) -> tuple[np.ndarray, np.ndarray]:
+    """(start, end) of the default trajectory (see the module docstring)."""
+    lower = np.asarray(mech.model.lower_limits, float)
+    upper = np.asarray(mech.model.upper_limits, float)
+    types = {j.name: j.type for j in mech.model.description.joints}
+    step = np.array([MAX_STEP[types[n]] for n in mech.joint_names])
+    start = np.clip(np.zeros(mech.dof), lower, upper)
+    room_up, room_down = upper - start, start - lower
+    up = np.minimum(step, 0.5 * room_up)
+    down = np.minimum(step, 0.5 * room_down)
+    end = np.where(room_up >= room_down, start + up, start - down)
+    return start, end
+
+
+@register(KIND, stages=3)
+def run(config: dict, out: Path) -> dict:
+    from mechbal.cases.serial_chain import run_mechanism
+
+    path = Path(require(require(config, "urdf", ""), "path", "urdf"))
+    table = require(config, "trajectory", "")
+    duration = number(require(table, "duration", "trajectory"), "trajectory.duration (--duration)",
+                      positive=True)
+    samples = integer(require(table, "samples", "trajectory"), "trajectory.samples (--samples)",
+                      minimum=3)
+    mech = Mechanism.from_urdf(path)
+    if mech.dof == 0:
+        raise ConfigError(f"URDF file '{path}'", "has no moving joint to run", has_value=False)
+    start, end = default_motion(mech)
+    traj = _core.RestToRestTrajectory(start, end, duration, _core.TimeLaw.quintic)
+    t = np.linspace(0.0, duration, samples)
+    return run_mechanism(mech, traj, t, out, name=config["case"]["name"], kind=KIND,
+                         title=config["case"].get("title", config["case"]["name"]),
+                         summary_extra={"urdf": str(path), "joint_names": mech.joint_names,
+                                        "body_names": mech.body_names, "start": start, "end": end})
