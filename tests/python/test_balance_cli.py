@@ -189,3 +189,24 @@ def test_balance_errors_are_one_line(capsys, tmp_path):
     assert main(["balance", str(tmp_path / "robot.urdf"), "--out", out]) == 2
     one_line_error(capsys)
     assert not (tmp_path / "o").exists()
+
+
+def test_ur5_urdf_with_a_design_file(tmp_path):
+    """The README example: UR5 (example-robot-data) with docs/examples/ur5_balance.toml; slots
+    named by URDF link (positions in those frames); Pinocchio's gravity of the written URDF is
+    mechbal's; the residual is the least squares' (the wrist cannot be held)."""
+    from test_urdf import ROBOTS, _robot_file
+
+    urdf = _robot_file(*ROBOTS["ur5"])
+    design = Path(__file__).parents[2] / "docs" / "examples" / "ur5_balance.toml"
+    out = tmp_path / "ur5"
+    assert main(["balance", str(urdf), "--design", str(design), "--out", str(out), "-q"]) == 0
+    b = summary_of(out)["balance"]
+    assert b["design"]["upper_arm_counterweight"]["position"] == pytest.approx([0, 0, -0.25], abs=1e-9)
+    assert b["design"]["upper_arm_counterweight"]["frame"].startswith("frame 'upper_arm_link'")
+    assert b["residual"] == pytest.approx(b["metrics"]["least_squares_residual"], rel=1e-6)
+    assert b["residual"] < 0.01 * b["residual_before"]
+    mech = Mechanism.from_urdf(out / "balanced.urdf")
+    q = np.random.default_rng(2).uniform(-math.pi, math.pi, (200, mech.dof))
+    G = pin_gravity(out / "balanced.urdf", mech, q)
+    assert np.max(np.abs(G - mech.gravity_torque(q))) < 1e-9

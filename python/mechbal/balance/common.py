@@ -46,8 +46,9 @@ ACTIVE_RTOL = 1e-7
 @dataclass
 class Slot:
     """A :class:`CounterweightSlot` checked against a mechanism: ``T`` (4, 4) is the user frame
-    of ``link`` in the link frame; ``center``, ``direction`` (unit or None) and ``inertia`` are in
-    the user frame, as given."""
+    of ``link`` in the link frame (the link's own, or that of the named frame the slot gave as
+    its ``link``, e.g. a URDF link); ``center``, ``direction`` (unit or None) and ``inertia`` are
+    in the user frame, as given."""
 
     name: str
     link: str
@@ -59,6 +60,8 @@ class Slot:
     inertia: np.ndarray
     T: np.ndarray
     field: str
+    #: the name the user gave: the link, or a named frame on it (positions are in that frame)
+    given: str = ""
 
     @property
     def mass_fixed(self) -> bool:
@@ -104,9 +107,15 @@ def normalise_slots(mech, design: Sequence[CounterweightSlot], *, need_radius: b
         if s.name in names:
             raise ValueError(f"{f}.name: '{s.name}' is already a body of the mechanism or another slot")
         names.add(s.name)
-        if s.link not in moving:
+        link, T = s.link, None
+        frames = {fr.name: fr for fr in mech.model.description.frames}
+        if link not in moving and link in frames and frames[link].link in moving:
+            # a named frame on a link (a URDF link's own frame): positions are in that frame
+            T = mech.user_frame(frames[link].link) @ np.asarray(frames[link].placement, float)
+            link = frames[link].link
+        if link not in moving:
             import difflib
-            hint = difflib.get_close_matches(str(s.link), sorted(moving), n=1)
+            hint = difflib.get_close_matches(str(s.link), sorted(moving) + sorted(frames), n=1)
             more = f" (did you mean '{hint[0]}'?)" if hint else f" (moving links: {', '.join(sorted(moving))})"
             what = "the base does not move" if s.link == mech.model.root_name else "no moving link named"
             raise ValueError(f"{f}.link: {what} '{s.link}'{more}")
@@ -135,7 +144,8 @@ def normalise_slots(mech, design: Sequence[CounterweightSlot], *, need_radius: b
             I = np.diag(I)
         if I.shape != (3, 3) or not np.all(np.isfinite(I)):
             raise ValueError(f"{f}.inertia: must be a 3x3 matrix or 3 principal moments")
-        out.append(Slot(s.name, s.link, lo, hi, R, c, u, 0.5 * (I + I.T), mech.user_frame(s.link), f))
+        out.append(Slot(s.name, link, lo, hi, R, c, u, 0.5 * (I + I.T),
+                        mech.user_frame(link) if T is None else T, f, s.link))
     return out
 
 
@@ -577,10 +587,11 @@ def design_from_solution(x: np.ndarray, slots: Sequence[Slot], active: Sequence[
 
 
 def _slot_design(s: Slot, m: float, p: np.ndarray, active: Sequence[str]) -> dict:
+    given = s.given or s.link
+    frame = (f"frame '{given}' (on link '{s.link}')" if given != s.link else
+             f"the frame link '{s.link}' is described in" + ("" if np.allclose(s.T, np.eye(4)) else " (its DH frame)"))
     out = {"link": s.link, "mass": m, "position": p, "radius": float(np.linalg.norm(p - s.center)),
-           "mass_moment": m * p,
-           "frame": f"the frame link '{s.link}' is described in" + ("" if np.allclose(s.T, np.eye(4))
-                                                                    else " (its DH frame)"),
+           "mass_moment": m * p, "frame": frame,
            "bounds": {"mass_min": s.mass_min, "mass_max": _or_none(s.mass_max),
                       "max_radius": _or_none(s.max_radius), "center": s.center, "direction": s.direction},
            "active_bounds": [a.split(".", 1)[1] for a in active if a.startswith(s.name + ".")]}

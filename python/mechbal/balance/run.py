@@ -54,23 +54,6 @@ class BalanceCase:
     default_slots: list
 
 
-def arm2dof_mechanism(arm, name: str = "arm2dof"):
-    """The 2-DOF arm of Arakelian, Le Baron & Mottu 2011 (an ``[arm]`` table) as a Mechanism in
-    the vertical x-z plane: joints ``shoulder`` at A and ``elbow`` at B = (l1, 0, 0), axes -y
-    (a positive angle lifts +x towards +z), x along each link, centres of mass at l_S1 and l_S2,
-    inertias I_S1, I_S2 about them (slender rods: zero about the link's axis)."""
-    from mechbal.mechanism import Mechanism
-    from mechbal.spec import mechanism_spec
-
-    a = arm.model_dump() if hasattr(arm, "model_dump") else dict(arm)
-    table = {"gravity": [0.0, 0.0, -float(a.get("g", 9.81))], "joints": [
-        {"name": "shoulder", "axis": [0.0, -1.0, 0.0],
-         "link": {"mass": a["m1"], "com": [a["l_s1"], 0.0, 0.0], "inertia": [0.0, a["i_s1"], a["i_s1"]]}},
-        {"name": "elbow", "origin": {"xyz": [a["l1"], 0.0, 0.0]}, "axis": [0.0, -1.0, 0.0],
-         "link": {"mass": a["m2"], "com": [a["l_s2"], 0.0, 0.0], "inertia": [0.0, a["i_s2"], a["i_s2"]]}}]}
-    return Mechanism.from_spec(mechanism_spec(table), name=name)
-
-
 def slots_from_table(table, field: str = "balance.counterweights") -> list[CounterweightSlot]:
     """CounterweightSlots of ``[[balance.counterweights]]`` (validated entries)."""
     from mechbal.schema import inertia_matrix
@@ -152,7 +135,9 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
         return BalanceCase(name, title, mech, table, t, motion, tt,
                            None if guess is None else np.array(guess, float), raw, cfg.case.kind, [])
     if isinstance(cfg, Arm2DofCase):
-        mech = arm2dof_mechanism(cfg.arm, name)
+        from mechbal.papers.arm2dof import arm2dof_mechanism
+
+        mech = arm2dof_mechanism(cfg.arm.model_dump(), name=name)
         cw = cfg.counterweights
         slots = [CounterweightSlot("counterweight1", "shoulder", cw.m_cw1, cw.m_cw1, direction=(-1.0, 0.0, 0.0)),
                  CounterweightSlot("counterweight2", "elbow", cw.m_cw2, cw.m_cw2, direction=(-1.0, 0.0, 0.0))]
@@ -270,14 +255,16 @@ def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
         data["case"] = {**data["case"], **case, "kind": bc.kind}
         mech = data["mechanism"]
         bodies = list(mech.get("bodies", []))
-        for k, v in result.design.items():
-            if "mass" not in v:
+        own = set(bc.mechanism.body_names)
+        for b in result.balanced.bodies:   # the counterweights, back in the user's link frames
+            if b.name in own:
                 continue
-            slot = next((s for s in slots_from_table(bc.table) or bc.default_slots if s.name == k), None)
-            I = np.zeros((3, 3)) if slot is None or slot.inertia is None else np.asarray(slot.inertia, float)
-            bodies.append({"name": k, "kind": "counterweight", "link": v["link"], "mass": float(v["mass"]),
-                           "com": np.asarray(v["position"], float).tolist(),
-                           "inertia": [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]})
+            T = bc.mechanism.user_frame(b.link)
+            R, t = T[:3, :3], T[:3, 3]
+            com = R.T @ (np.asarray(b.com, float) - t)
+            I = R.T @ np.asarray(b.inertia, float) @ R
+            bodies.append({"name": b.name, "kind": "counterweight", "link": b.link, "mass": float(b.mass),
+                           "com": com.tolist(), "inertia": [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]})
         mech["bodies"] = bodies
         return toml_text(data, header)
     data = {"case": case, "mechanism": mechanism_table(result.balanced), "trajectory": tt}
