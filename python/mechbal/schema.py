@@ -307,6 +307,54 @@ class ChainTrajectory(Table):
                           "(picks the assembly mode of the loops), rad or m")
 
 
+# ---- [balance]: the design variables of `mechbal balance` (mechbal.balance) -----------------
+
+BalanceMethod = Literal["static", "force", "moment", "springs", "rms"]
+
+
+class BalanceCounterweight(Table):
+    """``[[balance.counterweights]]``: a counterweight the method may add (a point mass, plus
+    ``inertia`` about its centre): its mass within [mass_min, mass_max] (or fixed: ``mass``),
+    its centre within ``max_radius`` of ``center``, on the line ``direction`` through ``center``
+    if given; positions in the frame the user described the link in (DH frame for ``dh``)."""
+    name: Name = Field(description="the counterweight's body name (must be new)")
+    link: Name = Field(description="name of the joint whose link carries it")
+    mass: Optional[Mass] = Field(None, description="kg, a fixed mass (instead of mass_min / mass_max)")
+    mass_min: Optional[Mass] = Field(None, description="kg (default 0)")
+    mass_max: Optional[Mass] = Field(None, description="kg (absent: unbounded)")
+    max_radius: Optional[NonNeg] = Field(None, description="m, largest distance from center (absent: unbounded)")
+    center: Xyz = Field([0.0, 0.0, 0.0], description="m, in the link's frame")
+    direction: Optional[Vec3] = Field(None, description="the counterweight slides on this line through center")
+    inertia: Optional[Inertia] = None
+
+    @model_validator(mode="after")
+    def _masses(self):
+        if self.mass is not None and (self.mass_min is not None or self.mass_max is not None):
+            raise _custom("give either mass or mass_min / mass_max", ".mass", self.mass)
+        lo = self.mass_min or 0.0
+        if self.mass_max is not None and self.mass_max < lo:
+            raise _custom(f"must be >= mass_min = {lo!r}", ".mass_max", self.mass_max)
+        if self.direction is not None and not any(self.direction):
+            raise _custom("must be a non-zero vector", ".direction", self.direction)
+        return self
+
+
+class Balance(Table):
+    """``[balance]``: what ``mechbal balance`` may change and what it must hold over."""
+    method: Optional[BalanceMethod] = Field(None, description="default of --method")
+    counterweights: Annotated[list[BalanceCounterweight], Field(max_length=MAX_BODIES)] = []
+    mass_budget: Optional[Pos] = Field(None, description="kg, total counterweight mass")
+    samples: Optional[Annotated[int, Field(ge=1, le=MAX_CONFIGURATIONS, strict=True)]] = Field(
+        None, description="random workspace samples (static: 1000, force: 200 motions)")
+    seed: Annotated[int, Field(ge=0, le=2**63 - 1, strict=True)] = 0
+    lower: Optional[JointValues] = Field(None, description="sample box, per independent (closed: actuated) joint")
+    upper: Optional[JointValues] = None
+    objective: Literal["rms", "peak"] = Field("rms", description="rms method: RMS or peak torque")
+    coupling: Optional[Literal["per_joint", "total"]] = Field(
+        None, description="rms method: each joint by its own link's slots (default, open) or all together")
+    weights: Optional[JointValues] = Field(None, description="rms method, total coupling: per actuated joint")
+
+
 class SerialChainCaseHeader(CaseHeader):
     kind: Literal["serial_chain", "mechanism"]
 
@@ -316,6 +364,7 @@ class SerialChainCase(Table):
     case: SerialChainCaseHeader
     mechanism: Mechanism
     trajectory: ChainTrajectory
+    balance: Optional[Balance] = None
     _spec: Any = PrivateAttr(None)
 
     @property
@@ -388,6 +437,9 @@ class Arm2DofCase(Table):
     trajectory: Arm2DofTrajectory
     controller: Arm2DofController
     paper: Arm2DofPaper = Arm2DofPaper()
+    balance: Optional[Balance] = Field(
+        None, description="mechbal balance: links 'shoulder' and 'elbow' (x along each link); "
+                          "without counterweights, those of [counterweights] on the link extensions")
 
 
 # ---- paminsa (Briot & Arakelian 2009) -------------------------------------------------------------

@@ -178,7 +178,7 @@ def test_the_issue_examples_are_refused():
         validate_case(bad)
     bad = copy.deepcopy(base)
     bad["counterweights"] = {"m_cw1": 1.0}
-    with pytest.raises(ConfigError, match=r"^counterweights: unknown table \(allowed: case, mechanism, trajectory\)"):
+    with pytest.raises(ConfigError, match=r"^counterweights: unknown table \(allowed: case, mechanism, trajectory, balance\)"):
         validate_case(bad)
 
 

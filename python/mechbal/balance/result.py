@@ -107,7 +107,11 @@ class BalanceResult:
     ``"impossible: ..."``), empty when the balance is exact; ``metrics``: before/after peak and
     RMS values (gravity torque, actuator torque, shaking force and moment) where computed;
     ``balanced``: the balanced :class:`mechbal.Mechanism`; ``elements``: balancing elements that
-    are not bodies of the mechanism (the sized :class:`SpringSlot` objects of the spring method)."""
+    are not bodies of the mechanism (the sized :class:`SpringSlot` objects of the spring method);
+    ``active_bounds``: every bound the design sits on (``"cw1.max_radius"``, ``"mass_budget"``),
+    whether or not it limited the balance (when it did, it is also in ``limited_by``);
+    ``undetermined``: combinations of the unknowns that the condition does not determine (the
+    null space of the linear problem)."""
 
     method: str
     design: dict[str, dict[str, Any]]
@@ -120,6 +124,8 @@ class BalanceResult:
     metrics: dict[str, Any] = field(default_factory=dict)
     balanced: Any = None
     elements: list = field(default_factory=list)
+    active_bounds: list[str] = field(default_factory=list)
+    undetermined: list[str] = field(default_factory=list)
 
     @property
     def exact(self) -> bool:
@@ -141,4 +147,5 @@ class BalanceResult:
         return plain({"method": self.method, "design": self.design, "residual": self.residual,
                       "residual_before": self.residual_before, "residual_units": self.residual_units,
                       "rank": self.rank, "unknowns": self.unknowns, "limited_by": self.limited_by,
-                      "exact": self.exact, "metrics": self.metrics})
+                      "exact": self.exact, "active_bounds": self.active_bounds,
+                      "undetermined": self.undetermined, "metrics": self.metrics})
