@@ -262,8 +262,8 @@ def rpsp_run(tmp_path_factory):
     import mechbal.cases as cases
 
     raw = load_case("rpsp")
-    raw["motion"]["samples"] = 1001
-    raw["motion"]["survey_samples"] = 1501
+    raw["motion"]["samples"] = 501
+    raw["motion"]["survey_samples"] = 801
     out = tmp_path_factory.mktemp("rpsp") / "out"
     original = cases.load_case
     cases.load_case = lambda _name: copy.deepcopy(raw)
