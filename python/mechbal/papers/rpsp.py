@@ -134,50 +134,56 @@ def inverse_kinematics(geometry: RpspGeometry, phi, dphi=None, ddphi=None, *, to
     out["e"] = np.zeros((n, 3, 3))
     out["tip"] = np.zeros((n, 3, 3))
     out["degenerate"] = np.zeros((n, 3), bool)
+    R, w, dw = _rotations(phi, dphi, ddphi)
     hvec = np.array([0.0, 0.0, geometry.h])
     k = np.array([0.0, 0.0, 1.0])
-    for s in range(n):
-        R, w, dw = platform_rotation(phi[s], dphi[s], ddphi[s])
-        for i in range(3):
-            u = np.array([np.cos(geometry.lam[i]), np.sin(geometry.lam[i]), 0.0])
-            v = R @ np.array([np.cos(geometry.alpha[i]), np.sin(geometry.alpha[i]), 0.0])
-            dv = np.cross(w, v)
-            ddv = np.cross(dw, v) + np.cross(w, dv)
-            den, dden, ddden = u @ v, u @ dv, u @ ddv
-            out["denominator"][s, i] = den
-            if not abs(den) >= tolerance:
-                out["degenerate"][s, i] = True
-                continue
-            a = geometry.a[i]
-            b = a / den                                                   # eq 8
-            db = -a * dden / den ** 2
-            ddb = -a * ddden / den ** 2 + 2.0 * a * dden ** 2 / den ** 3
-            r = hvec + b * v - a * u                                       # l_i e_i (eq 2)
-            dr = db * v + b * dv
-            ddr = ddb * v + 2.0 * db * dv + b * ddv
-            l = float(np.linalg.norm(r))                                   # eq 9
-            if not l >= tolerance:
-                out["degenerate"][s, i] = True
-                continue
-            e = r / l                                                      # eq 10
-            dl = e @ dr
-            ddl = e @ ddr + (dr @ dr - dl ** 2) / l
-            t_dir = np.cross(u, k)                                         # e = cos th k + sin th (u x k), eq 12
-            y, x = t_dir @ r, k @ r
-            dy, dx = t_dir @ dr, k @ dr
-            ddy, ddx = t_dir @ ddr, k @ ddr
-            D = x * x + y * y
-            N = x * dy - y * dx
-            dN = x * ddy - y * ddx
-            dD = 2.0 * (x * dx + y * dy)
-            out["b"][s, i], out["b_dot"][s, i], out["b_ddot"][s, i] = b, db, ddb
-            out["l"][s, i], out["l_dot"][s, i], out["l_ddot"][s, i] = l, dl, ddl
-            out["theta"][s, i] = np.arctan2(y, x)                          # eq 13
-            out["theta_dot"][s, i] = N / D
-            out["theta_ddot"][s, i] = (dN * D - N * dD) / D ** 2
-            out["e"][s, i] = e
-            out["tip"][s, i] = hvec + b * v
+    dot = lambda x, y: np.einsum("ni,ni->n", x, y)  # noqa: E731
+    for i in range(3):
+        u = np.array([np.cos(geometry.lam[i]), np.sin(geometry.lam[i]), 0.0])
+        v = R @ np.array([np.cos(geometry.alpha[i]), np.sin(geometry.alpha[i]), 0.0])
+        dv = np.cross(w, v)
+        ddv = np.cross(dw, v) + np.cross(w, dv)
+        den, dden, ddden = v @ u, dv @ u, ddv @ u
+        out["denominator"][:, i] = den
+        a = geometry.a[i]
+        ok = np.abs(den) >= tolerance
+        sd = np.where(ok, den, 1.0)
+        b = a / sd                                                         # eq 8
+        db = -a * dden / sd ** 2
+        ddb = -a * ddden / sd ** 2 + 2.0 * a * dden ** 2 / sd ** 3
+        r = hvec + b[:, None] * v - a * u                                  # l_i e_i (eq 2)
+        dr = db[:, None] * v + b[:, None] * dv
+        ddr = ddb[:, None] * v + 2.0 * db[:, None] * dv + b[:, None] * ddv
+        l = np.linalg.norm(r, axis=1)                                      # eq 9
+        ok &= l >= tolerance
+        sl = np.where(ok, l, 1.0)
+        e = r / sl[:, None]                                                # eq 10
+        dl = dot(e, dr)
+        ddl = dot(e, ddr) + (dot(dr, dr) - dl ** 2) / sl
+        t_dir = np.cross(u, k)                                             # e = cos th k + sin th (u x k), eq 12
+        y, x = r @ t_dir, r @ k
+        dy, dx = dr @ t_dir, dr @ k
+        ddy, ddx = ddr @ t_dir, ddr @ k
+        D = np.where(ok, x * x + y * y, 1.0)
+        N = x * dy - y * dx
+        dN = x * ddy - y * ddx
+        dD = 2.0 * (x * dx + y * dy)
+        z = lambda q: np.where(ok, q, 0.0)  # noqa: E731
+        out["b"][:, i], out["b_dot"][:, i], out["b_ddot"][:, i] = z(b), z(db), z(ddb)
+        out["l"][:, i], out["l_dot"][:, i], out["l_ddot"][:, i] = z(l), z(dl), z(ddl)
+        out["theta"][:, i] = z(np.arctan2(y, x))                           # eq 13
+        out["theta_dot"][:, i] = z(N / D)
+        out["theta_ddot"][:, i] = z((dN * D - N * dD) / D ** 2)
+        out["e"][:, i] = np.where(ok[:, None], e, 0.0)
+        out["tip"][:, i] = np.where(ok[:, None], hvec + b[:, None] * v, 0.0)
+        out["degenerate"][:, i] = ~ok
     return out
+
+
+def _rotations(phi, dphi, ddphi):
+    """Batch of :func:`platform_rotation`: R (N, 3, 3), w and w' (N, 3)."""
+    R, w, dw = zip(*(platform_rotation(p, d, dd) for p, d, dd in zip(phi, dphi, ddphi)))
+    return np.array(R), np.array(w), np.array(dw)
 
 
 def counterweights_eqs_29_31(m_E, m_Q, m_H, m_K, r_H, r_K, r_P, r_N, r_Q, r_F):
