@@ -10,6 +10,8 @@ gear couplings for geared discs. The papers' closed forms (``Arm2DofDynamics``,
   counterweights.
 * :mod:`mechbal.papers.discs`: Coutinho & Hess Coelho, the planar 3R, spatial 3R and SCARA with
   counter-rotating discs (gear couplings).
+* :mod:`mechbal.papers.rpsp`: Heydari & Enferadi, the 3(RPSP)-S robot: the closed-form inverse
+  kinematics (eqs 1-13) and sizing (eqs 29-31) that check the ``rpsp`` case's general model.
 """
 from mechbal.papers.arm2dof import arm2dof_mechanism
 from mechbal.papers.discs import disc_arm_mechanism, disc_design_mechanism
