@@ -504,6 +504,9 @@ MechanismData::MechanismData(const MechanismModel& model)
   reduced_ldlt = Eigen::LDLT<Eigen::MatrixXd>(na);
   reduced_ldlt.compute(Eigen::MatrixXd::Identity(na, na));
   loop_normal = Eigen::MatrixXd::Identity(np, np);
+  loop_passive_first = Eigen::VectorXi::Zero(np);
+  loop_passive_last = Eigen::VectorXi::Zero(np);
+  loop_normal_pivots = Eigen::VectorXd::Ones(np);
   loop_ldlt = Eigen::LDLT<Eigen::MatrixXd>(np);
   loop_ldlt.compute(loop_normal);  // sizes every internal buffer once
   loop_step = Eigen::VectorXd::Zero(np);
