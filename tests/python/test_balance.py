@@ -223,12 +223,42 @@ def test_force_serial_arm_needs_masses_at_each_joint(arm):
     assert res.design["cw2"]["signed_distance"] == pytest.approx(0.1, abs=1e-12)
 
 
-@pytest.mark.skip(reason="PAMINSA on the general model (mechbal.papers.paminsa.paminsa_mechanism) is on "
-                         "branch loopdata, not on main yet: the four-bar closed form above is the "
-                         "regression of the method until it lands")
-def test_force_paminsa_counterweights():
-    from mechbal.papers.paminsa import paminsa_mechanism  # noqa: F401
-    # expected per leg: CP1 2.7915 kg, CP2 1.3865 kg, CP3 0.436 kg, vertical counter-mass 9.615 kg
+def test_force_paminsa_counterweights_from_the_momentum_regressor():
+    """PAMINSA (38 bodies, 9 loop closures, mechbal.papers.paminsa) unbalanced: the linear-momentum
+    regressor of the general model over solved closed motions, with one unknown mass per
+    counterweight type at the paper's points (identical legs), gives Briot & Arakelian's
+    counterweights 2.7915 / 1.3865 / 0.436 kg per leg and the 9.615 kg vertical counter-mass.
+    Without the identical-legs tie the system has rank 9 of 10: legs 1 and 2 share an actuator, so
+    one combination of their counterweights moves no momentum (the paper's design is one member
+    of that family)."""
+    from mechbal.cases.paminsa import parameters_from_config
+    from mechbal.config import case_path, read_toml
+    from mechbal.papers.paminsa import paminsa_mechanism
+    from mechbal.schema import validate_case
+
+    params = parameters_from_config(validate_case(read_toml(case_path("paminsa")), warn=False))
+    unb = paminsa_mechanism(params, False)
+    traj = read_toml(case_path("paminsa-linkage"))["trajectory"]
+    start, end = np.array(traj["start"]), np.array(traj["end"])
+    rng = np.random.default_rng(3)
+    qa = start + np.linspace(0, 1, 30)[:, None] * (end - start) + rng.uniform(-0.03, 0.03, (30, start.size))
+    m = unb.closed_motion(qa, rng.standard_normal(qa.shape), q_guess=np.array(traj["initial_guess"]))
+    assert np.all(m.status == 0)
+    Y = unb.momentum_regressor(m.q, m.v)[:, :3, :]
+    P = unb.momentum(m.q, m.v).linear_momentum
+    cw = [(k, b) for k, b in enumerate(unb.bodies) if b.kind == "counterweight"]
+    A = np.stack([Y[:, :, 10 * k:10 * k + 4] @ np.r_[1.0, b.com] for k, b in cw], axis=-1).reshape(-1, len(cw))
+    assert np.linalg.matrix_rank(A) == len(cw) - 1
+    types = sorted({b.name.split(".", 1)[-1] for _, b in cw})
+    tie = np.array([[b.name.split(".", 1)[-1] == t for t in types] for _, b in cw], float)
+    x, _, rank, _ = np.linalg.lstsq(A @ tie, -P.reshape(-1), rcond=None)
+    assert rank == len(types)
+    masses = dict(zip(types, x))
+    assert masses["CP1_atA"] == pytest.approx(2.7915, abs=1e-6)
+    assert masses["CP2_atF"] == pytest.approx(1.3865, abs=1e-6)
+    assert masses["CP3_atL"] == pytest.approx(0.436, abs=1e-6)
+    assert masses["vertical_counter_mass"] == pytest.approx(9.615, abs=1e-6)
+    assert np.abs(A @ tie @ x + P.reshape(-1)).max() < 1e-9 * np.abs(P).max()
 
 
 # ---- RMS / peak torque ----------------------------------------------------------------------------
