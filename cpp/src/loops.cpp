@@ -318,6 +318,33 @@ namespace {
 /// loop_projection at q (checked); `solved`: q is where solve_loop_positions just converged, so
 /// data.loop_jacobian, the factorisation of A° and data.loop_rcond are already those of q (its last
 /// evaluation) and are not recomputed.
+/// One step of iterative refinement of x, the least-squares solution of A° x = -b from the factored
+/// normal equations: x += (A°^T A°)^-1 A°^T (-(b + A° x)). The normal equations square A°'s
+/// condition and carry a small damping; one step brings x back to the accuracy of A° itself (a
+/// machine's internal spring forces of thousands of newtons multiply C's error: Orthoglide).
+template <typename B, typename X>
+void refine(MechanismData& data, const B& b, X&& x) noexcept {
+  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
+  Eigen::VectorXd& r = data.loop_constraint_work;
+  for (Eigen::Index row = 0; row < Ap.rows(); ++row) {
+    double v = -b(row);
+    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+      const double a = Ap(row, i);
+      if (a != 0.0) v -= a * x(i);
+    }
+    r(row) = v;
+  }
+  Eigen::VectorXd& step = data.loop_step;
+  step.setZero();
+  for (Eigen::Index row = 0; row < Ap.rows(); ++row) {
+    const double rv = r(row);
+    if (rv == 0.0) continue;
+    for (Eigen::Index i = 0; i < Ap.cols(); ++i) step(i) += Ap(row, i) * rv;
+  }
+  ldl_solve(data.loop_normal, data.loop_normal_pivots, step);
+  x += step;
+}
+
 Status project(const MechanismModel& model, MechanismData& data, const ConstVector& q,
                const ConstVector& v_actuated, const LoopSolveOptions& options, bool solved) noexcept {
   const auto& actuated = model.actuated_coordinates();
@@ -350,6 +377,7 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   }
   for (Eigen::Index j = 0; j < data.loop_solution.cols(); ++j) {
     ldl_solve(data.loop_normal, data.loop_normal_pivots, data.loop_solution.col(j));
+    refine(data, data.loop_actuated_jacobian.col(j), data.loop_solution.col(j));
   }
   for (std::size_t j = 0; j < passive.size(); ++j) {
     data.loop_projection.row(passive[j]) = data.loop_solution.row(static_cast<Eigen::Index>(j));
@@ -367,8 +395,10 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   constraint_bias(model, data);
   data.loop_step.noalias() = -data.loop_passive_jacobian.transpose() * data.loop_bias;
   ldl_solve(data.loop_normal, data.loop_normal_pivots, data.loop_step);
+  data.loop_refine_solution = data.loop_step;
+  refine(data, data.loop_bias, data.loop_refine_solution);
   for (std::size_t j = 0; j < passive.size(); ++j) {
-    data.loop_acceleration_bias(passive[j]) = data.loop_step(static_cast<Eigen::Index>(j));
+    data.loop_acceleration_bias(passive[j]) = data.loop_refine_solution(static_cast<Eigen::Index>(j));
   }
   if (!data.loop_projection.allFinite() || !data.loop_acceleration_bias.allFinite()) {
     return status | Status::singular;

@@ -501,6 +501,7 @@ MechanismData::MechanismData(const MechanismModel& model)
   loop_passive_jacobian = Eigen::MatrixXd::Zero(m, np);
   loop_actuated_jacobian = Eigen::MatrixXd::Zero(m, na);
   loop_constraint_work = Eigen::VectorXd::Zero(m);
+  loop_refine_solution = Eigen::VectorXd::Zero(np);
   reduced_ldlt = Eigen::LDLT<Eigen::MatrixXd>(na);
   reduced_ldlt.compute(Eigen::MatrixXd::Identity(na, na));
   loop_normal = Eigen::MatrixXd::Identity(np, np);

@@ -89,6 +89,8 @@ class ClosedMotion:
     iterations: np.ndarray
     status: np.ndarray
     actuated_force: np.ndarray | None = None
+    #: the coupling matrix C (.., dof, na): v = C v#, a = C a# + c
+    projection: np.ndarray | None = None
 
 
 def _status_text(code: int) -> str:
@@ -477,7 +479,7 @@ class Mechanism:
             out = {k: v[0] for k, v in out.items()}
         return ClosedMotion(q=out["q"], v=out["v"], a=out["a"], rcond=out["rcond"], residual=out["residual"],
                             iterations=out["iterations"], status=out["status"],
-                            actuated_force=out.get("actuated_force"))
+                            actuated_force=out.get("actuated_force"), projection=out.get("projection"))
 
     def actuated_forces(self, q_actuated, v_actuated, a_actuated, **kw) -> np.ndarray:
         """Actuated forces tau# = C^T tau(q, v, a) of the closed mechanism [N m or N]; for one

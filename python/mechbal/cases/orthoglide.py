@@ -43,34 +43,18 @@ POINT_FRAMES = ("O1", "O2", "O3", "D1", "D2", "D3", "V", "S", "G_w")
 
 
 def coupling_matrix(mech: Mechanism, q) -> np.ndarray:
-    """C (N, dof, na) with v = C v# at assembled configurations q (N, dof), from the loops' rows
-    A = dPhi/dq built from the loop frames' Jacobians (point: J_B - J_A; planar_point: frame A's x
-    and y rows of it) and an LU solve of the square passive block: X = -(A°)^-1 A#.
-
-    Why not the C++ loop projection: it solves the normal equations (A°^T A° + 1e-14 s I) for any
-    shape of A°, which on this mechanism leaves ~1.5e-12 relative error in C and ~1.3e-9 N in the
-    balanced static motor forces (the springs' internal forces are ~4500 N). Point and planar-point
-    loops with as many equations as passive coordinates only."""
+    """C (N, dof, na) with v = C v# at assembled configurations q (N, dof): the general loop
+    projection (C = [I; -(A°)^-1 A#], algorithm/loops.hpp) at each configuration, the loops
+    re-solved from the configuration itself (a warm start at the solution)."""
     q = np.atleast_2d(np.asarray(q, float))
-    rows = []
-    for lp in mech.model.description.loops:
-        d = mech.frame_jacobian(q, lp.frame_b)[:, :3, :] - mech.frame_jacobian(q, lp.frame_a)[:, :3, :]
-        if lp.type == _core.LoopType.point:
-            rows.append(d)
-        elif lp.type == _core.LoopType.planar_point:
-            R = mech.frame_placement(q, lp.frame_a)[:, :3, :3]
-            rows.append(np.einsum("nki,nkd->nid", R[:, :, :2], d))
-        else:
-            raise ConfigError(f"mechanism.loops.{lp.name}", "the orthoglide runner handles point and planar_point "
-                                                            "loops only", has_value=False)
-    A = np.concatenate(rows, 1)
-    act, pas = list(mech.model.actuated_coordinates), list(mech.model.passive_coordinates)
-    if A.shape[1] != len(pas):
-        raise ConfigError("mechanism.loops", f"{A.shape[1]} closure equations for {len(pas)} passive coordinates "
-                                             "(the orthoglide runner needs them equal)", has_value=False)
-    C = np.zeros((len(q), mech.dof, len(act)))
-    C[:, act, :] = np.eye(len(act))
-    C[:, pas, :] = -np.linalg.solve(A[:, :, pas], A[:, :, act])
+    act = list(mech.model.actuated_coordinates)
+    C = np.empty((len(q), mech.dof, len(act)))
+    for k in range(len(q)):  # each instant warm-starts from its own solved pose
+        m = mech.closed_motion(q[k:k + 1, act], q_guess=q[k], tolerance=1e-15)
+        if m.status[0] & ~np.uint32(int(_core.Status.singular)):
+            raise ConfigError("mechanism.loops", f"the loops do not close at a configuration of the path "
+                                                 f"(status {int(m.status[0])})", has_value=False)
+        C[k] = m.projection[0]
     return C
 
 
