@@ -7,7 +7,8 @@
    the 2-DOF closed form), ReactionlessWrist.step (Euler, RK4), DecoupledJointController.step (3 joints).
    The fast tick of issue 15 (target <= 1.5 us median): step_into(q, qd, q_des, qd_des, qdd_des,
    out), float64 arrays read and the torque written in place (no copy, no allocation, no tuple),
-   for the same three joint controllers (ct6_step_into, ct2_step_into, decoupled3_step_into).
+   for the same three joint controllers (ct6_step_into, ct2_step_into, decoupled3_step_into) and
+   the reactionless wrist (wrist_euler_step_into, wrist_rk4_step_into: the command into a (3, 3)).
 2. Batch throughput (instants per second) of mechbal.shaking_wrench over a 1e5-instant trajectory
    of 10 bodies against a pure-numpy implementation of the same formula (Briot & Arakelian 2009,
    eqs 1-4): F = sum m a_G; M_O = sum (m OG x a_G + I alpha + w x I w), I = R I_body R^T. The two
@@ -153,6 +154,9 @@ def main(argv=None):
         D, Dd = np.array([0.05, -0.02, 0.01]), np.array([0.3, 0.1, -0.2])
         med, p99 = median_per_call_ns(lambda: wrist.step(D, Dd, D, D), calls)
         results["per_call"][name] = {"median_ns": med, "p99_ns": p99}
+        command = np.zeros((3, 3))
+        med, p99 = median_per_call_ns(lambda: wrist.step_into(D, Dd, D, D, command), calls)
+        results["per_call"][f"{name}_step_into"] = {"median_ns": med, "p99_ns": p99}
 
     # ---- 2. batch throughput against numpy ------------------------------------------------------
     data = random_bodies(rng, args.instants, args.bodies)

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "array_checks.hpp"
+#include "controller_step.hpp"
 #include "bindings.hpp"
 #include "mechbal/paminsa.hpp"
 #include "mechbal/reactionless_wrist.hpp"
@@ -196,6 +197,26 @@ void bind_paminsa(py::module_& m) {
            },
            py::arg("angles"), py::arg("target_momentum"))
       .def(
+          "step_into",
+          [](ReactionlessWrist& w, FastArg D, FastArg Dd, FastArg Dh, FastArg Dn, FastArg out) {
+            using CV = Eigen::Map<const Vec3>;
+            const double* d = detail::fast_array(D.h, "D", 3);
+            const double* dd = detail::fast_array(Dd.h, "D_dot", 3);
+            const double* dh = detail::fast_array(Dh.h, "D_half", 3);
+            const double* dn = detail::fast_array(Dn.h, "D_next", 3);
+            double* o = detail::fast_matrix(out.h, "out", 3, 3, true);
+            const Status s = w.step(CV(d), CV(dd), CV(dh), CV(dn));
+            const WristCommand& c = w.command();
+            Eigen::Map<Vec3>{o} = c.angles;
+            Eigen::Map<Vec3>(o + 3) = c.rates;
+            Eigen::Map<Vec3>(o + 6) = c.accelerations;
+            return static_cast<std::uint32_t>(s);
+          },
+          py::arg("D"), py::arg("D_dot"), py::arg("D_half"), py::arg("D_next"), py::arg("out"),
+          "The fast tick: D [kg m^2/s], D_dot [N m], D_half, D_next as float64 arrays of 3; writes "
+          "the command into `out` (3, 3): rows angles [rad], rates [rad/s], accelerations "
+          "[rad/s^2]; returns the status as an int. Nothing is copied or allocated.")
+      .def(
           "run",
           [](ReactionlessWrist& w, const Array& D, const Array& Dd, const Array& Dh,
              const Array& Dn) {
@@ -360,6 +381,32 @@ void bind_paminsa(py::module_& m) {
           "One tick: platform position [m], velocity [m/s], acceleration [m/s^2] at t_n, "
           "t_n + dt/2, t_n + dt (Euler ignores the last two). Returns the Status; the result is "
           "in shaking_force, shaking_moment, D, D_dot and wrist_command")
+      .def(
+          "step_into",
+          [](PaminsaController& c, FastArg now, FastArg half, FastArg next, FastArg out) {
+            auto motion = [](const double* p) {
+              PlatformMotion m;
+              m.position = Eigen::Map<const Vec3>(p);
+              m.velocity = Eigen::Map<const Vec3>(p + 3);
+              m.acceleration = Eigen::Map<const Vec3>(p + 6);
+              return m;
+            };
+            const double* n = detail::fast_matrix(now.h, "now", 3, 3);
+            const double* h = detail::fast_matrix(half.h, "half", 3, 3);
+            const double* x = detail::fast_matrix(next.h, "next", 3, 3);
+            double* o = detail::fast_matrix(out.h, "out", 3, 3, true);
+            const Status s = c.tick(motion(n), motion(h), motion(x));
+            const WristCommand& w = c.wrist().command();
+            Eigen::Map<Vec3>{o} = w.angles;
+            Eigen::Map<Vec3>(o + 3) = w.rates;
+            Eigen::Map<Vec3>(o + 6) = w.accelerations;
+            return static_cast<std::uint32_t>(s);
+          },
+          py::arg("now"), py::arg("half"), py::arg("next"), py::arg("out"),
+          "The fast tick: the platform motion at t_n, t_n + dt/2, t_n + dt, each a (3, 3) float64 "
+          "array with rows position [m], velocity [m/s], acceleration [m/s^2]; writes the wrist "
+          "command into `out` (3, 3): rows angles [rad], rates [rad/s], accelerations [rad/s^2]; "
+          "returns the status as an int (the wrench stays in shaking_force, shaking_moment)")
       .def_property_readonly("shaking_force",
                              [](const PaminsaController& c) { return Vec3(c.wrench().force); })
       .def_property_readonly("shaking_moment",

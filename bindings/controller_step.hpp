@@ -100,6 +100,34 @@ inline double* fast_array(pybind11::handle h, const char* name, pybind11::ssize_
   return reinterpret_cast<double*>(a->data);
 }
 
+/// A (rows, cols) native float64 C-contiguous aligned array (the fast path's matrices).
+inline double* fast_matrix(pybind11::handle h, const char* name, pybind11::ssize_t rows,
+                           pybind11::ssize_t cols, bool writeable = false) {
+  namespace pd = pybind11::detail;
+  const auto& api = pd::npy_api::get();
+  constexpr int need = pd::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | pd::npy_api::NPY_ARRAY_ALIGNED_;
+  if (api.PyArray_Check_(h.ptr())) {
+    const pd::PyArray_Proxy* a = pd::array_proxy(h.ptr());
+    const pd::PyArrayDescr_Proxy* d = pd::array_descriptor_proxy(a->descr);
+    const int flags = a->flags;
+    if (a->nd == 2 && a->dimensions[0] == rows && a->dimensions[1] == cols &&
+        d->type_num == pd::npy_api::NPY_DOUBLE_ && d->byteorder != '>' && (flags & need) == need &&
+        (!writeable || (flags & pd::npy_api::NPY_ARRAY_WRITEABLE_)))
+      return reinterpret_cast<double*>(a->data);
+    const auto arr = pybind11::reinterpret_borrow<pybind11::array>(h);
+    if (arr.ndim() != 2 || arr.shape(0) != rows || arr.shape(1) != cols)
+      throw pybind11::value_error(std::string("step_into: ") + name + " must have shape (" +
+                                  std::to_string(rows) + ", " + std::to_string(cols) + "), got " +
+                                  shape_of(arr));
+    if (writeable && !arr.writeable())
+      throw pybind11::value_error(std::string("step_into: ") + name + " must be writeable");
+  }
+  throw pybind11::type_error(std::string("step_into: ") + name +
+                             " must be a C-contiguous numpy array of float64 "
+                             "(numpy.ascontiguousarray(x, dtype=float)), got " +
+                             pybind11::str(pybind11::type::handle_of(h)).cast<std::string>());
+}
+
 }  // namespace detail
 
 template <typename Controller>

@@ -935,6 +935,10 @@ class ReactionlessWrist:
         """
     def step_euler(self, D: numpy.typing.ArrayLike, D_dot: numpy.typing.ArrayLike) -> Status:
         ...
+    def step_into(self, D: numpy.typing.NDArray[numpy.float64], D_dot: numpy.typing.NDArray[numpy.float64], D_half: numpy.typing.NDArray[numpy.float64], D_next: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+        """
+        The fast tick: D [kg m^2/s], D_dot [N m], D_half, D_next as float64 arrays of 3; writes the command into `out` (3, 3): rows angles [rad], rates [rad/s], accelerations [rad/s^2]; returns the status as an int. Nothing is copied or allocated.
+        """
     @property
     def angles(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         ...
@@ -994,6 +998,10 @@ class PaminsaController:
     def step(self, P: numpy.typing.ArrayLike, Pd: numpy.typing.ArrayLike, Pdd: numpy.typing.ArrayLike, P_half: numpy.typing.ArrayLike, Pd_half: numpy.typing.ArrayLike, Pdd_half: numpy.typing.ArrayLike, P_next: numpy.typing.ArrayLike, Pd_next: numpy.typing.ArrayLike, Pdd_next: numpy.typing.ArrayLike) -> Status:
         """
         One tick: platform position [m], velocity [m/s], acceleration [m/s^2] at t_n, t_n + dt/2, t_n + dt (Euler ignores the last two). Returns the Status; the result is in shaking_force, shaking_moment, D, D_dot and wrist_command
+        """
+    def step_into(self, now: numpy.typing.NDArray[numpy.float64], half: numpy.typing.NDArray[numpy.float64], next: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+        """
+        The fast tick: the platform motion at t_n, t_n + dt/2, t_n + dt, each a (3, 3) float64 array with rows position [m], velocity [m/s], acceleration [m/s^2]; writes the wrist command into `out` (3, 3): rows angles [rad], rates [rad/s], accelerations [rad/s^2]; returns the status as an int (the wrench stays in shaking_force, shaking_moment)
         """
     @property
     def D(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:

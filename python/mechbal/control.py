@@ -210,7 +210,9 @@ class ReactionlessWrist(_core.ReactionlessWrist):
     A tick ``step(D, D_dot, D_half, D_next) -> int`` takes D [kg m^2/s] and dD/dt [N m] of the
     rest of the mechanism at t_n (RK4 also D at t_n + dt/2 and t_n + dt) and leaves the
     :class:`WristCommand` in ``command`` (angles, rates, accelerations, condition_number,
-    status); :meth:`run` ticks N times in one call.
+    status); ``step_into(D, D_dot, D_half, D_next, out) -> int`` is the fast tick (float64
+    arrays; the command written into ``out`` (3, 3), rows angles [rad], rates [rad/s],
+    accelerations [rad/s^2]); :meth:`run` ticks N times in one call.
     """
 
     def run(self, D: npt.ArrayLike, D_dot: npt.ArrayLike, D_half: npt.ArrayLike,  # type: ignore[override]
@@ -236,7 +238,9 @@ class PaminsaController(_core.PaminsaController):
     Pdd_half, P_next, Pd_next, Pdd_next) -> int`` with the platform position [m], velocity
     [m/s] and acceleration [m/s^2] at t_n, t_n + dt/2 and t_n + dt; the result is in
     ``shaking_force`` [N], ``shaking_moment`` [N m], ``D``, ``D_dot`` and ``wrist_command``.
-    Batch: :meth:`run`.
+    Fast tick: ``step_into(now, half, next, out) -> int`` with (3, 3) float64 arrays whose rows
+    are position, velocity, acceleration, the wrist command written into ``out`` (3, 3): rows
+    angles, rates, accelerations. Batch: :meth:`run`.
     """
 
     def __init__(self, model: Any, config: Any, initial_wrist_angles: npt.ArrayLike,

@@ -139,7 +139,11 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
 
 @dataclass
 class ChainRun:
-    """One serial chain evaluated along a trajectory (all arrays in the base frame, SI units)."""
+    """One serial chain evaluated along a trajectory (all arrays in the base frame, SI units):
+    times ``t`` [s], the motion ``q``, ``qd``, ``qdd``, every link's ``bodies`` motion, the
+    ``wrench`` of the bodies and the KDL joint ``torque`` with the base ``support_force`` /
+    ``support_moment``; ``shaking_force``, ``shaking_moment``, ``joint_torque``,
+    ``base_reaction_force`` and ``base_reaction_moment`` name them as elsewhere in mechbal."""
 
     t: np.ndarray
     q: np.ndarray
@@ -154,6 +158,32 @@ class ChainRun:
     support_force: np.ndarray
     support_moment: np.ndarray
     extra: dict = field(default_factory=dict)
+
+    # the names used everywhere else in mechbal (Mechanism, ClosedLoopResult, summaries, files)
+    @property
+    def shaking_force(self) -> np.ndarray:
+        """dP/dt of the chain's bodies (N, 3) [N] (``wrench["force"]``)."""
+        return np.asarray(self.wrench["force"])
+
+    @property
+    def shaking_moment(self) -> np.ndarray:
+        """dH_O/dt about the base origin (N, 3) [N m] (``wrench["moment"]``)."""
+        return np.asarray(self.wrench["moment"])
+
+    @property
+    def joint_torque(self) -> np.ndarray:
+        """Joint torques or forces (N, n) [N m or N] (``torque``)."""
+        return self.torque
+
+    @property
+    def base_reaction_force(self) -> np.ndarray:
+        """Force the base exerts on the chain, gravity included (N, 3) [N] (``support_force``)."""
+        return self.support_force
+
+    @property
+    def base_reaction_moment(self) -> np.ndarray:
+        """Its moment about the base origin (N, 3) [N m] (``support_moment``)."""
+        return self.support_moment
 
 
 def run_chain(model: _core.ChainModel, trajectory: Any, t: np.ndarray) -> ChainRun:

@@ -173,11 +173,21 @@ def test_reactionless_wrist_run_equals_ticks():
     D = rng.uniform(-0.05, 0.05, (4, 20, 3))
     w1 = control.ReactionlessWrist(J[0], J[1], J[2], cfg, np.full(3, np.pi / 2), np.zeros(3))
     w2 = control.ReactionlessWrist(J[0], J[1], J[2], cfg, np.full(3, np.pi / 2), np.zeros(3))
+    w3 = control.ReactionlessWrist(J[0], J[1], J[2], cfg, np.full(3, np.pi / 2), np.zeros(3))
     run = w1.run(*D)
+    out = np.zeros((3, 3))
     for k in range(20):
         assert w2.step(*D[:, k]) == run.status[k]
         np.testing.assert_array_equal(w2.command.rates, run.wrist_rates[k])
         np.testing.assert_array_equal(w2.command.angles, run.wrist_angles[k])
+        args = [np.ascontiguousarray(x) for x in D[:, k]]
+        assert w3.step_into(*args, out) == run.status[k]
+        np.testing.assert_array_equal(out, [run.wrist_angles[k], run.wrist_rates[k],
+                                            run.wrist_accelerations[k]])
+    with pytest.raises(ValueError, match=r"out must have shape \(3, 3\)"):
+        w3.step_into(*args, np.zeros(9))
+    with pytest.raises(TypeError, match="D_dot"):
+        w3.step_into(args[0], [0.0, 0.0, 0.0], args[2], args[3], out)
 
 
 def test_paminsa_controller_ticks_equal_its_batch_run():
@@ -189,7 +199,10 @@ def test_paminsa_controller_ticks_equal_its_batch_run():
     ctl = control.PaminsaController(pam, cfg, q0)
     run = ctl.run(P, Pd, Pdd)
     assert run.shaking_force.shape == (steps + 1, 3) and run.com.shape == (steps + 1, 38, 3)
-    assert ctl.reset(P[0], q0) == 0
+    fast = control.PaminsaController(pam, cfg, q0)
+    assert ctl.reset(P[0], q0) == 0 and fast.reset(P[0], q0) == 0
+    motion = np.ascontiguousarray(np.stack([P, Pd, Pdd], axis=1))  # (2 steps + 1, 3, 3)
+    out = np.zeros((3, 3))
     for n in range(steps):
         j = 2 * n
         s = ctl.step(P[j], Pd[j], Pdd[j], P[j + 1], Pd[j + 1], Pdd[j + 1], P[j + 2], Pd[j + 2], Pdd[j + 2])
@@ -197,6 +210,10 @@ def test_paminsa_controller_ticks_equal_its_batch_run():
         np.testing.assert_allclose(ctl.wrist_command.angles, run.wrist_angles[n], atol=1e-12)
         np.testing.assert_allclose(ctl.shaking_moment, run.shaking_moment[n], atol=1e-9)
         np.testing.assert_allclose(ctl.D, run.D[n], atol=1e-12)
+        assert fast.step_into(motion[j], motion[j + 1], motion[j + 2], out) == 0
+        np.testing.assert_array_equal(out[0], ctl.wrist_command.angles)
+        np.testing.assert_array_equal(out[1], ctl.wrist_command.rates)
+        np.testing.assert_array_equal(fast.shaking_moment, ctl.shaking_moment)
 
 
 # ---- trajectories ------------------------------------------------------------------------------
@@ -318,3 +335,4 @@ def test_run_chain_still_works():
     motion = trajectory.quintic([0.0, 0.0], [0.5, -0.5], 1.0)
     run = simulate.run_chain(model, motion, np.linspace(0, 1, 11))
     assert run.torque.shape == (11, 2) and run.wrench["force"].shape == (11, 3)
+    assert run.shaking_force is not None and run.base_reaction_force is run.support_force
