@@ -127,11 +127,15 @@ def _control_run(result: dict) -> ControlRun:
                       status=np.asarray(result["status"]))
 
 
-def _dynamics(model: Any) -> Any:
+def _dynamics(model: Any, q_guess: npt.ArrayLike | None) -> Any:
     from mechbal.mechanism import Mechanism
 
     if isinstance(model, Mechanism):
-        return _core.MechanismDynamics(model.model)
+        guess = np.zeros(model.dof) if q_guess is None else np.asarray(q_guess, dtype=float)
+        return _core.MechanismDynamics(model.model, guess)
+    if q_guess is not None:
+        raise ValueError("q_guess is for a Mechanism model (closed loops); a dynamics back end "
+                         "was given")
     return model
 
 
@@ -151,14 +155,17 @@ class ComputedTorque(_core.ComputedTorque):
         max_position, max_speed, max_acceleration: the input range of a tick (|q| [rad or m],
             |qd|, |qdd_des|); beyond it the tick holds the last command with
             ``Status.out_of_range``.
+        q_guess: with a closed-loop Mechanism, every joint coordinate near the assembly [rad or
+            m] (picks the assembly mode the loop solve follows; default zeros).
 
     Ticks: ``step`` / ``step_into`` / ``run`` (see :mod:`mechbal.control`); ``reset()`` forgets
     the held command.
     """
 
     def __init__(self, model: Any, kp: npt.ArrayLike, kd: npt.ArrayLike,
-                 torque_limit: npt.ArrayLike | None = None, **input_range: float):
-        super().__init__(_dynamics(model), kp, kd, torque_limit, **input_range)
+                 torque_limit: npt.ArrayLike | None = None, *, q_guess: npt.ArrayLike | None = None,
+                 **input_range: float):
+        super().__init__(_dynamics(model, q_guess), kp, kd, torque_limit, **input_range)
 
     def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
              qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:

@@ -97,7 +97,7 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
             sampled every dt/2 first.
         q0, qd0: initial state [rad or m, rad/s or m/s]; default: the trajectory at t = 0.
         dt: controller period = RK4 step [s].
-        duration: simulated time [s]; default the trajectory's end time.
+        duration: simulated time [s]; default the trajectory's ``end_time`` (or ``duration``).
         sampling: ``"zero_order_hold"`` (a digital controller: the torque of tick k is held over
             the step) or ``"every_rk4_stage"`` (the continuous control law at each RK4 stage).
         q_guess: full coordinates near the assembly, for a closed-loop Mechanism.
@@ -113,9 +113,8 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
         raise TypeError("controller must be a joint controller (mechbal.control.ComputedTorque, "
                         f"DecoupledJointController), got {type(controller).__name__}")
     traj = as_trajectory(trajectory)
-    if duration is None:
-        end = getattr(traj, "_t", None)
-        duration = float(end[-1]) if end is not None else traj.duration
+    if duration is None:  # until the motion ends (a trajectory may start after t = 0)
+        duration = float(getattr(traj, "end_time", traj.duration))
     q_start, qd_start, _ = traj.evaluate(0.0)
     q0 = q_start if q0 is None else q0
     qd0 = qd_start if qd0 is None else qd0

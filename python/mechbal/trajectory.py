@@ -110,6 +110,11 @@ class RestToRest:
         return float(self.core.duration)
 
     @property
+    def end_time(self) -> float:
+        """Time the motion ends [s] (= ``duration``: it starts at t = 0)."""
+        return self.duration
+
+    @property
     def law(self) -> str:
         """``"quintic"`` or ``"cubic"``."""
         return str(self.core.law.name)
@@ -201,6 +206,11 @@ class ViaPoints:
         """``times[-1] - times[0]`` [s]."""
         return float(self._t[-1] - self._t[0])
 
+    @property
+    def end_time(self) -> float:
+        """``times[-1]`` [s]: when the motion ends."""
+        return float(self._t[-1])
+
     def evaluate(self, t: Times) -> Motion:
         """``(q, qd, qdd)`` at absolute times ``t`` [s]; held at rest outside ``times``."""
         single, ts = _times(t)
@@ -263,6 +273,11 @@ class Sampled:
     def duration(self) -> float:
         """``times[-1] - times[0]`` [s]."""
         return float(self._t[-1] - self._t[0])
+
+    @property
+    def end_time(self) -> float:
+        """``times[-1]`` [s]: when the motion ends."""
+        return float(self._t[-1])
 
     def evaluate(self, t: Times) -> Motion:
         """``(q, qd, qdd)`` at absolute times ``t`` [s]; held at rest outside the samples."""

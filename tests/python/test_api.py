@@ -318,7 +318,7 @@ def test_closed_loop_on_a_closed_linkage_from_toml():
 
     mech = mechbal.Mechanism.from_toml(CASES_DIR / "four-bar.toml")
     guess = np.array([1.0, -0.6, 1.3])
-    ctl = control.ComputedTorque(control.MechanismDynamics(mech.model, guess), [100.0], [20.0])
+    ctl = control.ComputedTorque(mech, [100.0], [20.0], q_guess=guess)
     motion = trajectory.ViaPoints([0.0, 0.1, 0.2], [[1.0], [1.1], [1.15]])
     r = simulate.closed_loop(mech, ctl, motion, q0=[1.02], q_guess=guess, dt=1e-3,
                              sampling="every_rk4_stage")
