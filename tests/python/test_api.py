@@ -137,6 +137,21 @@ def test_step_into_bad_input_is_a_named_error_or_a_status():
     assert control.status_text(s) == "non_finite_input"
 
 
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf, 5e-324, 1e155, -1e300, 0.5])
+@pytest.mark.parametrize("slot", range(5))
+def test_step_into_matches_step_on_extreme_input(value, slot):
+    a, b = arm_controller(), arm_controller()
+    x = [np.array([0.1, -0.2]), np.zeros(2), np.array([0.3, 0.1]), np.zeros(2), np.zeros(2)]
+    a.step(*x)
+    b.step_into(*x, np.zeros(2))
+    x[slot] = np.array([value, 0.0])
+    tau, s = a.step(*x)
+    out = np.full(2, np.nan)
+    assert b.step_into(*x, out) == s
+    np.testing.assert_array_equal(out, tau)
+    assert np.all(np.isfinite(out))
+
+
 def test_saturated_ticks_come_back_as_a_status_array():
     c = arm_controller(torque_limit=[1.0, 1.0])
     run = c.run(np.zeros((3, 2)), np.zeros((3, 2)), np.ones((3, 2)), np.zeros((3, 2)), np.zeros((3, 2)))
