@@ -13,6 +13,10 @@
    of 10 bodies against a pure-numpy implementation of the same formula (Briot & Arakelian 2009,
    eqs 1-4): F = sum m a_G; M_O = sum (m OG x a_G + I alpha + w x I w), I = R I_body R^T. The two
    are checked to agree (1e-9 relative) before anything is timed.
+4. Sizing (issue 11): static balancing by counterweights (mechbal.balance.static: batched C++
+   gravity regressor of the probe bodies, least squares, bounds) of a random spatial 7-joint arm
+   with a counterweight slot on each of links 2-7, over 10 000 random poses (target < 1 s on one
+   core: run with OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1).
 3. Controllers in batch: paminsa_reactionless_run (RK4 wrist, 2000 ticks, also writing every
    body's motion) and simulate_computed_torque (2-DOF closed loop, 2000 ticks), ticks per second.
    These are sequential closed loops: there is no vectorised numpy equivalent to compare with.
@@ -215,11 +219,41 @@ def main(argv=None):
     results["batch_controllers"]["closed_loop_ct2"] = {
         "ticks": ticks, "seconds": t_sim, "ticks_per_s": ticks / t_sim,
         "ns_per_tick": t_sim / ticks * 1e9}
+    results["sizing"] = bench_sizing(repeat)
     text = json.dumps(results, indent=2)
     print(text)
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)
         args.out.write_text(text + "\n")
+
+
+def seven_joint_arm(seed: int = 7):
+    """A random spatial 7R arm (placements, axes, masses) as a mechbal.Mechanism."""
+    from mechbal.spec import mechanism_spec
+
+    rng = np.random.default_rng(seed)
+    joints = [{"name": f"j{i + 1}", "origin": {"xyz": rng.uniform(-0.3, 0.3, 3).tolist(),
+                                                "rpy": rng.uniform(-1.5, 1.5, 3).tolist()},
+               "axis": rng.normal(size=3).tolist(),
+               "link": {"mass": float(rng.uniform(0.5, 4.0)), "com": rng.uniform(-0.2, 0.2, 3).tolist(),
+                        "inertia": [0.02, 0.03, 0.04]}} for i in range(7)]
+    return mechbal.Mechanism.from_spec(mechanism_spec({"joints": joints}), name="random-7R")
+
+
+def bench_sizing(repeat: int) -> dict:
+    from mechbal.balance import CounterweightSlot, static
+
+    mech = seven_joint_arm()
+    out = {}
+    # a slot on every link: exact; on links 2-7 only: joint 1 cannot be held (constrained stage)
+    for label, first in (("static_7R_10000_poses", 1), ("static_7R_10000_poses_links_2_7", 2)):
+        slots = [CounterweightSlot(f"cw{i}", f"j{i}", 0.0, 50.0, max_radius=0.4) for i in range(first, 8)]
+        res = static.balance(mech, slots, 10_000)
+        seconds = best_time(lambda: static.balance(mech, slots, 10_000), max(1, min(repeat, 3)))
+        out[label] = {"seconds": seconds, "poses": 10_000, "slots": len(slots), "exact": res.exact,
+                      "residual_Nm": res.residual, "residual_before_Nm": res.residual_before,
+                      "target_s": 1.0}
+    return out
 
 
 if __name__ == "__main__":

@@ -171,6 +171,11 @@ def main(argv=None):
         for alg in URDF_ALGORITHMS:
             key = f"pinocchio_over_mechbal_{alg}_{robot}"
             targets[f"{key} >= 1"] = check(ratios[key], lambda v: v >= 1.0)
+    from merge_loops import loop_results  # closed loops on the general model (bench_loops.cpp)
+
+    loop_ratios, loop_targets, loop_notes = loop_results(cases, ratio, median, check)
+    ratios.update(loop_ratios)
+    targets.update(loop_targets)
     if loop_paminsa:
         targets["loop_paminsa_p999_ns < 10000"] = check(loop_paminsa["p999_ns"],
                                                         lambda v: v < 10000)
@@ -225,6 +230,7 @@ def main(argv=None):
         "targets": targets,
         "python": py,
     }
+    result["notes"].update(loop_notes)
     args.out_json.parent.mkdir(parents=True, exist_ok=True)
     args.out_json.write_text(json.dumps(result, indent=2) + "\n")
 

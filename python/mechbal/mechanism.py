@@ -89,6 +89,8 @@ class ClosedMotion:
     iterations: np.ndarray
     status: np.ndarray
     actuated_force: np.ndarray | None = None
+    #: the coupling matrix C (.., dof, na): v = C v#, a = C a# + c
+    projection: np.ndarray | None = None
 
 
 def _status_text(code: int) -> str:
@@ -103,12 +105,15 @@ class Mechanism:
     """
 
     def __init__(self, model: "_core.MechanismModel", *, name: str = "mechanism",
-                 source: str | None = None):
+                 source: str | None = None, link_frames=None):
         if not isinstance(model, _core.MechanismModel):
             raise TypeError(f"model must be a mechbal._core.MechanismModel, got {type(model).__name__}")
         self.model = model
         self.name = name
         self.source = source
+        #: link -> (4, 4) placement in the link frame of the frame the user described the link in
+        #: (see :meth:`user_frame`); absent links: the identity
+        self.link_frames = {str(k): np.array(v, dtype=float) for k, v in (link_frames or {}).items()}
 
     # ---- construction ------------------------------------------------------------------------
     @classmethod
@@ -201,7 +206,32 @@ class Mechanism:
             model = _core.MechanismModel(desc)
         except ValueError as exc:
             raise ConfigError("mechanism", str(exc), has_value=False) from None
-        return cls(model, name=name, source=source)
+        return cls(model, name=name, source=source, link_frames=getattr(spec, "link_frames", None))
+
+    def user_frame(self, link: str) -> np.ndarray:
+        """(4, 4) placement, in the link frame of ``link`` (the frame right after its joint's
+        motion), of the frame the user described that link in: the standard-DH frame of a ``dh``
+        joint of a TOML file, ``mechanism.base`` for ``base``, the identity otherwise (URDF link
+        frames, ``origin`` and ``mdh`` joints). A point p given by the user is ``T @ [p, 1]``."""
+        if link not in self.link_names:
+            import difflib
+            hint = difflib.get_close_matches(link, self.link_names, n=1)
+            raise ValueError(f"link: no link named '{link}'" + (f" (did you mean '{hint[0]}'?)" if hint
+                                                                else f" (links: {', '.join(self.link_names)})"))
+        return self.link_frames.get(link, np.eye(4)).copy()
+
+    def with_bodies(self, bodies: Sequence["_core.Body"], *, replace: bool = False,
+                    name: str | None = None) -> "Mechanism":
+        """A copy with ``bodies`` (:class:`mechbal.Body`, com and inertia in the link frames)
+        added to its own (``replace``: instead of its own): same joints, frames, loops, gravity
+        and user frames. Raises ValueError naming the problem (duplicate name, unknown link)."""
+        d = self.model.description
+        own = [] if replace else list(d.bodies)
+        desc = _core.MechanismDescription(list(d.joints), own + list(bodies), list(d.frames),
+                                          np.asarray(d.gravity, float), d.root_name, list(d.loops),
+                                          list(d.actuated))
+        return Mechanism(_core.MechanismModel(desc), name=name or self.name, source=self.source,
+                         link_frames=self.link_frames)
 
     # ---- structure ---------------------------------------------------------------------------
     @property
@@ -454,7 +484,7 @@ class Mechanism:
             out = {k: v[0] for k, v in out.items()}
         return ClosedMotion(q=out["q"], v=out["v"], a=out["a"], rcond=out["rcond"], residual=out["residual"],
                             iterations=out["iterations"], status=out["status"],
-                            actuated_force=out.get("actuated_force"))
+                            actuated_force=out.get("actuated_force"), projection=out.get("projection"))
 
     def actuated_forces(self, q_actuated, v_actuated, a_actuated, **kw) -> np.ndarray:
         """Actuated forces tau# = C^T tau(q, v, a) of the closed mechanism [N m or N]; for one

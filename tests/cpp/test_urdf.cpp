@@ -72,24 +72,23 @@ std::string error_of(const std::string& xml) {
 TEST(Urdf, TreeStructure) {
   const MechanismModel model = model_from_urdf_string(kTree);
   EXPECT_EQ(model.root_name(), "base");
-  EXPECT_EQ(model.num_links(), 6);
+  // the fixed joint j4 is folded into j2's link when the model is built (bodies and frames move)
+  EXPECT_EQ(model.num_links(), 5);
   ASSERT_EQ(model.dof(), 3);
   EXPECT_EQ(model.coordinate_names(), (std::vector<std::string>{"j1", "j2", "j3"}));
-  // depth-first, children by name: j1, j2, j4, j3, j5
+  // depth-first, children by name: j1, j2, (j4 folded), j3, j5
   EXPECT_EQ(model.link_name(1), "j1");
   EXPECT_EQ(model.link_name(2), "j2");
-  EXPECT_EQ(model.link_name(3), "j4");
-  EXPECT_EQ(model.link_name(4), "j3");
-  EXPECT_EQ(model.link_name(5), "j5");
-  EXPECT_EQ(model.parent(5), 4);
+  EXPECT_EQ(model.link_name(3), "j3");
+  EXPECT_EQ(model.link_name(4), "j5");
+  EXPECT_EQ(model.parent(4), 3);
   EXPECT_EQ(model.joint_type(1), JointType::revolute);
   EXPECT_EQ(model.joint_type(2), JointType::revolute);  // continuous
-  EXPECT_EQ(model.joint_type(3), JointType::fixed);
-  EXPECT_EQ(model.joint_type(4), JointType::prismatic);
+  EXPECT_EQ(model.joint_type(3), JointType::prismatic);
   EXPECT_TRUE(model.axis(1).isApprox(Vec3::UnitX()));  // URDF's default axis
   EXPECT_TRUE(model.axis(2).isApprox(Vec3::UnitY()));
   EXPECT_TRUE(model.placement(2).linear().isApprox(Eigen::AngleAxisd(0.3, Vec3::UnitX()).toRotationMatrix()));
-  EXPECT_TRUE(model.placement(4).translation().isApprox(Vec3(0.1, 0.0, 0.2)));
+  EXPECT_TRUE(model.placement(3).translation().isApprox(Vec3(0.1, 0.0, 0.2)));
 
   // limits: continuous has none; a zero velocity limit means "unspecified"
   EXPECT_DOUBLE_EQ(model.lower_limits()(0), -1.5);
@@ -100,9 +99,9 @@ TEST(Urdf, TreeStructure) {
   EXPECT_DOUBLE_EQ(model.velocity_limits()(2), 0.5);
 
   // mimic: j5 = -2 j1 + 0.1
-  EXPECT_EQ(model.coordinate(5), 0);
-  EXPECT_DOUBLE_EQ(model.coordinate_ratio(5), -2.0);
-  EXPECT_DOUBLE_EQ(model.coordinate_offset(5), 0.1);
+  EXPECT_EQ(model.coordinate(4), 0);
+  EXPECT_DOUBLE_EQ(model.coordinate_ratio(4), -2.0);
+  EXPECT_DOUBLE_EQ(model.coordinate_offset(4), 0.1);
 
   // bodies: one per URDF link with an inertial, on the link its parent joint moves
   ASSERT_EQ(model.num_bodies(), 6);
@@ -114,14 +113,15 @@ TEST(Urdf, TreeStructure) {
   EXPECT_NEAR(root.inertia(0, 0), 0.2, 1e-15);
   EXPECT_NEAR(root.inertia(1, 1), 0.1, 1e-15);
   EXPECT_NEAR(root.inertia(2, 2), 0.25, 1e-15);
-  EXPECT_EQ(model.body(model.body_index("tool")).link, "j4");
+  EXPECT_EQ(model.body(model.body_index("tool")).link, "j2");  // folded with j4
   EXPECT_EQ(model.body(model.body_index("l4")).link, "j5");
   EXPECT_DOUBLE_EQ(model.total_mass(), 4.0 + 2.0 + 1.0 + 0.5 + 0.3 + 0.2);
 
   // frames: every URDF link by its own name
   ASSERT_EQ(model.num_frames(), 6);
   for (const char* name : {"base", "l1", "l2", "l3", "l4", "tool"}) EXPECT_GE(model.frame_index(name), 0) << name;
-  EXPECT_EQ(model.frame(model.frame_index("tool")).link, "j4");
+  EXPECT_EQ(model.frame(model.frame_index("tool")).link, "j2");
+  EXPECT_TRUE(model.frame(model.frame_index("tool")).placement.translation().isApprox(Vec3(0.3, 0.0, 0.0)));
   EXPECT_EQ(model.frame(model.frame_index("l3")).link, "j3");
 }
 
