@@ -1,73 +1,42 @@
 """Statically balance an arm: size two counterweights so that gravity needs no joint torque.
 
-Gravity torque is linear in the bodies' inertial parameters, G(q) = Y(q) pi (the gravity
-regressor). With a counterweight of unknown mass m_k at a chosen place on each link, its parameters
-are m_k times those of a unit mass there, so G(q) = G_arm(q) + sum_k m_k Y(q) phi_k: the masses
-that make G zero over the workspace are a linear least-squares problem. (The balancing methods of
-mechbal.balance generalise this: bounds, budgets, springs, discs.)
+mechbal.balance.static writes the gravity torque as linear in the bodies' mass moments (the
+gravity regressor, G(q) = Y(q) pi), solves the counterweights' masses and positions by least
+squares over a workspace sample, within each slot's bounds, and returns the balanced mechanism.
 
 Run: python docs/examples/balance_arm.py
 """
+from pathlib import Path
+
 import numpy as np
 
 import mechbal
+from mechbal.balance import CounterweightSlot, static
 
-ARM = """<?xml version="1.0"?>
-<robot name="arm_with_counterweights">
-  <link name="base_link"/>
-  <joint name="shoulder" type="revolute">
-    <parent link="base_link"/> <child link="upper_arm"/>
-    <origin xyz="0 0 0.1"/> <axis xyz="0 -1 0"/>
-    <limit lower="-3" upper="3" effort="200" velocity="5"/>
-  </joint>
-  <link name="upper_arm">
-    <inertial><origin xyz="0.2 0 0"/><mass value="2.0"/>
-      <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.03"/></inertial>
-  </link>
-  <joint name="elbow" type="revolute">
-    <parent link="upper_arm"/> <child link="forearm"/>
-    <origin xyz="0.4 0 0"/> <axis xyz="0 -1 0"/>
-    <limit lower="-3" upper="3" effort="100" velocity="5"/>
-  </joint>
-  <link name="forearm">
-    <inertial><origin xyz="0.15 0 0"/><mass value="1.0"/>
-      <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
-  </link>
-  <!-- counterweights behind each joint (point masses, mass to be sized) -->
-  <joint name="cw1_mount" type="fixed"><parent link="upper_arm"/><child link="cw1"/>
-    <origin xyz="-0.15 0 0"/></joint>
-  <link name="cw1"><inertial><mass value="{m1}"/>
-    <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
-  <joint name="cw2_mount" type="fixed"><parent link="forearm"/><child link="cw2"/>
-    <origin xyz="-0.1 0 0"/></joint>
-  <link name="cw2"><inertial><mass value="{m2}"/>
-    <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
-</robot>"""
+HERE = Path(__file__).resolve().parent
+arm = mechbal.Mechanism.from_urdf(HERE / "two_link_arm.urdf")
 
-# The arm with unit counterweights: their parameter vectors phi_k are those of a unit mass.
-unit = mechbal.Mechanism.from_urdf_string(ARM.format(m1=1.0, m2=1.0), name="unit")
-names = unit.body_names
-pi = unit.inertial_parameters().reshape(len(names), 10)
-cw = [names.index("cw1"), names.index("cw2")]
-arm = [i for i in range(len(names)) if i not in cw]
+# Where counterweights may go: at most 0.15 m from the shoulder axis, 0.10 m from the elbow axis.
+slots = [CounterweightSlot("shoulder_counterweight", link="upper_arm", mass_max=20.0, max_radius=0.15),
+         CounterweightSlot("elbow_counterweight", link="forearm", mass_max=5.0, max_radius=0.10)]
+result = static.balance(arm, slots, samples=200)
+for name, cw in result.design.items():
+    print(f"{name}: {cw['mass']:.4f} kg at {np.round(cw['position'], 4)} m in {cw['frame']}")
+print(f"RMS gravity torque over the sample: {result.residual_before:.3f} N m before, "
+      f"{result.residual:.1e} N m after (exact: {result.exact})")
 
-# Workspace sample and the regressor there: (N, dof, 10 B).
-rng = np.random.default_rng(0)
-q = rng.uniform(-np.pi, np.pi, (200, unit.dof))
-Y = unit.gravity_regressor(q).reshape(len(q), unit.dof, len(names), 10)
-G_arm = np.einsum("nibk,bk->ni", Y[:, :, arm], pi[arm]).reshape(-1)          # N m
-A = np.stack([np.einsum("nik,k->ni", Y[:, :, b], pi[b]) for b in cw], -1).reshape(-1, 2)
-masses, *_ = np.linalg.lstsq(A, -G_arm, rcond=None)
-print(f"counterweights: {masses[0]:.4f} kg at 0.15 m behind the shoulder, "
-      f"{masses[1]:.4f} kg at 0.10 m behind the elbow")
+# Check on the balanced arm, elsewhere in the workspace: no gravity torque (to rounding).
+q = np.random.default_rng(1).uniform(-np.pi, np.pi, (500, arm.dof))
+before = np.abs(arm.gravity_torque(q)).max()
+after = np.abs(result.balanced.gravity_torque(q)).max()
+print(f"peak gravity torque: {before:.3f} N m unbalanced, {after:.1e} N m balanced")
+assert result.exact and after < 1e-9 * before
 
-# Check on the balanced arm: no gravity torque anywhere (to rounding).
-before = mechbal.Mechanism.from_urdf_string(ARM.format(m1=0.0, m2=0.0), name="unbalanced")
-after = mechbal.Mechanism.from_urdf_string(ARM.format(m1=masses[0], m2=masses[1]), name="balanced")
-q_test = rng.uniform(-np.pi, np.pi, (500, unit.dof))
-g0 = np.abs(before.gravity_torque(q_test)).max()
-g1 = np.abs(after.gravity_torque(q_test)).max()
-print(f"peak gravity torque: {g0:.3f} N m unbalanced, {g1:.2e} N m balanced")
-assert g1 < 1e-9 * g0
-# the forearm's counterweight puts its centre of mass on the elbow: 1 kg x 0.15 m / 0.10 m
-assert abs(masses[1] - 1.5) < 1e-9
+# The closed form of a two-link arm (Arakelian, Le Baron & Mottu 2011, eqs 21-22): the elbow's
+# counterweight puts the forearm's centre of mass on the elbow axis, the shoulder's puts that of
+# everything on the shoulder axis. Link masses 2.0 / 1.0 kg at 0.2 / 0.15 m, upper arm 0.4 m.
+m_elbow = 1.0 * 0.15 / 0.10
+m_shoulder = (2.0 * 0.2 + (1.0 + m_elbow) * 0.4) / 0.15
+assert abs(result.design["elbow_counterweight"]["mass"] - m_elbow) < 1e-9
+assert abs(result.design["shoulder_counterweight"]["mass"] - m_shoulder) < 1e-9
+print(f"closed form: {m_shoulder:.4f} kg and {m_elbow:.4f} kg: agree")
