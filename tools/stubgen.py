@@ -32,9 +32,11 @@ def versions() -> dict[str, str]:
 def generate() -> str:
     """The stub text of the installed mechbal._core, with its header."""
     with tempfile.TemporaryDirectory() as tmp:
-        subprocess.run([sys.executable, "-m", "pybind11_stubgen", "mechbal._core", "-o", tmp,
-                        "--enum-class-locations", ENUMS, "--exit-code"],
-                       check=True, capture_output=True, text=True)
+        r = subprocess.run([sys.executable, "-m", "pybind11_stubgen", "mechbal._core", "-o", tmp,
+                            "--enum-class-locations", ENUMS, "--exit-code"],
+                           capture_output=True, text=True)
+        if r.returncode != 0:  # e.g. a C++ type in a signature: bind it before its first use
+            raise RuntimeError(f"pybind11-stubgen failed:\n{r.stdout[-3000:]}{r.stderr[-3000:]}")
         text = (Path(tmp) / "mechbal" / "_core.pyi").read_text()
     return HEADER.format(**versions()) + text
 
