@@ -33,15 +33,30 @@ def _bar(total: int):
     return _progress.counter("sweep", total, unit="chunk")
 
 
+class _Tap:
+    """The progress bar plus the caller's ``callback(chunks_done, chunks_total)``."""
+
+    def __init__(self, bar, callback, total):
+        self.bar, self.callback, self.total, self.done = bar, callback, total, 0
+
+    def update(self, n: int = 1) -> None:
+        self.done += n
+        self.bar.update(n)
+        if self.callback is not None:
+            self.callback(self.done, self.total)
+
+
 def run_chunks(plan, chunks: list[tuple[int, Any]], *, backend: str = "serial", workers: int | None = None,
-               scheduler=None, progress: bool = True) -> list[dict]:
-    """Results of every chunk ``(start, values)``, in chunk order."""
+               scheduler=None, progress: bool = True, callback=None) -> list[dict]:
+    """Results of every chunk ``(start, values)``, in chunk order; ``callback(done, total)`` after
+    each chunk completes (in this process)."""
     if scheduler is not None and backend in ("serial", "processes"):
         backend = "dask"
     if backend not in BACKENDS:
         from mechbal.schema import did_you_mean
         raise ValueError(f"backend: must be one of {', '.join(BACKENDS)}{did_you_mean(str(backend), list(BACKENDS))}")
-    with (_bar(len(chunks)) if progress else _progress.counter("sweep", 0, show=False)) as bar:
+    with (_bar(len(chunks)) if progress else _progress.counter("sweep", 0, show=False)) as shown:
+        bar = _Tap(shown, callback, len(chunks))
         if backend == "serial":
             out = []
             for start, values in chunks:
@@ -82,7 +97,7 @@ def _distributed(plan, chunks, scheduler, bar) -> list[dict]:
                    for start, values in chunks]
         index = {f.key: i for i, f in enumerate(futures)}
         out: list[dict | None] = [None] * len(futures)
-        for future, result in distributed.as_completed(futures, with_results=True):
+        for future, result in distributed.as_completed(futures, with_results=True, loop=client.loop):
             out[index[future.key]] = result
             future.release()
             bar.update(1)

@@ -365,10 +365,11 @@ class Sweep:
         return CHUNK_REBUILT if rebuilt else CHUNK_BATCHED
 
     def run(self, backend: str = "serial", *, workers: int | None = None, scheduler=None,
-            progress: bool = True):
+            progress: bool = True, callback=None):
         """Evaluate every set: ``backend`` serial, processes (``workers`` local processes, default
         every core, through Dask's process scheduler) or dask (a distributed cluster: ``scheduler``
-        an address ``tcp://host:port`` or a ``distributed.Client``). Returns a
+        an address ``tcp://host:port`` or a ``distributed.Client``); ``callback(done, total)``
+        is called with the chunks done after each one (progress in a notebook). Returns a
         :class:`mechbal.sweep.results.SweepResult`; the table is the same on every backend."""
         from mechbal.sweep.backends import run_chunks
         from mechbal.sweep.evaluate import evaluate_chunk
@@ -379,7 +380,7 @@ class Sweep:
         size = self.default_chunk_size()
         chunks = [(start, values[start:start + size]) for start in range(0, len(values), size)]
         results = run_chunks(plan, chunks, backend=backend, workers=workers, scheduler=scheduler,
-                             progress=progress)
+                             progress=progress, callback=callback)
         nominal = evaluate_chunk(plan, 0, self.nominal[None, :])
         return SweepResult.assemble(self, plan, values, labels, results, nominal)
 
