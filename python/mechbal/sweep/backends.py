@@ -92,6 +92,9 @@ def _distributed(plan, chunks, scheduler, bar) -> list[dict]:
         raise ValueError("backend dask: give the scheduler's address (--scheduler tcp://host:port) or a Client")
     client = distributed.Client(scheduler, set_as_default=False) if own else scheduler
     try:
+        # The plan once to every worker (each keeps a copy, so a dead worker loses none). Each task
+        # carries its own chunk of values: scattered data would die with the worker that holds it,
+        # and its chunks could not be rerun; a task's own arguments stay with the scheduler.
         plan_f = client.scatter(plan, broadcast=True, hash=False)
         futures = [client.submit(evaluate_chunk, plan_f, start, values, pure=False, retries=2)
                    for start, values in chunks]

@@ -34,8 +34,9 @@ from mechbal.sweep.parameters import Target, apply_values, inertial_parameters, 
 
 #: names of the six virtual base joints of the momentum-rate model
 _VIRTUAL = ("__sweep_px", "__sweep_py", "__sweep_pz", "__sweep_rx", "__sweep_ry", "__sweep_rz")
-#: largest rows x sets block of one regressor product (memory bound, ~32 MB of float64)
-_BLOCK_ELEMENTS = 4_000_000
+#: largest rows x sets block of one regressor product: ~2 MB of float64, so that the product and
+#: the statistics over it stay in cache (the work is memory-bound, not flop-bound)
+_BLOCK_ELEMENTS = 262_144
 
 
 @dataclass
@@ -118,18 +119,24 @@ def _statistic(norm2: np.ndarray, statistic: str) -> np.ndarray:
     return np.sqrt(np.mean(norm2, axis=0))
 
 
-def builtin_values(quantities: dict[str, np.ndarray], metrics: list[MetricSpec], joint_index) -> dict:
-    """Built-in metrics from quantity arrays (samples, components, ...sets)."""
-    out = {}
+def builtin_values(quantities: dict[str, np.ndarray], metrics: list[MetricSpec], joint_index,
+                   buffer=None) -> dict:
+    """Built-in metrics from quantity arrays (samples, components, ...sets); ``buffer(key, shape)``
+    gives scratch arrays for the squared norms."""
+    out, norms = {}, {}
     for m in metrics:
         if not m.builtin:
             continue
-        X = quantities[m.quantity]
-        if m.joint is not None:
-            norm2 = X[:, joint_index[m.joint]] ** 2
-        else:
-            norm2 = np.sum(X * X, axis=1)
-        out[m.name] = _statistic(norm2, m.statistic)
+        key = (m.quantity, m.joint)
+        if key not in norms:
+            X = quantities[m.quantity]
+            shape = (X.shape[0],) + X.shape[2:]
+            scratch = buffer(("norm",) + key, shape) if buffer is not None else np.empty(shape)
+            if m.joint is not None:
+                norms[key] = np.square(X[:, joint_index[m.joint]], out=scratch)
+            else:
+                norms[key] = np.einsum("ij...,ij...->i...", X, X, out=scratch)
+        out[m.name] = _statistic(norms[key], m.statistic)
     return out
 
 
@@ -206,8 +213,6 @@ class Context:
         var = sorted({t.name for t in plan.targets if t.kind == "body"}, key=model_bodies.index)
         frames = self._body_frames(var) if var else {}
         spec_bodies = {b.name: b for b in plan.spec.bodies}
-        cols = np.concatenate([np.arange(10 * model_bodies.index(n), 10 * model_bodies.index(n) + 10)
-                               for n in var]) if var else np.zeros(0, int)
         pi = mech.inertial_parameters()
         regressors = {}
         wanted = needed(plan.metrics)
@@ -230,17 +235,45 @@ class Context:
                 Yw = self._wrench_regressor(q, v, a)
                 regressors["shaking_force"] = Yw[:, :3]
                 regressors["shaking_moment"] = Yw[:, 3:]
+        # the variable bodies in the model's frames, at their nominal values; a body whose mass
+        # alone varies changes pi along one direction, pi = pi0 + (m - m0) [1, c, c.c 1 - c c^T]:
+        # one regressor column instead of ten
+        self._var = var
+        self._bodies = {}
+        blocks = []
+        for n in var:
+            R, t = frames[n]
+            b = spec_bodies[n]
+            com0, inertia0 = R @ np.asarray(b.com, float) + t, R @ np.asarray(b.inertia, float) @ R.T
+            mass_only = all(x.attr == "mass" for x in plan.targets if x.kind == "body" and x.name == n)
+            pi0 = inertial_parameters(np.array([b.mass]), com0[None], inertia0[None])[0]
+            direction = inertial_parameters(np.ones(1), com0[None], np.zeros((1, 3, 3)))[0]
+            k = model_bodies.index(n)
+            blocks.append((slice(10 * k, 10 * k + 10), direction[:, None] if mass_only else np.eye(10)))
+            self._bodies[n] = dict(mass=float(b.mass), com=np.asarray(b.com, float),
+                                   inertia=np.asarray(b.inertia, float), R=R, t=t, pi0=pi0,
+                                   inertia_model=inertia0, mass_only=mass_only)
         self._regressors = {}
         for name, Y in regressors.items():
             samples, comps, _ = Y.shape
             flat = Y.reshape(samples * comps, -1)
             base = flat @ pi
-            self._regressors[name] = (np.ascontiguousarray(flat[:, cols]), base, (samples, comps))
-        # nominal link-frame values of the variable bodies and their pi (D = 0 at the nominal)
-        self._var = var
-        self._frames = frames
-        self._nominal_bodies = {n: (spec_bodies[n].mass, np.asarray(spec_bodies[n].com, float),
-                                    np.asarray(spec_bodies[n].inertia, float)) for n in var}
+            reduced = np.concatenate([flat[:, cols] @ W for cols, W in blocks], axis=1) if blocks \
+                else np.zeros((flat.shape[0], 0))
+            self._regressors[name] = (np.ascontiguousarray(reduced), base, (samples, comps))
+
+    def _buffer(self, key, shape) -> np.ndarray:
+        """A scratch array kept between chunks: large temporaries allocated anew each time are
+        fresh pages for the kernel to fault in (Dask workers set MALLOC_TRIM_THRESHOLD_, which
+        turns glibc's reuse of large blocks off), which made a worker 2-3x slower than this
+        process."""
+        buffers = self.__dict__.setdefault("_buffers", {})
+        b = buffers.get((key, shape))
+        if b is None:
+            if len(buffers) > 32:
+                buffers.clear()
+            b = buffers[(key, shape)] = np.empty(shape)
+        return b
 
     def _wrench_regressor(self, q, v, a) -> np.ndarray:
         """(T, 6, 10 B): [dP/dt; dH_O/dt] = Y pi, the torques of six virtual joints (x, y, z slides
@@ -276,11 +309,11 @@ class Context:
         S = values.shape[0]
         ok = np.ones(S, dtype=bool)
         reasons = [""] * S
-        pis = []
+        columns = []
         for n in self._var:
-            m0, c0, I0 = self._nominal_bodies[n]
-            mass = np.full(S, float(m0))
-            com = np.tile(c0, (S, 1))
+            b = self._bodies[n]
+            mass = np.full(S, b["mass"])
+            com = None
             inertia = None
             for k, t in enumerate(plan.targets):
                 if t.kind != "body" or t.name != n:
@@ -288,42 +321,46 @@ class Context:
                 if t.attr == "mass":
                     mass = values[:, k].copy()
                 elif t.attr == "com":
+                    if com is None:
+                        com = np.tile(b["com"], (S, 1))
                     com[:, t.index] = values[:, k]
                 else:
                     if inertia is None:
-                        inertia = np.tile(I0, (S, 1, 1))
+                        inertia = np.tile(b["inertia"], (S, 1, 1))
                     i, j = t.index
                     inertia[:, i, j] = values[:, k]
                     inertia[:, j, i] = values[:, k]
             good = physical_status(mass, inertia)
-            for s in np.flatnonzero(~good & ok):
-                reasons[s] = f"bodies.{n}: not a physical body (mass >= 0, inertia positive semi-definite " \
-                             "with the triangle inequality)"
+            for s_i in np.flatnonzero(~good & ok):
+                reasons[s_i] = f"bodies.{n}: not a physical body (mass >= 0, inertia positive semi-definite " \
+                               "with the triangle inequality)"
             ok &= good
-            R, t = self._frames[n]
-            I_spec = np.broadcast_to(I0, (S, 3, 3)) if inertia is None else inertia
-            pis.append(inertial_parameters(mass, com @ R.T + t, np.einsum("ij,sjk,lk->sil", R, I_spec, R)))
-        if pis:
-            pi = np.concatenate(pis, axis=1)
-            pi0 = np.concatenate([inertial_parameters(np.array([m0]), (c0 @ self._frames[n][0].T
-                                                                         + self._frames[n][1])[None],
-                                                      (self._frames[n][0] @ I0 @ self._frames[n][0].T)[None])
-                                  for n, (m0, c0, I0) in ((n, self._nominal_bodies[n]) for n in self._var)],
-                                 axis=1)[0]
-            D = pi - pi0
-        else:
-            D = np.zeros((S, 0))
+            if b["mass_only"]:
+                columns.append((mass - b["mass"])[:, None])
+                continue
+            R, t = b["R"], b["t"]
+            com_model = np.broadcast_to(R @ b["com"] + t, (S, 3)) if com is None else com @ R.T + t
+            inertia_model = (np.broadcast_to(b["inertia_model"], (S, 3, 3)) if inertia is None
+                             else np.einsum("ij,sjk,lk->sil", R, inertia, R))
+            columns.append(inertial_parameters(mass, com_model, inertia_model) - b["pi0"])
+        D = np.concatenate(columns, axis=1) if columns else np.zeros((S, 0))
         results = {m.name: np.empty(S) for m in plan.metrics if m.builtin}
         rows = max(Yv.shape[0] for Yv, _, _ in self._regressors.values()) if self._regressors else 1
         block = max(1, _BLOCK_ELEMENTS // max(1, rows))
         for start in range(0, S, block):
             stop = min(S, start + block)
-            Db = D[start:stop]
+            n = stop - start
+            DbT = np.ascontiguousarray(D[start:stop].T)
             quantities = {}
             for name, (Yv, base, (samples, comps)) in self._regressors.items():
-                X = base[:, None] + Yv @ Db.T if Db.shape[1] else np.repeat(base[:, None], stop - start, 1)
-                quantities[name] = X.reshape(samples, comps, stop - start)
-            for k, v in builtin_values(quantities, plan.metrics, self.joint_index).items():
+                X = self._buffer(name, (Yv.shape[0], n))
+                if DbT.shape[0]:
+                    np.matmul(Yv, DbT, out=X)
+                    X += base[:, None]
+                else:
+                    X[...] = base[:, None]
+                quantities[name] = X.reshape(samples, comps, n)
+            for k, v in builtin_values(quantities, plan.metrics, self.joint_index, self._buffer).items():
                 results[k][start:stop] = v
         for v in results.values():
             v[~ok] = np.nan
@@ -383,10 +420,36 @@ def _as_float(x) -> float:
         return math.nan
 
 
+_BLAS = []
+
+
+def _one_blas_thread():
+    """BLAS on one thread while a chunk runs (threadpoolctl, part of the 'sweep' extra): the
+    products are small (a few hundred rows by tens of columns), a second BLAS thread only spins
+    against the other workers, and the result cannot depend on a thread count."""
+    import contextlib
+
+    if not _BLAS:
+        try:
+            from threadpoolctl import ThreadpoolController
+
+            _BLAS.append(ThreadpoolController())
+        except ImportError:
+            _BLAS.append(None)
+    if _BLAS[0] is None:
+        return contextlib.nullcontext()
+    return _BLAS[0].limit(limits=1, user_api="blas")
+
+
 def evaluate_chunk(plan: Plan, start: int, values: np.ndarray) -> dict[str, Any]:
     """The metrics of the sets ``values`` (s, parameters), evaluations ``start .. start + s - 1``:
     ``{"start": start, "columns": {column: (s,) float}, "status": [str] * s}``. Pure: the result
     depends only on the plan and the rows."""
+    with _one_blas_thread():
+        return _evaluate_chunk(plan, start, values)
+
+
+def _evaluate_chunk(plan: Plan, start: int, values: np.ndarray) -> dict[str, Any]:
     ctx = context(plan)
     values = np.asarray(values, dtype=float)
     s = values.shape[0]
