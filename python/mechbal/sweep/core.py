@@ -150,15 +150,17 @@ def spec_of_mechanism(mech) -> Any:
              _core.JointType.fixed: "fixed"}
     loop_names = {_core.LoopType.point: "point", _core.LoopType.planar_point: "planar_point",
                   _core.LoopType.axis: "axis", _core.LoopType.weld: "weld"}
+    root = d.root_name  # a URDF's root link: "base" in a spec
+    link = lambda name: "base" if name == root else name  # noqa: E731
     joints = []
     for j in d.joints:
         mimic = (j.mimic_joint, float(j.mimic_ratio), float(j.mimic_offset)) if j.mimic_joint else None
-        joints.append(JointSpec(j.name, names[j.type], j.parent, np.array(j.placement), np.array(j.axis),
+        joints.append(JointSpec(j.name, names[j.type], link(j.parent), np.array(j.placement), np.array(j.axis),
                                 float(j.lower), float(j.upper), float(j.velocity_limit),
                                 float(j.effort_limit), mimic))
-    bodies = [BodySpec(b.name, b.kind, b.link, float(b.mass), np.array(b.com), np.array(b.inertia))
+    bodies = [BodySpec(b.name, b.kind, link(b.link), float(b.mass), np.array(b.com), np.array(b.inertia))
               for b in d.bodies]
-    frames = [FrameSpec(f.name, f.link, np.array(f.placement)) for f in d.frames]
+    frames = [FrameSpec(f.name, link(f.link), np.array(f.placement)) for f in d.frames]
     loops = [LoopSpec(lp.name, loop_names[lp.type], lp.frame_a, lp.frame_b) for lp in d.loops]
     return MechanismSpec(np.array(d.gravity), joints, bodies, frames, loops, list(d.actuated))
 
