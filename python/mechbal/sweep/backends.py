@@ -30,18 +30,18 @@ def require_extra(module: str):
 
 
 def _bar(total: int):
-    return _progress.counter("sweep", total, unit="chunk")
+    return _progress.counter("sweep", total, unit="evaluation")
 
 
 class _Tap:
-    """The progress bar plus the caller's ``callback(chunks_done, chunks_total)``."""
+    """The progress bar (in evaluations) plus the caller's ``callback(chunks_done, chunks_total)``."""
 
     def __init__(self, bar, callback, total):
         self.bar, self.callback, self.total, self.done = bar, callback, total, 0
 
-    def update(self, n: int = 1) -> None:
-        self.done += n
-        self.bar.update(n)
+    def chunk_done(self, result: dict) -> None:
+        self.done += 1
+        self.bar.update(len(result["status"]))
         if self.callback is not None:
             self.callback(self.done, self.total)
 
@@ -55,13 +55,13 @@ def run_chunks(plan, chunks: list[tuple[int, Any]], *, backend: str = "serial", 
     if backend not in BACKENDS:
         from mechbal.schema import did_you_mean
         raise ValueError(f"backend: must be one of {', '.join(BACKENDS)}{did_you_mean(str(backend), list(BACKENDS))}")
-    with (_bar(len(chunks)) if progress else _progress.counter("sweep", 0, show=False)) as shown:
+    with (_bar(sum(len(v) for _, v in chunks)) if progress else _progress.counter("sweep", 0, show=False)) as shown:
         bar = _Tap(shown, callback, len(chunks))
         if backend == "serial":
             out = []
             for start, values in chunks:
                 out.append(evaluate_chunk(plan, start, values))
-                bar.update(1)
+                bar.chunk_done(out[-1])
             return out
         if backend == "processes":
             return _processes(plan, chunks, workers, bar)
@@ -78,7 +78,7 @@ def _processes(plan, chunks, workers, bar) -> list[dict]:
 
     def posttask(key, result, dsk, state, worker_id):
         if isinstance(result, dict) and "status" in result:
-            bar.update(1)
+            bar.chunk_done(result)
 
     with Callback(posttask=posttask):
         return list(dask.compute(*tasks, scheduler="processes", num_workers=workers))
@@ -103,7 +103,7 @@ def _distributed(plan, chunks, scheduler, bar) -> list[dict]:
         for future, result in distributed.as_completed(futures, with_results=True, loop=client.loop):
             out[index[future.key]] = result
             future.release()
-            bar.update(1)
+            bar.chunk_done(result)
         return out  # type: ignore[return-value]
     finally:
         if own:
