@@ -5,6 +5,10 @@
    binding overhead is this minus the C++ tick time of mechbal-bench (the merge script subtracts).
    Also one controller tick through the bindings: ComputedTorque.step (6-joint RNE back end, and
    the 2-DOF closed form), ReactionlessWrist.step (Euler, RK4), DecoupledJointController.step (3 joints).
+   The fast tick of issue 15 (target <= 1.5 us median): step_into(q, qd, q_des, qd_des, qdd_des,
+   out), float64 arrays read and the torque written in place (no copy, no allocation, no tuple),
+   for the same three joint controllers (ct6_step_into, ct2_step_into, decoupled3_step_into) and
+   the reactionless wrist (wrist_euler_step_into, wrist_rk4_step_into: the command into a (3, 3)).
 2. Batch throughput (instants per second) of mechbal.shaking_wrench over a 1e5-instant trajectory
    of 10 bodies against a pure-numpy implementation of the same formula (Briot & Arakelian 2009,
    eqs 1-4): F = sum m a_G; M_O = sum (m OG x a_G + I alpha + w x I w), I = R I_body R^T. The two
@@ -111,7 +115,7 @@ def main(argv=None):
 
     # ---- 1. single-instant calls through the bindings ----------------------------------------
     model = chain_from_specs(random_chain_specs(rng, "RRRRRR"))
-    rne = mechbal.RneChainDynamics(model)
+    rne = mechbal.control.RneChainDynamics(model)
     q, qd, qdd = (rng.uniform(-1, 1, (1, 6)) for _ in range(3))
     med, p99 = median_per_call_ns(lambda: rne.inverse_dynamics(q, qd, qdd), calls)
     results["per_call"]["id6_mechbal"] = {"median_ns": med, "p99_ns": p99}
@@ -130,12 +134,20 @@ def main(argv=None):
     q2, qd2, q2_d, qd2_d, qdd2_d = (rng.uniform(-1, 1, 2) for _ in range(5))
     med, p99 = median_per_call_ns(lambda: ct2.step(q2, qd2, q2_d, qd2_d, qdd2_d), calls)
     results["per_call"]["ct2_closed_form"] = {"median_ns": med, "p99_ns": p99}
+    out6, out2 = np.zeros(n), np.zeros(2)
+    med, p99 = median_per_call_ns(lambda: ct.step_into(q, qd, q_d, qd_d, qdd_d, out6), calls)
+    results["per_call"]["ct6_step_into"] = {"median_ns": med, "p99_ns": p99}
+    med, p99 = median_per_call_ns(lambda: ct2.step_into(q2, qd2, q2_d, qd2_d, qdd2_d, out2), calls)
+    results["per_call"]["ct2_step_into"] = {"median_ns": med, "p99_ns": p99}
     # decoupled joint control (3 joints; the C++ case decoupled_step3 uses the balanced 3R's k)
-    dc = mechbal._core.DecoupledJointController(np.array([0.9, 0.2, 0.01]), np.full(3, 100.0),
+    dc = mechbal.control.DecoupledJointController(np.array([0.9, 0.2, 0.01]), np.full(3, 100.0),
                                           np.full(3, 20.0))
     q3, qd3, q3_d, qd3_d, qdd3_d = (rng.uniform(-1, 1, 3) for _ in range(5))
     med, p99 = median_per_call_ns(lambda: dc.step(q3, qd3, q3_d, qd3_d, qdd3_d), calls)
     results["per_call"]["decoupled_step3"] = {"median_ns": med, "p99_ns": p99}
+    out3 = np.zeros(3)
+    med, p99 = median_per_call_ns(lambda: dc.step_into(q3, qd3, q3_d, qd3_d, qdd3_d, out3), calls)
+    results["per_call"]["decoupled3_step_into"] = {"median_ns": med, "p99_ns": p99}
     pam = mechbal.PaminsaModel(mechbal.PaminsaParameters())
     J = pam.inertia_body[35:38]
     for name, integ in (("wrist_euler", mechbal.WristIntegrator.euler),
@@ -146,6 +158,9 @@ def main(argv=None):
         D, Dd = np.array([0.05, -0.02, 0.01]), np.array([0.3, 0.1, -0.2])
         med, p99 = median_per_call_ns(lambda: wrist.step(D, Dd, D, D), calls)
         results["per_call"][name] = {"median_ns": med, "p99_ns": p99}
+        command = np.zeros((3, 3))
+        med, p99 = median_per_call_ns(lambda: wrist.step_into(D, Dd, D, D, command), calls)
+        results["per_call"][f"{name}_step_into"] = {"median_ns": med, "p99_ns": p99}
 
     # ---- 2. batch throughput against numpy ------------------------------------------------------
     data = random_bodies(rng, args.instants, args.bodies)

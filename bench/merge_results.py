@@ -162,6 +162,11 @@ def main(argv=None):
                                                 lambda v: v >= 10),
         "allocations_per_tick == 0 (every case)": check(max(allocs.values()), lambda v: v == 0),
     }
+    if py:  # issue 15: one controller tick from Python (the fast step_into) <= 1.5 us median
+        for name in ("ct6_step_into", "ct2_step_into", "decoupled3_step_into",
+                     "wrist_euler_step_into", "wrist_rk4_step_into"):
+            v = py["per_call"].get(name, {}).get("median_ns")
+            targets[f"python_{name}_median_ns <= 1500"] = check(v, lambda x: x <= 1500)
     for robot in URDF_ROBOTS:
         for alg in URDF_ALGORITHMS:
             key = f"pinocchio_over_mechbal_{alg}_{robot}"

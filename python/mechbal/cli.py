@@ -141,9 +141,7 @@ def _cmd_demo(args) -> int:
 def _cmd_init(args) -> int:
     from mechbal import templates
 
-    if args.kind == "linkage":
-        raise UserError(templates.LINKAGE_NOT_YET)
-    sys.stdout.write(templates.SERIAL)
+    sys.stdout.write(templates.LINKAGE if args.kind == "linkage" else templates.SERIAL)
     return 0
 
 

@@ -251,10 +251,12 @@ class Mechanism:
 
     @property
     def body_names(self) -> list[str]:
+        """Names of the bodies (links' inertias, counterweights, motors, discs...), in model order."""
         return list(self.model.body_names)
 
     @property
     def frame_names(self) -> list[str]:
+        """Names of the named frames (URDF links, tool and sensor frames, loop-closure frames)."""
         return list(self.model.frame_names)
 
     @property
@@ -264,10 +266,12 @@ class Mechanism:
 
     @property
     def gravity(self) -> np.ndarray:
+        """Gravity acceleration in O [m/s^2] (3,)."""
         return np.array(self.model.gravity)
 
     @property
     def bodies(self):
+        """The bodies (``mechbal.Body``: name, link, mass [kg], com [m], inertia [kg m^2])."""
         return list(self.model.bodies)
 
     @property
@@ -283,6 +287,7 @@ class Mechanism:
 
     @property
     def passive_names(self) -> list[str]:
+        """Passive joints of a closed mechanism (solved from the loop closures)."""
         names = self.joint_names
         return [names[i] for i in self.model.passive_coordinates]
 
@@ -398,7 +403,7 @@ class Mechanism:
         keys = ["com", "rotation", "com_velocity", "com_acceleration", "angular_velocity",
                 "angular_acceleration", "link_rotation", "link_position", "frame_placement"]
         values, st = self._finish(single, _core.mechanism_kinematics(self.model, q, v, a), keys)
-        return BodyMotion(*values, st)
+        return BodyMotion(**dict(zip(keys, values)), status=st)
 
     def body_poses(self, q) -> tuple[np.ndarray, np.ndarray]:
         """(com, rotation) of every body: (B, 3) and (B, 3, 3), or with a leading N axis."""
@@ -472,8 +477,8 @@ class Mechanism:
                                  f"{np.asarray(x).shape}")
             arrays.append(x)
         guess = np.zeros(self.dof) if q_guess is None else np.ascontiguousarray(q_guess, dtype=float)
-        r = _core.mechanism_closed_motion(self.model, *arrays, guess, max_iterations, tolerance,
-                                          singular_rcond, with_forces)
+        r = _core.mechanism_closed_motion(self.model, arrays[0], arrays[1], arrays[2], guess,
+                                          max_iterations, tolerance, singular_rcond, with_forces)
         out = {k: np.asarray(v) for k, v in r.items()}
         if single:
             out = {k: v[0] for k, v in out.items()}
@@ -487,6 +492,7 @@ class Mechanism:
         m = self.closed_motion(q_actuated, v_actuated, a_actuated, with_forces=True, **kw)
         if np.ndim(m.status) == 0 and (int(m.status) & ~int(_core.Status.singular)):
             raise ValueError(f"{self.name}: the loops cannot be solved here ({_status_text(int(m.status))})")
+        assert m.actuated_force is not None  # asked for with_forces
         return m.actuated_force
 
     def reduced_mass_matrix(self, q_actuated, *, q_guess=None) -> tuple[np.ndarray, np.ndarray]:
