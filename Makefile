@@ -25,13 +25,15 @@ print('\n'.join(p['dependencies'] if sys.argv[1] == 'runtime' else p['optional-d
 endef
 say = @printf '\n==> %s\n' $(1)
 
-.PHONY: demo test test-cpp test-python test-sanitize bench apt apt-test venv install install-test clean help
+.PHONY: demo test test-cpp test-python test-sanitize bench docs stubs apt apt-test venv install install-test install-docs clean help
 
 help:
 	@echo "make demo   - install what is missing, then run 'mechbal demo' (output in out/demo)"
 	@echo "make test   - install what is missing, then run the C++ tests (ctest) and pytest"
 	@echo "make test-sanitize - the C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 	@echo "make bench  - build and run the benchmarks"
+	@echo "make docs   - build the user guide and API reference into build/site (MkDocs, offline)"
+	@echo "make stubs  - regenerate python/mechbal/_core.pyi from the bindings (pybind11-stubgen)"
 	@echo "make clean  - remove build outputs and the virtual environment"
 	@echo "JOBS=N      - parallel compile jobs (default 2)"
 
@@ -92,6 +94,23 @@ $(VENV)/.stamp-install-test: pyproject.toml | $(VENV)/.stamp-install $(VENV)/.st
 	$(call say,"Installing the test packages")
 	@$(call pip_list,test)
 	@touch $@
+
+install-docs: $(VENV)/.stamp-install-docs
+$(VENV)/.stamp-install-docs: pyproject.toml | $(VENV)/.stamp-venv
+	$(call say,"Installing the documentation packages")
+	@$(call pip_list,docs)
+	@touch $@
+
+# ---- docs and stubs ---------------------------------------------------------------------------
+# The site is built from the sources and the checked-in stubs (no compiled module needed).
+docs: $(VENV)/.stamp-install-docs
+	$(call say,"Building the user guide and API reference: build/site/index.html")
+	$(VENV)/bin/mkdocs build --strict --quiet -f mkdocs.yml
+
+# After changing a binding: regenerate the checked-in stubs (tests/python/test_typing.py fails
+# until they match the bindings).
+stubs: install $(VENV)/.stamp-install-test
+	$(PY) tools/stubgen.py
 
 # ---- tests ------------------------------------------------------------------------------------
 $(CPP_BUILD)/build.ninja: | $(VENV)/.stamp-venv $(VENV)/.stamp-apt-test

@@ -5,15 +5,23 @@
    binding overhead is this minus the C++ tick time of mechbal-bench (the merge script subtracts).
    Also one controller tick through the bindings: ComputedTorque.step (6-joint RNE back end, and
    the 2-DOF closed form), ReactionlessWrist.step (Euler, RK4), DecoupledJointController.step (3 joints).
+   The fast tick of issue 15 (target <= 1.5 us median): step_into(q, qd, q_des, qd_des, qdd_des,
+   out), float64 arrays read and the torque written in place (no copy, no allocation, no tuple),
+   for the same three joint controllers (ct6_step_into, ct2_step_into, decoupled3_step_into) and
+   the reactionless wrist (wrist_euler_step_into, wrist_rk4_step_into: the command into a (3, 3)).
 2. Batch throughput (instants per second) of mechbal.shaking_wrench over a 1e5-instant trajectory
    of 10 bodies against a pure-numpy implementation of the same formula (Briot & Arakelian 2009,
    eqs 1-4): F = sum m a_G; M_O = sum (m OG x a_G + I alpha + w x I w), I = R I_body R^T. The two
    are checked to agree (1e-9 relative) before anything is timed.
+4. Sizing (issue 11): static balancing by counterweights (mechbal.balance.static: batched C++
+   gravity regressor of the probe bodies, least squares, bounds) of a random spatial 7-joint arm
+   with a counterweight slot on each of links 2-7, over 10 000 random poses (target < 1 s on one
+   core: run with OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1).
 3. Controllers in batch: paminsa_reactionless_run (RK4 wrist, 2000 ticks, also writing every
    body's motion) and simulate_computed_torque (2-DOF closed loop, 2000 ticks), ticks per second.
    These are sequential closed loops: there is no vectorised numpy equivalent to compare with.
 
-4. Design sweeps (issue 16): a tolerance Monte Carlo of a statically balanced 7-joint arm (7 links +
+5. Design sweeps (issue 16): a tolerance Monte Carlo of a statically balanced 7-joint arm (7 links +
    7 counterweights, every mass +-2 %) over 100 poses, peak and RMS gravity torque: 10^5
    evaluations serially in this process, then on a Dask LocalCluster of 1 and of 2 worker
    processes (one thread each: one core each), throughput and the parallel efficiency
@@ -235,7 +243,7 @@ def main(argv=None):
 
     # ---- 1. single-instant calls through the bindings ----------------------------------------
     model = chain_from_specs(random_chain_specs(rng, "RRRRRR"))
-    rne = mechbal.RneChainDynamics(model)
+    rne = mechbal.control.RneChainDynamics(model)
     q, qd, qdd = (rng.uniform(-1, 1, (1, 6)) for _ in range(3))
     med, p99 = median_per_call_ns(lambda: rne.inverse_dynamics(q, qd, qdd), calls)
     results["per_call"]["id6_mechbal"] = {"median_ns": med, "p99_ns": p99}
@@ -254,12 +262,20 @@ def main(argv=None):
     q2, qd2, q2_d, qd2_d, qdd2_d = (rng.uniform(-1, 1, 2) for _ in range(5))
     med, p99 = median_per_call_ns(lambda: ct2.step(q2, qd2, q2_d, qd2_d, qdd2_d), calls)
     results["per_call"]["ct2_closed_form"] = {"median_ns": med, "p99_ns": p99}
+    out6, out2 = np.zeros(n), np.zeros(2)
+    med, p99 = median_per_call_ns(lambda: ct.step_into(q, qd, q_d, qd_d, qdd_d, out6), calls)
+    results["per_call"]["ct6_step_into"] = {"median_ns": med, "p99_ns": p99}
+    med, p99 = median_per_call_ns(lambda: ct2.step_into(q2, qd2, q2_d, qd2_d, qdd2_d, out2), calls)
+    results["per_call"]["ct2_step_into"] = {"median_ns": med, "p99_ns": p99}
     # decoupled joint control (3 joints; the C++ case decoupled_step3 uses the balanced 3R's k)
-    dc = mechbal._core.DecoupledJointController(np.array([0.9, 0.2, 0.01]), np.full(3, 100.0),
+    dc = mechbal.control.DecoupledJointController(np.array([0.9, 0.2, 0.01]), np.full(3, 100.0),
                                           np.full(3, 20.0))
     q3, qd3, q3_d, qd3_d, qdd3_d = (rng.uniform(-1, 1, 3) for _ in range(5))
     med, p99 = median_per_call_ns(lambda: dc.step(q3, qd3, q3_d, qd3_d, qdd3_d), calls)
     results["per_call"]["decoupled_step3"] = {"median_ns": med, "p99_ns": p99}
+    out3 = np.zeros(3)
+    med, p99 = median_per_call_ns(lambda: dc.step_into(q3, qd3, q3_d, qd3_d, qdd3_d, out3), calls)
+    results["per_call"]["decoupled3_step_into"] = {"median_ns": med, "p99_ns": p99}
     pam = mechbal.PaminsaModel(mechbal.PaminsaParameters())
     J = pam.inertia_body[35:38]
     for name, integ in (("wrist_euler", mechbal.WristIntegrator.euler),
@@ -270,6 +286,9 @@ def main(argv=None):
         D, Dd = np.array([0.05, -0.02, 0.01]), np.array([0.3, 0.1, -0.2])
         med, p99 = median_per_call_ns(lambda: wrist.step(D, Dd, D, D), calls)
         results["per_call"][name] = {"median_ns": med, "p99_ns": p99}
+        command = np.zeros((3, 3))
+        med, p99 = median_per_call_ns(lambda: wrist.step_into(D, Dd, D, D, command), calls)
+        results["per_call"][f"{name}_step_into"] = {"median_ns": med, "p99_ns": p99}
 
     # ---- 2. batch throughput against numpy ------------------------------------------------------
     data = random_bodies(rng, args.instants, args.bodies)
@@ -328,7 +347,8 @@ def main(argv=None):
     results["batch_controllers"]["closed_loop_ct2"] = {
         "ticks": ticks, "seconds": t_sim, "ticks_per_s": ticks / t_sim,
         "ns_per_tick": t_sim / ticks * 1e9}
-    # ---- 4. design sweeps (needs the 'sweep' extra) ------------------------------------------------
+    results["sizing"] = bench_sizing(repeat)
+    # ---- design sweeps (needs the 'sweep' extra) ----------------------------------------------------
     try:
         results["sweep"] = bench_sweep(args.sweep_evaluations, 2 if args.quick else 3)
     except ImportError as exc:
@@ -338,6 +358,35 @@ def main(argv=None):
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)
         args.out.write_text(text + "\n")
+
+
+def seven_joint_arm(seed: int = 7):
+    """A random spatial 7R arm (placements, axes, masses) as a mechbal.Mechanism."""
+    from mechbal.spec import mechanism_spec
+
+    rng = np.random.default_rng(seed)
+    joints = [{"name": f"j{i + 1}", "origin": {"xyz": rng.uniform(-0.3, 0.3, 3).tolist(),
+                                                "rpy": rng.uniform(-1.5, 1.5, 3).tolist()},
+               "axis": rng.normal(size=3).tolist(),
+               "link": {"mass": float(rng.uniform(0.5, 4.0)), "com": rng.uniform(-0.2, 0.2, 3).tolist(),
+                        "inertia": [0.02, 0.03, 0.04]}} for i in range(7)]
+    return mechbal.Mechanism.from_spec(mechanism_spec({"joints": joints}), name="random-7R")
+
+
+def bench_sizing(repeat: int) -> dict:
+    from mechbal.balance import CounterweightSlot, static
+
+    mech = seven_joint_arm()
+    out = {}
+    # a slot on every link: exact; on links 2-7 only: joint 1 cannot be held (constrained stage)
+    for label, first in (("static_7R_10000_poses", 1), ("static_7R_10000_poses_links_2_7", 2)):
+        slots = [CounterweightSlot(f"cw{i}", f"j{i}", 0.0, 50.0, max_radius=0.4) for i in range(first, 8)]
+        res = static.balance(mech, slots, 10_000)
+        seconds = best_time(lambda: static.balance(mech, slots, 10_000), max(1, min(repeat, 3)))
+        out[label] = {"seconds": seconds, "poses": 10_000, "slots": len(slots), "exact": res.exact,
+                      "residual_Nm": res.residual, "residual_before_Nm": res.residual_before,
+                      "target_s": 1.0}
+    return out
 
 
 if __name__ == "__main__":

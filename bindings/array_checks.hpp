@@ -189,7 +189,7 @@ namespace pybind11::detail {
 /// refusals are reported (naming the argument) where the binding first uses the argument.
 template <>
 struct type_caster<mechbal::pyb::Array> {
-  PYBIND11_TYPE_CASTER(mechbal::pyb::Array, const_name("numpy.ndarray[numpy.float64]"));
+  PYBIND11_TYPE_CASTER(mechbal::pyb::Array, const_name("numpy.typing.ArrayLike"));
   bool load(handle src, bool) {
     value = mechbal::pyb::to_real_array(src);
     return true;

@@ -69,6 +69,7 @@ py::dict log_to_dict(const ClosedLoopLog& log) {
   d["qd_des"] = log.qd_des;
   d["tau"] = log.tau;
   d["status"] = log.status;
+  d["tick_status"] = log.tick_status;
   d["saturated_ticks"] = log.saturated_ticks;
   d["steps_completed"] = log.steps_completed;
   return d;
@@ -106,14 +107,14 @@ void bind_arm2dof(py::module_& m) {
       .def_readwrite("r_cw2", &Arm2DofCounterweights::r_cw2);
 
   m.def("arm2dof_chain_model", &arm2dof_chain_model, py::arg("arm"),
-        py::arg("counterweights") = Arm2DofCounterweights{},
+        py::arg_v("counterweights", Arm2DofCounterweights{}, "Arm2DofCounterweights()"),
         "The 2-DOF arm (counterweights merged into the links) as a ChainModel: x-z plane, joint "
         "axes along -y, gravity (0, 0, -g)");
 
   py::class_<Arm2DofDynamics, InverseDynamics, ForwardDynamics>(m, "Arm2DofDynamics",
                               "Closed-form dynamics of the 2-DOF arm, eqs 14-31 (corrected)")
       .def(py::init<const Arm2DofParameters&, const Arm2DofCounterweights&>(), py::arg("arm"),
-           py::arg("counterweights") = Arm2DofCounterweights{})
+           py::arg_v("counterweights", Arm2DofCounterweights{}, "Arm2DofCounterweights()"))
       .def_property_readonly("dof", [](const Arm2DofDynamics& d) { return d.dof(); })
       .def_property_readonly("lumped",
                              [](const Arm2DofDynamics& d) {
@@ -178,10 +179,10 @@ void bind_arm2dof(py::module_& m) {
            },
            py::arg("q"));
 
-  py::class_<ComputedTorque, JointController>(m, "ComputedTorque",
+  py::class_<ComputedTorque, JointController> ct(m, "ComputedTorque",
                              "Computed-torque control, Arakelian et al. 2011 eqs 2-6, over any "
-                             "inverse-dynamics back end (keeps the model alive)")
-      .def(py::init(&make_computed_torque<InverseDynamics>), py::arg("model"), py::arg("kp"),
+                             "inverse-dynamics back end (keeps the model alive)");
+  ct.def(py::init(&make_computed_torque<InverseDynamics>), py::arg("model"), py::arg("kp"),
            py::arg("kd"), py::arg("torque_limit") = py::none(), MECHBAL_JOINT_RANGE_ARGS,
            py::keep_alive<1, 2>(),
            "model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, "
@@ -190,11 +191,8 @@ void bind_arm2dof(py::module_& m) {
            "input range of a tick (beyond it: the held command and Status.out_of_range)")
       .def_property_readonly("torque_limit", &ComputedTorque::torque_limit)
       .def_property_readonly("dof", &ComputedTorque::dof)
-      .def_property_readonly("last_command", &ComputedTorque::last_command)
-      .def("step", &controller_step<ComputedTorque>,
-          py::arg("q"), py::arg("qd"), py::arg("q_des"), py::arg("qd_des"), py::arg("qdd_des"),
-          "One tick: (tau, status). Non-finite input returns the last command and a status.")
-      .def("reset", &ComputedTorque::reset);
+      .def_property_readonly("last_command", &ComputedTorque::last_command);
+  bind_joint_controller_ticks<ComputedTorque>(ct);
 
   m.def(
       "simulate_closed_loop",
@@ -225,6 +223,44 @@ void bind_arm2dof(py::module_& m) {
       "mechanism) under `controller` (any JointController) tracking `desired`; returns a dict of arrays "
       "t (N+1,), q, qd, q_des, qd_des, tau (N+1, dof), status, saturated_ticks, steps_completed.");
   m.attr("simulate_computed_torque") = m.attr("simulate_closed_loop");
+  m.def(
+      "simulate_closed_loop_sampled",
+      [](ForwardDynamics& plant, JointController& controller, const Array& q_des,
+         const Array& qd_des, const Array& qdd_des, const Array& q0_arg, const Array& qd0_arg,
+         double dt, double duration, const std::string& sampling) {
+        const auto n = static_cast<py::ssize_t>(plant.dof());
+        require_shape(q_des, "q_des", {-1, n}, "one row every dt/2, one value per joint");
+        const auto J = q_des.shape(0);
+        require_shape(qd_des, "qd_des", {J, n});
+        require_shape(qdd_des, "qdd_des", {J, n});
+        using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+        SampledMotion desired;
+        desired.q = Eigen::Map<const RowMajor>(q_des.data(), J, n);
+        desired.qd = Eigen::Map<const RowMajor>(qd_des.data(), J, n);
+        desired.qdd = Eigen::Map<const RowMajor>(qdd_des.data(), J, n);
+        const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "qd0", -1);
+        ClosedLoopOptions opt;
+        opt.dt = dt;
+        opt.duration = duration;
+        if (sampling == "zero_order_hold")
+          opt.sampling = ControlSampling::zero_order_hold;
+        else if (sampling == "every_rk4_stage")
+          opt.sampling = ControlSampling::every_rk4_stage;
+        else
+          throw py::value_error("sampling must be 'zero_order_hold' or 'every_rk4_stage', got '" +
+                                sampling + "'");
+        ClosedLoopLog log;
+        {
+          py::gil_scoped_release release;
+          log = simulate_closed_loop(plant, controller, desired, q0, qd0, opt);
+        }
+        return log_to_dict(log);
+      },
+      py::arg("plant"), py::arg("controller"), py::arg("q_des"), py::arg("qd_des"),
+      py::arg("qdd_des"), py::arg("q0"), py::arg("qd0"), py::arg("dt") = 1e-3,
+      py::arg("duration") = 1.0, py::arg("sampling") = "zero_order_hold",
+      "simulate_closed_loop tracking a sampled desired motion: q_des, qd_des, qdd_des each "
+      "(2 steps + 1, dof), sampled every dt/2 from t = 0 (steps = round(duration / dt)).");
 
   m.def(
       "pd_error_analytic",

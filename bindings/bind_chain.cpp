@@ -142,16 +142,6 @@ void bind_chain(pybind11::module_& m) {
   py::class_<KdlChainDynamics, InverseDynamics>(m, "KdlChainDynamics",
                                "Joint-space dynamics of a ChainModel through Orocos KDL")
       .def(py::init<const ChainModel&>(), py::arg("model"))
-      .def(py::init([](const MechanismModel& model) {
-             try {
-               return std::make_unique<KdlChainDynamics>(model);
-             } catch (const std::invalid_argument& e) {
-               throw py::value_error(e.what());
-             }
-           }),
-           py::arg("model"),
-           "From the general MechanismModel when it is a serial chain (bodies lumped per link); "
-           "ValueError naming the link or joint otherwise")
       .def_property_readonly("dof", &KdlChainDynamics::dof)
       .def(
           "inverse_dynamics",

@@ -46,6 +46,34 @@ void bind_core(pybind11::module_& m) {
       .value("bad_size", Status::bad_size)
       .value("solver_error", Status::solver_error)
       .value("out_of_range", Status::out_of_range);
+  // A status compares equal to the integer of its bit flags (and hashes like it), so that the
+  // Status a tick returns, the int of step_into and the uint32 entries of a batch's status array
+  // are interchangeable: `status == Status.ok`, `run.status[k] == Status.saturated`.
+  py::object status_cls = m.attr("Status");
+  auto index_of = [](const py::handle& o) -> py::object {
+    PyObject* r = PyNumber_Index(o.ptr());
+    if (!r) {
+      PyErr_Clear();
+      return py::none();
+    }
+    return py::reinterpret_steal<py::object>(r);
+  };
+  status_cls.attr("__eq__") = py::cpp_function(
+      [index_of](const py::object& a, const py::object& b) -> py::object {
+        py::object ib = index_of(b);
+        if (ib.is_none()) return py::reinterpret_borrow<py::object>(Py_NotImplemented);
+        return py::bool_(index_of(a).equal(ib));
+      },
+      py::is_method(status_cls), py::arg("other"));
+  status_cls.attr("__ne__") = py::cpp_function(
+      [index_of](const py::object& a, const py::object& b) -> py::object {
+        py::object ib = index_of(b);
+        if (ib.is_none()) return py::reinterpret_borrow<py::object>(Py_NotImplemented);
+        return py::bool_(!index_of(a).equal(ib));
+      },
+      py::is_method(status_cls), py::arg("other"));
+  status_cls.attr("__hash__") = py::cpp_function(
+      [index_of](const py::object& a) { return py::hash(index_of(a)); }, py::is_method(status_cls));
 
   m.def("status_name", [](std::uint32_t s) { return std::string(status_name(static_cast<Status>(s))); },
         py::arg("status"), "Name of a Status value ('multiple' for a combination of flags)");

@@ -125,11 +125,11 @@ void bind_discs(py::module_& m) {
          py::arg("kd"), py::arg("torque_limit") = py::none(), MECHBAL_JOINT_RANGE_ARGS,
          py::keep_alive<1, 2>());
 
-  py::class_<DecoupledJointController, JointController>(
+  py::class_<DecoupledJointController, JointController> dc(
       m, "DecoupledJointController",
       "tau_i = k_i (qdd_d + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho "
-      "eqs 15, 26, 36)")
-      .def(py::init([](const Array& k, const Array& kp, const Array& kd,
+      "eqs 15, 26, 36)");
+  dc.def(py::init([](const Array& k, const Array& kp, const Array& kd,
                        const py::object& torque_limit, double max_position, double max_speed,
                        double max_acceleration) {
              const Eigen::VectorXd limit =
@@ -144,8 +144,8 @@ void bind_discs(py::module_& m) {
            MECHBAL_JOINT_RANGE_ARGS,
            "k, kp, kd: one value per joint; torque_limit: one per joint (default and +inf: mechbal "
            "default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range "
-           "of a tick (beyond it: the held command and Status.out_of_range)")
-      .def_property_readonly("torque_limit", [](const DecoupledJointController& c) {
+           "of a tick (beyond it: the held command and Status.out_of_range)");
+  dc.def_property_readonly("torque_limit", [](const DecoupledJointController& c) {
         return Eigen::VectorXd(c.torque_limit());
       })
       .def_property_readonly("dof", &DecoupledJointController::dof)
@@ -154,11 +154,8 @@ void bind_discs(py::module_& m) {
       })
       .def_property_readonly("last_command", [](const DecoupledJointController& c) {
         return Eigen::VectorXd(c.last_command());
-      })
-      .def("step", &controller_step<DecoupledJointController>,
-          py::arg("q"), py::arg("qd"), py::arg("q_des"), py::arg("qd_des"), py::arg("qdd_des"),
-          "One tick: (tau, status). Non-finite input returns the last command and a status.")
-      .def("reset", &DecoupledJointController::reset);
+      });
+  bind_joint_controller_ticks<DecoupledJointController>(dc);
 }
 
 }  // namespace

@@ -371,7 +371,8 @@ void bind_mechanism(py::module_& m) {
         opt.max_iterations = max_iterations;
         opt.tolerance = tolerance;
         opt.singular_rcond = singular_rcond;
-        Array Q = make_array({N, n}), V = make_array({N, n}), A = make_array({N, n}), F = make_array({N, na});
+        Array Q = make_array({N, n}), V = make_array({N, n}), A = make_array({N, n}), F = make_array({N, na}),
+              Cm = make_array({N, n, na});
         py::array_t<double> rcond(N), residual(N);
         py::array_t<std::int32_t> iterations(N);
         StatusArray status(N);
@@ -406,6 +407,7 @@ void bind_mechanism(py::module_& m) {
             }
             double* fo = F.mutable_data(k);
             for (py::ssize_t i = 0; i < na; ++i) fo[i] = finite && dynamics ? d.actuated_force(i) : 0.0;
+            put(Cm, k, d.loop_projection, finite);
           }
         }
         py::dict out;
@@ -413,6 +415,7 @@ void bind_mechanism(py::module_& m) {
         out["v"] = V;
         out["a"] = A;
         if (dynamics) out["actuated_force"] = F;
+        out["projection"] = Cm;
         out["rcond"] = rcond;
         out["residual"] = residual;
         out["iterations"] = iterations;

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "array_checks.hpp"
+#include "controller_step.hpp"
 #include "bindings.hpp"
 #include "mechbal/paminsa.hpp"
 #include "mechbal/reactionless_wrist.hpp"
@@ -155,7 +156,10 @@ void bind_paminsa(py::module_& m) {
         py::arg("J1"), py::arg("J2"), py::arg("J3"), py::arg("angles"), py::arg("rates"),
         "d/dt(N qdot) - N qddot");
 
-  py::class_<WristCommand>(m, "WristCommand")
+  py::class_<WristCommand>(m, "WristCommand",
+                           "A reactionless-wrist tick's command: angles [rad], rates [rad/s], "
+                           "accelerations [rad/s^2] (feed-forward), next_angles [rad], the "
+                           "condition number of N(q) and the status")
       .def_readonly("angles", &WristCommand::angles)
       .def_readonly("rates", &WristCommand::rates)
       .def_readonly("accelerations", &WristCommand::accelerations)
@@ -192,6 +196,64 @@ void bind_paminsa(py::module_& m) {
              return w.reset(fixed_vector<3>(q, "angles"), fixed_vector<3>(H, "target_momentum"));
            },
            py::arg("angles"), py::arg("target_momentum"))
+      .def(
+          "step_into",
+          [](ReactionlessWrist& w, FastArg D, FastArg Dd, FastArg Dh, FastArg Dn, FastArg out) {
+            using CV = Eigen::Map<const Vec3>;
+            const double* d = detail::fast_array(D.h, "D", 3);
+            const double* dd = detail::fast_array(Dd.h, "D_dot", 3);
+            const double* dh = detail::fast_array(Dh.h, "D_half", 3);
+            const double* dn = detail::fast_array(Dn.h, "D_next", 3);
+            double* o = detail::fast_matrix(out.h, "out", 3, 3, true);
+            const Status s = w.step(CV(d), CV(dd), CV(dh), CV(dn));
+            const WristCommand& c = w.command();
+            Eigen::Map<Vec3>{o} = c.angles;
+            Eigen::Map<Vec3>(o + 3) = c.rates;
+            Eigen::Map<Vec3>(o + 6) = c.accelerations;
+            return static_cast<std::uint32_t>(s);
+          },
+          py::arg("D"), py::arg("D_dot"), py::arg("D_half"), py::arg("D_next"), py::arg("out"),
+          "The fast tick: D [kg m^2/s], D_dot [N m], D_half, D_next as float64 arrays of 3; writes "
+          "the command into `out` (3, 3): rows angles [rad], rates [rad/s], accelerations "
+          "[rad/s^2]; returns the status as an int. Nothing is copied or allocated.")
+      .def(
+          "run",
+          [](ReactionlessWrist& w, const Array& D, const Array& Dd, const Array& Dh,
+             const Array& Dn) {
+            require_shape(D, "D", {-1, 3});
+            const auto N = D.shape(0);
+            require_shape(Dd, "D_dot", {N, 3});
+            require_shape(Dh, "D_half", {N, 3});
+            require_shape(Dn, "D_next", {N, 3});
+            OutArray q = make_array({N, 3}), qd = make_array({N, 3}), qdd = make_array({N, 3}),
+                     cond = make_array({N});
+            auto status = make_status_array(N);
+            using CV = Eigen::Map<const Vec3>;
+            {
+              py::gil_scoped_release release;
+              for (py::ssize_t k = 0; k < N; ++k) {
+                const Status st = w.step(CV(D.data(k, 0)), CV(Dd.data(k, 0)), CV(Dh.data(k, 0)),
+                                         CV(Dn.data(k, 0)));
+                const WristCommand& c = w.command();
+                Eigen::Map<Vec3>(q.mutable_data(k, 0)) = c.angles;
+                Eigen::Map<Vec3>(qd.mutable_data(k, 0)) = c.rates;
+                Eigen::Map<Vec3>(qdd.mutable_data(k, 0)) = c.accelerations;
+                cond.mutable_data()[k] = c.condition_number;
+                status.mutable_data()[k] = static_cast<std::uint32_t>(st);
+              }
+            }
+            py::dict d;
+            d["wrist_angles"] = q;
+            d["wrist_rates"] = qd;
+            d["wrist_accelerations"] = qdd;
+            d["condition"] = cond;
+            d["status"] = status;
+            return d;
+          },
+          py::arg("D"), py::arg("D_dot"), py::arg("D_half"), py::arg("D_next"),
+          "N consecutive ticks in one call: D, D_dot, D_half, D_next each (N, 3) -> "
+          "{'wrist_angles', 'wrist_rates', 'wrist_accelerations' (N, 3), 'condition' (N,), "
+          "'status' (N,) per tick}")
       .def_property_readonly("command", &ReactionlessWrist::command)
       .def_property_readonly("angles", &ReactionlessWrist::angles)
       .def_property_readonly("dt", &ReactionlessWrist::dt);
@@ -270,6 +332,91 @@ void bind_paminsa(py::module_& m) {
            py::arg("P"),
            "(points, status): base-frame points A, B, C, D, E, F of each leg (3, 6, 3) at pose P; "
            "zeros and the status when P is not finite, unreachable or overflows");
+
+  py::class_<PaminsaController>(
+      m, "PaminsaController",
+      "One tick of the fully balanced PAMINSA (Briot & Arakelian 2009): kinematics at t_n, D "
+      "(eq 19), the reactionless-wrist step, every body's motion and the shaking wrench")
+      .def(py::init([](const PaminsaModel& mo, const ReactionlessWristConfig& c, const Array& q0,
+                       double max_speed, double max_acceleration) {
+             PlatformLimits lim;
+             lim.max_speed = max_speed;
+             lim.max_acceleration = max_acceleration;
+             return new PaminsaController(mo, c, fixed_vector<3>(q0, "initial_wrist_angles"), lim);
+           }),
+           py::arg("model"), py::arg("config"), py::arg("initial_wrist_angles"),
+           py::arg("max_speed") = PlatformLimits{}.max_speed,
+           py::arg("max_acceleration") = PlatformLimits{}.max_acceleration,
+           "max_speed [m/s], max_acceleration [m/s^2]: the platform motion a tick accepts (per "
+           "component)")
+      .def(
+          "reset",
+          [](PaminsaController& c, const Array& P, const Array& wrist_angles) {
+            PlatformMotion rest;
+            rest.position = fixed_vector<3>(P, "P");
+            return c.reset(rest, fixed_vector<3>(wrist_angles, "wrist_angles"));
+          },
+          py::arg("P"), py::arg("wrist_angles"),
+          "Restart at rest at platform position P [m] with the wrist at `wrist_angles` [rad]; "
+          "returns the Status (nothing changes unless ok)")
+      .def(
+          "step",
+          [](PaminsaController& c, const Array& P, const Array& Pd, const Array& Pdd,
+             const Array& P_half, const Array& Pd_half, const Array& Pdd_half,
+             const Array& P_next, const Array& Pd_next, const Array& Pdd_next) {
+            auto motion = [](const Array& a, const Array& b, const Array& cc, const char* na,
+                             const char* nb, const char* nc) {
+              PlatformMotion m;
+              m.position = fixed_vector<3>(a, na);
+              m.velocity = fixed_vector<3>(b, nb);
+              m.acceleration = fixed_vector<3>(cc, nc);
+              return m;
+            };
+            return c.tick(motion(P, Pd, Pdd, "P", "Pd", "Pdd"),
+                          motion(P_half, Pd_half, Pdd_half, "P_half", "Pd_half", "Pdd_half"),
+                          motion(P_next, Pd_next, Pdd_next, "P_next", "Pd_next", "Pdd_next"));
+          },
+          py::arg("P"), py::arg("Pd"), py::arg("Pdd"), py::arg("P_half"), py::arg("Pd_half"),
+          py::arg("Pdd_half"), py::arg("P_next"), py::arg("Pd_next"), py::arg("Pdd_next"),
+          "One tick: platform position [m], velocity [m/s], acceleration [m/s^2] at t_n, "
+          "t_n + dt/2, t_n + dt (Euler ignores the last two). Returns the Status; the result is "
+          "in shaking_force, shaking_moment, D, D_dot and wrist_command")
+      .def(
+          "step_into",
+          [](PaminsaController& c, FastArg now, FastArg half, FastArg next, FastArg out) {
+            auto motion = [](const double* p) {
+              PlatformMotion m;
+              m.position = Eigen::Map<const Vec3>(p);
+              m.velocity = Eigen::Map<const Vec3>(p + 3);
+              m.acceleration = Eigen::Map<const Vec3>(p + 6);
+              return m;
+            };
+            const double* n = detail::fast_matrix(now.h, "now", 3, 3);
+            const double* h = detail::fast_matrix(half.h, "half", 3, 3);
+            const double* x = detail::fast_matrix(next.h, "next", 3, 3);
+            double* o = detail::fast_matrix(out.h, "out", 3, 3, true);
+            const Status s = c.tick(motion(n), motion(h), motion(x));
+            const WristCommand& w = c.wrist().command();
+            Eigen::Map<Vec3>{o} = w.angles;
+            Eigen::Map<Vec3>(o + 3) = w.rates;
+            Eigen::Map<Vec3>(o + 6) = w.accelerations;
+            return static_cast<std::uint32_t>(s);
+          },
+          py::arg("now"), py::arg("half"), py::arg("next"), py::arg("out"),
+          "The fast tick: the platform motion at t_n, t_n + dt/2, t_n + dt, each a (3, 3) float64 "
+          "array with rows position [m], velocity [m/s], acceleration [m/s^2]; writes the wrist "
+          "command into `out` (3, 3): rows angles [rad], rates [rad/s], accelerations [rad/s^2]; "
+          "returns the status as an int (the wrench stays in shaking_force, shaking_moment)")
+      .def_property_readonly("shaking_force",
+                             [](const PaminsaController& c) { return Vec3(c.wrench().force); })
+      .def_property_readonly("shaking_moment",
+                             [](const PaminsaController& c) { return Vec3(c.wrench().moment); })
+      .def_property_readonly("D", [](const PaminsaController& c) { return Vec3(c.D()); })
+      .def_property_readonly("D_dot", [](const PaminsaController& c) { return Vec3(c.D_dot()); })
+      .def_property_readonly("wrist_command",
+                             [](const PaminsaController& c) { return c.wrist().command(); })
+      .def_property_readonly("wrist_angles",
+                             [](const PaminsaController& c) { return Vec3(c.wrist().angles()); });
 
   m.def("paminsa_kinematics",
         [](const PaminsaModel& mo, const Array& P, const Array& Pd, const Array& Pdd,

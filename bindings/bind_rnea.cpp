@@ -4,6 +4,7 @@
 #include "array_checks.hpp"
 #include "batch_inverse_dynamics.hpp"
 #include "bindings.hpp"
+#include "mechbal/kdl_chain.hpp"
 #include "mechbal/rnea.hpp"
 
 namespace py = pybind11;
@@ -17,6 +18,18 @@ Eigen::VectorXd one_state(const MechanismDynamics& d, const Array& v, const char
 }
 
 void bind_rnea(py::module_& m) {
+  // KdlChainDynamics is bound in bind_chain.cpp (20); its general-model constructor is added here.
+  auto kdl = py::reinterpret_borrow<py::class_<KdlChainDynamics, InverseDynamics>>(m.attr("KdlChainDynamics"));
+  kdl.def(py::init([](const MechanismModel& model) {
+             try {
+               return std::make_unique<KdlChainDynamics>(model);
+             } catch (const std::invalid_argument& e) {
+               throw py::value_error(e.what());
+             }
+           }),
+           py::arg("model"),
+           "From the general MechanismModel when it is a serial chain (bodies lumped per link); "
+           "ValueError naming the link or joint otherwise");
   py::class_<MechanismDynamics, InverseDynamics, ForwardDynamics>(
       m, "MechanismDynamics",
       "Joint-space dynamics of a MechanismModel (recursive Newton-Euler inverse dynamics with the "
@@ -99,6 +112,7 @@ void bind_rnea(py::module_& m) {
 
 }  // namespace
 
-MECHBAL_REGISTER_BINDINGS(25, rnea, bind_rnea);
+// after bind_mechanism (30): the signatures name MechanismModel, so it must be bound first
+MECHBAL_REGISTER_BINDINGS(32, rnea, bind_rnea);
 
 }  // namespace mechbal::pyb

@@ -7,12 +7,37 @@
 #include <pybind11/pybind11.h>
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <string>
 
 #include "array_checks.hpp"
 #include "mechbal/status.hpp"
 #include "mechbal/computed_torque.hpp"
 #include "mechbal/joint_limits.hpp"
+
+namespace mechbal::pyb {
+
+/// An argument of the fast tick: the Python object as is (checked by detail::fast_array), typed
+/// as a float64 numpy array in the signature (and so in the stubs).
+struct FastArg {
+  pybind11::handle h;
+};
+
+}  // namespace mechbal::pyb
+
+namespace pybind11::detail {
+template <>
+struct type_caster<mechbal::pyb::FastArg> {
+  PYBIND11_TYPE_CASTER(mechbal::pyb::FastArg, const_name("numpy.typing.NDArray[numpy.float64]"));
+  bool load(handle src, bool) {
+    value.h = src;
+    return true;
+  }
+  static handle cast(const mechbal::pyb::FastArg& a, return_value_policy, handle) {
+    return a.h.inc_ref();
+  }
+};
+}  // namespace pybind11::detail
 
 namespace mechbal::pyb {
 
@@ -29,6 +54,147 @@ pybind11::tuple controller_step(Controller& c, const Array& q, const Array& qd, 
   Eigen::VectorXd tau = c.last_command();
   const Status s = c.step(q_, qd_, q_des_, qd_des_, qdd_des_, tau);
   return pybind11::make_tuple(tau, s);
+}
+
+/// The fast tick (issue 15: at most 1.5 us from Python). The arguments arrive as plain handles
+/// (no pybind11 conversion, no overload resolution) and are checked here on the array header:
+/// a numpy array, 1-D, of n native float64 values, C-contiguous and aligned (`out` also
+/// writeable); the data are then read and written in place through Eigen::Map, nothing copied or
+/// allocated. Anything else is a TypeError or ValueError naming the argument. Returns the status
+/// as an int.
+namespace detail {
+
+[[noreturn]] inline void fast_refuse(pybind11::handle h, const char* name, pybind11::ssize_t n,
+                                     bool writeable) {
+  std::string got = pybind11::str(pybind11::type::handle_of(h)).cast<std::string>();
+  if (pybind11::isinstance<pybind11::array>(h)) {
+    const auto a = pybind11::reinterpret_borrow<pybind11::array>(h);
+    got = "an array of dtype " + pybind11::str(a.dtype()).cast<std::string>() + " and shape " +
+          shape_of(a);
+    if (a.ndim() != 1 || a.shape(0) != n)
+      throw pybind11::value_error(std::string("step_into: ") + name + " must have shape (" +
+                                  std::to_string(n) + ",) (the controller has " +
+                                  std::to_string(n) + " joints), got " + shape_of(a));
+    if (writeable && !a.writeable())
+      throw pybind11::value_error(std::string("step_into: ") + name + " must be writeable");
+  }
+  throw pybind11::type_error(std::string("step_into: ") + name +
+                             " must be a C-contiguous numpy array of float64 "
+                             "(numpy.ascontiguousarray(x, dtype=float)), got " + got +
+                             "; step() accepts any real array-like");
+}
+
+inline double* fast_array(pybind11::handle h, const char* name, pybind11::ssize_t n,
+                          bool writeable = false) {
+  namespace pd = pybind11::detail;
+  const auto& api = pd::npy_api::get();
+  if (!api.PyArray_Check_(h.ptr())) fast_refuse(h, name, n, writeable);
+  const pd::PyArray_Proxy* a = pd::array_proxy(h.ptr());
+  const pd::PyArrayDescr_Proxy* d = pd::array_descriptor_proxy(a->descr);
+  constexpr int need = pd::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | pd::npy_api::NPY_ARRAY_ALIGNED_;
+  const int flags = a->flags;
+  if (a->nd != 1 || a->dimensions[0] != n || d->type_num != pd::npy_api::NPY_DOUBLE_ ||
+      d->byteorder == '>' || (flags & need) != need ||
+      (writeable && !(flags & pd::npy_api::NPY_ARRAY_WRITEABLE_)))
+    fast_refuse(h, name, n, writeable);
+  return reinterpret_cast<double*>(a->data);
+}
+
+/// A (rows, cols) native float64 C-contiguous aligned array (the fast path's matrices).
+inline double* fast_matrix(pybind11::handle h, const char* name, pybind11::ssize_t rows,
+                           pybind11::ssize_t cols, bool writeable = false) {
+  namespace pd = pybind11::detail;
+  const auto& api = pd::npy_api::get();
+  constexpr int need = pd::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | pd::npy_api::NPY_ARRAY_ALIGNED_;
+  if (api.PyArray_Check_(h.ptr())) {
+    const pd::PyArray_Proxy* a = pd::array_proxy(h.ptr());
+    const pd::PyArrayDescr_Proxy* d = pd::array_descriptor_proxy(a->descr);
+    const int flags = a->flags;
+    if (a->nd == 2 && a->dimensions[0] == rows && a->dimensions[1] == cols &&
+        d->type_num == pd::npy_api::NPY_DOUBLE_ && d->byteorder != '>' && (flags & need) == need &&
+        (!writeable || (flags & pd::npy_api::NPY_ARRAY_WRITEABLE_)))
+      return reinterpret_cast<double*>(a->data);
+    const auto arr = pybind11::reinterpret_borrow<pybind11::array>(h);
+    if (arr.ndim() != 2 || arr.shape(0) != rows || arr.shape(1) != cols)
+      throw pybind11::value_error(std::string("step_into: ") + name + " must have shape (" +
+                                  std::to_string(rows) + ", " + std::to_string(cols) + "), got " +
+                                  shape_of(arr));
+    if (writeable && !arr.writeable())
+      throw pybind11::value_error(std::string("step_into: ") + name + " must be writeable");
+  }
+  throw pybind11::type_error(std::string("step_into: ") + name +
+                             " must be a C-contiguous numpy array of float64 "
+                             "(numpy.ascontiguousarray(x, dtype=float)), got " +
+                             pybind11::str(pybind11::type::handle_of(h)).cast<std::string>());
+}
+
+}  // namespace detail
+
+template <typename Controller>
+std::uint32_t controller_step_into(Controller& c, FastArg q, FastArg qd, FastArg q_des,
+                                   FastArg qd_des, FastArg qdd_des, FastArg out) {
+  const auto n = static_cast<pybind11::ssize_t>(c.dof());
+  using CMap = Eigen::Map<const Eigen::VectorXd>;
+  const double* q_ = detail::fast_array(q.h, "q", n);
+  const double* qd_ = detail::fast_array(qd.h, "qd", n);
+  const double* q_des_ = detail::fast_array(q_des.h, "q_des", n);
+  const double* qd_des_ = detail::fast_array(qd_des.h, "qd_des", n);
+  const double* qdd_des_ = detail::fast_array(qdd_des.h, "qdd_des", n);
+  Eigen::Map<Eigen::VectorXd> tau(detail::fast_array(out.h, "out", n, true), n);
+  return static_cast<std::uint32_t>(c.step(CMap(q_, n), CMap(qd_, n), CMap(q_des_, n),
+                                           CMap(qd_des_, n), CMap(qdd_des_, n), tau));
+}
+
+/// Batch: N consecutive ticks over (N, n) arrays in one call -> {'joint_torque' (N, n),
+/// 'status' (N,) per tick}. The controller's state (held command) carries from tick to tick.
+template <typename Controller>
+pybind11::dict controller_run(Controller& c, const Array& q, const Array& qd, const Array& q_des,
+                              const Array& qd_des, const Array& qdd_des) {
+  const auto n = static_cast<pybind11::ssize_t>(c.dof());
+  const std::string context = "the controller has " + std::to_string(n) + " joints";
+  require_shape(q, "q", {-1, n}, context.c_str());
+  const auto N = q.shape(0);
+  require_shape(qd, "qd", {N, n}, context.c_str());
+  require_shape(q_des, "q_des", {N, n}, context.c_str());
+  require_shape(qd_des, "qd_des", {N, n}, context.c_str());
+  require_shape(qdd_des, "qdd_des", {N, n}, context.c_str());
+  OutArray tau = make_array({N, n});
+  auto status = make_status_array(N);
+  using CMap = Eigen::Map<const Eigen::VectorXd>;
+  {
+    pybind11::gil_scoped_release release;
+    for (pybind11::ssize_t k = 0; k < N; ++k) {
+      Eigen::Map<Eigen::VectorXd> t(tau.mutable_data(k, 0), n);
+      status.mutable_data()[k] = static_cast<std::uint32_t>(
+          c.step(CMap(q.data(k, 0), n), CMap(qd.data(k, 0), n), CMap(q_des.data(k, 0), n),
+                 CMap(qd_des.data(k, 0), n), CMap(qdd_des.data(k, 0), n), t));
+    }
+  }
+  pybind11::dict d;
+  d["joint_torque"] = tau;
+  d["status"] = status;
+  return d;
+}
+
+/// step, step_into, run and reset of a joint controller class (the same methods on every one).
+template <typename Controller, typename PyClass>
+void bind_joint_controller_ticks(PyClass& cls) {
+  namespace py = pybind11;
+  cls.def("step", &controller_step<Controller>, py::arg("q"), py::arg("qd"), py::arg("q_des"),
+          py::arg("qd_des"), py::arg("qdd_des"),
+          "One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or "
+          "out-of-range input returns the held command and a non-ok status.")
+      .def("step_into", &controller_step_into<Controller>, py::arg("q"), py::arg("qd"),
+           py::arg("q_des"), py::arg("qd_des"), py::arg("qdd_des"), py::arg("out"),
+           "The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n "
+           "values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every "
+           "argument must be a C-contiguous float64 numpy array of n values; nothing is copied or "
+           "allocated.")
+      .def("run", &controller_run<Controller>, py::arg("q"), py::arg("qd"), py::arg("q_des"),
+           py::arg("qd_des"), py::arg("qdd_des"),
+           "N consecutive ticks in one call: q, qd [rad or m, rad/s or m/s], q_des, qd_des, "
+           "qdd_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}")
+      .def("reset", &Controller::reset, "Forget the held command (zero torque).");
 }
 
 /// The input range of a joint controller from the Python keyword arguments.

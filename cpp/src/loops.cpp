@@ -120,6 +120,48 @@ void evaluate(const MechanismModel& model, MechanismData& data, const Eigen::Ref
   constraint_rows(model, data, jacobian);
 }
 
+/// N = L D L^T in place, without pivoting (N is symmetric positive semi-definite: the normal matrix
+/// of A° plus a small damping): L in N's strict lower triangle (unit diagonal implied), D in `D`.
+/// Written out for the small sizes of loop closures, where Eigen's LDLT (pivot search, blocked
+/// triangular solves) costs several times more. A pivot that is not positive (a singular A°) is
+/// kept as is and its component is zeroed by ldl_solve, as Eigen's LDLT does (pseudo-inverse of D).
+void ldl_factor(Eigen::MatrixXd& N, Eigen::VectorXd& D) noexcept {
+  const Eigen::Index n = N.rows();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double d = N(k, k);
+    D(k) = d;
+    const Eigen::Index rest = n - k - 1;
+    if (!(d > 0.0)) {
+      N.col(k).tail(rest).setZero();
+      continue;
+    }
+    for (Eigen::Index j = k + 1; j < n; ++j) {
+      const double f = N(j, k) / d;
+      if (f != 0.0) N.col(j).segment(j, n - j) -= f * N.col(k).segment(j, n - j);
+    }
+    N.col(k).tail(rest) /= d;
+  }
+}
+
+/// x = (L D L^T)^-1 x with the factors of ldl_factor (plain loops: these are short vectors).
+void ldl_solve(const Eigen::MatrixXd& L, const Eigen::VectorXd& D, Eigen::Ref<Eigen::VectorXd> x) noexcept {
+  const Eigen::Index n = L.rows();
+  double* const v = x.data();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double xk = v[k];
+    if (xk == 0.0) continue;
+    const double* l = L.data() + k * n;
+    for (Eigen::Index i = k + 1; i < n; ++i) v[i] -= xk * l[i];
+  }
+  for (Eigen::Index k = 0; k < n; ++k) v[k] = D(k) > 0.0 ? v[k] / D(k) : 0.0;
+  for (Eigen::Index k = n - 1; k >= 0; --k) {
+    const double* l = L.data() + k * n;
+    double sum = 0.0;
+    for (Eigen::Index i = k + 1; i < n; ++i) sum += l[i] * v[i];
+    v[k] -= sum;
+  }
+}
+
 /// N = A°^T A° + damping from data.loop_jacobian, factorised; returns the rcond estimate of A°.
 double factor_passive(const MechanismModel& model, MechanismData& data) noexcept {
   const auto& passive = model.passive_coordinates();
@@ -127,11 +169,40 @@ double factor_passive(const MechanismModel& model, MechanismData& data) noexcept
   for (Eigen::Index j = 0; j < np; ++j) {
     data.loop_passive_jacobian.col(j) = data.loop_jacobian.col(passive[static_cast<std::size_t>(j)]);
   }
-  data.loop_normal.noalias() = data.loop_passive_jacobian.transpose() * data.loop_passive_jacobian;
+  // N = A°^T A°, lower triangle only (what ldl_factor reads), each entry a dot product over the rows
+  // where both columns can be nonzero: a loop's rows involve only the coordinates of its two
+  // frames' branches, so on mechanisms with several loops most column pairs do not overlap
+  // (PAMINSA: the legs' coordinates meet only through the platform's), several times cheaper than
+  // the dense product
+  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
+  Eigen::MatrixXd& N = data.loop_normal;
+  const auto m = static_cast<int>(Ap.rows());
+  for (Eigen::Index j = 0; j < np; ++j) {
+    int first = m, last = -1;
+    for (int r = 0; r < m; ++r) {
+      if (Ap(r, j) != 0.0) {
+        if (first == m) first = r;
+        last = r;
+      }
+    }
+    data.loop_passive_first(j) = first;
+    data.loop_passive_last(j) = last;
+  }
+  for (Eigen::Index i = 0; i < np; ++i) {
+    const double* ai = Ap.data() + i * m;
+    for (Eigen::Index j = i; j < np; ++j) {
+      const int lo = std::max(data.loop_passive_first(i), data.loop_passive_first(j));
+      const int hi = std::min(data.loop_passive_last(i), data.loop_passive_last(j));
+      const double* aj = Ap.data() + j * m;
+      double sum = 0.0;
+      for (int r = lo; r <= hi; ++r) sum += ai[r] * aj[r];
+      N(j, i) = sum;
+    }
+  }
   const double scale = std::max(1.0, data.loop_normal.diagonal().maxCoeff());
   data.loop_normal.diagonal().array() += 1e-14 * scale;
-  data.loop_ldlt.compute(data.loop_normal);
-  const auto D = data.loop_ldlt.vectorD();
+  ldl_factor(data.loop_normal, data.loop_normal_pivots);
+  const Eigen::VectorXd& D = data.loop_normal_pivots;
   if (np == 0) return 1.0;
   const double dmax = D.cwiseAbs().maxCoeff(), dmin = D.cwiseAbs().minCoeff();
   return dmax > 0.0 ? std::sqrt(std::max(0.0, dmin - 1e-14 * scale) / dmax) : 0.0;
@@ -168,7 +239,31 @@ Status solve_loop_positions(const MechanismModel& model, MechanismData& data, co
   const auto& passive = model.passive_coordinates();
   Eigen::VectorXd& trial = data.loop_trial;
   trial = q;
-  for (std::size_t i = 0; i < actuated.size(); ++i) trial(actuated[i]) = q_actuated(static_cast<Eigen::Index>(i));
+  // Warm start from the last solved motion (q is where data.loop_projection was computed: the
+  // usual tick, which passes back the q it got): follow the closure manifold to second order,
+  // q + C d + (s^2 / 2) c with d = q#_new - q# and s = d . v# / |v#|^2 (d = s v# to first order
+  // along a motion, and c, the acceleration bias of the last projection, is quadratic in v#), so
+  // that Newton starts O(|d|^3) from the solution instead of O(|d|) (two iterations fewer at
+  // 1 kHz). Only a starting point: Newton then converges as before. Not when the step would
+  // exceed options.max_step.
+  const bool tangent = model.is_closed() && q == data.closed_position;
+  double vv = 0.0, dv = 0.0;
+  for (std::size_t i = 0; i < actuated.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    const double step = q_actuated(k) - q(actuated[i]), rate = data.closed_velocity(actuated[i]);
+    if (tangent) trial.noalias() += data.loop_projection.col(k) * step;
+    trial(actuated[i]) = q_actuated(k);
+    vv += rate * rate;
+    dv += step * rate;
+  }
+  if (tangent && vv > 0.0) {
+    const double s = dv / vv;
+    trial.noalias() += (0.5 * s * s) * data.loop_acceleration_bias;  // zero on the actuated rows
+  }
+  if (tangent && !((trial - q).cwiseAbs().maxCoeff() <= options.max_step)) {
+    trial = q;
+    for (std::size_t i = 0; i < actuated.size(); ++i) trial(actuated[i]) = q_actuated(static_cast<Eigen::Index>(i));
+  }
   data.loop_iterations = 0;
   if (!model.is_closed()) {
     data.loop_residual_norm = 0.0;
@@ -183,7 +278,7 @@ Status solve_loop_positions(const MechanismModel& model, MechanismData& data, co
     data.loop_iterations = it + 1;
     factor_passive(model, data);
     data.loop_step.noalias() = -data.loop_passive_jacobian.transpose() * data.loop_residual;
-    data.loop_ldlt.solveInPlace(data.loop_step);
+    ldl_solve(data.loop_normal, data.loop_normal_pivots, data.loop_step);
     const double biggest = data.loop_step.cwiseAbs().maxCoeff();
     if (!(biggest < 1e300)) break;  // non-finite step: cannot assemble here
     if (biggest > options.max_step) data.loop_step *= options.max_step / biggest;
@@ -218,27 +313,72 @@ Status solve_loop_positions(const MechanismModel& model, MechanismData& data, co
   return data.loop_rcond < options.singular_rcond ? Status::singular : Status::ok;
 }
 
-Status loop_projection(const MechanismModel& model, MechanismData& data, const ConstVector& q,
-                       const ConstVector& v_actuated, const LoopSolveOptions& options) noexcept {
-  if (Status s = check(model, data, q, &v_actuated); s != Status::ok) return s;
+namespace {
+
+/// loop_projection at q (checked); `solved`: q is where solve_loop_positions just converged, so
+/// data.loop_jacobian, the factorisation of A° and data.loop_rcond are already those of q (its last
+/// evaluation) and are not recomputed.
+/// One step of iterative refinement of x, the least-squares solution of A° x = -b from the factored
+/// normal equations: x += (A°^T A°)^-1 A°^T (-(b + A° x)). The normal equations square A°'s
+/// condition and carry a small damping; one step brings x back to the accuracy of A° itself (a
+/// machine's internal spring forces of thousands of newtons multiply C's error: Orthoglide).
+template <typename B, typename X>
+void refine(MechanismData& data, const B& b, X&& x) noexcept {
+  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
+  Eigen::VectorXd& r = data.loop_constraint_work;
+  for (Eigen::Index row = 0; row < Ap.rows(); ++row) {
+    double v = -b(row);
+    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+      const double a = Ap(row, i);
+      if (a != 0.0) v -= a * x(i);
+    }
+    r(row) = v;
+  }
+  Eigen::VectorXd& step = data.loop_step;
+  step.setZero();
+  for (Eigen::Index row = 0; row < Ap.rows(); ++row) {
+    const double rv = r(row);
+    if (rv == 0.0) continue;
+    for (Eigen::Index i = 0; i < Ap.cols(); ++i) step(i) += Ap(row, i) * rv;
+  }
+  ldl_solve(data.loop_normal, data.loop_normal_pivots, step);
+  x += step;
+}
+
+Status project(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+               const ConstVector& v_actuated, const LoopSolveOptions& options, bool solved) noexcept {
   const auto& actuated = model.actuated_coordinates();
   const auto& passive = model.passive_coordinates();
   Status status = Status::ok;
   data.loop_acceleration_bias.setZero();
+  data.closed_position = q;
   if (!model.is_closed()) {
     data.loop_rcond = 1.0;
     data.closed_velocity.noalias() = data.loop_projection * v_actuated;
     return Status::ok;
   }
-  evaluate(model, data, q, true);
-  data.loop_rcond = factor_passive(model, data);
+  if (!solved) {
+    evaluate(model, data, q, true);
+    data.loop_rcond = factor_passive(model, data);
+  }
   if (data.loop_rcond < options.singular_rcond) status = Status::singular;
   // C: passive rows -(A°^T A°)^-1 A°^T A#
   for (std::size_t i = 0; i < actuated.size(); ++i) {
     data.loop_actuated_jacobian.col(static_cast<Eigen::Index>(i)) = data.loop_jacobian.col(actuated[i]);
   }
-  data.loop_solution.noalias() = -data.loop_passive_jacobian.transpose() * data.loop_actuated_jacobian;
-  data.loop_ldlt.solveInPlace(data.loop_solution);
+  // -A°^T A#, skipping the exact zeros of A° (as in factor_passive), then one solve per column
+  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
+  data.loop_solution.setZero();
+  for (Eigen::Index r = 0; r < Ap.rows(); ++r) {
+    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+      const double a = Ap(r, i);
+      if (a != 0.0) data.loop_solution.row(i) -= a * data.loop_actuated_jacobian.row(r);
+    }
+  }
+  for (Eigen::Index j = 0; j < data.loop_solution.cols(); ++j) {
+    ldl_solve(data.loop_normal, data.loop_normal_pivots, data.loop_solution.col(j));
+    refine(data, data.loop_actuated_jacobian.col(j), data.loop_solution.col(j));
+  }
   for (std::size_t j = 0; j < passive.size(); ++j) {
     data.loop_projection.row(passive[j]) = data.loop_solution.row(static_cast<Eigen::Index>(j));
   }
@@ -254,14 +394,24 @@ Status loop_projection(const MechanismModel& model, MechanismData& data, const C
   detail::forward_pass<true, false, false, false>(model, data);
   constraint_bias(model, data);
   data.loop_step.noalias() = -data.loop_passive_jacobian.transpose() * data.loop_bias;
-  data.loop_ldlt.solveInPlace(data.loop_step);
+  ldl_solve(data.loop_normal, data.loop_normal_pivots, data.loop_step);
+  data.loop_refine_solution = data.loop_step;
+  refine(data, data.loop_bias, data.loop_refine_solution);
   for (std::size_t j = 0; j < passive.size(); ++j) {
-    data.loop_acceleration_bias(passive[j]) = data.loop_step(static_cast<Eigen::Index>(j));
+    data.loop_acceleration_bias(passive[j]) = data.loop_refine_solution(static_cast<Eigen::Index>(j));
   }
   if (!data.loop_projection.allFinite() || !data.loop_acceleration_bias.allFinite()) {
     return status | Status::singular;
   }
   return status;
+}
+
+}  // namespace
+
+Status loop_projection(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                       const ConstVector& v_actuated, const LoopSolveOptions& options) noexcept {
+  if (Status s = check(model, data, q, &v_actuated); s != Status::ok) return s;
+  return project(model, data, q, v_actuated, options, false);
 }
 
 Status closed_motion(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
@@ -271,7 +421,7 @@ Status closed_motion(const MechanismModel& model, MechanismData& data, const Con
   Status status = solve_loop_positions(model, data, q_actuated, q, options);
   if (has(status, Status::solver_error)) return status;
   data.closed_position = q;
-  status |= loop_projection(model, data, q, v_actuated, options);
+  status |= project(model, data, q, v_actuated, options, true);
   data.closed_acceleration = data.loop_acceleration_bias;
   data.closed_acceleration.noalias() += data.loop_projection * a_actuated;
   return status;
@@ -297,7 +447,7 @@ Status closed_mass_matrix(const MechanismModel& model, MechanismData& data, cons
   if (has(status, Status::solver_error)) return status;
   data.closed_position = q;
   data.actuated_force.setZero();  // v# = 0 for the projection only
-  status |= loop_projection(model, data, q, data.actuated_force, options);
+  status |= project(model, data, q, data.actuated_force, options, true);
   mass_matrix(model, data, q);
   data.loop_reduced_work.noalias() = data.mass_matrix * data.loop_projection;
   data.reduced_mass_matrix.noalias() = data.loop_projection.transpose() * data.loop_reduced_work;
@@ -313,7 +463,7 @@ Status closed_forward_dynamics(const MechanismModel& model, MechanismData& data,
   Status status = solve_loop_positions(model, data, q_actuated, q, options);
   if (has(status, Status::solver_error)) return status;
   data.closed_position = q;
-  status |= loop_projection(model, data, q, v_actuated, options);
+  status |= project(model, data, q, v_actuated, options, true);
   // C^T (M c + b) = C^T tau(q, v, c)
   inverse_dynamics(model, data, q, data.closed_velocity, data.loop_acceleration_bias);
   data.actuated_acceleration.noalias() = -data.loop_projection.transpose() * data.joint_torque;

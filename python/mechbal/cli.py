@@ -104,6 +104,31 @@ def _cmd_run(args) -> int:
     return 0
 
 
+def _cmd_balance(args) -> int:
+    from mechbal import progress
+    from mechbal.balance.run import run_balance
+    from mechbal.output import check_output_dir, staged_output
+
+    out = Path(args.out)
+    check_output_dir(out)           # before anything else: a bad --out fails in the first second
+    buffer = io.StringIO()
+    with contextlib.redirect_stdout(buffer), staged_output(out) as tmp, \
+            progress.run_bar(f"balance {Path(args.case).stem}", 5):
+        summary = run_balance(args.case, args.method, tmp, design=args.design)
+        progress.finish()
+    if not args.quiet:
+        sys.stdout.write(buffer.getvalue())
+    notes = summary.get("non_finite_values") if isinstance(summary, dict) else None
+    if notes:
+        print(f"mechbal: warning: {len(notes)} non-finite value(s) written as null in "
+              f"{out}/summary.json (listed under non_finite_values)", file=sys.stderr)
+    if not args.quiet:
+        print(f"wrote {out}/summary.json, the balanced mechanism (balanced.toml"
+              f"{', balanced.urdf' if 'balanced.urdf' in summary.get('files', []) else ''}), plots and "
+              "bodies files beside it")
+    return 0
+
+
 def _cmd_demo(args) -> int:
     from mechbal.cases import DEFAULT_CASE
 
@@ -116,9 +141,7 @@ def _cmd_demo(args) -> int:
 def _cmd_init(args) -> int:
     from mechbal import templates
 
-    if args.kind == "linkage":
-        raise UserError(templates.LINKAGE_NOT_YET)
-    sys.stdout.write(templates.SERIAL)
+    sys.stdout.write(templates.LINKAGE if args.kind == "linkage" else templates.SERIAL)
     return 0
 
 
@@ -177,6 +200,23 @@ def build_parser() -> argparse.ArgumentParser:
                    help="URDF files: number of instants of the default trajectory (default: 501)")
     s.add_argument("-q", "--quiet", **quiet)
     s.set_defaults(func=_cmd_run)
+    s = sub.add_parser("balance", help="balance a mechanism by a method (static, force, moment, springs, rms)",
+                       description="Size counterweights (static: gravity torque zero over the "
+                                   "workspace; force: centre of mass stationary; rms: least RMS or "
+                                   "peak actuator torque along the trajectory) from the case's "
+                                   "[balance] table, and write DIR/summary.json, before/after plots, "
+                                   "bodies_unbalanced.npz, bodies_balanced.npz and the balanced "
+                                   "mechanism (balanced.toml, and balanced.urdf for trees). DIR "
+                                   "receives a whole run or nothing.")
+    s.add_argument("case", help="built-in case name, a TOML case file, or a URDF file (with --design)")
+    s.add_argument("--method", choices=("static", "force", "moment", "springs", "rms"), default=None,
+                   help="balancing method (default: balance.method of the case)")
+    s.add_argument("--design", metavar="FILE", default=None,
+                   help="a TOML file with a [balance] table (and optionally a [trajectory]) that "
+                        "replaces the case's (required for a URDF)")
+    s.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    s.add_argument("-q", "--quiet", **quiet)
+    s.set_defaults(func=_cmd_balance)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")
     s.add_argument("--out", default="out/demo", metavar="DIR", help="output folder")

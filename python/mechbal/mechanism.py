@@ -89,6 +89,8 @@ class ClosedMotion:
     iterations: np.ndarray
     status: np.ndarray
     actuated_force: np.ndarray | None = None
+    #: the coupling matrix C (.., dof, na): v = C v#, a = C a# + c
+    projection: np.ndarray | None = None
 
 
 def _status_text(code: int) -> str:
@@ -103,12 +105,15 @@ class Mechanism:
     """
 
     def __init__(self, model: "_core.MechanismModel", *, name: str = "mechanism",
-                 source: str | None = None):
+                 source: str | None = None, link_frames=None):
         if not isinstance(model, _core.MechanismModel):
             raise TypeError(f"model must be a mechbal._core.MechanismModel, got {type(model).__name__}")
         self.model = model
         self.name = name
         self.source = source
+        #: link -> (4, 4) placement in the link frame of the frame the user described the link in
+        #: (see :meth:`user_frame`); absent links: the identity
+        self.link_frames = {str(k): np.array(v, dtype=float) for k, v in (link_frames or {}).items()}
 
     # ---- construction ------------------------------------------------------------------------
     @classmethod
@@ -201,7 +206,32 @@ class Mechanism:
             model = _core.MechanismModel(desc)
         except ValueError as exc:
             raise ConfigError("mechanism", str(exc), has_value=False) from None
-        return cls(model, name=name, source=source)
+        return cls(model, name=name, source=source, link_frames=getattr(spec, "link_frames", None))
+
+    def user_frame(self, link: str) -> np.ndarray:
+        """(4, 4) placement, in the link frame of ``link`` (the frame right after its joint's
+        motion), of the frame the user described that link in: the standard-DH frame of a ``dh``
+        joint of a TOML file, ``mechanism.base`` for ``base``, the identity otherwise (URDF link
+        frames, ``origin`` and ``mdh`` joints). A point p given by the user is ``T @ [p, 1]``."""
+        if link not in self.link_names:
+            import difflib
+            hint = difflib.get_close_matches(link, self.link_names, n=1)
+            raise ValueError(f"link: no link named '{link}'" + (f" (did you mean '{hint[0]}'?)" if hint
+                                                                else f" (links: {', '.join(self.link_names)})"))
+        return self.link_frames.get(link, np.eye(4)).copy()
+
+    def with_bodies(self, bodies: Sequence["_core.Body"], *, replace: bool = False,
+                    name: str | None = None) -> "Mechanism":
+        """A copy with ``bodies`` (:class:`mechbal.Body`, com and inertia in the link frames)
+        added to its own (``replace``: instead of its own): same joints, frames, loops, gravity
+        and user frames. Raises ValueError naming the problem (duplicate name, unknown link)."""
+        d = self.model.description
+        own = [] if replace else list(d.bodies)
+        desc = _core.MechanismDescription(list(d.joints), own + list(bodies), list(d.frames),
+                                          np.asarray(d.gravity, float), d.root_name, list(d.loops),
+                                          list(d.actuated))
+        return Mechanism(_core.MechanismModel(desc), name=name or self.name, source=self.source,
+                         link_frames=self.link_frames)
 
     # ---- structure ---------------------------------------------------------------------------
     @property
@@ -221,10 +251,12 @@ class Mechanism:
 
     @property
     def body_names(self) -> list[str]:
+        """Names of the bodies (links' inertias, counterweights, motors, discs...), in model order."""
         return list(self.model.body_names)
 
     @property
     def frame_names(self) -> list[str]:
+        """Names of the named frames (URDF links, tool and sensor frames, loop-closure frames)."""
         return list(self.model.frame_names)
 
     @property
@@ -234,10 +266,12 @@ class Mechanism:
 
     @property
     def gravity(self) -> np.ndarray:
+        """Gravity acceleration in O [m/s^2] (3,)."""
         return np.array(self.model.gravity)
 
     @property
     def bodies(self):
+        """The bodies (``mechbal.Body``: name, link, mass [kg], com [m], inertia [kg m^2])."""
         return list(self.model.bodies)
 
     @property
@@ -253,6 +287,7 @@ class Mechanism:
 
     @property
     def passive_names(self) -> list[str]:
+        """Passive joints of a closed mechanism (solved from the loop closures)."""
         names = self.joint_names
         return [names[i] for i in self.model.passive_coordinates]
 
@@ -368,7 +403,7 @@ class Mechanism:
         keys = ["com", "rotation", "com_velocity", "com_acceleration", "angular_velocity",
                 "angular_acceleration", "link_rotation", "link_position", "frame_placement"]
         values, st = self._finish(single, _core.mechanism_kinematics(self.model, q, v, a), keys)
-        return BodyMotion(*values, st)
+        return BodyMotion(**dict(zip(keys, values)), status=st)
 
     def body_poses(self, q) -> tuple[np.ndarray, np.ndarray]:
         """(com, rotation) of every body: (B, 3) and (B, 3, 3), or with a leading N axis."""
@@ -442,14 +477,14 @@ class Mechanism:
                                  f"{np.asarray(x).shape}")
             arrays.append(x)
         guess = np.zeros(self.dof) if q_guess is None else np.ascontiguousarray(q_guess, dtype=float)
-        r = _core.mechanism_closed_motion(self.model, *arrays, guess, max_iterations, tolerance,
-                                          singular_rcond, with_forces)
+        r = _core.mechanism_closed_motion(self.model, arrays[0], arrays[1], arrays[2], guess,
+                                          max_iterations, tolerance, singular_rcond, with_forces)
         out = {k: np.asarray(v) for k, v in r.items()}
         if single:
             out = {k: v[0] for k, v in out.items()}
         return ClosedMotion(q=out["q"], v=out["v"], a=out["a"], rcond=out["rcond"], residual=out["residual"],
                             iterations=out["iterations"], status=out["status"],
-                            actuated_force=out.get("actuated_force"))
+                            actuated_force=out.get("actuated_force"), projection=out.get("projection"))
 
     def actuated_forces(self, q_actuated, v_actuated, a_actuated, **kw) -> np.ndarray:
         """Actuated forces tau# = C^T tau(q, v, a) of the closed mechanism [N m or N]; for one
@@ -457,6 +492,7 @@ class Mechanism:
         m = self.closed_motion(q_actuated, v_actuated, a_actuated, with_forces=True, **kw)
         if np.ndim(m.status) == 0 and (int(m.status) & ~int(_core.Status.singular)):
             raise ValueError(f"{self.name}: the loops cannot be solved here ({_status_text(int(m.status))})")
+        assert m.actuated_force is not None  # asked for with_forces
         return m.actuated_force
 
     def reduced_mass_matrix(self, q_actuated, *, q_guess=None) -> tuple[np.ndarray, np.ndarray]:

@@ -307,6 +307,54 @@ class ChainTrajectory(Table):
                           "(picks the assembly mode of the loops), rad or m")
 
 
+# ---- [balance]: the design variables of `mechbal balance` (mechbal.balance) -----------------
+
+BalanceMethod = Literal["static", "force", "moment", "springs", "rms"]
+
+
+class BalanceCounterweight(Table):
+    """``[[balance.counterweights]]``: a counterweight the method may add (a point mass, plus
+    ``inertia`` about its centre): its mass within [mass_min, mass_max] (or fixed: ``mass``),
+    its centre within ``max_radius`` of ``center``, on the line ``direction`` through ``center``
+    if given; positions in the frame the user described the link in (DH frame for ``dh``)."""
+    name: Name = Field(description="the counterweight's body name (must be new)")
+    link: Name = Field(description="name of the joint whose link carries it")
+    mass: Optional[Mass] = Field(None, description="kg, a fixed mass (instead of mass_min / mass_max)")
+    mass_min: Optional[Mass] = Field(None, description="kg (default 0)")
+    mass_max: Optional[Mass] = Field(None, description="kg (absent: unbounded)")
+    max_radius: Optional[NonNeg] = Field(None, description="m, largest distance from center (absent: unbounded)")
+    center: Xyz = Field([0.0, 0.0, 0.0], description="m, in the link's frame")
+    direction: Optional[Vec3] = Field(None, description="the counterweight slides on this line through center")
+    inertia: Optional[Inertia] = None
+
+    @model_validator(mode="after")
+    def _masses(self):
+        if self.mass is not None and (self.mass_min is not None or self.mass_max is not None):
+            raise _custom("give either mass or mass_min / mass_max", ".mass", self.mass)
+        lo = self.mass_min or 0.0
+        if self.mass_max is not None and self.mass_max < lo:
+            raise _custom(f"must be >= mass_min = {lo!r}", ".mass_max", self.mass_max)
+        if self.direction is not None and not any(self.direction):
+            raise _custom("must be a non-zero vector", ".direction", self.direction)
+        return self
+
+
+class Balance(Table):
+    """``[balance]``: what ``mechbal balance`` may change and what it must hold over."""
+    method: Optional[BalanceMethod] = Field(None, description="default of --method")
+    counterweights: Annotated[list[BalanceCounterweight], Field(max_length=MAX_BODIES)] = []
+    mass_budget: Optional[Pos] = Field(None, description="kg, total counterweight mass")
+    samples: Optional[Annotated[int, Field(ge=1, le=MAX_CONFIGURATIONS, strict=True)]] = Field(
+        None, description="random workspace samples (static: 1000, force: 200 motions)")
+    seed: Annotated[int, Field(ge=0, le=2**63 - 1, strict=True)] = 0
+    lower: Optional[JointValues] = Field(None, description="sample box, per independent (closed: actuated) joint")
+    upper: Optional[JointValues] = None
+    objective: Literal["rms", "peak"] = Field("rms", description="rms method: RMS or peak torque")
+    coupling: Optional[Literal["per_joint", "total"]] = Field(
+        None, description="rms method: each joint by its own link's slots (default, open) or all together")
+    weights: Optional[JointValues] = Field(None, description="rms method, total coupling: per actuated joint")
+
+
 class SerialChainCaseHeader(CaseHeader):
     kind: Literal["serial_chain", "mechanism"]
 
@@ -316,11 +364,98 @@ class SerialChainCase(Table):
     case: SerialChainCaseHeader
     mechanism: Mechanism
     trajectory: ChainTrajectory
+    balance: Optional[Balance] = None
     _spec: Any = PrivateAttr(None)
 
     @property
     def spec(self):
         """The :class:`mechbal.spec.MechanismSpec` of ``[mechanism]`` (built by validate_case)."""
+        if self._spec is None:
+            from mechbal.spec import mechanism_spec
+
+            self._spec = mechanism_spec(self.mechanism)
+        return self._spec
+
+
+# ---- rpsp (Heydari & Enferadi): the 3(RPSP)-S robot as data on the general model ----------------
+
+NameList = Annotated[list[Name], Field(min_length=1, max_length=MAX_BODIES)]
+
+
+class RpspBalancing(Table):
+    """``[balancing]``: what the unbalanced robot does not have, and the counterweight bodies the
+    methods size (one list per paper name, one body per leg)."""
+    extra_linkage: Annotated[list[Name], Field(max_length=MAX_JOINTS)] = Field(
+        description="joints of the extra linkage (with their links, bodies, frames and loops)")
+    m_P: NameList = Field(description="bodies: counterweights on A_iD_i (eq 23)")
+    m_N: NameList = Field(description="bodies: counterweights on D_iC_i (eq 25)")
+    m_F: NameList = Field(description="bodies: counterweights on the rotary arm (eq 27)")
+    platform: Annotated[list[Name], Field(max_length=MAX_BODIES)] = Field(
+        [], description="bodies: the platform's counterweight(s)")
+
+
+class RpspMotion(Table):
+    """``[motion]``: the paper's platform motion phi_x = A sin(2 pi t / T), phi_y = 0,
+    phi_z = B sin(f pi t / T)."""
+    platform: Name = Field(description="the spherical joint the motion drives")
+    roll_amplitude: Angle = Field(1.0, description="A [rad]")
+    yaw_amplitude: Angle = Field(math.pi / 6, description="B [rad]")
+    yaw_factor: Num = Field(0.125, description="f")
+    period: Duration = Field(2 * math.pi, description="T [s]")
+    duration: Duration = Field(description="s: the balanced / unbalanced comparison")
+    samples: Samples = 2001
+    survey_duration: Duration = Field(2 * math.pi, description="s: the conditioning survey")
+    survey_samples: Samples = 6284
+    initial_guess: JointValues = Field(
+        description="every joint coordinate at t = 0, in coordinate order (rad or m): the assembly mode")
+
+
+class RpspCounterweights(Table):
+    m_P: Mass
+    m_N: Mass
+    m_F: Mass
+
+
+class RpspPaper(Table):
+    """``[paper]``: the paper's parameters and reported numbers (closed-form checks)."""
+    a: Pos = Field(description="m, |O A_i|")
+    h: Pos = Field(description="m, column height")
+    lambda_i: Vec3 = Field(description="rad, angles of u_i from x_B (eq 4)")
+    alpha_i: Vec3 = Field(description="rad, angles of v_i from x_M (eq 5)")
+    m_p: Mass
+    m_E: Mass
+    m_Q: Mass
+    m_H: Mass
+    m_K: Mass
+    r_H: Num
+    r_K: Num
+    r_P: Num
+    r_F: Num
+    r_N: Num
+    r_Q: Num
+    AE: Pos = Field(description="m")
+    AD: Pos = Field(description="m")
+    DC: Pos = Field(description="m")
+    counterweights_kg: RpspCounterweights
+    mean_reduction_pct: Vec3
+    table_times: Annotated[list[NonNeg], Field(min_length=1, max_length=100)]
+
+
+class RpspCaseHeader(CaseHeader):
+    kind: Literal["rpsp"]
+
+
+class RpspCase(Table):
+    """The 3(RPSP)-S robot (Heydari & Enferadi): the mechanism as data, sized and compared."""
+    case: RpspCaseHeader
+    mechanism: Mechanism
+    balancing: RpspBalancing
+    motion: RpspMotion
+    paper: RpspPaper
+    _spec: Any = PrivateAttr(None)
+
+    @property
+    def spec(self):
         if self._spec is None:
             from mechbal.spec import mechanism_spec
 
@@ -388,6 +523,9 @@ class Arm2DofCase(Table):
     trajectory: Arm2DofTrajectory
     controller: Arm2DofController
     paper: Arm2DofPaper = Arm2DofPaper()
+    balance: Optional[Balance] = Field(
+        None, description="mechbal balance: links 'shoulder' and 'elbow' (x along each link); "
+                          "without counterweights, those of [counterweights] on the link extensions")
 
 
 # ---- paminsa (Briot & Arakelian 2009) -------------------------------------------------------------
@@ -783,18 +921,141 @@ class SweepFile(Table):
     sweep: Sweep
 
 
+# ---- orthoglide (Martini, Troncossi, Carricato & Rivola 2015) -------------------------------------
+
+Count = Annotated[int, Field(ge=1, le=1000, strict=True)]
+
+
+class OrthoglideSpring(Table):
+    """``[[springs]]``: a zero-free-length tension spring between anchor A on link ``link_a`` and
+    anchor B on ``link_b`` (positions in those links' frames); its rate is sized by least squares
+    over the workspace grid (static balance) unless ``rate`` is given."""
+    name: Name
+    link_a: Name = Field(description="joint whose link carries anchor A, or 'base'")
+    anchor_a: Xyz
+    link_b: Name = Field(description="joint whose link carries anchor B, or 'base'")
+    anchor_b: Xyz
+    rate: Optional[Pos] = Field(None, description="N/m; absent: sized for static balance")
+
+
+class JointValue(Table):
+    joint: Name
+    value: Num = Field(description="rad or m")
+
+
+class OrthoglideRoles(Table):
+    """``[roles]``: which frame, bodies and springs of the mechanism are the paper's P, m_p, m_s2,
+    distal and proximal springs, and the warm start of the loop solve."""
+    tool_frame: Name = Field(description="frame on the platform where the cutting force acts (P)")
+    platform_body: Name = Field(description="body m_p")
+    vertical_slider_body: Name = Field(description="body m_s2")
+    distal_spring: Name
+    proximal_spring: Name
+    initial_guess: Annotated[list[JointValue], Field(max_length=MAX_JOINTS)] = Field(
+        [], description="coordinates near the assembly mode (the loop solve's warm start); others start at 0")
+
+
+class OrthoglideWorkspace(Table):
+    """``[workspace]``: the cube the platform point P spans."""
+    center: Xyz = Field(description="m, the workspace centre C")
+    edge: Pos = Field(description="m, edge of the cube (parallel to the axes)")
+    grid: Annotated[int, Field(ge=2, le=41, strict=True, description="static grid points per edge")] = 11
+
+
+class OrthoglideCatalogue(Table):
+    """``[catalogue]``: practical spring selection (Tables 1-2)."""
+    file: Optional[Annotated[str, Field(min_length=1, max_length=4096, strict=True)]] = Field(
+        None, description="spring catalogue CSV (default: the one shipped with mechbal)")
+    counts: Annotated[list[Count], Field(min_length=2, max_length=2,
+                                         description="springs per cluster: from, to")] = [1, 12]
+    pulley_ratios: Annotated[list[Annotated[float, Field(ge=1, le=64, **_NUM)]],
+                             Field(min_length=1, max_length=8)] = [1.0, 2.0, 4.0, 8.0]
+    rate_tolerance: Annotated[float, Field(gt=0, le=1, **_NUM)] = 0.02
+
+
+Speeds = Annotated[list[Pos], Field(min_length=1, max_length=4, description="m/s")]
+
+
+class OrthoglidePaths(Table):
+    """``[paths]``: Paths A (helix) and B (cube edges and diagonals), the rapid moves of C-F."""
+    sample_period: Annotated[float, Field(ge=1e-4, le=0.1, description="s", **_NUM)] = 0.002
+    max_acceleration: Pos = Field(14.715, description="m/s^2 on each axis (1.5 g)")
+    helix_radius: Pos = Field(0.245, description="m")
+    helix_speeds: Speeds = [0.8, 1.2]
+    helix_vertical_ratio: Annotated[float, Field(ge=0, le=10, **_NUM)] = 1.0 / 6.0
+    helix_acceleration: Pos = Field(4.905, description="m/s^2 of the helix's start and stop ramps")
+    cube_speeds: Speeds = [0.6, 1.0]
+    rapid_speed: Pos = Field(1.0, description="m/s")
+
+
+class OrthoglidePocket(Table):
+    corner: Xyz = Field(description="m, relative to C: the pocket's (x, y, z) lowest corner")
+    size: PosVec2 = Field(description="m, along x and z")
+
+
+class OrthoglideTask(Table):
+    name: Name
+    operation: Literal["roughing", "finishing", "deburring", "drilling"]
+    feed: Pos = Field(description="m/s, v_f")
+    force: NonNeg = Field(description="N, total cutting force F_c at the feed v_f")
+
+
+class OrthoglideMachining(Table):
+    """``[machining]``: Paths C-F (Table 3)."""
+    pockets: Annotated[list[OrthoglidePocket], Field(min_length=1, max_length=8)]
+    holes: Annotated[list[Xyz], Field(min_length=1, max_length=32, description="m, relative to C")]
+    drill_depth: Pos = Field(description="m")
+    approach_height: Pos = Field(description="m")
+    tasks: Annotated[list[OrthoglideTask], Field(max_length=8)] = []
+
+
+class OrthoglideSensitivity(Table):
+    """``[sensitivity]``: Table 6."""
+    relative: Annotated[float, Field(ge=0, le=0.9, **_NUM)] = 0.10
+    anchor_offset: Annotated[float, Field(ge=0, le=1, description="m", **_NUM)] = 0.005
+
+
+class OrthoglideCaseHeader(CaseHeader):
+    kind: Literal["orthoglide"]
+
+
+class OrthoglideCase(Table):
+    """The Orthoglide 5-axis and its spring gravity compensation (Martini et al. 2015)."""
+    case: OrthoglideCaseHeader
+    mechanism: Mechanism
+    springs: Annotated[list[OrthoglideSpring], Field(min_length=1, max_length=16)]
+    roles: OrthoglideRoles
+    workspace: OrthoglideWorkspace
+    catalogue: OrthoglideCatalogue = OrthoglideCatalogue()
+    paths: OrthoglidePaths = OrthoglidePaths()
+    machining: OrthoglideMachining
+    sensitivity: OrthoglideSensitivity = OrthoglideSensitivity()
+    _spec: Any = PrivateAttr(None)
+
+    @property
+    def spec(self):
+        """The :class:`mechbal.spec.MechanismSpec` of ``[mechanism]``."""
+        if self._spec is None:
+            from mechbal.spec import mechanism_spec
+
+            self._spec = mechanism_spec(self.mechanism)
+        return self._spec
+
+
 #: case kind -> model (discs: case.mechanism -> model)
 CASE_MODELS: dict[str, Any] = {
     "serial_chain": SerialChainCase,
     "mechanism": SerialChainCase,
     "arm2dof": Arm2DofCase,
     "paminsa": PaminsaCase,
+    "rpsp": RpspCase,
     "discs": {"planar3r": Planar3rCase, "spatial3r": Spatial3rCase, "scara": ScaraCase,
               "fivebar": FivebarCase},
+    "orthoglide": OrthoglideCase,
 }
 KINDS = tuple(CASE_MODELS)
-CaseModel = Union[SerialChainCase, Arm2DofCase, PaminsaCase, Planar3rCase, Spatial3rCase, ScaraCase,
-                  FivebarCase]
+CaseModel = Union[SerialChainCase, RpspCase, OrthoglideCase, Arm2DofCase, PaminsaCase, Planar3rCase,
+                  Spatial3rCase, ScaraCase, FivebarCase]
 
 
 def _check_ticks(duration: float, rate_hz: float, sub: str, what: str = "duration x rate_hz"):
@@ -1085,6 +1346,10 @@ def validate_case(config: Any, *, warn: bool = True):
 
 
 def _cross_checks(case: Any) -> None:
+    if isinstance(case, OrthoglideCase):
+        _orthoglide_cross_checks(case)
+    if isinstance(case, RpspCase):
+        _rpsp_cross_checks(case)
     if isinstance(case, SerialChainCase):
         spec = case.spec  # cross references of the mechanism (ConfigError naming the field)
         names = list(spec.actuated) if spec.loops else spec.independent_joints
@@ -1102,6 +1367,68 @@ def _cross_checks(case: Any) -> None:
             raise ConfigError("trajectory.samples", f"must be <= {MAX_SAMPLE_BODIES // n_bodies} for "
                                                     f"{n_bodies} bodies (samples x bodies <= "
                                                     f"{MAX_SAMPLE_BODIES})", case.trajectory.samples)
+
+
+def _orthoglide_cross_checks(case: "OrthoglideCase") -> None:
+    spec = case.spec
+    links = ["base", *spec.joint_names]
+    bodies = [b.name for b in spec.bodies]
+    frames = [f.name for f in spec.frames]
+    springs = [s.name for s in case.springs]
+    if len(set(springs)) != len(springs):
+        raise ConfigError("springs", "names must be unique", springs)
+    if len(spec.actuated) != 3:
+        raise ConfigError("mechanism.actuated", "must name the three sliders", list(spec.actuated))
+    for i, s in enumerate(case.springs):
+        for side in ("link_a", "link_b"):
+            if getattr(s, side) not in links:
+                raise ConfigError(f"springs[{i}].{side}", f"unknown link{did_you_mean(getattr(s, side), links)}",
+                                  getattr(s, side))
+    r = case.roles
+    for key, allowed in (("tool_frame", frames), ("platform_body", bodies), ("vertical_slider_body", bodies),
+                         ("distal_spring", springs), ("proximal_spring", springs)):
+        if getattr(r, key) not in allowed:
+            raise ConfigError(f"roles.{key}", f"unknown name{did_you_mean(getattr(r, key), allowed)}",
+                              getattr(r, key))
+    for i, jv in enumerate(r.initial_guess):
+        if jv.joint not in spec.independent_joints:
+            raise ConfigError(f"roles.initial_guess[{i}].joint", "not a joint with a coordinate"
+                                                                 f"{did_you_mean(jv.joint, spec.independent_joints)}",
+                              jv.joint)
+    c = case.catalogue.counts
+    if c[0] > c[1]:
+        raise ConfigError("catalogue.counts", "must be [from, to] with from <= to", c)
+    names = [t.name for t in case.machining.tasks]
+    if len(set(names)) != len(names):
+        raise ConfigError("machining.tasks", "names must be unique", names)
+
+
+def _rpsp_cross_checks(case: "RpspCase") -> None:
+    spec = case.spec
+    joints = {j.name: j for j in spec.joints}
+    bodies = [b.name for b in spec.bodies]
+    if not spec.loops:
+        raise ConfigError("mechanism.loops", "the rpsp kind needs the loop closures", has_value=False)
+    for i, name in enumerate(case.balancing.extra_linkage):
+        if name not in joints:
+            raise ConfigError(f"balancing.extra_linkage[{i}]", "no such joint" + did_you_mean(name, list(joints)),
+                              name)
+    for key in ("m_P", "m_N", "m_F", "platform"):
+        for i, name in enumerate(getattr(case.balancing, key)):
+            if name not in bodies:
+                raise ConfigError(f"balancing.{key}[{i}]", "no such body" + did_you_mean(name, bodies), name)
+    p = case.motion.platform
+    wanted = [f"{p}_z", f"{p}_y", f"{p}_x"]
+    if any(w not in joints for w in wanted):
+        raise ConfigError("motion.platform", "must name a spherical joint" + did_you_mean(p, list(joints)), p)
+    coords = spec.independent_joints
+    if len(case.motion.initial_guess) != len(coords):
+        raise ConfigError("motion.initial_guess", f"must have {len(coords)} values (every joint with a "
+                          f"coordinate: {', '.join(coords)})", list(case.motion.initial_guess))
+    for key, n in (("samples", case.motion.samples), ("survey_samples", case.motion.survey_samples)):
+        if n * max(1, len(bodies)) > MAX_SAMPLE_BODIES:
+            raise ConfigError(f"motion.{key}", f"must be <= {MAX_SAMPLE_BODIES // max(1, len(bodies))} "
+                              f"for {len(bodies)} bodies", n)
 
 
 # ---- unit warnings -------------------------------------------------------------------------------
@@ -1129,7 +1456,7 @@ def unit_warnings(case: Any) -> list[tuple[str, str]]:
     """(field, message) of every likely unit mistake in a validated case."""
     out = []
     add = lambda w: w is not None and out.append(w)  # noqa: E731
-    if isinstance(case, SerialChainCase):
+    if isinstance(case, (SerialChainCase, RpspCase)):
         m = case.mechanism
         reach = 0.0
         origins = [("mechanism.base", m.base)] if m.base is not None else []

@@ -1,16 +1,148 @@
-"""Batch simulation through the C++ core: a whole trajectory per call, numpy in, numpy out."""
+"""Simulation through the C++ core: a whole run per call, numpy in, numpy out.
+
+* :func:`closed_loop`: any joint controller (:mod:`mechbal.control`) driving any mechanism
+  (a :class:`mechbal.Mechanism`, closed loops included, or any forward-dynamics plant such as
+  ``Arm2DofDynamics``) along any trajectory (:mod:`mechbal.trajectory`), integrated by RK4 at the
+  controller period.
+* :func:`run_chain`: kinematics, shaking wrench and inverse dynamics of a serial chain along a
+  trajectory (open loop).
+
+Units: SI (s, rad or m, rad/s or m/s, N m or N).
+"""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from mechbal import _core
+
+__all__ = ["closed_loop", "ClosedLoopResult", "ForwardDynamics", "MechanismDynamics", "run_chain",
+           "ChainRun"]
+
+ForwardDynamics = _core.ForwardDynamics
+MechanismDynamics = _core.MechanismDynamics
+
+
+@dataclass(frozen=True)
+class ClosedLoopResult:
+    """One closed-loop run, one row per controller tick k = 0 .. steps (t_k = k dt):
+
+    * ``t`` (N,) [s];
+    * ``q``, ``qd`` (N, n): the plant's state [rad or m, rad/s or m/s];
+    * ``q_des``, ``qd_des`` (N, n): the desired motion at the ticks;
+    * ``joint_torque`` (N, n) [N m or N]: the command applied from t_k on;
+    * ``status`` (N,): per tick, the controller's and the plant's flags (0 = ok,
+      :class:`mechbal.Status`);
+    * ``saturated_ticks``: ticks on which the controller clipped the torque;
+    * ``steps_completed``: ``steps`` unless the plant failed (later rows repeat the last state).
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    q_des: np.ndarray
+    qd_des: np.ndarray
+    joint_torque: np.ndarray
+    status: np.ndarray
+    saturated_ticks: int
+    steps_completed: int
+
+    @property
+    def tracking_error(self) -> np.ndarray:
+        """``q_des - q`` (N, n) [rad or m]."""
+        return self.q_des - self.q
+
+    @property
+    def ok(self) -> bool:
+        """True when every tick's status is 0 (ok)."""
+        return bool(np.all(self.status == 0))
+
+
+def _plant(mechanism_or_plant: Any, q_guess: npt.ArrayLike | None) -> Any:
+    from mechbal.mechanism import Mechanism
+
+    if isinstance(mechanism_or_plant, Mechanism):
+        model = mechanism_or_plant.model
+        guess = np.zeros(model.dof) if q_guess is None else np.asarray(q_guess, dtype=float)
+        return _core.MechanismDynamics(model, guess)
+    if isinstance(mechanism_or_plant, _core.MechanismModel):
+        return _plant(__import__("mechbal").Mechanism(mechanism_or_plant), q_guess)
+    if not isinstance(mechanism_or_plant, _core.ForwardDynamics):
+        raise TypeError("plant must be a mechbal.Mechanism, a MechanismModel or a forward-dynamics "
+                        "plant (MechanismDynamics, Arm2DofDynamics), got "
+                        f"{type(mechanism_or_plant).__name__}")
+    return mechanism_or_plant
+
+
+def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
+                q0: npt.ArrayLike | None = None, qd0: npt.ArrayLike | None = None, *,
+                dt: float = 1e-3, duration: float | None = None,
+                sampling: str = "zero_order_hold",
+                q_guess: npt.ArrayLike | None = None) -> ClosedLoopResult:
+    """Simulate ``controller`` driving ``mechanism_or_plant`` along ``trajectory`` (one C++ call).
+
+    Args:
+        mechanism_or_plant: a :class:`mechbal.Mechanism` (its forward dynamics in the actuated
+            coordinates; loops solved at every stage, warm-started from ``q_guess``, the full
+            coordinates near the assembly) or any forward-dynamics plant (``MechanismDynamics``,
+            ``Arm2DofDynamics``).
+        controller: any joint controller (:class:`mechbal.control.ComputedTorque`, whose model
+            may differ from the plant, or :class:`mechbal.control.DecoupledJointController`).
+            Its state carries over from previous ticks; call ``reset()`` to start afresh.
+        trajectory: any :mod:`mechbal.trajectory` object, evaluated at the simulation time
+            t = 0 .. duration [s]. A rest-to-rest trajectory runs on the C++ path; any other is
+            sampled every dt/2 first.
+        q0, qd0: initial state [rad or m, rad/s or m/s]; default: the trajectory at t = 0.
+        dt: controller period = RK4 step [s].
+        duration: simulated time [s]; default the trajectory's ``end_time`` (or ``duration``).
+        sampling: ``"zero_order_hold"`` (a digital controller: the torque of tick k is held over
+            the step) or ``"every_rk4_stage"`` (the continuous control law at each RK4 stage).
+        q_guess: full coordinates near the assembly, for a closed-loop Mechanism.
+
+    Returns:
+        :class:`ClosedLoopResult`. A plant failure (an unassemblable pose, a non-finite state)
+        stops the integration and shows in ``status`` and ``steps_completed``; it does not raise.
+    """
+    from mechbal.trajectory import RestToRest, as_trajectory
+
+    plant = _plant(mechanism_or_plant, q_guess)
+    if not isinstance(controller, _core.JointController):
+        raise TypeError("controller must be a joint controller (mechbal.control.ComputedTorque, "
+                        f"DecoupledJointController), got {type(controller).__name__}")
+    traj = as_trajectory(trajectory)
+    if duration is None:  # until the motion ends (a trajectory may start after t = 0)
+        duration = float(getattr(traj, "end_time", traj.duration))
+    q_start, qd_start, _ = traj.evaluate(0.0)
+    q0 = q_start if q0 is None else q0
+    qd0 = qd_start if qd0 is None else qd0
+    if isinstance(traj, RestToRest):
+        log = _core.simulate_closed_loop(plant, controller, traj.core, q0, qd0, dt, duration,
+                                         sampling)
+    else:
+        if not (np.isfinite(dt) and dt > 0 and np.isfinite(duration) and duration >= dt):
+            raise ValueError(f"dt must be > 0 and duration >= dt, got dt={dt}, duration={duration}")
+        steps = int(round(duration / dt))
+        q_des, qd_des, qdd_des = traj.evaluate(np.arange(2 * steps + 1) * (0.5 * dt))
+        log = _core.simulate_closed_loop_sampled(plant, controller, q_des, qd_des, qdd_des, q0,
+                                                 qd0, dt, duration, sampling)
+    return ClosedLoopResult(t=np.asarray(log["t"]), q=np.asarray(log["q"]),
+                            qd=np.asarray(log["qd"]), q_des=np.asarray(log["q_des"]),
+                            qd_des=np.asarray(log["qd_des"]), joint_torque=np.asarray(log["tau"]),
+                            status=np.asarray(log["tick_status"]),
+                            saturated_ticks=int(log["saturated_ticks"]),
+                            steps_completed=int(log["steps_completed"]))
 
 
 @dataclass
 class ChainRun:
-    """One serial chain evaluated along a trajectory (all arrays in the base frame, SI units)."""
+    """One serial chain evaluated along a trajectory (all arrays in the base frame, SI units):
+    times ``t`` [s], the motion ``q``, ``qd``, ``qdd``, every link's ``bodies`` motion, the
+    ``wrench`` of the bodies and the KDL joint ``torque`` with the base ``support_force`` /
+    ``support_moment``; ``shaking_force``, ``shaking_moment``, ``joint_torque``,
+    ``base_reaction_force`` and ``base_reaction_moment`` name them as elsewhere in mechbal."""
 
     t: np.ndarray
     q: np.ndarray
@@ -26,11 +158,40 @@ class ChainRun:
     support_moment: np.ndarray
     extra: dict = field(default_factory=dict)
 
+    # the names used everywhere else in mechbal (Mechanism, ClosedLoopResult, summaries, files)
+    @property
+    def shaking_force(self) -> np.ndarray:
+        """dP/dt of the chain's bodies (N, 3) [N] (``wrench["force"]``)."""
+        return np.asarray(self.wrench["force"])
 
-def run_chain(model: _core.ChainModel, trajectory: _core.RestToRestTrajectory,
-              t: np.ndarray) -> ChainRun:
+    @property
+    def shaking_moment(self) -> np.ndarray:
+        """dH_O/dt about the base origin (N, 3) [N m] (``wrench["moment"]``)."""
+        return np.asarray(self.wrench["moment"])
+
+    @property
+    def joint_torque(self) -> np.ndarray:
+        """Joint torques or forces (N, n) [N m or N] (``torque``)."""
+        return self.torque
+
+    @property
+    def base_reaction_force(self) -> np.ndarray:
+        """Force the base exerts on the chain, gravity included (N, 3) [N] (``support_force``)."""
+        return self.support_force
+
+    @property
+    def base_reaction_moment(self) -> np.ndarray:
+        """Its moment about the base origin (N, 3) [N m] (``support_moment``)."""
+        return self.support_moment
+
+
+def run_chain(model: _core.ChainModel, trajectory: Any, t: np.ndarray) -> ChainRun:
     """Kinematics, shaking wrench (eqs 1-4 of Briot & Arakelian 2009) and KDL inverse dynamics of
-    a serial chain along ``trajectory`` sampled at ``t``."""
+    a serial chain along ``trajectory`` (a C++ ``RestToRestTrajectory`` or a
+    :class:`mechbal.trajectory.RestToRest`) sampled at ``t`` [s]: forces [N], moments about the
+    base origin [N m], joint torques [N m or N]."""
+    if hasattr(trajectory, "core"):
+        trajectory = trajectory.core
     t = np.asarray(t, float)
     q, qd, qdd = trajectory.evaluate_batch(t)
     bodies = _core.chain_kinematics(model, q, qd, qdd)

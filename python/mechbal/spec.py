@@ -134,6 +134,10 @@ class MechanismSpec:
     loops: list[LoopSpec] = field(default_factory=list)
     #: actuated joints (the independent coordinates q#); empty without loops means every joint
     actuated: list[str] = field(default_factory=list)
+    #: link name -> (4, 4) placement, in the link frame, of the frame the user described the link
+    #: in (the standard-DH frame of a ``dh`` joint; ``mechanism.base`` for ``base``); absent:
+    #: the identity. Balancing reports counterweight positions in these frames.
+    link_frames: dict[str, np.ndarray] = field(default_factory=dict)
 
     def joint(self, name: str) -> JointSpec:
         for j in self.joints:
@@ -360,5 +364,7 @@ def mechanism_spec(mechanism: Any, field: str = "mechanism") -> MechanismSpec:
     if loops and not m.actuated:
         raise ConfigError(f"{field}.actuated", "a mechanism with loops must name its actuated joints",
                           has_value=False)
+    link_frames = {n: frame_of_link(n) for n in [BASE, *(j.name for j in joints)]}
+    link_frames = {n: T for n, T in link_frames.items() if not np.array_equal(T, np.eye(4))}
     return MechanismSpec(np.array(m.gravity, dtype=float), joints, bodies, frames, loops,
-                         list(m.actuated))
+                         list(m.actuated), link_frames)

@@ -53,8 +53,106 @@ duration = 1.0                # s
 samples = 501                 # instants evaluated (at least 3)
 '''
 
-LINKAGE_NOT_YET = (
-    "'mechbal init linkage' is not available yet: closed-loop mechanisms (a four-bar with a "
-    "counterweight) need the general mechanism model's file format (loop closures), which is "
-    "being added; start from 'mechbal init serial' or the built-in five-bar case "
-    "('mechbal cases')")
+LINKAGE = '''\
+# A mechbal case: a closed linkage (here a four-bar in the vertical x-z plane with a
+# counterweight on its crank) moving along a rest-to-rest motion of its actuated joint. Run it with
+#     mechbal run my.toml --out out/my
+# to get out/my/summary.json (peak shaking force and moment, actuator and base-reaction torques),
+# PNG plots and out/my/bodies_nominal.npz (every body's pose along the motion).
+# Units are SI throughout: m, kg, kg m^2, rad, s. The base frame has z up.
+#
+# A closed linkage is described as a tree of joints (each with a parent) plus loop closures that
+# join two frames on different branches. Here: crank -> coupler is one branch, rocker another,
+# and the loop pins the coupler's tip to the rocker's tip.
+#
+#      coupler_tip = rocker_tip   (loop "coupler_rocker")
+#            /         \
+#     coupler           rocker
+#        /                 \
+#   crank (motor)          |
+#   base O ---- 0.45 m ---- rocker pivot
+
+[case]
+name = "my_linkage"           # a name for the reports
+kind = "mechanism"            # the runner of the general model (trees and closed loops)
+title = "My four-bar with a crank counterweight, quintic crank motion in 1 s"
+
+[mechanism]
+gravity = [0.0, 0.0, -9.81]   # m/s^2 in the base frame
+actuated = ["crank"]          # the motor-driven joints (one per degree of freedom of the linkage);
+                              # the other joints are passive and follow from the loop closures
+
+# One [[mechanism.joints]] table per joint. Each joint:
+#   name    a label used in plots and files (also the name of the link it moves)
+#   parent  the joint whose link carries it, or "base" (default: the previous joint)
+#   type    "revolute" (angle) or "prismatic" (displacement); default revolute
+#   origin = { xyz = [...], rpy = [...] }  the joint frame in the parent link's frame
+#   axis    the joint axis in that frame
+#   link = { mass, com, inertia }  the link after the joint: mass [kg], centre of mass [m] in the
+#           joint frame, inertia about the centre of mass [kg m^2] as [Ixx, Iyy, Izz],
+#           [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix
+
+[[mechanism.joints]]
+name = "crank"
+parent = "base"
+origin = { xyz = [0.0, 0.0, 0.0] }
+axis = [0.0, -1.0, 0.0]       # a positive angle lifts +x towards +z
+link = { mass = 0.8, com = [0.1, 0.0, 0.0], inertia = [0.0002, 0.003, 0.003] }
+
+[[mechanism.joints]]
+name = "coupler"
+parent = "crank"
+origin = { xyz = [0.2, 0.0, 0.0] }   # at the crank's end: crank length 0.2 m
+axis = [0.0, -1.0, 0.0]
+link = { mass = 1.5, com = [0.25, 0.0, 0.0], inertia = [0.0005, 0.032, 0.032] }
+
+[[mechanism.joints]]
+name = "rocker"
+parent = "base"               # a second branch from the base
+origin = { xyz = [0.45, 0.0, 0.0] }  # ground link 0.45 m
+axis = [0.0, -1.0, 0.0]
+link = { mass = 1.1, com = [0.2, 0.0, 0.0], inertia = [0.0003, 0.015, 0.015] }
+
+# Extra bodies on any link: counterweights, motors, discs, payloads (kind is a label).
+[[mechanism.bodies]]
+name = "crank_counterweight"
+kind = "counterweight"
+link = "crank"
+mass = 0.6                    # kg
+com = [-0.08, 0.0, 0.0]       # m, in the crank's frame (opposite the coupler)
+inertia = [0.0001, 0.0001, 0.0001]
+
+# Named frames on links: the loop closures join two of them.
+[[mechanism.frames]]
+name = "coupler_tip"
+link = "coupler"
+origin = { xyz = [0.5, 0.0, 0.0] }   # coupler length 0.5 m
+
+[[mechanism.frames]]
+name = "rocker_tip"
+link = "rocker"
+origin = { xyz = [0.4, 0.0, 0.0] }   # rocker length 0.4 m
+
+# One [[mechanism.loops]] table per closure. type:
+#   "point"         the two frame origins coincide (a spherical or, in a plane, a revolute pin;
+#                   3 equations)
+#   "planar_point"  the origins coincide in the plane normal to frame_a's z (2 equations: a pin
+#                   of a planar linkage without redundant constraints)
+#   "axis"          origins coincide and z axes are parallel (5 equations: a revolute pin)
+#   "weld"          the frames coincide (6 equations)
+[[mechanism.loops]]
+name = "coupler_rocker"
+type = "point"
+frame_a = "coupler_tip"
+frame_b = "rocker_tip"
+
+[trajectory]
+law = "quintic"               # quintic | cubic (minimum energy)
+start = [1.0]                 # one value per actuated joint [rad or m]
+end = [2.2]
+duration = 1.0                # s
+samples = 1001                # instants evaluated (at least 3)
+initial_guess = [1.0, -0.6, 1.3]  # every joint (crank, coupler, rocker) near the assembly at
+                                  # start [rad]: picks which of the linkage's assembly modes
+                                  # (elbow up or down) is followed
+'''

@@ -292,6 +292,58 @@ TEST(ClosedLoop, PerturbedModelAndTorqueLimits) {
   EXPECT_LE(sat.tau.cwiseAbs().maxCoeff(), 5.0);
 }
 
+TEST(ClosedLoop, SampledDesiredMotionEqualsTheTrajectoryAndTickStatusesAddUp) {
+  // The same quintic, given as samples every dt/2, drives the same loop to the same state (the
+  // path any Python trajectory takes); tick_status ORs to status and counts the saturated ticks.
+  const Arm2DofParameters arm;
+  Arm2DofDynamics plant(arm), model(arm);
+  RestToRestTrajectory traj(kStart, kEnd, 1.0, TimeLaw::quintic);
+  ClosedLoopOptions opt;
+  opt.duration = 1.0;
+  opt.sampling = ControlSampling::every_rk4_stage;
+  const int steps = 1000;
+  SampledMotion desired;
+  desired.q.resize(2 * steps + 1, 2);
+  desired.qd.resize(2 * steps + 1, 2);
+  desired.qdd.resize(2 * steps + 1, 2);
+  for (int j = 0; j <= 2 * steps; ++j) {
+    Eigen::Vector2d q, qd, qdd;
+    traj.evaluate(j * 0.5e-3, q, qd, qdd);
+    desired.q.row(j) = q.transpose();
+    desired.qd.row(j) = qd.transpose();
+    desired.qdd.row(j) = qdd.transpose();
+  }
+  const Eigen::Vector2d q0 = kStart - Eigen::Vector2d(0.02, -0.01);
+  ComputedTorque a(model, Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20));
+  ComputedTorque b(model, Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20));
+  const ClosedLoopLog from_traj = simulate_closed_loop(plant, a, traj, q0, Eigen::Vector2d::Zero(), opt);
+  const ClosedLoopLog from_samples =
+      simulate_closed_loop(plant, b, desired, q0, Eigen::Vector2d::Zero(), opt);
+  EXPECT_EQ(from_samples.status, Status::ok);
+  EXPECT_LT((from_traj.q - from_samples.q).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_EQ(from_samples.tick_status.size(), steps + 1);
+  EXPECT_EQ(from_samples.tick_status.maxCoeff(), 0u);
+
+  SampledMotion short_desired = desired;
+  short_desired.q.conservativeResize(steps, 2);
+  EXPECT_THROW(simulate_closed_loop(plant, b, short_desired, q0, Eigen::Vector2d::Zero(), opt),
+               std::invalid_argument);
+
+  ComputedTorque limited(model, Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20),
+                         Eigen::Vector2d(5.0, 5.0));
+  opt.sampling = ControlSampling::zero_order_hold;
+  const ClosedLoopLog sat = simulate_closed_loop(plant, limited, traj, kStart, Eigen::Vector2d::Zero(), opt);
+  std::uint32_t all = 0;
+  int saturated = 0;
+  for (int k = 0; k < sat.tick_status.size(); ++k) {
+    all |= sat.tick_status(k);
+    saturated += (sat.tick_status(k) & static_cast<std::uint32_t>(Status::saturated)) != 0;
+  }
+  EXPECT_EQ(all, static_cast<std::uint32_t>(sat.status));
+  EXPECT_EQ(saturated, sat.saturated_ticks);
+  EXPECT_GT(saturated, 0);
+}
+
 TEST(ClosedLoop, PdErrorAnalyticSolvesEq6) {
   for (double kd : {5.0, 20.0, 40.0}) {
     const double kp = 100.0, h = 1e-4;

@@ -274,9 +274,15 @@ def test_init_serial_template_runs(tmp_path, capsys):
     assert summary["case"] == "my_robot" and summary["dof"] == 2
 
 
-def test_init_linkage_says_it_is_not_available(capsys):
-    assert main(["init", "linkage"]) == 2
-    one_line_error(capsys, 2, "not available yet", "init serial")
+def test_init_linkage_template_runs(tmp_path, capsys):
+    assert main(["init", "linkage"]) == 0
+    text = capsys.readouterr().out
+    assert text.count("\n#") > 10 and "[[mechanism.loops]]" in text  # commented, closed
+    p = tmp_path / "my.toml"
+    p.write_text(text)
+    assert main(["run", str(p), "--out", str(tmp_path / "o"), "-q"]) == 0
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["case"] == "my_linkage"
 
 
 # ---- progress ---------------------------------------------------------------------------------

@@ -117,10 +117,22 @@ def _valid_keys(config, path):
     return set(_allowed_keys(_model_for(config), path)) if path else set(_model_for(config).model_fields)
 
 
+def _distinct_key_paths(config, first: int = 3):
+    """_key_paths, but beyond the first entries of an array of tables only the keys not seen
+    before at the same place (a generated 38-body mechanism repeats the same keys hundreds of times;
+    mutating every repeat would only slow the suite down)."""
+    seen = set()
+    for path, key in _key_paths(config):
+        generic = (tuple("*" if isinstance(x, int) else x for x in path), key)
+        if all(x < first for x in path if isinstance(x, int)) or generic not in seen:
+            seen.add(generic)
+            yield path, key
+
+
 def misspelled_cases():
     """(case name, mutated config, dotted path of the mutated key, original key)."""
     for name, config in CASES.items():
-        for path, key in _key_paths(config):
+        for path, key in _distinct_key_paths(config):
             allowed = _valid_keys(config, path) if path[:1] != ("case",) else \
                 {"name", "kind", "title", "mechanism"}
             for wrong in _one_edit(key):
@@ -178,7 +190,7 @@ def test_the_issue_examples_are_refused():
         validate_case(bad)
     bad = copy.deepcopy(base)
     bad["counterweights"] = {"m_cw1": 1.0}
-    with pytest.raises(ConfigError, match=r"^counterweights: unknown table \(allowed: case, mechanism, trajectory\)"):
+    with pytest.raises(ConfigError, match=r"^counterweights: unknown table \(allowed: case, mechanism, trajectory, balance\)"):
         validate_case(bad)
 
 

@@ -448,3 +448,54 @@ def test_urdf_robot_batched_equals_rebuilt():
                   "shaking_moment_peak": _stat(mech.shaking_wrench(qa, va, aa).shaking_moment, "peak")}
         for c, v in direct.items():
             assert table.at[i, c] == pytest.approx(v, rel=1e-12), (i, c)
+
+
+def test_paminsa_counterweight_tolerance_brings_shaking_force_back():
+    """The issue's example on PAMINSA as data (38 bodies, 9 loops, geared counter-mass): balanced
+    at nominal, +-2 % counterweights bring shaking force back; batched sets equal the linkage
+    rebuilt and solved directly."""
+    from mechbal.sweep.config import SWEEPS_DIR, from_toml
+    from mechbal.sweep.parameters import apply_values
+
+    full = from_toml(SWEEPS_DIR / "paminsa-tolerance.toml", "paminsa-linkage")
+    assert len(full.parameters) == 10 and full.evaluations == 10_000
+    sweep = Sweep(full.base, [Parameter(p.path, tolerance=0.02) for p in full.parameters],
+                  ["shaking_force_peak", "actuator_torque_rms"], kind="monte_carlo", evaluations=5,
+                  seed=2009, trajectory_samples=31)
+    result = sweep.run("serial", progress=False)
+    t = result.table
+    assert result.nominal["shaking_force_peak"] < 1e-10
+    assert (t["shaking_force_peak"] > 1e-3).all()
+    plan = sweep.plan()
+    qa, va, aa = sweep.trajectory
+    for i in range(len(t)):
+        mech = Mechanism.from_spec(apply_values(plan.spec, plan.targets, t.loc[i, sweep.paths].to_numpy(float),
+                                                plan.nominal))
+        m = mech.closed_motion(qa, va, aa, q_guess=sweep.q_guess, with_forces=True)
+        w = mech.shaking_wrench(m.q, m.v, m.a)
+        assert t.at[i, "shaking_force_peak"] == pytest.approx(_stat(w.shaking_force, "peak"), rel=1e-12, abs=1e-12 * 30)
+        assert t.at[i, "actuator_torque_rms"] == pytest.approx(_stat(m.actuated_force, "rms"), rel=1e-12)
+
+
+def test_a_balancing_method_is_a_metric():
+    """mechbal.balance.static sizes the counterweights of every perturbed arm2link; with the
+    lightest solution at the largest radius allowed, the 2-DOF arm's closed form gives them
+    (Arakelian, Le Baron & Mottu 2011, eqs 21-22): m_cw2 r2 = m2 l_s2, m_cw1 r1 = m1 l_s1 + (m2 + m_cw2) l1."""
+    from mechbal.balance import CounterweightSlot, method
+
+    slots = [CounterweightSlot("cw1", "shoulder", max_radius=0.5, direction=(-1.0, 0.0, 0.0)),
+             CounterweightSlot("cw2", "elbow", max_radius=0.4, direction=(-1.0, 0.0, 0.0))]
+
+    def counterweights(mech):
+        r = method("static").balance(mech, slots, samples=30)
+        return {"cw1": r.design["cw1"]["mass"], "cw2": r.design["cw2"]["mass"], "residual": r.residual}
+
+    sweep = Sweep("arm2link", [Parameter("bodies.shoulder.mass", tolerance=0.05),
+                               Parameter("bodies.elbow.mass", tolerance=0.05)],
+                  {"static": counterweights}, kind="sensitivity", pose_count=5, trajectory_samples=11)
+    t = sweep.run("serial", progress=False).table
+    m1, m2 = t["bodies.shoulder.mass"], t["bodies.elbow.mass"]
+    cw2 = m2 * 0.2 / 0.4
+    np.testing.assert_allclose(t["static.cw2"], cw2, rtol=1e-9)
+    np.testing.assert_allclose(t["static.cw1"], (m1 * 0.25 + (m2 + cw2) * 0.5) / 0.5, rtol=1e-9)
+    assert (t["static.residual"] < 1e-9).all()

@@ -16,6 +16,7 @@
 ///
 /// Batch, not real-time: the log is allocated once up front; the loop itself allocates nothing.
 #include <Eigen/Core>
+#include <cstdint>
 
 #include "mechbal/arm2dof.hpp"
 #include "mechbal/computed_torque.hpp"
@@ -39,6 +40,9 @@ struct ClosedLoopOptions {
 struct ClosedLoopLog {
   Eigen::VectorXd t;
   Eigen::MatrixXd q, qd, q_des, qd_des, tau;
+  /// status of tick k: the controller at t_k (and at the RK4 stages of step k in
+  /// every_rk4_stage mode) OR the plant over step k (bit flags of Status)
+  Eigen::Matrix<std::uint32_t, Eigen::Dynamic, 1> tick_status;
   Status status = Status::ok;  ///< OR of every controller and plant status
   int saturated_ticks = 0;     ///< ticks on which the controller clipped the torque
   int steps_completed = 0;     ///< < steps when the plant failed (then later rows repeat the last state)
@@ -51,6 +55,20 @@ struct ClosedLoopLog {
 /// options.
 ClosedLoopLog simulate_closed_loop(ForwardDynamics& plant, JointController& controller,
                                    const RestToRestTrajectory& desired, const Eigen::VectorXd& q0,
+                                   const Eigen::VectorXd& qd0, const ClosedLoopOptions& options);
+
+/// A desired motion given as samples on the half-step grid t_j = j dt / 2, j = 0 .. 2 steps
+/// (any trajectory a caller can evaluate: via points, splines of measured data), one row per
+/// sample, dof() columns. The controller reads row 2k at tick k (and rows 2k+1, 2k+2 at the
+/// RK4 stages in every_rk4_stage mode).
+struct SampledMotion {
+  Eigen::MatrixXd q, qd, qdd;
+};
+
+/// As above, tracking a sampled desired motion: `desired` must have 2 round(duration / dt) + 1
+/// finite rows of plant.dof() values each (std::invalid_argument naming the field otherwise).
+ClosedLoopLog simulate_closed_loop(ForwardDynamics& plant, JointController& controller,
+                                   const SampledMotion& desired, const Eigen::VectorXd& q0,
                                    const Eigen::VectorXd& qd0, const ClosedLoopOptions& options);
 
 /// simulate_closed_loop with a ComputedTorque controller (Arakelian et al. 2011's closed loop).

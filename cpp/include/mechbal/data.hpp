@@ -72,8 +72,11 @@ struct MechanismData {
   Eigen::MatrixXd loop_passive_jacobian;   ///< A° (m x np)
   Eigen::MatrixXd loop_actuated_jacobian;  ///< A# (m x na)
   Eigen::VectorXd loop_constraint_work;    ///< m
+  Eigen::VectorXd loop_refine_solution;    ///< np
   Eigen::LDLT<Eigen::MatrixXd> reduced_ldlt;  ///< of C^T M C (na x na)
   Eigen::MatrixXd loop_normal;             ///< A°^T A° + damping (np x np)
+  Eigen::VectorXi loop_passive_first, loop_passive_last;  ///< rows of A° holding each column's nonzeros (np)
+  Eigen::VectorXd loop_normal_pivots;      ///< D of N = L D L^T (L in loop_normal's lower triangle) (np)
   Eigen::LDLT<Eigen::MatrixXd> loop_ldlt;
   Eigen::VectorXd loop_step, loop_trial;   ///< np, n
   Eigen::MatrixXd loop_solution;           ///< np x na

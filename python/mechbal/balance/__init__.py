@@ -15,12 +15,14 @@ rms        :mod:`mechbal.balance.rms`      RMS or peak actuator torque over a tr
 
 The design variables (which bodies or springs may be added or changed, where, with which bounds
 and mass budget) are :class:`~mechbal.balance.result.CounterweightSlot` /
-:class:`~mechbal.balance.result.SpringSlot` objects (or the ``[balance]`` table of a case file);
+:class:`~mechbal.balance.result.SpringSlot` / :class:`~mechbal.balance.result.DiscSlot` /
+:class:`~mechbal.balance.result.InertiaSlot` objects (or the ``[balance]`` table of a case file);
 a result names what limited it (rank, an active bound, an impossibility).
 """
 from __future__ import annotations
 
-from mechbal.balance.result import BalanceResult, CounterweightSlot, SpringSlot  # noqa: F401
+from mechbal.balance.result import (BalanceResult, CounterweightSlot, DiscSlot, InertiaSlot,  # noqa: F401
+                                    SpringSlot)
 
 #: method name -> module path; each module has ``balance(mechanism, design, samples, **options)``
 METHODS = {

@@ -30,9 +30,16 @@ class CounterweightSlot:
 @dataclass(frozen=True)
 class SpringSlot:
     """A spring a method may add between anchor ``anchor_a`` on link ``link_a`` and ``anchor_b``
-    on ``link_b`` (positions [m] in those links' frames); ``free_length`` 0 for a zero-free-length
-    spring; ``rate`` [N/m] chosen by the method unless fixed; ``pulley_ratio`` of a
-    block-and-tackle (the spring stretches ``pulley_ratio`` times the anchor distance change)."""
+    on ``link_b`` (positions [m] in those links' frames; ``link_a``/``link_b`` may also name a
+    frame of the mechanism, e.g. a DH frame, and the anchor is then in that frame);
+    ``free_length`` [m] the anchor distance at which each spring carries only its ``preload``
+    (0 and no preload: a zero-free-length spring); ``rate`` [N/m] of each spring, chosen by the
+    method unless fixed (within ``rate_min``..``rate_max``); ``count`` identical springs in
+    parallel; ``pulley_ratio`` k of a block and tackle: the anchor distance changes k times as
+    much as the springs' length, so (virtual work) the tension at the anchors is count * spring
+    force / k and the equivalent rate there is count * rate / k**2 (Martini et al. 2015, Tables
+    1-2); ``anchor_a_bounds`` / ``anchor_b_bounds`` ((lower xyz), (upper xyz)) let the method move
+    an anchor within a box (None: fixed)."""
 
     name: str
     link_a: str
@@ -43,6 +50,49 @@ class SpringSlot:
     rate: float | None = None
     pulley_ratio: float = 1.0
     rate_max: float = math.inf
+    preload: float = 0.0
+    count: int = 1
+    rate_min: float = 0.0
+    anchor_a_bounds: Any = None
+    anchor_b_bounds: Any = None
+
+
+@dataclass(frozen=True)
+class DiscSlot:
+    """A counter-rotating disc a method may add (shaking-moment balancing, Coutinho & Hess
+    Coelho): an axle on link ``carrier`` through ``position`` [m] along ``axis`` (carrier frame),
+    the disc turning relative to the carrier by ``ratio`` times the rate of coordinate ``joint``
+    (a gear train; ratio 1: the disc turns with the next link). Its mass is part of the
+    carrier's; it adds its axial ``inertia`` J_a [kg m^2] about the axle and
+    ``transverse_inertia`` (None: J_a / 2, a thin disc). ``ratio`` and ``inertia`` None are
+    chosen by the method (inertia within ``inertia_min``..``inertia_max``; a chosen ratio
+    outside ``ratio_min``..``ratio_max`` is reported)."""
+
+    name: str
+    carrier: str
+    joint: str
+    axis: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    ratio: float | None = None
+    inertia: float | None = None
+    transverse_inertia: float | None = None
+    inertia_min: float = 0.0
+    inertia_max: float = math.inf
+    ratio_min: float = -math.inf
+    ratio_max: float = math.inf
+
+
+@dataclass(frozen=True)
+class InertiaSlot:
+    """Central principal inertias of an existing body that a method may choose (``components``
+    among ``"Ixx", "Iyy", "Izz"``, about the body's centre of mass in its link's axes, each >=
+    ``minimum``): e.g. the cross-bar of the spatial arm's link 2 (corrected eq 25 of the discs
+    paper)."""
+
+    name: str
+    body: str
+    components: tuple[str, ...] = ("Iyy",)
+    minimum: float = 0.0
 
 
 @dataclass
@@ -56,7 +106,12 @@ class BalanceResult:
     the result is not exact (``"rank 4 < 6 unknowns: ..."``, ``"bound: cw1.mass_max"``,
     ``"impossible: ..."``), empty when the balance is exact; ``metrics``: before/after peak and
     RMS values (gravity torque, actuator torque, shaking force and moment) where computed;
-    ``balanced``: the balanced :class:`mechbal.Mechanism`."""
+    ``balanced``: the balanced :class:`mechbal.Mechanism`; ``elements``: balancing elements that
+    are not bodies of the mechanism (the sized :class:`SpringSlot` objects of the spring method);
+    ``active_bounds``: every bound the design sits on (``"cw1.max_radius"``, ``"mass_budget"``),
+    whether or not it limited the balance (when it did, it is also in ``limited_by``);
+    ``undetermined``: combinations of the unknowns that the condition does not determine (the
+    null space of the linear problem)."""
 
     method: str
     design: dict[str, dict[str, Any]]
@@ -68,6 +123,9 @@ class BalanceResult:
     limited_by: list[str] = field(default_factory=list)
     metrics: dict[str, Any] = field(default_factory=dict)
     balanced: Any = None
+    elements: list = field(default_factory=list)
+    active_bounds: list[str] = field(default_factory=list)
+    undetermined: list[str] = field(default_factory=list)
 
     @property
     def exact(self) -> bool:
@@ -89,4 +147,5 @@ class BalanceResult:
         return plain({"method": self.method, "design": self.design, "residual": self.residual,
                       "residual_before": self.residual_before, "residual_units": self.residual_units,
                       "rank": self.rank, "unknowns": self.unknowns, "limited_by": self.limited_by,
-                      "exact": self.exact, "metrics": self.metrics})
+                      "exact": self.exact, "active_bounds": self.active_bounds,
+                      "undetermined": self.undetermined, "metrics": self.metrics})

@@ -203,7 +203,8 @@ def rms_optimal_radii_numerical(arm, m_cw1: float, m_cw2: float, q, qd, qdd,
     return r1, r2
 
 
-# ---- generalisation: any serial chain through KDL ----------------------------------------------
+# ---- generalisation: any serial chain (kept for its callers; mechbal.balance.rms is the general
+# ---- method on any mechanism, of which the functions above are the 2-DOF fast path) ------------
 
 @dataclass(frozen=True)
 class CounterweightMount:
@@ -261,18 +262,27 @@ class ChainTorqueModel:
 
 
 def chain_torque_model(model, mounts: Sequence[CounterweightMount], q, qd, qdd) -> ChainTorqueModel:
+    """The exact torque model of :class:`ChainTorqueModel`, evaluated on the general model of the
+    chain (``chain_description``: its base placement included) with the mounts' point masses as
+    extra bodies. For new code, :mod:`mechbal.balance.rms` does this for any mechanism on the
+    torque regressor (one sweep instead of 3K + 1)."""
+    from mechbal.mechanism import Mechanism
+
     for i, mt in enumerate(mounts):
         if not 0 <= mt.link < model.dof:
             raise ValueError(f"mounts[{i}].link must be in [0, {model.dof - 1}] (got {mt.link})")
         if np.linalg.norm(mt.direction) == 0.0:
             raise ValueError(f"mounts[{i}].direction must be non-zero (got {list(mt.direction)})")
+    mech = Mechanism(_core.MechanismModel(_core.chain_description(model)), name="chain")
+    links = [j.name for j in mech.model.description.joints]
 
     def tau(masses):
-        out = _core.KdlChainDynamics(chain_with_point_masses(model, masses)).inverse_dynamics(q, qd, qdd)
-        if out["status"] != _core.Status.ok:
-            raise ValueError(f"KDL inverse dynamics failed: {out['status']}")
-        return out["tau"]
+        bodies = [_core.Body(f"mount{link}_{k}", links[link], float(m_p), np.asarray(p, float),
+                             np.zeros((3, 3)), "counterweight")
+                  for link, items in masses.items() for k, (m_p, p) in enumerate(items)]
+        return (mech.with_bodies(bodies) if bodies else mech).inverse_dynamics(q, qd, qdd)
 
+    q, qd, qdd = (np.ascontiguousarray(x, dtype=float) for x in (q, qd, qdd))
     tau0 = tau({})
     a, b, c = [], [], []
     for mt in mounts:

@@ -45,12 +45,15 @@ Status loop_constraints(const MechanismModel& model, MechanismData& data, const 
 /// with step limiting and backtracking. Status::ok when converged; Status::singular is added when
 /// A° is near singular (rcond in data.loop_rcond); Status::solver_error when it does not converge
 /// within the iteration bound (the mechanism cannot be assembled there): `q` is then left
-/// unchanged. data.loop_iterations, data.loop_residual_norm report the solve.
+/// unchanged. data.loop_iterations, data.loop_residual_norm report the solve. When `q` is the
+/// position of the last projection (data.closed_position: the usual tick passes back the q it got),
+/// the warm start is first moved along the closure manifold to second order (q + C d + s^2 c / 2,
+/// d the change of the actuated coordinates), which saves Newton iterations at control rates.
 Status solve_loop_positions(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
                             Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options = {}) noexcept;
 
-/// At a solved q: data.loop_projection (C), data.closed_velocity = C v#, data.loop_bias (gamma),
-/// data.loop_acceleration_bias (c), data.loop_rcond. Status::singular near a parallel singularity
+/// At a solved q: data.loop_projection (C), data.closed_position = q, data.closed_velocity = C v#,
+/// data.loop_bias (gamma), data.loop_acceleration_bias (c), data.loop_rcond. Status::singular near a parallel singularity
 /// (rcond below options.singular_rcond, or actuated velocities that the loops cannot accept).
 Status loop_projection(const MechanismModel& model, MechanismData& data, const ConstVector& q,
                        const ConstVector& v_actuated, const LoopSolveOptions& options = {}) noexcept;

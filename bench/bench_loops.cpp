@@ -1,0 +1,267 @@
+// Closed loops on the general model (issue 10, "Performance"): one tick of the general path where
+// the papers have closed forms.
+//  - paminsa_general_wrench: PAMINSA as 38 bodies on a tree with 9 loop closures (22 passive
+//    coordinates, 24 closure equations; paminsa_general.hpp): closed_motion (position solve
+//    warm-started from the last tick, v = C v#, a = C a# + c) from the paper's actuators (M_1, M_3,
+//    M_v) and the wrist, then shaking_wrench (momenta and their rates about O) of every body.
+//    Same platform and wrist motion as paminsa_wrench (the closed form of the same quantities):
+//    ratio paminsa_general_over_closed_form.
+//  - four_bar_tick: closed_inverse_dynamics of a four-bar (position solve, projection, tree
+//    inverse dynamics, tau# = C^T tau; the test's four-bar, tests/cpp/test_loops.cpp).
+// Ticks run back and forth along 1024 precomputed instants at 1 kHz (no jump for the warm start).
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "bench_registry.hpp"
+#include "mechbal/algorithm/loops.hpp"
+#include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/paminsa.hpp"
+#include "paminsa_general.hpp"
+
+namespace mechbal::bench {
+namespace {
+
+constexpr double kDt = 1e-3;
+constexpr int kTicks = 1024;
+
+[[noreturn]] void fail(const char* what, double value) {
+  std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
+  std::abort();
+}
+
+/// 0, 1, ..., kTicks - 1, kTicks - 2, ..., 1, 0, 1, ...: consecutive instants stay neighbours.
+struct PingPong {
+  int k = 0, step = 1;
+  std::size_t next() noexcept {
+    const int out = k;
+    if (k + step < 0 || k + step >= kTicks) step = -step;
+    k += step;
+    return static_cast<std::size_t>(out);
+  }
+};
+
+// The platform and wrist motion of paminsa_wrench (bench_controllers.cpp).
+PlatformMotion platform_at(double t) {
+  const Vec3 P0(0.48, 0.05, 0.6775), amp(0.04, 0.12, 0.03), om(3.0, 2.0, 5.0), ph(0.3, 1.1, 0.7);
+  PlatformMotion m;
+  for (int i = 0; i < 3; ++i) {
+    const double a = om(i) * t + ph(i);
+    m.position(i) = P0(i) + amp(i) * std::sin(a);
+    m.velocity(i) = amp(i) * om(i) * std::cos(a);
+    m.acceleration(i) = -amp(i) * om(i) * om(i) * std::sin(a);
+  }
+  return m;
+}
+
+WristMotion wrist_at(double t) {
+  const Vec3 q0(0.4, 1.2, -0.5), amp(0.7, 0.5, 1.3), om(2.0, 3.0, 4.0);
+  WristMotion w;
+  for (int i = 0; i < 3; ++i) {
+    w.angles(i) = q0(i) + amp(i) * std::sin(om(i) * t);
+    w.rates(i) = amp(i) * om(i) * std::cos(om(i) * t);
+    w.accelerations(i) = -amp(i) * om(i) * om(i) * std::sin(om(i) * t);
+  }
+  return w;
+}
+
+struct ActuatedState {
+  Eigen::VectorXd q, v, a;
+};
+
+/// The actuated joints' motion for a platform and wrist motion (the closed form's inverse
+/// kinematics and its derivatives; mechbal.papers.paminsa.paminsa_actuated_motion): alpha_i is the
+/// angle of A_h,i - M_i, A_h,i = (k B_h,i - C_h,i)/(k - 1); z_B = z_A + (z_P - l_CJ - z_A)/k.
+ActuatedState actuated(const PaminsaModel& pm, const MechanismModel& model, const PlatformMotion& m,
+                       const WristMotion& w) {
+  const PaminsaParameters& p = pm.parameters();
+  const double k = p.k;
+  double q[3][3];  // alpha1, alpha3, z_B: value, rate, acceleration
+  for (int leg : {0, 2}) {
+    const Eigen::Vector2d Ah = (k * pm.slider_line()[leg] - (m.position + pm.platform_joint_offset()[leg]).head<2>()) / (k - 1.0);
+    const Eigen::Vector2d g = Ah - pm.guide_pivot()[leg], gd = -m.velocity.head<2>() / (k - 1.0),
+                          gdd = -m.acceleration.head<2>() / (k - 1.0);
+    const auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a(0) * b(1) - a(1) * b(0); };
+    const double r2 = g.squaredNorm(), ad = cross(g, gd) / r2;
+    double* out = q[leg == 0 ? 0 : 1];
+    out[0] = std::atan2(g(1), g(0));
+    out[1] = ad;
+    out[2] = (cross(g, gdd) - 2.0 * ad * g.dot(gd)) / r2;
+  }
+  q[2][0] = p.z_A + (m.position(2) - p.length_CJ - p.z_A) / k;
+  q[2][1] = m.velocity(2) / k;
+  q[2][2] = m.acceleration(2) / k;
+  ActuatedState s{Eigen::VectorXd(model.num_actuated()), Eigen::VectorXd(model.num_actuated()),
+                  Eigen::VectorXd(model.num_actuated())};
+  for (int i = 0; i < model.num_actuated(); ++i) {
+    const std::string& name = model.coordinate_name(model.actuated_coordinates()[static_cast<std::size_t>(i)]);
+    const int wrist = name == "wrist_phi" ? 0 : name == "wrist_theta" ? 1 : name == "wrist_psi" ? 2 : -1;
+    const int act = name == "leg1_guide" ? 0 : name == "leg3_guide" ? 1 : name == "leg1_slider" ? 2 : -1;
+    if (wrist >= 0) {
+      s.q(i) = w.angles(wrist);
+      s.v(i) = w.rates(wrist);
+      s.a(i) = w.accelerations(wrist);
+    } else if (act >= 0) {
+      s.q(i) = q[act][0];
+      s.v(i) = q[act][1];
+      s.a(i) = q[act][2];
+    } else {
+      fail("PAMINSA general model: unexpected actuated joint", i);
+    }
+  }
+  return s;
+}
+
+/// Every coordinate at platform position P from the closed form's leg points (the assembly mode).
+Eigen::VectorXd initial_guess(const PaminsaModel& pm, const MechanismModel& model, const PlatformMotion& m,
+                              const WristMotion& w) {
+  PaminsaWorkspace ws;
+  if (paminsa_mechanism_kinematics(pm, m, ws) != Status::ok) fail("PAMINSA bench pose unreachable", 0.0);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(model.dof());
+  const auto set = [&](const std::string& name, double value) {
+    for (int c = 0; c < model.dof(); ++c)
+      if (model.coordinate_name(c) == name) q(c) = value;
+  };
+  set("platform_x", m.position(0));
+  set("platform_y", m.position(1));
+  set("platform_z", m.position(2));
+  set("wrist_phi", w.angles(0));
+  set("wrist_theta", w.angles(1));
+  set("wrist_psi", w.angles(2));
+  for (int i = 0; i < 3; ++i) {
+    const auto& pts = ws.leg_points[static_cast<std::size_t>(i)];  // A, B, C, D, E, F
+    const Vec3 &A = pts[0], &B = pts[1], &C = pts[2], &D = pts[3], &E = pts[4], &F = pts[5];
+    const Eigen::Vector2d u = (A - B).head<2>().normalized();
+    const auto elevation = [&](const Vec3& d) { return std::atan2(d(2), d.head<2>().dot(u)); };
+    const double g_df = elevation(F - D), g_ec = elevation(C - E), g_ae = elevation(E - A);
+    const Eigen::Vector2d g = A.head<2>() - pm.guide_pivot()[static_cast<std::size_t>(i)];
+    const std::string L = "leg" + std::to_string(i + 1);
+    set(L + "_slider", B(2));
+    set(L + "_column", std::atan2(u(1), u(0)));
+    set(L + "_link2", g_df);
+    set(L + "_link1", g_ec - g_df);
+    set(L + "_link3", g_ae - g_ec);
+    set(L + "_link4", g_ec - g_df);
+    set(L + "_guide", std::atan2(g(1), g(0)));
+    set(L + "_stroke", g.norm());
+  }
+  return q;
+}
+
+// ---------------------------------------------------------------------------- PAMINSA general
+struct PaminsaGeneralCase {
+  PaminsaModel closed{PaminsaParameters{}};
+  MechanismModel model{paminsa_description(closed)};
+  MechanismData data{model};
+  std::vector<ActuatedState> in;
+  Eigen::VectorXd q;
+  PingPong order;
+  Status status = Status::ok;
+};
+
+Tick paminsa_general_case() {
+  auto s = std::make_shared<PaminsaGeneralCase>();
+  for (int n = 0; n < kTicks; ++n) s->in.push_back(actuated(s->closed, s->model, platform_at(n * kDt), wrist_at(n * kDt)));
+  // check at setup, at 64 consecutive ticks: the general path's momenta and shaking wrench equal
+  // the closed form's (paminsa_kinematics + shaking_wrench of the 38 bodies) to 1e-9
+  s->q = initial_guess(s->closed, s->model, platform_at(0.0), wrist_at(0.0));
+  PaminsaWorkspace ws;
+  for (int n = 0; n < 64; ++n) {
+    const ActuatedState& a = s->in[static_cast<std::size_t>(n)];
+    if (closed_motion(s->model, s->data, a.q, a.v, a.a, s->q) != Status::ok)
+      fail("PAMINSA general model: closed_motion failed on the bench trajectory", n);
+    if (shaking_wrench(s->model, s->data, s->data.closed_position, s->data.closed_velocity,
+                       s->data.closed_acceleration) != Status::ok)
+      fail("PAMINSA general model: shaking_wrench failed", n);
+    ShakingWrench w;
+    if (paminsa_kinematics(s->closed, platform_at(n * kDt), wrist_at(n * kDt), ws) != Status::ok ||
+        shaking_wrench(s->closed.bodies().data(), ws.states.data(), PaminsaBodyIndex::count, w) != Status::ok)
+      fail("PAMINSA closed form failed on the bench trajectory", n);
+    const ShakingWrench& g = s->data.shaking;
+    const double rel = std::max({(g.force - w.force).norm() / std::max(1.0, w.force.norm()),
+                                 (g.moment - w.moment).norm() / std::max(1.0, w.moment.norm()),
+                                 (g.linear_momentum - w.linear_momentum).norm() / std::max(1.0, w.linear_momentum.norm()),
+                                 (g.angular_momentum - w.angular_momentum).norm() / std::max(1.0, w.angular_momentum.norm())});
+    if (!(rel < 1e-9)) fail("PAMINSA general model != closed form (relative)", rel);
+  }
+  s->q = initial_guess(s->closed, s->model, platform_at(0.0), wrist_at(0.0));
+  return [s] {
+    const ActuatedState& a = s->in[s->order.next()];
+    s->status = closed_motion(s->model, s->data, a.q, a.v, a.a, s->q);
+    s->status |= shaking_wrench(s->model, s->data, s->data.closed_position, s->data.closed_velocity,
+                                s->data.closed_acceleration);
+    benchmark::DoNotOptimize(s->status);
+    benchmark::DoNotOptimize(&s->data.shaking);
+    benchmark::ClobberMemory();
+  };
+}
+
+// ---------------------------------------------------------------------------- four-bar
+Eigen::Isometry3d at(double x) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Vec3(x, 0.0, 0.0);
+  return T;
+}
+
+MechanismModel four_bar() {
+  const auto rod = [](const std::string& name, double mass, double length) {
+    return Body{name, "link", name, mass, Vec3(0.5 * length, 0.01, 0.0),
+                Mat3(Vec3(1e-4, mass * length * length / 12.0, mass * length * length / 12.0).asDiagonal())};
+  };
+  MechanismDescription d;
+  d.gravity = Vec3(0.0, -9.81, 0.0);
+  d.joints = {Joint{"crank", JointType::revolute, "base"}, Joint{"coupler", JointType::revolute, "crank", at(0.2)},
+              Joint{"rocker", JointType::revolute, "base", at(0.45)}};
+  d.bodies = {rod("crank", 0.8, 0.2), rod("coupler", 1.5, 0.5), rod("rocker", 1.1, 0.4)};
+  d.frames = {Frame{"coupler_tip", "coupler", at(0.5)}, Frame{"rocker_tip", "rocker", at(0.4)}};
+  d.loops = {LoopConstraint{"tip", LoopType::point, "coupler_tip", "rocker_tip"}};
+  d.actuated = {"crank"};
+  return MechanismModel(d);
+}
+
+struct FourBarCase {
+  MechanismModel model{four_bar()};
+  MechanismData data{model};
+  std::vector<ActuatedState> in;
+  Eigen::VectorXd q = (Eigen::VectorXd(3) << 1.0, -0.6, 1.75).finished();
+  PingPong order;
+  Status status = Status::ok;
+};
+
+Tick four_bar_case() {
+  auto s = std::make_shared<FourBarCase>();
+  for (int n = 0; n < kTicks; ++n) {  // the crank swings 1.0 +- 0.4 rad at 2 rad/s
+    const double t = n * kDt;
+    s->in.push_back({Eigen::VectorXd::Constant(1, 1.0 + 0.4 * std::sin(2.0 * t)),
+                     Eigen::VectorXd::Constant(1, 0.8 * std::cos(2.0 * t)),
+                     Eigen::VectorXd::Constant(1, -1.6 * std::sin(2.0 * t))});
+  }
+  // check at setup: the loop closes and forward dynamics of the actuated force gives back a#
+  for (int n = 0; n < 64; ++n) {
+    const ActuatedState& a = s->in[static_cast<std::size_t>(n)];
+    if (closed_inverse_dynamics(s->model, s->data, a.q, a.v, a.a, s->q) != Status::ok)
+      fail("four-bar: closed_inverse_dynamics failed", n);
+    if (!(s->data.loop_residual_norm < 1e-12)) fail("four-bar: loop not closed", s->data.loop_residual_norm);
+    const Eigen::VectorXd tau = s->data.actuated_force;
+    if (closed_forward_dynamics(s->model, s->data, a.q, a.v, tau, s->q) != Status::ok)
+      fail("four-bar: closed_forward_dynamics failed", n);
+    const double err = (s->data.actuated_acceleration - a.a).cwiseAbs().maxCoeff();
+    if (!(err < 1e-9)) fail("four-bar: forward dynamics does not invert inverse dynamics", err);
+  }
+  s->q << 1.0, -0.6, 1.75;
+  return [s] {
+    const ActuatedState& a = s->in[s->order.next()];
+    s->status = closed_inverse_dynamics(s->model, s->data, a.q, a.v, a.a, s->q);
+    benchmark::DoNotOptimize(s->status);
+    benchmark::DoNotOptimize(s->data.actuated_force.data());
+    benchmark::ClobberMemory();
+  };
+}
+
+}  // namespace
+}  // namespace mechbal::bench
+
+using namespace mechbal::bench;
+MECHBAL_BENCH_CASE(paminsa_general_wrench) { return paminsa_general_case(); }
+MECHBAL_BENCH_CASE(four_bar_tick) { return four_bar_case(); }

@@ -1,0 +1,619 @@
+"""What the counterweight methods share (static, force, rms): slots in the user's frames, probe
+columns of the regressors, workspace samples, closed-loop projection, and the two-stage solve of
+a balancing condition that is linear in the counterweights' mass moments.
+
+**Why linear.** A counterweight of mass m whose centre of mass is at p in the frame of link L
+adds the 10 inertial parameters ``[m, m p, I_c + m (|p|^2 E - p p^T)]`` (about the link origin,
+the regressors' convention) to that link. The gravity torque and the linear momentum depend only
+on the first four, (m, h = m p): ``G(q) = G_0(q) + sum_k Y_g,L_k(q)[:, 0:4] (m_k, h_k)`` and
+``P(q, v) = P_0(q, v) + sum_k Y_P,L_k(q, v)[:, 0:4] (m_k, h_k)``. The columns of a link are the
+same for every body on it, so they are read from a *probe*: a copy of the mechanism whose only
+bodies are one zero-mass body per slot link.
+
+**Two stages.** (1) The exact least squares ``min |A x + b|`` over the stacked samples, with its
+rank, its residual, the minimum-norm solution and a basis of the undetermined combinations (the
+null space of A). (2) Among the least-squares solutions, the one with the least added mass that
+satisfies the slots' bounds (mass range, distance ``max_radius`` from ``center``, on the line
+``direction``) and the mass budget: if there is one the balance is as good as the least squares
+allow and the bounds only chose among equals; if there is none, the constrained least squares
+(convex: the bounds are linear or second-order cones in (m, h)) is solved instead, and the active
+bounds are reported as what limited the balance.
+
+Positions are in the frame the user described each link in (:meth:`Mechanism.user_frame`):
+the variables are (m, h_user) with ``h_link = R h_user + m t`` for the user frame (R, t).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+
+from mechbal import _core
+from mechbal.balance.result import CounterweightSlot
+
+#: a least-squares residual below this fraction of the unbalanced one counts as exact
+EXACT_RTOL = 1e-9
+#: singular values below this fraction of the largest are zero (undetermined combinations)
+RANK_RTOL = 1e-10
+#: bounds met to this (relative) tolerance are active
+ACTIVE_RTOL = 1e-7
+
+
+# ---- slots ----------------------------------------------------------------------------------------
+
+@dataclass
+class Slot:
+    """A :class:`CounterweightSlot` checked against a mechanism: ``T`` (4, 4) is the user frame
+    of ``link`` in the link frame (the link's own, or that of the named frame the slot gave as
+    its ``link``, e.g. a URDF link); ``center``, ``direction`` (unit or None) and ``inertia`` are
+    in the user frame, as given."""
+
+    name: str
+    link: str
+    mass_min: float
+    mass_max: float
+    max_radius: float
+    center: np.ndarray
+    direction: np.ndarray | None
+    inertia: np.ndarray
+    T: np.ndarray
+    field: str
+    #: the name the user gave: the link, or a named frame on it (positions are in that frame)
+    given: str = ""
+
+    @property
+    def mass_fixed(self) -> bool:
+        return math.isfinite(self.mass_max) and self.mass_max - self.mass_min <= 1e-15 * max(1.0, self.mass_max)
+
+    def link_point(self, p_user: np.ndarray) -> np.ndarray:
+        return self.T[:3, :3] @ np.asarray(p_user, float) + self.T[:3, 3]
+
+    def link_inertia(self) -> np.ndarray:
+        R = self.T[:3, :3]
+        return R @ self.inertia @ R.T
+
+
+def _finite(x: Any, what: str) -> float:
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}: must be a number (got {x!r})") from None
+    if math.isnan(v):
+        raise ValueError(f"{what}: must be a number (got nan)")
+    return v
+
+
+def normalise_slots(mech, design: Sequence[CounterweightSlot], *, need_radius: bool = True,
+                    field_name: str = "design") -> list[Slot]:
+    """Check the slots against ``mech`` (ValueError naming ``design[i].field``): a moving link,
+    0 <= mass_min <= mass_max, max_radius >= 0, a non-zero direction, unique names that are not
+    already bodies of the mechanism. With ``need_radius`` a slot whose mass is free needs a finite
+    ``max_radius`` or ``mass_min > 0`` (otherwise the lightest counterweight is a zero mass at an
+    infinite distance)."""
+    if isinstance(design, CounterweightSlot):
+        design = [design]
+    design = list(design)
+    if not design:
+        raise ValueError(f"{field_name}: no counterweight slots: give at least one")
+    names = set(mech.body_names)
+    out: list[Slot] = []
+    moving = set(mech.link_names[1:])
+    for i, s in enumerate(design):
+        f = f"{field_name}[{i}]"
+        if not isinstance(s, CounterweightSlot):
+            raise ValueError(f"{f}: must be a mechbal.balance.CounterweightSlot (got {type(s).__name__})")
+        if s.name in names:
+            raise ValueError(f"{f}.name: '{s.name}' is already a body of the mechanism or another slot")
+        names.add(s.name)
+        link, T = s.link, None
+        frames = {fr.name: fr for fr in mech.model.description.frames}
+        if link not in moving and link in frames and frames[link].link in moving:
+            # a named frame on a link (a URDF link's own frame): positions are in that frame
+            T = mech.user_frame(frames[link].link) @ np.asarray(frames[link].placement, float)
+            link = frames[link].link
+        if link not in moving:
+            import difflib
+            hint = difflib.get_close_matches(str(s.link), sorted(moving) + sorted(frames), n=1)
+            more = f" (did you mean '{hint[0]}'?)" if hint else f" (moving links: {', '.join(sorted(moving))})"
+            what = "the base does not move" if s.link == mech.model.root_name else "no moving link named"
+            raise ValueError(f"{f}.link: {what} '{s.link}'{more}")
+        lo, hi = _finite(s.mass_min, f"{f}.mass_min"), _finite(s.mass_max, f"{f}.mass_max")
+        if lo < 0 or math.isinf(lo):
+            raise ValueError(f"{f}.mass_min: must be >= 0 and finite (got {lo})")
+        if hi < lo:
+            raise ValueError(f"{f}.mass_max: must be >= mass_min = {lo} (got {hi})")
+        R = _finite(s.max_radius, f"{f}.max_radius")
+        if R < 0:
+            raise ValueError(f"{f}.max_radius: must be >= 0 (got {R})")
+        if need_radius and math.isinf(R) and lo == 0.0 and hi > 0.0:
+            raise ValueError(f"{f}: give max_radius (or mass_min > 0): with neither, the lightest "
+                             "counterweight is a vanishing mass at an infinite distance")
+        c = np.array([_finite(x, f"{f}.center") for x in s.center], float)
+        if c.shape != (3,):
+            raise ValueError(f"{f}.center: must have 3 values (got {list(s.center)})")
+        u = None
+        if s.direction is not None:
+            u = np.array([_finite(x, f"{f}.direction") for x in s.direction], float)
+            if u.shape != (3,) or not np.linalg.norm(u) > 0 or not np.all(np.isfinite(u)):
+                raise ValueError(f"{f}.direction: must be 3 finite values, not all zero (got {list(s.direction)})")
+            u = u / np.linalg.norm(u)
+        I = np.zeros((3, 3)) if s.inertia is None else np.asarray(s.inertia, float)
+        if I.shape == (3,):
+            I = np.diag(I)
+        if I.shape != (3, 3) or not np.all(np.isfinite(I)):
+            raise ValueError(f"{f}.inertia: must be a 3x3 matrix or 3 principal moments")
+        out.append(Slot(s.name, link, lo, hi, R, c, u, 0.5 * (I + I.T),
+                        mech.user_frame(link) if T is None else T, f, s.link))
+    return out
+
+
+def probe_mechanism(mech, slots: Sequence[Slot]):
+    """(probe, column) : ``probe`` is ``mech`` with only one zero-mass body per distinct slot
+    link, and ``column[k]`` the first regressor column (of 10) of slot k's link in the probe."""
+    links = list(dict.fromkeys(s.link for s in slots))
+    bodies = [_core.Body(f"__probe_{i}", link, 0.0, np.zeros(3), np.zeros((3, 3)), "other")
+              for i, link in enumerate(links)]
+    probe = mech.with_bodies(bodies, replace=True, name=f"{mech.name}-probe")
+    return probe, [10 * links.index(s.link) for s in slots]
+
+
+def user_columns(Y: np.ndarray, slots: Sequence[Slot], column: Sequence[int]) -> np.ndarray:
+    """(.., 4K) columns of the unknowns (m_k, h_k in the user frame) from a probe regressor
+    (.., 10 L): ``h_link = R h_user + m t``."""
+    cols = []
+    for s, c in zip(slots, column):
+        Ym, Yh = Y[..., c], Y[..., c + 1:c + 4]
+        R, t = s.T[:3, :3], s.T[:3, 3]
+        cols.append(np.concatenate([(Ym + Yh @ t)[..., None], Yh @ R], axis=-1))
+    return np.concatenate(cols, axis=-1)
+
+
+def unknown_names(slots: Sequence[Slot]) -> list[str]:
+    return [f"{s.name}.{k}" for s in slots for k in ("mass", "mass_moment_x", "mass_moment_y", "mass_moment_z")]
+
+
+def length_scale(mech) -> float:
+    """A characteristic length of the mechanism [m] (its joints' offsets), to weigh the mass
+    unknowns against the mass moments."""
+    d = mech.model.description
+    L = sum(float(np.linalg.norm(np.asarray(j.placement)[:3, 3])) for j in d.joints)
+    return L if L > 1e-6 else 1.0
+
+
+# ---- samples ----------------------------------------------------------------------------------------
+
+def sample_box(mech, lower=None, upper=None, coordinates: str = "independent"):
+    """(lower, upper) of the sampled coordinates: the given bounds, else the joint limits where
+    finite, else [-pi, pi] (revolute) or [-0.5, 0.5] m (prismatic). ``coordinates``: "independent"
+    (every q) or "actuated" (q# of a closed mechanism)."""
+    idx = (list(mech.model.actuated_coordinates) if coordinates == "actuated" else list(range(mech.dof)))
+    lo = np.asarray(mech.model.lower_limits, float)[idx]
+    hi = np.asarray(mech.model.upper_limits, float)[idx]
+    types = {j.name: j.type for j in mech.model.description.joints}
+    names = [mech.joint_names[i] for i in idx]
+    default = np.array([0.5 if types.get(n) == _core.JointType.prismatic else math.pi for n in names])
+    lo = np.where(np.isfinite(lo), lo, -default)
+    hi = np.where(np.isfinite(hi), hi, default)
+    if lower is not None:
+        lo = np.broadcast_to(np.asarray(lower, float), lo.shape).copy()
+    if upper is not None:
+        hi = np.broadcast_to(np.asarray(upper, float), hi.shape).copy()
+    if np.any(hi < lo):
+        raise ValueError(f"samples: upper bound below lower bound ({list(lo)} .. {list(hi)})")
+    return lo, hi
+
+
+def _nearest_neighbour_order(x: np.ndarray) -> np.ndarray:
+    """A greedy path through the points (so that warm-started loop solves move little)."""
+    n = len(x)
+    if n <= 2:
+        return np.arange(n)
+    order = [int(np.argmin(x[:, 0]))]
+    left = np.ones(n, bool)
+    left[order[0]] = False
+    for _ in range(n - 1):
+        d = np.sum((x - x[order[-1]]) ** 2, axis=1)
+        d[~left] = np.inf
+        k = int(np.argmin(d))
+        order.append(k)
+        left[k] = False
+    return np.array(order)
+
+
+@dataclass
+class ClosedSamples:
+    """Solved closed-loop samples: full ``q`` (N, dof), ``v`` (N, dof) or None, coupling matrices
+    ``C`` (N, dof, na) with v = C v#, and ``dropped`` instants that could not be assembled."""
+
+    q_actuated: np.ndarray
+    q: np.ndarray
+    v: np.ndarray | None
+    C: np.ndarray
+    dropped: int
+
+
+def closed_samples(mech, q_actuated, v_actuated=None, q_guess=None) -> ClosedSamples:
+    """Solve the loops at the actuated positions (visited along a nearest-neighbour path from
+    ``q_guess`` so each solve warm-starts the next) and the coupling matrix C at each (one
+    velocity solve per actuated joint). Instants that cannot be assembled or are singular are
+    dropped (counted)."""
+    qa = np.atleast_2d(np.asarray(q_actuated, float))
+    order = _nearest_neighbour_order(qa)
+    qa = qa[order]
+    va = None if v_actuated is None else np.atleast_2d(np.asarray(v_actuated, float))[order]
+    na = qa.shape[1]
+    cols, status, q = [], None, None
+    for i in range(na):
+        e = np.zeros_like(qa)
+        e[:, i] = 1.0
+        m = mech.closed_motion(qa, e, q_guess=q_guess)
+        cols.append(m.v)
+        status = m.status if status is None else status | m.status
+        q = m.q
+    C = np.stack(cols, axis=-1)
+    ok = np.asarray(status) == 0
+    v = None if va is None else np.einsum("nij,nj->ni", C, va)
+    return ClosedSamples(qa[ok], q[ok], None if v is None else v[ok], C[ok], int(np.sum(~ok)))
+
+
+# ---- the linear solve ---------------------------------------------------------------------------------
+
+@dataclass
+class LinearSolution:
+    """What :func:`solve_mass_moments` found. ``x`` (4K,): (m, h_user) per slot; ``residual`` and
+    ``residual_before``: RMS of A x + b and of b over the rows; ``least_squares_residual``: RMS of
+    the unconstrained optimum; ``rank`` of A; ``undetermined``: the combinations of unknowns that
+    change nothing (a basis of the null space of A); ``active_bounds``; ``limited_by``."""
+
+    x: np.ndarray
+    residual: float
+    residual_before: float
+    least_squares_residual: float
+    rank: int
+    unknowns: int
+    undetermined: list[str]
+    active_bounds: list[str]
+    limited_by: list[str]
+    stage: str
+    singular_values: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+
+def _rref(M: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+    M = M.astype(float).copy()
+    rows, cols = M.shape
+    r = 0
+    for c in range(cols):
+        if r >= rows:
+            break
+        p = r + int(np.argmax(np.abs(M[r:, c])))
+        if abs(M[p, c]) <= tol:
+            continue
+        M[[r, p]] = M[[p, r]]
+        M[r] /= M[r, c]
+        for i in range(rows):
+            if i != r:
+                M[i] -= M[i, c] * M[r]
+        r += 1
+    M[np.abs(M) < tol] = 0.0
+    return M[:r]
+
+
+def describe_null_space(Z: np.ndarray, names: Sequence[str]) -> list[str]:
+    """Each basis vector of the null space as ``"a name + b name"``: a direction (masses in kg,
+    moments in kg m) along which the unknowns can move together without changing the condition
+    (reduced row echelon form, so most are a single unknown or a short combination)."""
+    if Z.shape[1] == 0:
+        return []
+    out = []
+    for row in _rref(Z.T):
+        row = row / np.max(np.abs(row))
+        terms = [(c, n) for c, n in zip(row, names) if abs(c) > 1e-9]
+        if len(terms) == 1:
+            out.append(terms[0][1])
+        else:
+            out.append(" ".join(f"{'+' if c > 0 else '-'} {abs(c):.6g} {n}" for c, n in terms).lstrip("+ "))
+    return out
+
+
+class _Design:
+    """The design freedom of the slots as an affine map x = P y + x_c from the free variables y
+    to (m, h_user) per slot: per slot its mass (scaled by the length scale L: y = m L, so that
+    every variable is in kg m) unless fixed, and its offset moment d = m (p - center) (3 values,
+    or 1 along ``direction``): h = m center + d. The bounds are functions of y: mass range and
+    budget (linear), ``|d| <= max_radius m`` (linear along a direction, a second-order cone
+    otherwise)."""
+
+    def __init__(self, slots: Sequence[Slot], mass_budget: float | None, L: float):
+        self.slots, self.L = list(slots), L
+        n = 4 * len(slots)
+        cols, names, self.mass_var, self.d_vars = [], [], [], []
+        xc = np.zeros(n)
+        for k, s in enumerate(slots):
+            i = 4 * k
+            if s.mass_fixed:
+                xc[i] = s.mass_min
+                xc[i + 1:i + 4] = s.mass_min * s.center
+                self.mass_var.append(None)
+            else:
+                c = np.zeros(n)
+                c[i] = 1.0 / L
+                c[i + 1:i + 4] = s.center / L
+                self.mass_var.append(len(cols))
+                cols.append(c), names.append(f"{s.name}.mass")
+            dirs = [s.direction] if s.direction is not None else list(np.eye(3))
+            labels = ["mass_moment_along_direction"] if s.direction is not None else \
+                ["mass_moment_x", "mass_moment_y", "mass_moment_z"]
+            idx = []
+            for u, lab in zip(dirs, labels):
+                c = np.zeros(n)
+                c[i + 1:i + 4] = u
+                idx.append(len(cols))
+                cols.append(c), names.append(f"{s.name}.{lab}")
+            self.d_vars.append(idx)
+        self.P = np.array(cols).T.reshape(n, len(cols))
+        self.xc = xc
+        self.names = names
+        self.budget = mass_budget if mass_budget is not None and math.isfinite(mass_budget) else None
+        ny = len(cols)
+        # linear inequalities G y + g >= 0, each with a name and a scale (kg or kg m)
+        G, g, lin_names, lin_scale = [], [], [], []
+        for k, s in enumerate(slots):
+            j = self.mass_var[k]
+            if j is not None:
+                r = np.zeros(ny)
+                r[j] = 1.0 / L
+                G.append(r), g.append(-s.mass_min), lin_names.append(f"{s.name}.mass_min"), lin_scale.append(1.0)
+                if math.isfinite(s.mass_max):
+                    G.append(-r), g.append(s.mass_max), lin_names.append(f"{s.name}.mass_max"), lin_scale.append(1.0)
+            if s.direction is not None and math.isfinite(s.max_radius):
+                (jd,) = self.d_vars[k]
+                for sign in (1.0, -1.0):  # R m -+ d >= 0
+                    r = np.zeros(ny)
+                    r[jd] = -sign
+                    const = 0.0
+                    if j is not None:
+                        r[j] = s.max_radius / L
+                    else:
+                        const = s.max_radius * s.mass_min
+                    G.append(r), g.append(const), lin_names.append(f"{s.name}.max_radius"), lin_scale.append(L)
+        if self.budget is not None:
+            r = np.zeros(ny)
+            const = self.budget
+            for k, s in enumerate(slots):
+                if self.mass_var[k] is None:
+                    const -= s.mass_min
+                else:
+                    r[self.mass_var[k]] = -1.0 / L
+            G.append(r), g.append(const), lin_names.append("mass_budget"), lin_scale.append(1.0)
+        self.G = np.array(G).reshape(-1, ny)
+        self.g = np.array(g)
+        self.lin_names, self.lin_scale = lin_names, np.array(lin_scale)
+        self.cones = [k for k, s in enumerate(slots) if s.direction is None and math.isfinite(s.max_radius)]
+        self.mass_row = np.zeros(ny)  # total free mass (kg) = mass_row @ y
+        for j in self.mass_var:
+            if j is not None:
+                self.mass_row[j] = 1.0 / L
+
+    def x(self, y):
+        return self.P @ y + self.xc
+
+    def _mass(self, k, y):
+        j = self.mass_var[k]
+        return (y[j] / self.L, 1.0 / self.L) if j is not None else (self.slots[k].mass_min, 0.0)
+
+    def cone(self, y):
+        """(R m - |d|) / L (>= 0), kg; |d| smoothed at d = 0 by 1e-12 L."""
+        out = []
+        eps = 1e-12 * self.L
+        for k in self.cones:
+            m, _ = self._mass(k, y)
+            d = y[self.d_vars[k]]
+            out.append((self.slots[k].max_radius * m - math.sqrt(d @ d + eps * eps)) / self.L)
+        return np.array(out)
+
+    def cone_jac(self, y):
+        J = np.zeros((len(self.cones), len(y)))
+        eps = 1e-12 * self.L
+        for r, k in enumerate(self.cones):
+            _, dm = self._mass(k, y)
+            d = y[self.d_vars[k]]
+            if self.mass_var[k] is not None:
+                J[r, self.mass_var[k]] = self.slots[k].max_radius * dm / self.L
+            J[r, self.d_vars[k]] = -d / math.sqrt(d @ d + eps * eps) / self.L
+        return J
+
+    def slack(self, y):
+        """[(name, slack in its unit, scale)] of every inequality: >= 0 when met."""
+        out = []
+        if len(self.g):
+            for name, v, sc in zip(self.lin_names, self.G @ y + self.g, self.lin_scale):
+                out.append((name, float(v), float(sc)))
+        for k in self.cones:
+            m, _ = self._mass(k, y)
+            out.append((f"{self.slots[k].name}.max_radius",
+                        float(self.slots[k].max_radius * m - np.linalg.norm(y[self.d_vars[k]])), self.L))
+        return out
+
+    def violation(self, y, mscale) -> float:
+        """Largest violation, in kg (moments divided by L), relative to the mass scale."""
+        return max([0.0] + [-v / (sc * mscale) for _, v, sc in self.slack(y)])
+
+    def active(self, y, mscale) -> list[str]:
+        return list(dict.fromkeys(n for n, v, sc in self.slack(y) if v <= ACTIVE_RTOL * sc * mscale))
+
+    def scipy(self, to_y, jac_y):
+        cons = []
+        if len(self.g):
+            cons.append({"type": "ineq", "fun": lambda z: (self.G @ to_y(z) + self.g) / self.lin_scale,
+                         "jac": lambda z: (self.G @ jac_y) / self.lin_scale[:, None]})
+        if self.cones:
+            cons.append({"type": "ineq", "fun": lambda z: self.cone(to_y(z)),
+                         "jac": lambda z: self.cone_jac(to_y(z)) @ jac_y})
+        return cons
+
+
+def _slsqp(fun, starts, cons, violation, tol, maxiter=1000, ftol=1e-16):
+    """Best SLSQP result over the starts (feasible first, then the least objective); trust-constr
+    when SLSQP finds nothing feasible."""
+    from scipy.optimize import minimize
+
+    best, best_key = None, None
+    for start in starts:
+        for method in ("SLSQP",):
+            r = minimize(fun, start, jac=True, method=method, constraints=cons,
+                         options=dict(ftol=ftol, maxiter=maxiter))
+            key = (violation(r.x) > tol, float(fun(r.x)[0]))
+            if best is None or key < best_key:
+                best, best_key = r.x, key
+    return best
+
+
+def _feasible_point(cons, start, violation, tol):
+    """A point meeting every constraint, by minimising a slack t >= every constraint's deficit
+    (SLSQP from a feasible (z, t)); None when there is none."""
+    from scipy.optimize import minimize
+
+    def lifted(c):
+        return {"type": c["type"], "fun": (lambda w, f=c["fun"]: f(w[:-1]) + w[-1]),
+                "jac": (lambda w, j=c["jac"]: np.hstack([np.atleast_2d(j(w[:-1])),
+                                                         np.ones((np.atleast_1d(c["fun"](w[:-1])).size, 1))]))}
+
+    if violation(start) <= tol:
+        return start
+    t0 = max(1.0, max(float(np.max(-np.atleast_1d(c["fun"](start)), initial=0.0)) for c in cons) * 1.1)
+    w0 = np.append(start, t0)
+    obj = lambda w: (w[-1], np.append(np.zeros(len(w) - 1), 1.0))  # noqa: E731
+    r = minimize(obj, w0, jac=True, method="SLSQP", constraints=[lifted(c) for c in cons],
+                 bounds=[(None, None)] * len(start) + [(0.0, None)], options=dict(ftol=1e-16, maxiter=1000))
+    z = r.x[:-1]
+    return z if violation(z) <= tol else None
+
+
+def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
+                       mass_budget: float | None = None, L: float = 1.0,
+                       what: str = "the balancing condition") -> LinearSolution:
+    """The two stages of the module docstring for ``A x + b = 0`` (rows: every sample and
+    component; x: (m, h_user) per slot). The least squares is over the design's free variables
+    (a fixed mass is not an unknown; a slot with a direction has one moment along it)."""
+    A = np.asarray(A, float)
+    b = np.asarray(b, float).reshape(-1)
+    if A.shape[0] == 0:
+        raise ValueError("samples: no usable sample (every closed-loop sample failed to assemble?)")
+    dsg = _Design(slots, mass_budget, L)
+    Ay = A @ dsg.P
+    by = A @ dsg.xc + b
+    ny = Ay.shape[1]
+    before = float(np.sqrt(np.mean(b ** 2)))
+    rms = lambda y: float(np.sqrt(np.mean((Ay @ y + by) ** 2)))  # noqa: E731
+    if ny:
+        U, sv, Vt = np.linalg.svd(Ay, full_matrices=False)
+        rank = int(np.sum(sv > RANK_RTOL * sv[0])) if sv[0] > 0 else 0
+        y0 = Vt[:rank].T @ ((U[:, :rank].T @ -by) / sv[:rank])
+        Z = Vt[rank:].T
+    else:
+        sv, rank, y0, Z = np.zeros(0), 0, np.zeros(0), np.zeros((0, 0))
+    ls = rms(y0)
+    unit = np.array([1.0 / L if n.endswith(".mass") else 1.0 for n in dsg.names])
+    undetermined = describe_null_space(unit[:, None] * Z, dsg.names)
+    mscale = max([1.0] + [abs(s.mass_min) for s in slots] + [abs(v) / L for v in y0])
+    tol = 1e-9
+
+    # stage 2a: the lightest least-squares solution within the bounds
+    d = Z.shape[1]
+    y = y0
+    if d:
+        to_y = lambda z: y0 + Z @ z  # noqa: E731
+        g_mass = (dsg.mass_row @ Z) / mscale
+        mu = 0.0  # (flat directions: SLSQP stays near the minimum-norm start)
+
+        def f(z):
+            return float(dsg.mass_row @ to_y(z)) / mscale + mu * float(z @ z), g_mass + 2 * mu * z
+
+        cons_z = dsg.scipy(to_y, Z)
+        z = _feasible_point(cons_z, np.zeros(d), lambda z: dsg.violation(to_y(z), mscale), tol)
+        if z is not None:
+            z = _slsqp(f, [z], cons_z, lambda z: dsg.violation(to_y(z), mscale), tol)
+        else:
+            z = np.zeros(d)
+        y = to_y(z)
+    stage = "least squares within the bounds"
+    if dsg.violation(y, mscale) > tol:
+        # stage 2b: no least-squares solution meets the bounds: constrained least squares, on the
+        # triangular factor (|A y + b|^2 = |R y + Q^T b|^2 + const: ny x ny, whatever the rows)
+        Qf, Rf = np.linalg.qr(Ay)
+        cf = Qf.T @ by
+        bs = max(float(cf @ cf), 1e-300)
+
+        def g(yy):
+            r = Rf @ yy + cf
+            return float(r @ r) / bs, 2.0 * (Rf.T @ r) / bs
+
+        starts = [y, np.zeros(ny)]
+        y = _slsqp(g, starts, dsg.scipy(lambda yy: yy, np.eye(ny)), lambda yy: dsg.violation(yy, mscale), tol,
+                   ftol=1e-13)
+        stage = "constrained least squares (the bounds exclude every least-squares solution)"
+    x = dsg.x(y)
+    residual = rms(y)
+    active = dsg.active(y, mscale)
+    limited = []
+    scale = max(before, 1e-300)
+    if ls > EXACT_RTOL * scale:
+        limited.append(f"impossible: rank {rank} of {ny} unknowns and a least-squares residual of "
+                       f"{ls:.6g} (RMS; {100 * ls / scale:.3g} % of the unbalanced {before:.6g}): these "
+                       f"slots cannot make {what} zero over the samples")
+    if residual > max(ls * (1 + 1e-6), EXACT_RTOL * scale):
+        limited += [f"bound: {a}" for a in active] or ["bound: the solver could not meet the bounds "
+                                                      f"(violation {dsg.violation(y, mscale):.3g})"]
+    return LinearSolution(x, residual, before, ls, rank, ny, undetermined, active, limited, stage, sv)
+
+
+def design_from_solution(x: np.ndarray, slots: Sequence[Slot], active: Sequence[str]) -> tuple[dict, list]:
+    """(design dict per slot, [(slot, mass, position_user)]) from (m, h_user) per slot: position
+    h/m (on the slot's line when it has a direction); a vanishing mass sits at the centre."""
+    design, placed = {}, []
+    for k, s in enumerate(slots):
+        m, h = float(x[4 * k]), np.array(x[4 * k + 1:4 * k + 4])
+        if m > 1e-12 * max(1.0, abs(s.mass_max) if math.isfinite(s.mass_max) else 1.0):
+            p = h / m
+            if s.direction is not None:
+                p = s.center + s.direction * float(s.direction @ (p - s.center))
+        else:
+            m, p = max(m, 0.0), s.center.copy()
+        design[s.name] = _slot_design(s, m, p, active)
+        placed.append((s, m, p))
+    return design, placed
+
+
+def _slot_design(s: Slot, m: float, p: np.ndarray, active: Sequence[str]) -> dict:
+    given = s.given or s.link
+    frame = (f"frame '{given}' (on link '{s.link}')" if given != s.link else
+             f"the frame link '{s.link}' is described in" + ("" if np.allclose(s.T, np.eye(4)) else " (its DH frame)"))
+    out = {"link": s.link, "mass": m, "position": p, "radius": float(np.linalg.norm(p - s.center)),
+           "mass_moment": m * p, "frame": frame,
+           "bounds": {"mass_min": s.mass_min, "mass_max": _or_none(s.mass_max),
+                      "max_radius": _or_none(s.max_radius), "center": s.center, "direction": s.direction},
+           "active_bounds": [a.split(".", 1)[1] for a in active if a.startswith(s.name + ".")]}
+    if s.direction is not None:
+        out["signed_distance"] = float(s.direction @ (p - s.center))
+    return out
+
+
+def _or_none(x: float):
+    """An unbounded bound is absent (None in summary.json), not infinity."""
+    return float(x) if math.isfinite(x) else None
+
+
+def reduction_pct(before, after):
+    """100 (1 - after / before) per entry; None where before is 0 (nothing to reduce)."""
+    b, a = np.atleast_1d(np.asarray(before, float)), np.atleast_1d(np.asarray(after, float))
+    return [None if bi == 0 else 100.0 * (1.0 - ai / bi) for bi, ai in zip(b, a)]
+
+
+def balanced_mechanism(mech, placed) -> Any:
+    """``mech`` with each slot's counterweight added as a body of kind ``counterweight`` (point
+    mass plus the slot's inertia)."""
+    bodies = [_core.Body(s.name, s.link, float(m), s.link_point(p), s.link_inertia(), "counterweight")
+              for s, m, p in placed]
+    return mech.with_bodies(bodies, name=f"{mech.name}-balanced")

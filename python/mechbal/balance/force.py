@@ -1,0 +1,96 @@
+"""Shaking-force balancing by counterweights: the centre of mass stationary for every motion.
+
+The shaking force is the rate of the linear momentum, F = dP/dt, and P is linear in every body's
+mass moments: ``P(q, v) = Y_P(q, v) pi`` (the linear rows of the momentum regressor,
+``mechbal/algorithm/regressor.hpp``). So with counterweights (m_k, m_k p_k) on links L_k:
+
+    P(q, v) = P_0(q, v) + sum_k Y_P,L_k(q, v)[:, 0:4] (m_k, m_k p_k) = 0   for sampled (q, v)
+
+(P = 0 for every motion means the total centre of mass does not move, so F = 0 whatever the
+accelerations). This is solved as a linear least squares with its rank, residual and
+undetermined combinations, then masses and positions under the bounds
+(:mod:`mechbal.balance.common`). Closed mechanisms: (q, v) come from the loop solve of sampled
+actuated states (``Mechanism.closed_motion``: v = C v#), so only the motions the loops allow are
+required to be balanced.
+
+It generalises the papers' force-balancing conditions: Briot & Arakelian 2009 (PAMINSA), eqs 6-16
+(the counterweights CP1, CP2, CP3 and the vertical counter-mass make the momentum of every leg
+zero: ``mechbal.sizing.paminsa_counterweights``), and the classical conditions of a four-bar
+(Berkof & Lowen 1969: counterweights on the crank and rocker), which the tests reproduce.
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from mechbal.balance import common
+from mechbal.balance.result import BalanceResult, CounterweightSlot
+
+
+def motion_sample(mech, samples, *, seed: int = 0, lower=None, upper=None, q_guess=None):
+    """(q, v, dropped): ``samples`` an int (random positions in the box of
+    :func:`common.sample_box`, velocities standard normal, for the actuated joints of a closed
+    mechanism) or a tuple (q, v) of (N, dof) arrays (closed: (q#, v#), (N, na))."""
+    closed = mech.is_closed
+    width = len(mech.actuated_names) if closed else mech.dof
+    if isinstance(samples, (int, np.integer)):
+        if samples < 1:
+            raise ValueError(f"samples: must be >= 1 (got {samples})")
+        lo, hi = common.sample_box(mech, lower, upper, "actuated" if closed else "independent")
+        rng = np.random.default_rng(seed)
+        q = lo + (hi - lo) * rng.random((int(samples), width))
+        v = rng.standard_normal((int(samples), width))
+    else:
+        try:
+            q, v = (np.atleast_2d(np.asarray(x, float)) for x in samples)
+        except (TypeError, ValueError):
+            raise ValueError("samples: must be an int or a tuple (q, v) of arrays") from None
+        if q.shape != v.shape or q.ndim != 2 or q.shape[1] != width:
+            raise ValueError(f"samples: q and v must both be (N, {width}) arrays of "
+                             f"{'actuated ' if closed else ''}joint positions and velocities "
+                             f"(got {q.shape} and {v.shape})")
+    if not closed:
+        return q, v, 0
+    cs = common.closed_samples(mech, q, v, q_guess=q_guess)
+    return cs.q, cs.v, cs.dropped
+
+
+def balance(mechanism, design: Sequence[CounterweightSlot], samples=200, *, mass_budget: float | None = None,
+            seed: int = 0, lower=None, upper=None, q_guess=None) -> BalanceResult:
+    """Counterweights that make the linear momentum zero (least squares) over sampled motions:
+    complete shaking-force balance where the residual is zero.
+
+    ``design``: counterweight slots (:class:`CounterweightSlot`); ``samples``: a number of random
+    (q, v), or a tuple of arrays (:func:`motion_sample`); ``mass_budget``: bound on the total
+    counterweight mass. ``residual``: the RMS linear momentum of the balanced mechanism over the
+    samples [kg m/s], recomputed from the balanced model."""
+    mech = mechanism
+    slots = common.normalise_slots(mech, design)
+    q, v, dropped = motion_sample(mech, samples, seed=seed, lower=lower, upper=upper, q_guess=q_guess)
+    probe, col = common.probe_mechanism(mech, slots)
+    Y = probe.momentum_regressor(q, v)[:, :3, :]                         # (N, 3, 10 L)
+    A = common.user_columns(Y, slots, col)                               # (N, 3, 4K)
+    b = mech.momentum(q, v).linear_momentum
+    sol = common.solve_mass_moments(A.reshape(-1, A.shape[-1]), b.reshape(-1), slots,
+                                    mass_budget=mass_budget, L=common.length_scale(mech),
+                                    what="the linear momentum (shaking force)")
+    design_out, placed = common.design_from_solution(sol.x, slots, sol.active_bounds)
+    balanced = common.balanced_mechanism(mech, placed)
+    after = balanced.momentum(q, v).linear_momentum
+    residual = float(np.sqrt(np.mean(after ** 2)))
+    metrics = {
+        "samples": int(len(q)), "dropped_samples": int(dropped),
+        "linear_momentum_rms_before": np.sqrt(np.mean(b ** 2, axis=0)),
+        "linear_momentum_rms_after": np.sqrt(np.mean(after ** 2, axis=0)),
+        "least_squares_residual": sol.least_squares_residual,
+        "solve": sol.stage,
+        "added_mass": float(sum(m for _, m, _ in placed)),
+        "total_mass_after": balanced.total_mass,
+    }
+    return BalanceResult(method="force", design=design_out, residual=residual,
+                         residual_before=sol.residual_before,
+                         residual_units="kg m/s (RMS linear momentum over the sampled motions)",
+                         rank=sol.rank, unknowns=sol.unknowns, limited_by=sol.limited_by,
+                         metrics=metrics, balanced=balanced, active_bounds=sol.active_bounds,
+                         undetermined=sol.undetermined)

@@ -1,0 +1,338 @@
+"""``mechbal balance CASE --method METHOD --out DIR``: balance a case's mechanism and write the run.
+
+CASE is a TOML case of kind ``mechanism`` / ``serial_chain`` (its ``[mechanism]``, ``[trajectory]``
+and ``[balance]`` tables), the built-in ``arm2dof`` (its arm as a mechanism with links
+``shoulder`` and ``elbow``, x along each link; the counterweights of ``[counterweights]`` on the
+link extensions unless ``[balance]`` gives others; the minimum-energy cubic law of its
+``[trajectory]``), or a URDF file (with ``--design FILE.toml`` holding a ``[balance]`` table and
+optionally a ``[trajectory]``).
+
+DIR receives (all or nothing, :mod:`mechbal.output`): ``summary.json`` (the design, the
+residuals, the bounds and undetermined combinations, and before/after peak and RMS of the gravity
+torque, the actuator torques, the shaking force and the shaking moment along the trajectory),
+``gravity_torque.png``, ``joint_torques.png``, ``shaking_wrench.png``, ``bodies_unbalanced.npz``
+and ``bodies_balanced.npz`` (the schema of :mod:`mechbal.export`), ``balanced.toml`` (a case that
+``mechbal run`` runs) and, for trees, ``balanced.urdf``.
+"""
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mechbal import _core, progress, report
+from mechbal.balance import METHODS, common, method as method_module
+from mechbal.balance.result import BalanceResult, CounterweightSlot
+from mechbal.errors import ConfigError
+from mechbal.export import write_bodies, write_summary
+
+#: methods written here; the others are dispatched to their modules when they exist
+COUNTERWEIGHT_METHODS = ("static", "force", "rms")
+DEFAULT_SAMPLES = {"static": 1000, "force": 200}
+
+
+@dataclass
+class BalanceCase:
+    """What a balance run needs: the mechanism, the validated ``[balance]`` table (or None),
+    the trajectory (actuated joints: q, v, a (N, na) and t), its description for the TOML
+    written back, the assembly guess of a closed mechanism, and the source."""
+
+    name: str
+    title: str
+    mechanism: Any
+    table: Any
+    t: np.ndarray
+    motion: tuple
+    trajectory_table: dict
+    q_guess: np.ndarray | None
+    raw: dict | None
+    kind: str
+    default_slots: list
+
+
+def slots_from_table(table, field: str = "balance.counterweights") -> list[CounterweightSlot]:
+    """CounterweightSlots of ``[[balance.counterweights]]`` (validated entries)."""
+    from mechbal.schema import inertia_matrix
+
+    out = []
+    for c in table.counterweights if table is not None else []:
+        lo = c.mass if c.mass is not None else (c.mass_min or 0.0)
+        hi = c.mass if c.mass is not None else (c.mass_max if c.mass_max is not None else math.inf)
+        out.append(CounterweightSlot(
+            name=c.name, link=c.link, mass_min=lo, mass_max=hi,
+            max_radius=c.max_radius if c.max_radius is not None else math.inf,
+            center=tuple(c.center), direction=None if c.direction is None else tuple(c.direction),
+            inertia=None if c.inertia is None else inertia_matrix(c.inertia)))
+    return out
+
+
+def _trajectory_motion(mech, tt, law=None, field="trajectory"):
+    from mechbal.config import trajectory_from_config
+
+    n = len(mech.actuated_names) if mech.is_closed else mech.dof
+    table = tt if isinstance(tt, dict) else tt.model_dump(exclude_none=True)
+    if law is not None:
+        table = {**table, "law": law}
+    table = {k: v for k, v in table.items() if k != "initial_guess"}
+    traj, t = trajectory_from_config(table, n, field)
+    return t, traj.evaluate_batch(t), table
+
+
+def load_case(case: str, design: str | None = None) -> BalanceCase:
+    """Read CASE (and ``--design``) into a :class:`BalanceCase`; ConfigError naming the field."""
+    from mechbal.cli import check_case_file
+    from mechbal.config import load_case as load_toml_case
+    from mechbal.mechanism import Mechanism
+    from mechbal.schema import (Arm2DofCase, Balance, ChainTrajectory, SerialChainCase, Table,
+                                validate_case, validate_table)
+
+    design_cfg = None
+    if design is not None:
+        from mechbal.config import read_toml
+        from typing import Optional
+
+        class DesignFile(Table):
+            balance: Balance
+            trajectory: Optional[ChainTrajectory] = None
+
+        path = check_case_file(design)
+        design_cfg = validate_table(DesignFile, read_toml(path), "")
+    if str(case).lower().endswith(".urdf"):
+        try:
+            mech = Mechanism.from_urdf(case)
+        except AttributeError:
+            raise ConfigError("case", "URDF input needs the URDF reader (mechbal._core.mechanism_from_urdf), "
+                                      "which this build does not have yet", str(case)) from None
+        if design_cfg is None:
+            raise ConfigError("--design", "a URDF has no [balance] table: give --design FILE.toml with "
+                                          "[[balance.counterweights]] (and optionally a [trajectory])", has_value=False)
+        rng = np.random.default_rng(design_cfg.balance.seed)
+        if design_cfg.trajectory is not None:
+            t, motion, tt = _trajectory_motion(mech, design_cfg.trajectory)
+        else:
+            lo, hi = common.sample_box(mech, design_cfg.balance.lower, design_cfg.balance.upper)
+            start, end = lo + (hi - lo) * rng.random(len(lo)), lo + (hi - lo) * rng.random(len(lo))
+            t, motion, tt = _trajectory_motion(mech, {"law": "quintic", "start": start.tolist(),
+                                                      "end": end.tolist(), "duration": 1.0, "samples": 501})
+        return BalanceCase(mech.name, f"{mech.name} (URDF)", mech, design_cfg.balance, t, motion, tt,
+                           None, None, "urdf", [])
+    path = check_case_file(case)
+    raw = load_toml_case(path)
+    cfg = validate_case(raw)
+    table = design_cfg.balance if design_cfg is not None else getattr(cfg, "balance", None)
+    name, title = cfg.case.name, cfg.case.title or cfg.case.name
+    if isinstance(cfg, SerialChainCase):
+        mech = Mechanism.from_spec(cfg.spec, name=name, source=str(path))
+        tr = design_cfg.trajectory if design_cfg is not None and design_cfg.trajectory is not None else cfg.trajectory
+        guess = getattr(tr, "initial_guess", None)
+        t, motion, tt = _trajectory_motion(mech, tr)
+        if guess is not None:
+            tt["initial_guess"] = list(guess)
+        return BalanceCase(name, title, mech, table, t, motion, tt,
+                           None if guess is None else np.array(guess, float), raw, cfg.case.kind, [])
+    if isinstance(cfg, Arm2DofCase):
+        from mechbal.papers.arm2dof import arm2dof_mechanism
+
+        mech = arm2dof_mechanism(cfg.arm.model_dump(), name=name)
+        cw = cfg.counterweights
+        slots = [CounterweightSlot("counterweight1", "shoulder", cw.m_cw1, cw.m_cw1, direction=(-1.0, 0.0, 0.0)),
+                 CounterweightSlot("counterweight2", "elbow", cw.m_cw2, cw.m_cw2, direction=(-1.0, 0.0, 0.0))]
+        tr = cfg.trajectory
+        t, motion, tt = _trajectory_motion(mech, {"start": tr.start, "end": tr.end, "duration": tr.duration,
+                                                  "samples": tr.samples}, law="cubic")
+        return BalanceCase(name, title, mech, table, t, motion, tt, None, raw, "arm2dof", slots)
+    raise ConfigError("case.kind", f"mechbal balance reads cases of kind mechanism, serial_chain or "
+                                   f"arm2dof, and URDF files ({cfg.case.kind!r}: its mechanism is not on the "
+                                   "general model yet)", cfg.case.kind)
+
+
+# ---- evaluation --------------------------------------------------------------------------------
+
+def evaluate(bc: BalanceCase, mech) -> dict:
+    """Along the case's trajectory: q, v, a, actuator torque, gravity torque (actuated), shaking
+    wrench and the bodies' poses."""
+    qa, va, aa = bc.motion
+    if mech.is_closed:
+        m = mech.closed_motion(qa, va, aa, q_guess=bc.q_guess, with_forces=True)
+        bad = (np.asarray(m.status) & ~np.uint32(int(_core.Status.singular))) != 0
+        if np.any(bad):
+            raise ConfigError("trajectory", f"the loops cannot be assembled at t = {bc.t[int(np.argmax(bad))]:.4g} s",
+                              has_value=False)
+        q, v, a, tau = m.q, m.v, m.a, m.actuated_force
+        _, G = mech.reduced_mass_matrix(qa, q_guess=bc.q_guess)
+    else:
+        q, v, a = qa, va, aa
+        tau = mech.inverse_dynamics(q, v, a)
+        G = mech.gravity_torque(q)
+    sw = mech.shaking_wrench(q, v, a)
+    bm = mech.body_motion(q, v, a)
+    return dict(q=q, v=v, a=a, torque=tau, gravity_torque=G, shaking_force=sw.shaking_force,
+                shaking_moment=sw.shaking_moment, com=bm.com, rotation=bm.rotation)
+
+
+def _stats(x: np.ndarray) -> dict:
+    return {"peak": report.peak_abs(x), "rms": np.sqrt(np.mean(np.asarray(x) ** 2, axis=0))}
+
+
+def _comparison(before: dict, after: dict) -> dict:
+    out = {}
+    for key, unit in (("gravity_torque", "N m or N"), ("torque", "N m or N"), ("shaking_force", "N"),
+                      ("shaking_moment", "N m")):
+        b, a = _stats(before[key]), _stats(after[key])
+        name = "actuator_torque" if key == "torque" else key
+        out[name] = {"unit": unit, "unbalanced": b, "balanced": a,
+                     "peak_reduction_pct": common.reduction_pct(b["peak"], a["peak"]),
+                     "rms_reduction_pct": common.reduction_pct(b["rms"], a["rms"])}
+    return out
+
+
+# ---- the run -------------------------------------------------------------------------------------
+
+def run_method(bc: BalanceCase, name: str) -> BalanceResult:
+    """Run balancing method ``name`` on the case (slots from ``[balance]``, else the case's own)."""
+    if name not in METHODS:
+        raise ConfigError("--method", f"unknown balancing method (known: {', '.join(METHODS)})", name)
+    try:
+        module = method_module(name)
+    except ModuleNotFoundError:
+        raise ConfigError("--method", f"'{name}' is not available yet (mechbal.balance.{name} is being "
+                                      f"written); available: {', '.join(COUNTERWEIGHT_METHODS)}",
+                          has_value=False) from None
+    table = bc.table
+    mech = bc.mechanism
+    if name not in COUNTERWEIGHT_METHODS:
+        make = getattr(module, "design_from_table", None)
+        if make is None:
+            raise ConfigError("--method", f"mechbal.balance.{name} has no design_from_table(table, mechanism): "
+                                          "mechbal balance cannot read its design", has_value=False)
+        design, samples, options = make(table, mech)
+        return module.balance(mech, design, samples, **options)
+    slots = slots_from_table(table) or list(bc.default_slots)
+    if not slots:
+        raise ConfigError("balance.counterweights", "no counterweight slots: add [[balance.counterweights]] "
+                                                    "entries (name, link, mass bounds, max_radius, direction)",
+                          has_value=False)
+    try:
+        common.normalise_slots(mech, slots, field_name="balance.counterweights", need_radius=name != "rms")
+    except ValueError as exc:
+        raise ConfigError("", str(exc), has_value=False) from None
+    budget = table.mass_budget if table is not None else None
+    if name == "rms":
+        opts = {}
+        if table is not None:
+            opts = dict(objective=table.objective, coupling=table.coupling, weights=table.weights, seed=table.seed)
+        return module.balance(mech, slots, bc.motion, mass_budget=budget, q_guess=bc.q_guess, **opts)
+    n = table.samples if table is not None and table.samples is not None else DEFAULT_SAMPLES[name]
+    lower = table.lower if table is not None else None
+    upper = table.upper if table is not None else None
+    if mech.is_closed and lower is None and upper is None:  # the trajectory's range assembles
+        lower = np.minimum(bc.trajectory_table["start"], bc.trajectory_table["end"])
+        upper = np.maximum(bc.trajectory_table["start"], bc.trajectory_table["end"])
+    width = len(mech.actuated_names) if mech.is_closed else mech.dof
+    for key, v in (("lower", lower), ("upper", upper)):
+        if v is not None and len(v) != width:
+            raise ConfigError(f"balance.{key}", f"must have {width} values", list(v))
+    return module.balance(mech, slots, int(n), mass_budget=budget, seed=table.seed if table is not None else 0,
+                          lower=lower, upper=upper, q_guess=bc.q_guess)
+
+
+def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
+    from mechbal.balance.writers import mechanism_table, toml_text
+
+    header = (f"{bc.name} balanced by `mechbal balance --method {method}`: counterweights "
+              + ", ".join(f"{k} {v['mass']:.6g} kg at {np.round(np.asarray(v['position'], float), 6).tolist()} m "
+                          f"on {v['link']}" for k, v in result.design.items() if "mass" in v)
+              + f".\nResidual {result.residual:.6g} {result.residual_units} (unbalanced {result.residual_before:.6g}).")
+    case = {"name": f"{bc.name}-balanced", "kind": "mechanism", "title": f"{bc.title}, balanced ({method})"}
+    tt = dict(bc.trajectory_table)
+    if bc.kind in ("mechanism", "serial_chain") and bc.raw is not None:
+        data = copy.deepcopy(bc.raw)
+        data.pop("balance", None)
+        data["case"] = {**data["case"], **case, "kind": bc.kind}
+        mech = data["mechanism"]
+        bodies = list(mech.get("bodies", []))
+        own = set(bc.mechanism.body_names)
+        for b in result.balanced.bodies:   # the counterweights, back in the user's link frames
+            if b.name in own:
+                continue
+            T = bc.mechanism.user_frame(b.link)
+            R, t = T[:3, :3], T[:3, 3]
+            com = R.T @ (np.asarray(b.com, float) - t)
+            I = R.T @ np.asarray(b.inertia, float) @ R
+            bodies.append({"name": b.name, "kind": "counterweight", "link": b.link, "mass": float(b.mass),
+                           "com": com.tolist(), "inertia": [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]})
+        mech["bodies"] = bodies
+        return toml_text(data, header)
+    data = {"case": case, "mechanism": mechanism_table(result.balanced), "trajectory": tt}
+    return toml_text(data, header)
+
+
+def run_balance(case: str, method: str | None, out: Path, design: str | None = None) -> dict:
+    """The whole run into ``out`` (a fresh folder: the caller stages it). Returns the summary."""
+    progress.stage("reading the case")
+    bc = load_case(case, design)
+    name = method or (bc.table.method if bc.table is not None else None)
+    if name is None:
+        raise ConfigError("--method", "give --method static|force|moment|springs|rms (or balance.method "
+                                      "in the case)", has_value=False)
+    progress.stage(f"balancing ({name})")
+    result = run_method(bc, name)
+    progress.stage("evaluating the trajectory")
+    before = evaluate(bc, bc.mechanism)
+    after = evaluate(bc, result.balanced)
+    progress.stage("files")
+    for label, mech, ev in (("unbalanced", bc.mechanism, before), ("balanced", result.balanced, after)):
+        bodies = mech.bodies
+        write_bodies(out / f"bodies_{label}.npz", t=bc.t, names=mech.body_names,
+                     mass=np.array([b.mass for b in bodies]),
+                     inertia_body=np.array([b.inertia for b in bodies]).reshape(-1, 3, 3),
+                     com=ev["com"], rotation=ev["rotation"], shaking_force=ev["shaking_force"],
+                     shaking_moment=ev["shaking_moment"], q=ev["q"], qd=ev["v"], qdd=ev["a"],
+                     torque=ev["torque"], gravity_torque=ev["gravity_torque"])
+    joints = bc.mechanism.actuated_names
+    types = {j.name: j.type for j in bc.mechanism.model.description.joints}
+    units = ["N" if types.get(n) == _core.JointType.prismatic else "N m" for n in joints]
+    variants = {"unbalanced": before, "balanced": after}
+    title = f"{bc.title}: {name} balancing"
+    report.plot_series(out / "gravity_torque.png", bc.t, {k: v["gravity_torque"] for k, v in variants.items()},
+                       joints, [f"gravity torque [{u}]" for u in units], title=title,
+                       caption="Gravity torque (the actuator torque that holds each pose) along the "
+                               "trajectory, before and after balancing.")
+    report.plot_series(out / "joint_torques.png", bc.t, {k: v["torque"] for k, v in variants.items()},
+                       joints, [f"torque [{u}]" for u in units], title=title,
+                       caption="Actuator torque (revolute) or force (prismatic) along the trajectory, "
+                               "gravity included, before and after balancing.")
+    report.plot_wrench(out / "shaking_wrench.png", bc.t,
+                       {k: (v["shaking_force"], v["shaking_moment"]) for k, v in variants.items()},
+                       title=title, caption="Shaking force dP/dt and shaking moment dH_O/dt about the base "
+                                            "origin (inertial only), before and after balancing.")
+    files = ["bodies_unbalanced.npz", "bodies_balanced.npz", "gravity_torque.png", "joint_torques.png",
+             "shaking_wrench.png", "balanced.toml"]
+    (out / "balanced.toml").write_text(_balanced_toml(bc, result, name))
+    if not result.balanced.is_closed:
+        from mechbal.balance.writers import urdf_text
+
+        (out / "balanced.urdf").write_text(urdf_text(result.balanced, f"{bc.name}-balanced"))
+        files.append("balanced.urdf")
+    progress.stage("summary")
+    summary = {"case": bc.name, "kind": bc.kind, "method": name, "mechanism": repr(bc.mechanism),
+               "actuated": joints, "closed": bc.mechanism.is_closed,
+               "balance": result.summary(),
+               "trajectory": {k: v for k, v in bc.trajectory_table.items()},
+               "before_after": _comparison(before, after),
+               "total_mass_kg": {"unbalanced": bc.mechanism.total_mass, "balanced": result.balanced.total_mass},
+               "files": files}
+    write_summary(out / "summary.json", summary)
+    rows = [[k, v["mass"], np.asarray(v["position"], float), ", ".join(v.get("active_bounds", [])) or "-"]
+            for k, v in result.design.items() if "mass" in v]
+    print(report.table(rows, ["counterweight", "mass [kg]", "position [m] (link frame)", "active bounds"]))
+    cmp = summary["before_after"]
+    print(report.table([[k, cmp[k]["unbalanced"]["peak"], cmp[k]["balanced"]["peak"]] for k in cmp],
+                       ["peak along the trajectory", "unbalanced", "balanced"]))
+    print(f"residual {result.residual:.4g} {result.residual_units} (unbalanced {result.residual_before:.4g})"
+          + ("" if result.exact else "; limited by: " + "; ".join(result.limited_by)))
+    return summary

@@ -1,0 +1,270 @@
+"""Real-time controllers of balanced robots, from Python: tick by tick and in batch.
+
+The classes here are the C++ controllers themselves (Python subclasses that add named results):
+a tick from Python runs the same ``noexcept``, allocation-free ``step()`` an embedded 1 kHz loop
+calls.
+
+* `ComputedTorque`: `tau = M(q) (qdd_des + Kp e + Kd e') + C(q, qd) qd + G(q)` over any
+  dynamics back end (Arakelian, Le Baron & Mottu 2011, eqs 2-6);
+* `DecoupledJointController`: `tau_i = k_i (qdd_des + Kp e + Kd e')` for a dynamically balanced
+  arm whose mass matrix is diagonal and constant (Coutinho & Hess Coelho, eqs 15, 26, 36);
+* `ReactionlessWrist`: wrist rates that keep the total angular momentum constant, so the shaking
+  moment is zero (Briot & Arakelian 2009, eqs 23-26);
+* `PaminsaController`: the fully balanced PAMINSA tick: kinematics, D (eq 19), the reactionless
+  wrist and the shaking wrench (Briot & Arakelian 2009).
+
+Three ways to tick a joint controller (``n`` joints; positions in rad or m, velocities in rad/s
+or m/s, accelerations in rad/s^2 or m/s^2, torques in N m or forces in N):
+
+* ``step(q, qd, q_des, qd_des, qdd_des) -> JointCommand(joint_torque, status)``: any real
+  array-like input;
+* ``step_into(q, qd, q_des, qd_des, qdd_des, out) -> int``: the fast tick (about a microsecond;
+  ``bench/bench_python.py``): C-contiguous float64 arrays only, the torque written into the
+  preallocated ``out``, the status returned;
+* ``run(q, qd, q_des, qd_des, qdd_des) -> ControlRun``: N consecutive ticks over (N, n) arrays
+  in one C++ call.
+
+Statuses are bit flags of `mechbal.Status` (0 = ok), one per tick (``status`` arrays in
+batch results, as in every batch result of mechbal). Non-finite or out-of-range input never
+raises in a tick: it returns the held (last safe) command and a non-ok status.
+
+The dynamics back ends a :class:`ComputedTorque` computes over are here too:
+`MechanismDynamics` (the general model, any mechanism, closed loops included),
+`RneChainDynamics` and `KdlChainDynamics` (serial chains), and the papers' closed forms in
+`mechbal.papers`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from mechbal import _core
+
+__all__ = [
+    "ComputedTorque", "DecoupledJointController", "ReactionlessWrist", "ReactionlessWristConfig",
+    "WristIntegrator", "WristCommand", "PaminsaController", "JointController", "JointCommand",
+    "ControlRun", "WristRun", "PaminsaRun", "InverseDynamics", "ForwardDynamics",
+    "MechanismDynamics", "RneChainDynamics", "KdlChainDynamics", "Status", "status_text",
+]
+
+Status = _core.Status
+JointController = _core.JointController
+InverseDynamics = _core.InverseDynamics
+ForwardDynamics = _core.ForwardDynamics
+MechanismDynamics = _core.MechanismDynamics
+RneChainDynamics = _core.RneChainDynamics
+KdlChainDynamics = _core.KdlChainDynamics
+ReactionlessWristConfig = _core.ReactionlessWristConfig
+WristIntegrator = _core.WristIntegrator
+WristCommand = _core.WristCommand
+
+
+def status_text(status: int) -> str:
+    """The names of the flags set in a status (``"ok"`` for 0), e.g. ``"saturated"``."""
+    return str(_core.status_name(int(status)))
+
+
+class JointCommand(NamedTuple):
+    """One tick's result: ``joint_torque`` (n,) [N m or N] and its ``status`` (int, 0 = ok).
+    A tuple, so ``tau, status = controller.step(...)`` works."""
+
+    joint_torque: np.ndarray
+    status: int
+
+
+@dataclass(frozen=True)
+class ControlRun:
+    """N ticks of a joint controller: ``joint_torque`` (N, n) [N m or N], ``status`` (N,)."""
+
+    joint_torque: np.ndarray
+    status: np.ndarray
+
+
+@dataclass(frozen=True)
+class WristRun:
+    """N ticks of the reactionless wrist: commanded ``wrist_angles`` [rad], ``wrist_rates``
+    [rad/s], ``wrist_accelerations`` [rad/s^2] (N, 3), the condition number of N(q)
+    ``condition`` (N,) and ``status`` (N,)."""
+
+    wrist_angles: np.ndarray
+    wrist_rates: np.ndarray
+    wrist_accelerations: np.ndarray
+    condition: np.ndarray
+    status: np.ndarray
+
+
+@dataclass(frozen=True)
+class PaminsaRun:
+    """A fully balanced PAMINSA run at the ticks t_n = n dt: ``shaking_force`` [N] and
+    ``shaking_moment`` [N m] about O (N, 3) of all 38 bodies; ``D`` [kg m^2/s] and ``D_dot``
+    [N m] (eq 19); the wrist command ``wrist_angles``, ``wrist_rates``, ``wrist_accelerations``
+    (N, 3); ``condition`` (N,); every body's motion ``com`` [m], ``com_velocity``,
+    ``com_acceleration``, ``angular_velocity``, ``angular_acceleration`` (N, 38, 3),
+    ``rotation`` (N, 38, 3, 3); ``status`` (N,)."""
+
+    shaking_force: np.ndarray
+    shaking_moment: np.ndarray
+    D: np.ndarray
+    D_dot: np.ndarray
+    wrist_angles: np.ndarray
+    wrist_rates: np.ndarray
+    wrist_accelerations: np.ndarray
+    condition: np.ndarray
+    com: np.ndarray
+    com_velocity: np.ndarray
+    com_acceleration: np.ndarray
+    rotation: np.ndarray
+    angular_velocity: np.ndarray
+    angular_acceleration: np.ndarray
+    status: np.ndarray
+
+
+def _control_run(result: dict) -> ControlRun:
+    return ControlRun(joint_torque=np.asarray(result["joint_torque"]),
+                      status=np.asarray(result["status"]))
+
+
+def _dynamics(model: Any, q_guess: npt.ArrayLike | None) -> Any:
+    from mechbal.mechanism import Mechanism
+
+    if isinstance(model, Mechanism):
+        guess = np.zeros(model.dof) if q_guess is None else np.asarray(q_guess, dtype=float)
+        return _core.MechanismDynamics(model.model, guess)
+    if q_guess is not None:
+        raise ValueError("q_guess is for a Mechanism model (closed loops); a dynamics back end "
+                         "was given")
+    return model
+
+
+class ComputedTorque(_core.ComputedTorque):
+    """Computed-torque control (Arakelian, Le Baron & Mottu 2011, eqs 2-6):
+    ``tau = M(q) (qdd_des + Kp (q_des - q) + Kd (qd_des - qd)) + C(q, qd) qd + G(q)``, clipped
+    to ``torque_limit``; with an exact model the error obeys ``e'' + Kd e' + Kp e = 0`` (eq 6).
+
+    Args:
+        model: a :class:`mechbal.Mechanism` (its :class:`MechanismDynamics` is built and kept) or
+            any dynamics back end: :class:`MechanismDynamics`, :class:`RneChainDynamics`,
+            :class:`KdlChainDynamics`, ``Arm2DofDynamics``, ``DiscArmDynamics``,
+            ``FiveBarDynamics`` (:mod:`mechbal.papers`). The model may differ from the plant.
+        kp: proportional gains [1/s^2], one per joint.
+        kd: derivative gains [1/s], one per joint.
+        torque_limit: |tau| limit per joint [N m or N] (default and +inf: 1e4).
+        max_position, max_speed, max_acceleration: the input range of a tick (|q| [rad or m],
+            |qd|, |qdd_des|); beyond it the tick holds the last command with
+            ``Status.out_of_range``.
+        q_guess: with a closed-loop Mechanism, every joint coordinate near the assembly [rad or
+            m] (picks the assembly mode the loop solve follows; default zeros).
+
+    Ticks: ``step`` / ``step_into`` / ``run`` (see :mod:`mechbal.control`); ``reset()`` forgets
+    the held command.
+    """
+
+    def __init__(self, model: Any, kp: npt.ArrayLike, kd: npt.ArrayLike,
+                 torque_limit: npt.ArrayLike | None = None, *, q_guess: npt.ArrayLike | None = None,
+                 **input_range: float):
+        super().__init__(_dynamics(model, q_guess), kp, kd, torque_limit, **input_range)
+
+    def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+             qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:
+        """One tick: :class:`JointCommand` (joint_torque (n,) [N m or N], status)."""
+        tau, status = super().step(q, qd, q_des, qd_des, qdd_des)
+        return JointCommand(np.asarray(tau), int(status))
+
+    def run(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+            qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> ControlRun:
+        """N consecutive ticks over (N, n) arrays in one C++ call: :class:`ControlRun`."""
+        return _control_run(super().run(q, qd, q_des, qd_des, qdd_des))
+
+
+class DecoupledJointController(_core.DecoupledJointController):
+    """Decoupled joint control of a dynamically balanced arm (Coutinho & Hess Coelho, eqs 15,
+    26, 36): ``tau_i = k_i (qdd_des_i + Kp_i e_i + Kd_i e'_i)``, exact when counter-rotating
+    discs make the mass matrix diagonal and constant and gravity is balanced.
+
+    Args:
+        k: the constant diagonal of the mass matrix [kg m^2 or kg], one per joint.
+        kp: proportional gains [1/s^2]; kd: derivative gains [1/s].
+        torque_limit, max_position, max_speed, max_acceleration: as :class:`ComputedTorque`.
+    """
+
+    def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+             qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:
+        """One tick: :class:`JointCommand` (joint_torque (n,) [N m or N], status)."""
+        tau, status = super().step(q, qd, q_des, qd_des, qdd_des)
+        return JointCommand(np.asarray(tau), int(status))
+
+    def run(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+            qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> ControlRun:
+        """N consecutive ticks over (N, n) arrays in one C++ call: :class:`ControlRun`."""
+        return _control_run(super().run(q, qd, q_des, qd_des, qdd_des))
+
+
+class ReactionlessWrist(_core.ReactionlessWrist):
+    """Reactionless z-x-z wrist (Briot & Arakelian 2009, eqs 23-26, corrected): each tick
+    commands wrist rates ``qdot = N(q)^-1 (H_target - D)`` so that the total angular momentum
+    about O stays ``target_momentum``, which makes the shaking moment zero.
+
+    Args:
+        J1, J2, J3: inertia matrices of the three wrist links about their centres [kg m^2]
+            (3, 3), link frames.
+        config: :class:`ReactionlessWristConfig` (rate [Hz], integrator, limits, damping).
+        initial_angles: wrist angles at the start [rad] (3,).
+        target_momentum: H_target [kg m^2/s] (3,), usually D at the rest the motion starts from.
+
+    A tick ``step(D, D_dot, D_half, D_next) -> int`` takes D [kg m^2/s] and dD/dt [N m] of the
+    rest of the mechanism at t_n (RK4 also D at t_n + dt/2 and t_n + dt) and leaves the
+    :class:`WristCommand` in ``command`` (angles, rates, accelerations, condition_number,
+    status); ``step_into(D, D_dot, D_half, D_next, out) -> int`` is the fast tick (float64
+    arrays; the command written into ``out`` (3, 3), rows angles [rad], rates [rad/s],
+    accelerations [rad/s^2]); :meth:`run` ticks N times in one call.
+    """
+
+    def run(self, D: npt.ArrayLike, D_dot: npt.ArrayLike, D_half: npt.ArrayLike,  # type: ignore[override]
+            D_next: npt.ArrayLike) -> WristRun:
+        """N consecutive ticks, each argument (N, 3): :class:`WristRun`."""
+        r = super().run(D, D_dot, D_half, D_next)
+        return WristRun(**{k: np.asarray(v) for k, v in r.items()})
+
+
+class PaminsaController(_core.PaminsaController):
+    """The fully balanced PAMINSA controller (Briot & Arakelian 2009): at each tick the
+    platform motion gives the mechanism's kinematics and D (eq 19), the reactionless wrist
+    cancels the shaking moment, and the shaking wrench of all 38 bodies is computed.
+
+    Args:
+        model: ``PaminsaModel`` (:mod:`mechbal.papers`), with its counterweights.
+        config: :class:`ReactionlessWristConfig` (the tick rate is ``config.rate_hz``).
+        initial_wrist_angles: [rad] (3,).
+        max_speed: |platform velocity| per component a tick accepts [m/s] (default 10).
+        max_acceleration: |platform acceleration| per component [m/s^2] (default 1e3).
+
+    Tick: ``reset(P, wrist_angles)`` at rest, then ``step(P, Pd, Pdd, P_half, Pd_half,
+    Pdd_half, P_next, Pd_next, Pdd_next) -> int`` with the platform position [m], velocity
+    [m/s] and acceleration [m/s^2] at t_n, t_n + dt/2 and t_n + dt; the result is in
+    ``shaking_force`` [N], ``shaking_moment`` [N m], ``D``, ``D_dot`` and ``wrist_command``.
+    Fast tick: ``step_into(now, half, next, out) -> int`` with (3, 3) float64 arrays whose rows
+    are position, velocity, acceleration, the wrist command written into ``out`` (3, 3): rows
+    angles, rates, accelerations. Batch: :meth:`run`.
+    """
+
+    def __init__(self, model: Any, config: Any, initial_wrist_angles: npt.ArrayLike,
+                 max_speed: float = 10.0, max_acceleration: float = 1000.0):
+        super().__init__(model, config, initial_wrist_angles, max_speed, max_acceleration)
+        self._model = model
+        self._config = config
+        self._initial = np.array(initial_wrist_angles, dtype=float)
+
+    def run(self, P_half: npt.ArrayLike, Pd_half: npt.ArrayLike,
+            Pdd_half: npt.ArrayLike) -> PaminsaRun:
+        """A whole run in one C++ call, from rest at ``P_half[0]`` with the wrist at
+        ``initial_wrist_angles`` (a fresh controller: this object's tick state is not used).
+        Platform motion sampled every dt/2 (dt = 1 / config.rate_hz): position [m], velocity
+        [m/s], acceleration [m/s^2], each (2 steps + 1, 3). Results at the steps + 1 ticks."""
+        r = _core.paminsa_reactionless_run(self._model, self._config, self._initial,
+                                           P_half, Pd_half, Pdd_half)
+        keys = PaminsaRun.__dataclass_fields__
+        values = {k: np.asarray(r["status_per_instant" if k == "status" else k]) for k in keys}
+        return PaminsaRun(**values)

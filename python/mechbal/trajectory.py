@@ -1,0 +1,305 @@
+"""Desired motions: one interface, ``evaluate(t) -> (q, qd, qdd)``, for every kind of trajectory.
+
+Every trajectory here has ``dof`` (number of coordinates), ``duration`` [s] (the motion runs over
+``[0, duration]``; :class:`Sampled` over the span of its samples) and ``evaluate(t)``:
+
+* ``t`` a number: ``(q, qd, qdd)`` each of shape ``(dof,)``;
+* ``t`` an array of N times: each of shape ``(N, dof)`` (one call, no Python loop).
+
+Positions are in rad (revolute) or m (prismatic), velocities in rad/s or m/s, accelerations in
+rad/s^2 or m/s^2, times in s. Before its start and after its end a trajectory holds its first or
+last point at rest (zero velocity and acceleration), as the C++ ``RestToRestTrajectory`` does.
+
+* `quintic`: rest-to-rest, `s = 10 u^3 - 15 u^4 + 6 u^5` (the C++ `RestToRestTrajectory`);
+* `minimum_energy_cubic`: rest-to-rest, `s = 3 u^2 - 2 u^3`, the law of least integral of
+  squared acceleration (Arakelian, Le Baron & Mottu 2011, eq 13);
+* `ViaPoints`: a piecewise quintic through given points at given times;
+* `Sampled`: a user's time series, interpolated by cubic splines.
+
+All of them are accepted by `mechbal.simulate.closed_loop`; a `RestToRest` runs on the C++ path
+directly, the others are sampled every `dt / 2` first.
+"""
+from __future__ import annotations
+
+from typing import Protocol, Union, runtime_checkable
+
+import numpy as np
+import numpy.typing as npt
+
+from mechbal import _core
+
+__all__ = ["Trajectory", "RestToRest", "quintic", "minimum_energy_cubic", "ViaPoints", "Sampled",
+           "TimeLaw"]
+
+TimeLaw = _core.TimeLaw
+ArrayLike = npt.ArrayLike
+Times = Union[float, npt.ArrayLike]
+Motion = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+@runtime_checkable
+class Trajectory(Protocol):
+    """What every desired motion offers (see the module docstring)."""
+
+    @property
+    def dof(self) -> int:
+        """Number of coordinates."""
+
+    @property
+    def duration(self) -> float:
+        """Time span of the motion [s]."""
+
+    def evaluate(self, t: Times) -> Motion:
+        """``(q, qd, qdd)`` at time(s) ``t`` [s]."""
+
+
+def _times(t: Times) -> tuple[bool, np.ndarray]:
+    a = np.asarray(t)
+    if a.dtype.kind not in "biuf":
+        raise TypeError(f"t must be real numbers, got dtype {a.dtype}")
+    a = a.astype(float)
+    if a.ndim > 1:
+        raise ValueError(f"t must be a number or a 1-D array of times, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError("t must be finite")
+    return a.ndim == 0, np.atleast_1d(a)
+
+
+def _vector(name: str, value: ArrayLike) -> np.ndarray:
+    a = np.asarray(value)
+    if a.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must be real numbers, got dtype {a.dtype}")
+    a = np.array(a, dtype=float)
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be finite")
+    return a
+
+
+class RestToRest:
+    """Rest-to-rest motion from ``start`` to ``end`` in ``duration`` seconds along a time law
+    (the C++ ``RestToRestTrajectory``; Arakelian, Le Baron & Mottu 2011, eqs 10-13):
+    ``q(t) = start + (end - start) s(t / duration)``.
+
+    Args:
+        start, end: positions [rad or m], one per coordinate.
+        duration: motion time [s], > 0.
+        law: ``"quintic"`` (zero velocity and acceleration at both ends) or ``"cubic"``
+            (minimum energy: least integral of squared acceleration; its acceleration jumps at
+            both ends).
+    """
+
+    def __init__(self, start: ArrayLike, end: ArrayLike, duration: float,
+                 law: str | _core.TimeLaw = "quintic"):
+        if isinstance(law, str):
+            if law not in ("quintic", "cubic"):
+                raise ValueError(f"law must be 'quintic' or 'cubic', got '{law}'")
+            time_law: _core.TimeLaw = getattr(_core.TimeLaw, law)
+        else:
+            time_law = law
+        #: the C++ trajectory (what :func:`mechbal.simulate.closed_loop` runs on)
+        self.core = _core.RestToRestTrajectory(start, end, duration, time_law)
+
+    @property
+    def dof(self) -> int:
+        """Number of coordinates."""
+        return int(self.core.size)
+
+    @property
+    def duration(self) -> float:
+        """Motion time [s]."""
+        return float(self.core.duration)
+
+    @property
+    def end_time(self) -> float:
+        """Time the motion ends [s] (= ``duration``: it starts at t = 0)."""
+        return self.duration
+
+    @property
+    def law(self) -> str:
+        """``"quintic"`` or ``"cubic"``."""
+        return str(self.core.law.name)
+
+    def evaluate(self, t: Times) -> Motion:
+        """``(q, qd, qdd)`` at ``t`` [s]: ``(dof,)`` each for a number, ``(N, dof)`` for N times."""
+        single, ts = _times(t)
+        q, qd, qdd = self.core.evaluate_batch(ts)
+        if single:
+            return q[0], qd[0], qdd[0]
+        return q, qd, qdd
+
+    def __repr__(self) -> str:
+        return f"<RestToRest {self.law}, {self.dof} coordinates, {self.duration:g} s>"
+
+
+def quintic(start: ArrayLike, end: ArrayLike, duration: float) -> RestToRest:
+    """Quintic rest-to-rest motion (zero velocity and acceleration at both ends); positions
+    [rad or m], duration [s]."""
+    return RestToRest(start, end, duration, "quintic")
+
+
+def minimum_energy_cubic(start: ArrayLike, end: ArrayLike, duration: float) -> RestToRest:
+    """Minimum-energy cubic rest-to-rest motion ``s = 3 u^2 - 2 u^3`` (Arakelian, Le Baron &
+    Mottu 2011, eq 13): least integral of squared acceleration between two rests; positions
+    [rad or m], duration [s]."""
+    return RestToRest(start, end, duration, "cubic")
+
+
+class ViaPoints:
+    """Piecewise quintic through ``points`` at ``times``: continuous position, velocity and
+    acceleration; at rest at the first and last point.
+
+    Args:
+        times: (K,) strictly increasing times [s], K >= 2; the motion starts at ``times[0]``.
+        points: (K, dof) positions [rad or m].
+        velocities: optional (K, dof) velocities at the points [rad/s or m/s]. By default the
+            first and last are zero and an interior one is the mean of the slopes of its two
+            segments, or zero where the motion turns back (the slopes differ in sign), so the path
+            does not overshoot a via point.
+        accelerations: optional (K, dof) accelerations at the points [rad/s^2 or m/s^2];
+            default zero at every point.
+
+    ``duration`` is ``times[-1] - times[0]`` and ``evaluate(t)`` takes absolute times.
+    """
+
+    def __init__(self, times: ArrayLike, points: ArrayLike, velocities: ArrayLike | None = None,
+                 accelerations: ArrayLike | None = None):
+        t = _vector("times", times)
+        p = _vector("points", points)
+        if t.ndim != 1 or t.size < 2:
+            raise ValueError(f"times must be a 1-D array of at least 2 times, got shape {t.shape}")
+        if np.any(np.diff(t) <= 0):
+            raise ValueError("times must be strictly increasing")
+        if p.ndim == 1:
+            p = p[:, None]
+        if p.ndim != 2 or p.shape[0] != t.size:
+            raise ValueError(f"points must have shape ({t.size}, dof), got {np.shape(points)}")
+        h = np.diff(t)[:, None]
+        if velocities is None:
+            slope = np.diff(p, axis=0) / h
+            v = np.zeros_like(p)
+            inner = 0.5 * (slope[:-1] + slope[1:])
+            v[1:-1] = np.where(slope[:-1] * slope[1:] > 0, inner, 0.0)
+        else:
+            v = _vector("velocities", velocities).reshape(p.shape)
+        a = np.zeros_like(p) if accelerations is None else _vector("accelerations",
+                                                                   accelerations).reshape(p.shape)
+        # quintic coefficients per segment in u = (t - t_i) / h, x(u) = sum c_k u^k
+        p0, p1, v0, v1, a0, a1 = p[:-1], p[1:], v[:-1] * h, v[1:] * h, a[:-1] * h**2, a[1:] * h**2
+        c0, c1, c2 = p0, v0, 0.5 * a0
+        d = p1 - p0 - v0 - 0.5 * a0
+        # c3, c4, c5 from position, velocity and acceleration at u = 1
+        A = np.array([[1.0, 1.0, 1.0], [3.0, 4.0, 5.0], [6.0, 12.0, 20.0]])
+        rhs = np.stack([d, v1 - v0 - a0, a1 - a0], axis=-1)  # (K-1, dof, 3)
+        c3, c4, c5 = np.moveaxis(rhs @ np.linalg.inv(A).T, -1, 0)
+        self._t = t
+        self._h = h[:, 0]
+        self._c = np.stack([c0, c1, c2, c3, c4, c5], axis=0)  # (6, K-1, dof)
+        self._points = p
+
+    @property
+    def dof(self) -> int:
+        """Number of coordinates."""
+        return int(self._points.shape[1])
+
+    @property
+    def duration(self) -> float:
+        """``times[-1] - times[0]`` [s]."""
+        return float(self._t[-1] - self._t[0])
+
+    @property
+    def end_time(self) -> float:
+        """``times[-1]`` [s]: when the motion ends."""
+        return float(self._t[-1])
+
+    def evaluate(self, t: Times) -> Motion:
+        """``(q, qd, qdd)`` at absolute times ``t`` [s]; held at rest outside ``times``."""
+        single, ts = _times(t)
+        i = np.clip(np.searchsorted(self._t, ts, side="right") - 1, 0, len(self._h) - 1)
+        h = self._h[i][:, None]
+        u = np.clip((ts - self._t[i]) / self._h[i], 0.0, 1.0)[:, None]
+        c = self._c[:, i, :]  # (6, N, dof)
+        q = c[0] + u * (c[1] + u * (c[2] + u * (c[3] + u * (c[4] + u * c[5]))))
+        qd = (c[1] + u * (2 * c[2] + u * (3 * c[3] + u * (4 * c[4] + u * 5 * c[5])))) / h
+        qdd = (2 * c[2] + u * (6 * c[3] + u * (12 * c[4] + u * 20 * c[5]))) / h**2
+        outside = ((ts < self._t[0]) | (ts > self._t[-1]))[:, None]
+        qd = np.where(outside, 0.0, qd)
+        qdd = np.where(outside, 0.0, qdd)
+        if single:
+            return q[0], qd[0], qdd[0]
+        return q, qd, qdd
+
+
+class Sampled:
+    """A user's sampled motion (measured or planned elsewhere), interpolated by a cubic spline
+    (``scipy.interpolate.CubicSpline``) per coordinate: q(t) the spline, qd and qdd its first
+    and second derivatives.
+
+    Args:
+        times: (K,) strictly increasing sample times [s], K >= 2.
+        positions: (K, dof) samples [rad or m].
+        bc_type: the spline's end conditions (scipy's ``bc_type``): ``"clamped"`` (default: zero
+            velocity at both ends, a motion between rests), ``"natural"`` (zero acceleration) or
+            ``"not-a-knot"``.
+
+    ``duration`` is ``times[-1] - times[0]``; ``evaluate(t)`` takes absolute times and holds the
+    first or last sample at rest outside them.
+    """
+
+    def __init__(self, times: ArrayLike, positions: ArrayLike, bc_type: str = "clamped"):
+        from scipy.interpolate import CubicSpline
+
+        t = _vector("times", times)
+        p = _vector("positions", positions)
+        if t.ndim != 1 or t.size < 2:
+            raise ValueError(f"times must be a 1-D array of at least 2 times, got shape {t.shape}")
+        if np.any(np.diff(t) <= 0):
+            raise ValueError("times must be strictly increasing")
+        if p.ndim == 1:
+            p = p[:, None]
+        if p.ndim != 2 or p.shape[0] != t.size:
+            raise ValueError(f"positions must have shape ({t.size}, dof), got {np.shape(positions)}")
+        self._t = t
+        self._spline = CubicSpline(t, p, axis=0, bc_type=bc_type)
+        self._d1 = self._spline.derivative(1)
+        self._d2 = self._spline.derivative(2)
+        self._dof = p.shape[1]
+
+    @property
+    def dof(self) -> int:
+        """Number of coordinates."""
+        return int(self._dof)
+
+    @property
+    def duration(self) -> float:
+        """``times[-1] - times[0]`` [s]."""
+        return float(self._t[-1] - self._t[0])
+
+    @property
+    def end_time(self) -> float:
+        """``times[-1]`` [s]: when the motion ends."""
+        return float(self._t[-1])
+
+    def evaluate(self, t: Times) -> Motion:
+        """``(q, qd, qdd)`` at absolute times ``t`` [s]; held at rest outside the samples."""
+        single, ts = _times(t)
+        tc = np.clip(ts, self._t[0], self._t[-1])
+        outside = ((ts < self._t[0]) | (ts > self._t[-1]))[:, None]
+        q = self._spline(tc)
+        qd = np.where(outside, 0.0, self._d1(tc))
+        qdd = np.where(outside, 0.0, self._d2(tc))
+        if single:
+            return q[0], qd[0], qdd[0]
+        return q, qd, qdd
+
+
+def as_trajectory(obj: object) -> Trajectory:
+    """A :class:`Trajectory` from a trajectory object or a C++ ``RestToRestTrajectory``."""
+    if isinstance(obj, _core.RestToRestTrajectory):
+        r = RestToRest.__new__(RestToRest)
+        r.core = obj
+        return r
+    if not isinstance(obj, Trajectory):
+        raise TypeError(f"trajectory must have dof, duration and evaluate(t) (see "
+                        f"mechbal.trajectory), got {type(obj).__name__}")
+    return obj
+

@@ -1,0 +1,177 @@
+// Closed loops on the general model (algorithm/loops.hpp) from C++: a four-bar and a five-bar built
+// here, the closure after the position solve, the coupling matrix C and the acceleration bias c
+// against finite differences of solved positions, and the real-time contract (no heap allocation
+// per tick in the solve, the projection and the projected dynamics).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "alloc_counter.hpp"
+#include "mechbal/algorithm/loops.hpp"
+
+using namespace mechbal;
+
+namespace {
+
+Eigen::Isometry3d at(double x, double y, double z) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Vec3(x, y, z);
+  return T;
+}
+
+Body rod(const std::string& name, const std::string& link, double mass, double length) {
+  // a slender rod along the link's x, centre of mass at its middle
+  return Body{name, "link", link, mass, Vec3(0.5 * length, 0.01, 0.0),
+              Mat3(Vec3(1e-4, mass * length * length / 12.0, mass * length * length / 12.0).asDiagonal())};
+}
+
+/// Crank (0.2 m) about z at O, coupler (0.5 m), rocker (0.4 m) about z at (0.45, 0, 0); the coupler
+/// and rocker tips closed by a loop of `type`; gravity along -y (the plane of motion); crank actuated.
+MechanismModel four_bar(LoopType type) {
+  MechanismDescription d;
+  d.gravity = Vec3(0.0, -9.81, 0.0);
+  d.joints = {Joint{"crank", JointType::revolute, "base"}, Joint{"coupler", JointType::revolute, "crank", at(0.2, 0, 0)},
+              Joint{"rocker", JointType::revolute, "base", at(0.45, 0, 0)}};
+  d.bodies = {rod("crank", "crank", 0.8, 0.2), rod("coupler", "coupler", 1.5, 0.5), rod("rocker", "rocker", 1.1, 0.4)};
+  d.frames = {Frame{"coupler_tip", "coupler", at(0.5, 0, 0)}, Frame{"rocker_tip", "rocker", at(0.4, 0, 0)}};
+  d.loops = {LoopConstraint{"tip", type, "coupler_tip", "rocker_tip"}};
+  d.actuated = {"crank"};
+  return MechanismModel(d);
+}
+
+/// Planar 5R: proximal links (0.3 m) at (0, 0) and (0.25, 0), distal links (0.45 m) meeting at a
+/// point; both proximal joints actuated.
+MechanismModel five_bar() {
+  MechanismDescription d;
+  d.gravity = Vec3(0.0, -9.81, 0.0);
+  d.joints = {Joint{"p1", JointType::revolute, "base"}, Joint{"d1", JointType::revolute, "p1", at(0.3, 0, 0)},
+              Joint{"p2", JointType::revolute, "base", at(0.25, 0, 0)},
+              Joint{"d2", JointType::revolute, "p2", at(0.3, 0, 0)}};
+  d.bodies = {rod("p1", "p1", 1.0, 0.3), rod("d1", "d1", 0.7, 0.45), rod("p2", "p2", 1.0, 0.3),
+              rod("d2", "d2", 0.7, 0.45)};
+  d.frames = {Frame{"tip1", "d1", at(0.45, 0, 0)}, Frame{"tip2", "d2", at(0.45, 0, 0)}};
+  d.loops = {LoopConstraint{"tip", LoopType::point, "tip1", "tip2"}};
+  d.actuated = {"p1", "p2"};
+  return MechanismModel(d);
+}
+
+/// q near an assembly (the order of the coordinates is the joints', depth first)
+Eigen::VectorXd four_bar_guess() { return (Eigen::VectorXd(3) << 1.0, -0.6, 1.75).finished(); }
+Eigen::VectorXd five_bar_guess() { return (Eigen::VectorXd(4) << 2.0, -1.2, 1.1, 1.2).finished(); }
+
+/// The solved q at actuated qa, warm-started from `guess`.
+Eigen::VectorXd solved(const MechanismModel& model, MechanismData& data, const Eigen::VectorXd& qa,
+                       const Eigen::VectorXd& guess) {
+  Eigen::VectorXd q = guess;
+  const Status s = solve_loop_positions(model, data, qa, q);
+  EXPECT_EQ(s, Status::ok);
+  return q;
+}
+
+struct Case {
+  const char* name;
+  MechanismModel model;
+  Eigen::VectorXd guess, qa;
+};
+
+std::vector<Case> cases() {
+  std::vector<Case> out;
+  for (auto [name, type] : {std::pair{"point", LoopType::point}, {"planar_point", LoopType::planar_point},
+                            {"axis", LoopType::axis}}) {
+    out.push_back(Case{name, four_bar(type), four_bar_guess(), (Eigen::VectorXd(1) << 1.0).finished()});
+  }
+  out.push_back(Case{"five_bar", five_bar(), five_bar_guess(), (Eigen::VectorXd(2) << 2.0, 1.1).finished()});
+  return out;
+}
+
+}  // namespace
+
+TEST(Loops, ClosureHoldsAfterTheSolve) {
+  for (const auto& c : cases()) {
+    MechanismData data(c.model);
+    Eigen::VectorXd q = c.guess;
+    for (int k = 0; k < 50; ++k) {  // a motion of the actuators, warm-started tick to tick
+      const Eigen::VectorXd qa = c.qa + Eigen::VectorXd::Constant(c.qa.size(), 0.4 * std::sin(0.1 * k));
+      ASSERT_EQ(solve_loop_positions(c.model, data, qa, q), Status::ok) << c.name << " tick " << k;
+      ASSERT_EQ(loop_constraints(c.model, data, q), Status::ok);
+      EXPECT_LT(data.loop_residual.cwiseAbs().maxCoeff(), 1e-12) << c.name;
+      EXPECT_LE(data.loop_iterations, 6) << c.name;
+      for (int i = 0; i < c.model.num_actuated(); ++i) {
+        EXPECT_EQ(q(c.model.actuated_coordinates()[static_cast<std::size_t>(i)]), qa(i));
+      }
+    }
+  }
+}
+
+TEST(Loops, CouplingMatrixAndBiasMatchFiniteDifferences) {
+  for (const auto& c : cases()) {
+    const MechanismModel& model = c.model;
+    MechanismData data(model);
+    const int na = model.num_actuated();
+    const Eigen::VectorXd q0 = solved(model, data, c.qa, c.guess);
+    // C: columns are d q / d qa_j (central differences of solved positions)
+    Eigen::VectorXd va = Eigen::VectorXd::LinSpaced(na, 0.7, -1.3);
+    ASSERT_EQ(loop_projection(model, data, q0, va), Status::ok) << c.name;
+    const Eigen::MatrixXd C = data.loop_projection;
+    const Eigen::VectorXd c_bias = data.loop_acceleration_bias;
+    const double h = 1e-6;
+    for (int j = 0; j < na; ++j) {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(na);
+      e(j) = h;
+      const Eigen::VectorXd dq = (solved(model, data, c.qa + e, q0) - solved(model, data, c.qa - e, q0)) / (2 * h);
+      EXPECT_LT((C.col(j) - dq).cwiseAbs().maxCoeff(), 1e-7) << c.name << " column " << j;
+    }
+    // c: along qa(t) = qa + va t + aa t^2/2, q''(0) = C aa + c (second differences)
+    const Eigen::VectorXd aa = Eigen::VectorXd::LinSpaced(na, -0.4, 0.9);
+    const double dt = 1e-4;
+    const auto qa_at = [&](double t) { return Eigen::VectorXd(c.qa + va * t + 0.5 * aa * t * t); };
+    const Eigen::VectorXd qdd = (solved(model, data, qa_at(dt), q0) - 2.0 * q0 + solved(model, data, qa_at(-dt), q0)) /
+                                (dt * dt);
+    EXPECT_LT((C * aa + c_bias - qdd).cwiseAbs().maxCoeff(), 1e-5) << c.name;
+    // closed_motion returns the same
+    Eigen::VectorXd q = q0;
+    ASSERT_EQ(closed_motion(model, data, c.qa, va, aa, q), Status::ok);
+    EXPECT_LT((data.closed_velocity - C * va).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT((data.closed_acceleration - (C * aa + c_bias)).cwiseAbs().maxCoeff(), 1e-12);
+  }
+}
+
+TEST(Loops, TicksAllocateNothing) {
+  for (const auto& c : cases()) {
+    const MechanismModel& model = c.model;
+    MechanismData data(model);
+    const int na = model.num_actuated();
+    Eigen::VectorXd q = c.guess, qa = c.qa, va(na), aa(na), tau(na);
+    ASSERT_EQ(solve_loop_positions(model, data, qa, q), Status::ok);  // first assembly
+    test::AllocationScope scope;
+    for (int k = 0; k < 20; ++k) {
+      // a different pose each tick, warm-started from the last one (Newton iterates every tick)
+      qa.setConstant(0.3 * std::sin(0.05 * k));
+      qa += c.qa;
+      va.setConstant(0.5 * std::cos(0.05 * k));
+      aa.setConstant(-0.2);
+      tau.setConstant(0.1);
+      EXPECT_EQ(solve_loop_positions(model, data, qa, q), Status::ok) << c.name;
+      EXPECT_EQ(loop_projection(model, data, q, va), Status::ok) << c.name;
+      EXPECT_EQ(closed_motion(model, data, qa, va, aa, q), Status::ok) << c.name;
+      EXPECT_EQ(closed_inverse_dynamics(model, data, qa, va, aa, q), Status::ok) << c.name;
+      EXPECT_EQ(closed_mass_matrix(model, data, qa, q), Status::ok) << c.name;
+      EXPECT_EQ(closed_forward_dynamics(model, data, qa, va, tau, q), Status::ok) << c.name;
+    }
+    EXPECT_EQ(scope.count(), 0u) << c.name;
+  }
+}
+
+TEST(Loops, ForwardDynamicsInvertsInverseDynamics) {
+  for (const auto& c : cases()) {
+    const MechanismModel& model = c.model;
+    MechanismData data(model);
+    const int na = model.num_actuated();
+    Eigen::VectorXd q = c.guess;
+    const Eigen::VectorXd va = Eigen::VectorXd::LinSpaced(na, 0.8, -0.5), aa = Eigen::VectorXd::LinSpaced(na, 1.5, 0.3);
+    ASSERT_EQ(closed_inverse_dynamics(model, data, c.qa, va, aa, q), Status::ok);
+    const Eigen::VectorXd tau = data.actuated_force;
+    ASSERT_EQ(closed_forward_dynamics(model, data, c.qa, va, tau, q), Status::ok);
+    EXPECT_LT((data.actuated_acceleration - aa).cwiseAbs().maxCoeff(), 1e-9) << c.name;
+  }
+}
