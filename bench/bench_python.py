@@ -21,7 +21,14 @@
    body's motion) and simulate_computed_torque (2-DOF closed loop, 2000 ticks), ticks per second.
    These are sequential closed loops: there is no vectorised numpy equivalent to compare with.
 
+5. Design sweeps (issue 16): a tolerance Monte Carlo of a statically balanced 7-joint arm (7 links +
+   7 counterweights, every mass +-2 %) over 100 poses, peak and RMS gravity torque: 10^5
+   evaluations serially in this process, then on a Dask LocalCluster of 1 and of 2 worker
+   processes (one thread each: one core each), throughput and the parallel efficiency
+   T1 / (2 T2). The tables of the three runs are checked to be identical first.
+
 Usage: python bench/bench_python.py [--out FILE.json] [--instants N] [--quick]
+       python bench/bench_python.py --only sweep [--sweep-evaluations N]
 """
 from __future__ import annotations
 
@@ -102,13 +109,134 @@ def median_per_call_ns(fn, calls):
     return float(np.median(samples)), float(np.percentile(samples, 99))
 
 
+def seven_joint_arm():
+    """A 7-joint arm (alternating z / y axes, 0.3 m links) with a counterweight on each link, as a
+    MechanismSpec; counterweights placed so the arm is close to statically balanced."""
+    from mechbal.spec import mechanism_spec
+
+    joints, bodies = [], []
+    for i in range(7):
+        axis = [0.0, 0.0, 1.0] if i % 2 == 0 else [0.0, 1.0, 0.0]
+        joints.append({"name": f"j{i + 1}", "origin": {"xyz": [0.0, 0.0, 0.3] if i else [0.0, 0.0, 0.2]},
+                       "axis": axis, "link": {"mass": 3.0 - 0.3 * i, "com": [0.0, 0.01 * i, 0.15],
+                                              "inertia": [0.02, 0.02, 0.004]}})
+        bodies.append({"name": f"counterweight{i + 1}", "kind": "counterweight", "link": f"j{i + 1}",
+                       "mass": 1.0 + 0.1 * i, "com": [0.0, 0.0, -0.1], "inertia": [0.001, 0.001, 0.001]})
+    return mechanism_spec({"joints": joints, "bodies": bodies})
+
+
+def _busy(seconds_of_work: int) -> float:
+    """A fixed amount of single-threaded numpy work; returns its wall time (machine calibration)."""
+    from threadpoolctl import threadpool_limits
+
+    a = np.random.default_rng(0).uniform(size=(300, 300))
+    with threadpool_limits(1, "blas"):
+        t0 = time.perf_counter()
+        x = a
+        for _ in range(60 * seconds_of_work):
+            x = np.tanh(a @ x) * 0.5
+        return time.perf_counter() - t0
+
+
+def machine_parallel_efficiency(work: int = 20) -> dict:
+    """What the machine gives two processes right now (other users' load included): the same
+    fixed work in one process, then in each of two at once; efficiency = t1 / t2 (1 when two cores
+    are free)."""
+    import concurrent.futures
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(2, mp_context=ctx) as pool:
+        list(pool.map(_busy, [0, 0]))  # start both
+        t1 = pool.submit(_busy, work).result()
+        t2 = max(pool.map(_busy, [work, work]))
+    return {"one_process_s": t1, "two_processes_s": t2, "efficiency": t1 / t2}
+
+
+def bench_sweep(evaluations: int, repeat: int, scaling_evaluations: int = 500_000) -> dict:
+    """Section 4 (see the module docstring). Throughput: the 14 masses, peak and RMS gravity torque
+    over 100 poses, ``evaluations`` sets (the issue's target). Scaling over 1 and 2 workers: a
+    heavier sweep (the masses and the counterweights' positions, so 10 regressor columns per
+    counterweight, plus actuator torque and shaking force over a 201-instant trajectory), so that
+    each task's compute outweighs what this process does alone (drawing the sets, shipping them,
+    assembling the table)."""
+    import os
+
+    import distributed
+    import pandas as pd
+
+    from mechbal.sweep import Parameter, Sweep
+
+    spec = seven_joint_arm()
+    masses = [Parameter(f"bodies.{b.name}.mass", tolerance=0.02) for b in spec.bodies]
+    law = mechbal.RestToRestTrajectory(np.zeros(7), np.full(7, 0.8), 1.0, mechbal.TimeLaw.quintic)
+    trajectory = law.evaluate_batch(np.linspace(0.0, 1.0, 201))
+
+    def light(n=evaluations):
+        return Sweep(spec, masses, ["gravity_torque_peak", "gravity_torque_rms"], kind="monte_carlo",
+                     evaluations=n, seed=1, pose_source="uniform", pose_count=100)
+
+    def heavy(n=scaling_evaluations):
+        positions = [Parameter(f"bodies.counterweight{i + 1}.com[2]", delta=0.002) for i in range(7)]
+        return Sweep(spec, masses + positions, ["gravity_torque_peak", "actuator_torque_rms",
+                                                "shaking_force_peak"], kind="monte_carlo", evaluations=n,
+                     seed=2, pose_source="uniform", pose_count=100, trajectory=trajectory)
+
+    out = {"arm": "7 revolute joints, 14 bodies (7 links + 7 counterweights)",
+           "throughput": {"parameters": 14, "poses": 100, "metrics": "gravity torque peak and RMS",
+                          "evaluations": evaluations, "chunk_size": light().default_chunk_size()},
+           "scaling": {"parameters": 21, "poses": 100, "trajectory_instants": 201,
+                       "metrics": "gravity torque peak, actuator torque RMS, shaking force peak",
+                       "evaluations": scaling_evaluations, "chunk_size": heavy().default_chunk_size()},
+           "load_average_before": list(os.getloadavg())}
+    reference = light().run("serial", progress=False).table
+    t = best_time(lambda: light().run("serial", progress=False), repeat)
+    out["throughput"]["serial_in_process"] = {"seconds": t, "evaluations_per_minute": 60 * evaluations / t}
+    heavy_reference = heavy().run("serial", progress=False).table
+    t = best_time(lambda: heavy().run("serial", progress=False), max(1, repeat - 1))
+    out["scaling"]["serial_in_process"] = {"seconds": t, "evaluations_per_minute": 60 * scaling_evaluations / t}
+    for workers in (1, 2):
+        with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                      host="127.0.0.1", dashboard_address=None, silence_logs=50) as c, \
+                distributed.Client(c, set_as_default=False) as client:
+            table = light().run("dask", scheduler=client, progress=False).table  # warm-up: imports
+            pd.testing.assert_frame_equal(reference, table, check_exact=True)
+            t = best_time(lambda: light().run("dask", scheduler=client, progress=False), repeat)
+            out["throughput"][f"dask_{workers}_workers"] = {"seconds": t,
+                                                            "evaluations_per_minute": 60 * evaluations / t}
+            table = heavy().run("dask", scheduler=client, progress=False).table
+            pd.testing.assert_frame_equal(heavy_reference, table, check_exact=True)
+            t = best_time(lambda: heavy().run("dask", scheduler=client, progress=False), max(1, repeat - 1))
+            out["scaling"][f"dask_{workers}_workers"] = {
+                "seconds": t, "evaluations_per_minute": 60 * scaling_evaluations / t}
+    for section in ("throughput", "scaling"):
+        d = out[section]
+        t1, t2 = d["dask_1_workers"]["seconds"], d["dask_2_workers"]["seconds"]
+        d["speedup_2_workers"] = t1 / t2
+        d["parallel_efficiency_2_workers"] = t1 / (2 * t2)
+    out["load_average_after"] = list(os.getloadavg())
+    out["machine_two_process_efficiency"] = machine_parallel_efficiency()
+    out["target_evaluations_per_minute_one_core"] = 1e5
+    out["target_met"] = out["throughput"]["dask_1_workers"]["evaluations_per_minute"] >= 1e5
+    return out
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path)
     ap.add_argument("--instants", type=int, default=100_000)
     ap.add_argument("--bodies", type=int, default=10)
     ap.add_argument("--quick", action="store_true", help="fewer repetitions")
+    ap.add_argument("--only", choices=("sweep",), help="run one section only")
+    ap.add_argument("--sweep-evaluations", type=int, default=100_000)
     args = ap.parse_args(argv)
+    if args.only == "sweep":
+        text = json.dumps({"sweep": bench_sweep(args.sweep_evaluations, 2 if args.quick else 3)}, indent=2)
+        print(text)
+        if args.out:
+            args.out.parent.mkdir(parents=True, exist_ok=True)
+            args.out.write_text(text + "\n")
+        return
     rng = np.random.default_rng(2024)
     calls = 2000 if args.quick else 20000
     results = {"per_call": {}, "batch": {}}
@@ -220,6 +348,11 @@ def main(argv=None):
         "ticks": ticks, "seconds": t_sim, "ticks_per_s": ticks / t_sim,
         "ns_per_tick": t_sim / ticks * 1e9}
     results["sizing"] = bench_sizing(repeat)
+    # ---- design sweeps (needs the 'sweep' extra) ----------------------------------------------------
+    try:
+        results["sweep"] = bench_sweep(args.sweep_evaluations, 2 if args.quick else 3)
+    except ImportError as exc:
+        results["sweep"] = {"skipped": str(exc)}
     text = json.dumps(results, indent=2)
     print(text)
     if args.out:

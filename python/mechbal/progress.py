@@ -65,6 +65,25 @@ def _tqdm(**kwargs):
     return tqdm(file=sys.stderr, leave=False, delay=_delay(), **size, **kwargs)
 
 
+class _NoBar:
+    def update(self, n: int = 1) -> None:
+        pass
+
+
+@contextlib.contextmanager
+def counter(desc: str, total: int, unit: str = "step", show: bool = True):
+    """A bar advanced by hand (``bar.update(n)``) for work done out of a loop (callbacks, futures
+    completing); a do-nothing object when bars are off."""
+    if not (show and enabled()):
+        yield _NoBar()
+        return
+    bar = _tqdm(desc=desc, total=total, unit=unit)
+    try:
+        yield bar
+    finally:
+        bar.close()
+
+
 def track(iterable: Iterable[T], desc: str, total: int | None = None) -> Iterator[T]:
     """``iterable`` itself, with a bar while it is consumed when bars are enabled."""
     if not enabled():
@@ -120,4 +139,4 @@ def finish() -> None:
         _bar.set_postfix_str("done", refresh=True)
 
 
-__all__ = ["configure", "enabled", "finish", "run_bar", "stage", "track"]
+__all__ = ["configure", "counter", "enabled", "finish", "run_bar", "stage", "track"]

@@ -826,6 +826,101 @@ class FivebarCase(_DiscsCase):
     controller: DiscsController2
 
 
+# ---- sweep files (mechbal sweep CASE --spec FILE; mechbal.sweep) --------------------------------------
+
+#: rows of one sweep's table
+MAX_EVALUATIONS = 10_000_000
+SweepPath = Annotated[str, Field(min_length=1, max_length=300, strict=True)]
+
+
+class SweepParameter(Table):
+    """``[[sweep.parameters]]``: a swept number and its range (exactly one of tolerance, delta,
+    lower + upper, std, values)."""
+    path: SweepPath = Field(description="bodies.<body>.mass | .com[i] | .inertia[k] | .inertia[i][j], "
+                                        "joints.<joint>.placement.xyz[i] | .placement.rpy[i] | .axis[i], "
+                                        "gravity[i], design.<name>")
+    distribution: Literal["uniform", "normal"] = Field(
+        "uniform", description="uniform over the range, or normal (the range's half-width is 3 sigma)")
+    tolerance: Optional[NonNeg] = Field(None, description="relative: nominal x (1 -+ tolerance), e.g. 0.02")
+    delta: Optional[NonNeg] = Field(None, description="absolute: nominal -+ delta (units of the parameter)")
+    lower: Optional[Num] = Field(None, description="absolute lower bound (with upper)")
+    upper: Optional[Num] = Field(None, description="absolute upper bound (with lower)")
+    mean: Optional[Num] = Field(None, description="normal law: mean (default the nominal value), with std")
+    std: Optional[NonNeg] = Field(None, description="normal law: standard deviation")
+    values: Optional[Annotated[list[Num], Field(min_length=1, max_length=10_000)]] = Field(
+        None, description="a list: Monte Carlo draws from it, a grid takes each value")
+    nominal: Optional[Num] = Field(None, description="overrides the mechanism's value; required for design.<name>")
+    steps: Optional[Annotated[int, Field(ge=2, le=10_000, strict=True)]] = Field(
+        None, description="grid: evenly spaced values across the range (default 3)")
+
+    @model_validator(mode="after")
+    def _one_range(self):
+        given = [k for k in ("tolerance", "delta", "lower", "std", "values") if getattr(self, k) is not None]
+        if self.upper is not None and self.lower is None:
+            raise _custom("goes with lower", ".upper", self.upper)
+        if self.lower is not None and self.upper is None:
+            raise _custom("is required with lower", ".upper", has_value=False)
+        if len(given) != 1:
+            raise _custom("give exactly one range: tolerance, delta, lower and upper, std or values",
+                          value=given or "none")
+        if self.lower is not None and self.lower > self.upper:
+            raise _custom(f"must be >= lower = {self.lower!r}", ".upper", self.upper)
+        if self.std is not None and self.distribution != "normal":
+            raise _custom('is for distribution = "normal"', ".std", self.std)
+        if self.mean is not None and self.std is None:
+            raise _custom("goes with std (a normal law)", ".mean", self.mean)
+        if self.path.startswith("design.") and self.nominal is None:
+            raise _custom("a design variable needs a nominal value", ".nominal", has_value=False)
+        return self
+
+
+class SweepPoses(Table):
+    """``[sweep.poses]``: the workspace sample of the gravity-torque metrics."""
+    source: Optional[Literal["trajectory", "uniform"]] = Field(
+        None, description="trajectory: instants evenly spread along the case's trajectory (default); "
+                          "uniform: random in lower/upper (default the joint limits or -+pi), from the seed")
+    count: Annotated[int, Field(ge=1, le=100_000, strict=True)] = 100
+    lower: Optional[JointValues] = Field(None, description="uniform: one value per actuated joint (rad or m)")
+    upper: Optional[JointValues] = Field(None, description="uniform: one value per actuated joint (rad or m)")
+
+
+class Sweep(Table):
+    """``[sweep]``: what to vary, how, and what to measure."""
+    name: Name
+    title: Title = ""
+    kind: Literal["monte_carlo", "sensitivity", "grid"] = Field(
+        description="monte_carlo: random draws; sensitivity: one parameter at a time at the ends of its "
+                    "range (tornado chart); grid: every combination")
+    evaluations: Optional[Annotated[int, Field(ge=1, le=MAX_EVALUATIONS, strict=True)]] = Field(
+        None, description="monte_carlo: number of draws")
+    seed: Annotated[int, Field(ge=0, le=2**63 - 1, strict=True)] = 0
+    metrics: Annotated[list[Name], Field(min_length=1, max_length=64, description=(
+        "gravity_torque_peak | gravity_torque_rms | actuator_torque_peak | actuator_torque_rms | "
+        "shaking_force_peak | shaking_force_rms | shaking_moment_peak | shaking_moment_rms, "
+        "torques optionally .<joint>"))]
+    parameters: Annotated[list[SweepParameter], Field(min_length=1, max_length=256)]
+    poses: SweepPoses = SweepPoses()
+    trajectory_samples: Optional[Samples] = Field(
+        None, description="instants of the case's trajectory for the trajectory metrics (default the case's)")
+    chunk_size: Optional[Annotated[int, Field(ge=1, le=1_000_000, strict=True)]] = Field(
+        None, description="evaluations per task (default 4096 when only body parameters vary, else 64)")
+    output: Literal["parquet", "csv"] = "parquet"
+
+    @model_validator(mode="after")
+    def _evaluations(self):
+        if self.kind == "monte_carlo" and self.evaluations is None:
+            raise _custom("is required for kind = \"monte_carlo\"", ".evaluations", has_value=False)
+        if self.kind != "monte_carlo" and self.evaluations is not None:
+            raise _custom(f"is only for kind = \"monte_carlo\" ({self.kind} sweeps have as many "
+                          "evaluations as their parameters give)", ".evaluations", self.evaluations)
+        return self
+
+
+class SweepFile(Table):
+    """A sweep file: a ``[sweep]`` table over the case given on the command line."""
+    sweep: Sweep
+
+
 # ---- orthoglide (Martini, Troncossi, Carricato & Rivola 2015) -------------------------------------
 
 Count = Annotated[int, Field(ge=1, le=1000, strict=True)]
@@ -1461,9 +1556,11 @@ def _case_models(kind: str | None) -> list[type]:
             for x in (m.values() if isinstance(m, dict) else [m]):
                 if x not in models:
                     models.append(x)
-        return models
+        return models + [SweepFile]
+    if kind == "sweep":
+        return [SweepFile]
     if kind not in CASE_MODELS:
-        raise ValueError(f"unknown kind {kind!r} (known: {', '.join(KINDS)})")
+        raise ValueError(f"unknown kind {kind!r} (known: {', '.join(KINDS)}, and sweep files: sweep)")
     m = CASE_MODELS[kind]
     return list(m.values()) if isinstance(m, dict) else [m]
 
@@ -1475,7 +1572,8 @@ def json_schema(kind: str | None = None) -> dict:
     target = models[0] if len(models) == 1 else Union[tuple(models)]
     schema = TypeAdapter(target).json_schema(schema_generator=_TomlJsonSchema)
     head = {"$schema": "http://json-schema.org/draft-07/schema#",
-            "title": f"mechbal case file{'' if kind is None else f' (kind {kind})'}",
+            "title": f"mechbal case file{'' if kind is None else f' (kind {kind})'}"
+                     + (" or sweep file" if kind is None else ""),
             "description": "A mechbal case (python/mechbal/cases/*.toml): [case] kind selects the "
                            "tables. Generated from mechbal.schema; SI units, angles in radians."}
     return {**head, **schema}
