@@ -27,7 +27,6 @@ MechanismDynamics::MechanismDynamics(std::shared_ptr<const MechanismModel> model
   q_ = q_guess.size() ? q_guess : Eigen::VectorXd::Zero(model_->dof());
   zero_ = Eigen::VectorXd::Zero(dof());
   work_ = Eigen::VectorXd::Zero(dof());
-  ldlt_ = Eigen::LDLT<Eigen::MatrixXd>(dof());
   ldlt_.compute(Eigen::MatrixXd::Identity(dof(), dof()));
 }
 

@@ -502,13 +502,11 @@ MechanismData::MechanismData(const MechanismModel& model)
   loop_actuated_jacobian = Eigen::MatrixXd::Zero(m, na);
   loop_constraint_work = Eigen::VectorXd::Zero(m);
   loop_refine_solution = Eigen::VectorXd::Zero(np);
-  reduced_ldlt = Eigen::LDLT<Eigen::MatrixXd>(na);
   reduced_ldlt.compute(Eigen::MatrixXd::Identity(na, na));
   loop_normal = Eigen::MatrixXd::Identity(np, np);
   loop_passive_first = Eigen::VectorXi::Zero(np);
   loop_passive_last = Eigen::VectorXi::Zero(np);
   loop_normal_pivots = Eigen::VectorXd::Ones(np);
-  loop_ldlt = Eigen::LDLT<Eigen::MatrixXd>(np);
   loop_ldlt.compute(loop_normal);  // sizes every internal buffer once
   loop_step = Eigen::VectorXd::Zero(np);
   loop_trial = Eigen::VectorXd::Zero(dof);
