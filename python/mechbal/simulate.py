@@ -19,7 +19,12 @@ import numpy.typing as npt
 
 from mechbal import _core
 
+#: the C++ RK4 closed loop (any ForwardDynamics plant, any JointController): dict of arrays
+simulate_closed_loop = _core.simulate_closed_loop
+simulate_computed_torque = _core.simulate_computed_torque
+
 __all__ = ["closed_loop", "ClosedLoopResult", "ForwardDynamics", "MechanismDynamics", "run_chain",
+           "simulate_closed_loop", "simulate_computed_torque",
            "ChainRun"]
 
 ForwardDynamics = _core.ForwardDynamics

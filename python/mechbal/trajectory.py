@@ -29,9 +29,11 @@ import numpy.typing as npt
 from mechbal import _core
 
 __all__ = ["Trajectory", "RestToRest", "quintic", "minimum_energy_cubic", "ViaPoints", "Sampled",
-           "TimeLaw"]
+           "TimeLaw", "RestToRestTrajectory"]
 
 TimeLaw = _core.TimeLaw
+#: the C++ rest-to-rest law (quintic or minimum-energy cubic) that RestToRest wraps
+RestToRestTrajectory = _core.RestToRestTrajectory
 ArrayLike = npt.ArrayLike
 Times = Union[float, npt.ArrayLike]
 Motion = tuple[np.ndarray, np.ndarray, np.ndarray]

@@ -86,6 +86,19 @@ def test_runners_need_nothing_outside_the_public_modules():
     assert not missing, f"runners use _core names no public module exports: {missing}"
 
 
+def test_runners_do_not_reach_into_core():
+    """Issue 15: the case runners use only the public modules (mechbal.control, .trajectory,
+    .simulate, .papers, .balance, mechbal.Mechanism), never mechbal._core."""
+    import re
+    from pathlib import Path
+
+    runners = Path(mechbal.__file__).parent / "cases"
+    offenders = {f.name: sorted(set(re.findall(r"\b_core\b[\w.]*", f.read_text())))
+                 for f in sorted(runners.glob("*.py"))}
+    offenders = {k: v for k, v in offenders.items() if v}
+    assert not offenders, f"runners reach into mechbal._core: {offenders}"
+
+
 # ---- controllers -------------------------------------------------------------------------------
 def arm_controller(**kw):
     arm = papers.Arm2DofDynamics(papers.Arm2DofParameters())

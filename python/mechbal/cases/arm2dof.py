@@ -15,7 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import _core, progress, report
+from mechbal import control
+from mechbal import papers
+from mechbal import simulate
+from mechbal import trajectory
+from mechbal import progress, report
 from mechbal.cases import register
 from mechbal.schema import Arm2DofArm, validate_case, validate_table
 from mechbal.export import write_bodies, write_summary
@@ -23,10 +27,10 @@ from mechbal.papers import arm2dof_mechanism
 from mechbal.sizing import rms_counterweights as rc
 
 
-def arm_from_config(table) -> "_core.Arm2DofParameters":
+def arm_from_config(table) -> "papers.Arm2DofParameters":
     """The arm of an ``[arm]`` table (a dict or a validated :class:`mechbal.schema.Arm2DofArm`)."""
     arm = table if isinstance(table, Arm2DofArm) else validate_table(Arm2DofArm, table, "arm")
-    return _core.Arm2DofParameters(**arm.model_dump())
+    return papers.Arm2DofParameters(**arm.model_dump())
 
 
 def _rms(tau):
@@ -64,27 +68,27 @@ def _closed_loop(arm, cw, cfg, traj, start):
     p = cfg.perturbation
     limit = np.array(cfg.torque_limit if cfg.torque_limit is not None else [np.inf, np.inf], float)
     q0 = np.asarray(start) - e0
-    cwc = cw if cw is not None else _core.Arm2DofCounterweights()
-    plant = _core.Arm2DofDynamics(arm, cwc)
+    cwc = cw if cw is not None else papers.Arm2DofCounterweights()
+    plant = papers.Arm2DofDynamics(arm, cwc)
 
     def run(true_plant, model, sampling="zero_order_hold", lim=None, x0=q0):
-        ctrl = _core.ComputedTorque(model, kp, kd, np.array([]) if lim is None else lim)
-        return _core.simulate_computed_torque(true_plant, ctrl, traj, x0, np.zeros(2), dt,
+        ctrl = control.ComputedTorque(model, kp, kd, np.array([]) if lim is None else lim)
+        return simulate.simulate_computed_torque(true_plant, ctrl, traj, x0, np.zeros(2), dt,
                                               duration, sampling)
 
-    nominal = _core.Arm2DofDynamics(arm, cwc)
+    nominal = papers.Arm2DofDynamics(arm, cwc)
     exact = run(plant, nominal, "every_rk4_stage")
     zoh = run(plant, nominal)
     on_track = run(plant, nominal, x0=np.asarray(start, float))
     t = exact["t"]
-    e_eq6 = np.stack([_core.pd_error_analytic(e0[j], 0.0, kp[j], kd[j], t) for j in range(2)], 1)
+    e_eq6 = np.stack([papers.pd_error_analytic(e0[j], 0.0, kp[j], kd[j], t) for j in range(2)], 1)
     dev = lambda log: float(np.max(np.abs(log["q_des"] - log["q"] - e_eq6)))  # noqa: E731
     err = lambda log: float(np.max(np.abs(log["q_des"] - log["q"])))  # noqa: E731
     worst, worst_on_track = None, None
     for s in progress.track(list(itertools.product((1 - p, 1 + p), repeat=4)), "perturbed models"):
-        true_arm = _core.Arm2DofParameters(arm.m1 * s[0], arm.m2 * s[1], arm.l1, arm.l_s1,
+        true_arm = papers.Arm2DofParameters(arm.m1 * s[0], arm.m2 * s[1], arm.l1, arm.l_s1,
                                            arm.l_s2, arm.i_s1 * s[2], arm.i_s2 * s[3], arm.g)
-        true_plant = _core.Arm2DofDynamics(true_arm, cwc)
+        true_plant = papers.Arm2DofDynamics(true_arm, cwc)
         log = run(true_plant, nominal)
         if worst is None or dev(log) > worst[0]:
             worst = (dev(log), s, log)
@@ -127,8 +131,8 @@ def run(config, out: Path) -> dict:
     T, N = tt.duration, tt.samples
     paper = case.paper.model_dump()
     t = np.linspace(0.0, T, N)
-    laws = {"A": _core.TimeLaw.quintic, "B": _core.TimeLaw.cubic}
-    trajs = {k: _core.RestToRestTrajectory(start, end, T, law) for k, law in laws.items()}
+    laws = {"A": trajectory.TimeLaw.quintic, "B": trajectory.TimeLaw.cubic}
+    trajs = {k: trajectory.RestToRestTrajectory(start, end, T, law) for k, law in laws.items()}
     motion = {k: tr.evaluate_batch(t) for k, tr in trajs.items()}
 
     # ---- sizing (eqs 39-59) and its numerical check ----
@@ -136,14 +140,14 @@ def run(config, out: Path) -> dict:
     res = rc.rms_optimal_radii(arm, m_cw1, m_cw2, *motion["B"])
     r_num = rc.rms_optimal_radii_numerical(arm, m_cw1, m_cw2, *motion["B"])
     r_static = rc.static_balancing_radii(arm, m_cw1, m_cw2)
-    cw = {"C": _core.Arm2DofCounterweights(m_cw1, m_cw2, res.r_cw1, res.r_cw2),
-          "static": _core.Arm2DofCounterweights(m_cw1, m_cw2, *r_static)}
+    cw = {"C": papers.Arm2DofCounterweights(m_cw1, m_cw2, res.r_cw1, res.r_cw2),
+          "static": papers.Arm2DofCounterweights(m_cw1, m_cw2, *r_static)}
     runs = {
         "A": ("A", None), "B": ("B", None), "C": ("B", cw["C"]),
         "B_static_cw": ("B", cw["static"]), "A_static_cw": ("A", cw["static"]),
     }
     if np.all(np.isfinite(paper_r)):
-        runs["C_paper_radii"] = ("B", _core.Arm2DofCounterweights(m_cw1, m_cw2, *paper_r))
+        runs["C_paper_radii"] = ("B", papers.Arm2DofCounterweights(m_cw1, m_cw2, *paper_r))
     tau = {k: rc.arm_torques(arm, c, *motion[law]) for k, (law, c) in runs.items()}
     rms = {k: _rms(v) for k, v in tau.items()}
     peak = {k: report.peak_abs(v) for k, v in tau.items()}
@@ -155,14 +159,14 @@ def run(config, out: Path) -> dict:
     for k, (law, c) in runs.items():
         mech = arm2dof_mechanism(arm, c)
         scale = np.max(np.abs(tau[k]))
-        tk = _core.KdlChainDynamics(mech.model).inverse_dynamics(*motion[law])["tau"]
+        tk = control.KdlChainDynamics(mech.model).inverse_dynamics(*motion[law])["tau"]
         kdl_dev = max(kdl_dev, float(np.max(np.abs(tk - tau[k])) / scale))
         tg = mech.inverse_dynamics(*motion[law])
         general_dev = max(general_dev, float(np.max(np.abs(tg - tau[k])) / scale))
 
     progress.stage("computed-torque closed loops")
     # ---- closed loop on the arm of run C (and, for comparison, the bare arm of run B) ----
-    traj_B = _core.RestToRestTrajectory(start, end, T, _core.TimeLaw.cubic)
+    traj_B = trajectory.RestToRestTrajectory(start, end, T, trajectory.TimeLaw.cubic)
     cl = _closed_loop(arm, cw["C"], case.controller, traj_B, start)
     cl_bare = _closed_loop(arm, None, case.controller, traj_B, start)
 

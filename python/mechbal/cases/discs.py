@@ -14,7 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import _core, progress, report
+from mechbal import control
+from mechbal import papers
+from mechbal import trajectory
+from mechbal import progress, report
 from mechbal.cases import register
 from mechbal.config import ConfigError, inertia
 from mechbal.schema import inertia_matrix, validate_case
@@ -92,7 +95,7 @@ def _controller_check(kind, p, cfg, q_des, qd_des, qdd_des, n):
     an offset actual state (so the PD terms act)."""
     kp, kd = np.array(cfg.kp, float), np.array(cfg.kd, float)
     k = np.asarray(dz.BALANCE[kind](p)["k"])
-    dc = _core.DecoupledJointController(k, kp, kd)
+    dc = control.DecoupledJointController(k, kp, kd)
     rng = np.random.default_rng(0)
     q = q_des + rng.uniform(-0.05, 0.05, q_des.shape)
     qd = qd_des + rng.uniform(-0.1, 0.1, qd_des.shape)
@@ -100,14 +103,14 @@ def _controller_check(kind, p, cfg, q_des, qd_des, qdd_des, n):
         zip(q, qd, q_des, qd_des, qdd_des), "decoupled control ticks", total=len(q))])
     bal = dz.design(kind, p, True)
     if kind == "fivebar":
-        ct = _core.ComputedTorque(dz.fivebar_dynamics(bal), kp, kd)
+        ct = control.ComputedTorque(dz.fivebar_dynamics(bal), kp, kd)
         backend = "mechbal.ComputedTorque over FiveBarDynamics (C++, 4x4 A° per tick)"
     else:
-        ct = _core.ComputedTorque(_core.MechanismDynamics(dz.disc_mechanism(kind, bal).model), kp, kd)
+        ct = control.ComputedTorque(control.MechanismDynamics(dz.disc_mechanism(kind, bal).model), kp, kd)
         backend = "mechbal.ComputedTorque over MechanismDynamics (the general model, discs as gear couplings)"
     steps = [ct.step(*x) for x in progress.track(
         zip(q, qd, q_des, qd_des, qdd_des), "computed torque ticks", total=len(q))]
-    if any(s != _core.Status.ok for _, s in steps):
+    if any(s != control.Status.ok for _, s in steps):
         raise RuntimeError(f"computed torque failed on the trajectory: {[s for _, s in steps]}")
     tau_ct = np.array([t for t, _ in steps])
     dev = float(np.max(np.abs(tau_dc - tau_ct)) / np.max(np.abs(tau_ct)))
@@ -129,7 +132,7 @@ def _disc_bodies(kind, d, q, qd, qdd):
     N = len(q)
     if kind == "fivebar":
         m = dz.fivebar_dynamics(d).motion(q, qd, qdd)
-        if m["status"] != _core.Status.ok:
+        if m["status"] != control.Status.ok:
             raise RuntimeError(f"five-bar trajectory hits a singular pose ({m['status']})")
         th, w, al = m["angles"], m["rates"], m["accelerations"]
         names, mass, inertia = [], [], []
@@ -181,8 +184,8 @@ def _disc_bodies(kind, d, q, qd, qdd):
                     angular_acceleration=stack(alp))
 
     joints, links, discs = dz.serial_structure(kind, d)
-    kin = _core.chain_kinematics(dz.chain_model(joints, links), q, qd, qdd)
-    if kin["status"] != _core.Status.ok:
+    kin = papers.chain_kinematics(dz.chain_model(joints, links), q, qd, qdd)
+    if kin["status"] != control.Status.ok:
         raise RuntimeError(f"chain kinematics failed: {kin['status']}")
     names = [f"link{i + 1}" for i in range(len(links))]
     mass = [b.mass for b in links]
@@ -219,10 +222,10 @@ def _disc_bodies(kind, d, q, qd, qdd):
 
 def _write_bodies(path, t, b, q, qd, qdd):
     """bodies_<variant>.npz (mechbal.export schema) with mechbal.shaking_wrench of the bodies."""
-    w = _core.shaking_wrench(b["mass"], b["inertia_body"], b["com"], b["com_velocity"],
+    w = papers.shaking_wrench(b["mass"], b["inertia_body"], b["com"], b["com_velocity"],
                              b["com_acceleration"], b["rotation"], b["angular_velocity"],
                              b["angular_acceleration"])
-    if w["status"] != _core.Status.ok:
+    if w["status"] != control.Status.ok:
         raise RuntimeError(f"shaking wrench failed: {w['status']}")
     write_bodies(path, t=t, names=b["names"], mass=b["mass"], inertia_body=b["inertia_body"],
                  com=b["com"], rotation=b["rotation"], shaking_force=w["force"],
@@ -266,7 +269,7 @@ def run(config, out: Path) -> dict:
     start, end = np.array(tt.start, float), np.array(tt.end, float)
     T, Nt = tt.duration, tt.samples
     t = np.linspace(0.0, T, Nt)
-    qt, qdt, qddt = _core.RestToRestTrajectory(start, end, T, _core.TimeLaw.quintic).evaluate_batch(t)
+    qt, qdt, qddt = trajectory.RestToRestTrajectory(start, end, T, trajectory.TimeLaw.quintic).evaluate_batch(t)
     progress.stage("trajectory torques, decoupled and computed-torque control")
     tau_u = _torques(kind, dz.design(kind, p, False), qt, qdt, qddt)
     tau_b = _torques(kind, dz.design(kind, p, True), qt, qdt, qddt)

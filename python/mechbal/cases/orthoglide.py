@@ -25,7 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import _core, progress, report
+from mechbal import control
+from mechbal import progress, report
 from mechbal.cases import register
 from mechbal.config import ConfigError
 from mechbal.export import write_bodies, write_summary
@@ -51,7 +52,7 @@ def coupling_matrix(mech: Mechanism, q) -> np.ndarray:
     C = np.empty((len(q), mech.dof, len(act)))
     for k in range(len(q)):  # each instant warm-starts from its own solved pose
         m = mech.closed_motion(q[k:k + 1, act], q_guess=q[k], tolerance=1e-15)
-        if m.status[0] & ~np.uint32(int(_core.Status.singular)):
+        if m.status[0] & ~np.uint32(int(control.Status.singular)):
             raise ConfigError("mechanism.loops", f"the loops do not close at a configuration of the path "
                                                  f"(status {int(m.status[0])})", has_value=False)
         C[k] = m.projection[0]
@@ -139,7 +140,7 @@ class Orthoglide:
         rho, rho_d, rho_dd = self.rho(p, zero if v is None else v, zero if a is None else a)
         m = self.mech.closed_motion(rho, rho_d, rho_dd, q_guess=self.q_guess,
                                     tolerance=CLOSURE_TOLERANCE)
-        bad = (m.status & ~np.uint32(int(_core.Status.singular))) != 0
+        bad = (m.status & ~np.uint32(int(control.Status.singular))) != 0
         if np.any(bad) or not np.all(np.isfinite(rho)):
             k = int(np.argmax(bad | ~np.all(np.isfinite(rho), axis=1)))
             raise ConfigError("workspace", f"the mechanism cannot be assembled with P at {p[k].round(4).tolist()} m "

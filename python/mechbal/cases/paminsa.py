@@ -35,7 +35,7 @@ def parameters_from_config(config):
     """mechbal.PaminsaParameters (without counterweights) from the [geometry], [masses],
     [inertias] tables of a case (validated, or a dict validated here); ConfigError names the
     field. The C++ model validates the rest (ValueError naming the field)."""
-    from mechbal._core import PaminsaParameters
+    from mechbal.papers import PaminsaParameters
 
     case = validate_case(config, warn=False)
     p = PaminsaParameters()
@@ -56,7 +56,7 @@ def parameters_from_config(config):
 
 
 def wrist_config_from_config(config, integrator: str | None = None):
-    from mechbal._core import ReactionlessWristConfig, WristIntegrator
+    from mechbal.control import ReactionlessWristConfig, WristIntegrator
 
     w = validate_case(config, warn=False).wrist
     try:
@@ -68,7 +68,7 @@ def wrist_config_from_config(config, integrator: str | None = None):
 
 
 def trajectory_from_config(config):
-    from mechbal._core import RestToRestTrajectory, TimeLaw
+    from mechbal.trajectory import RestToRestTrajectory, TimeLaw
 
     tr = validate_case(config, warn=False).trajectory
     return RestToRestTrajectory(np.array(tr.start, float), np.array(tr.end, float), tr.duration,
@@ -77,7 +77,7 @@ def trajectory_from_config(config):
 
 def identification_trajectories(cycle, nominal):
     """The cycle plus two rest-to-rest lines that excite x and z (least-squares identification)."""
-    from mechbal._core import RestToRestTrajectory, TimeLaw
+    from mechbal.trajectory import RestToRestTrajectory, TimeLaw
 
     P0 = np.asarray(nominal, float)
     return [cycle,
@@ -123,7 +123,7 @@ def pose_wrench(model, t, P, Pd, Pdd, wrist_angles):
     own truncation error at 1 kHz)."""
     from scipy.interpolate import make_interp_spline
 
-    from mechbal._core import paminsa_kinematics
+    from mechbal.papers import paminsa_kinematics
 
     spline = make_interp_spline(t, wrist_angles, k=5)
     return paminsa_kinematics(model, P, Pd, Pdd, wrist_angles, spline(t, 1), spline(t, 2))
@@ -136,7 +136,7 @@ def moment_about(M, F, point):
 
 @register("paminsa", stages=5)
 def run(config, out: Path) -> dict:
-    from mechbal._core import PaminsaModel, paminsa_kinematics, paminsa_reactionless_run
+    from mechbal.papers import PaminsaModel, paminsa_kinematics, paminsa_reactionless_run
 
     config = validate_case(config, warn=False)
     params = parameters_from_config(config)

@@ -25,7 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import _core, progress, report
+from mechbal import control
+from mechbal import progress, report
 from mechbal.cases import register
 from mechbal.config import ConfigError
 from mechbal.export import write_bodies, write_summary
@@ -40,7 +41,7 @@ NEAR_SINGULAR_FRACTION = 0.2
 #: Newton tolerance of the loop solve [m]: 1e-14 keeps theta_i within 1e-12 rad of the closed form
 #: even where a leg is 17 mm long (an angle error is a position error over l_i)
 SOLVE_TOLERANCE = 1e-14
-_SINGULAR = np.uint32(int(_core.Status.singular))
+_SINGULAR = np.uint32(int(control.Status.singular))
 
 
 # ---- the mechanism's variants, as specs ---------------------------------------------------------

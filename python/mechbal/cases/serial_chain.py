@@ -8,7 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import _core, progress, report
+from mechbal import control
+import mechbal
+from mechbal import progress, report
 from mechbal.cases import register
 from mechbal.config import ConfigError, trajectory_from_config
 from mechbal.export import write_bodies, write_summary
@@ -24,13 +26,13 @@ def mechanism_motion(mech: Mechanism, traj, t, q_guess=None):
     if not mech.is_closed:
         return qa, va, aa, mech.inverse_dynamics(qa, va, aa), {}
     m = mech.closed_motion(qa, va, aa, q_guess=q_guess, with_forces=True)
-    bad = (m.status & ~np.uint32(int(_core.Status.singular))) != 0
+    bad = (m.status & ~np.uint32(int(control.Status.singular))) != 0
     if np.any(bad):
         k = int(np.argmax(bad))
         raise ConfigError("trajectory", f"the loops cannot be assembled at t = {t[k]:.4g} s (closure "
                                         f"residual {m.residual[k]:.3g}); check the geometry, the "
                                         "trajectory and trajectory.initial_guess", has_value=False)
-    singular = (m.status & np.uint32(int(_core.Status.singular))) != 0
+    singular = (m.status & np.uint32(int(control.Status.singular))) != 0
     extra = {"min_rcond": float(np.min(m.rcond)), "singular_instants": int(np.sum(singular)),
              "max_closure_residual": float(np.max(m.residual)),
              "max_newton_iterations": int(np.max(m.iterations))}
@@ -89,7 +91,7 @@ def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, 
                                "about O) against the shaking wrench (inertial only): they differ "
                                "by the weight, -m g and -(m c) x g.")
     types = {j.name: j.type for j in mech.model.description.joints}
-    kinds = ["prismatic" if types[n] == _core.JointType.prismatic else "revolute" for n in names]
+    kinds = ["prismatic" if types[n] == mechbal.JointType.prismatic else "revolute" for n in names]
     report.plot_series(out / "joint_torques.png", t, {"general model": torque},
                        [f"{n} ({k})" for n, k in zip(names, kinds)],
                        ["torque [N m]" if k == "revolute" else "force [N]" for k in kinds],

@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mechbal import _core
+import mechbal
+from mechbal import trajectory
 from mechbal.cases import register
 from mechbal.config import ConfigError, integer, number, require
 from mechbal.mechanism import Mechanism
@@ -24,7 +25,7 @@ KIND = "urdf"
 DEFAULT_DURATION = 2.0
 DEFAULT_SAMPLES = 501
 #: largest default motion of one joint: revolute [rad], prismatic [m]
-MAX_STEP = {_core.JointType.revolute: 0.5, _core.JointType.prismatic: 0.1}
+MAX_STEP = {mechbal.JointType.revolute: 0.5, mechbal.JointType.prismatic: 0.1}
 
 
 def urdf_case(path: str | Path, duration: float | None = None, samples: int | None = None) -> dict:
@@ -66,7 +67,7 @@ def run(config: dict, out: Path) -> dict:
     if mech.dof == 0:
         raise ConfigError(f"URDF file '{path}'", "has no moving joint to run", has_value=False)
     start, end = default_motion(mech)
-    traj = _core.RestToRestTrajectory(start, end, duration, _core.TimeLaw.quintic)
+    traj = trajectory.RestToRestTrajectory(start, end, duration, trajectory.TimeLaw.quintic)
     t = np.linspace(0.0, duration, samples)
     return run_mechanism(mech, traj, t, out, name=config["case"]["name"], kind=KIND,
                          title=config["case"].get("title", config["case"]["name"]),
