@@ -570,3 +570,49 @@ DISCREPANCIES = [
     "The unbalanced static loads of Table 6 (y rms 728 N) match (m_p + m_s2 + m_w + m_t/2) g = 723 N: the paper's "
     "unbalanced machine evidently keeps the balancing linkage's masses; ours does the same (springs removed).",
 ]
+
+
+def table6_sweep(case=None, *, rates: dict[str, float] | None = None, grid=None):
+    """The Orthoglide's Table 6 (Martini et al. 2015) as a :class:`mechbal.sweep.Sweep`
+    (sensitivity): m_p and m_s2 +-``sensitivity.relative`` (body masses of the case's
+    ``roles.platform_body`` / ``roles.vertical_slider_body``), the spring rates K_D and K_P
+    +-``sensitivity.relative`` and the distal spring's platform anchor +-``sensitivity.anchor_offset``
+    per component (design variables), one callable metric: the static motor loads over the
+    workspace grid, per axis (``static_loads.<axis>_rms`` and ``_max`` [N]).
+    ``case``: the validated case (default: the built-in ``orthoglide``); ``rates``: the balanced
+    rates [N/m] (default: sized by least squares as the runner does); ``grid``: the platform points
+    (default: the case's workspace grid). ``table6_sweep().run("serial")`` gives the same numbers as
+    the runner's Table 6 (tests/python/test_orthoglide.py)."""
+    from mechbal.config import case_path, read_toml
+    from mechbal.sweep import Parameter, Sweep
+
+    case = case if case is not None else validate_case(read_toml(case_path("orthoglide")), warn=False)
+    roles, sens = case.roles, case.sensitivity
+    nominal = Orthoglide(case)
+    if grid is None:
+        grid = workspace_grid(case.workspace.center, case.workspace.edge, case.workspace.grid)
+    if rates is None:
+        sized, *_ = nominal.size_rates(grid)
+        rates = {s.name: (s.rate if s.rate is not None else sized[s.name]) for s in case.springs}
+    distal = next(x for x in case.springs if x.name == roles.distal_spring)
+
+    def static_loads(mechanism, design):
+        design = {k.split(".", 1)[-1]: v for k, v in design.items()}  # "design.K_D" -> "K_D"
+        masses = {b.name: b.mass for b in mechanism.bodies}
+        b = tuple(distal.anchor_b[k] + design[f"r_B{ax}"] for k, ax in enumerate("xyz"))
+        o = Orthoglide(case, masses=masses, anchors={distal.name: {"b": b}})
+        sprs = o.springs({**rates, roles.distal_spring: design["K_D"], roles.proximal_spring: design["K_P"]})
+        stats = static_stats(o.static_forces(grid, sprs))
+        return {f"{ax}_{k}": stats[ax][k] for ax in "xyz" for k in ("rms", "max")}
+
+    rel, off = sens.relative, sens.anchor_offset
+    parameters = [Parameter(f"bodies.{roles.platform_body}.mass", tolerance=rel),
+                  Parameter(f"bodies.{roles.vertical_slider_body}.mass", tolerance=rel),
+                  Parameter("design.K_D", nominal=rates[roles.distal_spring], tolerance=rel),
+                  Parameter("design.K_P", nominal=rates[roles.proximal_spring], tolerance=rel)]
+    parameters += [Parameter(f"design.r_B{ax}", nominal=0.0, delta=off) for ax in "xyz"]
+    q_guess = nominal.q_guess
+    qa = q_guess[list(nominal.mech.model.actuated_coordinates)][None]
+    return Sweep(dataclasses.replace(case.spec), parameters, {"static_loads": static_loads},
+                 kind="sensitivity", poses=qa, q_guess=q_guess, name="orthoglide-table6",
+                 title="Orthoglide Table 6: static motor loads, +-10 % masses and rates, +-5 mm anchor")
