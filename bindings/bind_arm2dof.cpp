@@ -22,6 +22,21 @@ namespace mechbal::pyb {
 
 namespace {
 
+/// The simulator's options from the Python arguments (ValueError naming a bad sampling mode).
+ClosedLoopOptions closed_loop_options(double dt, double duration, const std::string& sampling) {
+  ClosedLoopOptions opt;
+  opt.dt = dt;
+  opt.duration = duration;
+  if (sampling == "zero_order_hold") {
+    opt.sampling = ControlSampling::zero_order_hold;
+  } else if (sampling == "every_rk4_stage") {
+    opt.sampling = ControlSampling::every_rk4_stage;
+  } else {
+    throw py::value_error("sampling must be 'zero_order_hold' or 'every_rk4_stage', got '" + sampling + "'");
+  }
+  return opt;
+}
+
 using CVec = Eigen::Map<const Eigen::VectorXd>;
 
 // Applies a per-sample 2-in-3-out function over (N, 2) arrays.
@@ -200,16 +215,7 @@ void bind_arm2dof(py::module_& m) {
          const Array& q0_arg, const Array& qd0_arg, double dt, double duration,
          const std::string& sampling) {
         const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "qd0", -1);
-        ClosedLoopOptions opt;
-        opt.dt = dt;
-        opt.duration = duration;
-        if (sampling == "zero_order_hold")
-          opt.sampling = ControlSampling::zero_order_hold;
-        else if (sampling == "every_rk4_stage")
-          opt.sampling = ControlSampling::every_rk4_stage;
-        else
-          throw py::value_error("sampling must be 'zero_order_hold' or 'every_rk4_stage', got '" +
-                                sampling + "'");
+        const ClosedLoopOptions opt = closed_loop_options(dt, duration, sampling);
         ClosedLoopLog log;
         {
           py::gil_scoped_release release;
@@ -239,16 +245,7 @@ void bind_arm2dof(py::module_& m) {
         desired.qd = Eigen::Map<const RowMajor>(qd_des.data(), J, n);
         desired.qdd = Eigen::Map<const RowMajor>(qdd_des.data(), J, n);
         const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "qd0", -1);
-        ClosedLoopOptions opt;
-        opt.dt = dt;
-        opt.duration = duration;
-        if (sampling == "zero_order_hold")
-          opt.sampling = ControlSampling::zero_order_hold;
-        else if (sampling == "every_rk4_stage")
-          opt.sampling = ControlSampling::every_rk4_stage;
-        else
-          throw py::value_error("sampling must be 'zero_order_hold' or 'every_rk4_stage', got '" +
-                                sampling + "'");
+        const ClosedLoopOptions opt = closed_loop_options(dt, duration, sampling);
         ClosedLoopLog log;
         {
           py::gil_scoped_release release;

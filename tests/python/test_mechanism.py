@@ -11,6 +11,7 @@ import pytest
 import mechbal
 from mechbal import _core
 from random_trees import random_tree
+from pinocchio_checks import _base_fixed_mass_moment, _rel  # noqa: F401
 
 pin = pytest.importorskip("pinocchio")
 
@@ -27,41 +28,12 @@ def _index(pm, mech):
     return [pm.idx_qs[pm.getJointId(n)] for n in mech.joint_names]
 
 
-def _rel(a, b):
-    a, b = np.asarray(a), np.asarray(b)
-    if a.size == 0 and b.size == 0:
-        return 0.0
-    return np.abs(a - b).max() / max(1.0, np.abs(b).max())
-
-
 def _states(rng, mech, pm, idx, count):
     for _ in range(count):
         q, v, a = rng.uniform(-2, 2, mech.dof), rng.normal(size=mech.dof), rng.normal(size=mech.dof)
         qp, vp, ap = np.zeros(pm.nq), np.zeros(pm.nv), np.zeros(pm.nv)
         qp[idx], vp[idx], ap[idx] = q, v, a
         yield q, v, a, qp, vp, ap
-
-
-def _base_fixed_mass_moment(mech, q):
-    """m c of the bodies that cannot move: on the base or on links welded to it by fixed joints
-    (Pinocchio leaves them out of its centre of mass)."""
-    motion = mech.body_motion(q)
-    parents = mech.model.link_parents
-    types = {j.name: j.type for j in mech.model.description.joints}
-    names = mech.link_names
-
-    def welded(link):
-        while link != 0:
-            if types[names[link]] != _core.JointType.fixed:
-                return False
-            link = parents[link]
-        return True
-
-    out = np.zeros(3)
-    for b, body in enumerate(mech.bodies):
-        if welded(mech.model.body_links[b]):
-            out += body.mass * motion.com[b]
-    return out
 
 
 @pytest.mark.parametrize("types", ["R", "RP", "RRRPF", "RF"])
