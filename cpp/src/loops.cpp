@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
@@ -13,68 +14,97 @@ namespace mechbal {
 
 namespace {
 
-/// Row `row` of the loop Jacobian: sum_k (lin_k . JX_lin col) + (ang_k . JY_ang col), written
-/// column by column (no temporaries).
-template <typename J>
-void set_row(J& jac, int row, const Vec3& lin, const Eigen::MatrixXd& JL, double lin_sign_b,
-             const Eigen::MatrixXd& JLa, const Vec3& ang, const Eigen::MatrixXd& JW) {
-  // jac(row, c) = lin . (JL_lin(c) * sign_b - JLa_lin(c)) + ang . JW_ang(c)
-  for (Eigen::Index c = 0; c < jac.cols(); ++c) {
-    const Vec3 dl = lin_sign_b * JL.col(c).head<3>() - JLa.col(c).head<3>();
-    jac(row, c) = lin.dot(dl) + ang.dot(JW.col(c).tail<3>());
+/// Position and orientation (O axes) of a named frame, from placed links.
+struct FramePose {
+  Vec3 position;
+  Mat3 rotation;
+};
+
+FramePose frame_pose(const MechanismModel& model, const MechanismData& data, int frame) noexcept {
+  const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
+  const auto f = static_cast<std::size_t>(frame);
+  return {W.world_position + W.world_rotation * data.frame_position_in_link[f],
+          W.world_rotation * data.frame_rotation_in_link[f]};
+}
+
+/// Each closure row is a linear function of the frames' relative motion:
+/// row = a . (v_B - v_A) + b . w_A + e . w_B (v: origin velocities, w: angular velocities, O axes).
+struct RowFunctional {
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero(), e = Vec3::Zero();
+};
+
+/// Adds the columns of the joints on the path from `link` to the root to the loop's rows:
+/// joint k moves the frame's origin p by r z x (p - p_k) (revolute) or r z (prismatic) and turns
+/// it by r z (revolute); `side` -1 for frame A, +1 for frame B. Only the loop's own coordinates are
+/// touched (no dense 6 x n frame Jacobians).
+void add_path_columns(const MechanismModel& model, const MechanismData& data, int link, const Vec3& p, double side,
+                      const RowFunctional* f, int rows, int row0, Eigen::MatrixXd& jac) noexcept {
+  for (int k = link; k >= 1; k = model.parent(k)) {
+    const int c = model.coordinate(k);
+    if (c < 0) continue;
+    const auto& K = data.work[static_cast<std::size_t>(k)];
+    const Vec3 z = model.coordinate_ratio(k) * K.world_rotation.col(2);
+    if (model.joint_type(k) == JointType::revolute) {
+      const Vec3 lin = z.cross(p - K.world_position);
+      for (int r = 0; r < rows; ++r) {
+        jac(row0 + r, c) += side * f[r].a.dot(lin) + (side < 0.0 ? f[r].b : f[r].e).dot(z);
+      }
+    } else {
+      for (int r = 0; r < rows; ++r) jac(row0 + r, c) += side * f[r].a.dot(z);
+    }
   }
 }
 
 /// Residual (and Jacobian) of every loop, from placed links (world poses computed).
 void constraint_rows(const MechanismModel& model, MechanismData& data, bool jacobian) noexcept {
   Eigen::MatrixXd& jac = data.loop_jacobian;
-  const Eigen::MatrixXd& JA = data.loop_frame_jacobian_a;
-  const Eigen::MatrixXd& JB = data.loop_frame_jacobian_b;
+  if (jacobian) jac.setZero();
   for (int i = 0; i < model.num_loops(); ++i) {
     const int row = model.loop_row(i), fa = model.loop_frame_a(i), fb = model.loop_frame_b(i);
-    const detail::FrameMotion A = detail::frame_motion(model, data, fa);
-    const detail::FrameMotion B = detail::frame_motion(model, data, fb);
+    const FramePose A = frame_pose(model, data, fa);
+    const FramePose B = frame_pose(model, data, fb);
     const Vec3 d = B.position - A.position;
-    if (jacobian) {
-      detail::frame_jacobian_placed(model, data, fa, data.loop_frame_jacobian_a);
-      detail::frame_jacobian_placed(model, data, fb, data.loop_frame_jacobian_b);
-    }
     const LoopType type = model.loop(i).type;
+    RowFunctional f[6];
+    int rows = 0;
     if (type == LoopType::planar_point) {
+      // x_k . d: its rate is x_k . (v_B - v_A) + (w_A x x_k) . d = x_k . (v_B - v_A) + (x_k x d) . w_A
       for (int k = 0; k < 2; ++k) {
         const Vec3 x = A.rotation.col(k);
         data.loop_residual(row + k) = x.dot(d);
-        if (jacobian) set_row(jac, row + k, x, JB, 1.0, JA, x.cross(d), JA);
+        f[k].a = x;
+        f[k].b = x.cross(d);
       }
-      continue;
+      rows = 2;
+    } else {
+      // point part of point, axis and weld
+      data.loop_residual.segment<3>(row) = d;
+      for (int k = 0; k < 3; ++k) f[k].a = Vec3::Unit(k);
+      rows = 3;
+      if (type == LoopType::axis) {
+        // z_A . e_k (e_k = x_B, y_B): its rate is (z x e_k) . (w_A - w_B)
+        const Vec3 z = A.rotation.col(2);
+        for (int k = 0; k < 2; ++k) {
+          const Vec3 e = B.rotation.col(k);
+          data.loop_residual(row + 3 + k) = z.dot(e);
+          f[3 + k].b = z.cross(e);
+          f[3 + k].e = -f[3 + k].b;
+        }
+        rows = 5;
+      } else if (type == LoopType::weld) {
+        // rotation vector of R_B R_A^T: its rate at the solution is w_B - w_A
+        const Eigen::AngleAxisd err(Mat3(B.rotation * A.rotation.transpose()));
+        data.loop_residual.segment<3>(row + 3) = err.angle() * err.axis();
+        for (int k = 0; k < 3; ++k) {
+          f[3 + k].b = -Vec3::Unit(k);
+          f[3 + k].e = Vec3::Unit(k);
+        }
+        rows = 6;
+      }
     }
-    // point part of point, axis and weld
-    data.loop_residual.segment<3>(row) = d;
     if (jacobian) {
-      for (Eigen::Index c = 0; c < jac.cols(); ++c) {
-        jac.block<3, 1>(row, c) = JB.col(c).head<3>() - JA.col(c).head<3>();
-      }
-    }
-    if (type == LoopType::axis) {
-      const Vec3 z = A.rotation.col(2);
-      for (int k = 0; k < 2; ++k) {
-        const Vec3 e = B.rotation.col(k);
-        data.loop_residual(row + 3 + k) = z.dot(e);
-        if (jacobian) {
-          const Vec3 ze = z.cross(e);
-          for (Eigen::Index c = 0; c < jac.cols(); ++c) {
-            jac(row + 3 + k, c) = ze.dot(JA.col(c).tail<3>() - JB.col(c).tail<3>());
-          }
-        }
-      }
-    } else if (type == LoopType::weld) {
-      const Eigen::AngleAxisd err(Mat3(B.rotation * A.rotation.transpose()));
-      data.loop_residual.segment<3>(row + 3) = err.angle() * err.axis();
-      if (jacobian) {
-        for (Eigen::Index c = 0; c < jac.cols(); ++c) {
-          jac.block<3, 1>(row + 3, c) = JB.col(c).tail<3>() - JA.col(c).tail<3>();
-        }
-      }
+      add_path_columns(model, data, model.frame_link(fa), A.position, -1.0, f, rows, row, jac);
+      add_path_columns(model, data, model.frame_link(fb), B.position, 1.0, f, rows, row, jac);
     }
   }
 }
@@ -120,92 +150,156 @@ void evaluate(const MechanismModel& model, MechanismData& data, const Eigen::Ref
   constraint_rows(model, data, jacobian);
 }
 
-/// N = L D L^T in place, without pivoting (N is symmetric positive semi-definite: the normal matrix
-/// of A° plus a small damping): L in N's strict lower triangle (unit diagonal implied), D in `D`.
-/// Written out for the small sizes of loop closures, where Eigen's LDLT (pivot search, blocked
-/// triangular solves) costs several times more. A pivot that is not positive (a singular A°) is
-/// kept as is and its component is zeroed by ldl_solve, as Eigen's LDLT does (pseudo-inverse of D).
-void ldl_factor(Eigen::MatrixXd& N, Eigen::VectorXd& D) noexcept {
+/// N = L D L^T in place, without pivoting, over the structure of data.loop_factor_rows (N is
+/// symmetric positive semi-definite: the normal matrix of A° plus a small damping; its rows and
+/// columns in the elimination order): L in N's strict lower triangle (unit diagonal implied, only
+/// the structural entries are read or written), D in `D`. Written out for the small, sparse
+/// systems of loop closures, where a dense LDLT (pivot search, blocked triangular solves) costs
+/// several times more. A pivot that is not positive (a singular A°) is kept as is and its
+/// component is zeroed by ldl_solve, as Eigen's LDLT does (pseudo-inverse of D).
+void ldl_factor(MechanismData& data) noexcept {
+  Eigen::MatrixXd& N = data.loop_normal;
+  Eigen::VectorXd& D = data.loop_normal_pivots;
+  const int* rows = data.loop_factor_rows.data();
   const Eigen::Index n = N.rows();
   for (Eigen::Index k = 0; k < n; ++k) {
     const double d = N(k, k);
     D(k) = d;
-    const Eigen::Index rest = n - k - 1;
+    const int begin = data.loop_factor_start[static_cast<std::size_t>(k)];
+    const int end = data.loop_factor_start[static_cast<std::size_t>(k) + 1];
+    double* lk = N.data() + k * n;
     if (!(d > 0.0)) {
-      N.col(k).tail(rest).setZero();
+      for (int p = begin; p < end; ++p) lk[rows[p]] = 0.0;
       continue;
     }
-    for (Eigen::Index j = k + 1; j < n; ++j) {
-      const double f = N(j, k) / d;
-      if (f != 0.0) N.col(j).segment(j, n - j) -= f * N.col(k).segment(j, n - j);
+    for (int p = begin; p < end; ++p) {
+      const int j = rows[p];
+      const double f = lk[j] / d;
+      if (f == 0.0) continue;
+      double* nj = N.data() + j * n;
+      for (int r = p; r < end; ++r) nj[rows[r]] -= f * lk[rows[r]];
     }
-    N.col(k).tail(rest) /= d;
+    for (int p = begin; p < end; ++p) lk[rows[p]] /= d;
   }
 }
 
-/// x = (L D L^T)^-1 x with the factors of ldl_factor (plain loops: these are short vectors).
-void ldl_solve(const Eigen::MatrixXd& L, const Eigen::VectorXd& D, Eigen::Ref<Eigen::VectorXd> x) noexcept {
+/// x = (L D L^T)^-1 x with the factors of ldl_factor.
+void ldl_solve(const MechanismData& data, Eigen::Ref<Eigen::VectorXd> x) noexcept {
+  const Eigen::MatrixXd& L = data.loop_normal;
+  const Eigen::VectorXd& D = data.loop_normal_pivots;
+  const int* rows = data.loop_factor_rows.data();
+  const int* start = data.loop_factor_start.data();
   const Eigen::Index n = L.rows();
   double* const v = x.data();
   for (Eigen::Index k = 0; k < n; ++k) {
     const double xk = v[k];
     if (xk == 0.0) continue;
     const double* l = L.data() + k * n;
-    for (Eigen::Index i = k + 1; i < n; ++i) v[i] -= xk * l[i];
+    for (int p = start[k]; p < start[k + 1]; ++p) v[rows[p]] -= xk * l[rows[p]];
   }
   for (Eigen::Index k = 0; k < n; ++k) v[k] = D(k) > 0.0 ? v[k] / D(k) : 0.0;
   for (Eigen::Index k = n - 1; k >= 0; --k) {
     const double* l = L.data() + k * n;
     double sum = 0.0;
-    for (Eigen::Index i = k + 1; i < n; ++i) sum += l[i] * v[i];
+    for (int p = start[k]; p < start[k + 1]; ++p) sum += l[rows[p]] * v[rows[p]];
     v[k] -= sum;
   }
 }
 
-/// N = A°^T A° + damping from data.loop_jacobian, factorised; returns the rcond estimate of A°.
-double factor_passive(const MechanismModel& model, MechanismData& data) noexcept {
-  const auto& passive = model.passive_coordinates();
-  const auto np = static_cast<Eigen::Index>(passive.size());
-  for (Eigen::Index j = 0; j < np; ++j) {
-    data.loop_passive_jacobian.col(j) = data.loop_jacobian.col(passive[static_cast<std::size_t>(j)]);
+/// y += a x over n contiguous entries (rows of the row-major blocks: a handful of actuated columns,
+/// too short for Eigen's dynamic-size expressions to pay off).
+inline void axpy(double* y, double a, const double* x, Eigen::Index n) noexcept {
+  for (Eigen::Index j = 0; j < n; ++j) y[j] += a * x[j];
+}
+
+/// X = (L D L^T)^-1 X for a block of right-hand sides (np x na, row-major): one pass over L for
+/// all of them (the columns of C).
+void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
+  const Eigen::MatrixXd& L = data.loop_normal;
+  const Eigen::VectorXd& D = data.loop_normal_pivots;
+  const int* rows = data.loop_factor_rows.data();
+  const int* start = data.loop_factor_start.data();
+  const Eigen::Index n = L.rows(), w = X.cols();
+  double* x = X.data();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double* l = L.data() + k * n;
+    for (int p = start[k]; p < start[k + 1]; ++p) axpy(x + rows[p] * w, -l[rows[p]], x + k * w, w);
   }
-  // N = A°^T A°, lower triangle only (what ldl_factor reads), each entry a dot product over the rows
-  // where both columns can be nonzero: a loop's rows involve only the coordinates of its two
-  // frames' branches, so on mechanisms with several loops most column pairs do not overlap
-  // (PAMINSA: the legs' coordinates meet only through the platform's), several times cheaper than
-  // the dense product
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double inv = D(k) > 0.0 ? 1.0 / D(k) : 0.0;
+    for (Eigen::Index j = 0; j < w; ++j) x[k * w + j] *= inv;
+  }
+  for (Eigen::Index k = n - 1; k >= 0; --k) {
+    const double* l = L.data() + k * n;
+    for (int p = start[k]; p < start[k + 1]; ++p) axpy(x + k * w, -l[rows[p]], x + rows[p] * w, w);
+  }
+}
+
+/// Relative damping of the normal equations: keeps the solves bounded at a singular A° (Status::singular).
+constexpr double kDamping = 1e-16;
+
+/// N = A°^T A° + damping from data.loop_jacobian, factorised; returns the rcond estimate of A°.
+double factor_passive(MechanismData& data) noexcept {
+  const auto& order = data.loop_elimination;
+  const auto np = static_cast<Eigen::Index>(order.size());
   const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
-  Eigen::MatrixXd& N = data.loop_normal;
   const auto m = static_cast<int>(Ap.rows());
+  // A°'s columns in the elimination order, and the rows holding each column's nonzeros (a loop's
+  // rows involve only the coordinates of its two frames' branches)
   for (Eigen::Index j = 0; j < np; ++j) {
-    int first = m, last = -1;
-    for (int r = 0; r < m; ++r) {
-      if (Ap(r, j) != 0.0) {
-        if (first == m) first = r;
-        last = r;
-      }
+    data.loop_passive_jacobian.col(j) = data.loop_jacobian.col(order[static_cast<std::size_t>(j)]);
+    const double* a = Ap.data() + j * m;
+    int first = 0, last = m - 1;
+    while (first < m && a[first] == 0.0) ++first;
+    while (last > first && a[last] == 0.0) --last;
+    if (first == m) last = -1;
+    int count = 0;
+    for (int r = first; r <= last; ++r) {
+      if (a[r] != 0.0) data.loop_passive_rows(count++, j) = r;
     }
+    data.loop_passive_count(j) = count;
     data.loop_passive_first(j) = first;
     data.loop_passive_last(j) = last;
   }
-  for (Eigen::Index i = 0; i < np; ++i) {
+  // N = A°^T A° on the structure of L (which holds N's), each entry a dot product over the rows
+  // where both columns can be nonzero
+  Eigen::MatrixXd& N = data.loop_normal;
+  const auto dot = [&](Eigen::Index i, Eigen::Index j) {
+    const int lo = std::max(data.loop_passive_first(i), data.loop_passive_first(j));
+    const int hi = std::min(data.loop_passive_last(i), data.loop_passive_last(j));
     const double* ai = Ap.data() + i * m;
-    for (Eigen::Index j = i; j < np; ++j) {
-      const int lo = std::max(data.loop_passive_first(i), data.loop_passive_first(j));
-      const int hi = std::min(data.loop_passive_last(i), data.loop_passive_last(j));
-      const double* aj = Ap.data() + j * m;
-      double sum = 0.0;
-      for (int r = lo; r <= hi; ++r) sum += ai[r] * aj[r];
-      N(j, i) = sum;
+    const double* aj = Ap.data() + j * m;
+    double sum = 0.0;
+    for (int r = lo; r <= hi; ++r) sum += ai[r] * aj[r];
+    return sum;
+  };
+  double scale = 1.0;
+  for (Eigen::Index i = 0; i < np; ++i) {
+    N(i, i) = dot(i, i);
+    scale = std::max(scale, N(i, i));
+    const int end = data.loop_factor_start[static_cast<std::size_t>(i) + 1];
+    for (int p = data.loop_factor_start[static_cast<std::size_t>(i)]; p < end; ++p) {
+      const int j = data.loop_factor_rows[static_cast<std::size_t>(p)];
+      N(j, i) = dot(i, j);
     }
   }
-  const double scale = std::max(1.0, data.loop_normal.diagonal().maxCoeff());
-  data.loop_normal.diagonal().array() += 1e-14 * scale;
-  ldl_factor(data.loop_normal, data.loop_normal_pivots);
+  for (Eigen::Index i = 0; i < np; ++i) N(i, i) += kDamping * scale;
+  ldl_factor(data);
   const Eigen::VectorXd& D = data.loop_normal_pivots;
   if (np == 0) return 1.0;
   const double dmax = D.cwiseAbs().maxCoeff(), dmin = D.cwiseAbs().minCoeff();
-  return dmax > 0.0 ? std::sqrt(std::max(0.0, dmin - 1e-14 * scale) / dmax) : 0.0;
+  return dmax > 0.0 ? std::sqrt(std::max(0.0, dmin - kDamping * scale) / dmax) : 0.0;
+}
+
+/// (A°^T y)_i: column i of A° (elimination order) against y, over the rows holding the column's
+/// nonzeros (data.loop_passive_rows, from factor_passive).
+double column_dot(const MechanismData& data, Eigen::Index i, const double* y) noexcept {
+  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
+  const double* a = Ap.data() + i * Ap.rows();
+  double sum = 0.0;
+  const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+  for (int p = 0; p < data.loop_passive_count(i); ++p) sum += a[rows[p]] * y[rows[p]];
+  return sum;
 }
 
 Status check(const MechanismModel& model, const MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,
@@ -271,53 +365,91 @@ Status solve_loop_positions(const MechanismModel& model, MechanismData& data, co
     q = trial;
     return Status::ok;
   }
-  evaluate(model, data, trial, true);
+  // Newton on Phi(q) = 0 over the passive coordinates. On a warm-started tick the factorisation of
+  // the last solve (at data.closed_position, a few micrometres away) is reused: chord steps, which
+  // need only the residual at each trial point, no Jacobian and no factorisation; the Jacobian is
+  // evaluated and factorised once, at the solution (the projection needs it there). When a chord
+  // step does not reduce the residual fourfold, the solve switches to full Newton (Jacobian and
+  // factorisation at every iterate), as it does from the start without a warm start.
+  bool chord = tangent;
+  bool jacobian_at_trial = false;  // data.loop_jacobian is that of `trial`
+  bool placed_at_trial = true;     // the links are placed at `trial` (the last evaluation)
+  evaluate(model, data, trial, false);
   double norm = data.loop_residual.cwiseAbs().maxCoeff();
   Eigen::VectorXd& candidate = data.loop_vector_work;
   for (int it = 0; it < options.max_iterations && norm > options.tolerance && !passive.empty(); ++it) {
     data.loop_iterations = it + 1;
-    factor_passive(model, data);
-    data.loop_step.noalias() = -data.loop_passive_jacobian.transpose() * data.loop_residual;
-    ldl_solve(data.loop_normal, data.loop_normal_pivots, data.loop_step);
+    if (!chord) {
+      if (!jacobian_at_trial) {
+        if (placed_at_trial) {
+          constraint_rows(model, data, true);
+        } else {
+          evaluate(model, data, trial, true);
+        }
+        jacobian_at_trial = placed_at_trial = true;
+      }
+      factor_passive(data);
+    } else if (!placed_at_trial) {
+      evaluate(model, data, trial, false);  // the residual at trial (the step needs it)
+      placed_at_trial = true;
+    }
+    for (Eigen::Index i = 0; i < data.loop_step.size(); ++i) {
+      data.loop_step(i) = -column_dot(data, i, data.loop_residual.data());
+    }
+    ldl_solve(data, data.loop_step);
     const double biggest = data.loop_step.cwiseAbs().maxCoeff();
-    if (!(biggest < 1e300)) break;  // non-finite step: cannot assemble here
+    if (!(biggest < 1e300)) {  // non-finite step: cannot assemble here
+      if (chord) {
+        chord = false;
+        continue;
+      }
+      break;
+    }
     if (biggest > options.max_step) data.loop_step *= options.max_step / biggest;
     bool improved = false;
     for (int halving = 0; halving <= 8; ++halving) {
       candidate = trial;
       for (std::size_t j = 0; j < passive.size(); ++j) {
-        candidate(passive[j]) += data.loop_step(static_cast<Eigen::Index>(j));
+        candidate(data.loop_elimination[j]) += data.loop_step(static_cast<Eigen::Index>(j));
       }
-      evaluate(model, data, candidate, true);
+      evaluate(model, data, candidate, false);
       const double n = data.loop_residual.cwiseAbs().maxCoeff();
       if (n < norm) {
+        if (chord && !(n <= 0.25 * norm)) chord = false;  // slow: full Newton from here
         trial = candidate;
         norm = n;
         improved = true;
+        jacobian_at_trial = false;
+        placed_at_trial = true;
         break;
       }
+      placed_at_trial = false;
+      if (chord) break;  // a stale factorisation: retry this iterate with full Newton
       data.loop_step *= 0.5;
     }
     if (!improved) {
-      evaluate(model, data, trial, true);
+      if (chord) {
+        chord = false;
+        continue;
+      }
       break;
     }
   }
   data.loop_residual_norm = norm;
-  if (!(norm <= options.tolerance)) {
-    data.loop_rcond = passive.empty() ? 1.0 : factor_passive(model, data);
-    return Status::solver_error;
+  // the Jacobian at the result, and the links placed there (project relies on both)
+  if (!placed_at_trial) {
+    evaluate(model, data, trial, true);
+  } else if (!jacobian_at_trial && !passive.empty()) {
+    constraint_rows(model, data, true);
   }
-  data.loop_rcond = factor_passive(model, data);
+  data.loop_rcond = passive.empty() ? 1.0 : factor_passive(data);
+  if (!(norm <= options.tolerance)) return Status::solver_error;
   q = trial;
   return data.loop_rcond < options.singular_rcond ? Status::singular : Status::ok;
 }
 
 namespace {
 
-/// loop_projection at q (checked); `solved`: q is where solve_loop_positions just converged, so
-/// data.loop_jacobian, the factorisation of A° and data.loop_rcond are already those of q (its last
-/// evaluation) and are not recomputed.
 /// One step of iterative refinement of x, the least-squares solution of A° x = -b from the factored
 /// normal equations: x += (A°^T A°)^-1 A°^T (-(b + A° x)). The normal equations square A°'s
 /// condition and carry a small damping; one step brings x back to the accuracy of A° itself (a
@@ -326,25 +458,22 @@ template <typename B, typename X>
 void refine(MechanismData& data, const B& b, X&& x) noexcept {
   const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
   Eigen::VectorXd& r = data.loop_constraint_work;
-  for (Eigen::Index row = 0; row < Ap.rows(); ++row) {
-    double v = -b(row);
-    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-      const double a = Ap(row, i);
-      if (a != 0.0) v -= a * x(i);
-    }
-    r(row) = v;
+  r = -b;
+  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+    const double xi = x(i);
+    const double* a = Ap.data() + i * Ap.rows();
+    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+    for (int p = 0; p < data.loop_passive_count(i); ++p) r(rows[p]) -= a[rows[p]] * xi;
   }
   Eigen::VectorXd& step = data.loop_step;
-  step.setZero();
-  for (Eigen::Index row = 0; row < Ap.rows(); ++row) {
-    const double rv = r(row);
-    if (rv == 0.0) continue;
-    for (Eigen::Index i = 0; i < Ap.cols(); ++i) step(i) += Ap(row, i) * rv;
-  }
-  ldl_solve(data.loop_normal, data.loop_normal_pivots, step);
+  for (Eigen::Index i = 0; i < Ap.cols(); ++i) step(i) = column_dot(data, i, r.data());
+  ldl_solve(data, step);
   x += step;
 }
 
+/// loop_projection at q (checked); `solved`: q is where solve_loop_positions just converged, so
+/// data.loop_jacobian, the factorisation of A° and data.loop_rcond are already those of q (its last
+/// evaluation) and are not recomputed.
 Status project(const MechanismModel& model, MechanismData& data, const ConstVector& q,
                const ConstVector& v_actuated, const LoopSolveOptions& options, bool solved) noexcept {
   const auto& actuated = model.actuated_coordinates();
@@ -359,28 +488,57 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   }
   if (!solved) {
     evaluate(model, data, q, true);
-    data.loop_rcond = factor_passive(model, data);
+    data.loop_rcond = factor_passive(data);
   }
   if (data.loop_rcond < options.singular_rcond) status = Status::singular;
   // C: passive rows -(A°^T A°)^-1 A°^T A#
   for (std::size_t i = 0; i < actuated.size(); ++i) {
     data.loop_actuated_jacobian.col(static_cast<Eigen::Index>(i)) = data.loop_jacobian.col(actuated[i]);
   }
-  // -A°^T A#, skipping the exact zeros of A° (as in factor_passive), then one solve per column
   const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
-  data.loop_solution.setZero();
-  for (Eigen::Index r = 0; r < Ap.rows(); ++r) {
-    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-      const double a = Ap(r, i);
-      if (a != 0.0) data.loop_solution.row(i) -= a * data.loop_actuated_jacobian.row(r);
+  // X = -A°^T A# (each column of A° over its nonzero rows), solved for all columns at once, then
+  // one step of iterative refinement (see refine): R = -A# - A° X, X += (A°^T A°)^-1 A°^T R
+  MechanismData::RowMajorMatrix& X = data.loop_solution;
+  MechanismData::RowMajorMatrix& R = data.loop_block_residual;
+  MechanismData::RowMajorMatrix& S = data.loop_block_step;
+  const MechanismData::RowMajorMatrix& Aa = data.loop_actuated_jacobian;
+  const Eigen::Index w = X.cols();
+  const auto column = [&](Eigen::Index i) { return Ap.data() + i * Ap.rows(); };
+  X.setZero();
+  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+    const double* a = column(i);
+    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+    for (int p = 0; p < data.loop_passive_count(i); ++p) {
+      const int r = rows[p];
+      axpy(X.data() + i * w, -a[r], Aa.data() + r * w, w);
     }
   }
-  for (Eigen::Index j = 0; j < data.loop_solution.cols(); ++j) {
-    ldl_solve(data.loop_normal, data.loop_normal_pivots, data.loop_solution.col(j));
-    refine(data, data.loop_actuated_jacobian.col(j), data.loop_solution.col(j));
+  ldl_solve_block(data, X);
+  const bool refine_solves = data.loop_rcond < options.refine_rcond;
+  if (refine_solves) {
+    R = -Aa;
+    S.setZero();
+    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+      const double* a = column(i);
+      const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+      for (int p = 0; p < data.loop_passive_count(i); ++p) {
+        const int r = rows[p];
+        axpy(R.data() + r * w, -a[r], X.data() + i * w, w);
+      }
+    }
+    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+      const double* a = column(i);
+      const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+      for (int p = 0; p < data.loop_passive_count(i); ++p) {
+        const int r = rows[p];
+        axpy(S.data() + i * w, a[r], R.data() + r * w, w);
+      }
+    }
+    ldl_solve_block(data, S);
+    X += S;
   }
   for (std::size_t j = 0; j < passive.size(); ++j) {
-    data.loop_projection.row(passive[j]) = data.loop_solution.row(static_cast<Eigen::Index>(j));
+    data.loop_projection.row(data.loop_elimination[j]) = data.loop_solution.row(static_cast<Eigen::Index>(j));
   }
   data.closed_velocity.noalias() = data.loop_projection * v_actuated;
   // the loops must accept the actuated velocities (A v = 0); they do not at a serial singularity of
@@ -390,15 +548,15 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   if (!(data.loop_constraint_work.cwiseAbs().maxCoeff() <= 1e-8 * scale)) status = Status::singular;
   // gamma at (q, v), then c = [0; -(A°^T A°)^-1 A°^T gamma]
   detail::joint_state<true, false>(model, data, q, data.closed_velocity, data.closed_velocity);
-  detail::place(model, data);
+  // (the links are placed at q: by the solve's last evaluation, or by evaluate above)
   detail::forward_pass<true, false, false, false>(model, data);
   constraint_bias(model, data);
-  data.loop_step.noalias() = -data.loop_passive_jacobian.transpose() * data.loop_bias;
-  ldl_solve(data.loop_normal, data.loop_normal_pivots, data.loop_step);
+  for (Eigen::Index i = 0; i < Ap.cols(); ++i) data.loop_step(i) = -column_dot(data, i, data.loop_bias.data());
+  ldl_solve(data, data.loop_step);
   data.loop_refine_solution = data.loop_step;
-  refine(data, data.loop_bias, data.loop_refine_solution);
+  if (refine_solves) refine(data, data.loop_bias, data.loop_refine_solution);
   for (std::size_t j = 0; j < passive.size(); ++j) {
-    data.loop_acceleration_bias(passive[j]) = data.loop_refine_solution(static_cast<Eigen::Index>(j));
+    data.loop_acceleration_bias(data.loop_elimination[j]) = data.loop_refine_solution(static_cast<Eigen::Index>(j));
   }
   if (!data.loop_projection.allFinite() || !data.loop_acceleration_bias.allFinite()) {
     return status | Status::singular;
@@ -482,3 +640,78 @@ Status closed_forward_dynamics(const MechanismModel& model, MechanismData& data,
 }
 
 }  // namespace mechbal
+
+namespace mechbal::detail {
+
+void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
+  data.frame_rotation_in_link.clear();
+  data.frame_position_in_link.clear();
+  for (int f = 0; f < model.num_frames(); ++f) {
+    const Mat3 aligned_t = model.link_constants(model.frame_link(f)).aligned.transpose();
+    data.frame_rotation_in_link.push_back(aligned_t * model.frame(f).placement.linear());
+    data.frame_position_in_link.push_back(aligned_t * model.frame(f).placement.translation());
+  }
+  const auto& passive = model.passive_coordinates();
+  const auto np = passive.size();
+  std::vector<int> slot(static_cast<std::size_t>(model.dof()), -1);  // coordinate -> passive index
+  for (std::size_t j = 0; j < np; ++j) slot[static_cast<std::size_t>(passive[j])] = static_cast<int>(j);
+  // N = A°^T A° couples two passive coordinates when a loop's frames depend on both: each loop's
+  // rows involve the coordinates on the paths from its two frames' links to the root
+  std::vector<std::vector<char>> adjacent(np, std::vector<char>(np, 0));
+  std::vector<int> members;
+  for (int i = 0; i < model.num_loops(); ++i) {
+    members.clear();
+    for (int frame : {model.loop_frame_a(i), model.loop_frame_b(i)}) {
+      for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) {
+        const int c = model.coordinate(k);
+        if (c >= 0 && slot[static_cast<std::size_t>(c)] >= 0) members.push_back(slot[static_cast<std::size_t>(c)]);
+      }
+    }
+    for (int u : members) {
+      for (int v : members) {
+        if (u != v) adjacent[static_cast<std::size_t>(u)][static_cast<std::size_t>(v)] = 1;
+      }
+    }
+  }
+  // minimum-degree elimination (ties: the lowest index), recording each column's rows of L: the
+  // neighbours not yet eliminated, fill included
+  std::vector<char> eliminated(np, 0);
+  std::vector<int> order, position(np, 0);
+  std::vector<std::vector<int>> below(np);
+  for (std::size_t step = 0; step < np; ++step) {
+    std::size_t best = np;
+    int best_degree = 0;
+    for (std::size_t u = 0; u < np; ++u) {
+      if (eliminated[u]) continue;
+      int degree = 0;
+      for (std::size_t v = 0; v < np; ++v) degree += !eliminated[v] && adjacent[u][v];
+      if (best == np || degree < best_degree) {
+        best = u;
+        best_degree = degree;
+      }
+    }
+    eliminated[best] = 1;
+    position[best] = static_cast<int>(step);
+    order.push_back(static_cast<int>(best));
+    for (std::size_t v = 0; v < np; ++v) {
+      if (eliminated[v] || !adjacent[best][v]) continue;
+      below[step].push_back(static_cast<int>(v));
+      for (std::size_t w = 0; w < np; ++w) {
+        if (w != v && !eliminated[w] && adjacent[best][w]) adjacent[v][w] = 1;
+      }
+    }
+  }
+  data.loop_elimination.clear();
+  data.loop_factor_start.assign(1, 0);
+  data.loop_factor_rows.clear();
+  for (std::size_t k = 0; k < np; ++k) {
+    data.loop_elimination.push_back(passive[static_cast<std::size_t>(order[k])]);
+    std::vector<int>& rows = below[k];
+    for (int& v : rows) v = position[static_cast<std::size_t>(v)];
+    std::sort(rows.begin(), rows.end());
+    data.loop_factor_rows.insert(data.loop_factor_rows.end(), rows.begin(), rows.end());
+    data.loop_factor_start.push_back(static_cast<int>(data.loop_factor_rows.size()));
+  }
+}
+
+}  // namespace mechbal::detail

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "mechbal/data.hpp"
+#include "mechbal/algorithm/loops.hpp"
 
 namespace mechbal {
 
@@ -496,23 +497,25 @@ MechanismData::MechanismData(const MechanismModel& model)
   actuated_gravity = Eigen::VectorXd::Zero(na);
   actuated_acceleration = Eigen::VectorXd::Zero(na);
   reduced_mass_matrix = Eigen::MatrixXd::Zero(na, na);
-  loop_frame_jacobian_a = Eigen::MatrixXd::Zero(6, dof);
-  loop_frame_jacobian_b = Eigen::MatrixXd::Zero(6, dof);
   loop_passive_jacobian = Eigen::MatrixXd::Zero(m, np);
-  loop_actuated_jacobian = Eigen::MatrixXd::Zero(m, na);
+  loop_actuated_jacobian = RowMajorMatrix::Zero(m, na);
+  loop_block_residual = RowMajorMatrix::Zero(m, na);
+  loop_block_step = RowMajorMatrix::Zero(np, na);
   loop_constraint_work = Eigen::VectorXd::Zero(m);
   loop_refine_solution = Eigen::VectorXd::Zero(np);
   reduced_ldlt.compute(Eigen::MatrixXd::Identity(na, na));
   loop_normal = Eigen::MatrixXd::Identity(np, np);
   loop_passive_first = Eigen::VectorXi::Zero(np);
   loop_passive_last = Eigen::VectorXi::Zero(np);
+  loop_passive_rows = Eigen::MatrixXi::Zero(m, np);
+  loop_passive_count = Eigen::VectorXi::Zero(np);
   loop_normal_pivots = Eigen::VectorXd::Ones(np);
-  loop_ldlt.compute(loop_normal);  // sizes every internal buffer once
   loop_step = Eigen::VectorXd::Zero(np);
   loop_trial = Eigen::VectorXd::Zero(dof);
-  loop_solution = Eigen::MatrixXd::Zero(np, na);
+  loop_solution = RowMajorMatrix::Zero(np, na);
   loop_reduced_work = Eigen::MatrixXd::Zero(dof, na);
   loop_vector_work = Eigen::VectorXd::Zero(dof);
+  detail::loop_factor_structure(model, *this);
 }
 
 }  // namespace mechbal

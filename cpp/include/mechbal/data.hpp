@@ -68,18 +68,33 @@ struct MechanismData {
   Eigen::VectorXd actuated_acceleration;   ///< a# of the forward dynamics (na)
   Eigen::MatrixXd reduced_mass_matrix;     ///< C^T M C (na x na)
   // scratch of the loop algorithms
-  Eigen::MatrixXd loop_frame_jacobian_a, loop_frame_jacobian_b;  ///< 6 x n
   Eigen::MatrixXd loop_passive_jacobian;   ///< A° (m x np)
-  Eigen::MatrixXd loop_actuated_jacobian;  ///< A# (m x na)
+  using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  RowMajorMatrix loop_actuated_jacobian;   ///< A# (m x na), row-major: the solves run over all columns at once
+  RowMajorMatrix loop_block_residual;      ///< m x na
+  RowMajorMatrix loop_block_step;          ///< np x na
   Eigen::VectorXd loop_constraint_work;    ///< m
   Eigen::VectorXd loop_refine_solution;    ///< np
   Eigen::LDLT<Eigen::MatrixXd> reduced_ldlt;  ///< of C^T M C (na x na)
   Eigen::MatrixXd loop_normal;             ///< A°^T A° + damping (np x np)
   Eigen::VectorXi loop_passive_first, loop_passive_last;  ///< rows of A° holding each column's nonzeros (np)
+  Eigen::MatrixXi loop_passive_rows;  ///< m x np: column j lists the rows of A°'s nonzeros in column j
+  Eigen::VectorXi loop_passive_count; ///< np: how many (the rest of loop_passive_rows' column is unused)
+  /// The passive coordinates in the elimination order of N = A°^T A° (a minimum-degree ordering of
+  /// the loops' structure, fixed at construction: PAMINSA's legs before the platform they share, so
+  /// that the factor keeps the legs' blocks apart); A°'s columns, the Newton step and the solution
+  /// rows are in this order.
+  std::vector<int> loop_elimination;
+  /// Structure of L in N = L D L^T: the rows (elimination positions, increasing) that column k may
+  /// fill are loop_factor_rows[loop_factor_start[k] .. loop_factor_start[k + 1]).
+  std::vector<int> loop_factor_start, loop_factor_rows;
+  /// Each named frame in its link's joint-aligned frame L (model.hpp): the loop equations place the
+  /// closure frames with one product each.
+  std::vector<Mat3> frame_rotation_in_link;
+  std::vector<Vec3> frame_position_in_link;
   Eigen::VectorXd loop_normal_pivots;      ///< D of N = L D L^T (L in loop_normal's lower triangle) (np)
-  Eigen::LDLT<Eigen::MatrixXd> loop_ldlt;
   Eigen::VectorXd loop_step, loop_trial;   ///< np, n
-  Eigen::MatrixXd loop_solution;           ///< np x na
+  RowMajorMatrix loop_solution;            ///< np x na (elimination order)
   Eigen::MatrixXd loop_reduced_work;       ///< n x na
   Eigen::VectorXd loop_vector_work;        ///< n
 

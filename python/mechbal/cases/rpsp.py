@@ -195,6 +195,9 @@ def size_by_momentum(mech: Mechanism, q, v, slots: list[str]):
     scale[scale == 0.0] = 1.0
     x, _, rank, sv = np.linalg.lstsq(A / scale, rhs, rcond=None)
     x = x / scale
+    # a mass the condition makes zero (the platform counterweight) comes out as +-round-off: a
+    # negative one within 1e-9 of the largest is zero (a real negative mass is refused by the model)
+    x = np.where((x < 0.0) & (x > -1e-9 * max(1.0, float(np.max(np.abs(x))))), 0.0, x)
     return (dict(zip(slots, x.tolist())), int(rank), sv, float(np.linalg.norm(A @ x - rhs)),
             float(np.linalg.norm(rhs)))
 

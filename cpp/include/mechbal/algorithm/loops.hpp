@@ -35,6 +35,11 @@ struct LoopSolveOptions {
   double tolerance = 1e-13;     ///< on max |Phi| [m, rad]
   double max_step = 0.5;        ///< largest change of a passive coordinate per iteration [rad, m]
   double singular_rcond = 1e-7; ///< reciprocal condition of A° under which Status::singular is set
+  /// C and c come from the normal equations of A° (damped by 1e-16 of their largest diagonal), whose
+  /// relative error grows as eps / rcond^2: below this rcond (about 1e-12 relative error) they get
+  /// one step of iterative refinement, which brings them to the accuracy of A° itself (rcond 1:
+  /// always). PAMINSA's rcond is about 0.05 (error ~1e-13), the Orthoglide's 0.13 to 0.26.
+  double refine_rcond = 0.02;
 };
 
 /// data.loop_residual = Phi(q) and data.loop_jacobian = A(q) (and world poses of every link).
@@ -78,5 +83,12 @@ Status closed_mass_matrix(const MechanismModel& model, MechanismData& data, cons
 Status closed_forward_dynamics(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
                                const ConstVector& v_actuated, const ConstVector& tau_actuated,
                                Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options = {}) noexcept;
+
+namespace detail {
+/// Fills data.loop_elimination and data.loop_factor_start / loop_factor_rows from the model's
+/// structure (which coordinates each loop's frames depend on). Called by MechanismData's
+/// constructor; allocates.
+void loop_factor_structure(const MechanismModel& model, MechanismData& data);
+}  // namespace detail
 
 }  // namespace mechbal
