@@ -15,6 +15,9 @@ from. Everything the TOML format lets a user say in several ways is settled here
   ``link``; ``[[mechanism.bodies]]`` are added as given. Every body's centre of mass and inertia
   (about the centre of mass) are in its link's frame (``rpy`` and DH frames already applied); a
   body on ``base`` is in O (``mechanism.base`` applied).
+* **Springs.** ``[[mechanism.springs]]`` anchors are given like a body's ``com``: in the frame
+  the user described the link in (DH frame, ``mechanism.base`` for ``base``), moved here into the
+  link frame (:class:`SpringSpec`).
 * **Spherical joints** become three revolute joints about z, y and x of the joint frame, named
   ``<name>_z``, ``<name>_y``, ``<name>_x``; the link ``<name>`` (its body, children, bodies and
   frames that name it) is the last one's, the two intermediate links are massless.
