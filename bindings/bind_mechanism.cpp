@@ -6,6 +6,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 
@@ -20,6 +21,7 @@
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/regressor.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/algorithm/springs.hpp"
 #include "mechbal/data.hpp"
 #include "mechbal/model.hpp"
 #include "mechbal/serial_chain.hpp"
@@ -258,13 +260,42 @@ void bind_mechanism(py::module_& m) {
       .def_readonly("frame_a", &LoopConstraint::frame_a)
       .def_readonly("frame_b", &LoopConstraint::frame_b);
 
+  py::class_<Spring>(m, "Spring",
+                     "A linear spring between anchor A on link_a and anchor B on link_b (anchors in the "
+                     "link frames [m]): count identical springs of rate [N/m] each, carrying preload [N] at "
+                     "the anchor distance free_length [m], through a block and tackle of ratio pulley_ratio "
+                     "(model.hpp)")
+      .def(py::init([](const std::string& name, const std::string& link_a, const Eigen::Vector3d& anchor_a,
+                       const std::string& link_b, const Eigen::Vector3d& anchor_b, double rate, double free_length,
+                       double preload, int count, double pulley_ratio) {
+             return Spring{name, link_a, anchor_a, link_b, anchor_b, rate, free_length, preload, count, pulley_ratio};
+           }),
+           py::arg("name"), py::arg("link_a"), py::arg("anchor_a"), py::arg("link_b"), py::arg("anchor_b"),
+           py::arg("rate"), py::arg("free_length") = 0.0, py::arg("preload") = 0.0, py::arg("count") = 1,
+           py::arg("pulley_ratio") = 1.0)
+      .def_readonly("name", &Spring::name)
+      .def_readonly("link_a", &Spring::link_a)
+      .def_readonly("anchor_a", &Spring::anchor_a)
+      .def_readonly("link_b", &Spring::link_b)
+      .def_readonly("anchor_b", &Spring::anchor_b)
+      .def_readonly("rate", &Spring::rate)
+      .def_readonly("free_length", &Spring::free_length)
+      .def_readonly("preload", &Spring::preload)
+      .def_readonly("count", &Spring::count)
+      .def_readonly("pulley_ratio", &Spring::pulley_ratio)
+      .def_property_readonly("equivalent_rate",
+                             [](const Spring& sp) { return sp.count * sp.rate / (sp.pulley_ratio * sp.pulley_ratio); })
+      .def("__repr__", [](const Spring& sp) { return "<Spring " + sp.name + " " + sp.link_a + " -> " + sp.link_b + ">"; });
+
   py::class_<MechanismDescription>(m, "MechanismDescription",
                                    "Joints, bodies, frames, gravity and loop closures: what a MechanismModel "
                                    "is built from")
       .def(py::init([](std::vector<Joint> joints, std::vector<Body> bodies, std::vector<Frame> frames,
                        const Eigen::Vector3d& gravity, const std::string& root_name,
-                       std::vector<LoopConstraint> loops, std::vector<std::string> actuated) {
+                       std::vector<LoopConstraint> loops, std::vector<std::string> actuated,
+                       std::vector<Spring> springs) {
              MechanismDescription d;
+             d.springs = std::move(springs);
              d.joints = std::move(joints);
              d.bodies = std::move(bodies);
              d.frames = std::move(frames);
@@ -276,8 +307,10 @@ void bind_mechanism(py::module_& m) {
            }),
            py::arg("joints"), py::arg("bodies") = std::vector<Body>{}, py::arg("frames") = std::vector<Frame>{},
            py::arg("gravity") = Eigen::Vector3d(0.0, 0.0, -9.81), py::arg("root_name") = "base",
-           py::arg("loops") = std::vector<LoopConstraint>{}, py::arg("actuated") = std::vector<std::string>{})
+           py::arg("loops") = std::vector<LoopConstraint>{}, py::arg("actuated") = std::vector<std::string>{},
+           py::arg("springs") = std::vector<Spring>{})
       .def_readonly("loops", &MechanismDescription::loops)
+      .def_readonly("springs", &MechanismDescription::springs)
       .def_readonly("actuated", &MechanismDescription::actuated)
       .def_readonly("joints", &MechanismDescription::joints)
       .def_readonly("bodies", &MechanismDescription::bodies)
@@ -341,6 +374,23 @@ void bind_mechanism(py::module_& m) {
                                return n;
                              })
       .def_property_readonly("bodies", &MechanismModel::bodies)
+      .def_property_readonly("springs", &MechanismModel::springs)
+      .def_property_readonly("num_springs", &MechanismModel::num_springs)
+      .def_property_readonly("spring_names",
+                             [](const MechanismModel& mo) {
+                               std::vector<std::string> n;
+                               for (const auto& sp : mo.springs()) n.push_back(sp.name);
+                               return n;
+                             })
+      .def_property_readonly("spring_links",
+                             [](const MechanismModel& mo) {
+                               std::vector<std::pair<int, int>> n;
+                               for (int i = 0; i < mo.num_springs(); ++i) {
+                                 n.emplace_back(mo.spring_constants(i).link_a, mo.spring_constants(i).link_b);
+                               }
+                               return n;
+                             })
+      .def("spring_index", &MechanismModel::spring_index, py::arg("name"))
       .def_property_readonly("lower_limits", &MechanismModel::lower_limits)
       .def_property_readonly("upper_limits", &MechanismModel::upper_limits)
       .def_property_readonly("velocity_limits", &MechanismModel::velocity_limits)
@@ -514,6 +564,59 @@ void bind_mechanism(py::module_& m) {
                             });
       },
       py::arg("model"), py::arg("q"));
+
+  m.def(
+      "mechanism_static_torque",
+      [](const MechanismModel& mo, const Array& q) {
+        const auto N = batch_rows(mo, q, "q");
+        const auto n = static_cast<Eigen::Index>(mo.dof());
+        return matrix_batch(mo, N, n, 1, true, "static_torque", &MechanismData::static_torque,
+                            [&](py::ssize_t k, MechanismData& d) {
+                              return static_torque(mo, d, CVec(row(q, k), n));
+                            });
+      },
+      py::arg("model"), py::arg("q"), "G(q) + K(q): gravity and springs (N, dof)");
+
+  m.def(
+      "mechanism_springs",
+      [](const MechanismModel& mo, const Array& q) {
+        const auto N = batch_rows(mo, q, "q");
+        const auto n = static_cast<Eigen::Index>(mo.dof());
+        const py::ssize_t S = mo.num_springs();
+        Array length = make_array({N, S}), tension = make_array({N, S}), torque = make_array({N, n}),
+              energy = make_array({N}), potential = make_array({N});
+        auto status = run_batch(
+            mo, N,
+            [&](py::ssize_t k, MechanismData& d) {
+              const CVec qk(row(q, k), n);
+              Status s = potential_energy(mo, d, qk);
+              if (s == Status::ok) s = spring_torque(mo, d, qk);
+              return s;
+            },
+            [](const MechanismData& d) {
+              return d.spring_torque.allFinite() && d.spring_length.allFinite() && d.spring_tension.allFinite() &&
+                     std::isfinite(d.spring_energy) && std::isfinite(d.potential_energy);
+            },
+            [&](py::ssize_t k, const MechanismData& d, bool ok) {
+              put(length, k, d.spring_length, ok);
+              put(tension, k, d.spring_tension, ok);
+              put(torque, k, d.spring_torque, ok);
+              energy.mutable_data()[k] = ok ? d.spring_energy : 0.0;
+              potential.mutable_data()[k] = ok ? d.potential_energy : 0.0;
+            });
+        py::dict out;
+        out["spring_length"] = length;
+        out["spring_tension"] = tension;
+        out["spring_torque"] = torque;
+        out["spring_energy"] = energy;
+        out["potential_energy"] = potential;
+        out["status"] = status;
+        return out;
+      },
+      py::arg("model"), py::arg("q"),
+      "Springs over a batch of configurations (N, dof): spring_length (anchor distance d [m]) and "
+      "spring_tension (T at the anchors [N]) (N, S), spring_torque K(q) = dV_s/dq (N, dof), "
+      "spring_energy [J] and potential_energy (gravity plus springs [J]) (N,), status (N,)");
 
   m.def(
       "mechanism_bias_torque",

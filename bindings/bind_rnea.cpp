@@ -84,7 +84,16 @@ void bind_rnea(py::module_& m) {
             raise_unless_ok(d.gravity(q_, g), "MechanismDynamics.gravity");
             return g;
           },
-          py::arg("q"), "Gravity torques G(q)")
+          py::arg("q"), "Gravity torques G(q) (gravity alone; with springs see static_torque)")
+      .def(
+          "static_torque",
+          [](MechanismDynamics& d, const Array& q) {
+            const Eigen::VectorXd q_ = one_state(d, q, "q");
+            Eigen::VectorXd g = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.static_torque(q_, g), "MechanismDynamics.static_torque");
+            return g;
+          },
+          py::arg("q"), "Static torques G(q) + K(q): gravity and springs")
       .def(
           "bias",
           [](MechanismDynamics& d, const Array& q, const Array& qd) {
@@ -93,7 +102,7 @@ void bind_rnea(py::module_& m) {
             raise_unless_ok(d.bias(q_, qd_, b), "MechanismDynamics.bias");
             return b;
           },
-          py::arg("q"), py::arg("qd"), "Bias torques C(q, qd) qd + G(q)")
+          py::arg("q"), py::arg("qd"), "Bias torques C(q, qd) qd + G(q) + K(q) (springs included)")
       .def(
           "coriolis",
           [](MechanismDynamics& d, const Array& q, const Array& qd) {

@@ -7,7 +7,10 @@
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/regressor.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/algorithm/springs.hpp"
 #include "mechbal/detail/tree.hpp"
+
+#include <cmath>
 
 namespace mechbal {
 
@@ -110,6 +113,17 @@ void sum_wrenches(const MechanismModel& model, MechanismData& data) noexcept {
   }
   data.shaking.force = F;
   data.shaking.moment = M;
+}
+
+/// With springs: data.spring_torque = K(q) from placed links, added to tau. The base's entry of
+/// the backward pass needs nothing: it is the rate of momentum minus the weights, the whole wrench
+/// the base exerts on the moving links, through their joints and the springs anchored to it
+/// (data.spring_base_force/moment is the springs' part). Nothing without springs.
+void add_springs(const MechanismModel& model, MechanismData& data, Eigen::VectorXd& tau) noexcept {
+  if (model.num_springs() == 0) return;
+  data.spring_torque.setZero();
+  detail::spring_forces<true>(model, data, data.spring_torque);
+  tau += data.spring_torque;
 }
 
 }  // namespace
@@ -222,9 +236,10 @@ Status inverse_dynamics(const MechanismModel& model, MechanismData& data, const 
                         const ConstVector& v, const ConstVector& a) noexcept {
   if (Status s = check_state(model, data, &q, &v, &a); s != Status::ok) return s;
   detail::joint_state<true, true>(model, data, q, v, a);
-  detail::place<false>(model, data);
+  detail::place_for_springs(model, data);
   detail::forward_pass<true, true, true, true>(model, data);
   detail::backward_pass(model, data, data.joint_torque);
+  add_springs(model, data, data.joint_torque);
   return finite_result(data.joint_torque);
 }
 
@@ -241,10 +256,52 @@ Status bias_torque(const MechanismModel& model, MechanismData& data, const Const
                    const ConstVector& v) noexcept {
   if (Status s = check_state(model, data, &q, &v); s != Status::ok) return s;
   detail::joint_state<true, false>(model, data, q, v, v);
-  detail::place<false>(model, data);
+  detail::place_for_springs(model, data);
   detail::forward_pass<true, false, true, true>(model, data);
   detail::backward_pass(model, data, data.bias_torque);
+  add_springs(model, data, data.bias_torque);
   return finite_result(data.bias_torque);
+}
+
+// ---- springs and potential energy ------------------------------------------------------------
+
+Status spring_state(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place(model, data);
+  detail::spring_forces<false>(model, data, data.spring_torque);
+  return std::isfinite(data.spring_energy) ? finite_result(data.spring_length, data.spring_tension)
+                                           : Status::out_of_range;
+}
+
+Status spring_torque(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place(model, data);
+  data.spring_torque.setZero();
+  detail::spring_forces<true>(model, data, data.spring_torque);
+  return finite_result(data.spring_torque, data.spring_length, data.spring_tension);
+}
+
+Status static_torque(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place_for_springs(model, data);
+  detail::forward_pass<false, false, true, true>(model, data);
+  detail::backward_pass(model, data, data.gravity_torque);
+  data.spring_torque.setZero();
+  if (model.num_springs() > 0) detail::spring_forces<true>(model, data, data.spring_torque);
+  data.static_torque = data.gravity_torque + data.spring_torque;
+  return finite_result(data.static_torque);
+}
+
+Status potential_energy(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place(model, data);
+  detail::spring_forces<false>(model, data, data.spring_torque);
+  data.potential_energy = -model.gravity().dot(mass_moment(model, data)) + data.spring_energy;
+  return std::isfinite(data.potential_energy) ? Status::ok : Status::out_of_range;
 }
 
 // ---- mass matrix --------------------------------------------------------------------------------

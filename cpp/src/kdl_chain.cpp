@@ -21,6 +21,7 @@ namespace {
 ChainModel chain_of(const MechanismModel& model) {
   const int nl = model.num_links();
   if (nl < 2) not_a_chain("it has no joint");
+  if (model.num_springs() > 0) not_a_chain("it has springs, which KDL does not model (use MechanismDynamics)");
   if (!model.is_serial_chain()) {
     // name the first link that breaks the chain
     const auto& joints = model.description().joints;  // depth-first: joint l - 1 moves link l

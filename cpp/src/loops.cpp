@@ -1,5 +1,6 @@
 // Closed loops on the general model (algorithm/loops.hpp).
 #include "mechbal/algorithm/loops.hpp"
+#include "mechbal/algorithm/springs.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -609,8 +610,9 @@ Status closed_mass_matrix(const MechanismModel& model, MechanismData& data, cons
   mass_matrix(model, data, q);
   data.loop_reduced_work.noalias() = data.mass_matrix * data.loop_projection;
   data.reduced_mass_matrix.noalias() = data.loop_projection.transpose() * data.loop_reduced_work;
-  gravity_torque(model, data, q);
+  static_torque(model, data, q);  // G and, with springs, K
   data.actuated_gravity.noalias() = data.loop_projection.transpose() * data.gravity_torque;
+  data.actuated_static_torque.noalias() = data.loop_projection.transpose() * data.static_torque;
   return status;
 }
 

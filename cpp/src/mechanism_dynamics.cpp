@@ -5,6 +5,7 @@
 
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
+#include "mechbal/algorithm/springs.hpp"
 #include "mechbal/detail/tree.hpp"
 
 namespace mechbal {
@@ -107,6 +108,19 @@ Status MechanismDynamics::gravity(const Eigen::Ref<const Eigen::VectorXd>& q,
   return s;
 }
 
+Status MechanismDynamics::static_torque(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                        Eigen::Ref<Eigen::VectorXd> g) noexcept {
+  if (g.size() != dof()) return Status::bad_size;
+  if (model_->is_closed()) {
+    const Status s = closed_mass_matrix(*model_, data_, q, q_, options_);
+    if (!failed(s)) g = data_.actuated_static_torque;
+    return s;
+  }
+  const Status s = mechbal::static_torque(*model_, data_, q);
+  if (s == Status::ok) g = data_.static_torque;
+  return s;
+}
+
 Status MechanismDynamics::bias(const Eigen::Ref<const Eigen::VectorXd>& q,
                                const Eigen::Ref<const Eigen::VectorXd>& qd,
                                Eigen::Ref<Eigen::VectorXd> b) noexcept {
@@ -130,7 +144,7 @@ Status MechanismDynamics::coriolis(const Eigen::Ref<const Eigen::VectorXd>& q,
     Status s = bias(q, qd, c);
     if (failed(s)) return s;
     work_ = c;
-    s |= gravity(q, c);
+    s |= static_torque(q, c);
     if (failed(s)) return s;
     c = work_ - c;
     return s;

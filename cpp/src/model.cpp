@@ -229,6 +229,11 @@ MechanismModel::MechanismModel(MechanismDescription d) {
     }
   }
   for (Frame& fr : d.frames) fold(fr.link, &fr.placement);
+  for (Spring& sp : d.springs) {
+    Eigen::Isometry3d Ta = Eigen::Isometry3d::Identity(), Tb = Eigen::Isometry3d::Identity();
+    if (fold(sp.link_a, &Ta) && sp.anchor_a.allFinite()) sp.anchor_a = Ta * sp.anchor_a;
+    if (fold(sp.link_b, &Tb) && sp.anchor_b.allFinite()) sp.anchor_b = Tb * sp.anchor_b;
+  }
 
   // ---- links in DFS order ----
   const std::size_t nl = order.size() + 1;
@@ -355,6 +360,58 @@ MechanismModel::MechanismModel(MechanismDescription d) {
     c.inertia_origin += I + m * (com.squaredNorm() * Mat3::Identity() - com * com.transpose());
   }
 
+  // ---- springs ----
+  std::map<std::string, std::size_t> spring_names;
+  for (std::size_t i = 0; i < d.springs.size(); ++i) {
+    const Spring& sp = d.springs[i];
+    auto field = [&](const char* f) { return indexed_field("springs", i, sp.name, f); };
+    auto value = [](double x) {
+      std::ostringstream s;
+      s << x;
+      return s.str();
+    };
+    if (sp.name.empty()) throw std::invalid_argument(field("name") + " must not be empty");
+    if (!spring_names.emplace(sp.name, i).second) throw std::invalid_argument(field("name") + " is used by two springs");
+    int links[2];
+    for (int side = 0; side < 2; ++side) {
+      const std::string& link = side == 0 ? sp.link_a : sp.link_b;
+      const Vec3& anchor = side == 0 ? sp.anchor_a : sp.anchor_b;
+      auto it = link_of.find(link);
+      if (it == link_of.end()) {
+        throw std::invalid_argument(field(side == 0 ? "link_a" : "link_b") + ": no link named '" + link + "'" +
+                                    nearest(link, link_names_));
+      }
+      if (!anchor.allFinite()) throw std::invalid_argument(field(side == 0 ? "anchor_a" : "anchor_b") + " must be finite");
+      links[side] = it->second;
+    }
+    if (links[0] == links[1]) {
+      throw std::invalid_argument(field("link_b") + ": both anchors are on the same link ('" +
+                                  link_names_[static_cast<std::size_t>(links[0])] +
+                                  "', fixed joints folded), so the spring never changes length");
+    }
+    if (!(std::isfinite(sp.rate) && sp.rate >= 0.0)) throw std::invalid_argument(field("rate") + ": must be >= 0 [N/m], got " + value(sp.rate));
+    if (!(std::isfinite(sp.free_length) && sp.free_length >= 0.0)) {
+      throw std::invalid_argument(field("free_length") + ": must be >= 0 [m], got " + value(sp.free_length));
+    }
+    if (!(std::isfinite(sp.preload) && sp.preload >= 0.0)) {
+      throw std::invalid_argument(field("preload") + ": must be >= 0 [N], got " + value(sp.preload));
+    }
+    if (sp.count < 1) throw std::invalid_argument(field("count") + ": must be >= 1, got " + std::to_string(sp.count));
+    if (!(std::isfinite(sp.pulley_ratio) && sp.pulley_ratio > 0.0)) {
+      throw std::invalid_argument(field("pulley_ratio") + ": must be > 0, got " + value(sp.pulley_ratio));
+    }
+    SpringConstants c;
+    c.link_a = links[0];
+    c.link_b = links[1];
+    c.anchor_a = constants_[static_cast<std::size_t>(links[0])].aligned.transpose() * sp.anchor_a;
+    c.anchor_b = constants_[static_cast<std::size_t>(links[1])].aligned.transpose() * sp.anchor_b;
+    c.equivalent_rate = sp.count * sp.rate / (sp.pulley_ratio * sp.pulley_ratio);
+    c.preload_tension = sp.count * sp.preload / sp.pulley_ratio;
+    c.free_length = sp.free_length;
+    springs_.push_back(sp);
+    spring_constants_.push_back(c);
+  }
+
   // ---- loops and actuation ----
   std::vector<std::string> frame_name_list;
   for (const auto& fr : frames_) frame_name_list.push_back(fr.name);
@@ -427,6 +484,13 @@ int MechanismModel::body_index(const std::string& name) const noexcept {
   return -1;
 }
 
+int MechanismModel::spring_index(const std::string& name) const noexcept {
+  for (std::size_t i = 0; i < springs_.size(); ++i) {
+    if (springs_[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
 int MechanismModel::frame_index(const std::string& name) const noexcept {
   for (std::size_t i = 0; i < frames_.size(); ++i) {
     if (frames_[i].name == name) return static_cast<int>(i);
@@ -438,7 +502,8 @@ MechanismData::MechanismData(const MechanismModel& model)
     : dof(model.dof()),
       num_links(model.num_links()),
       num_bodies(model.num_bodies()),
-      num_frames(model.num_frames()) {
+      num_frames(model.num_frames()),
+      num_springs(model.num_springs()) {
   const auto nl = static_cast<std::size_t>(num_links);
   const auto nb = static_cast<std::size_t>(num_bodies);
   joint_position.assign(nl, 0.0);
@@ -461,6 +526,10 @@ MechanismData::MechanismData(const MechanismModel& model)
   joint_torque = Eigen::VectorXd::Zero(dof);
   gravity_torque = Eigen::VectorXd::Zero(dof);
   bias_torque = Eigen::VectorXd::Zero(dof);
+  spring_torque = Eigen::VectorXd::Zero(dof);
+  static_torque = Eigen::VectorXd::Zero(dof);
+  spring_length = Eigen::VectorXd::Zero(num_springs);
+  spring_tension = Eigen::VectorXd::Zero(num_springs);
   mass_matrix = Eigen::MatrixXd::Zero(dof, dof);
   momentum_matrix = Eigen::MatrixXd::Zero(6, dof);
   frame_jacobian = Eigen::MatrixXd::Zero(6, dof);
@@ -495,6 +564,7 @@ MechanismData::MechanismData(const MechanismModel& model)
   closed_acceleration = Eigen::VectorXd::Zero(dof);
   actuated_force = Eigen::VectorXd::Zero(na);
   actuated_gravity = Eigen::VectorXd::Zero(na);
+  actuated_static_torque = Eigen::VectorXd::Zero(na);
   actuated_acceleration = Eigen::VectorXd::Zero(na);
   reduced_mass_matrix = Eigen::MatrixXd::Zero(na, na);
   loop_passive_jacobian = Eigen::MatrixXd::Zero(m, np);

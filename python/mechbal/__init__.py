@@ -27,7 +27,7 @@ from typing import Any
 
 from mechbal._core import Status, __version__
 from mechbal._core import (  # the description objects of Mechanism.from_description
-    Body, Frame, Joint, JointType, LoopConstraint, LoopType, MechanismDescription, MechanismModel)
+    Body, Frame, Joint, JointType, LoopConstraint, LoopType, MechanismDescription, MechanismModel, Spring)
 from mechbal.config import ConfigError, ConfigWarning, load_case
 from mechbal.mechanism import (
     BaseReaction, BodyMotion, ClosedMotion, Mechanism, Momentum, ShakingWrench)
@@ -35,7 +35,7 @@ from mechbal import balance, control, papers, simulate, trajectory
 
 __all__ = [
     "Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion",
-    "Joint", "JointType", "Body", "Frame", "LoopConstraint", "LoopType", "MechanismDescription",
+    "Joint", "JointType", "Body", "Frame", "LoopConstraint", "LoopType", "MechanismDescription", "Spring",
     "MechanismModel", "Status", "ConfigError", "ConfigWarning", "load_case",
     "balance", "control", "trajectory", "simulate", "papers", "cases", "__version__",
 ]

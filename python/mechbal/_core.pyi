@@ -8,7 +8,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ChainModel', 'ComputedTorque', 'DecoupledJointController', 'DiscArmDynamics', 'DiscSpec', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointSpec', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'RneChainDynamics', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_chain_model', 'chain_description', 'chain_kinematics', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
+__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ChainModel', 'ComputedTorque', 'DecoupledJointController', 'DiscArmDynamics', 'DiscSpec', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointSpec', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'RneChainDynamics', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_chain_model', 'chain_description', 'chain_kinematics', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
 class Status:
     """
     Bit flags returned by real-time algorithms
@@ -467,11 +467,52 @@ class LoopConstraint:
     @property
     def type(self) -> LoopType:
         ...
+class Spring:
+    """
+    A linear spring between anchor A on link_a and anchor B on link_b (anchors in the link frames [m]): count identical springs of rate [N/m] each, carrying preload [N] at the anchor distance free_length [m], through a block and tackle of ratio pulley_ratio (model.hpp)
+    """
+    def __init__(self, name: str, link_a: str, anchor_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], link_b: str, anchor_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], rate: typing.SupportsFloat | typing.SupportsIndex, free_length: typing.SupportsFloat | typing.SupportsIndex = 0.0, preload: typing.SupportsFloat | typing.SupportsIndex = 0.0, count: typing.SupportsInt | typing.SupportsIndex = 1, pulley_ratio: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> None:
+        ...
+    def __repr__(self) -> str:
+        ...
+    @property
+    def anchor_a(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def anchor_b(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def count(self) -> int:
+        ...
+    @property
+    def equivalent_rate(self) -> float:
+        ...
+    @property
+    def free_length(self) -> float:
+        ...
+    @property
+    def link_a(self) -> str:
+        ...
+    @property
+    def link_b(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def preload(self) -> float:
+        ...
+    @property
+    def pulley_ratio(self) -> float:
+        ...
+    @property
+    def rate(self) -> float:
+        ...
 class MechanismDescription:
     """
     Joints, bodies, frames, gravity and loop closures: what a MechanismModel is built from
     """
-    def __init__(self, joints: collections.abc.Sequence[Joint], bodies: collections.abc.Sequence[Body] = [], frames: collections.abc.Sequence[Frame] = [], gravity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., root_name: str = 'base', loops: collections.abc.Sequence[LoopConstraint] = [], actuated: collections.abc.Sequence[str] = []) -> None:
+    def __init__(self, joints: collections.abc.Sequence[Joint], bodies: collections.abc.Sequence[Body] = [], frames: collections.abc.Sequence[Frame] = [], gravity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., root_name: str = 'base', loops: collections.abc.Sequence[LoopConstraint] = [], actuated: collections.abc.Sequence[str] = [], springs: collections.abc.Sequence[Spring] = []) -> None:
         ...
     @property
     def actuated(self) -> list[str]:
@@ -494,6 +535,9 @@ class MechanismDescription:
     @property
     def root_name(self) -> str:
         ...
+    @property
+    def springs(self) -> list[Spring]:
+        ...
 class MechanismModel:
     """
     The validated general mechanism model (C++ mechbal::MechanismModel). Use mechbal.Mechanism for the Python API.
@@ -509,6 +553,8 @@ class MechanismModel:
     def frame_index(self, name: str) -> int:
         ...
     def link_index(self, name: str) -> int:
+        ...
+    def spring_index(self, name: str) -> int:
         ...
     @property
     def actuated_coordinates(self) -> list[int]:
@@ -568,10 +614,22 @@ class MechanismModel:
     def num_links(self) -> int:
         ...
     @property
+    def num_springs(self) -> int:
+        ...
+    @property
     def passive_coordinates(self) -> list[int]:
         ...
     @property
     def root_name(self) -> str:
+        ...
+    @property
+    def spring_links(self) -> list[tuple[int, int]]:
+        ...
+    @property
+    def spring_names(self) -> list[str]:
+        ...
+    @property
+    def springs(self) -> list[Spring]:
         ...
     @property
     def total_mass(self) -> float:
@@ -592,7 +650,7 @@ class MechanismDynamics(InverseDynamics, ForwardDynamics):
         """
     def bias(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
-        Bias torques C(q, qd) qd + G(q)
+        Bias torques C(q, qd) qd + G(q) + K(q) (springs included)
         """
     def coriolis(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
@@ -604,7 +662,7 @@ class MechanismDynamics(InverseDynamics, ForwardDynamics):
         """
     def gravity(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
-        Gravity torques G(q)
+        Gravity torques G(q) (gravity alone; with springs see static_torque)
         """
     def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
         """
@@ -613,6 +671,10 @@ class MechanismDynamics(InverseDynamics, ForwardDynamics):
     def mass_matrix(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         """
         Mass matrix M(q) (dof, dof) by the composite rigid body algorithm
+        """
+    def static_torque(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Static torques G(q) + K(q): gravity and springs
         """
     @property
     def dof(self) -> int:
@@ -1464,6 +1526,14 @@ def mechanism_momentum_regressor(model: MechanismModel, q: numpy.typing.ArrayLik
     ...
 def mechanism_shaking_wrench(model: MechanismModel, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike, with_gravity: bool = True) -> dict:
     ...
+def mechanism_springs(model: MechanismModel, q: numpy.typing.ArrayLike) -> dict:
+    """
+    Springs over a batch of configurations (N, dof): spring_length (anchor distance d [m]) and spring_tension (T at the anchors [N]) (N, S), spring_torque K(q) = dV_s/dq (N, dof), spring_energy [J] and potential_energy (gravity plus springs [J]) (N,), status (N,)
+    """
+def mechanism_static_torque(model: MechanismModel, q: numpy.typing.ArrayLike) -> dict:
+    """
+    G(q) + K(q): gravity and springs (N, dof)
+    """
 def mechanism_torque_regressor(model: MechanismModel, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
     ...
 def paminsa_kinematics(model: PaminsaModel, P: numpy.typing.ArrayLike, Pd: numpy.typing.ArrayLike, Pdd: numpy.typing.ArrayLike, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:

@@ -121,13 +121,15 @@ class Mechanism:
                          frames: Sequence["_core.Frame"] = (), gravity=(0.0, 0.0, -9.81),
                          root_name: str = "base", name: str = "mechanism",
                          loops: Sequence["_core.LoopConstraint"] = (),
-                         actuated: Sequence[str] = ()) -> "Mechanism":
+                         actuated: Sequence[str] = (),
+                         springs: Sequence["_core.Spring"] = ()) -> "Mechanism":
         """From C++ description objects (:class:`mechbal.Joint`, :class:`mechbal.Body`,
-        :class:`mechbal.Frame`, :class:`mechbal.LoopConstraint`) and the names of the actuated
-        joints (required with loops). Raises ValueError naming the field on bad input."""
+        :class:`mechbal.Frame`, :class:`mechbal.LoopConstraint`, :class:`mechbal.Spring`) and the
+        names of the actuated joints (required with loops). Raises ValueError naming the field on
+        bad input."""
         desc = _core.MechanismDescription(list(joints), list(bodies), list(frames),
                                           np.asarray(gravity, dtype=float), root_name, list(loops),
-                                          list(actuated))
+                                          list(actuated), list(springs))
         return cls(_core.MechanismModel(desc), name=name)
 
     @classmethod
@@ -200,8 +202,12 @@ class Mechanism:
         frames = [_core.Frame(f.name, f.link, np.asarray(f.placement, float)) for f in spec.frames]
         loops = [_core.LoopConstraint(lp.name, loop_types[lp.type], lp.frame_a, lp.frame_b)
                  for lp in getattr(spec, "loops", [])]
+        springs = [_core.Spring(sp.name, sp.link_a, np.asarray(sp.anchor_a, float), sp.link_b,
+                                np.asarray(sp.anchor_b, float), float(sp.rate), float(sp.free_length),
+                                float(sp.preload), int(sp.count), float(sp.pulley_ratio))
+                   for sp in getattr(spec, "springs", [])]
         desc = _core.MechanismDescription(joints, bodies, frames, np.asarray(spec.gravity, float), "base",
-                                          loops, list(getattr(spec, "actuated", [])))
+                                          loops, list(getattr(spec, "actuated", [])), springs)
         try:
             model = _core.MechanismModel(desc)
         except ValueError as exc:
@@ -229,7 +235,21 @@ class Mechanism:
         own = [] if replace else list(d.bodies)
         desc = _core.MechanismDescription(list(d.joints), own + list(bodies), list(d.frames),
                                           np.asarray(d.gravity, float), d.root_name, list(d.loops),
-                                          list(d.actuated))
+                                          list(d.actuated), list(d.springs))
+        return Mechanism(_core.MechanismModel(desc), name=name or self.name, source=self.source,
+                         link_frames=self.link_frames)
+
+    def with_springs(self, springs: Sequence["_core.Spring"], *, replace: bool = False,
+                     name: str | None = None) -> "Mechanism":
+        """A copy with ``springs`` (:class:`mechbal.Spring`, anchors in the link frames) added to
+        its own (``replace``: instead of its own): same joints, bodies, frames, loops, gravity
+        and user frames. Raises ValueError naming the problem (duplicate name, unknown link,
+        negative rate...)."""
+        d = self.model.description
+        own = [] if replace else list(d.springs)
+        desc = _core.MechanismDescription(list(d.joints), list(d.bodies), list(d.frames),
+                                          np.asarray(d.gravity, float), d.root_name, list(d.loops),
+                                          list(d.actuated), own + list(springs))
         return Mechanism(_core.MechanismModel(desc), name=name or self.name, source=self.source,
                          link_frames=self.link_frames)
 
@@ -275,6 +295,17 @@ class Mechanism:
         return list(self.model.bodies)
 
     @property
+    def springs(self):
+        """The springs (``mechbal.Spring``: name, link_a, anchor_a, link_b, anchor_b [m, link
+        frames], rate [N/m], free_length [m], preload [N], count, pulley_ratio), in model order."""
+        return list(self.model.springs)
+
+    @property
+    def spring_names(self) -> list[str]:
+        """Names of the springs, in model order (the columns of :meth:`spring_lengths`)."""
+        return list(self.model.spring_names)
+
+    @property
     def is_closed(self) -> bool:
         """True when the mechanism has loop closures."""
         return bool(self.model.is_closed)
@@ -292,8 +323,9 @@ class Mechanism:
         return [names[i] for i in self.model.passive_coordinates]
 
     def __repr__(self) -> str:
+        springs = f", {self.model.num_springs} springs" if self.model.num_springs else ""
         return (f"<Mechanism {self.name!r}: {self.dof} dof, {len(self.link_names) - 1} joints, "
-                f"{len(self.body_names)} bodies, {self.total_mass:.4g} kg>")
+                f"{len(self.body_names)} bodies{springs}, {self.total_mass:.4g} kg>")
 
     # ---- argument handling -------------------------------------------------------------------
     def _args(self, names: tuple[str, ...], values: tuple) -> tuple[bool, list[np.ndarray]]:
@@ -333,7 +365,8 @@ class Mechanism:
 
     # ---- algorithms --------------------------------------------------------------------------
     def inverse_dynamics(self, q, v, a) -> np.ndarray:
-        """Joint forces tau = M(q) a + C(q, v) v + G(q) [N m or N], gear couplings projected.
+        """Joint forces tau = M(q) a + C(q, v) v + G(q) + K(q) [N m or N] (K: the springs' joint
+        forces, :meth:`spring_torque`), gear couplings projected.
         A batch returns (N, dof); see :meth:`status_of` for per-instant statuses."""
         single, (q, v, a) = self._args(("q", "v", "a"), (q, v, a))
         (tau,), _ = self._finish(single, _core.mechanism_inverse_dynamics(self.model, q, v, a),
@@ -347,13 +380,51 @@ class Mechanism:
         return M
 
     def gravity_torque(self, q) -> np.ndarray:
-        """Gravity torques G(q): the joint forces that hold the mechanism still [N m or N]."""
+        """Gravity torques G(q): the joint forces that hold the weights still [N m or N]; with
+        springs, :meth:`static_torque` is what holds the mechanism still."""
         single, (q,) = self._args(("q",), (q,))
         (g,), _ = self._finish(single, _core.mechanism_gravity_torque(self.model, q), ["gravity_torque"])
         return g
 
+    def static_torque(self, q) -> np.ndarray:
+        """G(q) + K(q): the joint forces that hold the mechanism still, gravity and springs [N m
+        or N] (:meth:`gravity_torque` without springs). Zero over the workspace exactly when the
+        springs balance the mechanism statically."""
+        single, (q,) = self._args(("q",), (q,))
+        (g,), _ = self._finish(single, _core.mechanism_static_torque(self.model, q), ["static_torque"])
+        return g
+
+    def _springs(self, q, key: str):
+        single, (q,) = self._args(("q",), (q,))
+        (x,), _ = self._finish(single, _core.mechanism_springs(self.model, q), [key])
+        return x
+
+    def spring_torque(self, q) -> np.ndarray:
+        """K(q) = dV_springs/dq: the joint forces that hold the springs still [N m or N] (the
+        convention of :meth:`gravity_torque`; ``cpp/include/mechbal/algorithm/springs.hpp``)."""
+        return self._springs(q, "spring_torque")
+
+    def spring_lengths(self, q) -> np.ndarray:
+        """Anchor distance d of each spring [m]: (S,) or (N, S), columns as :attr:`spring_names`."""
+        return self._springs(q, "spring_length")
+
+    def spring_tension(self, q) -> np.ndarray:
+        """Tension at each spring's anchors, count preload / k + K_eq (d - free_length) [N]."""
+        return self._springs(q, "spring_tension")
+
+    def spring_energy(self, q):
+        """Elastic energy of all springs [J] (zero when each is at its free length): a float, or (N,)."""
+        e = self._springs(q, "spring_energy")
+        return float(e) if np.ndim(e) == 0 else e
+
+    def potential_energy(self, q):
+        """Gravity (-sum m g . c, zero at O) plus springs' energy [J]: constant over the workspace
+        exactly when the mechanism is statically balanced. A float, or (N,)."""
+        e = self._springs(q, "potential_energy")
+        return float(e) if np.ndim(e) == 0 else e
+
     def bias_torque(self, q, v) -> np.ndarray:
-        """C(q, v) v + G(q) [N m or N]."""
+        """C(q, v) v + G(q) + K(q) [N m or N] (springs included: the inverse dynamics at a = 0)."""
         single, (q, v) = self._args(("q", "v"), (q, v))
         (b,), _ = self._finish(single, _core.mechanism_bias_torque(self.model, q, v), ["bias_torque"])
         return b

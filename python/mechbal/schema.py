@@ -282,8 +282,32 @@ class Loop(Table):
     frame_b: Name = Field(description="a frame of [[mechanism.frames]], on another branch")
 
 
+SpringCount = Annotated[int, Field(ge=1, le=1000, strict=True, description="identical springs in parallel")]
+PulleyRatio = Annotated[float, Field(gt=0, le=1000, description="k: the anchor distance changes k times "
+                                                                "as much as each spring's length", **_NUM)]
+
+
+class MechanismSpring(Table):
+    """``[[mechanism.springs]]``: ``count`` identical linear springs of ``rate`` [N/m] each
+    between anchor A on link ``link_a`` and anchor B on ``link_b`` (anchors in the frames the
+    user described those links in, as a body's ``com``), carrying ``preload`` [N] each at the
+    anchor distance ``free_length`` [m], through a block and tackle of ratio ``pulley_ratio``:
+    tension at the anchors count preload / k + count rate / k^2 (d - free_length). Part of the
+    model: the inverse dynamics, static torque and simulation include it."""
+    name: Name
+    link_a: Name = Field(description="joint whose link carries anchor A, or 'base'")
+    anchor_a: Xyz = Field(description="m, in link_a's frame")
+    link_b: Name = Field(description="joint whose link carries anchor B, or 'base'")
+    anchor_b: Xyz = Field(description="m, in link_b's frame")
+    rate: NonNeg = Field(description="N/m, of each spring")
+    free_length: NonNeg = Field(0.0, description="m: anchor distance at which each spring carries only its preload")
+    preload: NonNeg = Field(0.0, description="N: initial tension of each spring")
+    count: SpringCount = 1
+    pulley_ratio: PulleyRatio = 1.0
+
+
 class Mechanism(Table):
-    """``[mechanism]``: a tree of joints with bodies, gears, frames and loop closures."""
+    """``[mechanism]``: a tree of joints with bodies, gears, frames, loop closures and springs."""
     gravity: Vec3 = Field([0.0, 0.0, -9.81], description="m/s^2, in O")
     base: Optional[Origin] = Field(None, description="placement of the root joints' base frame in O")
     joints: Annotated[list[Joint], Field(min_length=1, max_length=MAX_JOINTS)]
@@ -292,6 +316,7 @@ class Mechanism(Table):
     loops: Annotated[list[Loop], Field(max_length=MAX_FRAMES)] = []
     actuated: Annotated[list[Name], Field(max_length=MAX_JOINTS,
                                           description="actuated joints (required with loops)")] = []
+    springs: Annotated[list[MechanismSpring], Field(max_length=MAX_BODIES)] = []
 
 
 class ChainTrajectory(Table):
@@ -339,10 +364,53 @@ class BalanceCounterweight(Table):
         return self
 
 
+AnchorBounds = Annotated[list[Xyz], Field(min_length=2, max_length=2,
+                                           description="m: [lower xyz, upper xyz] the method may move the anchor in")]
+
+
+class BalanceSpring(Table):
+    """``[[balance.springs]]``: a spring the springs method may add (or size), as
+    ``[[mechanism.springs]]`` but with ``rate`` optional: absent, it is chosen within
+    ``rate_min`` .. ``rate_max`` by least squares (static balance over the workspace sample);
+    ``anchor_a_bounds`` / ``anchor_b_bounds`` let the method move an anchor within a box (its
+    coordinates with lower < upper)."""
+    name: Name = Field(description="the spring's name (must be new)")
+    link_a: Name = Field(description="joint whose link carries anchor A, or 'base'")
+    anchor_a: Xyz = Field(description="m, in link_a's frame (the frame the link was described in)")
+    link_b: Name = Field(description="joint whose link carries anchor B, or 'base'")
+    anchor_b: Xyz = Field(description="m, in link_b's frame")
+    free_length: NonNeg = Field(0.0, description="m: anchor distance at which each spring carries only its preload")
+    rate: Optional[NonNeg] = Field(None, description="N/m, of each spring (absent: sized)")
+    rate_min: Optional[NonNeg] = Field(None, description="N/m (default 0)")
+    rate_max: Optional[NonNeg] = Field(None, description="N/m (absent: unbounded)")
+    preload: NonNeg = Field(0.0, description="N: initial tension of each spring")
+    count: SpringCount = 1
+    pulley_ratio: PulleyRatio = 1.0
+    anchor_a_bounds: Optional[AnchorBounds] = None
+    anchor_b_bounds: Optional[AnchorBounds] = None
+
+    @model_validator(mode="after")
+    def _rates_and_bounds(self):
+        if self.rate is not None and (self.rate_min is not None or self.rate_max is not None):
+            raise _custom("give either rate or rate_min / rate_max", ".rate", self.rate)
+        lo = self.rate_min or 0.0
+        if self.rate_max is not None and self.rate_max < lo:
+            raise _custom(f"must be >= rate_min = {lo!r}", ".rate_max", self.rate_max)
+        for side in ("a", "b"):
+            b = getattr(self, f"anchor_{side}_bounds")
+            if b is not None and any(l > u for l, u in zip(b[0], b[1])):
+                raise _custom("lower must be <= upper in every coordinate", f".anchor_{side}_bounds", b)
+        return self
+
+
 class Balance(Table):
     """``[balance]``: what ``mechbal balance`` may change and what it must hold over."""
     method: Optional[BalanceMethod] = Field(None, description="default of --method")
     counterweights: Annotated[list[BalanceCounterweight], Field(max_length=MAX_BODIES)] = []
+    springs: Annotated[list[BalanceSpring], Field(max_length=MAX_BODIES)] = []
+    catalogue: Optional[Annotated[str, Field(min_length=1, max_length=4096, strict=True)]] = Field(
+        None, description="springs method: a spring catalogue CSV to select off-the-shelf springs from "
+                          "(path relative to the case file), or 'shipped' for mechbal's own")
     mass_budget: Optional[Pos] = Field(None, description="kg, total counterweight mass")
     samples: Optional[Annotated[int, Field(ge=1, le=MAX_CONFIGURATIONS, strict=True)]] = Field(
         None, description="random workspace samples (static: 1000, force: 200 motions)")

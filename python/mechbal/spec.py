@@ -15,6 +15,9 @@ from. Everything the TOML format lets a user say in several ways is settled here
   ``link``; ``[[mechanism.bodies]]`` are added as given. Every body's centre of mass and inertia
   (about the centre of mass) are in its link's frame (``rpy`` and DH frames already applied); a
   body on ``base`` is in O (``mechanism.base`` applied).
+* **Springs.** ``[[mechanism.springs]]`` anchors are given like a body's ``com``: in the frame
+  the user described the link in (DH frame, ``mechanism.base`` for ``base``), moved here into the
+  link frame (:class:`SpringSpec`).
 * **Spherical joints** become three revolute joints about z, y and x of the joint frame, named
   ``<name>_z``, ``<name>_y``, ``<name>_x``; the link ``<name>`` (its body, children, bodies and
   frames that name it) is the last one's, the two intermediate links are massless.
@@ -126,6 +129,24 @@ class LoopSpec:
 
 
 @dataclass(frozen=True, eq=False)
+class SpringSpec:
+    """A spring between anchor ``anchor_a`` (3,) on the link of joint ``link_a`` (or ``base``) and
+    ``anchor_b`` on ``link_b``, both in the link frames (DH frames and ``mechanism.base`` already
+    applied); ``rate`` [N/m] each, ``free_length`` [m], ``preload`` [N], ``count``,
+    ``pulley_ratio`` (see ``cpp/include/mechbal/model.hpp``, ``Spring``)."""
+    name: str
+    link_a: str
+    anchor_a: np.ndarray
+    link_b: str
+    anchor_b: np.ndarray
+    rate: float
+    free_length: float = 0.0
+    preload: float = 0.0
+    count: int = 1
+    pulley_ratio: float = 1.0
+
+
+@dataclass(frozen=True, eq=False)
 class MechanismSpec:
     gravity: np.ndarray
     joints: list[JointSpec]
@@ -138,6 +159,7 @@ class MechanismSpec:
     #: in (the standard-DH frame of a ``dh`` joint; ``mechanism.base`` for ``base``); absent:
     #: the identity. Balancing reports counterweight positions in these frames.
     link_frames: dict[str, np.ndarray] = field(default_factory=dict)
+    springs: list[SpringSpec] = field(default_factory=list)
 
     def joint(self, name: str) -> JointSpec:
         for j in self.joints:
@@ -354,6 +376,25 @@ def mechanism_spec(mechanism: Any, field: str = "mechanism") -> MechanismSpec:
                 raise ConfigError(f"{f}.{key}", "no such frame (define it in [[mechanism.frames]])"
                                   + _hint(name, list(frame_field)), name)
         loops.append(LoopSpec(lp.name, lp.type, lp.frame_a, lp.frame_b))
+    springs: list[SpringSpec] = []
+    spring_field: dict[str, str] = {}
+    for s_i, sp in enumerate(m.springs):
+        f = f"{field}.springs[{s_i}]"
+        if sp.name in spring_field:
+            raise ConfigError(f"{f}.name", f"duplicate spring name: also {spring_field[sp.name]}", sp.name)
+        spring_field[sp.name] = f
+        ends = []
+        for side in ("a", "b"):
+            link = resolve(getattr(sp, f"link_{side}"), f"{f}.link_{side}", "link")
+            T = frame_of_link(link)
+            ends.append((link, T[:3, :3] @ np.asarray(getattr(sp, f"anchor_{side}"), float) + T[:3, 3]))
+        if ends[0][0] == ends[1][0]:
+            raise ConfigError(f"{f}.link_b", "both anchors are on the same link, so the spring never changes "
+                                             "length", sp.link_b)
+        springs.append(SpringSpec(sp.name, ends[0][0], ends[0][1], ends[1][0], ends[1][1], float(sp.rate),
+                                  float(sp.free_length), float(sp.preload), int(sp.count),
+                                  float(sp.pulley_ratio)))
+
     independent = [j.name for j in joints if j.type != "fixed" and j.mimic is None]
     for a_i, name in enumerate(m.actuated):
         if name not in independent:
@@ -367,4 +408,4 @@ def mechanism_spec(mechanism: Any, field: str = "mechanism") -> MechanismSpec:
     link_frames = {n: frame_of_link(n) for n in [BASE, *(j.name for j in joints)]}
     link_frames = {n: T for n, T in link_frames.items() if not np.array_equal(T, np.eye(4))}
     return MechanismSpec(np.array(m.gravity, dtype=float), joints, bodies, frames, loops,
-                         list(m.actuated), link_frames)
+                         list(m.actuated), link_frames, springs)

@@ -20,6 +20,7 @@ struct MechanismData {
   int num_links;
   int num_bodies;
   int num_frames;
+  int num_springs;
 
   // ---- joint positions (every link's joint, gear couplings applied) ----
   std::vector<double> joint_position, joint_velocity, joint_acceleration;
@@ -40,9 +41,20 @@ struct MechanismData {
   Vec3 center_of_mass = Vec3::Zero();  ///< in O [m]
   ShakingWrench shaking;   ///< momenta about O and their rates (shaking force and moment)
   BaseReaction base_reaction;  ///< wrench the base exerts on the mechanism (gravity included)
-  Eigen::VectorXd joint_torque;    ///< inverse dynamics [N m or N], size dof
+  Eigen::VectorXd joint_torque;    ///< inverse dynamics, springs included [N m or N], size dof
   Eigen::VectorXd gravity_torque;  ///< G(q)
-  Eigen::VectorXd bias_torque;     ///< C(q, v) v + G(q)
+  Eigen::VectorXd bias_torque;     ///< C(q, v) v + G(q) + K(q) (springs included)
+  /// K(q) = dV_springs/dq: the joint forces that hold the springs still (algorithm/springs.hpp)
+  Eigen::VectorXd spring_torque;
+  Eigen::VectorXd static_torque;   ///< G(q) + K(q): the joint forces that hold the mechanism still
+  Eigen::VectorXd spring_length;   ///< anchor distance d of each spring [m]
+  Eigen::VectorXd spring_tension;  ///< tension T at each spring's anchors [N]
+  double spring_energy = 0.0;      ///< elastic energy of all springs [J]
+  double potential_energy = 0.0;   ///< gravity (zero at O) plus springs [J]
+  /// Wrench the base exerts on the moving links through the springs anchored to it (in O, moment
+  /// about O): the springs' part of the support wrench (which, the rate of momentum minus the
+  /// weights, includes it).
+  Vec3 spring_base_force = Vec3::Zero(), spring_base_moment = Vec3::Zero();
   Eigen::MatrixXd mass_matrix;     ///< M(q), dof x dof, symmetric
   Eigen::MatrixXd momentum_matrix;  ///< 6 x dof: [P; H_O] = A(q) v (linear first)
   Eigen::MatrixXd frame_jacobian;   ///< 6 x dof: [v; w] of a frame's origin, O axes
@@ -65,6 +77,7 @@ struct MechanismData {
   Eigen::VectorXd closed_position, closed_velocity, closed_acceleration;  ///< q, v, a (n)
   Eigen::VectorXd actuated_force;          ///< tau# = C^T tau (na)
   Eigen::VectorXd actuated_gravity;        ///< C^T G (na)
+  Eigen::VectorXd actuated_static_torque;  ///< C^T (G + K): gravity and springs (na)
   Eigen::VectorXd actuated_acceleration;   ///< a# of the forward dynamics (na)
   Eigen::MatrixXd reduced_mass_matrix;     ///< C^T M C (na x na)
   // scratch of the loop algorithms

@@ -43,7 +43,7 @@ class MechanismDynamics : public InverseDynamics, public ForwardDynamics {
   const Eigen::VectorXd& solved_position() const noexcept { return q_; }
   LoopSolveOptions& loop_options() noexcept { return options_; }
 
-  /// tau# = M#(q#) a# + b#(q#, v#) (gravity included). Sizes must equal dof() (Status::bad_size),
+  /// tau# = M#(q#) a# + b#(q#, v#) (gravity and springs included). Sizes must equal dof() (Status::bad_size),
   /// input finite (Status::non_finite_input), tau untouched otherwise; a closed mechanism that
   /// cannot be assembled gives Status::solver_error (tau untouched); near a parallel singularity
   /// Status::singular with the computed tau.
@@ -67,12 +67,14 @@ class MechanismDynamics : public InverseDynamics, public ForwardDynamics {
                           Eigen::Ref<Eigen::VectorXd> qdd) noexcept override;
   /// M#(q#) (dof x dof).
   Status mass_matrix(const Eigen::Ref<const Eigen::VectorXd>& q, Eigen::Ref<Eigen::MatrixXd> M) noexcept;
-  /// G#(q#).
+  /// G#(q#): gravity alone (springs: static_torque).
   Status gravity(const Eigen::Ref<const Eigen::VectorXd>& q, Eigen::Ref<Eigen::VectorXd> g) noexcept;
-  /// b#(q#, v#) = C#(q#, v#) v# + G#(q#).
+  /// G#(q#) + K#(q#): gravity and springs, the actuated forces that hold the mechanism still.
+  Status static_torque(const Eigen::Ref<const Eigen::VectorXd>& q, Eigen::Ref<Eigen::VectorXd> s) noexcept;
+  /// b#(q#, v#) = C#(q#, v#) v# + G#(q#) + K#(q#) (springs included).
   Status bias(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& qd,
               Eigen::Ref<Eigen::VectorXd> b) noexcept;
-  /// C#(q#, v#) v# alone (no gravity).
+  /// C#(q#, v#) v# alone (no gravity, no springs).
   Status coriolis(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& qd,
                   Eigen::Ref<Eigen::VectorXd> c) noexcept;
 

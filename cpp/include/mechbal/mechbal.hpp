@@ -21,6 +21,7 @@
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/regressor.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/algorithm/springs.hpp"
 #include "mechbal/mechanism_dynamics.hpp"
 /// Serial chains, trajectories, dynamics back ends
 #include "mechbal/serial_chain.hpp"

@@ -69,6 +69,35 @@ struct Frame {
   Eigen::Isometry3d placement = Eigen::Isometry3d::Identity();  ///< in the link frame
 };
 
+/// A linear spring between anchor A on link `link_a` and anchor B on link `link_b` (Martini et al.
+/// 2015, Tables 1-2; mechbal.balance.springs): `count` identical springs in parallel, each of rate
+/// `rate` [N/m] carrying `preload` [N] (its initial tension) when the anchor distance is
+/// `free_length` [m], acting through a block and tackle of ratio k = `pulley_ratio` (the anchor
+/// distance d changes k times as much as each spring's length). By virtual work the tension at the
+/// anchors and its potential energy are
+///
+///     T(d) = count preload / k + K_eq (d - free_length),   K_eq = count rate / k^2,
+///     V(d) = count preload / k (d - free_length) + K_eq (d - free_length)^2 / 2.
+///
+/// A zero-free-length spring has free_length = 0 and preload = 0: T = K_eq d. The law is linear
+/// on both sides of the free length (no slack): a tension spring shorter than its free length is
+/// the caller's to avoid (the balancing method reports it). Anchors are in the frame of their link
+/// (as a body's centre of mass: the frame right after the joint's motion; a link welded by fixed
+/// joints is folded into its moving ancestor with the anchor moved along). The springs are
+/// massless: give their mass as bodies when it matters.
+struct Spring {
+  std::string name;
+  std::string link_a;  ///< link carrying anchor A: a joint's name, or the root's name
+  Vec3 anchor_a = Vec3::Zero();  ///< in link_a's frame [m]
+  std::string link_b;
+  Vec3 anchor_b = Vec3::Zero();  ///< in link_b's frame [m]
+  double rate = 0.0;          ///< of each spring [N/m]
+  double free_length = 0.0;   ///< anchor distance at which each spring carries only its preload [m]
+  double preload = 0.0;       ///< initial tension of each spring [N]
+  int count = 1;              ///< identical springs in parallel
+  double pulley_ratio = 1.0;  ///< k: anchor distance change / spring length change
+};
+
 /// Loop-closure constraint types between two frames A and B (loops.hpp for the equations):
 ///  - point: the origins coincide (3 equations, a spherical closure);
 ///  - planar_point: the origins coincide in the plane normal to A's z axis (2 equations);
@@ -101,6 +130,8 @@ struct MechanismDescription {
   std::vector<LoopConstraint> loops;
   /// Names of the actuated joints (coordinates). Empty without loops: every coordinate.
   std::vector<std::string> actuated;
+  /// Springs between links (algorithm/springs.hpp); their forces enter the inverse dynamics.
+  std::vector<Spring> springs;
 };
 
 /// The validated, immutable model. Link 0 is the base; links 1..num_links()-1 are the joints'
@@ -160,6 +191,22 @@ class MechanismModel {
   /// gear) and has no loops.
   bool is_serial_chain() const noexcept { return serial_chain_; }
 
+  // ---- springs ----
+  int num_springs() const noexcept { return static_cast<int>(springs_.size()); }
+  const Spring& spring(int s) const { return springs_.at(static_cast<std::size_t>(s)); }
+  const std::vector<Spring>& springs() const noexcept { return springs_; }
+  int spring_index(const std::string& name) const noexcept;
+  /// Per-spring constants the algorithms use: link indices, anchors in the joint-aligned frames
+  /// L_i (see LinkConstants), K_eq = count rate / k^2 and the preload tension count preload / k.
+  struct SpringConstants {
+    int link_a, link_b;
+    Vec3 anchor_a, anchor_b;  ///< in L_{link_a}, L_{link_b}
+    double equivalent_rate;   ///< [N/m] at the anchors
+    double preload_tension;   ///< [N] at the anchors, at d = free_length
+    double free_length;       ///< [m]
+  };
+  const SpringConstants& spring_constants(int s) const noexcept { return spring_constants_[static_cast<std::size_t>(s)]; }
+
   // ---- loops and actuation ----
   int num_loops() const noexcept { return static_cast<int>(loops_.size()); }
   bool is_closed() const noexcept { return !loops_.empty(); }
@@ -207,6 +254,8 @@ class MechanismModel {
   std::vector<Frame> frames_;
   std::vector<int> frame_link_;
   std::vector<LinkConstants> constants_;
+  std::vector<Spring> springs_;
+  std::vector<SpringConstants> spring_constants_;
   std::vector<LoopConstraint> loops_;
   std::vector<std::pair<int, int>> loop_frames_;
   std::vector<int> loop_rows_;

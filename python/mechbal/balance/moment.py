@@ -109,7 +109,8 @@ def with_discs(mechanism: Mechanism, discs: Sequence[DiscSlot], inertias: Mappin
         I = Jt * (np.eye(3) - np.outer(a, a)) + Ja * np.outer(a, a)
         bodies.append(_core.Body(s.name, s.name, 0.0, np.zeros(3), I, "disc"))
     return Mechanism.from_description(joints, bodies, d.frames, d.gravity, root_name=d.root_name,
-                                      name=name or mechanism.name, loops=d.loops, actuated=d.actuated)
+                                      name=name or mechanism.name, loops=d.loops, actuated=d.actuated,
+                                      springs=d.springs)
 
 
 def _transverse(s: DiscSlot, axial: float) -> float:

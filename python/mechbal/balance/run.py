@@ -12,7 +12,8 @@ residuals, the bounds and undetermined combinations, and before/after peak and R
 torque, the actuator torques, the shaking force and the shaking moment along the trajectory),
 ``gravity_torque.png``, ``joint_torques.png``, ``shaking_wrench.png``, ``bodies_unbalanced.npz``
 and ``bodies_balanced.npz`` (the schema of :mod:`mechbal.export`), ``balanced.toml`` (a case that
-``mechbal run`` runs) and, for trees, ``balanced.urdf``.
+``mechbal run`` runs; springs as ``[[mechanism.springs]]``) and, for trees without springs,
+``balanced.urdf`` (URDF cannot carry springs: summary.json says so instead).
 """
 from __future__ import annotations
 
@@ -153,7 +154,8 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
 # ---- evaluation --------------------------------------------------------------------------------
 
 def evaluate(bc: BalanceCase, mech) -> dict:
-    """Along the case's trajectory: q, v, a, actuator torque, gravity torque (actuated), shaking
+    """Along the case's trajectory: q, v, a, actuator torque, gravity torque (actuated; with
+    springs the static torque, gravity plus springs: what the actuators hold still), shaking
     wrench and the bodies' poses."""
     qa, va, aa = bc.motion
     if mech.is_closed:
@@ -164,10 +166,12 @@ def evaluate(bc: BalanceCase, mech) -> dict:
                               has_value=False)
         q, v, a, tau = m.q, m.v, m.a, m.actuated_force
         _, G = mech.reduced_mass_matrix(qa, q_guess=bc.q_guess)
+        if mech.springs:  # the static torque: gravity and springs, C^T (G + K)
+            G = G + np.einsum("ndk,nd->nk", m.projection, mech.spring_torque(q))
     else:
         q, v, a = qa, va, aa
-        tau = mech.inverse_dynamics(q, v, a)
-        G = mech.gravity_torque(q)
+        tau = mech.inverse_dynamics(q, v, a)   # springs included
+        G = mech.static_torque(q)              # gravity plus springs (gravity alone without springs)
     sw = mech.shaking_wrench(q, v, a)
     bm = mech.body_motion(q, v, a)
     return dict(q=q, v=v, a=a, torque=tau, gravity_torque=G, shaking_force=sw.shaking_force,
@@ -210,6 +214,8 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
             raise ConfigError("--method", f"mechbal.balance.{name} has no design_from_table(table, mechanism): "
                                           "mechbal balance cannot read its design", has_value=False)
         design, samples, options = make(table, mech)
+        if mech.is_closed and bc.q_guess is not None:
+            options.setdefault("q_guess", bc.q_guess)
         return module.balance(mech, design, samples, **options)
     slots = slots_from_table(table) or list(bc.default_slots)
     if not slots:
@@ -243,9 +249,13 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
 def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
     from mechbal.balance.writers import mechanism_table, toml_text
 
-    header = (f"{bc.name} balanced by `mechbal balance --method {method}`: counterweights "
-              + ", ".join(f"{k} {v['mass']:.6g} kg at {np.round(np.asarray(v['position'], float), 6).tolist()} m "
-                          f"on {v['link']}" for k, v in result.design.items() if "mass" in v)
+    added = ([f"counterweights " + ", ".join(
+        f"{k} {v['mass']:.6g} kg at {np.round(np.asarray(v['position'], float), 6).tolist()} m on {v['link']}"
+        for k, v in result.design.items() if "mass" in v)] if any("mass" in v for v in result.design.values()) else [])
+    added += ([f"springs " + ", ".join(f"{k} {v['rate']:.6g} N/m x {v['count']} ({v['link_a']} - {v['link_b']})"
+                                       for k, v in result.design.items() if "rate" in v and "link_a" in v)]
+              if any("link_a" in v for v in result.design.values()) else [])
+    header = (f"{bc.name} balanced by `mechbal balance --method {method}`: " + "; ".join(added or ["nothing added"])
               + f".\nResidual {result.residual:.6g} {result.residual_units} (unbalanced {result.residual_before:.6g}).")
     case = {"name": f"{bc.name}-balanced", "kind": "mechanism", "title": f"{bc.title}, balanced ({method})"}
     tt = dict(bc.trajectory_table)
@@ -266,6 +276,24 @@ def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
             bodies.append({"name": b.name, "kind": "counterweight", "link": b.link, "mass": float(b.mass),
                            "com": com.tolist(), "inertia": [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]})
         mech["bodies"] = bodies
+        springs = list(mech.get("springs", []))
+        own_springs = set(bc.mechanism.spring_names)
+        root = result.balanced.model.root_name
+        for sp in result.balanced.springs:   # the springs, back in the user's link frames
+            if sp.name in own_springs:
+                continue
+            entry = {"name": sp.name}
+            for side in ("a", "b"):
+                link = getattr(sp, f"link_{side}")
+                T = bc.mechanism.user_frame(link)
+                anchor = T[:3, :3].T @ (np.asarray(getattr(sp, f"anchor_{side}"), float) - T[:3, 3])
+                entry[f"link_{side}"] = "base" if link == root else link
+                entry[f"anchor_{side}"] = anchor.tolist()
+            entry.update(rate=float(sp.rate), free_length=float(sp.free_length), preload=float(sp.preload),
+                         count=int(sp.count), pulley_ratio=float(sp.pulley_ratio))
+            springs.append(entry)
+        if springs:
+            mech["springs"] = springs
         return toml_text(data, header)
     data = {"case": case, "mechanism": mechanism_table(result.balanced), "trajectory": tt}
     return toml_text(data, header)
@@ -313,7 +341,11 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
     files = ["bodies_unbalanced.npz", "bodies_balanced.npz", "gravity_torque.png", "joint_torques.png",
              "shaking_wrench.png", "balanced.toml"]
     (out / "balanced.toml").write_text(_balanced_toml(bc, result, name))
-    if not result.balanced.is_closed:
+    urdf_note = None
+    if result.balanced.springs:   # URDF has no springs: no file that silently drops them
+        urdf_note = ("no balanced.urdf: the balanced mechanism has springs, which URDF cannot describe "
+                     "(balanced.toml carries them as [[mechanism.springs]])")
+    elif not result.balanced.is_closed:
         from mechbal.balance.writers import urdf_text
 
         (out / "balanced.urdf").write_text(urdf_text(result.balanced, f"{bc.name}-balanced"))
@@ -326,10 +358,17 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
                "before_after": _comparison(before, after),
                "total_mass_kg": {"unbalanced": bc.mechanism.total_mass, "balanced": result.balanced.total_mass},
                "files": files}
+    if urdf_note:
+        summary["urdf"] = urdf_note
     write_summary(out / "summary.json", summary)
     rows = [[k, v["mass"], np.asarray(v["position"], float), ", ".join(v.get("active_bounds", [])) or "-"]
             for k, v in result.design.items() if "mass" in v]
-    print(report.table(rows, ["counterweight", "mass [kg]", "position [m] (link frame)", "active bounds"]))
+    if rows:
+        print(report.table(rows, ["counterweight", "mass [kg]", "position [m] (link frame)", "active bounds"]))
+    rows = [[k, v["rate"], v["count"], v["pulley_ratio"], v["peak_tension"]]
+            for k, v in result.design.items() if "link_a" in v and "rate" in v]
+    if rows:
+        print(report.table(rows, ["spring", "rate [N/m]", "count", "pulley ratio", "peak tension [N]"]))
     cmp = summary["before_after"]
     print(report.table([[k, cmp[k]["unbalanced"]["peak"], cmp[k]["balanced"]["peak"]] for k in cmp],
                        ["peak along the trajectory", "unbalanced", "balanced"]))

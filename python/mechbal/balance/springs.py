@@ -29,9 +29,12 @@ the anchor points, the joint forces that hold the springs still (the convention 
 
     spring_torque = dV/dq = T (J_B - J_A)^T u = J_A^T f - J_B^T f,   f = -T u
 
-(f the force the spring exerts on B). The anchor Jacobians come in batch from
-:meth:`mechbal.Mechanism.frame_jacobian` at frames added at the link origins (a copy of the
-description), shifted to the anchor: J_v(anchor) = J_v(origin) - [R a]x J_w.
+(f the force the spring exerts on B). The springs are elements of the mechanism model
+(``mechbal.Spring``, ``cpp/include/mechbal/algorithm/springs.hpp``): lengths, tensions, energy and
+these joint forces are computed there, and the balanced mechanism returned by :func:`balance`
+carries its springs, so its inverse dynamics, static torque and simulation include them. A slot
+becomes a model spring through :func:`model_spring` (an anchor given in a named frame, e.g. a DH
+frame, moved into its link's frame).
 
 **Sizing** (:func:`balance`). For fixed anchors, free lengths and preloads, T and V are affine in
 the rates, so "gravity torque + spring torque = 0 at every sample" is a linear least-squares
@@ -65,10 +68,10 @@ from mechbal.balance.result import BalanceResult, SpringSlot
 from mechbal.mechanism import Mechanism
 
 __all__ = ["spring_torque", "potential_energy", "spring_energy", "spring_tension", "spring_lengths",
-           "gravity_potential_energy", "equivalent_rate", "balance", "CatalogueSpring",
-           "SpringCluster", "load_catalogue", "select_springs", "select_for_result"]
+           "gravity_potential_energy", "equivalent_rate", "balance", "model_spring", "with_springs",
+           "design_from_table", "CatalogueSpring", "SpringCluster", "load_catalogue", "select_springs",
+           "select_for_result"]
 
-_ORIGIN_FRAME = "__mechbal_spring_origin_{}"
 
 
 # ------------------------------------------------------------------------------------------------
@@ -106,96 +109,66 @@ def _check_slot(slot: SpringSlot) -> None:
 
 
 # ------------------------------------------------------------------------------------------------
-# Anchor kinematics (batch)
+# The springs on the model: a SpringSlot becomes a mechbal.Spring of the mechanism (C++ model)
 # ------------------------------------------------------------------------------------------------
-class _Anchors:
-    """The mechanism with a frame at the origin of every link that carries an anchor, and how to
-    find each anchor: (link name, placement of the anchor's reference frame in the link frame).
-    An anchor's ``link`` may be a link (a joint's name, or the base) or a named frame (the anchor
-    is then in that frame's axes, e.g. the DH frame of a link)."""
-
-    def __init__(self, mechanism: Mechanism, springs: Sequence[SpringSlot]):
-        self.mechanism = mechanism
-        model = mechanism.model
-        desc = model.description
-        root = model.root_name
-        frames_by_name = {f.name: f for f in desc.frames}
-        links = set(mechanism.link_names)
-        self.reference: dict[str, tuple[str, np.ndarray]] = {}
-        for s in springs:
-            for side in ("a", "b"):
-                ref = getattr(s, f"link_{side}")
-                if ref in self.reference:
-                    continue
-                if ref in links:
-                    self.reference[ref] = (ref, np.eye(4))
-                elif ref in frames_by_name:
-                    f = frames_by_name[ref]
-                    self.reference[ref] = (f.link, np.asarray(f.placement, float))
-                else:
-                    from mechbal.schema import did_you_mean
-                    more = did_you_mean(ref, sorted(links | set(frames_by_name)))
-                    raise ValueError(f"springs.{s.name}.link_{side}: no link or frame named '{ref}'{more}")
-        moving = sorted({link for link, _ in self.reference.values() if link != root})
-        self.frame_of = {link: _ORIGIN_FRAME.format(link) for link in moving}
-        extra = [_core.Frame(self.frame_of[link], link, np.eye(4)) for link in moving
-                 if model.frame_index(self.frame_of[link]) < 0]
-        if extra:
-            self.model = Mechanism.from_description(
-                desc.joints, desc.bodies, list(desc.frames) + extra, desc.gravity, root_name=root,
-                name=mechanism.name, loops=desc.loops, actuated=desc.actuated)
-        else:
-            self.model = mechanism
-        self.root = root
-
-    def local_point(self, ref: str, anchor) -> np.ndarray:
-        """The anchor in its link's frame."""
-        _, T = self.reference[ref]
-        return T[:3, :3] @ np.asarray(anchor, float) + T[:3, 3]
-
-    def evaluate(self, q: np.ndarray):
-        """Per link that carries anchors: (R (N, 3, 3), p (N, 3), J (N, 6, dof) or None for the
-        base)."""
-        q = np.atleast_2d(q)
-        frames = self.model.body_motion(q).frame_placement
-        out = {}
-        for link, fname in self.frame_of.items():
-            i = self.model.model.frame_index(fname)
-            out[link] = (frames[:, i, :3, :3], frames[:, i, :3, 3], self.model.frame_jacobian(q, fname))
-        return out
-
-    def point(self, kin, ref: str, anchor, with_jacobian: bool = True):
-        """World position (N, 3) and linear Jacobian (N, 3, dof) of an anchor."""
-        link, _ = self.reference[ref]
-        a = self.local_point(ref, anchor)
-        if link == self.root:
-            n = next(iter(kin.values()))[1].shape[0] if kin else 1
-            p = np.broadcast_to(a, (n, 3)).copy()
-            return p, (np.zeros((n, 3, self.model.dof)) if with_jacobian else None)
-        R, o, J = kin[link]
-        ra = R @ a
-        p = o + ra
-        if not with_jacobian:
-            return p, None
-        Jv = J[:, :3, :] - np.cross(ra[:, :, None], J[:, 3:, :], axis=1)
-        return p, Jv
+def _reference(mechanism: Mechanism, slot: SpringSlot, side: str) -> tuple[str, np.ndarray]:
+    """(link, (4, 4) placement of the anchor's reference frame in the link frame) of an anchor:
+    ``link_a``/``link_b`` names a link (a joint's name, or the root) or a named frame."""
+    ref = getattr(slot, f"link_{side}")
+    if ref in mechanism.link_names:
+        return ref, np.eye(4)
+    for f in mechanism.model.description.frames:
+        if f.name == ref:
+            return f.link, np.asarray(f.placement, float)
+    from mechbal.schema import did_you_mean
+    more = did_you_mean(ref, sorted(set(mechanism.link_names) | set(mechanism.frame_names)))
+    raise ValueError(f"springs.{slot.name}.link_{side}: no link or frame named '{ref}'{more}")
 
 
-def _geometry(anchors: _Anchors, springs: Sequence[SpringSlot], q: np.ndarray, kin=None,
+def model_spring(mechanism: Mechanism, slot: SpringSlot, *, anchors=None, probe: bool = False) -> "_core.Spring":
+    """The :class:`mechbal.Spring` of a slot on ``mechanism`` (anchors moved into the link frames
+    when the slot names a frame). ``anchors``: (anchor_a, anchor_b) overriding the slot's;
+    ``probe``: a unit-tension spring (tension 1 N at any length, no rate) whose energy is the
+    anchor distance d and whose joint force is dd/dq -- what the least squares are built from."""
+    _check_slot(slot)
+    aa, ab = (slot.anchor_a, slot.anchor_b) if anchors is None else anchors
+    ends = []
+    for side, anchor in (("a", aa), ("b", ab)):
+        link, T = _reference(mechanism, slot, side)
+        ends.append((link, T[:3, :3] @ np.asarray(anchor, float) + T[:3, 3]))
+    if probe:
+        return _core.Spring(slot.name, ends[0][0], ends[0][1], ends[1][0], ends[1][1], 0.0, 0.0, 1.0, 1, 1.0)
+    if slot.rate is None:
+        raise ValueError(f"springs.{slot.name}.rate: not set (size it with mechbal.balance.springs.balance)")
+    return _core.Spring(slot.name, ends[0][0], ends[0][1], ends[1][0], ends[1][1], float(slot.rate),
+                        float(slot.free_length), float(getattr(slot, "preload", 0.0)), _count(slot),
+                        float(slot.pulley_ratio))
+
+
+def with_springs(mechanism: Mechanism, springs: Sequence[SpringSlot], *, replace: bool = False,
+                 name: str | None = None) -> Mechanism:
+    """``mechanism`` with the (sized) slots as springs of its model (``replace``: instead of its
+    own springs): what its inverse dynamics, static torque, energy and simulation then include."""
+    try:
+        return mechanism.with_springs([model_spring(mechanism, s) for s in springs], replace=replace, name=name)
+    except ValueError as exc:
+        if str(exc).startswith("springs."):
+            raise
+        raise ValueError(f"springs: {exc}") from None
+
+
+def _geometry(mechanism: Mechanism, springs: Sequence[SpringSlot], q: np.ndarray,
               overrides: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None):
-    """Per spring: anchor distance d (N,) and its gradient dd/dq (N, dof)."""
-    kin = anchors.evaluate(q) if kin is None else kin
+    """Per spring: anchor distance d (N,) and its gradient dd/dq (N, dof), from the model (a
+    unit-tension probe spring: its energy is d, its joint force dd/dq)."""
     out = []
     for s in springs:
-        aa, ab = (overrides or {}).get(s.name, (s.anchor_a, s.anchor_b))
-        pa, Ja = anchors.point(kin, s.link_a, aa)
-        pb, Jb = anchors.point(kin, s.link_b, ab)
-        r = pb - pa
-        d = np.linalg.norm(r, axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            u = np.where(d[:, None] > 0, r / d[:, None], 0.0)
-        grad = np.einsum("ni,nij->nj", u, Jb - Ja)
-        out.append((d, grad))
+        probe = model_spring(mechanism, s, anchors=(overrides or {}).get(s.name), probe=True)
+        m = mechanism.with_springs([probe], replace=True)
+        r = _core.mechanism_springs(m.model, np.ascontiguousarray(q, dtype=float))
+        if np.any(np.asarray(r["status"]) != 0):
+            raise ValueError(f"springs.{s.name}: its length cannot be evaluated at some samples (non-finite)")
+        out.append((np.asarray(r["spring_length"])[:, 0], np.asarray(r["spring_torque"])))
     return out
 
 
@@ -208,23 +181,28 @@ def _prepare(mechanism: Mechanism, springs, q):
     return springs, np.atleast_2d(q), single
 
 
+def _evaluated(mechanism: Mechanism, springs: Sequence[SpringSlot], need_rate: bool = True) -> Mechanism:
+    """The mechanism with exactly these springs (its own replaced); without ``need_rate`` an
+    unsized slot counts with rate 0 (for lengths)."""
+    if not need_rate:
+        springs = [s if s.rate is not None else dataclasses.replace(s, rate=0.0) for s in springs]
+    return with_springs(mechanism, springs, replace=True)
+
+
 # ------------------------------------------------------------------------------------------------
-# Public helpers
+# Public helpers: evaluated by the model with exactly the given springs (its own replaced)
 # ------------------------------------------------------------------------------------------------
 def spring_lengths(mechanism: Mechanism, springs: Sequence[SpringSlot], q) -> np.ndarray:
     """Anchor distances d [m] of each spring: (S,) for one configuration, (N, S) for a batch."""
     springs, q2, single = _prepare(mechanism, springs, q)
-    geo = _geometry(_Anchors(mechanism, springs), springs, q2)
-    d = np.stack([g[0] for g in geo], axis=1) if geo else np.zeros((len(q2), 0))
+    d = _evaluated(mechanism, springs, need_rate=False).spring_lengths(q2)
     return d[0] if single else d
 
 
 def spring_tension(mechanism: Mechanism, springs: Sequence[SpringSlot], q) -> np.ndarray:
     """Tension T [N] at the anchors of each spring (module docstring): (S,) or (N, S)."""
     springs, q2, single = _prepare(mechanism, springs, q)
-    d = np.atleast_2d(spring_lengths(mechanism, springs, q2))
-    T = np.stack([_preload_at_anchors(s) + equivalent_rate(s) * (d[:, i] - s.free_length)
-                  for i, s in enumerate(springs)], axis=1) if springs else d
+    T = _evaluated(mechanism, springs).spring_tension(q2)
     return T[0] if single else T
 
 
@@ -232,11 +210,7 @@ def spring_energy(mechanism: Mechanism, springs: Sequence[SpringSlot], q) -> np.
     """Elastic potential energy of all springs [J] (zero when every spring is at its free length):
     a float for one configuration, (N,) for a batch."""
     springs, q2, single = _prepare(mechanism, springs, q)
-    d = np.atleast_2d(spring_lengths(mechanism, springs, q2))
-    V = np.zeros(len(q2))
-    for i, s in enumerate(springs):
-        x = d[:, i] - s.free_length
-        V += _preload_at_anchors(s) * x + 0.5 * equivalent_rate(s) * x ** 2
+    V = np.atleast_1d(_evaluated(mechanism, springs).spring_energy(q2))
     return float(V[0]) if single else V
 
 
@@ -250,7 +224,9 @@ def gravity_potential_energy(mechanism: Mechanism, q) -> np.ndarray:
 def potential_energy(mechanism: Mechanism, springs: Sequence[SpringSlot], q) -> np.ndarray:
     """Total potential energy, gravity plus springs [J]: constant over the workspace exactly when
     the mechanism is statically balanced (Martini et al. 2015, eq 11)."""
-    return gravity_potential_energy(mechanism, q) + spring_energy(mechanism, springs, q)
+    springs, q2, single = _prepare(mechanism, springs, q)
+    V = np.atleast_1d(_evaluated(mechanism, springs).potential_energy(q2))
+    return float(V[0]) if single else V
 
 
 def spring_torque(mechanism: Mechanism, springs: Sequence[SpringSlot], q) -> np.ndarray:
@@ -260,14 +236,8 @@ def spring_torque(mechanism: Mechanism, springs: Sequence[SpringSlot], q) -> np.
     :meth:`mechbal.Mechanism.gravity_torque`: the static motor torque is their sum.
     (dof,) for one configuration, (N, dof) for a batch."""
     springs, q2, single = _prepare(mechanism, springs, q)
-    geo = _geometry(_Anchors(mechanism, springs), springs, q2)
-    tau = np.zeros((len(q2), mechanism.dof))
-    for s, (d, grad) in zip(springs, geo):
-        T = _preload_at_anchors(s) + equivalent_rate(s) * (d - s.free_length)
-        tau += T[:, None] * grad
+    tau = _evaluated(mechanism, springs).spring_torque(q2)
     return tau[0] if single else tau
-
-
 # ------------------------------------------------------------------------------------------------
 # Sizing
 # ------------------------------------------------------------------------------------------------
@@ -319,7 +289,7 @@ def _bounds_of(slot: SpringSlot, side: str):
 
 
 def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: float = 1e-9,
-            max_nfev: int = 200, **options) -> BalanceResult:
+            max_nfev: int = 200, catalogue=None, **options) -> BalanceResult:
     """Size springs so that gravity torque + spring torque = 0 over a workspace sample.
 
     ``design``: :class:`~mechbal.balance.result.SpringSlot` objects (or ``{"springs": [...]}``).
@@ -336,7 +306,12 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     or N], ``residual_before`` the peak gravity torque; ``rank``/``unknowns`` of the linear rate
     problem; ``limited_by`` naming a rank deficiency, an active bound, a slack spring or an
     impossibility; ``metrics`` with peak and RMS static torque per joint before and after and the
-    potential-energy variation (max - min [J]) before and after; ``elements`` the sized slots.
+    potential-energy variation (max - min [J]) before and after; ``elements`` the sized slots;
+    ``balanced`` the mechanism with the sized springs as elements of its model (what the static
+    torque after, the tensions and the energy are evaluated on). The springs cancel the static
+    torque of ``mechanism`` as it is (gravity, and the springs it may already have).
+    With ``catalogue`` (a path, a list of :class:`CatalogueSpring`, or "shipped"),
+    ``metrics["catalogue"]`` holds the ranked clusters of :func:`select_for_result` per spring.
     """
     from scipy.optimize import least_squares, lsq_linear
 
@@ -360,9 +335,11 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     if not np.all(np.isfinite(q)):
         raise ValueError("samples: must be finite")
 
-    anchors = _Anchors(mechanism, springs)
-    kin = anchors.evaluate(q)
-    G = np.atleast_2d(mechanism.gravity_torque(q))
+    for s in springs:  # names the bad link or frame before any work
+        model_spring(mechanism, s, probe=True)
+    # what the springs must cancel: the static torque of the mechanism as it is (its weights and
+    # any springs it already has)
+    G = np.atleast_2d(mechanism.static_torque(q))
 
     def project(x):  # (N, dof, ...) -> actuated rows, flattened per sample
         return np.einsum("ndk,nd...->nk...", C, x) if closed else x
@@ -394,7 +371,7 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
 
     # scaled equivalent-rate unknowns: K_eq = scale * z (conditioning of the linear problem)
     def linear_system(x):
-        geo = _geometry(anchors, springs, q, kin, anchors_from(x))
+        geo = _geometry(mechanism, springs, q, anchors_from(x))
         rhs = -Gp.copy()
         cols = []
         for i, (s, (d, grad)) in enumerate(zip(springs, geo)):
@@ -467,14 +444,16 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
             rate = float(K[free.index(i)] * s.pulley_ratio ** 2 / _count(s))
         sized.append(dataclasses.replace(s, rate=rate, anchor_a=tuple(map(float, aa)), anchor_b=tuple(map(float, ab))))
 
-    # evaluation of the sized design on the same sample
-    tau_s = np.zeros_like(G)
+    # evaluation of the sized design on the same sample, by the model with the springs on it
+    balanced = with_springs(mechanism, sized)
+    columns = [balanced.spring_names.index(s.name) for s in sized]
+    lengths = np.atleast_2d(balanced.spring_lengths(q))[:, columns]
+    tensions = np.atleast_2d(balanced.spring_tension(q))[:, columns]
     design_out: dict[str, dict[str, Any]] = {}
     limited: list[str] = []
-    for s, (d, grad) in zip(sized, geo):
+    for i, s in enumerate(sized):
+        d, T = lengths[:, i], tensions[:, i]
         x_s = d - s.free_length
-        T = _preload_at_anchors(s) + equivalent_rate(s) * x_s
-        tau_s += T[:, None] * grad
         design_out[s.name] = {
             "rate": s.rate, "rate_N_per_mm": s.rate / 1000.0, "equivalent_rate": equivalent_rate(s),
             "count": _count(s), "pulley_ratio": s.pulley_ratio, "free_length": s.free_length,
@@ -489,12 +468,11 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
             limited.append(f"slack: {s.name} is shorter than its free length at some samples "
                            f"(min stretch {np.min(x_s):.4g} m): the spring model does not hold there")
     static_before = Gp
-    static_after = project(G + tau_s)
+    static_after = project(np.atleast_2d(balanced.static_torque(q)))
     residual = float(np.max(np.abs(static_after))) if static_after.size else 0.0
     residual_before = float(np.max(np.abs(static_before))) if static_before.size else 0.0
-    Vg = gravity_potential_energy(mechanism, q)
-    Vs = spring_energy(anchors.model, sized, q)
-    V = np.atleast_1d(Vg + Vs)
+    V_before = np.atleast_1d(mechanism.potential_energy(q))
+    V = np.atleast_1d(balanced.potential_energy(q))
     exact_tol = tolerance * max(1.0, residual_before)
     limited += active
     notes = []
@@ -518,7 +496,7 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
 
     metrics = {
         "static_torque_before": per_joint(static_before), "static_torque_after": per_joint(static_after),
-        "potential_energy_variation_before": float(np.ptp(np.atleast_1d(Vg))),
+        "potential_energy_variation_before": float(np.ptp(V_before)),
         "potential_energy_variation_after": float(np.ptp(V)),
         "samples": int(len(q)),
         "spring_mass_note": "springs are massless here; add their mass as bodies if they move",
@@ -530,8 +508,122 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     result = BalanceResult(method="springs", design=design_out, residual=residual,
                            residual_before=residual_before, residual_units="N m (N on prismatic joints)",
                            rank=rank if unknowns else None, unknowns=unknowns, limited_by=limited,
-                           metrics=metrics, balanced=mechanism, elements=sized)
+                           metrics=metrics, balanced=balanced, elements=sized)
+    if catalogue is not None:
+        springs_cat = catalogue if isinstance(catalogue, Sequence) and not isinstance(catalogue, str) \
+            else load_catalogue(None if str(catalogue) == "shipped" else catalogue)
+        clusters = select_for_result(mechanism, result, q, springs_cat)
+        metrics["catalogue"] = {
+            "source": "mechbal/data/springs.csv" if isinstance(catalogue, str) and catalogue == "shipped"
+            else (str(catalogue) if isinstance(catalogue, (str, Path)) else "given"),
+            "note": "clusters of identical catalogue springs behind a block and tackle, ranked by total "
+                    "spring mass (Martini et al. 2015, Tables 1-2); the anchors stay, so a chosen rate "
+                    "that differs from the sized one leaves a small residual",
+            "springs": {name: [c.summary() for c in cands] for name, cands in clusters.items()}}
+        for name, cands in clusters.items():
+            if not cands:
+                notes.append(f"catalogue: no cluster implements {name} (rate "
+                             f"{design_out[name]['equivalent_rate']:.4g} N/m, peak {design_out[name]['peak_tension']:.4g} N)")
     return result
+
+
+# ------------------------------------------------------------------------------------------------
+# mechbal balance CASE --method springs: the [balance] table
+# ------------------------------------------------------------------------------------------------
+DEFAULT_SAMPLES = 1000
+
+
+def design_from_table(table, mechanism: Mechanism):
+    """(design, samples, options) of a validated ``[balance]`` table for :func:`balance` (what
+    ``mechbal balance --method springs`` runs): the ``[[balance.springs]]`` slots with their
+    anchors moved from the frames the user described the links in (:meth:`Mechanism.user_frame`)
+    into the link frames; ``balance.samples`` (default 1000) random poses in
+    ``balance.lower``..``balance.upper`` (default the joint limits, else +-pi / +-0.5 m) drawn
+    with ``balance.seed`` -- for a closed mechanism its actuated coordinates, in a nearest-neighbour
+    order so that the warm-started loop solves move little; ``balance.catalogue`` (a CSV path
+    relative to the case file, or "shipped") as the ``catalogue`` option. ConfigError naming the
+    field otherwise."""
+    from mechbal.balance import common
+    from mechbal.errors import ConfigError
+    from mechbal.schema import did_you_mean
+
+    entries = list(table.springs) if table is not None else []
+    if not entries:
+        raise ConfigError("balance.springs", "no spring slots: add [[balance.springs]] entries (name, link_a, "
+                                             "anchor_a, link_b, anchor_b, rate or rate_min / rate_max)",
+                          has_value=False)
+    root = mechanism.model.root_name
+    links = mechanism.link_names
+    frames = mechanism.frame_names
+    slots = []
+    for i, e in enumerate(entries):
+        field = f"balance.springs[{i}]"
+        anchors, refs, bounds = [], [], []
+        for side in ("a", "b"):
+            ref = getattr(e, f"link_{side}")
+            link = root if ref == "base" else ref
+            a = np.asarray(getattr(e, f"anchor_{side}"), float)
+            b = getattr(e, f"anchor_{side}_bounds")
+            b = None if b is None else (np.asarray(b[0], float), np.asarray(b[1], float))
+            if link in links:
+                T = mechanism.user_frame(link)
+                R, t = T[:3, :3], T[:3, 3]
+                a = R @ a + t
+                if b is not None:
+                    if not np.allclose(np.abs(R), np.eye(3)) or not np.allclose(R, np.diag(np.diag(R))):
+                        raise ConfigError(f"{field}.anchor_{side}_bounds", "anchor bounds on a link described in "
+                                          "a rotated frame (a DH frame) are not supported: give them on "
+                                          "a link without rotation", [list(x) for x in b])
+                    lo, hi = R @ b[0] + t, R @ b[1] + t
+                    b = (np.minimum(lo, hi), np.maximum(lo, hi))
+            elif link not in frames:
+                raise ConfigError(f"{field}.link_{side}", "no link (joint name or 'base') or frame of that name"
+                                  + did_you_mean(ref, sorted(set(links + frames + ["base"]) - {root})), ref)
+            refs.append(link)
+            anchors.append(tuple(float(x) for x in a))
+            bounds.append(None if b is None else (tuple(map(float, b[0])), tuple(map(float, b[1]))))
+        rate_max = e.rate_max if e.rate_max is not None else math.inf
+        slots.append(SpringSlot(
+            name=e.name, link_a=refs[0], anchor_a=anchors[0], link_b=refs[1], anchor_b=anchors[1],
+            free_length=float(e.free_length), rate=None if e.rate is None else float(e.rate),
+            pulley_ratio=float(e.pulley_ratio), rate_max=rate_max, preload=float(e.preload), count=int(e.count),
+            rate_min=float(e.rate_min or 0.0), anchor_a_bounds=bounds[0], anchor_b_bounds=bounds[1]))
+        try:
+            model_spring(mechanism, dataclasses.replace(slots[-1], rate=slots[-1].rate or 0.0))
+        except ValueError as exc:
+            raise ConfigError(field, str(exc), has_value=False) from None
+    n = table.samples if table.samples is not None else DEFAULT_SAMPLES
+    coordinates = "actuated" if mechanism.is_closed else "independent"
+    width = len(mechanism.actuated_names) if mechanism.is_closed else mechanism.dof
+    for key in ("lower", "upper"):
+        v = getattr(table, key)
+        if v is not None and len(v) != width:
+            raise ConfigError(f"balance.{key}", f"must have {width} values (one per "
+                                                f"{'actuated' if mechanism.is_closed else 'independent'} joint)", list(v))
+    try:
+        lo, hi = common.sample_box(mechanism, table.lower, table.upper, coordinates=coordinates)
+    except ValueError as exc:
+        raise ConfigError("balance.upper", str(exc), list(table.upper or [])) from None
+    rng = np.random.default_rng(table.seed)
+    samples = lo + (hi - lo) * rng.random((int(n), len(lo)))
+    if mechanism.is_closed:
+        samples = samples[common._nearest_neighbour_order(samples)]
+    options: dict[str, Any] = {}
+    if table.catalogue is not None:
+        cat = table.catalogue
+        if cat != "shipped":
+            path = Path(cat)
+            if not path.is_absolute() and mechanism.source:
+                path = Path(mechanism.source).parent / path
+            if not path.is_file():
+                raise ConfigError("balance.catalogue", "no such spring catalogue file (give a CSV path relative "
+                                                       "to the case file, or 'shipped')", cat)
+            try:
+                cat = load_catalogue(path)
+            except ValueError as exc:
+                raise ConfigError("balance.catalogue", str(exc), has_value=False) from None
+        options["catalogue"] = cat
+    return slots, samples, options
 
 
 # ------------------------------------------------------------------------------------------------

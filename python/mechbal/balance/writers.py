@@ -130,6 +130,17 @@ def mechanism_table(mech) -> dict:
         out["bodies"] = bodies
     if frames:
         out["frames"] = frames
+    springs = list(d.springs)
+    if springs:
+        root = d.root_name
+        out["springs"] = [{"name": sp.name,
+                           "link_a": "base" if sp.link_a == root else sp.link_a,
+                           "anchor_a": np.asarray(sp.anchor_a, float).tolist(),
+                           "link_b": "base" if sp.link_b == root else sp.link_b,
+                           "anchor_b": np.asarray(sp.anchor_b, float).tolist(),
+                           "rate": float(sp.rate), "free_length": float(sp.free_length),
+                           "preload": float(sp.preload), "count": int(sp.count),
+                           "pulley_ratio": float(sp.pulley_ratio)} for sp in springs]
     loops = list(d.loops)
     if loops:
         names = {_core.LoopType.point: "point", _core.LoopType.planar_point: "planar_point",
@@ -169,6 +180,9 @@ def urdf_text(mech, name: str | None = None) -> str:
 
     if mech.is_closed:
         raise ValueError("URDF describes trees only: this mechanism has loop closures (write TOML)")
+    if mech.springs:
+        raise ValueError("URDF has no springs: this mechanism has springs, which a URDF would silently "
+                         "drop (write TOML)")
     d = mech.model.description
     g = np.asarray(d.gravity, float)
     out = ['<?xml version="1.0"?>',

@@ -123,6 +123,15 @@ def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, 
     }
     if extra:
         summary["loops"] = extra
+    if mech.springs:  # springs are part of the model: the torques above include them
+        static = mech.static_torque(q)
+        if mech.is_closed:
+            qa = q[:, list(mech.model.actuated_coordinates)]
+            static = np.einsum("ndk,nd->nk", mech.closed_motion(qa, q_guess=q_guess).projection, static)
+        summary["springs"] = mech.spring_names
+        summary["peak_static_torque"] = {"nominal": report.peak_abs(static)}
+        summary["static_torque"] = ("actuator torque that holds each pose still, gravity plus springs; "
+                                    "the joint torques include the springs' forces")
     summary.update(summary_extra or {})
     write_summary(out / "summary.json", summary)
     print(report.table(

@@ -143,7 +143,7 @@ def spec_of_mechanism(mech) -> Any:
     """A :class:`mechbal.spec.MechanismSpec` of a built :class:`mechbal.Mechanism` (from its
     model's description: the way to sweep a URDF robot)."""
     from mechbal import _core
-    from mechbal.spec import BodySpec, FrameSpec, JointSpec, LoopSpec, MechanismSpec
+    from mechbal.spec import BodySpec, FrameSpec, JointSpec, LoopSpec, MechanismSpec, SpringSpec
 
     d = mech.model.description
     names = {_core.JointType.revolute: "revolute", _core.JointType.prismatic: "prismatic",
@@ -162,7 +162,10 @@ def spec_of_mechanism(mech) -> Any:
               for b in d.bodies]
     frames = [FrameSpec(f.name, link(f.link), np.array(f.placement)) for f in d.frames]
     loops = [LoopSpec(lp.name, loop_names[lp.type], lp.frame_a, lp.frame_b) for lp in d.loops]
-    return MechanismSpec(np.array(d.gravity), joints, bodies, frames, loops, list(d.actuated))
+    springs = [SpringSpec(sp.name, link(sp.link_a), np.array(sp.anchor_a), link(sp.link_b), np.array(sp.anchor_b),
+                          float(sp.rate), float(sp.free_length), float(sp.preload), int(sp.count),
+                          float(sp.pulley_ratio)) for sp in d.springs]
+    return MechanismSpec(np.array(d.gravity), joints, bodies, frames, loops, list(d.actuated), springs=springs)
 
 
 @dataclass

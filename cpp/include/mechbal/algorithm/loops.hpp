@@ -70,12 +70,14 @@ Status closed_motion(const MechanismModel& model, MechanismData& data, const Con
                      const LoopSolveOptions& options = {}) noexcept;
 
 /// Actuated forces of the closed mechanism for the motion: data.actuated_force = C^T tau(q, v, a)
+/// (tau of inverse_dynamics: springs included)
 /// (after closed_motion with the same arguments; also fills data.joint_torque of the tree).
 Status closed_inverse_dynamics(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
                                const ConstVector& v_actuated, const ConstVector& a_actuated,
                                Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options = {}) noexcept;
 
-/// data.reduced_mass_matrix = C^T M C and data.actuated_gravity = C^T G at the solved q.
+/// data.reduced_mass_matrix = C^T M C, data.actuated_gravity = C^T G and
+/// data.actuated_static_torque = C^T (G + K) (springs, algorithm/springs.hpp) at the solved q.
 Status closed_mass_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
                           Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options = {}) noexcept;
 

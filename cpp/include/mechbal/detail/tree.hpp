@@ -20,6 +20,7 @@ inline Vec3 cross_ez(const Vec3& w) noexcept { return Vec3(w.y(), -w.x(), 0.0); 
 inline bool data_matches(const MechanismModel& model, const MechanismData& data) noexcept {
   return data.dof == model.dof() && data.num_links == model.num_links() &&
          data.num_bodies == model.num_bodies() && data.num_frames == model.num_frames() &&
+         data.num_springs == model.num_springs() &&
          static_cast<int>(data.work.size()) == model.num_links();
 }
 
@@ -295,6 +296,76 @@ inline void frame_jacobian_placed(const MechanismModel& model, const MechanismDa
       J.col(c).template tail<3>() += r * z;
     } else {
       J.col(c).template head<3>() += r * z;
+    }
+  }
+}
+
+/// place<true> when the model has springs (their anchors need world positions), place<false>
+/// otherwise: a model without springs pays one branch.
+inline void place_for_springs(const MechanismModel& model, MechanismData& data) noexcept {
+  if (model.num_springs() > 0) {
+    place<true>(model, data);
+  } else {
+    place<false>(model, data);
+  }
+}
+
+/// Adds J_p(q)^T f to tau: the generalised force of a force f (in O) applied at the point p (in O)
+/// of link `link`, through the joints from the link to the base (from placed links).
+template <typename Tau>
+inline void add_point_force(const MechanismModel& model, const MechanismData& data, int link, const Vec3& p,
+                            const Vec3& f, Tau& tau) noexcept {
+  for (int k = link; k >= 1; k = model.parent(k)) {
+    const int c = model.coordinate(k);
+    if (c < 0) continue;
+    const auto& K = data.work[static_cast<std::size_t>(k)];
+    const Vec3 z = K.world_rotation.col(2);
+    const double r = model.coordinate_ratio(k);
+    if (model.joint_type(k) == JointType::revolute) {
+      tau(c) += r * z.dot((p - K.world_position).cross(f));
+    } else {
+      tau(c) += r * z.dot(f);
+    }
+  }
+}
+
+/// Springs from placed links (world poses computed): data.spring_length, spring_tension,
+/// spring_energy and the base's wrench through its springs (spring_base_force/moment); with
+/// Torque, also tau += K(q) = dV_springs/dq = -(J_A^T f_A + J_B^T f_B), f_A = T u the force on
+/// anchor A (u = (p_B - p_A) / d), f_B = -f_A. The force is K_eq (p_B - p_A) + (T_0 - K_eq L_0) u,
+/// so a zero-free-length spring stays defined at d = 0; another spring at d = 0 has no direction
+/// and its u is taken as zero there.
+template <bool Torque, typename Tau>
+inline void spring_forces(const MechanismModel& model, MechanismData& data, Tau& tau) noexcept {
+  data.spring_energy = 0.0;
+  data.spring_base_force.setZero();
+  data.spring_base_moment.setZero();
+  const int ns = model.num_springs();
+  for (int s = 0; s < ns; ++s) {
+    const auto& c = model.spring_constants(s);
+    const auto& A = data.work[static_cast<std::size_t>(c.link_a)];
+    const auto& B = data.work[static_cast<std::size_t>(c.link_b)];
+    const Vec3 pa = A.world_position + A.world_rotation * c.anchor_a;
+    const Vec3 pb = B.world_position + B.world_rotation * c.anchor_b;
+    const Vec3 r = pb - pa;
+    const double d = r.norm();
+    const double x = d - c.free_length;
+    data.spring_length(s) = d;
+    data.spring_tension(s) = c.preload_tension + c.equivalent_rate * x;
+    data.spring_energy += x * (c.preload_tension + 0.5 * c.equivalent_rate * x);
+    const double offset = c.preload_tension - c.equivalent_rate * c.free_length;
+    Vec3 fa = c.equivalent_rate * r;
+    if (offset != 0.0 && d > 0.0) fa += (offset / d) * r;
+    if (c.link_a == 0 && c.link_b != 0) {  // the base pulls B with -f_A
+      data.spring_base_force -= fa;
+      data.spring_base_moment -= pb.cross(fa);
+    } else if (c.link_b == 0 && c.link_a != 0) {
+      data.spring_base_force += fa;
+      data.spring_base_moment += pa.cross(fa);
+    }
+    if (Torque) {
+      add_point_force(model, data, c.link_a, pa, Vec3(-fa), tau);
+      add_point_force(model, data, c.link_b, pb, fa, tau);
     }
   }
 }
