@@ -66,7 +66,8 @@ def slots_from_table(table, field: str = "balance.counterweights") -> list[Count
             name=c.name, link=c.link, mass_min=lo, mass_max=hi,
             max_radius=c.max_radius if c.max_radius is not None else math.inf,
             center=tuple(c.center), direction=None if c.direction is None else tuple(c.direction),
-            inertia=None if c.inertia is None else inertia_matrix(c.inertia)))
+            inertia=None if c.inertia is None else inertia_matrix(c.inertia),
+            position=None if c.position is None else tuple(c.position), tie=c.tie))
     return out
 
 
@@ -145,9 +146,14 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
         t, motion, tt = _trajectory_motion(mech, {"start": tr.start, "end": tr.end, "duration": tr.duration,
                                                   "samples": tr.samples}, law="cubic")
         return BalanceCase(name, title, mech, table, t, motion, tt, None, raw, "arm2dof", slots)
-    raise ConfigError("case.kind", f"mechbal balance reads cases of kind mechanism, serial_chain or "
-                                   f"arm2dof, and URDF files ({cfg.case.kind!r}: its mechanism is not on the "
-                                   "general model yet)", cfg.case.kind)
+    if cfg.case.kind in ("paminsa", "discs"):
+        from mechbal.balance import cases as builtin
+
+        make = builtin.paminsa_case if cfg.case.kind == "paminsa" else builtin.discs_case
+        return make(cfg, raw, table, design_cfg)
+    raise ConfigError("case.kind", f"mechbal balance reads cases of kind mechanism, serial_chain, arm2dof, "
+                                   f"paminsa or discs, and URDF files ({cfg.case.kind!r}: its mechanism is not "
+                                   "on the general model yet)", cfg.case.kind)
 
 
 # ---- evaluation --------------------------------------------------------------------------------
@@ -210,6 +216,10 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
             raise ConfigError("--method", f"mechbal.balance.{name} has no design_from_table(table, mechanism): "
                                           "mechbal balance cannot read its design", has_value=False)
         design, samples, options = make(table, mech)
+        import inspect
+
+        if bc.q_guess is not None and "q_guess" in inspect.signature(module.balance).parameters:
+            options.setdefault("q_guess", bc.q_guess)   # the assembly mode of a closed mechanism
         return module.balance(mech, design, samples, **options)
     slots = slots_from_table(table) or list(bc.default_slots)
     if not slots:
@@ -329,7 +339,11 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
     write_summary(out / "summary.json", summary)
     rows = [[k, v["mass"], np.asarray(v["position"], float), ", ".join(v.get("active_bounds", [])) or "-"]
             for k, v in result.design.items() if "mass" in v]
-    print(report.table(rows, ["counterweight", "mass [kg]", "position [m] (link frame)", "active bounds"]))
+    if rows:
+        print(report.table(rows, ["counterweight", "mass [kg]", "position [m] (link frame)", "active bounds"]))
+    discs = [[k, v["carrier"], v["joint"], v["ratio"], v["inertia"]] for k, v in result.design.items() if "ratio" in v]
+    if discs:
+        print(report.table(discs, ["disc", "carrier", "geared to", "ratio", "inertia [kg m^2]"]))
     cmp = summary["before_after"]
     print(report.table([[k, cmp[k]["unbalanced"]["peak"], cmp[k]["balanced"]["peak"]] for k in cmp],
                        ["peak along the trajectory", "unbalanced", "balanced"]))
