@@ -1,7 +1,8 @@
 """``mechbal balance CASE --method METHOD --out DIR``: balance a case's mechanism and write the run.
 
 CASE is a TOML case of kind ``mechanism`` / ``serial_chain`` (its ``[mechanism]``, ``[trajectory]``
-and ``[balance]`` tables), the built-in ``arm2dof`` (its arm as a mechanism with links
+and ``[balance]`` tables), the built-in ``paminsa`` and disc cases (kinds ``paminsa`` and
+``discs``: :mod:`mechbal.balance.cases`), the built-in ``arm2dof`` (its arm as a mechanism with links
 ``shoulder`` and ``elbow``, x along each link; the counterweights of ``[counterweights]`` on the
 link extensions unless ``[balance]`` gives others; the minimum-energy cubic law of its
 ``[trajectory]``), or a URDF file (with ``--design FILE.toml`` holding a ``[balance]`` table and
@@ -253,9 +254,11 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
 def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
     from mechbal.balance.writers import mechanism_table, toml_text
 
-    header = (f"{bc.name} balanced by `mechbal balance --method {method}`: counterweights "
-              + ", ".join(f"{k} {v['mass']:.6g} kg at {np.round(np.asarray(v['position'], float), 6).tolist()} m "
-                          f"on {v['link']}" for k, v in result.design.items() if "mass" in v)
+    header = (f"{bc.name} balanced by `mechbal balance --method {method}`: "
+              + ", ".join([f"counterweight {k} {v['mass']:.6g} kg at {np.round(np.asarray(v['position'], float), 6).tolist()} m "
+                           f"on {v['link']}" for k, v in result.design.items() if "mass" in v]
+                          + [f"disc {k} ({v['inertia']:.6g} kg m^2, ratio {v['ratio']:.6g} to {v['joint']}) on {v['carrier']}"
+                             for k, v in result.design.items() if "ratio" in v])
               + f".\nResidual {result.residual:.6g} {result.residual_units} (unbalanced {result.residual_before:.6g}).")
     case = {"name": f"{bc.name}-balanced", "kind": "mechanism", "title": f"{bc.title}, balanced ({method})"}
     tt = dict(bc.trajectory_table)
