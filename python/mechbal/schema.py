@@ -341,7 +341,10 @@ class BalanceCounterweight(Table):
     """``[[balance.counterweights]]``: a counterweight the method may add (a point mass, plus
     ``inertia`` about its centre): its mass within [mass_min, mass_max] (or fixed: ``mass``),
     its centre within ``max_radius`` of ``center``, on the line ``direction`` through ``center``
-    if given; positions in the frame the user described the link in (DH frame for ``dh``)."""
+    if given, or at ``position`` (given: only the mass is chosen); positions in the frame the user
+    described the link in (DH frame for ``dh``). ``tie``: share the mass and position (each in its
+    own link frame) of another counterweight of the table, e.g. the same counterweight on each
+    identical leg of a parallel mechanism; a tied counterweight gives only name, link and tie."""
     name: Name = Field(description="the counterweight's body name (must be new)")
     link: Name = Field(description="name of the joint whose link carries it")
     mass: Optional[Mass] = Field(None, description="kg, a fixed mass (instead of mass_min / mass_max)")
@@ -350,10 +353,26 @@ class BalanceCounterweight(Table):
     max_radius: Optional[NonNeg] = Field(None, description="m, largest distance from center (absent: unbounded)")
     center: Xyz = Field([0.0, 0.0, 0.0], description="m, in the link's frame")
     direction: Optional[Vec3] = Field(None, description="the counterweight slides on this line through center")
+    position: Optional[Xyz] = Field(None, description="m, in the link's frame: the position is given, only "
+                                                      "the mass is chosen (no center, direction, max_radius)")
+    tie: Optional[Name] = Field(None, description="name of another counterweight of this table whose mass and "
+                                                  "position (in each one's own link frame) this one shares")
     inertia: Optional[Inertia] = None
 
     @model_validator(mode="after")
     def _masses(self):
+        given = self.model_fields_set
+        if self.tie is not None:
+            own = [k for k in ("mass", "mass_min", "mass_max", "max_radius", "center", "direction", "position",
+                               "inertia") if k in given]
+            if own:
+                raise _custom(f"a counterweight tied to {self.tie!r} takes its mass, position and bounds from "
+                              f"it: give only name, link and tie", f".{own[0]}", getattr(self, own[0]))
+        if self.position is not None:
+            for k in ("max_radius", "direction", "center"):
+                if k in given:
+                    raise _custom(f"the position is given ({self.position}): only the mass is chosen, so "
+                                  f"give no {k}", f".{k}", getattr(self, k))
         if self.mass is not None and (self.mass_min is not None or self.mass_max is not None):
             raise _custom("give either mass or mass_min / mass_max", ".mass", self.mass)
         lo = self.mass_min or 0.0
@@ -403,6 +422,55 @@ class BalanceSpring(Table):
         return self
 
 
+class BalanceDisc(Table):
+    """``[[balance.discs]]`` (method moment): a counter-rotating disc the method may add on an axle
+    of link ``carrier`` through ``position`` along ``axis`` (carrier frame), turning relative to
+    the carrier by ``ratio`` times the rate of coordinate ``joint`` (a gear train: a gear coupling
+    on the model). Its mass is part of the carrier's; ``inertia`` (axial, about the axle) and
+    ``ratio`` absent are chosen by the method (mechbal.balance.DiscSlot)."""
+    name: Name = Field(description="the disc's joint and body name (must be new)")
+    carrier: Name = Field(description="link (joint name, or 'base') that carries the axle")
+    joint: Name = Field(description="the coordinate the disc is geared to")
+    axis: Vec3 = Field([1.0, 0.0, 0.0], description="the axle's direction in the carrier's frame")
+    position: Xyz = Field([0.0, 0.0, 0.0], description="m, a point of the axle in the carrier's frame")
+    ratio: Optional[Num] = Field(None, description="gear ratio (absent: chosen)")
+    inertia: Optional[NonNeg] = Field(None, description="kg m^2, axial inertia (absent: chosen)")
+    transverse_inertia: Optional[NonNeg] = Field(None, description="kg m^2 (absent: inertia / 2, a thin disc)")
+    inertia_min: NonNeg = Field(0.0, description="kg m^2, bound on a chosen inertia")
+    inertia_max: Optional[NonNeg] = Field(None, description="kg m^2, bound on a chosen inertia (absent: none)")
+    ratio_min: Optional[Num] = Field(None, description="a chosen ratio below it is reported")
+    ratio_max: Optional[Num] = Field(None, description="a chosen ratio above it is reported")
+
+    @model_validator(mode="after")
+    def _disc(self):
+        if not any(self.axis):
+            raise _custom("must be a non-zero vector", ".axis", self.axis)
+        given = self.model_fields_set
+        if self.inertia is not None:
+            for k in ("inertia_min", "inertia_max"):
+                if k in given:
+                    raise _custom(f"the inertia is given ({self.inertia!r}): give no {k}", f".{k}", getattr(self, k))
+        if self.inertia_max is not None and self.inertia_max < self.inertia_min:
+            raise _custom(f"must be >= inertia_min = {self.inertia_min!r}", ".inertia_max", self.inertia_max)
+        if self.ratio is not None:
+            for k in ("ratio_min", "ratio_max"):
+                if k in given:
+                    raise _custom(f"the ratio is given ({self.ratio!r}): give no {k}", f".{k}", getattr(self, k))
+        if self.ratio_min is not None and self.ratio_max is not None and self.ratio_max < self.ratio_min:
+            raise _custom(f"must be >= ratio_min = {self.ratio_min!r}", ".ratio_max", self.ratio_max)
+        return self
+
+
+class BalanceInertia(Table):
+    """``[[balance.inertias]]`` (method moment): central principal inertias of an existing body
+    that the method may choose (mechbal.balance.InertiaSlot)."""
+    name: Name
+    body: Name = Field(description="an existing body of the mechanism")
+    components: Annotated[list[Literal["Ixx", "Iyy", "Izz"]], Field(min_length=1, max_length=3)] = Field(
+        ["Iyy"], description="which central principal inertias (link axes) are chosen")
+    minimum: NonNeg = Field(0.0, description="kg m^2, lower bound of each")
+
+
 class Balance(Table):
     """``[balance]``: what ``mechbal balance`` may change and what it must hold over."""
     method: Optional[BalanceMethod] = Field(None, description="default of --method")
@@ -411,9 +479,11 @@ class Balance(Table):
     catalogue: Optional[Annotated[str, Field(min_length=1, max_length=4096, strict=True)]] = Field(
         None, description="springs method: a spring catalogue CSV to select off-the-shelf springs from "
                           "(path relative to the case file), or 'shipped' for mechbal's own")
+    discs: Annotated[list[BalanceDisc], Field(max_length=MAX_BODIES)] = []
+    inertias: Annotated[list[BalanceInertia], Field(max_length=MAX_BODIES)] = []
     mass_budget: Optional[Pos] = Field(None, description="kg, total counterweight mass")
     samples: Optional[Annotated[int, Field(ge=1, le=MAX_CONFIGURATIONS, strict=True)]] = Field(
-        None, description="random workspace samples (static: 1000, force: 200 motions)")
+        None, description="random workspace samples (static: 1000, force: 200 motions, moment: 200 poses)")
     seed: Annotated[int, Field(ge=0, le=2**63 - 1, strict=True)] = 0
     lower: Optional[JointValues] = Field(None, description="sample box, per independent (closed: actuated) joint")
     upper: Optional[JointValues] = None
@@ -421,6 +491,25 @@ class Balance(Table):
     coupling: Optional[Literal["per_joint", "total"]] = Field(
         None, description="rms method: each joint by its own link's slots (default, open) or all together")
     weights: Optional[JointValues] = Field(None, description="rms method, total coupling: per actuated joint")
+    check_motions: Optional[Annotated[int, Field(ge=1, le=MAX_CONFIGURATIONS, strict=True)]] = Field(
+        None, description="moment method: random motions the balanced angular momentum is checked on (1000)")
+
+    @model_validator(mode="after")
+    def _names(self):
+        names = [c.name for c in self.counterweights]
+        for i, c in enumerate(self.counterweights):
+            if c.tie is not None and (c.tie not in names or c.tie == c.name):
+                others = [n for n in names if n != c.name]
+                what = "itself" if c.tie == c.name else "no counterweight of this table"
+                raise _custom(f"names {what}{did_you_mean(c.tie, others) if c.tie != c.name else ''}",
+                              f".counterweights[{i}].tie", c.tie)
+        seen: dict[str, str] = {}
+        for key in ("counterweights", "discs", "inertias"):
+            for i, c in enumerate(getattr(self, key)):
+                if c.name in seen:
+                    raise _custom(f"is already the name of {seen[c.name]}", f".{key}[{i}].name", c.name)
+                seen[c.name] = f"{key}[{i}]"
+        return self
 
 
 class SerialChainCaseHeader(CaseHeader):
@@ -692,6 +781,9 @@ class PaminsaCase(Table):
     counterweights: PaminsaCounterweights = PaminsaCounterweights()
     trajectory: PaminsaTrajectory
     wrist: PaminsaWrist
+    balance: Optional[Balance] = Field(
+        None, description="mechbal balance: the mechanism of mechbal.papers.paminsa (unbalanced, without its "
+                          "placeholder counterweights); links are its joints (leg1_link3, leg1_guide, ...)")
 
     @model_validator(mode="after")
     def _ticks(self):
@@ -852,6 +944,9 @@ class FivebarHeader(DiscsCaseHeader):
 class _DiscsCase(Table):
     sampling: DiscsSampling = DiscsSampling()
     sensitivity: DiscsSensitivity = DiscsSensitivity()
+    balance: Optional[Balance] = Field(
+        None, description="mechbal balance: the statically balanced mechanism without discs (links joint1..3 "
+                          "of mechbal.papers.discs; five-bar: theta1, theta12, theta2, theta22)")
 
 
 class Planar3rCase(_DiscsCase):

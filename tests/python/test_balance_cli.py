@@ -169,14 +169,13 @@ def test_toml_text_round_trips():
 
 def test_balance_errors_are_one_line(capsys, tmp_path):
     out = str(tmp_path / "o")
-    # moment and springs are dispatched to their modules, which read their own design keys
-    # through design_from_table(table, mechanism) (not written yet: one line, exit 2)
+    # moment reads its own design keys through design_from_table(table, mechanism)
     assert main(["balance", "arm2link", "--method", "moment", "--out", out]) == 2
-    one_line_error(capsys, "--method", "moment")
-    assert main(["balance", "paminsa", "--out", out]) == 2
-    one_line_error(capsys, "case.kind", "arm2dof")
+    one_line_error(capsys, "balance.discs", "no disc or inertia slots")
+    assert main(["balance", "paminsa", "--method", "moment", "--out", out]) == 2
+    one_line_error(capsys, "balance.discs")
     assert main(["balance", "discs-3r", "--method", "static", "--out", out]) == 2
-    one_line_error(capsys, "case.kind")
+    one_line_error(capsys, "balance.counterweights", "no counterweight slots")
     bad = tmp_path / "bad.toml"
     text = (Path(__file__).parents[2] / "python/mechbal/cases/arm2link.toml").read_text()
     bad.write_text(text.replace('link = "elbow"\nmax_radius', 'link = "elbo"\nmax_radius'))

@@ -21,7 +21,16 @@ bounds are reported as what limited the balance.
 
 Positions are in the frame the user described each link in (:meth:`Mechanism.user_frame`):
 the variables are (m, h_user) with ``h_link = R h_user + m t`` for the user frame (R, t).
-"""
+
+**Fixed positions.** A slot whose position is given (``position``, or ``max_radius = 0``) has one
+unknown, its mass: its four columns collapse to one, ``(1, p)``, and the balance is an exact linear
+least squares in the masses (Briot & Arakelian's counterweights at the points of their eqs 11-16).
+
+**Tied slots.** Slots tied to another (``tie``) share its unknowns (m, h_user): the same mass at
+the same position in each one's own link frame, as identical legs of a parallel mechanism do.
+Their columns are summed (x = E x_group), the bounds are the group's, and the mass budget counts
+each member. Without the tie such a system is often rank-deficient (legs driven by one actuator
+move no momentum along some combinations of their counterweights)."""
 from __future__ import annotations
 
 import math
@@ -62,6 +71,10 @@ class Slot:
     field: str
     #: the name the user gave: the link, or a named frame on it (positions are in that frame)
     given: str = ""
+    #: the position is given (``position`` or ``max_radius = 0``): only the mass is unknown
+    fixed_position: bool = False
+    #: the slot whose unknowns this one shares (the root of its tie chain); None: its own
+    tie: str | None = None
 
     @property
     def mass_fixed(self) -> bool:
@@ -85,13 +98,19 @@ def _finite(x: Any, what: str) -> float:
     return v
 
 
+_TIED_OWN = (("mass_min", 0.0), ("mass_max", math.inf), ("max_radius", math.inf), ("direction", None),
+             ("inertia", None), ("position", None))
+
+
 def normalise_slots(mech, design: Sequence[CounterweightSlot], *, need_radius: bool = True,
                     field_name: str = "design") -> list[Slot]:
     """Check the slots against ``mech`` (ValueError naming ``design[i].field``): a moving link,
     0 <= mass_min <= mass_max, max_radius >= 0, a non-zero direction, unique names that are not
-    already bodies of the mechanism. With ``need_radius`` a slot whose mass is free needs a finite
-    ``max_radius`` or ``mass_min > 0`` (otherwise the lightest counterweight is a zero mass at an
-    infinite distance)."""
+    already bodies of the mechanism, a ``position`` without ``center``, ``direction`` or a finite
+    ``max_radius``, a ``tie`` naming another slot of the design (and no bounds of its own: a tied
+    slot takes its group's). With ``need_radius`` a slot whose mass and position are free needs a
+    finite ``max_radius`` or ``mass_min > 0`` (otherwise the lightest counterweight is a zero mass
+    at an infinite distance)."""
     if isinstance(design, CounterweightSlot):
         design = [design]
     design = list(design)
@@ -100,6 +119,8 @@ def normalise_slots(mech, design: Sequence[CounterweightSlot], *, need_radius: b
     names = set(mech.body_names)
     out: list[Slot] = []
     moving = set(mech.link_names[1:])
+    frames = {fr.name: fr for fr in mech.model.description.frames}
+    slot_names = [getattr(s, "name", None) for s in design]
     for i, s in enumerate(design):
         f = f"{field_name}[{i}]"
         if not isinstance(s, CounterweightSlot):
@@ -108,7 +129,6 @@ def normalise_slots(mech, design: Sequence[CounterweightSlot], *, need_radius: b
             raise ValueError(f"{f}.name: '{s.name}' is already a body of the mechanism or another slot")
         names.add(s.name)
         link, T = s.link, None
-        frames = {fr.name: fr for fr in mech.model.description.frames}
         if link not in moving and link in frames and frames[link].link in moving:
             # a named frame on a link (a URDF link's own frame): positions are in that frame
             T = mech.user_frame(frames[link].link) @ np.asarray(frames[link].placement, float)
@@ -119,6 +139,23 @@ def normalise_slots(mech, design: Sequence[CounterweightSlot], *, need_radius: b
             more = f" (did you mean '{hint[0]}'?)" if hint else f" (moving links: {', '.join(sorted(moving))})"
             what = "the base does not move" if s.link == mech.model.root_name else "no moving link named"
             raise ValueError(f"{f}.link: {what} '{s.link}'{more}")
+        T = mech.user_frame(link) if T is None else T
+        if s.tie is not None:
+            if s.tie == s.name:
+                raise ValueError(f"{f}.tie: a slot cannot be tied to itself ('{s.tie}')")
+            if s.tie not in slot_names:
+                from mechbal.schema import did_you_mean
+                raise ValueError(f"{f}.tie: no counterweight slot named '{s.tie}' in the design"
+                                 f"{did_you_mean(str(s.tie), [n for n in slot_names if n and n != s.name])}")
+            own = [k for k, default in _TIED_OWN if not _is_default(getattr(s, k), default)]
+            if any(float(x) != 0.0 for x in s.center):
+                own.insert(0, "center")
+            if own:
+                raise ValueError(f"{f}.{own[0]}: '{s.name}' is tied to '{s.tie}' and takes its mass, position "
+                                 f"and bounds from it: give no {own[0]} of its own")
+            out.append(Slot(s.name, link, 0.0, math.inf, math.inf, np.zeros(3), None, np.zeros((3, 3)), T, f,
+                            s.link, False, s.tie))
+            continue
         lo, hi = _finite(s.mass_min, f"{f}.mass_min"), _finite(s.mass_max, f"{f}.mass_max")
         if lo < 0 or math.isinf(lo):
             raise ValueError(f"{f}.mass_min: must be >= 0 and finite (got {lo})")
@@ -127,14 +164,29 @@ def normalise_slots(mech, design: Sequence[CounterweightSlot], *, need_radius: b
         R = _finite(s.max_radius, f"{f}.max_radius")
         if R < 0:
             raise ValueError(f"{f}.max_radius: must be >= 0 (got {R})")
-        if need_radius and math.isinf(R) and lo == 0.0 and hi > 0.0:
-            raise ValueError(f"{f}: give max_radius (or mass_min > 0): with neither, the lightest "
-                             "counterweight is a vanishing mass at an infinite distance")
         c = np.array([_finite(x, f"{f}.center") for x in s.center], float)
         if c.shape != (3,):
             raise ValueError(f"{f}.center: must have 3 values (got {list(s.center)})")
+        fixed = R == 0.0
+        if s.position is not None:
+            if math.isfinite(R):
+                raise ValueError(f"{f}.max_radius: the position is given (position = {list(s.position)}): "
+                                 f"only the mass is chosen, so give no max_radius (got {R})")
+            if s.direction is not None:
+                raise ValueError(f"{f}.direction: the position is given (position = {list(s.position)}): "
+                                 f"give either position or direction (got {list(s.direction)})")
+            if np.any(c != 0.0):
+                raise ValueError(f"{f}.center: the position is given (position = {list(s.position)}): give "
+                                 f"either position or center (got {list(s.center)})")
+            c = np.array([_finite(x, f"{f}.position") for x in s.position], float)
+            if c.shape != (3,):
+                raise ValueError(f"{f}.position: must have 3 values (got {list(s.position)})")
+            R, fixed = 0.0, True
+        if need_radius and not fixed and math.isinf(R) and lo == 0.0 and hi > 0.0:
+            raise ValueError(f"{f}: give max_radius (or mass_min > 0, or a fixed position): with none, the "
+                             "lightest counterweight is a vanishing mass at an infinite distance")
         u = None
-        if s.direction is not None:
+        if s.direction is not None and not fixed:
             u = np.array([_finite(x, f"{f}.direction") for x in s.direction], float)
             if u.shape != (3,) or not np.linalg.norm(u) > 0 or not np.all(np.isfinite(u)):
                 raise ValueError(f"{f}.direction: must be 3 finite values, not all zero (got {list(s.direction)})")
@@ -144,9 +196,54 @@ def normalise_slots(mech, design: Sequence[CounterweightSlot], *, need_radius: b
             I = np.diag(I)
         if I.shape != (3, 3) or not np.all(np.isfinite(I)):
             raise ValueError(f"{f}.inertia: must be a 3x3 matrix or 3 principal moments")
-        out.append(Slot(s.name, link, lo, hi, R, c, u, 0.5 * (I + I.T),
-                        mech.user_frame(link) if T is None else T, f, s.link))
+        out.append(Slot(s.name, link, lo, hi, R, c, u, 0.5 * (I + I.T), T, f, s.link, fixed))
+    # ties: every slot shares the unknowns of the root of its chain, and takes its bounds
+    by_name = {s.name: s for s in out}
+    for s in out:
+        seen, root = [s.name], s
+        while root.tie is not None:
+            root = by_name[root.tie]
+            if root.name in seen:
+                raise ValueError(f"{s.field}.tie: the ties form a cycle ({' -> '.join(seen + [root.name])})")
+            seen.append(root.name)
+        if root is not s:
+            s.tie = root.name
+            s.mass_min, s.mass_max, s.max_radius = root.mass_min, root.mass_max, root.max_radius
+            s.center, s.direction, s.fixed_position = root.center.copy(), root.direction, root.fixed_position
+            # the inertia is the root's in its user frame, carried to the member's user frame axes
+            s.inertia = root.inertia.copy()
     return out
+
+
+def _is_default(value, default) -> bool:
+    if default is None:
+        return value is None
+    try:
+        return float(value) == default
+    except (TypeError, ValueError):
+        return False
+
+
+def tied_groups(slots: Sequence[Slot]) -> dict[str, list[str]]:
+    """{root: [root, members...]} of every group of two or more tied slots."""
+    groups: dict[str, list[str]] = {}
+    for s in slots:
+        if s.tie is not None:
+            groups.setdefault(s.tie, [s.tie]).append(s.name)
+    return groups
+
+
+def tie_matrix(slots: Sequence[Slot]) -> tuple[np.ndarray, list[Slot], np.ndarray]:
+    """(E (4K, 4G), the G group roots, members per group): x of every slot = E x of the roots."""
+    roots = [s for s in slots if s.tie is None]
+    index = {s.name: g for g, s in enumerate(roots)}
+    E = np.zeros((4 * len(slots), 4 * len(roots)))
+    count = np.zeros(len(roots))
+    for k, s in enumerate(slots):
+        g = index[s.tie if s.tie is not None else s.name]
+        E[4 * k:4 * k + 4, 4 * g:4 * g + 4] = np.eye(4)
+        count[g] += 1
+    return E, roots, count
 
 
 def probe_mechanism(mech, slots: Sequence[Slot]):
@@ -325,8 +422,10 @@ class _Design:
     budget (linear), ``|d| <= max_radius m`` (linear along a direction, a second-order cone
     otherwise)."""
 
-    def __init__(self, slots: Sequence[Slot], mass_budget: float | None, L: float):
+    def __init__(self, slots: Sequence[Slot], mass_budget: float | None, L: float, count=None):
         self.slots, self.L = list(slots), L
+        #: members per slot (a tied group counts each of its slots in the mass budget)
+        self.count = np.ones(len(slots)) if count is None else np.asarray(count, float)
         n = 4 * len(slots)
         cols, names, self.mass_var, self.d_vars = [], [], [], []
         xc = np.zeros(n)
@@ -342,9 +441,12 @@ class _Design:
                 c[i + 1:i + 4] = s.center / L
                 self.mass_var.append(len(cols))
                 cols.append(c), names.append(f"{s.name}.mass")
-            dirs = [s.direction] if s.direction is not None else list(np.eye(3))
-            labels = ["mass_moment_along_direction"] if s.direction is not None else \
-                ["mass_moment_x", "mass_moment_y", "mass_moment_z"]
+            if s.fixed_position:   # h = m p: the mass is the only unknown
+                dirs, labels = [], []
+            elif s.direction is not None:
+                dirs, labels = [s.direction], ["mass_moment_along_direction"]
+            else:
+                dirs, labels = list(np.eye(3)), ["mass_moment_x", "mass_moment_y", "mass_moment_z"]
             idx = []
             for u, lab in zip(dirs, labels):
                 c = np.zeros(n)
@@ -367,7 +469,7 @@ class _Design:
                 G.append(r), g.append(-s.mass_min), lin_names.append(f"{s.name}.mass_min"), lin_scale.append(1.0)
                 if math.isfinite(s.mass_max):
                     G.append(-r), g.append(s.mass_max), lin_names.append(f"{s.name}.mass_max"), lin_scale.append(1.0)
-            if s.direction is not None and math.isfinite(s.max_radius):
+            if s.direction is not None and math.isfinite(s.max_radius) and not s.fixed_position:
                 (jd,) = self.d_vars[k]
                 for sign in (1.0, -1.0):  # R m -+ d >= 0
                     r = np.zeros(ny)
@@ -383,18 +485,19 @@ class _Design:
             const = self.budget
             for k, s in enumerate(slots):
                 if self.mass_var[k] is None:
-                    const -= s.mass_min
+                    const -= self.count[k] * s.mass_min
                 else:
-                    r[self.mass_var[k]] = -1.0 / L
+                    r[self.mass_var[k]] = -self.count[k] / L
             G.append(r), g.append(const), lin_names.append("mass_budget"), lin_scale.append(1.0)
         self.G = np.array(G).reshape(-1, ny)
         self.g = np.array(g)
         self.lin_names, self.lin_scale = lin_names, np.array(lin_scale)
-        self.cones = [k for k, s in enumerate(slots) if s.direction is None and math.isfinite(s.max_radius)]
+        self.cones = [k for k, s in enumerate(slots)
+                      if s.direction is None and math.isfinite(s.max_radius) and not s.fixed_position]
         self.mass_row = np.zeros(ny)  # total free mass (kg) = mass_row @ y
-        for j in self.mass_var:
+        for k, j in enumerate(self.mass_var):
             if j is not None:
-                self.mass_row[j] = 1.0 / L
+                self.mass_row[j] = self.count[k] / L
 
     def x(self, y):
         return self.P @ y + self.xc
@@ -501,7 +604,9 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
     b = np.asarray(b, float).reshape(-1)
     if A.shape[0] == 0:
         raise ValueError("samples: no usable sample (every closed-loop sample failed to assemble?)")
-    dsg = _Design(slots, mass_budget, L)
+    E, roots, count = tie_matrix(slots)      # tied slots share their group's unknowns
+    A = A @ E
+    dsg = _Design(roots, mass_budget, L, count)
     Ay = A @ dsg.P
     by = A @ dsg.xc + b
     ny = Ay.shape[1]
@@ -517,7 +622,7 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
     ls = rms(y0)
     unit = np.array([1.0 / L if n.endswith(".mass") else 1.0 for n in dsg.names])
     undetermined = describe_null_space(unit[:, None] * Z, dsg.names)
-    mscale = max([1.0] + [abs(s.mass_min) for s in slots] + [abs(v) / L for v in y0])
+    mscale = max([1.0] + [abs(s.mass_min) for s in roots] + [abs(v) / L for v in y0])
     tol = 1e-9
 
     # stage 2a: the lightest least-squares solution within the bounds
@@ -554,7 +659,7 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
         y = _slsqp(g, starts, dsg.scipy(lambda yy: yy, np.eye(ny)), lambda yy: dsg.violation(yy, mscale), tol,
                    ftol=1e-13)
         stage = "constrained least squares (the bounds exclude every least-squares solution)"
-    x = dsg.x(y)
+    x = E @ dsg.x(y)
     residual = rms(y)
     active = dsg.active(y, mscale)
     limited = []
@@ -571,11 +676,14 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
 
 def design_from_solution(x: np.ndarray, slots: Sequence[Slot], active: Sequence[str]) -> tuple[dict, list]:
     """(design dict per slot, [(slot, mass, position_user)]) from (m, h_user) per slot: position
-    h/m (on the slot's line when it has a direction); a vanishing mass sits at the centre."""
+    h/m (on the slot's line when it has a direction; the given one when it is fixed); a vanishing
+    mass sits at the centre. Tied slots say which slot they are tied to (``tied_to``)."""
     design, placed = {}, []
     for k, s in enumerate(slots):
         m, h = float(x[4 * k]), np.array(x[4 * k + 1:4 * k + 4])
-        if m > 1e-12 * max(1.0, abs(s.mass_max) if math.isfinite(s.mass_max) else 1.0):
+        if s.fixed_position:
+            m, p = max(m, 0.0), s.center.copy()
+        elif m > 1e-12 * max(1.0, abs(s.mass_max) if math.isfinite(s.mass_max) else 1.0):
             p = h / m
             if s.direction is not None:
                 p = s.center + s.direction * float(s.direction @ (p - s.center))
@@ -594,9 +702,14 @@ def _slot_design(s: Slot, m: float, p: np.ndarray, active: Sequence[str]) -> dic
            "mass_moment": m * p, "frame": frame,
            "bounds": {"mass_min": s.mass_min, "mass_max": _or_none(s.mass_max),
                       "max_radius": _or_none(s.max_radius), "center": s.center, "direction": s.direction},
-           "active_bounds": [a.split(".", 1)[1] for a in active if a.startswith(s.name + ".")]}
+           "active_bounds": [a[len(key) + 1:] for key in [s.tie or s.name] for a in active
+                             if a.startswith(key + ".")]}
     if s.direction is not None:
         out["signed_distance"] = float(s.direction @ (p - s.center))
+    if s.fixed_position:
+        out["fixed_position"] = True
+    if s.tie is not None:
+        out["tied_to"] = s.tie
     return out
 
 

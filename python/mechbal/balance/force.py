@@ -93,4 +93,4 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples=200, *, mass
                          residual_units="kg m/s (RMS linear momentum over the sampled motions)",
                          rank=sol.rank, unknowns=sol.unknowns, limited_by=sol.limited_by,
                          metrics=metrics, balanced=balanced, active_bounds=sol.active_bounds,
-                         undetermined=sol.undetermined)
+                         undetermined=sol.undetermined, tied=common.tied_groups(slots))

@@ -45,7 +45,7 @@ from mechbal import _core
 from mechbal.balance.result import BalanceResult, DiscSlot, InertiaSlot
 from mechbal.mechanism import Mechanism
 
-__all__ = ["balance", "with_discs", "angular_momentum_columns"]
+__all__ = ["balance", "with_discs", "angular_momentum_columns", "design_from_table"]
 
 _COMPONENTS = "xyz"
 _INERTIA_INDEX = {"Ixx": 4, "Iyy": 6, "Izz": 9}   # in [m, mc, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]
@@ -147,6 +147,78 @@ def angular_momentum_columns(mechanism: Mechanism, samples, *, q_guess=None) -> 
     N, nb, dof = V.shape
     mom = mechanism.momentum(np.repeat(q, nb, axis=0), V.reshape(N * nb, dof))
     return mom.linear_momentum.reshape(N, nb, 3), mom.angular_momentum.reshape(N, nb, 3)
+
+
+#: workspace poses of ``mechbal balance --method moment`` unless ``balance.samples`` says otherwise
+DEFAULT_SAMPLES = 200
+
+
+def design_from_table(table, mechanism: Mechanism):
+    """(design, samples, options) of a validated ``[balance]`` table for :func:`balance` (what
+    ``mechbal balance --method moment`` runs): the :class:`DiscSlot` of ``[[balance.discs]]`` and
+    :class:`InertiaSlot` of ``[[balance.inertias]]``, checked against the mechanism
+    (:class:`~mechbal.errors.ConfigError` naming ``balance.discs[i].carrier`` ...); ``samples``:
+    ``balance.samples`` (default 200) uniform random poses in the box ``balance.lower`` ..
+    ``balance.upper`` (default the joint limits, else +-pi / +-0.5 m: ``common.sample_box``), of
+    the actuated joints of a closed mechanism (whose box must be given: where its loops
+    assemble), visited along a nearest-neighbour path so that each loop solve starts near the
+    last; ``options``: ``seed`` and ``check_motions``."""
+    from mechbal.balance import common
+    from mechbal.errors import ConfigError
+    from mechbal.schema import did_you_mean
+
+    if table is None or not (table.discs or table.inertias):
+        raise ConfigError("balance.discs", "no disc or inertia slots: add [[balance.discs]] (name, carrier, "
+                                           "joint, axis, position, ratio or inertia) or [[balance.inertias]]",
+                          has_value=False)
+    links = list(mechanism.link_names)
+    coords = list(mechanism.joint_names)
+    taken = set(links) | set(mechanism.body_names)
+    discs = []
+    for i, c in enumerate(table.discs):
+        f = f"balance.discs[{i}]"
+        if c.name in taken:
+            raise ConfigError(f"{f}.name", "is already a link or body of the mechanism", c.name)
+        if c.carrier not in links:
+            raise ConfigError(f"{f}.carrier", f"no link named so{did_you_mean(c.carrier, links)}", c.carrier)
+        if c.joint not in coords:
+            raise ConfigError(f"{f}.joint", f"is not a coordinate of the mechanism{did_you_mean(c.joint, coords)}",
+                              c.joint)
+        discs.append(DiscSlot(c.name, c.carrier, c.joint, axis=tuple(c.axis), position=tuple(c.position),
+                              ratio=c.ratio, inertia=c.inertia, transverse_inertia=c.transverse_inertia,
+                              inertia_min=c.inertia_min,
+                              inertia_max=math.inf if c.inertia_max is None else c.inertia_max,
+                              ratio_min=-math.inf if c.ratio_min is None else c.ratio_min,
+                              ratio_max=math.inf if c.ratio_max is None else c.ratio_max))
+    bodies = list(mechanism.body_names)
+    inertias = []
+    for i, c in enumerate(table.inertias):
+        if c.body not in bodies:
+            raise ConfigError(f"balance.inertias[{i}].body", f"no body named so{did_you_mean(c.body, bodies)}", c.body)
+        inertias.append(InertiaSlot(c.name, c.body, tuple(c.components), c.minimum))
+    closed = mechanism.is_closed
+    width = len(mechanism.actuated_names) if closed else mechanism.dof
+    for key in ("lower", "upper"):
+        v = getattr(table, key)
+        if v is not None and len(v) != width:
+            what = "actuated joint" if closed else "coordinate"
+            raise ConfigError(f"balance.{key}", f"must have {width} values (one per {what})", list(v))
+        if closed and v is None:
+            raise ConfigError(f"balance.{key}", f"a closed mechanism is sampled by its actuated joints "
+                                                f"({', '.join(mechanism.actuated_names)}) in a box where its loops "
+                                                "assemble: give balance.lower and balance.upper", has_value=False)
+    try:
+        lo, hi = common.sample_box(mechanism, table.lower, table.upper, "actuated" if closed else "independent")
+    except ValueError as exc:
+        raise ConfigError("balance.upper", str(exc).split(": ", 1)[-1], has_value=False) from None
+    n = DEFAULT_SAMPLES if table.samples is None else int(table.samples)
+    samples = lo + (hi - lo) * np.random.default_rng(table.seed).random((n, len(lo)))
+    if closed:
+        samples = samples[common._nearest_neighbour_order(samples)]
+    options: dict[str, Any] = {"seed": int(table.seed)}
+    if table.check_motions is not None:
+        options["check_motions"] = int(table.check_motions)
+    return discs + inertias, samples, options
 
 
 def _as_design(design):
@@ -318,7 +390,14 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
             rank_k, Nz = 0, np.eye(u)
         if Nz.shape[1] and A_d.shape[0]:
             z0 = x * col_scale
-            dz, *_ = np.linalg.lstsq((A_d / col_scale) @ Nz, b_d - A_d @ x, rcond=None)
+            # the cutoff is relative to the scaled system, not to this projection: where the
+            # dropped columns do not see the null space of the kept ones (the projection is
+            # round-off), nothing moves (a relative cutoff would solve the round-off)
+            Md = (A_d / col_scale) @ Nz
+            ref = max(float(sk[0]) if A_k.shape[0] and sk.size else 0.0, float(np.linalg.norm(A_d / col_scale, 2)))
+            Ud, sd, Vdt = np.linalg.svd(Md, full_matrices=False)
+            keep = sd > 1e-10 * ref
+            dz = Vdt[keep].T @ ((Ud[:, keep].T @ (b_d - A_d @ x)) / sd[keep])
             x_try = (z0 + Nz @ dz) / col_scale
             if np.all(x_try >= lo - 1e-12 * np.maximum(1, np.abs(x_try))) and np.all(x_try <= hi):
                 x = x_try
@@ -382,9 +461,12 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
                 if unb <= tol:
                     reason = f"cancelling {rname} needs a slot outside its bounds (e.g. a negative inertia)"
                 elif np.max(norm) - np.min(norm) <= 1e-7 * Hscale:
+                    done = [n for j, n in enumerate(rate_names) if j != k and
+                            all((j, c) not in dropped for c in range(3)) and any(acts[(j, c)] for c in range(3))]
                     reason = (f"the slots cannot cancel the angular momentum of {rname}: {norm.max():.6g} kg m^2/s "
                               "per unit rate remains at every sample (no slot supplies a constant geared "
-                              f"inertia for {rname})")
+                              f"inertia for {rname}" + (f" that cancelling {', '.join(done)} leaves free: the slots "
+                                                         f"act on both only together" if done else "") + ")")
                 else:
                     reason = (f"the angular momentum of {rname} varies over the workspace in a way these slots "
                               f"(constant inertias and ratios) cannot follow: what remains of a unit rate ranges "

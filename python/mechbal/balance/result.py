@@ -15,7 +15,13 @@ class CounterweightSlot:
     URDF link frame, the DH frame of a DH joint). The method chooses what is not fixed:
     ``mass`` within [mass_min, mass_max], ``position`` within ``max_radius`` of ``center``
     (default the link origin), optionally restricted to the line ``direction`` through ``center``.
-    ``inertia`` (3, 3) about its centre of mass, link axes (default: a point mass)."""
+    ``inertia`` (3, 3) about its centre of mass, link axes (default: a point mass).
+
+    ``position``: the counterweight's centre is given (user frame), only its mass is chosen (one
+    unknown, exact: no ``center``, ``direction`` or ``max_radius`` with it; ``max_radius = 0``
+    is the same). ``tie``: the name of another slot of the design whose mass and position (in
+    each slot's own link frame: identical legs of a parallel mechanism) this one shares; a tied
+    slot gives no bounds of its own, it takes them from the slot it is tied to."""
 
     name: str
     link: str
@@ -25,6 +31,8 @@ class CounterweightSlot:
     center: tuple[float, float, float] = (0.0, 0.0, 0.0)
     direction: tuple[float, float, float] | None = None
     inertia: Any = None
+    position: tuple[float, float, float] | None = None
+    tie: str | None = None
 
 
 @dataclass(frozen=True)
@@ -111,7 +119,8 @@ class BalanceResult:
     ``active_bounds``: every bound the design sits on (``"cw1.max_radius"``, ``"mass_budget"``),
     whether or not it limited the balance (when it did, it is also in ``limited_by``);
     ``undetermined``: combinations of the unknowns that the condition does not determine (the
-    null space of the linear problem)."""
+    null space of the linear problem); ``tied``: groups of counterweight slots that share one
+    mass and position (``{slot tied to: [every slot of the group]}``)."""
 
     method: str
     design: dict[str, dict[str, Any]]
@@ -126,6 +135,7 @@ class BalanceResult:
     elements: list = field(default_factory=list)
     active_bounds: list[str] = field(default_factory=list)
     undetermined: list[str] = field(default_factory=list)
+    tied: dict[str, list[str]] = field(default_factory=dict)
 
     @property
     def exact(self) -> bool:
@@ -148,4 +158,4 @@ class BalanceResult:
                       "residual_before": self.residual_before, "residual_units": self.residual_units,
                       "rank": self.rank, "unknowns": self.unknowns, "limited_by": self.limited_by,
                       "exact": self.exact, "active_bounds": self.active_bounds,
-                      "undetermined": self.undetermined, "metrics": self.metrics})
+                      "undetermined": self.undetermined, "tied": self.tied, "metrics": self.metrics})

@@ -85,18 +85,31 @@ def _theta(m: float, p: np.ndarray, Ic: np.ndarray):
 
 class _Variables:
     """The free variables of a group of slots: per slot its mass (unless fixed) and its position
-    (a signed distance r along ``direction``, or 3 coordinates), in the user frame."""
+    (a signed distance r along ``direction``, 3 coordinates, or none when it is given), in the
+    user frame. A tied slot shares the variables of the slot it is tied to (in the group)."""
 
     def __init__(self, slots: Sequence[common.Slot]):
         self.slots = list(slots)
-        self.index = []
+        index: list = [None] * len(self.slots)
+        #: False for a tied slot whose variables are another's (its bounds are the same)
+        self.owner = [False] * len(self.slots)
         n = 0
-        for s in slots:
+        first = {}
+        # the first slot of each group (its root if present) owns the variables, in slot order
+        for k, s in sorted(enumerate(self.slots), key=lambda e: (e[1].tie is not None, e[0])):
+            key = s.tie or s.name
+            if key in first:
+                index[k] = index[first[key]]
+                continue
+            first[key] = k
             im = None if s.mass_fixed else n
             n += 0 if s.mass_fixed else 1
-            ip = list(range(n, n + (1 if s.direction is not None else 3)))
+            width = 0 if s.fixed_position else (1 if s.direction is not None else 3)
+            ip = list(range(n, n + width))
             n += len(ip)
-            self.index.append((im, ip))
+            index[k] = (im, ip)
+            self.owner[k] = True
+        self.index = index
         self.n = n
 
     def unpack(self, y):
@@ -104,7 +117,10 @@ class _Variables:
         out = []
         for s, (im, ip) in zip(self.slots, self.index):
             m = s.mass_min if im is None else y[im]
-            p = s.center + s.direction * y[ip[0]] if s.direction is not None else y[ip]
+            if s.fixed_position:
+                p = s.center.copy()
+            else:
+                p = s.center + s.direction * y[ip[0]] if s.direction is not None else y[ip]
             out.append((m, p))
         return out
 
@@ -114,6 +130,8 @@ class _Variables:
             if im is not None:
                 b[im] = (s.mass_min, s.mass_max if math.isfinite(s.mass_max) else None)
             R = s.max_radius if math.isfinite(s.max_radius) else None
+            if not ip:
+                continue
             if s.direction is not None:
                 b[ip[0]] = (-R if R is not None else None, R)
             else:
@@ -128,6 +146,8 @@ class _Variables:
                 hi = s.mass_max if math.isfinite(s.mass_max) else max(2 * s.mass_min, 1.0)
                 y[im] = 0.5 * (s.mass_min + hi) if first else rng.uniform(s.mass_min, hi)
             R = s.max_radius if math.isfinite(s.max_radius) else 1.0
+            if not ip:
+                continue
             if s.direction is not None:
                 y[ip[0]] = 0.0 if first else rng.uniform(-R, R)
             else:
@@ -136,13 +156,15 @@ class _Variables:
 
     def active(self, y, tol=1e-7) -> list[str]:
         out = []
-        for s, (m, p), (im, ip) in zip(self.slots, self.unpack(y), self.index):
+        for s, (m, p), (im, ip), own in zip(self.slots, self.unpack(y), self.index, self.owner):
+            if not own:
+                continue
             if im is not None:
                 if m <= s.mass_min + tol * max(1.0, s.mass_min):
                     out.append(f"{s.name}.mass_min")
                 if math.isfinite(s.mass_max) and m >= s.mass_max - tol * max(1.0, s.mass_max):
                     out.append(f"{s.name}.mass_max")
-            if math.isfinite(s.max_radius) and np.linalg.norm(p - s.center) >= s.max_radius * (1 - tol) - tol:
+            if ip and math.isfinite(s.max_radius) and np.linalg.norm(p - s.center) >= s.max_radius * (1 - tol) - tol:
                 out.append(f"{s.name}.max_radius")
         return out
 
@@ -164,7 +186,9 @@ class _TorqueModel:
                 if im is not None:
                     J[..., im] += Yk @ dm
                 dpu = dp @ s.T[:3, :3]                       # d theta / d p_user
-                if s.direction is not None:
+                if not ip:
+                    pass
+                elif s.direction is not None:
                     J[..., ip[0]] += Yk @ (dpu @ s.direction)
                 else:
                     J[..., ip] += np.einsum("...i,ij->...j", Yk, dpu)
@@ -201,8 +225,8 @@ def _minimise(model: _TorqueModel, var: _Variables, columns, w, objective, start
     cols = np.asarray(columns)
     N = model.tau_fixed.shape[0]
     bounds = var.bounds()
-    cones = [(s, ip) for s, (im, ip) in zip(var.slots, var.index)
-             if s.direction is None and math.isfinite(s.max_radius)]
+    cones = [(s, ip) for s, (im, ip), own in zip(var.slots, var.index, var.owner)
+             if own and ip and s.direction is None and math.isfinite(s.max_radius)]
     budget_rows = []
     if mass_budget is not None and math.isfinite(mass_budget):
         row = np.zeros(var.n)
@@ -211,7 +235,7 @@ def _minimise(model: _TorqueModel, var: _Variables, columns, w, objective, start
             if im is None:
                 fixed += s.mass_min
             else:
-                row[im] = 1.0
+                row[im] += 1.0
         budget_rows.append((row, mass_budget - fixed))
 
     def rms(y):
@@ -340,12 +364,19 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples, *, objectiv
         var = _Variables(slots)
         model = _TorqueModel(tau0, Y, var)
         cols = [j for j in range(n_act) if w[j] > 0]
-        y = _minimise(model, var, cols, w[cols], objective, starts, rng, mass_budget)
+        y = _minimise(model, var, cols, w[cols], objective, starts, rng, mass_budget) if var.n else np.zeros(0)
         values = dict(zip([s.name for s in slots], var.unpack(y)))
         active = var.active(y)
         methods = {s.name: "numerical (scipy, all slots together)" for s in slots}
     else:
         served = [_served_joint(mech, s.link) for s in slots]
+        joint_of = dict(zip([s.name for s in slots], served))
+        for s in slots:
+            if s.tie is not None and joint_of[s.tie] != joint_of[s.name]:
+                raise ValueError(f"{s.field}.tie: '{s.name}' serves joint '{mech.joint_names[joint_of[s.name]]}' "
+                                 f"and '{s.tie}' joint '{mech.joint_names[joint_of[s.tie]]}': per_joint coupling "
+                                 "sizes joints one at a time, so tied slots must serve the same joint (use "
+                                 "coupling 'total')")
         tau_fixed = tau0.copy()
         for j in sorted(set(served), key=lambda k: -_depth(mech, k)):
             group = [i for i, sj in enumerate(served) if sj == j]
@@ -356,6 +387,8 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples, *, objectiv
                            and gs[0].direction is not None)
             if closed_form:
                 y = _cardano(model, var, j)
+            elif var.n == 0:
+                y = np.zeros(0)
             else:
                 y = _minimise(model, var, [j], np.ones(1), objective, starts, rng, mass_budget)
             for s, mp in zip(gs, var.unpack(y)):
@@ -391,5 +424,6 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples, *, objectiv
     return BalanceResult(method="rms", design=design_out, residual=float(np.sqrt(np.mean(tau_after ** 2))),
                          residual_before=float(np.sqrt(np.mean(tau0 ** 2))),
                          residual_units="N m (RMS of the actuator torques over the trajectory)",
-                         rank=None, unknowns=sum(_Variables([s]).n for s in slots), limited_by=limited,
-                         metrics=metrics, balanced=balanced, active_bounds=list(active))
+                         rank=None, unknowns=_Variables(slots).n, limited_by=limited,
+                         metrics=metrics, balanced=balanced, active_bounds=list(active),
+                         tied=common.tied_groups(slots))

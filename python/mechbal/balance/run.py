@@ -1,7 +1,8 @@
 """``mechbal balance CASE --method METHOD --out DIR``: balance a case's mechanism and write the run.
 
 CASE is a TOML case of kind ``mechanism`` / ``serial_chain`` (its ``[mechanism]``, ``[trajectory]``
-and ``[balance]`` tables), the built-in ``arm2dof`` (its arm as a mechanism with links
+and ``[balance]`` tables), the built-in ``paminsa`` and disc cases (kinds ``paminsa`` and
+``discs``: :mod:`mechbal.balance.cases`), the built-in ``arm2dof`` (its arm as a mechanism with links
 ``shoulder`` and ``elbow``, x along each link; the counterweights of ``[counterweights]`` on the
 link extensions unless ``[balance]`` gives others; the minimum-energy cubic law of its
 ``[trajectory]``), or a URDF file (with ``--design FILE.toml`` holding a ``[balance]`` table and
@@ -67,7 +68,8 @@ def slots_from_table(table, field: str = "balance.counterweights") -> list[Count
             name=c.name, link=c.link, mass_min=lo, mass_max=hi,
             max_radius=c.max_radius if c.max_radius is not None else math.inf,
             center=tuple(c.center), direction=None if c.direction is None else tuple(c.direction),
-            inertia=None if c.inertia is None else inertia_matrix(c.inertia)))
+            inertia=None if c.inertia is None else inertia_matrix(c.inertia),
+            position=None if c.position is None else tuple(c.position), tie=c.tie))
     return out
 
 
@@ -146,9 +148,14 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
         t, motion, tt = _trajectory_motion(mech, {"start": tr.start, "end": tr.end, "duration": tr.duration,
                                                   "samples": tr.samples}, law="cubic")
         return BalanceCase(name, title, mech, table, t, motion, tt, None, raw, "arm2dof", slots)
-    raise ConfigError("case.kind", f"mechbal balance reads cases of kind mechanism, serial_chain or "
-                                   f"arm2dof, and URDF files ({cfg.case.kind!r}: its mechanism is not on the "
-                                   "general model yet)", cfg.case.kind)
+    if cfg.case.kind in ("paminsa", "discs"):
+        from mechbal.balance import cases as builtin
+
+        make = builtin.paminsa_case if cfg.case.kind == "paminsa" else builtin.discs_case
+        return make(cfg, raw, table, design_cfg)
+    raise ConfigError("case.kind", f"mechbal balance reads cases of kind mechanism, serial_chain, arm2dof, "
+                                   f"paminsa or discs, and URDF files ({cfg.case.kind!r}: its mechanism is not "
+                                   "on the general model yet)", cfg.case.kind)
 
 
 # ---- evaluation --------------------------------------------------------------------------------
@@ -214,8 +221,10 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
             raise ConfigError("--method", f"mechbal.balance.{name} has no design_from_table(table, mechanism): "
                                           "mechbal balance cannot read its design", has_value=False)
         design, samples, options = make(table, mech)
-        if mech.is_closed and bc.q_guess is not None:
-            options.setdefault("q_guess", bc.q_guess)
+        import inspect
+
+        if bc.q_guess is not None and "q_guess" in inspect.signature(module.balance).parameters:
+            options.setdefault("q_guess", bc.q_guess)   # the assembly mode of a closed mechanism
         return module.balance(mech, design, samples, **options)
     slots = slots_from_table(table) or list(bc.default_slots)
     if not slots:
@@ -255,6 +264,9 @@ def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
     added += ([f"springs " + ", ".join(f"{k} {v['rate']:.6g} N/m x {v['count']} ({v['link_a']} - {v['link_b']})"
                                        for k, v in result.design.items() if "rate" in v and "link_a" in v)]
               if any("link_a" in v for v in result.design.values()) else [])
+    added += ([f"discs " + ", ".join(f"{k} ({v['inertia']:.6g} kg m^2, ratio {v['ratio']:.6g} to {v['joint']}) on {v['carrier']}"
+                                     for k, v in result.design.items() if "ratio" in v)]
+              if any("ratio" in v for v in result.design.values()) else [])
     header = (f"{bc.name} balanced by `mechbal balance --method {method}`: " + "; ".join(added or ["nothing added"])
               + f".\nResidual {result.residual:.6g} {result.residual_units} (unbalanced {result.residual_before:.6g}).")
     case = {"name": f"{bc.name}-balanced", "kind": "mechanism", "title": f"{bc.title}, balanced ({method})"}
@@ -369,6 +381,9 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
             for k, v in result.design.items() if "link_a" in v and "rate" in v]
     if rows:
         print(report.table(rows, ["spring", "rate [N/m]", "count", "pulley ratio", "peak tension [N]"]))
+    discs = [[k, v["carrier"], v["joint"], v["ratio"], v["inertia"]] for k, v in result.design.items() if "ratio" in v]
+    if discs:
+        print(report.table(discs, ["disc", "carrier", "geared to", "ratio", "inertia [kg m^2]"]))
     cmp = summary["before_after"]
     print(report.table([[k, cmp[k]["unbalanced"]["peak"], cmp[k]["balanced"]["peak"]] for k in cmp],
                        ["peak along the trajectory", "unbalanced", "balanced"]))

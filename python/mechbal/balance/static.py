@@ -103,4 +103,4 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples=1000, *, mas
                          residual_units="N m (RMS gravity torque over the sample)",
                          rank=sol.rank, unknowns=sol.unknowns, limited_by=sol.limited_by,
                          metrics=metrics, balanced=balanced, active_bounds=sol.active_bounds,
-                         undetermined=sol.undetermined)
+                         undetermined=sol.undetermined, tied=common.tied_groups(slots))

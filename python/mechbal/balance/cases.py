@@ -1,0 +1,95 @@
+"""The built-in paper cases that ``mechbal balance`` reads besides the general kinds: PAMINSA
+(``kind = "paminsa"``) and the disc cases (``kind = "discs"``), each as a
+:class:`mechbal.balance.run.BalanceCase` on the general model.
+
+* ``paminsa``: the mechanism of :func:`mechbal.papers.paminsa.paminsa_mechanism` built from the
+  case's ``[geometry]``, ``[masses]``, ``[inertias]``, unbalanced and without the zero-mass
+  placeholder counterweights (so the ``[balance]`` slots may carry the paper's names
+  ``leg1.CP1_atA`` ...); the trajectory rest-to-rest in the actuated joints between the actuator
+  positions of the case's start and end platform positions, wrist still at its initial angles
+  (as ``cases/paminsa-linkage.toml``), 501 samples, the closed form's assembly as initial guess.
+* ``discs`` (``discs-3r``, ``discs-spatial``, ``scara``): the statically balanced arm of
+  :func:`mechbal.papers.discs.disc_design_mechanism` without discs, its links' inertias as the
+  case gives them (``[inertia]``: the spatial arm's J_y2, J_y3 are then what the moment method's
+  inertia slots choose); ``five-bar``: the leg-wise statically balanced parallelogram 5R of
+  :func:`mechbal.papers.five_bar.five_bar_design_mechanism`. The trajectory is the case's quintic.
+
+A ``--design FILE`` replaces the ``[balance]`` table (and its ``[trajectory]``, in actuated
+joints, the case's trajectory).
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+
+def _trajectory(bc_mech, design_cfg, default: dict, guess):
+    from mechbal.balance.run import _trajectory_motion
+
+    if design_cfg is not None and design_cfg.trajectory is not None:
+        tr = design_cfg.trajectory
+        g = getattr(tr, "initial_guess", None)
+        guess = guess if g is None else np.array(g, float)
+        t, motion, tt = _trajectory_motion(bc_mech, tr)
+    else:
+        t, motion, tt = _trajectory_motion(bc_mech, default)
+    if guess is not None:
+        tt["initial_guess"] = [float(x) for x in guess]
+    return t, motion, tt, guess
+
+
+def paminsa_case(cfg, raw: dict, table: Any, design_cfg):
+    """The BalanceCase of a ``paminsa`` case (module docstring)."""
+    from mechbal.balance.run import BalanceCase
+    from mechbal.cases.paminsa import parameters_from_config
+    from mechbal.papers.paminsa import paminsa_actuated_motion, paminsa_initial_guess, paminsa_mechanism
+
+    name, title = cfg.case.name, cfg.case.title or cfg.case.name
+    params = parameters_from_config(cfg)
+    full = paminsa_mechanism(params, False, name=f"{name} (unbalanced)")
+    # the case file has no counterweights: drop their zero-mass placeholders, keep everything else
+    keep = [b for b in full.bodies if not (b.kind == "counterweight" and b.mass == 0.0)]
+    mech = full.with_bodies(keep, replace=True)
+    tr = cfg.trajectory
+    wrist = np.asarray(cfg.wrist.initial_angles, float)
+    ends = np.array([tr.start, tr.end], float)
+    qa, _, _ = paminsa_actuated_motion(mech, params, ends, np.zeros((2, 3)), np.zeros((2, 3)), np.tile(wrist, (2, 1)))
+    guess = paminsa_initial_guess(mech, params, ends[0], wrist)
+    default = {"law": tr.law, "start": qa[0].tolist(), "end": qa[1].tolist(), "duration": tr.duration,
+               "samples": 501}
+    t, motion, tt, guess = _trajectory(mech, design_cfg, default, guess)
+    return BalanceCase(name, title, mech, table, t, motion, tt, guess, raw, "paminsa", [])
+
+
+def discs_case(cfg, raw: dict, table: Any, design_cfg):
+    """The BalanceCase of a ``discs`` case (module docstring)."""
+    from mechbal.balance.run import BalanceCase
+    from mechbal.cases.discs import parameters_from_config
+    from mechbal.sizing import discs as dz
+
+    name, title = cfg.case.name, cfg.case.title or cfg.case.name
+    kind = cfg.case.mechanism
+    p = parameters_from_config(kind, cfg)
+    d = dict(dz.design(kind, p, True))
+    tr = cfg.trajectory
+    default = {"law": "quintic", "start": list(tr.start), "end": list(tr.end), "duration": tr.duration,
+               "samples": tr.samples}
+    if kind == "fivebar":
+        from mechbal.papers.five_bar import five_bar_design_mechanism, five_bar_initial_guess
+
+        mech = five_bar_design_mechanism(d, name=f"{name} (statically balanced)")
+        start = (design_cfg.trajectory.start if design_cfg is not None and design_cfg.trajectory is not None
+                 else tr.start)
+        guess = five_bar_initial_guess(mech, d, start)
+    else:
+        from mechbal.papers.discs import disc_design_mechanism
+
+        d["discs"] = False
+        for i in (1, 2, 3):   # the links' inertias as the case gives them (the method may choose some)
+            for axis in "xyz":
+                d[f"J{axis}{i}"] = p[f"J{axis}{i}"]
+        mech = disc_design_mechanism(kind, d, name=f"{name} (statically balanced, no discs)")
+        guess = None
+    t, motion, tt, guess = _trajectory(mech, design_cfg, default, guess)
+    return BalanceCase(name, title, mech, table, t, motion, tt, guess, raw, "discs", [])
