@@ -360,7 +360,7 @@ def main(argv=None):
         args.out.write_text(text + "\n")
 
 
-def seven_joint_arm(seed: int = 7):
+def random_seven_joint_arm(seed: int = 7):
     """A random spatial 7R arm (placements, axes, masses) as a mechbal.Mechanism."""
     from mechbal.spec import mechanism_spec
 
@@ -376,7 +376,7 @@ def seven_joint_arm(seed: int = 7):
 def bench_sizing(repeat: int) -> dict:
     from mechbal.balance import CounterweightSlot, static
 
-    mech = seven_joint_arm()
+    mech = random_seven_joint_arm()
     out = {}
     # a slot on every link: exact; on links 2-7 only: joint 1 cannot be held (constrained stage)
     for label, first in (("static_7R_10000_poses", 1), ("static_7R_10000_poses_links_2_7", 2)):
