@@ -83,14 +83,6 @@ int main() {
     std::printf("ComputedTorque over FiveBarDynamics: %s\n", mechbal::status_name(st));
     check(tau.allFinite(), "ComputedTorque over FiveBarDynamics");
   }
-  std::vector<mechbal::DiscSpec> discs(1);
-  discs[0].name = "disc";
-  discs[0].carrier = 0;
-  discs[0].joint = 1;
-  discs[0].ratio = -1.0;
-  discs[0].inertia = mechbal::Vec3(0.01, 0.005, 0.005);
-  mechbal::DiscArmDynamics disc_arm(arm, discs);
-  computed_torque_over(disc_arm, "DiscArmDynamics");
 
   // the general model: the same arm as a MechanismModel, its algorithms and a controller over it
   {
@@ -110,6 +102,15 @@ int main() {
       b.inertia = mechbal::Vec3(0.004, 0.09, 0.09).asDiagonal();
       d.bodies.push_back(b);
     }
+    mechbal::Joint disc;  // a counter-rotating disc on the shoulder link, geared to the elbow
+    disc.name = "disc";
+    disc.parent = "shoulder";
+    disc.axis = mechbal::Vec3(0.0, -1.0, 0.0);
+    disc.mimic_joint = "elbow";
+    disc.mimic_ratio = -1.0;
+    d.joints.push_back(disc);
+    d.bodies.push_back(mechbal::Body{"disc", "disc", "disc", 0.0, mechbal::Vec3::Zero(),
+                                     mechbal::Vec3(0.005, 0.01, 0.005).asDiagonal()});
     const mechbal::MechanismModel model(d);
     mechbal::MechanismData data(model);
     const Eigen::VectorXd q = Eigen::VectorXd::Constant(2, 0.3), v = Eigen::VectorXd::Ones(2),
