@@ -43,9 +43,7 @@ MechanismDescription random_chain_description(std::mt19937& rng, const std::stri
   return d;
 }
 
-double rel(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
-}
+using test::rel;
 
 std::string refusal(const MechanismDescription& d) {
   try {

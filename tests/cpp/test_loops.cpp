@@ -25,15 +25,16 @@ Body rod(const std::string& name, const std::string& link, double mass, double l
               Mat3(Vec3(1e-4, mass * length * length / 12.0, mass * length * length / 12.0).asDiagonal())};
 }
 
-/// Crank (0.2 m) about z at O, coupler (0.5 m), rocker (0.4 m) about z at (0.45, 0, 0); the coupler
-/// and rocker tips closed by a loop of `type`; gravity along -y (the plane of motion); crank actuated.
-MechanismModel four_bar(LoopType type) {
+/// Crank (0.2 m) about z at O, coupler (`coupler` m), rocker (0.4 m) about z at (0.45, 0, 0); the
+/// coupler and rocker tips closed by a loop of `type`; gravity along -y (the plane of motion); crank
+/// actuated.
+MechanismModel four_bar(LoopType type, double coupler = 0.5) {
   MechanismDescription d;
   d.gravity = Vec3(0.0, -9.81, 0.0);
   d.joints = {Joint{"crank", JointType::revolute, "base"}, Joint{"coupler", JointType::revolute, "crank", at(0.2, 0, 0)},
               Joint{"rocker", JointType::revolute, "base", at(0.45, 0, 0)}};
-  d.bodies = {rod("crank", "crank", 0.8, 0.2), rod("coupler", "coupler", 1.5, 0.5), rod("rocker", "rocker", 1.1, 0.4)};
-  d.frames = {Frame{"coupler_tip", "coupler", at(0.5, 0, 0)}, Frame{"rocker_tip", "rocker", at(0.4, 0, 0)}};
+  d.bodies = {rod("crank", "crank", 0.8, 0.2), rod("coupler", "coupler", 1.5, coupler), rod("rocker", "rocker", 1.1, 0.4)};
+  d.frames = {Frame{"coupler_tip", "coupler", at(coupler, 0, 0)}, Frame{"rocker_tip", "rocker", at(0.4, 0, 0)}};
   d.loops = {LoopConstraint{"tip", type, "coupler_tip", "rocker_tip"}};
   d.actuated = {"crank"};
   return MechanismModel(d);
@@ -136,26 +137,14 @@ TEST(Loops, CouplingMatrixAndBiasMatchFiniteDifferences) {
   }
 }
 
-/// A four-bar whose coupler (0.250002 m) and rocker (0.4 m) nearly align when the crank (0.2 m) points
-/// away from the rocker's pivot (0.45 m): A° is ill-conditioned there.
-MechanismModel near_singular_four_bar() {
-  MechanismDescription d;
-  d.gravity = Vec3(0.0, -9.81, 0.0);
-  d.joints = {Joint{"crank", JointType::revolute, "base"}, Joint{"coupler", JointType::revolute, "crank", at(0.2, 0, 0)},
-              Joint{"rocker", JointType::revolute, "base", at(0.45, 0, 0)}};
-  d.bodies = {rod("crank", "crank", 0.8, 0.2), rod("coupler", "coupler", 1.5, 0.250002), rod("rocker", "rocker", 1.1, 0.4)};
-  d.frames = {Frame{"coupler_tip", "coupler", at(0.250002, 0, 0)}, Frame{"rocker_tip", "rocker", at(0.4, 0, 0)}};
-  d.loops = {LoopConstraint{"tip", LoopType::point, "coupler_tip", "rocker_tip"}};
-  d.actuated = {"crank"};
-  return MechanismModel(d);
-}
-
 TEST(Loops, RefinementKeepsTheProjectionExactWhenIllConditioned) {
   // The normal equations of A° lose accuracy as 1 / rcond^2; below options.refine_rcond the
   // projection gets a step of iterative refinement. Walk the crank to the near-alignment, warm
   // started, and compare C and c with and without refinement against the closure itself
   // (A C = 0 and A c + gamma = 0).
-  const MechanismModel model = near_singular_four_bar();
+  // a coupler of 0.250002 m nearly aligns with the rocker when the crank points away from the
+  // rocker's pivot (0.2 + 0.45 = 0.65 m < 0.250002 + 0.4): A° is ill-conditioned there
+  const MechanismModel model = four_bar(LoopType::point, 0.250002);
   MechanismData data(model);
   Eigen::VectorXd q = (Eigen::VectorXd(3) << 2.0, 2.5, 2.0).finished();
   Eigen::VectorXd qa(1), va = Eigen::VectorXd::Constant(1, 0.8), aa = Eigen::VectorXd::Constant(1, -0.3);

@@ -44,26 +44,11 @@ MechanismModel random_tree(std::mt19937& rng, const std::string& types, bool gea
     d.frames.push_back(Frame{j.name + "_tool", j.name, test::random_pose(rng)});
     links.push_back(j.name);
   }
-  if (gear) {
-    for (auto it = d.joints.rbegin(); it != d.joints.rend(); ++it) {
-      if (it->type == JointType::fixed) continue;
-      for (const auto& m : d.joints) {
-        if (m.name != it->name && m.type != JointType::fixed) {
-          it->mimic_joint = m.name;
-          it->mimic_ratio = -1.7;
-          it->mimic_offset = 0.3;
-          break;
-        }
-      }
-      break;
-    }
-  }
+  if (gear) test::gear_last_joint(d);
   return MechanismModel(d);
 }
 
-double rel(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
-}
+using test::rel;
 
 }  // namespace
 

@@ -42,20 +42,7 @@ MechanismDescription random_tree_with_springs(std::mt19937& rng, const std::stri
     d.bodies.push_back(Body{j.name + "_b", "link", j.name, rb.mass, Vec3(u(rng), u(rng), u(rng)), rb.inertia_body});
     links.push_back(j.name);
   }
-  if (gear) {
-    for (auto it = d.joints.rbegin(); it != d.joints.rend(); ++it) {
-      if (it->type == JointType::fixed) continue;
-      for (const auto& m : d.joints) {
-        if (m.name != it->name && m.type != JointType::fixed) {
-          it->mimic_joint = m.name;
-          it->mimic_ratio = -1.7;
-          it->mimic_offset = 0.3;
-          break;
-        }
-      }
-      break;
-    }
-  }
+  if (gear) test::gear_last_joint(d);
   std::uniform_int_distribution<std::size_t> pick(0, links.size() - 1);
   for (int s = 0; s < springs; ++s) {
     Spring sp;
@@ -81,8 +68,20 @@ MechanismDescription random_tree_with_springs(std::mt19937& rng, const std::stri
   return d;
 }
 
-double rel(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+using test::rel;
+
+/// Central differences (h = 1e-6) of a scalar function of q.
+template <typename F>
+Eigen::VectorXd gradient(const Eigen::VectorXd& q, F&& f) {
+  Eigen::VectorXd g(q.size());
+  const double h = 1e-6;
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    Eigen::VectorXd qp = q, qm = q;
+    qp(i) += h;
+    qm(i) -= h;
+    g(i) = (f(qp) - f(qm)) / (2 * h);
+  }
+  return g;
 }
 
 }  // namespace
@@ -98,17 +97,10 @@ TEST(Springs, TorqueIsTheGradientOfTheEnergy) {
       ASSERT_EQ(spring_torque(model, data, q), Status::ok);
       const Eigen::VectorXd K = data.spring_torque;
       ASSERT_GT(K.cwiseAbs().maxCoeff(), 1e-3);  // the springs do something here
-      Eigen::VectorXd fd(n);
-      const double h = 1e-6;
-      for (int i = 0; i < n; ++i) {
-        Eigen::VectorXd qp = q, qm = q;
-        qp(i) += h;
-        qm(i) -= h;
-        ASSERT_EQ(spring_state(model, data, qp), Status::ok);
-        const double Vp = data.spring_energy;
-        ASSERT_EQ(spring_state(model, data, qm), Status::ok);
-        fd(i) = (Vp - data.spring_energy) / (2 * h);
-      }
+      const Eigen::VectorXd fd = gradient(q, [&](const Eigen::VectorXd& x) {
+        EXPECT_EQ(spring_state(model, data, x), Status::ok);
+        return data.spring_energy;
+      });
       EXPECT_LT(rel(K, fd), 1e-7) << types << "\nK  = " << K.transpose() << "\nfd = " << fd.transpose();
       // the tension is dV/dd: the energy of one spring against its length and tension
       ASSERT_EQ(spring_state(model, data, q), Status::ok);
@@ -161,17 +153,10 @@ TEST(Springs, InverseDynamicsStaticTorqueAndSupportIncludeTheSprings) {
   EXPECT_LT(rel(dw.gravity_torque, dn.gravity_torque), 1e-12);  // gravity_torque stays gravity alone
   EXPECT_LT(rel(dw.static_torque, dn.gravity_torque + K), 1e-12);
   // static torque = dV/dq with V gravity plus springs
-  Eigen::VectorXd fd(n);
-  const double h = 1e-6;
-  for (int i = 0; i < n; ++i) {
-    Eigen::VectorXd qp = q, qm = q;
-    qp(i) += h;
-    qm(i) -= h;
-    ASSERT_EQ(potential_energy(with, dw, qp), Status::ok);
-    const double Vp = dw.potential_energy;
-    ASSERT_EQ(potential_energy(with, dw, qm), Status::ok);
-    fd(i) = (Vp - dw.potential_energy) / (2 * h);
-  }
+  const Eigen::VectorXd fd = gradient(q, [&](const Eigen::VectorXd& x) {
+    EXPECT_EQ(potential_energy(with, dw, x), Status::ok);
+    return dw.potential_energy;
+  });
   ASSERT_EQ(static_torque(with, dw, q), Status::ok);
   EXPECT_LT(rel(dw.static_torque, fd), 1e-7);
   // the wrench the base exerts on the moving links (joints and springs anchored to it) is the

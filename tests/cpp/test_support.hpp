@@ -1,8 +1,10 @@
 #pragma once
 // Shared helpers for the C++ tests: random rigid bodies, random serial chains, smooth motions.
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <random>
 
+#include "mechbal/model.hpp"
 #include "mechbal/rigid_body.hpp"
 #include "mechbal/serial_chain.hpp"
 
@@ -50,6 +52,28 @@ inline Eigen::VectorXd random_vector(std::mt19937& rng, int n, double scale) {
   Eigen::VectorXd v(n);
   for (int i = 0; i < n; ++i) v(i) = u(rng);
   return v;
+}
+
+/// max |a - b| relative to max(1, max |b|).
+inline double rel(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+}
+
+/// A gear coupling (mimic) on the last moving joint of a random tree: it follows the first other
+/// moving joint, q = -1.7 q_master + 0.3.
+inline void gear_last_joint(MechanismDescription& d) {
+  for (auto it = d.joints.rbegin(); it != d.joints.rend(); ++it) {
+    if (it->type == JointType::fixed) continue;
+    for (const auto& m : d.joints) {
+      if (m.name != it->name && m.type != JointType::fixed) {
+        it->mimic_joint = m.name;
+        it->mimic_ratio = -1.7;
+        it->mimic_offset = 0.3;
+        break;
+      }
+    }
+    break;
+  }
 }
 
 }  // namespace mechbal::test
