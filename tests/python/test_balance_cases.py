@@ -23,23 +23,13 @@ from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from mechbal.mechanism import Mechanism
 from mechbal.sizing import discs as dz
 
+from cli_checks import one_line_error, summary_of
+
 #: Briot & Arakelian 2009, the counterweights they print (per leg) and the vertical counter-mass
 PAMINSA_PRINTED = {"CP1_atA": 2.7915, "CP2_atF": 1.3865, "CP3_atL": 0.436}
 PAMINSA_VERTICAL = 9.615
 
 
-def summary_of(out: Path) -> dict:
-    return json.loads((out / "summary.json").read_text())
-
-
-def one_line_error(capsys, *needles):
-    cap = capsys.readouterr()
-    err = cap.err.strip()
-    assert "Traceback" not in cap.err + cap.out and len(err.splitlines()) == 1, err
-    assert err.startswith("mechbal: error:"), err
-    for n in needles:
-        assert n in err, (n, err)
-    return err
 
 
 def balance_table(case: str) -> str:

@@ -17,19 +17,9 @@ from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from mechbal.mechanism import Mechanism
 from mechbal.spec import mechanism_spec, rotation_rpy
 
-
-def one_line_error(capsys, *needles):
-    cap = capsys.readouterr()
-    err = cap.err.strip()
-    assert "Traceback" not in cap.err + cap.out and len(err.splitlines()) == 1, err
-    assert err.startswith("mechbal: error:"), err
-    for n in needles:
-        assert n in err, (n, err)
-    return err
+from cli_checks import one_line_error, summary_of
 
 
-def summary_of(out: Path) -> dict:
-    return json.loads((out / "summary.json").read_text())
 
 
 @pytest.fixture(scope="module")

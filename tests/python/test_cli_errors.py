@@ -15,19 +15,14 @@ import mechbal
 from mechbal import cases, export, output
 from mechbal.cli import main
 
+import cli_checks
+
 ARM2LINK = Path(mechbal.__file__).parent / "cases" / "arm2link.toml"
 
 
 def one_line_error(capsys, code, *needles):
-    cap = capsys.readouterr()
-    err = cap.err.strip()
-    assert "Traceback" not in cap.err + cap.out
-    assert len(err.splitlines()) == 1, err
-    prefix = "mechbal: internal error:" if code == 3 else "mechbal: error:"
-    assert err.startswith(prefix), err
-    for n in needles:
-        assert n in err, (n, err)
-    return err
+    """The one-line error of an exit `code` run (3: an internal error)."""
+    return cli_checks.one_line_error(capsys, *needles, internal=code == 3)
 
 
 # ---- a runner that fails on purpose, registered under its own kind ------------------------------
