@@ -6,7 +6,6 @@ impossibility and its reason, the written-back cases run by `mechbal run`, and t
 refusals naming the field. Everything through the CLI into tmp folders."""
 from __future__ import annotations
 
-import json
 import math
 import tomllib
 from pathlib import Path

@@ -3,7 +3,6 @@ summary.json, the exported poses' shaking force, the balanced mechanism written 
 with `mechbal run`) and URDF (Pinocchio's gravity of it is ~0), one-line errors."""
 from __future__ import annotations
 
-import json
 import math
 import tomllib
 from pathlib import Path
