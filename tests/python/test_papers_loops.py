@@ -125,11 +125,10 @@ def test_five_bar_linkage_toml_is_the_generated_mechanism_and_runs(tmp_path):
 def _paminsa_run(balanced: bool, samples: int = 251):
     from mechbal.cases.paminsa import parameters_from_config, trajectory_from_config
     from mechbal.papers import paminsa as pp
-    from mechbal.sizing import paminsa_counterweights as sizing
 
     config = load_case("paminsa")
     params = parameters_from_config(config)
-    built = sizing.closed_form(params).apply(params) if balanced else params
+    built = pp.closed_form_counterweights(params).apply(params) if balanced else params
     model = _core.PaminsaModel(built)
     mech = pp.paminsa_mechanism(params, balanced)
     traj = trajectory_from_config(config)

@@ -15,8 +15,10 @@ required to be balanced.
 
 It generalises the papers' force-balancing conditions: Briot & Arakelian 2009 (PAMINSA), eqs 6-16
 (the counterweights CP1, CP2, CP3 and the vertical counter-mass make the momentum of every leg
-zero: ``mechbal.sizing.paminsa_counterweights``), and the classical conditions of a four-bar
-(Berkof & Lowen 1969: counterweights on the crank and rocker), which the tests reproduce.
+zero: ``mechbal.papers.paminsa.closed_form_counterweights``, which checks this method in the
+``paminsa`` runner), the Heydari & Enferadi extra-linkage counterweights (eqs 29-31, the ``rpsp``
+runner), and the classical conditions of a four-bar (Berkof & Lowen 1969: counterweights on the
+crank and rocker), which the tests reproduce.
 """
 from __future__ import annotations
 
