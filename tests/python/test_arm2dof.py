@@ -1,5 +1,5 @@
 """2-DOF arm of Arakelian, Le Baron & Mottu 2011: closed form vs KDL vs Pinocchio vs the sympy
-Lagrangian, RMS-optimal counterweights (Cardano vs scipy), generalised chain sizing, closed loop,
+Lagrangian, RMS-optimal counterweights (Cardano vs scipy), the general RMS method on chains, closed loop,
 and the `mechbal run arm2dof` case."""
 import json
 

@@ -12,7 +12,7 @@ from mechbal import _core
 from mechbal import coupling as cp
 from mechbal.cases.discs import parameters_from_config
 from mechbal.config import ConfigError, load_case
-from mechbal.sizing import discs as dz
+from mechbal.papers import discs as dz
 
 CASES = {"planar3r": "discs-3r", "spatial3r": "discs-spatial", "scara": "scara",
          "fivebar": "five-bar"}
@@ -25,7 +25,7 @@ def params(kind):
 
 def k_closed_form(kind, p):
     """eqs 16, 27 (corrected: l2 where l1 is printed), 37 (general l2) and the 5R, from the
-    derivation, independently of mechbal.sizing.discs."""
+    derivation, independently of mechbal.papers.discs."""
     if kind == "planar3r":
         l1, l2, m1, m2, m3 = (p[k] for k in ("l1", "l2", "m1", "m2", "m3"))
         J = [None] + [p[f"Jx{i}"] for i in range(1, 8)]
@@ -377,7 +377,7 @@ def test_general_five_bar_is_not_decoupled_but_is_statically_balanced():
 
 def test_cpp_five_bar_equals_the_python_coupling_model():
     """mechbal._core.FiveBarDynamics (fixed-size CoupledProjection, 4x4 A° per tick) == the
-    Python coupling (mechbal.sizing.discs.fivebar_model), to 1e-12, on balanced, unbalanced,
+    Python coupling (mechbal.papers.discs.fivebar_model), to 1e-12, on balanced, unbalanced,
     perturbed parallelogram and general (d > 0, b_i free) five-bars."""
     rng = np.random.default_rng(21)
     p = params("fivebar")

@@ -16,7 +16,7 @@ from mechbal.cases.arm2dof import arm_from_config
 from mechbal.cases.discs import _disc_bodies, parameters_from_config
 from mechbal.config import load_case
 from mechbal.papers import arm2dof_mechanism, disc_arm_mechanism, disc_design_mechanism
-from mechbal.sizing import discs as dz
+from mechbal.papers import discs as dz
 from mechbal.papers import arm2dof as paper_arm2dof
 
 RTOL = 1e-12

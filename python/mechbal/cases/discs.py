@@ -3,7 +3,7 @@ balanced serial mechanisms" -- static balancing, counter-rotating discs and deco
 the planar 3R (``discs-3r``), the spatial 3R (``discs-spatial``), the SCARA (``scara``) and the
 parallelogram 5R (``five-bar``).
 
-For each: the balancing parameters (closed forms, mechbal.sizing.discs), the mass-matrix metrics
+For each: the balancing parameters (closed forms, mechbal.papers.discs), the mass-matrix metrics
 before/after over random configurations, the peak gravity torque, the sensitivity table, the
 joint torques on a rest-to-rest trajectory (unbalanced vs balanced), and the decoupled controller
 (tau_i = k_i (q''_d + Kp e + Kd e')) against computed torque over the balanced model.
@@ -22,7 +22,7 @@ from mechbal.cases import register
 from mechbal.config import ConfigError, inertia
 from mechbal.schema import inertia_matrix, validate_case
 from mechbal.export import write_bodies, write_summary
-from mechbal.sizing import discs as dz
+from mechbal.papers import discs as dz
 
 _SPEC = {
     "planar3r": dict(params=("l1", "l2", "m1", "m2", "m3"),
