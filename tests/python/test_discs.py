@@ -471,6 +471,19 @@ def test_discs_case_runs_and_writes_the_summary(kind, tmp_path):
     if kind == "spatial3r":
         assert abs(saved["inertia_conditions"]["Jy2"] - s["inertia_conditions"]["Jy2"]) == 0
         assert {c["id"] for c in saved["corrections"]} >= {"C2", "C3", "C6", "C8"}
+    # sized by mechbal.balance.moment on the [balance] table, the closed forms beside it
+    d = saved["discs"]
+    assert d["max_rel_difference"] < 1e-12 < d["tolerance_rel"]
+    assert set(d["general_method"]) == set(d["closed_form"])
+    sized = {"planar3r": ["beta", "gamma"], "spatial3r": ["Jy2", "Jy3", "beta"], "scara": ["beta"], "fivebar": []}
+    assert d["sized_by_the_general_method"] == sized[kind]
+    for key in sized[kind]:
+        value = saved["inertia_conditions"][key] if key.startswith("Jy") else saved[key]
+        assert value == d["general_method"][key] == pytest.approx(d["closed_form"][key], rel=1e-12)
+    if kind != "fivebar":
+        assert saved["k"] == d["general_method"]["k"]
+    else:   # impossible with leg discs, and why: what remains is k1 + k2 + the discs' inertias
+        assert not d["method"]["exact"] and d["method"]["limited_by"][0].startswith("impossible:")
     if kind == "fivebar":
         assert "FiveBarDynamics" in saved["decoupled_control"]["computed_torque_backend"]
     # bodies files: every link and disc, and the shaking wrench recomputed from the poses alone
