@@ -86,6 +86,11 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples=200, *, mass
         "linear_momentum_rms_before": np.sqrt(np.mean(b ** 2, axis=0)),
         "linear_momentum_rms_after": np.sqrt(np.mean(after ** 2, axis=0)),
         "least_squares_residual": sol.least_squares_residual,
+        # conditioning of the design (smallest / largest singular value of the least squares over
+        # the free variables, masses scaled by the mechanism's length): how well the samples
+        # separate the slots' effects
+        "singular_value_ratio": (float(sol.singular_values[-1] / sol.singular_values[0])
+                                 if len(sol.singular_values) and sol.singular_values[0] > 0 else None),
         "solve": sol.stage,
         "added_mass": float(sum(m for _, m, _ in placed)),
         "total_mass_after": balanced.total_mass,

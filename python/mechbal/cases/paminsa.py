@@ -288,6 +288,7 @@ def run(config, out: Path) -> dict:
             "max_abs_difference": difference, "tolerance": COUNTERWEIGHT_AGREEMENT_KG, "unit": "kg",
             "method": {"name": "force", "slots": "[balance] of the case (tied legs, fixed positions)",
                        "samples": result.metrics["samples"], "unknowns": result.unknowns, "rank": result.rank,
+                       "singular_value_ratio": result.metrics["singular_value_ratio"],
                        "residual": result.residual, "residual_before": result.residual_before,
                        "residual_units": result.residual_units, "exact": result.exact}},
         "counterweights_paper_printed_eqs_kg": printed.as_dict(),
@@ -370,12 +371,15 @@ def run(config, out: Path) -> dict:
     rows += [[f"residual M [% of |M_unbal|], {n}", *(100 * fd[n][1] / peak_M_norm)] for n in ("euler", "rk4")]
     rows += [[f"peak wrist rate [rad/s], {n}", *rates[n]] for n in ("euler", "rk4")]
     print(report.table(rows, ["PAMINSA (Briot & Arakelian 2009)", "x", "y", "z"]))
+    six = lambda *xs: [f"{x:.6g}" for x in xs]  # noqa: E731  (4 digits would show 1.3865 as 1.386 / 1.387)
     print(report.table(
-        [["CP1 at A_i", general.cp1[0], closed.cp1[0], printed.cp1[0], 4.49],
-         ["CP2 at F_i", general.cp2[0], closed.cp2[0], printed.cp2[0], 1.69],
-         ["CP3 at L_i", general.cp3[0], closed.cp3[0], printed.cp3[0], 0.436],
-         ["vertical counter-mass", general.vertical, closed.vertical, printed.vertical, "-"]],
+        [["CP1 at A_i", *six(general.cp1[0], closed.cp1[0], printed.cp1[0]), 4.49],
+         ["CP2 at F_i", *six(general.cp2[0], closed.cp2[0], printed.cp2[0]), 1.69],
+         ["CP3 at L_i", *six(general.cp3[0], closed.cp3[0], printed.cp3[0]), 0.436],
+         ["vertical counter-mass", *six(general.vertical, closed.vertical, printed.vertical), "-"]],
         ["counterweight [kg]", "general method", "closed form", "printed eqs", "paper reported"]))
+    print(f"general method (mechbal.balance.force) vs closed form: largest difference {difference:.2g} kg; "
+          f"the variants use the {use.replace('_', ' ')} masses")
     print(f"cond(N) along the run: [{cond.min():.3g}, {cond.max():.3g}];  "
           f"M_z force-balanced/unbalanced: {ratio_O:.2f} about O, {ratio_c:.2f} about the base centre "
           f"(paper: +35 %)")

@@ -415,6 +415,7 @@ def run(config, out: Path) -> dict:
                                      "run's closed motion, one slot per counterweight body at its given point "
                                      "(only the mass unknown, >= 0)",
                            "unknowns": sized.unknowns, "rank": sized.rank, "exact": sized.exact,
+                           "singular_value_ratio": sized.metrics["singular_value_ratio"],
                            "limited_by": sized.limited_by, "samples": sized.metrics["samples"],
                            "residual_momentum": sized.residual, "momentum_before": sized.residual_before,
                            "residual_units": sized.residual_units},
