@@ -60,7 +60,6 @@ Corrections to the printed equations (CORRECTIONS below, each proved by tests/py
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
