@@ -24,7 +24,7 @@ one with A° = 1). The per-tick C++ evaluators of the paper's form are
 ``mechbal._core.DiscArmDynamics`` (serial arms with discs, A° = 1, a cross-check) and
 ``mechbal._core.FiveBarDynamics`` (the 5R five-bar, A° a 4x4 matrix, over the general fixed-size
 ``mechbal::CoupledProjection``); this module is their
-independent Python reference (mechbal.sizing.discs.fivebar_model) and builds the two-stage model
+independent Python reference (mechbal.papers.discs.fivebar_model) and builds the two-stage model
 of the paper (arm model first, then discs coupled to it) used to cross-check the C++ single-stage
 form.
 """

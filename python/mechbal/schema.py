@@ -748,8 +748,9 @@ class PaminsaInertias(Table):
 
 
 class PaminsaCounterweights(Table):
-    use: Literal["closed_form", "least_squares", "paper_reported"] = "closed_form"
-    least_squares_samples: Annotated[int, Field(ge=5, le=10_000, strict=True)] = 40
+    # general_method: mechbal.balance.force on the case's [balance] slots (checked against the
+    # closed form); closed_form: eqs 11, 14-16 corrected; paper_reported: 4.49 / 1.69 / 0.436 kg
+    use: Literal["general_method", "closed_form", "paper_reported"] = "general_method"
 
 
 class PaminsaTrajectory(Table):

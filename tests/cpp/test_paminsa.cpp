@@ -48,7 +48,7 @@ Vec3 vee(const Mat3& S) {
 }
 
 // Corrected closed forms of Briot & Arakelian 2009, eqs 11, 14-16 (re-derived in the test from the
-// mass coefficients of the leg; see python/mechbal/sizing/paminsa_counterweights.py).
+// mass coefficients of the leg; see closed_form_counterweights in python/mechbal/papers/paminsa.py).
 PaminsaParameters force_balanced_parameters() {
   PaminsaParameters p;
   const double k = p.k;

@@ -1,5 +1,5 @@
 """2-DOF arm of Arakelian, Le Baron & Mottu 2011: closed form vs KDL vs Pinocchio vs the sympy
-Lagrangian, RMS-optimal counterweights (Cardano vs scipy), generalised chain sizing, closed loop,
+Lagrangian, RMS-optimal counterweights (Cardano vs scipy), the general RMS method on chains, closed loop,
 and the `mechbal run arm2dof` case."""
 import json
 
@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from mechbal import _core
-from mechbal.sizing import rms_counterweights as rc
+from mechbal.balance import rms
+from mechbal.papers import arm2dof as paper
 
 pin = pytest.importorskip("pinocchio")
 
@@ -108,12 +109,12 @@ def test_eqs_33_38_match_three_point_interpolation_of_the_dynamics():
     arm = _core.Arm2DofParameters()
     _, (q, qd, qdd) = motion(_core.TimeLaw.cubic)
     r2 = 0.17
-    c11, c12, c13, c21, c22 = rc.cw_coefficients(arm, 7.4, 2.0, r2, q, qd, qdd)
-    tau0 = rc.arm_torques(arm, None, q, qd, qdd)
-    a1, b1, g1 = rc.quadratic_in_radius(
-        lambda r: rc.arm_torques(arm, _core.Arm2DofCounterweights(7.4, 2.0, r, r2), q, qd, qdd)[:, 0])
-    a2, b2, g2 = rc.quadratic_in_radius(
-        lambda r: rc.arm_torques(arm, _core.Arm2DofCounterweights(7.4, 2.0, 0.0, r), q, qd, qdd)[:, 1])
+    c11, c12, c13, c21, c22 = paper.cw_coefficients(arm, 7.4, 2.0, r2, q, qd, qdd)
+    tau0 = paper.arm_torques(arm, None, q, qd, qdd)
+    a1, b1, g1 = rms.quadratic_in_radius(
+        lambda r: paper.arm_torques(arm, _core.Arm2DofCounterweights(7.4, 2.0, r, r2), q, qd, qdd)[:, 0])
+    a2, b2, g2 = rms.quadratic_in_radius(
+        lambda r: paper.arm_torques(arm, _core.Arm2DofCounterweights(7.4, 2.0, 0.0, r), q, qd, qdd)[:, 1])
     for x, y in ((a1, c11), (b1, c12), (g1, tau0[:, 0] + c13), (a2, c21), (b2, c22), (g2, tau0[:, 1])):
         assert np.max(np.abs(x - y)) < 1e-10
 
@@ -123,7 +124,7 @@ def test_cubic_roots_against_numpy():
     three = 0
     for _ in range(500):
         a, b, c = rng.normal(size=3) * rng.choice([0.1, 1, 10])
-        ours = np.sort(rc.cubic_real_roots(a, b, c))
+        ours = np.sort(rms.cubic_real_roots(a, b, c))
         ref = np.roots([1, a, b, c])
         ref = np.sort(ref[np.abs(ref.imag) < 1e-7 * max(1, np.max(np.abs(ref)))].real)
         if len(ref) != len(ours):  # near-confluent: numpy's tiny imaginary parts
@@ -132,7 +133,7 @@ def test_cubic_roots_against_numpy():
         assert np.allclose(ours, ref, atol=1e-8 * max(1, np.max(np.abs(ref))))
     assert three > 50
     # confluent case: (z - 1)^2 (z + 2) = z^3 - 3z + 2
-    assert np.allclose(sorted(rc.cubic_real_roots(0.0, -3.0, 2.0)), [-2.0, 1.0])
+    assert np.allclose(sorted(rms.cubic_real_roots(0.0, -3.0, 2.0)), [-2.0, 1.0])
 
 
 @pytest.mark.parametrize("case", ["paper", "quintic", "random"])
@@ -142,12 +143,12 @@ def test_cardano_optimum_matches_scipy_and_beats_every_root(case):
     law = _core.TimeLaw.quintic if case == "quintic" else _core.TimeLaw.cubic
     m1, m2 = (rng.uniform(1, 8), rng.uniform(0.5, 3)) if case == "random" else (7.4, 2.0)
     _, (q, qd, qdd) = motion(law, N=1001 if case == "paper" else 301)
-    res = rc.rms_optimal_radii(arm, m1, m2, q, qd, qdd)
-    r_num = rc.rms_optimal_radii_numerical(arm, m1, m2, q, qd, qdd)
+    res = paper.rms_optimal_radii(arm, m1, m2, q, qd, qdd)
+    r_num = paper.rms_optimal_radii_numerical(arm, m1, m2, q, qd, qdd)
     assert abs(res.r_cw1 - r_num[0]) < 1e-6 and abs(res.r_cw2 - r_num[1]) < 1e-6
 
     def ms(r1, r2):
-        tau = rc.arm_torques(arm, _core.Arm2DofCounterweights(m1, m2, r1, r2), q, qd, qdd)
+        tau = paper.arm_torques(arm, _core.Arm2DofCounterweights(m1, m2, r1, r2), q, qd, qdd)
         return np.mean(tau ** 2, axis=0)
 
     best = ms(res.r_cw1, res.r_cw2)
@@ -170,63 +171,83 @@ def test_cubic_with_three_real_roots_keeps_the_least_rms():
     alpha = np.array([1.0, 1.0, 0.5])
     beta = np.array([0.0, 0.3, -0.1])
     d = np.array([-1.0, -1.2, -0.4])
-    a, b, c = rc.stationarity_cubic(alpha, beta, d)
-    roots = rc.cubic_real_roots(a, b, c)
+    a, b, c = rms.stationarity_cubic(alpha, beta, d)
+    roots = rms.cubic_real_roots(a, b, c)
     assert len(roots) == 3
-    vals = [rc.squared_sum(alpha, beta, d, r) for r in roots]
+    vals = [rms.squared_sum(alpha, beta, d, r) for r in roots]
     grid = np.linspace(-5, 5, 200001)
     best_grid = grid[np.argmin([(np.sum((alpha * x * x + beta * x + d) ** 2)) for x in grid[::100]]) * 100]
     assert abs(roots[int(np.argmin(vals))] - best_grid) < 0.01
 
 
-def test_generalised_chain_sizing_reduces_to_cardano_on_the_arm():
-    arm = _core.Arm2DofParameters()
-    _, (q, qd, qdd) = motion(_core.TimeLaw.cubic, N=301)
-    res = rc.rms_optimal_radii(arm, 7.4, 2.0, q, qd, qdd)
-    chain = _core.arm2dof_chain_model(arm)
-    minus_x = (-1.0, 0.0, 0.0)
-    # joint 2 alone: r2 only (r1 fixed at 0)
-    mounts = [rc.CounterweightMount(0, (0, 0, 0), minus_x, 7.4, (0.0, 0.0)),
-              rc.CounterweightMount(1, (0, 0, 0), minus_x, 2.0, (-1.0, 1.0))]
-    s2 = rc.size_chain_counterweights(chain, mounts, q, qd, qdd, weights=[0.0, 1.0], starts=3)
-    assert abs(s2.radii[1] - res.r_cw2) < 1e-6
-    mounts = [rc.CounterweightMount(0, (0, 0, 0), minus_x, 7.4, (-1.0, 1.0)),
-              rc.CounterweightMount(1, (0, 0, 0), minus_x, 2.0, (s2.radii[1], s2.radii[1]))]
-    s1 = rc.size_chain_counterweights(chain, mounts, q, qd, qdd, weights=[1.0, 0.0], starts=3)
-    assert abs(s1.radii[0] - res.r_cw1) < 1e-6
-    # exactness of the quadratic torque model against a direct KDL evaluation
-    tm = rc.chain_torque_model(chain, mounts, q, qd, qdd)
-    r, m = np.array([0.31, -0.07]), np.array([3.0, 1.5])
-    direct = _core.KdlChainDynamics(rc.chain_with_point_masses(
-        chain, {0: [(3.0, np.array([-0.31, 0, 0]))], 1: [(1.5, np.array([0.07, 0, 0]))]})
-    ).inverse_dynamics(q, qd, qdd)["tau"]
-    assert np.max(np.abs(tm.torque(r, m) - direct)) < 1e-9 * np.max(np.abs(direct))
+def chain_mechanism(chain):
+    """The general model of a ChainModel (its base placement included)."""
+    import mechbal
+
+    return mechbal.Mechanism(_core.MechanismModel(_core.chain_description(chain)), name="chain")
 
 
-def test_generalised_sizing_with_mass_budget_on_a_3_joint_chain():
+def mean_square_torque(mech, slots, design, q, qd, qdd):
+    """sum_j mean_i tau_j^2 of ``mech`` with point masses (mass, signed distance) on the slots' lines."""
+    bodies = [_core.Body(s.name, s.link, float(m), r * np.asarray(s.direction) / np.linalg.norm(s.direction),
+                         np.zeros((3, 3)), "counterweight") for s, (m, r) in zip(slots, design)]
+    return float(np.sum(np.mean(mech.with_bodies(bodies).inverse_dynamics(q, qd, qdd) ** 2, axis=0)))
+
+
+def test_rms_method_with_mass_budget_on_a_3_joint_chain():
+    """The general RMS method (all slots together, masses free under a budget) on a random 3R
+    chain: no random feasible design beats its optimum, and the budget holds."""
     from conftest import chain_from_specs, random_chain_specs
+    from mechbal.balance import CounterweightSlot
 
     rng = np.random.default_rng(5)
-    chain = chain_from_specs(random_chain_specs(rng, "RRR"))
+    mech = chain_mechanism(chain_from_specs(random_chain_specs(rng, "RRR")))
+    links = [j.name for j in mech.model.description.joints]
     t = np.linspace(0, 1, 101)
     q, qd, qdd = _core.RestToRestTrajectory(np.zeros(3), np.array([0.8, -0.5, 0.6]), 1.0,
                                             _core.TimeLaw.cubic).evaluate_batch(t)
-    mounts = [rc.CounterweightMount(i, (0, 0, 0), (1.0, 0.3 * i, 0.0), 1.0, (-0.5, 0.5))
-              for i in range(3)]
-    fixed = rc.size_chain_counterweights(chain, mounts, q, qd, qdd, starts=4)
-    budget = rc.size_chain_counterweights(chain, mounts, q, qd, qdd, optimise_masses=True,
-                                          mass_budget=2.0, starts=4)
-    assert np.sum(budget.masses) <= 2.0 + 1e-6 and np.all(budget.masses >= -1e-9)
-    tm = rc.chain_torque_model(chain, mounts, q, qd, qdd)
-    J = lambda r, m: float(np.sum(np.mean(tm.torque(r, m) ** 2, axis=0)))  # noqa: E731
-    assert fixed.objective <= J(np.zeros(3), np.ones(3)) + 1e-12
+    fixed = [CounterweightSlot(f"cw{i}", links[i], 1.0, 1.0, max_radius=0.5, direction=(1.0, 0.3 * i, 0.0))
+             for i in range(3)]
+    free = [CounterweightSlot(f"cw{i}", links[i], 0.0, 2.0, max_radius=0.5, direction=(1.0, 0.3 * i, 0.0))
+            for i in range(3)]
+    best_fixed = rms.balance(mech, fixed, (q, qd, qdd), coupling="total", starts=4)
+    best_budget = rms.balance(mech, free, (q, qd, qdd), coupling="total", mass_budget=2.0, starts=4)
+    J = lambda res: float(np.sum(np.asarray(res.metrics["rms_torque_after"]) ** 2))  # noqa: E731
+    masses = [best_budget.design[f"cw{i}"]["mass"] for i in range(3)]
+    assert sum(masses) <= 2.0 + 1e-6 and min(masses) >= -1e-9
     for _ in range(50):  # no random feasible design beats the optimum
         r = rng.uniform(-0.5, 0.5, 3)
-        assert fixed.objective <= J(r, np.ones(3)) + 1e-9
+        assert J(best_fixed) <= mean_square_torque(mech, fixed, zip(np.ones(3), r), q, qd, qdd) + 1e-9
         m = rng.dirichlet(np.ones(3)) * 2.0
-        assert budget.objective <= J(r, m) + 1e-9
-    with pytest.raises(ValueError, match="mounts\\[0\\].link"):
-        rc.chain_torque_model(chain, [rc.CounterweightMount(7, (0, 0, 0), (1, 0, 0), 1.0)], q, qd, qdd)
+        assert J(best_budget) <= mean_square_torque(mech, free, zip(m, r), q, qd, qdd) + 1e-9
+
+
+def test_rms_method_honours_the_chain_base_placement():
+    """Issue 11: the old n-joint sizing ignored the chain's base transform. On the general model
+    (chain_description) a tilted base changes the gravity torques; the RMS method's torques before
+    and after are those of KDL on the same (tilted) chain, without and with the counterweight."""
+    from conftest import chain_from_specs, random_chain_specs
+    from mechbal.balance import CounterweightSlot
+    from mechbal.spec import transform_xyz_rpy
+
+    rng = np.random.default_rng(8)
+    specs = random_chain_specs(rng, "RRR")
+    base = transform_xyz_rpy((0.1, -0.2, 0.3), (0.7, -0.4, 0.2))
+    chain = chain_from_specs(specs, base=base)
+    t = np.linspace(0, 1, 41)
+    q, qd, qdd = _core.RestToRestTrajectory(np.zeros(3), np.array([0.8, -0.5, 0.6]), 1.0,
+                                            _core.TimeLaw.cubic).evaluate_batch(t)
+    mech = chain_mechanism(chain)
+    link = mech.model.description.joints[1].name
+    res = rms.balance(mech, [CounterweightSlot("m", link, 1.5, 1.5, max_radius=0.5, center=(0.05, 0.0, 0.0),
+                                               direction=(1.0, 0.2, 0.0))], (q, qd, qdd), coupling="total")
+    kdl = _core.KdlChainDynamics(chain).inverse_dynamics(q, qd, qdd)["tau"]
+    rms_of = lambda tau: np.sqrt(np.mean(tau ** 2, axis=0))  # noqa: E731
+    np.testing.assert_allclose(res.metrics["rms_torque_before"], rms_of(kdl), rtol=1e-9)
+    level = _core.KdlChainDynamics(chain_from_specs(specs)).inverse_dynamics(q, qd, qdd)["tau"]
+    assert np.max(np.abs(level - kdl)) > 1e-2
+    np.testing.assert_allclose(res.metrics["rms_torque_after"], rms_of(res.balanced.inverse_dynamics(q, qd, qdd)),
+                               rtol=1e-12)
 
 
 def test_closed_loop_exact_model_follows_eq6_and_controller_holds_on_nan():
@@ -268,6 +289,13 @@ def test_case_reproduces_the_paper_or_records_why_not(arm2dof_run):
     for k in ("A", "B", "C"):
         assert len(s["rms_torque_Nm"][k]) == 2 and len(s["peak_torque_Nm"][k]) == 2
     assert np.allclose(s["r_cw_m"], s["r_cw_numerical_m"], atol=1e-6)
+    # sized by mechbal.balance.rms (Cardano on the torque regressor), the paper's cubic beside it
+    r = s["r_cw"]
+    assert r["general_method"] == s["r_cw_m"] and r["general_method"] == pytest.approx([0.2509, 0.1913], abs=5e-5)
+    assert r["max_abs_difference"] < 1e-10 < r["tolerance"]
+    assert np.allclose(r["general_method"], r["closed_form"], atol=1e-10)
+    assert r["method"]["coupling"] == "per_joint" and r["method"]["exact"]
+    assert all("Cardano" in how for how in r["method"]["how"])
     # step 1 = law B + counterweights at the static radii: the paper's 71/59 % and 63/50 %
     r2 = s["first_step_readings"]["reading_2_B_with_cw_at_static_radii_vs_A"]
     assert np.array_equal(np.floor(r2["rms_reduction_pct"]), [71, 59])
@@ -318,32 +346,3 @@ def test_case_config_errors_name_the_field(tmp_path):
         bad.write_text(text.replace(old, new, 1))
         with pytest.raises(ConfigError, match=field.replace(".", r"\.")):
             run_case(bad, tmp_path / "out")
-
-
-def test_chain_torque_model_honours_the_base_placement():
-    """Issue 11: the n-joint sizing ignored the chain's base transform (it rebuilt the chain at the
-    identity). On the general model (chain_description) a tilted base changes the gravity torques,
-    and the torque model agrees with KDL on the same chain, with and without a point mass."""
-    import mechbal
-    from conftest import chain_from_specs, random_chain_specs
-    from mechbal.spec import transform_xyz_rpy
-
-    rng = np.random.default_rng(8)
-    specs = random_chain_specs(rng, "RRR")
-    base = transform_xyz_rpy((0.1, -0.2, 0.3), (0.7, -0.4, 0.2))
-    chain = chain_from_specs(specs, base=base)
-    t = np.linspace(0, 1, 41)
-    q, qd, qdd = _core.RestToRestTrajectory(np.zeros(3), np.array([0.8, -0.5, 0.6]), 1.0,
-                                            _core.TimeLaw.cubic).evaluate_batch(t)
-    mounts = [rc.CounterweightMount(1, (0.05, 0.0, 0.0), (1.0, 0.2, 0.0), 1.5)]
-    tm = rc.chain_torque_model(chain, mounts, q, qd, qdd)
-    kdl = _core.KdlChainDynamics(chain).inverse_dynamics(q, qd, qdd)["tau"]
-    assert np.max(np.abs(tm.tau0 - kdl)) < 1e-9 * np.max(np.abs(kdl))
-    level = _core.KdlChainDynamics(chain_from_specs(specs)).inverse_dynamics(q, qd, qdd)["tau"]
-    assert np.max(np.abs(level - kdl)) > 1e-2
-    u = np.array([1.0, 0.2, 0.0]) / np.linalg.norm([1.0, 0.2, 0.0])
-    mech = mechbal.Mechanism(_core.MechanismModel(_core.chain_description(chain)))
-    body = _core.Body("m", mech.model.description.joints[1].name, 1.5, np.array([0.05, 0, 0]) + 0.3 * u,
-                      np.zeros((3, 3)), "counterweight")
-    direct = mech.with_bodies([body]).inverse_dynamics(q, qd, qdd)
-    assert np.max(np.abs(tm.torque(np.array([0.3]), np.array([1.5])) - direct)) < 1e-9 * np.max(np.abs(direct))

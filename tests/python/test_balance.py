@@ -273,17 +273,17 @@ def test_rms_reproduces_the_2dof_radii_and_its_closed_form(arm):
     """0.2509 / 0.1913 m (the corrected eqs 39-59 of Arakelian et al. 2011; the paper prints
     0.25 / 0.147): the general method's closed form (Cardano on the torque regressor), its
     numerical path, and the paper's closed form on Arm2DofDynamics agree."""
-    from mechbal.sizing import rms_counterweights as rc
+    from mechbal.papers import arm2dof as paper
 
     motion = arm2dof_motion()
     design = [Slot("cw1", "shoulder", 7.4, 7.4, direction=MINUS_X),
               Slot("cw2", "elbow", 2.0, 2.0, direction=MINUS_X)]
     fast = rms.balance(arm, design, motion)
     slow = rms.balance(arm, design, motion, fast_path=False, starts=2)
-    paper = rc.rms_optimal_radii(_core.Arm2DofParameters(**ARM, g=9.81), 7.4, 2.0, *motion)
+    closed = paper.rms_optimal_radii(_core.Arm2DofParameters(**ARM, g=9.81), 7.4, 2.0, *motion)
     r = [fast.design[k]["signed_distance"] for k in ("cw1", "cw2")]
     assert r == pytest.approx([0.2509, 0.1913], abs=5e-5)
-    assert r == pytest.approx([paper.r_cw1, paper.r_cw2], abs=1e-10)
+    assert r == pytest.approx([closed.r_cw1, closed.r_cw2], abs=1e-10)
     assert [slow.design[k]["signed_distance"] for k in ("cw1", "cw2")] == pytest.approx(r, abs=1e-6)
     assert "Cardano" in fast.design["cw1"]["method"] and fast.exact
     # the reported torques are the balanced mechanism's

@@ -1,7 +1,7 @@
 """`mechbal balance` on the papers' built-in cases (issue 11): PAMINSA by shaking-force balancing
 with tied, fixed-position counterweight slots (Briot & Arakelian's 2.7915 / 1.3865 / 0.436 kg per
 leg and 9.615 kg), the disc cases by shaking-moment balancing from [[balance.discs]] tables (the
-closed forms' gear ratios and inertia conditions, mechbal.sizing.discs), the five-bar's
+closed forms' gear ratios and inertia conditions, mechbal.papers.discs), the five-bar's
 impossibility and its reason, the written-back cases run by `mechbal run`, and the new keys'
 refusals naming the field. Everything through the CLI into tmp folders."""
 from __future__ import annotations
@@ -20,7 +20,7 @@ from mechbal.cli import main
 from mechbal.config import case_path, load_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from mechbal.mechanism import Mechanism
-from mechbal.sizing import discs as dz
+from mechbal.papers import discs as dz
 
 from cli_checks import one_line_error, summary_of
 

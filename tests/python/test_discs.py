@@ -12,7 +12,7 @@ from mechbal import _core
 from mechbal import coupling as cp
 from mechbal.cases.discs import parameters_from_config
 from mechbal.config import ConfigError, load_case
-from mechbal.sizing import discs as dz
+from mechbal.papers import discs as dz
 
 CASES = {"planar3r": "discs-3r", "spatial3r": "discs-spatial", "scara": "scara",
          "fivebar": "five-bar"}
@@ -25,7 +25,7 @@ def params(kind):
 
 def k_closed_form(kind, p):
     """eqs 16, 27 (corrected: l2 where l1 is printed), 37 (general l2) and the 5R, from the
-    derivation, independently of mechbal.sizing.discs."""
+    derivation, independently of mechbal.papers.discs."""
     if kind == "planar3r":
         l1, l2, m1, m2, m3 = (p[k] for k in ("l1", "l2", "m1", "m2", "m3"))
         J = [None] + [p[f"Jx{i}"] for i in range(1, 8)]
@@ -377,7 +377,7 @@ def test_general_five_bar_is_not_decoupled_but_is_statically_balanced():
 
 def test_cpp_five_bar_equals_the_python_coupling_model():
     """mechbal._core.FiveBarDynamics (fixed-size CoupledProjection, 4x4 A° per tick) == the
-    Python coupling (mechbal.sizing.discs.fivebar_model), to 1e-12, on balanced, unbalanced,
+    Python coupling (mechbal.papers.discs.fivebar_model), to 1e-12, on balanced, unbalanced,
     perturbed parallelogram and general (d > 0, b_i free) five-bars."""
     rng = np.random.default_rng(21)
     p = params("fivebar")
@@ -471,6 +471,19 @@ def test_discs_case_runs_and_writes_the_summary(kind, tmp_path):
     if kind == "spatial3r":
         assert abs(saved["inertia_conditions"]["Jy2"] - s["inertia_conditions"]["Jy2"]) == 0
         assert {c["id"] for c in saved["corrections"]} >= {"C2", "C3", "C6", "C8"}
+    # sized by mechbal.balance.moment on the [balance] table, the closed forms beside it
+    d = saved["discs"]
+    assert d["max_rel_difference"] < 1e-12 < d["tolerance_rel"]
+    assert set(d["general_method"]) == set(d["closed_form"])
+    sized = {"planar3r": ["beta", "gamma"], "spatial3r": ["Jy2", "Jy3", "beta"], "scara": ["beta"], "fivebar": []}
+    assert d["sized_by_the_general_method"] == sized[kind]
+    for key in sized[kind]:
+        value = saved["inertia_conditions"][key] if key.startswith("Jy") else saved[key]
+        assert value == d["general_method"][key] == pytest.approx(d["closed_form"][key], rel=1e-12)
+    if kind != "fivebar":
+        assert saved["k"] == d["general_method"]["k"]
+    else:   # impossible with leg discs, and why: what remains is k1 + k2 + the discs' inertias
+        assert not d["method"]["exact"] and d["method"]["limited_by"][0].startswith("impossible:")
     if kind == "fivebar":
         assert "FiveBarDynamics" in saved["decoupled_control"]["computed_torque_backend"]
     # bodies files: every link and disc, and the shaking wrench recomputed from the poses alone

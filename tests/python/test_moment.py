@@ -1,7 +1,7 @@
 """Shaking-moment balancing by counter-rotating discs (mechbal.balance.moment) on the general
 model: the disc arms of Coutinho & Hess Coelho and the five-bar, built here from description
 objects (statically balanced links + disc slots). The general method must give the closed forms'
-gear ratios and inertia conditions (mechbal.sizing.discs, corrected eqs 14, 25, 35; §5 for the
+gear ratios and inertia conditions (mechbal.papers.discs, corrected eqs 14, 25, 35; §5 for the
 five-bar), say which columns cannot be cancelled and why, and -- with the discs it proposes --
 cancel the angular momentum to 1e-9 over random motions (Mechanism.momentum of the balanced
 mechanism: the C++ momentum, not the regressor the method solved with)."""
@@ -16,7 +16,7 @@ from mechbal.balance import DiscSlot, InertiaSlot
 from mechbal.balance import moment
 from mechbal.cases.discs import parameters_from_config
 from mechbal.config import load_case
-from mechbal.sizing import discs as dz
+from mechbal.papers import discs as dz
 
 EX, EZ = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
 CASES = {"planar3r": "discs-3r", "spatial3r": "discs-spatial", "scara": "scara"}

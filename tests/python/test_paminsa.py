@@ -1,5 +1,6 @@
 """PAMINSA (Briot & Arakelian 2009): the acceptance of the flagship case, checked from the exported
-poses alone (central finite differences), plus counterweight sizing by two independent routes and
+poses alone (central finite differences), plus the counterweights by two independent routes (the
+general force method the runner sizes with, and the paper's corrected closed form) and
 the wrist matrix N against the wrist links' angular momentum computed body by body."""
 import json
 
@@ -11,7 +12,7 @@ from mechbal import _core
 from mechbal.cases import DEFAULT_CASE, run_case
 from mechbal.config import ConfigError, load_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
-from mechbal.sizing import paminsa_counterweights as sizing
+from mechbal.papers import paminsa as paper
 
 INNER = slice(2, -2)  # np.gradient's one-sided ends are less accurate
 
@@ -119,32 +120,49 @@ def params():
     return parameters_from_config(load_case("paminsa"))
 
 
-def test_closed_form_equals_least_squares(params):
-    """Two independent routes: the corrected closed forms vs a least-squares fit of the total linear
-    momentum computed from the C++ kinematics only."""
-    from mechbal.cases.paminsa import identification_trajectories, trajectory_from_config
+def test_runner_sizes_by_the_general_method_and_reports_the_closed_form(paminsa_run):
+    """The runner's counterweights come from mechbal.balance.force on the [balance] slots; the
+    corrected closed form (eqs 11, 14-16) is reported beside them and agrees to round-off."""
+    _, s = paminsa_run
+    c = s["counterweights"]
+    assert s["counterweights_used"] == "general_method"
+    assert s["counterweights_kg"]["source"].startswith("general_method")
+    for key in ("cp1", "cp2", "cp3"):
+        assert s["counterweights_kg"][key] == c["general_method"][key]
+        np.testing.assert_allclose(c["general_method"][key], c["closed_form"][key], rtol=1e-9)
+    assert c["general_method"]["vertical"] == pytest.approx(9.615, abs=1e-3)
+    assert c["max_abs_difference"] < 1e-9 < c["tolerance"]
+    m = c["method"]
+    assert m["exact"] and m["rank"] == m["unknowns"] == 4 and m["residual"] < 1e-9 * m["residual_before"]
 
-    cycle = trajectory_from_config(load_case("paminsa"))
-    closed = sizing.closed_form(params)
-    lsq, sv = sizing.least_squares(params, identification_trajectories(cycle, params.nominal_platform), 25)
-    np.testing.assert_allclose(lsq.cp1, closed.cp1, rtol=1e-8)
-    np.testing.assert_allclose(lsq.cp2, closed.cp2, rtol=1e-8)
-    np.testing.assert_allclose(lsq.cp3, closed.cp3, rtol=1e-8)
-    assert np.isclose(lsq.vertical, closed.vertical, rtol=1e-8)
-    assert lsq.notes["relative_residual"] < 1e-10
-    assert lsq.notes["unidentified_directions"] == 2  # the leg 1 / leg 2 symmetry
-    _, sv_cycle = sizing.least_squares(params, [cycle], 25)
-    assert np.sum(sv_cycle < 1e-9 * sv_cycle[0]) == 3  # the paper's cycle alone: no x motion
+
+def test_runner_refuses_slots_that_disagree_with_the_closed_form():
+    """Slots no longer at the paper's points (here CP2 off F): the general method balances another
+    design, which the closed form does not check: the runner stops and says why."""
+    from mechbal.cases.paminsa import check_against_closed_form, general_counterweights
+
+    cfg = load_case("paminsa")
+    cfg["balance"]["counterweights"][3]["position"] = [0.2, 0.0, 0.0]
+    general, result = general_counterweights(cfg)
+    closed = paper.closed_form_counterweights(parameters_of(cfg))
+    with pytest.raises(ConfigError, match="differ from the closed form"):
+        check_against_closed_form(general, closed, result)
+
+
+def parameters_of(cfg):
+    from mechbal.cases.paminsa import parameters_from_config
+
+    return parameters_from_config(cfg)
 
 
 def test_paper_numbers(params):
-    printed = sizing.paper_printed(params)
-    closed = sizing.closed_form(params)
+    printed = paper.printed_counterweights(params)
+    closed = paper.closed_form_counterweights(params)
     # the printed eqs 14-16 agree with the first-principles closed forms
     assert np.isclose(printed.cp1[0], closed.cp1[0]) and np.isclose(printed.cp2[0], closed.cp2[0])
     assert np.isclose(printed.cp3[0], 0.436)
     # the paper's 1.69 is eq 15 without its m8 term; eq 11 misses 2 m8/(2k) per leg
-    assert abs(printed.notes["cp2_without_m8_term"] - sizing.PAPER_REPORTED["cp2"]) < 0.005
+    assert abs(printed.notes["cp2_without_m8_term"] - paper.REPORTED_COUNTERWEIGHTS_KG["cp2"]) < 0.005
     assert np.isclose(closed.vertical - printed.vertical, 3 * params.link_mass[7] / params.k * 1.0)
     assert abs(closed.cp1[0] - 4.49) > 1.0  # documented discrepancy
 
@@ -186,7 +204,7 @@ def test_wrist_matrix_against_body_by_body_angular_momentum(params):
 
 
 def test_kinematics_batch_matches_finite_differences(params):
-    model = _core.PaminsaModel(sizing.closed_form(params).apply(params))
+    model = _core.PaminsaModel(paper.closed_form_counterweights(params).apply(params))
     t = np.linspace(0.0, 0.3, 3001)
     dt = t[1] - t[0]
     P = params.nominal_platform + np.stack([0.03 * np.sin(5 * t), 0.1 * np.sin(3 * t + 1), 0.02 * np.cos(7 * t)], 1)
@@ -220,7 +238,7 @@ def test_inverse_kinematics_round_trip(params):
 
 
 def test_bad_parameters_name_the_field(params):
-    p = sizing.copy_parameters(params)
+    p = paper.copy_parameters(params)
     p.link_mass = [0.622, 0.406, 0.406, -0.1, 0.436, 0.921, 1.2, 0.305]
     with pytest.raises(ValueError, match=r"link_mass\[3\]"):
         _core.PaminsaModel(p)

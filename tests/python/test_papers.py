@@ -16,8 +16,8 @@ from mechbal.cases.arm2dof import arm_from_config
 from mechbal.cases.discs import _disc_bodies, parameters_from_config
 from mechbal.config import load_case
 from mechbal.papers import arm2dof_mechanism, disc_arm_mechanism, disc_design_mechanism
-from mechbal.sizing import discs as dz
-from mechbal.sizing import rms_counterweights as rc
+from mechbal.papers import discs as dz
+from mechbal.papers import arm2dof as paper_arm2dof
 
 RTOL = 1e-12
 
@@ -39,11 +39,11 @@ def arm_case():
     motion = {law: _core.RestToRestTrajectory(tt["start"], tt["end"], tt["duration"], tl).evaluate_batch(t)
               for law, tl in (("cubic", _core.TimeLaw.cubic), ("quintic", _core.TimeLaw.quintic))}
     m_cw1, m_cw2 = config["counterweights"]["m_cw1"], config["counterweights"]["m_cw2"]
-    opt = rc.rms_optimal_radii(arm, m_cw1, m_cw2, *motion["cubic"])  # run C of the case
+    opt = paper_arm2dof.rms_optimal_radii(arm, m_cw1, m_cw2, *motion["cubic"])  # run C of the case
     counterweights = {
         "bare": None,
         "rms_optimal": _core.Arm2DofCounterweights(m_cw1, m_cw2, opt.r_cw1, opt.r_cw2),
-        "static": _core.Arm2DofCounterweights(m_cw1, m_cw2, *rc.static_balancing_radii(arm, m_cw1, m_cw2)),
+        "static": _core.Arm2DofCounterweights(m_cw1, m_cw2, *paper_arm2dof.static_balancing_radii(arm, m_cw1, m_cw2)),
     }
     return arm, motion, counterweights
 

@@ -54,7 +54,7 @@ def _compare_bodies(mech: Mechanism, motion, closed: dict, names, inertia) -> di
 def _five_bar_run(balanced: bool):
     from mechbal.cases.discs import _disc_bodies, _torques, parameters_from_config
     from mechbal.papers.five_bar import five_bar_design_mechanism, five_bar_initial_guess
-    from mechbal.sizing import discs as dz
+    from mechbal.papers import discs as dz
 
     config = load_case("five-bar")
     p = parameters_from_config("fivebar", config)
@@ -90,7 +90,7 @@ def test_five_bar_general_model_equals_the_closed_form(balanced):
     # actuated torques: C^T tau of the tree = FiveBarDynamics' M' qdd + v' + g'
     diffs["actuated_torque"] = _rel(m.actuated_force, r["torque"])
     # reduced mass matrix and gravity: C^T M C, C^T G = FiveBarDynamics.evaluate's M', g'
-    from mechbal.sizing import discs as dz
+    from mechbal.papers import discs as dz
 
     M, _, g = dz.evaluate("fivebar", r["d"], r["q"][::10], r["qd"][::10] * 0.0)
     g_scale = np.abs(dz.evaluate("fivebar", baseline["d"], r["q"][::10], r["qd"][::10] * 0.0)[2]).max()
@@ -125,11 +125,10 @@ def test_five_bar_linkage_toml_is_the_generated_mechanism_and_runs(tmp_path):
 def _paminsa_run(balanced: bool, samples: int = 251):
     from mechbal.cases.paminsa import parameters_from_config, trajectory_from_config
     from mechbal.papers import paminsa as pp
-    from mechbal.sizing import paminsa_counterweights as sizing
 
     config = load_case("paminsa")
     params = parameters_from_config(config)
-    built = sizing.closed_form(params).apply(params) if balanced else params
+    built = pp.closed_form_counterweights(params).apply(params) if balanced else params
     model = _core.PaminsaModel(built)
     mech = pp.paminsa_mechanism(params, balanced)
     traj = trajectory_from_config(config)

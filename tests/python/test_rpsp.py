@@ -199,20 +199,32 @@ def test_forward_kinematics_with_the_motors_actuated_recovers_the_platform():
 
 # ---- balancing ------------------------------------------------------------------------------------
 
+def platform_samples(mech, c, t):
+    """(phi, phi', q_guess) of the paper's motion in ``mech.actuated_names`` order: the samples of
+    mechbal.balance.force on the platform-driven robot."""
+    phi, dphi, _ = runner.platform_motion(c.motion, t)
+    order = {"platform_z": 0, "platform_y": 1, "platform_x": 2}
+    cols = [order[n] for n in mech.actuated_names]
+    g = guess()
+    return phi[:, cols], dphi[:, cols], np.array([g[n] for n in mech.joint_names], float)
+
+
 def test_general_method_finds_the_eqs_29_31_masses_and_balances_the_robot():
     c = case()
     full, unbal = mechanisms()
     t = np.linspace(0.0, 1.0, 201)
     m = runner.solve(full, c.motion, t, guess())
     slots = [*c.balancing.m_P, *c.balancing.m_N, *c.balancing.m_F, *c.balancing.platform]
-    masses, rank, sv, residual, before = runner.size_by_momentum(full, m.q, m.v, slots)
-    assert rank == len(slots)
+    masses, res = runner.size_counterweights(full, c.spec, slots, *platform_samples(full, c, t))
+    assert res.rank == res.unknowns == len(slots) and res.exact and not res.undetermined
+    residual, before = res.residual, res.residual_before
     p = c.paper
     eqs = paper.counterweights_eqs_29_31(p.m_E, p.m_Q, p.m_H, p.m_K, p.r_H, p.r_K, p.r_P, p.r_N, p.r_Q, p.r_F)
     for key, names in (("m_P", c.balancing.m_P), ("m_N", c.balancing.m_N), ("m_F", c.balancing.m_F)):
         for n in names:
             assert masses[n] == pytest.approx(eqs[key], rel=1e-7), n
-    assert abs(masses["platform_counterweight"]) < 1e-7
+    # zero by the condition: held at its bound (mass_min 0), never a negative round-off mass
+    assert 0.0 <= masses["platform_counterweight"] < 1e-7
     assert residual < 1e-10 * before
     bal = Mechanism.from_spec(runner.driven_by_platform(runner.with_masses(c.spec, masses), "platform"))
     F = bal.shaking_wrench(m.q, m.v, m.a).shaking_force
@@ -231,9 +243,8 @@ def test_platform_counterweight_is_sized_when_the_platform_is_not_balanced():
                                                     if b.name == "platform" else b for b in spec.bodies])
     mech = Mechanism.from_spec(runner.driven_by_platform(spec, "platform"))
     t = np.linspace(0.0, 0.5, 101)
-    m = runner.solve(mech, c.motion, t, guess())
     slots = [*c.balancing.m_P, *c.balancing.m_N, *c.balancing.m_F, *c.balancing.platform]
-    masses, *_ = runner.size_by_momentum(mech, m.q, m.v, slots)
+    masses, _ = runner.size_counterweights(mech, spec, slots, *platform_samples(mech, c, t))
     # m_cw * 0.1 m = m_p * offset (the counterweight at -0.1 m on the platform's z axis)
     assert masses["platform_counterweight"] == pytest.approx(c.paper.m_p * offset / 0.1, rel=1e-7)
 
@@ -286,6 +297,12 @@ def test_run_summary_has_the_issue_fields(rpsp_run):
     assert [r["t"] for r in written["tables"]["x"]] == [0.0, 0.052, 0.1, 0.152, 0.2]
     assert all(r > 99.99 for r in written["mean_reduction_pct"])
     assert written["counterweights_kg"]["m_N"] == pytest.approx(2.85, rel=1e-7)
+    # sized by mechbal.balance.force, eqs 29-31 beside it
+    c = written["counterweights"]
+    assert c["general_method"] == written["counterweights_kg"]
+    assert c["closed_form"] == pytest.approx({"m_P": 17.97, "m_N": 2.85, "m_F": 4.5}, abs=1e-12)
+    assert c["max_abs_difference"] < 1e-7 and c["tolerance"] == 1e-6
+    assert written["general_method"]["exact"] and written["general_method"]["rank"] == 10
     assert written["added_mass_kg"] == pytest.approx(
         3 * (3.27 + 3.3 + 17.97 + 2.85 + 4.5), rel=1e-7)
     assert "non_finite_values" not in written

@@ -66,7 +66,7 @@ def discs_case(cfg, raw: dict, table: Any, design_cfg):
     """The BalanceCase of a ``discs`` case (module docstring)."""
     from mechbal.balance.run import BalanceCase
     from mechbal.cases.discs import parameters_from_config
-    from mechbal.sizing import discs as dz
+    from mechbal.papers import discs as dz
 
     name, title = cfg.case.name, cfg.case.title or cfg.case.name
     kind = cfg.case.mechanism

@@ -15,8 +15,10 @@ required to be balanced.
 
 It generalises the papers' force-balancing conditions: Briot & Arakelian 2009 (PAMINSA), eqs 6-16
 (the counterweights CP1, CP2, CP3 and the vertical counter-mass make the momentum of every leg
-zero: ``mechbal.sizing.paminsa_counterweights``), and the classical conditions of a four-bar
-(Berkof & Lowen 1969: counterweights on the crank and rocker), which the tests reproduce.
+zero: ``mechbal.papers.paminsa.closed_form_counterweights``, which checks this method in the
+``paminsa`` runner), the Heydari & Enferadi extra-linkage counterweights (eqs 29-31, the ``rpsp``
+runner), and the classical conditions of a four-bar (Berkof & Lowen 1969: counterweights on the
+crank and rocker), which the tests reproduce.
 """
 from __future__ import annotations
 
@@ -84,6 +86,11 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples=200, *, mass
         "linear_momentum_rms_before": np.sqrt(np.mean(b ** 2, axis=0)),
         "linear_momentum_rms_after": np.sqrt(np.mean(after ** 2, axis=0)),
         "least_squares_residual": sol.least_squares_residual,
+        # conditioning of the design (smallest / largest singular value of the least squares over
+        # the free variables, masses scaled by the mechanism's length): how well the samples
+        # separate the slots' effects
+        "singular_value_ratio": (float(sol.singular_values[-1] / sol.singular_values[0])
+                                 if len(sol.singular_values) and sol.singular_values[0] > 0 else None),
         "solve": sol.stage,
         "added_mass": float(sum(m for _, m, _ in placed)),
         "total_mass_after": balanced.total_mass,

@@ -21,7 +21,8 @@ the torques.
   already fixed: a counterweight does not change the torque of a joint that is not its ancestor,
   so this is the corrected ordering of eqs 43-45 for any tree. A joint served by one slot of fixed
   mass on a line, minimising RMS, is the paper's quartic: its stationarity cubic (eqs 41-49) is
-  solved in closed form (Viete / Cardano, eqs 50-59; :mod:`mechbal.sizing.rms_counterweights`)
+  solved in closed form (Viete / Cardano, eqs 50-59: :func:`cubic_real_roots`; the paper's own
+  coefficients, eqs 33-38, are :func:`mechbal.papers.arm2dof.rms_optimal_radii`)
   and every real root inside the bounds and both bounds are compared (the fast path, checked
   against the numerical path in the tests).
 * ``"total"``: every slot together minimises ``sum_j w_j mean(tau_j^2)`` (or the largest
@@ -33,16 +34,68 @@ limit); the result is ``exact`` only when no bound stops the optimum.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 
 from mechbal import _core
 from mechbal.balance import common
 from mechbal.balance.result import BalanceResult, CounterweightSlot
-from mechbal.sizing import rms_counterweights as rc
 
 _IDX = [(0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)]  # Ixx, Ixy, Iyy, Ixz, Iyz, Izz
+
+
+# ---- the quartic in a radius and its stationarity cubic (Arakelian et al. 2011, eqs 39-59, general form)
+
+def quadratic_in_radius(torque_of_r: Callable[[float], np.ndarray]):
+    """(alpha, beta, gamma) with torque(r) = alpha r^2 + beta r + gamma, exactly, from three
+    evaluations at r = -1, 0, 1 (valid for any mechanism where a point mass slides on a body-fixed
+    line: the torque is quadratic in its position)."""
+    tm, t0, tp = torque_of_r(-1.0), torque_of_r(0.0), torque_of_r(1.0)
+    return 0.5 * (tp + tm) - t0, 0.5 * (tp - tm), t0
+
+
+def stationarity_cubic(alpha, beta, d) -> tuple[float, float, float]:
+    """Monic z^3 + a z^2 + b z + c = 0 of d/dr sum_i (alpha_i r^2 + beta_i r + d_i)^2 = 0
+    (eqs 41-49 in general form): a = 3 S(ab)/(2 S(aa)), b = (S(bb) + 2 S(ad))/(2 S(aa)),
+    c = S(bd)/(2 S(aa)). Raises ValueError if S(aa) = 0 (no acceleration: the optimum is then the
+    static one, -S(bd)/S(bb))."""
+    den = 2.0 * float(np.sum(alpha * alpha))
+    if not den > 0.0:
+        raise ValueError("the cubic of eqs 41-49 degenerates: the counterweight has no "
+                         "acceleration along this trajectory (sum alpha^2 = 0)")
+    return (3.0 * float(np.sum(alpha * beta)) / den,
+            (float(np.sum(beta * beta)) + 2.0 * float(np.sum(alpha * d))) / den,
+            float(np.sum(beta * d)) / den)
+
+
+def cubic_real_roots(a: float, b: float, c: float) -> list[float]:
+    """Real roots of z^3 + a z^2 + b z + c = 0 by Viete / Cardano (eqs 50-59, eq 55 corrected).
+
+    Q = (a^2 - 3b)/9, R = (2a^3 - 9ab + 27c)/54.
+    R^2 < Q^3 (three real roots): t = acos(R / sqrt(Q^3)) / 3,
+        z = -2 sqrt(Q) cos(t) - a/3, -2 sqrt(Q) cos(t + 2pi/3) - a/3, -2 sqrt(Q) cos(t - 2pi/3) - a/3.
+    Otherwise: A = -sign(R) cbrt(|R| + sqrt(R^2 - Q^3)), B = Q/A (0 if A = 0), z1 = A + B - a/3;
+        when A = B (confluent case) the double root z2 = -A - a/3 is real as well.
+    """
+    Q = (a * a - 3.0 * b) / 9.0
+    R = (2.0 * a ** 3 - 9.0 * a * b + 27.0 * c) / 54.0
+    if R * R < Q ** 3:
+        t = math.acos(max(-1.0, min(1.0, R / math.sqrt(Q ** 3)))) / 3.0
+        s = -2.0 * math.sqrt(Q)
+        return [s * math.cos(t) - a / 3.0, s * math.cos(t + 2.0 * math.pi / 3.0) - a / 3.0,
+                s * math.cos(t - 2.0 * math.pi / 3.0) - a / 3.0]
+    A = -math.copysign(1.0, R) * (abs(R) + math.sqrt(R * R - Q ** 3)) ** (1.0 / 3.0)
+    B = Q / A if A != 0.0 else 0.0
+    roots = [A + B - a / 3.0]
+    if abs(A - B) <= 1e-12 * max(1.0, abs(A)):
+        roots.append(-A - a / 3.0)
+    return roots
+
+
+def squared_sum(alpha, beta, d, r: float) -> float:
+    """Delta tau of eq 39: sum_i (alpha_i r^2 + beta_i r + d_i)^2."""
+    return float(np.sum((alpha * r * r + beta * r + d) ** 2))
 
 
 def trajectory_sample(mech, samples, *, q_guess=None):
@@ -305,9 +358,9 @@ def _cardano(model: _TorqueModel, var: _Variables, j: int):
     Viete / Cardano and the best real root within the bounds (or a bound) is kept."""
     s = var.slots[0]
     tau_of = lambda r: model(np.array([r]), grad=False)[0][:, j]  # noqa: E731
-    alpha, beta, d = rc.quadratic_in_radius(tau_of)
+    alpha, beta, d = quadratic_in_radius(tau_of)
     R = s.max_radius
-    candidates = [r for r in ([] if not np.any(alpha) else rc.cubic_real_roots(*rc.stationarity_cubic(alpha, beta, d)))
+    candidates = [r for r in ([] if not np.any(alpha) else cubic_real_roots(*stationarity_cubic(alpha, beta, d)))
                   if abs(r) <= R]
     if not np.any(alpha):  # no acceleration of the counterweight: quadratic in r
         bb = float(beta @ beta)
@@ -318,7 +371,7 @@ def _cardano(model: _TorqueModel, var: _Variables, j: int):
         candidates += [-R, R]
     if not candidates:
         candidates = [0.0]
-    values = [rc.squared_sum(alpha, beta, d, r) for r in candidates]
+    values = [squared_sum(alpha, beta, d, r) for r in candidates]
     return np.array([candidates[int(np.argmin(values))]])
 
 

@@ -90,8 +90,7 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
     from mechbal.cli import check_case_file
     from mechbal.config import load_case as load_toml_case
     from mechbal.mechanism import Mechanism
-    from mechbal.schema import (Arm2DofCase, Balance, ChainTrajectory, SerialChainCase, Table,
-                                validate_case, validate_table)
+    from mechbal.schema import Balance, ChainTrajectory, Table, validate_case, validate_table
 
     design_cfg = None
     if design is not None:
@@ -125,11 +124,21 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
                            None, None, "urdf", [])
     path = check_case_file(case)
     raw = load_toml_case(path)
-    cfg = validate_case(raw)
+    return case_from_config(validate_case(raw), raw, design_cfg, source=str(path))
+
+
+def case_from_config(cfg, raw: dict | None = None, design_cfg=None, *, source: str | None = None) -> BalanceCase:
+    """The :class:`BalanceCase` of a validated case (``mechbal.schema.validate_case``; ``raw`` its
+    TOML table, for the case written back): what ``mechbal balance`` and the papers' runners
+    balance. ``design_cfg`` (a validated ``--design`` file) replaces the case's ``[balance]`` (and
+    its ``[trajectory]`` the case's trajectory). ConfigError for a kind without a general model."""
+    from mechbal.mechanism import Mechanism
+    from mechbal.schema import Arm2DofCase, SerialChainCase
+
     table = design_cfg.balance if design_cfg is not None else getattr(cfg, "balance", None)
     name, title = cfg.case.name, cfg.case.title or cfg.case.name
     if isinstance(cfg, SerialChainCase):
-        mech = Mechanism.from_spec(cfg.spec, name=name, source=str(path))
+        mech = Mechanism.from_spec(cfg.spec, name=name, source=source)
         tr = design_cfg.trajectory if design_cfg is not None and design_cfg.trajectory is not None else cfg.trajectory
         guess = getattr(tr, "initial_guess", None)
         t, motion, tt = _trajectory_motion(mech, tr)

@@ -1,7 +1,8 @@
 """Runner for ``kind = "arm2dof"``: Arakelian, Le Baron & Mottu 2011 (Mechatronics 21:310-314).
 
 Runs A (quintic law, bare arm), B (minimum-energy cubic law, eqs 10-13, bare arm) and C (law B
-with counterweights at the RMS-optimal radii of eqs 39-59, Cardano/Viete, checked by scipy), the
+with counterweights at the RMS-optimal radii sized by the general method, mechbal.balance.rms,
+checked against the paper's cubic, eqs 39-59 by Cardano/Viete, and by scipy), the
 readings of the paper's "after the first step", the paper's own radii, and the computed-torque
 closed loop (eqs 2-6) with an exact and a +-20 % perturbed model.
 
@@ -21,16 +22,42 @@ from mechbal import simulate
 from mechbal import trajectory
 from mechbal import progress, report
 from mechbal.cases import register
+from mechbal.config import ConfigError
 from mechbal.schema import Arm2DofArm, validate_case, validate_table
 from mechbal.export import write_bodies, write_summary
 from mechbal.papers import arm2dof_mechanism
-from mechbal.sizing import rms_counterweights as rc
+from mechbal.papers import arm2dof as closed_forms
 
 
 def arm_from_config(table) -> "papers.Arm2DofParameters":
     """The arm of an ``[arm]`` table (a dict or a validated :class:`mechbal.schema.Arm2DofArm`)."""
     arm = table if isinstance(table, Arm2DofArm) else validate_table(Arm2DofArm, table, "arm")
     return papers.Arm2DofParameters(**arm.model_dump())
+
+
+#: how far the general method's radii may be from the paper's cubic [m]: both minimise the same
+#: exact quartic (the general method builds it from the torque regressor, the closed form from
+#: eqs 33-38) and solve its cubic by Cardano: they agree to ~1e-13 m; 1 um is far above that and
+#: far below any counterweight tolerance
+RADIUS_AGREEMENT_M = 1e-6
+
+
+def general_radii(case):
+    """The counterweight radii by the general RMS method (:mod:`mechbal.balance.rms`) on the arm as
+    a mechanism, with the case's ``[balance]`` (default: the masses of ``[counterweights]`` on the
+    link extensions, direction -x) along its minimum-energy cubic law: what ``mechbal balance
+    arm2dof --method rms`` runs. Returns ([r_CW1, r_CW2] [m], BalanceResult)."""
+    from mechbal.balance.run import case_from_config, run_method
+
+    result = run_method(case_from_config(case), "rms")
+    r = []
+    for name, link in (("counterweight1", "shoulder"), ("counterweight2", "elbow")):
+        d = result.design.get(name)
+        if d is None or d["link"] != link or d["bounds"]["direction"] is None:
+            raise ConfigError("balance.counterweights", f"the arm2dof runner needs the slot '{name}' on '{link}' "
+                              "with a direction (the paper's counterweight on the link extension)", has_value=False)
+        r.append(float(np.dot(d["position"], [-1.0, 0.0, 0.0])))
+    return r, result
 
 
 def _rms(tau):
@@ -137,10 +164,20 @@ def run(config, out: Path) -> dict:
 
     # ---- sizing (eqs 39-59) and its numerical check ----
     progress.stage("RMS-optimal counterweights and torques")
-    res = rc.rms_optimal_radii(arm, m_cw1, m_cw2, *motion["B"])
-    r_num = rc.rms_optimal_radii_numerical(arm, m_cw1, m_cw2, *motion["B"])
-    r_static = rc.static_balancing_radii(arm, m_cw1, m_cw2)
-    cw = {"C": papers.Arm2DofCounterweights(m_cw1, m_cw2, res.r_cw1, res.r_cw2),
+    r_general, sized = general_radii(case)
+    res = closed_forms.rms_optimal_radii(arm, m_cw1, m_cw2, *motion["B"])
+    r_difference = float(np.max(np.abs(np.subtract(r_general, [res.r_cw1, res.r_cw2]))))
+    masses = [sized.design[n]["mass"] for n in ("counterweight1", "counterweight2")]
+    if r_difference > RADIUS_AGREEMENT_M or not np.allclose(masses, [m_cw1, m_cw2], rtol=1e-12):
+        raise ConfigError("balance", f"the general RMS method's counterweights ({masses[0]:.6g} kg at "
+                          f"{r_general[0]:.6g} m, {masses[1]:.6g} kg at {r_general[1]:.6g} m) differ from the "
+                          f"paper's cubic (eqs 39-59: {m_cw1:.6g} kg at {res.r_cw1:.6g} m, {m_cw2:.6g} kg at "
+                          f"{res.r_cw2:.6g} m; beyond {RADIUS_AGREEMENT_M:g} m): the runner compares them on the "
+                          "paper's design (fixed masses of [counterweights], per-joint RMS, no bounds)",
+                          has_value=False)
+    r_num = closed_forms.rms_optimal_radii_numerical(arm, m_cw1, m_cw2, *motion["B"])
+    r_static = closed_forms.static_balancing_radii(arm, m_cw1, m_cw2)
+    cw = {"C": papers.Arm2DofCounterweights(m_cw1, m_cw2, *r_general),
           "static": papers.Arm2DofCounterweights(m_cw1, m_cw2, *r_static)}
     runs = {
         "A": ("A", None), "B": ("B", None), "C": ("B", cw["C"]),
@@ -148,7 +185,7 @@ def run(config, out: Path) -> dict:
     }
     if np.all(np.isfinite(paper_r)):
         runs["C_paper_radii"] = ("B", papers.Arm2DofCounterweights(m_cw1, m_cw2, *paper_r))
-    tau = {k: rc.arm_torques(arm, c, *motion[law]) for k, (law, c) in runs.items()}
+    tau = {k: closed_forms.arm_torques(arm, c, *motion[law]) for k, (law, c) in runs.items()}
     rms = {k: _rms(v) for k, v in tau.items()}
     peak = {k: report.peak_abs(v) for k, v in tau.items()}
     red = lambda k: (_reduction(rms[k], rms["A"]), _reduction(peak[k], peak["A"]))  # noqa: E731
@@ -228,8 +265,8 @@ def run(config, out: Path) -> dict:
         f"(that gives RMS {rB[0]:.1f}/{rB[1]:.1f} %, peak {pB[0]:.1f}/{pB[1]:.1f} %); it is law B "
         f"with counterweights at the static-balancing radii {r_static[0]:.3f}/{r_static[1]:.3f} m: "
         f"RMS {rS[0]:.1f}/{rS[1]:.1f} %, peak {pS[0]:.1f}/{pS[1]:.1f} %.",
-        f"r_CW2: the paper's (corrected) eqs 39-59 give {res.r_cw2:.4f} m, confirmed by scipy "
-        f"({r_num[1]:.4f} m); the paper reports {paper_r[1]:.3f} m. Not reproducible from the "
+        f"r_CW2: the paper's (corrected) eqs 39-59 give {res.r_cw2:.4f} m, confirmed by the general "
+        f"method ({r_general[1]:.4f} m) and by scipy ({r_num[1]:.4f} m); the paper reports {paper_r[1]:.3f} m. Not reproducible from the "
         f"paper's data; r_CW1 {res.r_cw1:.4f} m agrees with its {paper_r[0]:.3f} m.",
     ]
     if "C_paper_radii" in rms:
@@ -243,7 +280,14 @@ def run(config, out: Path) -> dict:
         "case": case.case.name, "kind": "arm2dof",
         "source": "Arakelian, Le Baron & Mottu 2011, Mechatronics 21:310-314",
         "samples": N, "duration_s": T,
-        "r_cw_m": [res.r_cw1, res.r_cw2],
+        "r_cw_m": r_general,
+        "r_cw": {"general_method": r_general, "closed_form": [res.r_cw1, res.r_cw2],
+                 "max_abs_difference": r_difference, "tolerance": RADIUS_AGREEMENT_M, "unit": "m",
+                 "method": {"name": "rms", "coupling": sized.metrics["coupling"],
+                            "objective": sized.metrics["objective"], "exact": sized.exact,
+                            "how": [sized.design[n].get("method") for n in ("counterweight1", "counterweight2")],
+                            "rms_torque_after_Nm": sized.metrics["rms_torque_after"]},
+                 "closed_form_source": "Arakelian et al. 2011, eqs 39-59 corrected (Cardano)"},
         "r_cw_numerical_m": list(r_num),
         "paper_r_cw_m": paper_r,
         "static_balancing_r_cw_m": list(r_static),
@@ -281,7 +325,8 @@ def run(config, out: Path) -> dict:
     rows = [[k, *rms[k], *peak[k], *red(k)[0], *red(k)[1]] for k in rms]
     print(report.table(rows, ["run", "RMS1", "RMS2", "peak1", "peak2", "dRMS1%", "dRMS2%",
                               "dpk1%", "dpk2%"]))
-    print(report.table([["Cardano (eqs 50-59)", res.r_cw1, res.r_cw2],
+    print(report.table([["general method (mechbal.balance.rms)", *r_general],
+                        ["Cardano (eqs 50-59)", res.r_cw1, res.r_cw2],
                         ["scipy", *r_num], ["paper", *paper_r], ["static balancing", *r_static]],
                        ["radii [m]", "r_CW1", "r_CW2"]))
     s = cl["summary"]

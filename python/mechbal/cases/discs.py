@@ -3,7 +3,10 @@ balanced serial mechanisms" -- static balancing, counter-rotating discs and deco
 the planar 3R (``discs-3r``), the spatial 3R (``discs-spatial``), the SCARA (``scara``) and the
 parallelogram 5R (``five-bar``).
 
-For each: the balancing parameters (closed forms, mechbal.sizing.discs), the mass-matrix metrics
+For each: the balancing parameters (the discs' gear ratios and, for the spatial arm, the inertia
+conditions sized by the general shaking-moment method, mechbal.balance.moment, on the case's
+[balance] table and checked against the closed forms of mechbal.papers.discs; the static
+balancing l_g of eqs 8, 18, 29), the mass-matrix metrics
 before/after over random configurations, the peak gravity torque, the sensitivity table, the
 joint torques on a rest-to-rest trajectory (unbalanced vs balanced), and the decoupled controller
 (tau_i = k_i (q''_d + Kp e + Kd e')) against computed torque over the balanced model.
@@ -22,7 +25,7 @@ from mechbal.cases import register
 from mechbal.config import ConfigError, inertia
 from mechbal.schema import inertia_matrix, validate_case
 from mechbal.export import write_bodies, write_summary
-from mechbal.sizing import discs as dz
+from mechbal.papers import discs as dz
 
 _SPEC = {
     "planar3r": dict(params=("l1", "l2", "m1", "m2", "m3"),
@@ -85,23 +88,91 @@ def parameters_from_config(kind: str, config) -> dict:
     return p
 
 
+#: how far the general method's gear ratios, inertias and decoupled inertias k_i may be from the
+#: closed forms (relative). Both are exact (the method solves linear conditions on the angular
+#: momentum columns over sampled poses; the closed forms are algebra): measured ~1e-15. 1e-9 is
+#: far above round-off and far below any design tolerance (the sensitivity table starts at 1 %).
+DISC_AGREEMENT_RTOL = 1e-9
+#: the quantities the general method sizes, per mechanism: name -> (slot of [balance], its key)
+_SIZED = {"planar3r": {"beta": ("disc5", "ratio"), "gamma": ("disc7", "ratio")},
+          "spatial3r": {"beta": ("disc5", "ratio"), "Jy2": ("link2_cross_bar", "Iyy"),
+                        "Jy3": ("link3_shape", "Iyy")},
+          "scara": {"beta": ("disc5", "ratio")},
+          "fivebar": {}}
+
+
+def general_discs(case, kind: str, closed: dict):
+    """The discs by the general shaking-moment method (:mod:`mechbal.balance.moment`) on the
+    statically balanced arm with the case's ``[balance]`` (``mechbal balance CASE --method
+    moment``), next to the closed forms ``closed`` (``mechbal.papers.discs.BALANCE[kind]``).
+    Returns (general values, closed-form values, largest relative difference, BalanceResult);
+    ConfigError when they differ beyond :data:`DISC_AGREEMENT_RTOL`.
+
+    Serial arms: the chosen gear ratios (beta, gamma: eqs 14, 25, 35) and inertias (Jy2, Jy3:
+    corrected eq 25) and the constant diagonal of the mass matrix (k_i: eqs 16, 27, 37). Five-bar
+    (discs on the legs, the built-in table): the method proves full moment balance impossible
+    (the leg discs act on the two rates only together) and what remains of the angular momentum
+    per unit rate is k_1 + k_2 + the discs' inertias (docs/discs_derivation.md section 5)."""
+    from mechbal.balance.run import case_from_config, run_method
+
+    if getattr(case, "balance", None) is None or not case.balance.discs:
+        raise ConfigError("balance.discs", "the discs runner sizes the discs by the general method: give "
+                          "the [[balance.discs]] slots (see the built-in disc cases)", has_value=False)
+    result = run_method(case_from_config(case), "moment")
+    general, reference = {}, {}
+    for name, (slot, key) in _SIZED[kind].items():
+        if slot not in result.design or key not in result.design[slot]:
+            raise ConfigError("balance", f"the discs runner compares {name} with the closed form: it needs the "
+                              f"slot '{slot}' choosing '{key}' (see the built-in case {case.case.name!r})",
+                              has_value=False)
+        general[name] = float(result.design[slot][key])
+        reference[name] = float(closed["inertia_conditions"][name] if name.startswith("Jy") else closed[name])
+    if kind == "fivebar":
+        cols = result.metrics["columns"]
+        left = [c["peak_remaining"] for c in cols.values() if not c["cancelled"]]
+        discs = sum(float(v["inertia"]) for v in result.design.values() if "inertia" in v and "ratio" in v)
+        if len(left) != 1:
+            raise ConfigError("balance.discs", "the five-bar check expects the leg discs of the built-in table "
+                              f"(one actuated rate's angular momentum left; got {len(left)})", has_value=False)
+        general["remaining_angular_momentum_per_unit_rate"] = float(left[0])
+        reference["remaining_angular_momentum_per_unit_rate"] = float(sum(closed["k"])) + discs
+    else:
+        general["k"] = [float(x) for x in result.metrics["mass_matrix"]["diag_mean"]]
+        reference["k"] = [float(x) for x in closed["k"]]
+    diff = max(float(np.max(np.abs(np.subtract(general[k], reference[k])) / np.maximum(np.abs(reference[k]), 1e-300)))
+               for k in general)
+    if diff > DISC_AGREEMENT_RTOL:
+        raise ConfigError("balance.discs", f"the general moment method ({general}) and the closed forms "
+                          f"({reference}) differ by {diff:.3g} (relative) > {DISC_AGREEMENT_RTOL:g}: the "
+                          "[[balance.discs]] positions, axes, fixed ratios and inertias must be the paper's "
+                          "discs of [inertia]", has_value=False)
+    return general, reference, diff, result
+
+
+def balanced_design(kind: str, p: dict, general: dict) -> dict:
+    """The balanced design with what the general method sized (gear ratios, inertias) in place of
+    the closed forms' values (the static balancing l_g stays that of eqs 8, 18, 29)."""
+    d = dz.design(kind, p, True)
+    d.update({k: v for k, v in general.items() if k in ("beta", "gamma", "Jy2", "Jy3")})
+    return d
+
+
 def _torques(kind, d, q, qd, qdd):
     M, v, g = dz.evaluate(kind, d, q, qd)
     return np.einsum("nij,nj->ni", M, qdd) + v + g
 
 
-def _controller_check(kind, p, cfg, q_des, qd_des, qdd_des, n):
-    """DecoupledJointController vs ComputedTorque over the balanced model, on the trajectory with
-    an offset actual state (so the PD terms act)."""
+def _controller_check(kind, bal, k, cfg, q_des, qd_des, qdd_des, n):
+    """DecoupledJointController (gains k) vs ComputedTorque over the balanced design ``bal``, on
+    the trajectory with an offset actual state (so the PD terms act)."""
     kp, kd = np.array(cfg.kp, float), np.array(cfg.kd, float)
-    k = np.asarray(dz.BALANCE[kind](p)["k"])
+    k = np.asarray(k, float)
     dc = control.DecoupledJointController(k, kp, kd)
     rng = np.random.default_rng(0)
     q = q_des + rng.uniform(-0.05, 0.05, q_des.shape)
     qd = qd_des + rng.uniform(-0.1, 0.1, qd_des.shape)
     tau_dc = np.array([dc.step(*x)[0] for x in progress.track(
         zip(q, qd, q_des, qd_des, qdd_des), "decoupled control ticks", total=len(q))])
-    bal = dz.design(kind, p, True)
     if kind == "fivebar":
         ct = control.ComputedTorque(dz.fivebar_dynamics(bal), kp, kd)
         backend = "mechbal.ComputedTorque over FiveBarDynamics (C++, 4x4 A° per tick)"
@@ -255,11 +326,19 @@ def run(config, out: Path) -> dict:
                                                           if np.ndim(v) == 0)), name)
     errors = np.array(case.sensitivity.errors_pct, float) / 100.0
 
+    progress.stage("discs by the general moment method, checked by the closed forms")
+    general, reference, difference, sized = general_discs(case, kind, bal)
+    d_bal = balanced_design(kind, p, general)
+    if "k" in general:
+        bal = dict(bal, k=general["k"], **{k: general[k] for k in ("beta", "gamma") if k in general})
+        if "Jy2" in general:
+            bal["inertia_conditions"] = dict(bal["inertia_conditions"], Jy2=general["Jy2"], Jy3=general["Jy3"])
+
     N, seed = case.sampling.configurations, case.sampling.seed
     progress.stage("mass matrix over sampled configurations")
     q, qd = dz.sample_states(kind, N, np.random.default_rng(seed))
     before = dz.metrics(*dz.evaluate(kind, dz.design(kind, p, False), q, qd))
-    after = dz.metrics(*dz.evaluate(kind, dz.design(kind, p, True), q, qd), bal["k"])
+    after = dz.metrics(*dz.evaluate(kind, d_bal, q, qd), bal["k"])
 
     Ns = min(N, 200)
     progress.stage("sensitivity to parameter errors")
@@ -272,7 +351,7 @@ def run(config, out: Path) -> dict:
     qt, qdt, qddt = trajectory.RestToRestTrajectory(start, end, T, trajectory.TimeLaw.quintic).evaluate_batch(t)
     progress.stage("trajectory torques, decoupled and computed-torque control")
     tau_u = _torques(kind, dz.design(kind, p, False), qt, qdt, qddt)
-    tau_b = _torques(kind, dz.design(kind, p, True), qt, qdt, qddt)
+    tau_b = _torques(kind, d_bal, qt, qdt, qddt)
     tau_k = qddt * np.asarray(bal["k"])
     labels = [f"joint {j + 1}" for j in range(n)]
     if kind == "scara":
@@ -285,13 +364,13 @@ def run(config, out: Path) -> dict:
                                "arm balanced by counterweights and counter-rotating discs, and "
                                "the decoupled model k_i q''_i, which the balanced torque equals "
                                "(dashed over solid).")
-    control = _controller_check(kind, p, case.controller, qt, qdt, qddt, n)
+    control = _controller_check(kind, d_bal, bal["k"], case.controller, qt, qdt, qddt, n)
 
     # ---- every link and disc as a body along the trajectory: the shaking wrench ----
     progress.stage("bodies files (shaking wrench)")
     wrench = {}
-    for variant, balanced in (("unbalanced", False), ("balanced", True)):
-        b = _disc_bodies(kind, dz.design(kind, p, balanced), qt, qdt, qddt)
+    for variant, d in (("unbalanced", dz.design(kind, p, False)), ("balanced", d_bal)):
+        b = _disc_bodies(kind, d, qt, qdt, qddt)
         F, Mo = _write_bodies(out / f"bodies_{variant}.npz", t, b, qt, qdt, qddt)
         wrench[variant] = {"bodies": b["names"],
                            "peak_shaking_force_N": float(np.max(np.linalg.norm(F, axis=1))),
@@ -312,6 +391,14 @@ def run(config, out: Path) -> dict:
         "source": "Coutinho & Hess Coelho, A new approach for designing dynamic balanced serial "
                   "mechanisms (derivation: docs/discs_derivation.md)",
         "balancing": balancing,
+        "discs": {"general_method": general, "closed_form": reference, "max_rel_difference": difference,
+                  "tolerance_rel": DISC_AGREEMENT_RTOL,
+                  "method": {"name": "moment", "exact": sized.exact, "limited_by": sized.limited_by,
+                             "design": {k: {kk: v[kk] for kk in ("carrier", "joint", "ratio", "inertia", "Iyy")
+                                            if kk in v} for k, v in sized.design.items()}},
+                  "sized_by_the_general_method": sorted(k for k in general if k in ("beta", "gamma", "Jy2", "Jy3")),
+                  "closed_form_source": "Coutinho & Hess Coelho eqs 14, 16, 25, 27, 35, 37 corrected "
+                                        "(mechbal.papers.discs.BALANCE)"},
         **{k: v for k, v in balancing.items()},
         "configurations": N, "seed": seed,
         "offdiag_ratio_before": before["offdiag_ratio"],

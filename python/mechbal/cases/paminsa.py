@@ -24,7 +24,7 @@ from mechbal.cases import register
 from mechbal.config import ConfigError
 from mechbal.schema import validate_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences, write_bodies, write_summary
-from mechbal.sizing import paminsa_counterweights as sizing
+from mechbal.papers import paminsa as paper
 
 _GEOMETRY_SCALARS = ("k", "a", "b", "c", "d", "e", "f", "length_BG", "length_AE", "length_DF",
                      "length_CE", "length_AF", "length_CJ", "length_MS5", "length_MO", "nominal_rho",
@@ -75,14 +75,48 @@ def trajectory_from_config(config):
                                 getattr(TimeLaw, tr.law))
 
 
-def identification_trajectories(cycle, nominal):
-    """The cycle plus two rest-to-rest lines that excite x and z (least-squares identification)."""
-    from mechbal.trajectory import RestToRestTrajectory, TimeLaw
+#: how far the general method's counterweights may be from the closed form's [kg]. Both are exact
+#: (the method solves a rank-4, zero-residual least squares over solved closed motions; the closed
+#: form is algebra): they agree to ~1e-12 kg. A disagreement beyond 1 mg on masses of 0.4-10 kg is
+#: a different mechanism, not round-off: slot positions that no longer follow [geometry].
+COUNTERWEIGHT_AGREEMENT_KG = 1e-6
 
-    P0 = np.asarray(nominal, float)
-    return [cycle,
-            RestToRestTrajectory(P0 + [-0.06, -0.05, -0.02], P0 + [0.06, 0.08, 0.03], 0.5, TimeLaw.quintic),
-            RestToRestTrajectory(P0 + [0.05, 0.0, 0.03], P0 + [-0.05, 0.02, -0.03], 0.4, TimeLaw.quintic)]
+
+def general_counterweights(config):
+    """PAMINSA's counterweights by the general shaking-force method (:mod:`mechbal.balance.force`)
+    on the case's mechanism (:func:`mechbal.papers.paminsa.paminsa_mechanism`, unbalanced) with the
+    slots of its ``[balance]`` table, as ``mechbal balance paminsa --method force`` runs it.
+    Returns (:class:`mechbal.papers.paminsa.CounterweightSet`, the method's BalanceResult)."""
+    from mechbal.balance.run import case_from_config, run_method
+
+    case = validate_case(config, warn=False)
+    if getattr(case, "balance", None) is None or not case.balance.counterweights:
+        raise ConfigError("balance.counterweights", "the paminsa runner sizes its counterweights by the general "
+                          "method: give the [[balance.counterweights]] slots (leg<i>.CP1_atA, leg<i>.CP2_atF, "
+                          "leg<i>.CP3_atL, vertical_counter_mass; see cases/paminsa.toml)", has_value=False)
+    result = run_method(case_from_config(case), "force")
+    try:
+        cw = paper.counterweights_from_design(result.design, "general_method (mechbal.balance.force, [balance] slots)")
+    except KeyError as exc:
+        raise ConfigError("balance.counterweights", exc.args[0], has_value=False) from None
+    return cw, result
+
+
+def check_against_closed_form(general, closed, result, tolerance: float = COUNTERWEIGHT_AGREEMENT_KG) -> float:
+    """The largest |general - closed form| [kg] over every counterweight; ConfigError when the
+    method is not exact or the two differ by more than ``tolerance``."""
+    diff = max(float(np.max(np.abs(np.subtract(getattr(general, k), getattr(closed, k)))))
+               for k in ("cp1", "cp2", "cp3", "vertical"))
+    if not result.exact or diff > tolerance:
+        why = ("; the method is limited by: " + "; ".join(result.limited_by)) if not result.exact else ""
+        raise ConfigError("balance.counterweights",
+                          f"the general force method's counterweights (CP1 {general.cp1[0]:.6g}, CP2 {general.cp2[0]:.6g}, "
+                          f"CP3 {general.cp3[0]:.6g}, vertical {general.vertical:.6g} kg) differ from the closed form's "
+                          f"(eqs 11, 14-16: {closed.cp1[0]:.6g}, {closed.cp2[0]:.6g}, {closed.cp3[0]:.6g}, "
+                          f"{closed.vertical:.6g} kg) by {diff:.3g} kg > {tolerance:g} kg{why}. The slots' positions "
+                          "must follow [geometry]: A at -length_AE on link 3, F at length_DF / k on link 2, L at "
+                          "cp3_ratio * length_MS5 on the guide", has_value=False)
+    return diff
 
 
 def half_step_samples(traj, rate_hz: float):
@@ -144,17 +178,15 @@ def run(config, out: Path) -> dict:
     q0 = np.array(config.wrist.initial_angles, float)
     primary = config.wrist.integrator
     use = config.counterweights.use
-    ls_samples = config.counterweights.least_squares_samples
 
-    progress.stage("sizing counterweights (closed form, least squares)")
-    # ---- counterweights: closed forms, literal printed equations, least squares
-    closed = sizing.closed_form(params)
-    printed = sizing.paper_printed(params)
-    lsq, sv = sizing.least_squares(params, identification_trajectories(cycle, params.nominal_platform),
-                                   ls_samples)
-    lsq_cycle, sv_cycle = sizing.least_squares(params, [cycle], ls_samples)
-    reported = sizing.paper_reported(params, closed.vertical)
-    chosen = {"closed_form": closed, "least_squares": lsq, "paper_reported": reported}[use]
+    progress.stage("sizing counterweights (general force method, checked by the closed form)")
+    # ---- counterweights: the general method, checked by the closed forms; the printed equations
+    general, result = general_counterweights(config)
+    closed = paper.closed_form_counterweights(params)
+    difference = check_against_closed_form(general, closed, result)
+    printed = paper.printed_counterweights(params)
+    reported = paper.reported_counterweights(params, closed.vertical)
+    chosen = {"general_method": general, "closed_form": closed, "paper_reported": reported}[use]
 
     model_unbal = PaminsaModel(params)
     model_bal = PaminsaModel(chosen.apply(params))
@@ -249,13 +281,18 @@ def run(config, out: Path) -> dict:
         "integrators_run": ["euler", "rk4"],
         "wrist_initial_angles_rad": q0,
         "counterweights_used": use,
-        "counterweights_kg": {"cp1": closed.cp1, "cp2": closed.cp2, "cp3": closed.cp3,
-                              "vertical": closed.vertical, "source": closed.source},
-        "counterweights_least_squares_kg": lsq.as_dict(),
-        "least_squares_singular_values": {"three_trajectories": sv, "paper_cycle_only": sv_cycle,
-                                          "paper_cycle_only_unidentified": lsq_cycle.notes["unidentified_directions"]},
+        "counterweights_kg": {"cp1": chosen.cp1, "cp2": chosen.cp2, "cp3": chosen.cp3,
+                              "vertical": chosen.vertical, "source": chosen.source},
+        "counterweights": {
+            "general_method": general.as_dict(), "closed_form": closed.as_dict(),
+            "max_abs_difference": difference, "tolerance": COUNTERWEIGHT_AGREEMENT_KG, "unit": "kg",
+            "method": {"name": "force", "slots": "[balance] of the case (tied legs, fixed positions)",
+                       "samples": result.metrics["samples"], "unknowns": result.unknowns, "rank": result.rank,
+                       "singular_value_ratio": result.metrics["singular_value_ratio"],
+                       "residual": result.residual, "residual_before": result.residual_before,
+                       "residual_units": result.residual_units, "exact": result.exact}},
         "counterweights_paper_printed_eqs_kg": printed.as_dict(),
-        "paper_counterweights_kg": dict(sizing.PAPER_REPORTED, vertical=None),
+        "paper_counterweights_kg": dict(paper.REPORTED_COUNTERWEIGHTS_KG, vertical=None),
         "peak_shaking_force_N": {"unbalanced": report.peak_abs(F_unbal),
                                  "force_balanced": report.peak_abs(fbal["shaking_force"]),
                                  "balanced": fd[primary][0],
@@ -298,7 +335,7 @@ def run(config, out: Path) -> dict:
                             "reconstructed layout it drops.")},
         "discrepancies": [
             {"quantity": "m_CP1 [kg]", "paper": 4.49, "ours": closed.cp1[0],
-             "reason": "eq 14 (correct as printed) gives 2.7915; 4.49 not reproducible under any "
+             "reason": "eq 14 (correct as printed) and the general force method give 2.7915; 4.49 not reproducible under any "
                        "misprint tried"},
             {"quantity": "m_CP2 [kg]", "paper": 1.69, "ours": closed.cp2[0],
              "reason": "1.69 = eq 15 with its -2 m8 term dropped (%.4f); with m8 it is 1.3865"
@@ -334,12 +371,15 @@ def run(config, out: Path) -> dict:
     rows += [[f"residual M [% of |M_unbal|], {n}", *(100 * fd[n][1] / peak_M_norm)] for n in ("euler", "rk4")]
     rows += [[f"peak wrist rate [rad/s], {n}", *rates[n]] for n in ("euler", "rk4")]
     print(report.table(rows, ["PAMINSA (Briot & Arakelian 2009)", "x", "y", "z"]))
+    six = lambda *xs: [f"{x:.6g}" for x in xs]  # noqa: E731  (4 digits would show 1.3865 as 1.386 / 1.387)
     print(report.table(
-        [["CP1 at A_i", closed.cp1[0], lsq.cp1[0], printed.cp1[0], 4.49],
-         ["CP2 at F_i", closed.cp2[0], lsq.cp2[0], printed.cp2[0], 1.69],
-         ["CP3 at L_i", closed.cp3[0], lsq.cp3[0], printed.cp3[0], 0.436],
-         ["vertical counter-mass", closed.vertical, lsq.vertical, printed.vertical, "-"]],
-        ["counterweight [kg]", "closed form", "least squares", "printed eqs", "paper reported"]))
+        [["CP1 at A_i", *six(general.cp1[0], closed.cp1[0], printed.cp1[0]), 4.49],
+         ["CP2 at F_i", *six(general.cp2[0], closed.cp2[0], printed.cp2[0]), 1.69],
+         ["CP3 at L_i", *six(general.cp3[0], closed.cp3[0], printed.cp3[0]), 0.436],
+         ["vertical counter-mass", *six(general.vertical, closed.vertical, printed.vertical), "-"]],
+        ["counterweight [kg]", "general method", "closed form", "printed eqs", "paper reported"]))
+    print(f"general method (mechbal.balance.force) vs closed form: largest difference {difference:.2g} kg; "
+          f"the variants use the {use.replace('_', ' ')} masses")
     print(f"cond(N) along the run: [{cond.min():.3g}, {cond.max():.3g}];  "
           f"M_z force-balanced/unbalanced: {ratio_O:.2f} about O, {ratio_c:.2f} about the base centre "
           f"(paper: +35 %)")

@@ -10,8 +10,9 @@ comparison. Variants:
 
 * ``unbalanced``: the robot without the extra linkage and without counterweights (Fig. 3);
 * ``balanced``: with the extra linkage and the counterweights sized by the general
-  shaking-force method (least squares of the linear momentum over the run's closed motion, rows
-  0-2 of :meth:`mechbal.Mechanism.momentum_regressor`, one unknown mass per counterweight body);
+  shaking-force method (:func:`mechbal.balance.force.balance`: least squares of the linear
+  momentum over the run's closed motion, one slot per counterweight body at its given point, only
+  its mass unknown), checked against eqs 29-31 (:mod:`mechbal.papers.rpsp`);
 * ``paper_masses``: with the extra linkage and the paper's printed masses (17.61 / 2.76 / 4.5 kg).
 
 The survey stage follows the robot over the whole period of the paper's motion, reporting the
@@ -42,6 +43,11 @@ NEAR_SINGULAR_FRACTION = 0.2
 #: even where a leg is 17 mm long (an angle error is a position error over l_i)
 SOLVE_TOLERANCE = 1e-14
 _SINGULAR = np.uint32(int(control.Status.singular))
+#: how far the general method's masses may be from eqs 29-31 [kg]: both are exact (a full-rank,
+#: zero-residual least squares over the solved run; algebra), ~1e-9 kg apart (the loop solve's
+#: 1e-14 m tolerance through the regressor); 1e-6 kg on masses of 2.8-18 kg is a modelling
+#: difference, not round-off
+COUNTERWEIGHT_AGREEMENT_KG = 1e-6
 
 
 # ---- the mechanism's variants, as specs ---------------------------------------------------------
@@ -175,31 +181,36 @@ def ik_agreement(mech: Mechanism, m, geometry, motion, t) -> dict:
     return out
 
 
-def size_by_momentum(mech: Mechanism, q, v, slots: list[str]):
-    """The general shaking-force method: masses of the ``slots`` bodies (at their given points)
-    that make the linear momentum zero at every sample (q, v), by least squares on rows 0-2 of
-    the momentum regressor. Returns (masses by name, rank, singular values, residual [kg m/s],
-    residual before [kg m/s])."""
-    Y = mech.momentum_regressor(q, v)[:, :3, :]                # (N, 3, 10 B)
-    pi = mech.inertial_parameters()
-    names = mech.body_names
-    cols, fixed = [], pi.copy()
-    for name in slots:
-        b = names.index(name)
-        com = np.asarray(mech.bodies[b].com, float)
-        cols.append((Y[:, :, 10 * b] + Y[:, :, 10 * b + 1:10 * b + 4] @ com).reshape(-1))
-        fixed[10 * b:10 * b + 10] = 0.0
-    A = np.stack(cols, axis=1)
-    rhs = -(Y @ fixed).reshape(-1)
-    scale = np.linalg.norm(A, axis=0)
-    scale[scale == 0.0] = 1.0
-    x, _, rank, sv = np.linalg.lstsq(A / scale, rhs, rcond=None)
-    x = x / scale
-    # a mass the condition makes zero (the platform counterweight) comes out as +-round-off: a
-    # negative one within 1e-9 of the largest is zero (a real negative mass is refused by the model)
-    x = np.where((x < 0.0) & (x > -1e-9 * max(1.0, float(np.max(np.abs(x))))), 0.0, x)
-    return (dict(zip(slots, x.tolist())), int(rank), sv, float(np.linalg.norm(A @ x - rhs)),
-            float(np.linalg.norm(rhs)))
+def counterweight_slots(mech: Mechanism, spec, names: list[str]):
+    """The design variables of the general method: one :class:`mechbal.balance.CounterweightSlot`
+    per named counterweight body of ``spec``, on its link at its centre of mass (a fixed position,
+    in the frame the link is described in: only the mass is unknown, within [0, inf)), with its
+    inertia; and ``mech`` without those bodies (the robot the slots are added to)."""
+    from mechbal.balance import CounterweightSlot
+
+    bodies = {b.name: b for b in spec.bodies}
+    slots = []
+    for name in names:
+        b = bodies[name]
+        T = mech.user_frame(b.link)
+        R = T[:3, :3]
+        slots.append(CounterweightSlot(name, b.link, position=tuple(R.T @ (np.asarray(b.com, float) - T[:3, 3])),
+                                       inertia=R.T @ np.asarray(b.inertia, float) @ R))
+    return slots, mech.with_bodies([b for b in mech.bodies if b.name not in set(names)], replace=True)
+
+
+def size_counterweights(mech: Mechanism, spec, names: list[str], platform, dplatform, q_guess=None):
+    """The general shaking-force method (:func:`mechbal.balance.force.balance`): the masses of the
+    ``names`` counterweight bodies (at their given points, bounded below by 0) that make the linear
+    momentum zero over the samples (the platform's joint coordinates ``platform`` and rates
+    ``dplatform``, (N, 3) in ``mech.actuated_names`` order: the loop solve gives the rest).
+    Returns (masses by name, BalanceResult). A mass the condition makes zero (the platform
+    counterweight) is held at its bound 0, not left at -1e-13."""
+    from mechbal.balance import force
+
+    slots, bare = counterweight_slots(mech, spec, names)
+    result = force.balance(bare, slots, (platform, dplatform), q_guess=q_guess)
+    return {n: float(result.design[n]["mass"]) for n in names}, result
 
 
 def _bodies_file(path, mech, t, motion, F, M, **extra):
@@ -250,11 +261,26 @@ def run(config, out: Path) -> dict:
                                                  "run or check [motion.initial_guess]", mo.duration)
 
     progress.stage("sizing the counterweights (eqs 29-31 and the general method)")
-    masses, rank, sv, lsq_residual, lsq_before = size_by_momentum(mech_paper, m_full.q, m_full.v, slots)
+    phi, dphi, _ = platform_motion(mo, t)
+    order = {f"{mo.platform}_z": 0, f"{mo.platform}_y": 1, f"{mo.platform}_x": 2}
+    cols = [order[n] for n in mech_paper.actuated_names]
+    q0 = np.array([guess[n] for n in mech_paper.joint_names], float)
+    masses, sized = size_counterweights(mech_paper, spec_full, slots, phi[:, cols], dphi[:, cols], q_guess=q0)
+    if sized.metrics["dropped_samples"]:
+        raise ConfigError("motion.duration", f"{sized.metrics['dropped_samples']} samples of the run cannot be "
+                          "assembled for the sizing", mo.duration)
     eqs = paper.counterweights_eqs_29_31(pp.m_E, pp.m_Q, pp.m_H, pp.m_K, pp.r_H, pp.r_K, pp.r_P, pp.r_N,
                                          pp.r_Q, pp.r_F)
     per_group = {k: [masses[n] for n in names] for k, names in groups.items()}
     counterweights = {k: float(np.mean(per_group[k])) for k in ("m_P", "m_N", "m_F")}
+    closed_form = {k: float(eqs[k]) for k in ("m_P", "m_N", "m_F")}
+    max_difference = max(abs(m - closed_form[k]) for k in closed_form for m in per_group[k])
+    if not sized.exact or max_difference > COUNTERWEIGHT_AGREEMENT_KG:
+        raise ConfigError("balancing", f"the general force method's counterweights {per_group} differ from eqs "
+                          f"29-31 ({closed_form}) by {max_difference:.3g} kg > {COUNTERWEIGHT_AGREEMENT_KG:g} kg"
+                          + ("" if sized.exact else "; limited by: " + "; ".join(sized.limited_by))
+                          + ": the [paper] masses and radii and the [mechanism] bodies describe different robots",
+                          has_value=False)
     mech_bal = Mechanism.from_spec(driven_by_platform(with_masses(spec_full, masses), mo.platform),
                                    name=f"{name}_balanced")
     coeff_paper = paper.balance_coefficients(pp.counterweights_kg.m_P, pp.counterweights_kg.m_N,
@@ -385,12 +411,17 @@ def run(config, out: Path) -> dict:
         "counterweights_eqs_29_31_kg": eqs,
         "paper_counterweights_kg": pp.counterweights_kg.model_dump(),
         "platform_counterweight_kg": per_group["platform"],
-        "general_method": {"method": "least squares of the linear momentum (momentum_regressor rows 0-2) "
-                                     "over the run's closed motion; one unknown mass per counterweight body "
-                                     "(mechbal.balance.force not on main yet)",
-                           "unknowns": len(slots), "rank": rank,
-                           "singular_value_ratio": float(sv[-1] / sv[0]) if len(sv) else None,
-                           "residual_momentum": lsq_residual, "momentum_before": lsq_before},
+        "general_method": {"method": "mechbal.balance.force: least squares of the linear momentum over the "
+                                     "run's closed motion, one slot per counterweight body at its given point "
+                                     "(only the mass unknown, >= 0)",
+                           "unknowns": sized.unknowns, "rank": sized.rank, "exact": sized.exact,
+                           "singular_value_ratio": sized.metrics["singular_value_ratio"],
+                           "limited_by": sized.limited_by, "samples": sized.metrics["samples"],
+                           "residual_momentum": sized.residual, "momentum_before": sized.residual_before,
+                           "residual_units": sized.residual_units},
+        "counterweights": {"general_method": counterweights, "closed_form": closed_form,
+                           "max_abs_difference": max_difference, "tolerance": COUNTERWEIGHT_AGREEMENT_KG,
+                           "unit": "kg", "closed_form_source": "Heydari & Enferadi eqs 29-31"},
         "eq28_coefficients_with_paper_masses_kg": list(coeff_paper),
         "peak_shaking_force_N": {k: peak[k] for k in peak},
         "rms_shaking_force_N": {k: rms[k] for k in rms},

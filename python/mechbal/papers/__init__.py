@@ -5,7 +5,10 @@ joints with their parents and placements, every link's bodies (links, counterwei
 couplings for geared discs and, for the closed linkages, loop closures between named frames with
 the actuated joints named. The papers' closed forms (``Arm2DofDynamics``, ``DiscArmDynamics``,
 ``FiveBarDynamics``, ``PaminsaModel``) stay as fast paths and are tested against these general
-models (tests/python/test_papers.py, test_papers_loops.py).
+models (tests/python/test_papers.py, test_papers_loops.py). Each module also holds its paper's
+balancing closed forms (PAMINSA's counterweights, the disc conditions, the 2-DOF RMS cubic; the
+RPSP's eqs 29-31): the fast paths and regression tests of the general methods of
+:mod:`mechbal.balance`, with which the papers' runners size (and which they check against these).
 
 * :mod:`mechbal.papers.arm2dof`: Arakelian, Le Baron & Mottu 2011, the 2-DOF arm with
   counterweights.

@@ -26,14 +26,18 @@ paper's trajectories (tests/python/test_papers.py).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 import numpy as np
 
+from mechbal.balance.rms import cubic_real_roots, squared_sum, stationarity_cubic
+
 from mechbal import _core
 from mechbal.mechanism import Mechanism
 
-__all__ = ["arm2dof_mechanism"]
+__all__ = ["arm2dof_mechanism", "arm_torques", "static_balancing_radii", "cw_coefficients",
+           "RadiiResult", "rms_optimal_radii", "rms_optimal_radii_numerical"]
 
 _ARM_KEYS = ("m1", "m2", "l1", "l_s1", "l_s2", "i_s1", "i_s2", "g")
 _CW_KEYS = ("m_cw1", "m_cw2", "r_cw1", "r_cw2")
@@ -91,3 +95,138 @@ def arm2dof_mechanism(arm, counterweights=None, *, name: str = "arm2dof") -> Mec
                               np.zeros((3, 3)), "counterweight")]
     frames = [_core.Frame("B", "shoulder", elbow)]
     return Mechanism.from_description(joints, bodies, frames, gravity=(0.0, 0.0, -a["g"]), name=name)
+
+
+# ---- RMS-optimal counterweights ------------------------------------------------------------------
+# RMS-optimal counterweight radii (eqs 32-59): the paper's fast path, and the regression test of
+# the general method :mod:`mechbal.balance.rms`, which the ``arm2dof`` runner sizes with.
+#
+# Why it works for any mechanism: a point mass on a body-fixed line through a joint at signed
+# distance r has a position linear in r, so its kinetic energy is quadratic in r and its potential
+# energy linear: along a given motion every joint torque is exactly
+#
+#     tau_j(t_i) = alpha_ji r^2 + beta_ji r + d_ji            (eqs 32 and 36)
+#
+# and the squared-torque sum Delta tau_j(r) = sum_i tau_j(t_i)^2 (eq 39) is a quartic in r with
+# leading coefficient sum alpha^2 > 0 whenever the motion has acceleration. Its stationarity
+# condition is the cubic (2 S aa) r^3 + (3 S ab) r^2 + (S bb + 2 S ad) r + S bd = 0 (eqs 41-49;
+# S = sum over samples), solved in closed form by Viete/Cardano (eqs 50-59); every real root is
+# evaluated and the one with the least Delta tau kept.
+#
+# Corrections to the printed paper (see also mechbal/arm2dof.hpp):
+#  - eq 35 (c13): the theta1'' coefficient is l1^2 + r2^2 - 2 l1 r2 cos(theta2) (the factor 2 is
+#    missing in print);
+#  - eq 38 (c22): c22 = -m_CW2 [l1 theta1'' cos theta2 + l1 theta1'^2 sin theta2 + g cos(theta1+theta2)]
+#    (sign missing; with the printed sign the cubic returns r_CW2 = -0.191 m, the mirror image);
+#  - eq 55: t = (1/3) acos(R / sqrt(Q^3)) (printed acos(R sqrt(Q^3) / 3));
+#  - eqs 43-45: c13 depends on r_CW2, so joint 2 must be solved first and joint 1 with c13(r_CW2);
+#  - after eq 59: the confluent case R^2 = Q^3 has one simple and one double real root.
+#  - eqs 14 and 23 (in the torques themselves): -k32 theta2'^2 sin(theta2).
+#
+# The paper's optimum r_CW2 = 0.147 m is NOT reproduced: its own (corrected) equations give
+# 0.1913 m, confirmed by a direct numerical minimisation of the full inverse dynamics (see
+# :func:`rms_optimal_radii_numerical`, :mod:`mechbal.balance.rms` and ``mechbal run arm2dof``).
+
+def arm_torques(arm, counterweights, q, qd, qdd) -> np.ndarray:
+    """Joint torques (N, 2) of the 2-DOF arm (closed form, eqs 14-31 corrected) along samples."""
+    cw = counterweights if counterweights is not None else _core.Arm2DofCounterweights()
+    out = _core.Arm2DofDynamics(arm, cw).inverse_dynamics(q, qd, qdd)
+    if out["status"] != _core.Status.ok:
+        raise ValueError(f"inverse dynamics failed along the trajectory: {out['status']}")
+    return out["tau"]
+
+
+def static_balancing_radii(arm, m_cw1: float, m_cw2: float) -> tuple[float, float]:
+    """Radii that cancel the gravity torques for every pose: m_CW2 r2 = m2 l_S2 and
+    m_CW1 r1 = m1 l_S1 + (m2 + m_CW2) l1 (s1 + M2 l1 = 0 and s2 = 0 in eqs 21-22, 30-31)."""
+    if m_cw1 <= 0 or m_cw2 <= 0:
+        raise ValueError(f"static balancing needs m_cw1, m_cw2 > 0 (got {m_cw1}, {m_cw2})")
+    r2 = arm.m2 * arm.l_s2 / m_cw2
+    r1 = (arm.m1 * arm.l_s1 + (arm.m2 + m_cw2) * arm.l1) / m_cw1
+    return r1, r2
+
+
+def cw_coefficients(arm, m_cw1: float, m_cw2: float, r_cw2: float, q, qd, qdd):
+    """Per-sample coefficients of tau1_CW = c11 r1^2 + c12 r1 + c13(r2) (eq 32) and
+    tau2_CW = c21 r2^2 + c22 r2 (eq 36):
+
+    c11 = m_CW1 q1''                                                          (eq 33)
+    c12 = -m_CW1 g cos q1                                                     (eq 34)
+    c13 = m_CW2 [(l1^2 + r2^2 - 2 l1 r2 cos q2) q1'' + (r2^2 - l1 r2 cos q2) q2''
+                 + l1 r2 sin q2 (2 q1' q2' + q2'^2) + g l1 cos q1 - g r2 cos(q1+q2)]  (eq 35, factor 2)
+    c21 = m_CW2 (q1'' + q2'')                                                 (eq 37)
+    c22 = -m_CW2 [l1 q1'' cos q2 + l1 q1'^2 sin q2 + g cos(q1+q2)]             (eq 38, sign fixed)
+    """
+    q, qd, qdd = (np.asarray(x, float) for x in (q, qd, qdd))
+    q1, q2, d1, d2, a1, a2 = q[:, 0], q[:, 1], qd[:, 0], qd[:, 1], qdd[:, 0], qdd[:, 1]
+    l1, g, r2 = arm.l1, arm.g, r_cw2
+    c2, s2, c12 = np.cos(q2), np.sin(q2), np.cos(q1 + q2)
+    c11 = m_cw1 * a1
+    c12_ = -m_cw1 * g * np.cos(q1)
+    c13 = m_cw2 * ((l1 ** 2 + r2 ** 2 - 2 * l1 * r2 * c2) * a1 + (r2 ** 2 - l1 * r2 * c2) * a2
+                   + l1 * r2 * s2 * (2 * d1 * d2 + d2 ** 2) + g * l1 * np.cos(q1) - g * r2 * c12)
+    c21 = m_cw2 * (a1 + a2)
+    c22 = -m_cw2 * (l1 * a1 * c2 + l1 * d1 ** 2 * s2 + g * c12)
+    return c11, c12_, c13, c21, c22
+
+
+@dataclass
+class RadiiResult:
+    """RMS-optimal radii and how they were chosen (per joint: the monic cubic, its real roots and
+    the Delta tau of eq 39 at each root)."""
+
+    r_cw1: float
+    r_cw2: float
+    cubic1: tuple[float, float, float]
+    cubic2: tuple[float, float, float]
+    roots1: list[float]
+    roots2: list[float]
+    delta_tau1: list[float] = field(default_factory=list)
+    delta_tau2: list[float] = field(default_factory=list)
+
+
+def rms_optimal_radii(arm, m_cw1: float, m_cw2: float, q, qd, qdd) -> RadiiResult:
+    """Counterweight radii that minimise the RMS torque of each joint along the sampled motion
+    (q, qd, qdd each (N, 2)), for any 2R arm, trajectory and counterweight masses (eqs 39-59).
+
+    tau2 depends on r2 only (CW1 rides on link 1), tau1 on r1 and r2: r2 is found first from the
+    joint-2 cubic, then r1 from the joint-1 cubic with c13(r2) (corrected ordering of eqs 43-45).
+    Every real root of each cubic is tried and the one with the least Delta tau kept.
+    """
+    q, qd, qdd = (np.asarray(x, float) for x in (q, qd, qdd))
+    tau0 = arm_torques(arm, None, q, qd, qdd)
+    _, _, _, c21, c22 = cw_coefficients(arm, m_cw1, m_cw2, 0.0, q, qd, qdd)
+    cubic2 = stationarity_cubic(c21, c22, tau0[:, 1])
+    roots2 = cubic_real_roots(*cubic2)
+    dt2 = [squared_sum(c21, c22, tau0[:, 1], r) for r in roots2]
+    r2 = roots2[int(np.argmin(dt2))]
+    c11, c12, c13, _, _ = cw_coefficients(arm, m_cw1, m_cw2, r2, q, qd, qdd)
+    d1 = tau0[:, 0] + c13
+    cubic1 = stationarity_cubic(c11, c12, d1)
+    roots1 = cubic_real_roots(*cubic1)
+    dt1 = [squared_sum(c11, c12, d1, r) for r in roots1]
+    r1 = roots1[int(np.argmin(dt1))]
+    return RadiiResult(r1, r2, cubic1, cubic2, roots1, roots2, dt1, dt2)
+
+
+def rms_optimal_radii_numerical(arm, m_cw1: float, m_cw2: float, q, qd, qdd,
+                                bracket: tuple[float, float] = (-2.0, 2.0)) -> tuple[float, float]:
+    """Independent check of :func:`rms_optimal_radii`: scipy minimises the mean squared torque of
+    the full closed-form inverse dynamics (no coefficient formulas), joint 2 over r2 first, then
+    joint 1 over r1 at that r2. Global over ``bracket``: a dense grid, then bounded Brent."""
+    from scipy.optimize import minimize_scalar
+
+    def ms(joint, r1, r2):
+        cw = _core.Arm2DofCounterweights(m_cw1, m_cw2, r1, r2)
+        return float(np.mean(arm_torques(arm, cw, q, qd, qdd)[:, joint] ** 2))
+
+    def argmin(f):
+        grid = np.linspace(bracket[0], bracket[1], 201)
+        k = int(np.argmin([f(x) for x in grid]))
+        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
+        return float(minimize_scalar(f, bounds=(lo, hi), method="bounded",
+                                     options=dict(xatol=1e-12, maxiter=500)).x)
+
+    r2 = argmin(lambda r: ms(1, 0.0, r))
+    r1 = argmin(lambda r: ms(0, r, r2))
+    return r1, r2

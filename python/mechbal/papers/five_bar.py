@@ -3,7 +3,7 @@ dynamic balanced serial mechanisms": the 5R named in the abstract; model and bal
 docs/discs_derivation.md section 5) on the general mechanism model, as a tree of two legs and one
 loop closure.
 
-Geometry (as ``mechbal.FiveBarDynamics`` and ``mechbal.sizing.discs.fivebar_model``): the vertical
+Geometry (as ``mechbal.FiveBarDynamics`` and ``mechbal.papers.discs.fivebar_model``): the vertical
 y-z plane, every joint axis along x, z up, gravity (0, 0, -g). Leg i is a 2R arm:
 
 * ``theta1`` / ``theta2``: proximal link i about x at A_1 = 0 / A_2 = (0, d, 0); the joint angle is
@@ -19,7 +19,7 @@ y-z plane, every joint axis along x, z up, gravity (0, 0, -g). Leg i is a 2R arm
 * actuated ``theta1``, ``theta2``; passive ``theta12``, ``theta22``.
 
 The five-bar has no counter-rotating discs: its balancing is leg-wise static balancing (the
-balanced centres of mass of ``mechbal.sizing.discs.balance_fivebar``).
+balanced centres of mass of ``mechbal.papers.discs.balance_fivebar``).
 
 The closed form (``FiveBarDynamics``: positions, the coupling projection, M', v', g') and the
 five-bar motion of ``mechbal.cases.discs`` equal this general model to 1e-10 along the case's
@@ -54,7 +54,7 @@ def _T(y: float = 0.0, R: np.ndarray | None = None) -> np.ndarray:
 
 def five_bar_design_mechanism(d: Mapping[str, Any], *, name: str = "five-bar",
                               gravity: float = 9.81) -> Mechanism:
-    """A five-bar design (``mechbal.sizing.discs.design("fivebar", p, balanced)``: lengths a_i, b_i,
+    """A five-bar design (``mechbal.papers.discs.design("fivebar", p, balanced)``: lengths a_i, b_i,
     d, masses mp_i, md_i, mP, centres of mass cp_i, cd_i, inertias ``inertia_p1`` ...) as a closed
     :class:`mechbal.Mechanism` (module docstring)."""
     R = _core.JointType.revolute
@@ -78,8 +78,8 @@ def five_bar_design_mechanism(d: Mapping[str, Any], *, name: str = "five-bar",
 
 def five_bar_initial_guess(mech: Mechanism, d: Mapping[str, Any], q_actuated) -> np.ndarray:
     """Every coordinate at actuated angles (theta1, theta2), in the assembly mode of the closed form
-    (``mechbal.sizing.discs.fivebar_positions``: nearest the parallelogram point)."""
-    from mechbal.sizing.discs import fivebar_positions
+    (``mechbal.papers.discs.fivebar_positions``: nearest the parallelogram point)."""
+    from mechbal.papers.discs import fivebar_positions
 
     th1, th2 = map(float, q_actuated)
     B1, B2, P = fivebar_positions(d, th1, th2)
@@ -101,7 +101,7 @@ def five_bar_mechanism(case_config: Mapping[str, Any] | str | Path = "five-bar",
     loaded TOML dict), balanced (leg-wise static balancing) or the case's ``[unbalanced]``
     baseline, from the runner's parameters (``mechbal.cases.discs.parameters_from_config``)."""
     from mechbal.cases.discs import parameters_from_config
-    from mechbal.sizing import discs as dz
+    from mechbal.papers import discs as dz
 
     config = _case(case_config)
     p = parameters_from_config("fivebar", config)
@@ -117,7 +117,7 @@ def five_bar_case_toml(case_config: Mapping[str, Any] | str | Path = "five-bar",
     guess: what ``python/mechbal/cases/five-bar-linkage.toml`` holds for the shipped case."""
     from mechbal.cases.discs import parameters_from_config
     from mechbal.papers._toml import case_toml
-    from mechbal.sizing import discs as dz
+    from mechbal.papers import discs as dz
 
     config = _case(case_config)
     p = parameters_from_config("fivebar", config)

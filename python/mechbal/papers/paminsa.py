@@ -54,7 +54,7 @@ model to 1e-10 along the paper's cycle (tests/python/test_papers_loops.py).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Sequence
 
 import numpy as np
@@ -63,7 +63,9 @@ from mechbal import _core
 from mechbal.mechanism import Mechanism
 
 __all__ = ["paminsa_mechanism", "paminsa_layout", "paminsa_initial_guess", "paminsa_actuated_motion",
-           "paminsa_case_toml", "ACTUATED", "body_names"]
+           "paminsa_case_toml", "ACTUATED", "body_names", "CounterweightSet", "closed_form_counterweights",
+           "printed_counterweights", "reported_counterweights", "counterweights_from_design",
+           "REPORTED_COUNTERWEIGHTS_KG", "copy_parameters"]
 
 #: the paper's actuators: M_1, M_3 (revolute, in-plane), M_v (linear, vertical), then the wrist
 ACTUATED = ("leg1_guide", "leg3_guide", "leg1_slider", "wrist_phi", "wrist_theta", "wrist_psi")
@@ -124,17 +126,153 @@ def _T(xyz=(0.0, 0.0, 0.0), R=None) -> np.ndarray:
     return T
 
 
-def _balanced(params):
-    from mechbal.sizing import paminsa_counterweights as sizing
+# ---- counterweights ------------------------------------------------------------------------------
+# Counterweights for complete shaking-force balancing (Briot & Arakelian 2009, eqs 6-16): the
+# paper's fast path and the regression test of the general method.
+#
+# 1. :func:`closed_form_counterweights` -- the paper's closed forms, re-derived for the
+#    reconstructed leg. Writing every leg point as an affine combination of A, C and E
+#    (D = E + (C-E)/k, F = A + (C-E)/k, B = ((k-1)A + C)/k) and using G_A = G_C,h/(1-k),
+#    G_B = G_C,z/k, the momentum of leg i is
+#    m_C1 v_C,h + m_C2 v_C,z e_z + m_E v_E + (m5 v_S5 + m_CP3 v_L). Force balance needs
+#    m_E = 0 (eq 12 -> eq 15), m_C1 = 0 (eq 10 -> eq 14), m5 + r m_CP3 = 0 (eq 13 -> eq 16), and a
+#    vertical counter-mass sum_i m_C2,i moving as -z_P (eq 11).
+#
+#    Corrections to the printed equations (each checked by the general method, 2., and by the
+#    simulated shaking force):
+#
+#    * eq 6 / eq 11 (m_C2): must contain + 2 m8 / (2k) -- link 8 sits at F, which moves vertically,
+#      and eqs 7, 8, 12 already place it there. Printed eq 11 gives 3 x 3.1033 = 9.310 kg of vertical
+#      counter-mass; the correct value is 9.615 kg.
+#    * eq 7: (m1 + m2)/(2k) must be (m1 + m2/k)/2, as eq 10 has it.
+#    * eq 13: "OL_i = OO_i + r OS_5i" must read M_iL_i = r M_iS_5i (the pivot of link 5 is M_i).
+#    * k is D_iF_i / B_iF_i (the paper prints B_iF_i / D_iF_i, which would make BF = 1.26 m).
+#    * eqs 14-16 as printed are algebraically right: 2.7915 / 1.3865 / 0.436 kg.
+#    * the paper *reports* 4.49 / 1.69 / 0.436 kg. 1.69 is eq 15 with its -2 m8 term dropped
+#      (1.6915); 4.49 is not reproduced by eq 14 under any misprint we tried. The reported masses
+#      leave ~17 N of shaking force (63 % of the unbalanced peak) -- see the case summary.
+#
+# 2. The general method, :mod:`mechbal.balance.force` (least squares of the linear momentum of
+#    the general model over sampled closed motions), with the slots of ``cases/paminsa.toml``'s
+#    ``[balance]`` table: the ``paminsa`` runner sizes with it and reports the closed form beside it
+#    (:func:`counterweights_from_design` reads its design back into a :class:`CounterweightSet`).
+#    With the legs tied (identical legs) every mass is determined; untied, legs 1 and 2 (one
+#    actuator) leave combinations of their masses undetermined, as the paper's cycle alone does
+#    (no x motion).
 
-    return sizing.closed_form(params).apply(params)
+#: the values the paper reports (Sec. III) [kg]; the vertical counter-mass is not given
+REPORTED_COUNTERWEIGHTS_KG = {"cp1": 4.49, "cp2": 1.69, "cp3": 0.436}
+
+
+@dataclass
+class CounterweightSet:
+    cp1: list[float]          # at A_i, per leg
+    cp2: list[float]          # at F_i, per leg
+    cp3: list[float]          # at L_i, per leg
+    vertical: float           # vertical counter-mass
+    source: str
+    notes: dict = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        return {"cp1": list(self.cp1), "cp2": list(self.cp2), "cp3": list(self.cp3),
+                "vertical": float(self.vertical), "source": self.source, **self.notes}
+
+    def apply(self, params):
+        """A copy of ``params`` (mechbal.PaminsaParameters) carrying these counterweights."""
+        from mechbal._core import PaminsaCounterweights
+
+        cw = PaminsaCounterweights()
+        cw.at_A, cw.at_F, cw.at_L = list(self.cp1), list(self.cp2), list(self.cp3)
+        cw.vertical = float(self.vertical)
+        out = copy_parameters(params)
+        out.counterweights = cw
+        return out
+
+
+PARAMETER_FIELDS = ("k", "a", "b", "c", "d", "e", "f", "length_BG", "length_AE", "length_DF",
+                    "length_CE", "length_AF", "length_CJ", "length_MS5", "length_MO",
+                    "platform_mass", "link_mass", "link_inertia", "wrist_inertia",
+                    "nominal_platform", "nominal_rho", "z_A", "elbow", "vertical_mass_at_centroid",
+                    "vertical_mass_xy", "vertical_mass_z0", "cp3_ratio", "counterweights")
+
+
+def copy_parameters(params):
+    """A field-by-field copy of a mechbal.PaminsaParameters."""
+    from mechbal._core import PaminsaParameters
+
+    out = PaminsaParameters()
+    for name in PARAMETER_FIELDS:
+        setattr(out, name, getattr(params, name))
+    return out
+
+
+def _m(params):
+    return [float(x) for x in params.link_mass]
+
+
+def closed_form_counterweights(params) -> CounterweightSet:
+    """Corrected eqs 14, 15, 16 and eq 11 (with the m8 term) for leg masses m1..m8, platform mass
+    m_pl, magnification k and CP3 ratio r:
+
+    m_CP2 = k (m1+m3)/2 + (k-2) m2/2 - m4/2 - m8                            (eq 15)
+    m_CP1 = (k-1)(m_pl/3 + m1/2 + m2/(2k)) - (m3+m4)/2 - (m2+m4+2 m8+2 m_CP2)/(2k)   (eq 14)
+    m_CP3 = -m5 / r                                                         (eq 16)
+    m_vert = 3 [m_pl/3 + m1/2 + (2 m2 + m4 + 2 m6 + 2 m7 + 2 m8 + 2 m_CP2)/(2k)]     (eq 11 + m8)
+    """
+    k, r, mpl = params.k, params.cp3_ratio, params.platform_mass
+    m1, m2, m3, m4, m5, m6, m7, m8 = _m(params)
+    cp2 = k * (m1 + m3) / 2 + (k - 2) * m2 / 2 - m4 / 2 - m8
+    cp1 = (k - 1) * (mpl / 3 + m1 / 2 + m2 / (2 * k)) - (m3 + m4) / 2 - (m2 + m4 + 2 * m8 + 2 * cp2) / (2 * k)
+    cp3 = -m5 / r
+    mc2 = mpl / 3 + m1 / 2 + (2 * m2 + m4 + 2 * m6 + 2 * m7 + 2 * m8 + 2 * cp2) / (2 * k)
+    return CounterweightSet([cp1] * 3, [cp2] * 3, [cp3] * 3, 3 * mc2, "closed_form (eqs 11, 14-16 corrected)")
+
+
+def printed_counterweights(params) -> CounterweightSet:
+    """Eqs 14, 15, 16 evaluated literally as printed, and eq 11 (without m8) summed over the legs."""
+    k, r, mpl = params.k, params.cp3_ratio, params.platform_mass
+    m1, m2, m3, m4, m5, m6, m7, m8 = _m(params)
+    cp2 = k * ((m1 + m3) / 2 + (k - 1) * m2 / (2 * k) - (m2 + m4 + 2 * m8) / (2 * k))            # (15)
+    cp1 = ((k - 1) * ((m3 + m4) / (2 * (1 - k)) + (m1 + m2 / k) / 2 + mpl / 3)
+           - (m4 + m2 + 2 * m8 + 2 * cp2) / (2 * k))                                            # (14)
+    cp3 = -m5 / r                                                                               # (16)
+    mc2 = (2 * m2 + m4 + 2 * m6 + 2 * m7 + 2 * cp2) / (2 * k) + mpl / 3 + m1 / 2                 # (11)
+    return CounterweightSet([cp1] * 3, [cp2] * 3, [cp3] * 3, 3 * mc2, "paper eqs 11, 14-16 as printed",
+                            {"cp2_without_m8_term": cp2 + 2 * m8 * k / (2 * k)})
+
+
+def reported_counterweights(params, vertical: float) -> CounterweightSet:
+    """The masses the paper reports, with the given vertical counter-mass (the paper gives none)."""
+    p = REPORTED_COUNTERWEIGHTS_KG
+    return CounterweightSet([p["cp1"]] * 3, [p["cp2"]] * 3, [p["cp3"]] * 3, vertical, "paper reported")
+
+
+def counterweights_from_design(design: dict, source: str) -> CounterweightSet:
+    """A :class:`CounterweightSet` from the design of a balancing method (``BalanceResult.design``)
+    whose slots carry the paper's names (``leg<i>.CP1_atA``, ``leg<i>.CP2_atF``,
+    ``leg<i>.CP3_atL``, ``vertical_counter_mass``: ``cases/paminsa.toml``'s ``[balance]``).
+    KeyError naming the missing slot otherwise."""
+    def mass(name):
+        if name not in design:
+            raise KeyError(f"the design has no slot '{name}' (the paper's counterweights are "
+                           "leg<i>.CP1_atA, leg<i>.CP2_atF, leg<i>.CP3_atL and vertical_counter_mass)")
+        return float(design[name]["mass"])
+
+    return CounterweightSet([mass(f"leg{i}.CP1_atA") for i in (1, 2, 3)],
+                            [mass(f"leg{i}.CP2_atF") for i in (1, 2, 3)],
+                            [mass(f"leg{i}.CP3_atL") for i in (1, 2, 3)],
+                            mass("vertical_counter_mass"), source)
+
+
+def _balanced(params):
+    return closed_form_counterweights(params).apply(params)
 
 
 def paminsa_mechanism(params, balanced: bool = True, *, name: str | None = None) -> Mechanism:
     """PAMINSA as a closed :class:`mechbal.Mechanism` (module docstring) from
     ``mechbal.PaminsaParameters`` (``mechbal.cases.paminsa.parameters_from_config``).
     ``balanced=True``: the closed-form counterweights (eqs 11, 14-16 corrected:
-    ``mechbal.sizing.paminsa_counterweights.closed_form``) replace the parameters' own;
+    :func:`closed_form_counterweights`) replace the parameters' own;
     ``balanced=False``: the parameters' counterweights as given (none in the case file)."""
     p = _balanced(params) if balanced else params
     lay = paminsa_layout(p)

@@ -1,1 +1,0 @@
-"""Offline sizing of balancing elements: one module per method, each citing its paper."""
