@@ -113,7 +113,8 @@ def main(argv=None):
         "pinocchio_aligned_over_mechbal_ct6": ratio(cases, "ct6_pinocchio_aligned", "ct6_mechbal"),
         # what the ComputedTorque class costs over the inline law (checks, virtual call, clipping)
         "mechbal_class_over_inline_ct6": ratio(cases, "ct6_mechbal", "ct6_mechbal_inline"),
-        # ComputedTorque over the arm's coupled model (DiscArmDynamics) vs DecoupledJointController:
+        # ComputedTorque over the arm's full model (discs as gear-coupled links, MechanismDynamics)
+        # vs DecoupledJointController:
         # what dynamic balancing saves per tick. 3 joints: the balanced 3R (same torques, checked);
         # 6 joints: cost only (the 6-joint disc arm is not balanced)
         "computed_torque_over_decoupled": ratio(cases, "ct3_disc_arm", "decoupled_step3"),
@@ -198,7 +199,7 @@ def main(argv=None):
             "gbench_median_ns": "median over Google Benchmark repetitions of the CPU time per "
                                 "iteration (gbench_median_wall_ns: wall time)",
             "decoupled": "decoupled_step3 / ct3_disc_arm: DecoupledJointController vs "
-                         "ComputedTorque over DiscArmDynamics on the balanced planar 3R with four "
+                         "ComputedTorque over MechanismDynamics on the balanced planar 3R with four "
                          "discs (equal torques, checked at setup); decoupled_step6 / ct6_disc_arm: "
                          "the same two controllers at 6 joints on an unbalanced disc arm (cost "
                          "only)",

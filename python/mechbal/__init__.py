@@ -51,7 +51,6 @@ _MOVED = {
     "PaminsaParameters": "papers", "paminsa_kinematics": "papers",
     "paminsa_reactionless_run": "papers", "ChainModel": "papers", "JointSpec": "papers",
     "chain_kinematics": "papers", "shaking_wrench": "papers", "FiveBarDynamics": "papers",
-    "DiscArmDynamics": "papers",
 }
 _LEGACY_CORE = {"RestToRestTrajectory", "validate_rigid_body"}
 

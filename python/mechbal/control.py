@@ -147,7 +147,7 @@ class ComputedTorque(_core.ComputedTorque):
     Args:
         model: a :class:`mechbal.Mechanism` (its :class:`MechanismDynamics` is built and kept) or
             any dynamics back end: :class:`MechanismDynamics`, :class:`RneChainDynamics`,
-            :class:`KdlChainDynamics`, ``Arm2DofDynamics``, ``DiscArmDynamics``,
+            :class:`KdlChainDynamics`, ``Arm2DofDynamics``,
             ``FiveBarDynamics`` (:mod:`mechbal.papers`). The model may differ from the plant.
         kp: proportional gains [1/s^2], one per joint.
         kd: derivative gains [1/s], one per joint.

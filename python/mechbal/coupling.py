@@ -20,13 +20,11 @@ planar discs and after balancing but gives wrong Coriolis terms otherwise (eq 24
 
 The serial arms with discs are data on the general model (``mechbal.papers.discs``: each disc a
 gear-coupled joint, evaluated by MechanismDynamics, whose projection tau = G^T tau_joint is this
-one with A° = 1). The per-tick C++ evaluators of the paper's form are
-``mechbal._core.DiscArmDynamics`` (serial arms with discs, A° = 1, a cross-check) and
+one with A° = 1). The per-tick C++ evaluator of the paper's form is
 ``mechbal._core.FiveBarDynamics`` (the 5R five-bar, A° a 4x4 matrix, over the general fixed-size
-``mechbal::CoupledProjection``); this module is their
-independent Python reference (mechbal.papers.discs.fivebar_model) and builds the two-stage model
-of the paper (arm model first, then discs coupled to it) used to cross-check the C++ single-stage
-form.
+``mechbal::CoupledProjection``); this module is its independent Python reference
+(mechbal.papers.discs.fivebar_model) and builds the two-stage model of the paper (arm model
+first, then discs coupled to it) that cross-checks the general model's single-stage form.
 """
 from __future__ import annotations
 

@@ -242,7 +242,7 @@ def test_unbalanced_arm_links_match_pinocchio_and_kdl(kind):
     rng = np.random.default_rng(5)
     q, qd = dz.sample_states(kind, 40, rng)
     qdd = rng.uniform(-3, 3, q.shape)
-    ours = dz.disc_arm_dynamics(kind, d).inverse_dynamics(q, qd, qdd)["tau"]
+    ours = dz.disc_design_mechanism(kind, d).inverse_dynamics(q, qd, qdd)
     ref = np.array([pin.rnea(pm, pd, a, b, c) for a, b, c in zip(q, qd, qdd)])
     kdl = _core.KdlChainDynamics(chain).inverse_dynamics(q, qd, qdd)["tau"]
     scale = np.max(np.abs(ref), axis=1, keepdims=True)
@@ -251,19 +251,14 @@ def test_unbalanced_arm_links_match_pinocchio_and_kdl(kind):
 
 
 @pytest.mark.parametrize("kind", ["planar3r", "spatial3r", "scara"])
-def test_paper_two_stage_coupling_equals_the_cpp_single_stage_evaluator(kind):
+def test_paper_two_stage_coupling_equals_the_general_single_stage_model(kind):
     """Arm model (M#, v#, g#) first, then discs (the paper's procedure, Python) == the general
-    model (dz.evaluate: discs as gear couplings) and the C++ DiscArmDynamics, on a perturbed
-    design with non-axisymmetric discs."""
+    model (dz.evaluate: discs as gear couplings), on a perturbed design with non-axisymmetric
+    discs."""
     rng = np.random.default_rng(8)
     d = _perturbed(kind, rng)
     q, qd = dz.sample_states(kind, 20, rng)
     M, v, g = dz.evaluate(kind, d, q, qd)
-    fast = dz.disc_arm_dynamics(kind, d).evaluate(q, qd)
-    torque_scale = max(np.max(np.abs(fast["velocity"])), np.max(np.abs(fast["gravity"])))
-    assert np.max(np.abs(M - fast["mass"])) < 1e-12 * np.max(np.abs(fast["mass"]))
-    assert np.max(np.abs(v - fast["velocity"])) < 1e-12 * torque_scale
-    assert np.max(np.abs(g - fast["gravity"])) < 1e-12 * torque_scale
     joints, links, discs = dz.serial_structure(kind, d)
     for k in range(len(q)):
         ref = cp.arm_with_discs(joints, links, discs, q[k], qd[k])
@@ -292,7 +287,7 @@ def test_printed_spatial_equations_fail_and_corrections_hold():
     # it, so evaluate with the Python coupling, which does not validate)
     joints, links, discs = dz.serial_structure("spatial3r", d)
     with pytest.raises(ValueError, match="triangle"):
-        dz.disc_arm_dynamics("spatial3r", d)
+        dz.disc_design_mechanism("spatial3r", d)
     q, qd = dz.sample_states("spatial3r", 40, np.random.default_rng(1))
     out = [cp.arm_with_discs(joints, links, discs, a, b) for a, b in zip(q, qd)]
     D11 = np.array([o.mass[0, 0] for o in out])
@@ -427,7 +422,8 @@ def test_decoupled_controller_equals_computed_torque_on_the_balanced_model(kind)
     k = dz.BALANCE[kind](p)["k"]
     kp, kd = np.array([100.0, 80.0, 60.0]), np.array([20.0, 18.0, 15.0])
     dc = _core.DecoupledJointController(np.asarray(k), kp, kd)
-    ct = _core.ComputedTorque(dz.disc_arm_dynamics(kind, dz.design(kind, p, True)), kp, kd)
+    ct = _core.ComputedTorque(_core.MechanismDynamics(dz.disc_design_mechanism(kind, dz.design(kind, p, True)).model),
+                              kp, kd)
     rng = np.random.default_rng(4)
     for _ in range(50):
         x = [rng.uniform(-2, 2, 3) for _ in range(5)]
@@ -436,7 +432,8 @@ def test_decoupled_controller_equals_computed_torque_on_the_balanced_model(kind)
         assert s1 == s2 == _core.Status.ok
         assert np.allclose(t1, t2, rtol=1e-12, atol=1e-12 * np.max(np.abs(t2)))
     # the unbalanced model does not reduce to the decoupled law
-    ct0 = _core.ComputedTorque(dz.disc_arm_dynamics(kind, dz.design(kind, p, False)), kp, kd)
+    ct0 = _core.ComputedTorque(_core.MechanismDynamics(dz.disc_design_mechanism(kind, dz.design(kind, p, False)).model),
+                               kp, kd)
     x = [rng.uniform(-2, 2, 3) for _ in range(5)]
     assert np.max(np.abs(ct0.step(*x)[0] - dc.step(*x)[0])) > 1e-2
     bad = x[:]

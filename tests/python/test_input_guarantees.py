@@ -198,11 +198,11 @@ def test_batch_functions_return_a_status_per_instant_and_never_ok_on_overflow(ch
     outs["FiveBarDynamics.inverse_dynamics"] = fb.inverse_dynamics(q5, qd5, np.ones((3, 2)))
     outs["FiveBarDynamics.motion"] = fb.motion(q5, qd5, np.ones((3, 2)))
     outs["FiveBarDynamics.evaluate"] = fb.evaluate(q5, qd5)
-    disc_chain = chain_from_specs(random_chain_specs(np.random.default_rng(3), "RRR"))
-    discs = _core.DiscArmDynamics(disc_chain, [_core.DiscSpec("d1", 0, 1, [0, 0, 1], -2.0, [0.01, 0.01, 0.02])])
+    from mechbal.papers import disc_arm_mechanism
+
+    discs = _core.MechanismDynamics(disc_arm_mechanism("discs-3r").model)  # geared discs
     q3, qd3 = _three_rows(3, np.array([0.1, 0.2, 0.3]))
-    outs["DiscArmDynamics.inverse_dynamics"] = discs.inverse_dynamics(q3, qd3, np.ones((3, 3)))
-    outs["DiscArmDynamics.evaluate"] = discs.evaluate(q3, qd3)
+    outs["MechanismDynamics.inverse_dynamics"] = discs.inverse_dynamics(q3, qd3, np.ones((3, 3)))
     # shaking wrench over two bodies: a good instant, a NaN one, an overflowing acceleration
     N, B = 3, 2
     com, vel, acc, w, al = (np.zeros((N, B, 3)) for _ in range(5))

@@ -39,6 +39,5 @@
 #include "mechbal/closed_loop.hpp"
 /// Fast paths of the papers' mechanisms
 #include "mechbal/arm2dof.hpp"
-#include "mechbal/disc_arm.hpp"
 #include "mechbal/five_bar.hpp"
 #include "mechbal/paminsa.hpp"

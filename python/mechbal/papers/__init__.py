@@ -3,7 +3,7 @@
 Each module builds, from the parameters a case runner reads, the mechanism the paper describes:
 joints with their parents and placements, every link's bodies (links, counterweights, discs), gear
 couplings for geared discs and, for the closed linkages, loop closures between named frames with
-the actuated joints named. The papers' closed forms (``Arm2DofDynamics``, ``DiscArmDynamics``,
+the actuated joints named. The papers' closed forms (``Arm2DofDynamics``,
 ``FiveBarDynamics``, ``PaminsaModel``) stay as fast paths and are tested against these general
 models (tests/python/test_papers.py, test_papers_loops.py). Each module also holds its paper's
 balancing closed forms (PAMINSA's counterweights, the disc conditions, the 2-DOF RMS cubic; the
@@ -32,8 +32,9 @@ the general model; SI units: m, kg, kg m^2, rad, s, N, N m):
   :class:`PaminsaModel`, :func:`paminsa_kinematics`, :func:`paminsa_reactionless_run`,
   :func:`wrist_momentum_matrix`, :func:`wrist_momentum_bias` (its controller is
   :class:`mechbal.control.PaminsaController`).
-* Coutinho & Hess Coelho: :class:`FiveBarParameters`, :class:`FiveBarDynamics`,
-  :class:`DiscSpec`, :class:`DiscArmDynamics`.
+* Coutinho & Hess Coelho: :class:`FiveBarParameters`, :class:`FiveBarDynamics` (the serial arms
+  with discs are general mechanisms: :func:`disc_arm_mechanism`, evaluated by
+  :class:`mechbal.control.MechanismDynamics`).
 * The serial-chain evaluator the first case runners were written on (the general model,
   :class:`mechbal.Mechanism`, supersedes it): :class:`ChainModel`, :class:`JointSpec`,
   :func:`chain_kinematics` (every link's motion along a trajectory) and
@@ -57,8 +58,6 @@ wrist_momentum_matrix = _core.wrist_momentum_matrix
 wrist_momentum_bias = _core.wrist_momentum_bias
 FiveBarParameters = _core.FiveBarParameters
 FiveBarDynamics = _core.FiveBarDynamics
-DiscSpec = _core.DiscSpec
-DiscArmDynamics = _core.DiscArmDynamics
 ChainModel = _core.ChainModel
 JointSpec = _core.JointSpec
 chain_kinematics = _core.chain_kinematics
@@ -69,6 +68,6 @@ __all__ = [
     "Arm2DofParameters", "Arm2DofCounterweights", "Arm2DofDynamics", "pd_error_analytic",
     "PaminsaParameters", "PaminsaCounterweights", "PaminsaModel", "paminsa_kinematics",
     "paminsa_reactionless_run", "wrist_momentum_matrix", "wrist_momentum_bias",
-    "FiveBarParameters", "FiveBarDynamics", "DiscSpec", "DiscArmDynamics",
+    "FiveBarParameters", "FiveBarDynamics",
     "ChainModel", "JointSpec", "chain_kinematics", "shaking_wrench",
 ]

@@ -22,7 +22,7 @@ joints, y along the link; the closed forms below for the parameters and the corr
 * ``scara`` (Sec. 3.3, eqs 28-37, general l2): joints 1, 2 about x, joint 3 prismatic along x at
   (0, l2, 0) of link 2; discs 4, 5 on link 1 on the joint-2 axle (ratios 1 and beta).
 
-As in the case files (and ``mechbal.DiscArmDynamics``), a disc's mass is included in its carrier
+As in the case files, a disc's mass is included in its carrier
 link's mass and centre of mass, so the disc body carries only its central inertia
 diag(J_x, J_y, J_z) (disc frame, x = spin axis) and mass 0: where its axle sits then changes no
 force, torque or momentum, only the disc's reported pose. The unbalanced designs have no discs.
@@ -336,7 +336,7 @@ def serial_structure(kind: str, d: dict):
 
 
 def chain_model(joints, links):
-    """The arm links as a mechbal ChainModel (for KDL, Pinocchio and DiscArmDynamics)."""
+    """The arm links as a mechbal ChainModel (for KDL and Pinocchio)."""
     specs = []
     for i, (j, b) in enumerate(zip(joints, links)):
         T = np.eye(4)
@@ -350,16 +350,6 @@ def disc_mechanism(kind: str, d: dict):
     """A serial design on the general model: mechbal.Mechanism with each disc a gear-coupled
     joint (:func:`disc_design_mechanism`). What :func:`evaluate` and the runner use."""
     return disc_design_mechanism(kind, d)
-
-
-def disc_arm_dynamics(kind: str, d: dict):
-    """The C++ coupling-matrix evaluator (mechbal._core.DiscArmDynamics) of a serial design: the
-    paper's projection M' = C^T M# C, kept as a cross-check of the general model (it is not
-    faster than mechbal.MechanismDynamics)."""
-    joints, links, discs = serial_structure(kind, d)
-    specs = [_core.DiscSpec(f"disc{k + 4}", ds.carrier, ds.joint, ds.axis, ds.ratio, ds.inertia)
-             for k, ds in enumerate(discs)]
-    return _core.DiscArmDynamics(chain_model(joints, links), specs)
 
 
 # ---------------------------------------------------------------------------------------------
