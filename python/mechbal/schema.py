@@ -609,6 +609,9 @@ class RpspCase(Table):
     balancing: RpspBalancing
     motion: RpspMotion
     paper: RpspPaper
+    balance: Optional[Balance] = Field(
+        None, description="mechbal balance: the design variables (default: the [balancing] counterweight "
+                          "bodies as fixed-position slots)")
     _spec: Any = PrivateAttr(None)
 
     @property

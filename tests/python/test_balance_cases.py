@@ -354,3 +354,50 @@ def test_bad_balance_tables_are_refused_naming_the_field(capsys, tmp_path):
     refused("paminsa", pam.replace('link = "leg1_link3"', 'link = "leg1_lnk3"'),
             "balance.counterweights[0].link", "did you mean 'leg1_link3'")
     assert not (tmp_path / "o").exists()
+
+
+# ---- RPSP (Heydari & Enferadi): mechbal balance rpsp --method force ----------------------------
+
+def test_rpsp_force_reproduces_eqs_29_31_and_its_toml_runs(tmp_path):
+    """`mechbal balance rpsp --method force`: the [balancing] counterweight bodies as fixed-position
+    slots give the paper's eqs 29-31 masses (the platform counterweight zero); the balanced
+    robot's shaking force along the paper's motion, recomputed through the written-back case at
+    the exported joint states, is below 1e-9 of the unbalanced peak; balanced.toml runs."""
+    from mechbal.papers import rpsp as paper
+    from mechbal.schema import validate_case
+
+    out = tmp_path / "rpsp"
+    assert main(["balance", "rpsp", "--method", "force", "--out", str(out), "-q"]) == 0
+    s = summary_of(out)
+    b = s["balance"]
+    assert s["kind"] == "rpsp" and s["closed"] and b["exact"] and b["rank"] == b["unknowns"] == 10
+    c = validate_case(load_case("rpsp"), warn=False)
+    p = c.paper
+    eqs = paper.counterweights_eqs_29_31(p.m_E, p.m_Q, p.m_H, p.m_K, p.r_H, p.r_K, p.r_P, p.r_N, p.r_Q, p.r_F)
+    for key in ("m_P", "m_N", "m_F"):
+        for name in getattr(c.balancing, key):
+            assert b["design"][name]["mass"] == pytest.approx(eqs[key], rel=1e-7), name
+    assert 0.0 <= b["design"]["platform_counterweight"]["mass"] < 1e-7
+    unb = read_bodies(out / "bodies_unbalanced.npz")
+    bal = read_bodies(out / "bodies_balanced.npz")
+    peak = float(np.max(np.abs(unb["shaking_force"])))
+    assert peak > 10.0 and np.max(np.abs(bal["shaking_force"])) < 1e-9 * peak
+    data = tomllib.loads((out / "balanced.toml").read_text())
+    assert data["case"]["kind"] == "rpsp" and "balance" not in data
+    assert sum(x["name"] == "P_1" for x in data["mechanism"]["bodies"]) == 1   # replaced, not added
+    from mechbal.cases import rpsp as runner
+
+    written = validate_case(data, warn=False)
+    mech = Mechanism.from_spec(runner.driven_by_platform(written.spec, written.motion.platform))
+    assert sorted(mech.body_names) == sorted(bal["names"].tolist())
+    sw = mech.shaking_wrench(bal["q"], bal["qd"], bal["qdd"])
+    assert np.max(np.abs(sw.shaking_force)) < 1e-9 * peak
+    assert main(["run", str(out / "balanced.toml"), "--out", str(tmp_path / "run"), "-q"]) == 0
+
+
+def test_rpsp_design_file_gives_only_balance(capsys, tmp_path):
+    design = tmp_path / "design.toml"
+    design.write_text('[balance]\n[[balance.counterweights]]\nname = "cw"\nlink = "AD_1"\nmass_max = 5.0\n'
+                      '[trajectory]\nstart = [0.0, 0.0, 0.0]\nend = [0.1, 0.0, 0.0]\nduration = 1.0\n')
+    assert main(["balance", "rpsp", "--method", "force", "--design", str(design), "--out", str(tmp_path / "o")]) == 2
+    one_line_error(capsys, "trajectory", "[motion]")

@@ -1,8 +1,8 @@
 """``mechbal balance CASE --method METHOD --out DIR``: balance a case's mechanism and write the run.
 
 CASE is a TOML case of kind ``mechanism`` / ``serial_chain`` (its ``[mechanism]``, ``[trajectory]``
-and ``[balance]`` tables), the built-in ``paminsa`` and disc cases (kinds ``paminsa`` and
-``discs``: :mod:`mechbal.balance.cases`), the built-in ``arm2dof`` (its arm as a mechanism with links
+and ``[balance]`` tables), the built-in ``paminsa``, disc and ``rpsp`` cases (kinds ``paminsa``,
+``discs`` and ``rpsp``: :mod:`mechbal.balance.cases`), the built-in ``arm2dof`` (its arm as a mechanism with links
 ``shoulder`` and ``elbow``, x along each link; the counterweights of ``[counterweights]`` on the
 link extensions unless ``[balance]`` gives others; the minimum-energy cubic law of its
 ``[trajectory]``), or a URDF file (with ``--design FILE.toml`` holding a ``[balance]`` table and
@@ -157,13 +157,13 @@ def case_from_config(cfg, raw: dict | None = None, design_cfg=None, *, source: s
         t, motion, tt = _trajectory_motion(mech, {"start": tr.start, "end": tr.end, "duration": tr.duration,
                                                   "samples": tr.samples}, law="cubic")
         return BalanceCase(name, title, mech, table, t, motion, tt, None, raw, "arm2dof", slots)
-    if cfg.case.kind in ("paminsa", "discs"):
+    if cfg.case.kind in ("paminsa", "discs", "rpsp"):
         from mechbal.balance import cases as builtin
 
-        make = builtin.paminsa_case if cfg.case.kind == "paminsa" else builtin.discs_case
+        make = {"paminsa": builtin.paminsa_case, "rpsp": builtin.rpsp_case}.get(cfg.case.kind, builtin.discs_case)
         return make(cfg, raw, table, design_cfg)
     raise ConfigError("case.kind", f"mechbal balance reads cases of kind mechanism, serial_chain, arm2dof, "
-                                   f"paminsa or discs, and URDF files ({cfg.case.kind!r}: its mechanism is not "
+                                   f"paminsa, discs or rpsp, and URDF files ({cfg.case.kind!r}: its mechanism is not "
                                    "on the general model yet)", cfg.case.kind)
 
 
@@ -280,13 +280,16 @@ def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
               + f".\nResidual {result.residual:.6g} {result.residual_units} (unbalanced {result.residual_before:.6g}).")
     case = {"name": f"{bc.name}-balanced", "kind": "mechanism", "title": f"{bc.title}, balanced ({method})"}
     tt = dict(bc.trajectory_table)
-    if bc.kind in ("mechanism", "serial_chain") and bc.raw is not None:
+    if bc.kind in ("mechanism", "serial_chain", "rpsp") and bc.raw is not None:
+        # the case itself with the balancing elements added (rpsp: its counterweight bodies, which
+        # the case lists with the paper's masses, replaced by the sized ones)
         data = copy.deepcopy(bc.raw)
         data.pop("balance", None)
         data["case"] = {**data["case"], **case, "kind": bc.kind}
         mech = data["mechanism"]
-        bodies = list(mech.get("bodies", []))
         own = set(bc.mechanism.body_names)
+        bodies = [b for b in mech.get("bodies", []) if b.get("name") in own or b.get("name") not in
+                  {x.name for x in result.balanced.bodies}]
         for b in result.balanced.bodies:   # the counterweights, back in the user's link frames
             if b.name in own:
                 continue
