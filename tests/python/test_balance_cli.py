@@ -200,3 +200,54 @@ def test_ur5_urdf_with_a_design_file(tmp_path):
     q = np.random.default_rng(2).uniform(-math.pi, math.pi, (200, mech.dof))
     G = pin_gravity(out / "balanced.urdf", mech, q)
     assert np.max(np.abs(G - mech.gravity_torque(q))) < 1e-9
+
+
+def test_ur5_urdf_balanced_by_springs(tmp_path):
+    """The README example: UR5 (example-robot-data) with docs/examples/ur5_springs.toml through
+    the CLI: three zero-free-length springs behind blocks and tackles, anchors in the URDF link
+    frames; the residual is wrist 3's off-axis mass (without it the same slots balance the arm
+    exactly: static torque 1e-9 N m, potential energy constant to 1e-9 J); balanced.toml carries
+    the springs and reproduces the balanced static torque; catalogue clusters per spring."""
+    from test_urdf import ROBOTS, _robot_file
+
+    from mechbal import _core
+    from mechbal.balance import springs as sp
+    from mechbal.balance.run import load_case
+
+    urdf = _robot_file(*ROBOTS["ur5"])
+    design = Path(__file__).parents[2] / "docs" / "examples" / "ur5_springs.toml"
+    out = tmp_path / "ur5"
+    assert main(["balance", str(urdf), "--design", str(design), "--method", "springs", "--out", str(out), "-q"]) == 0
+    summary = summary_of(out)
+    b = summary["balance"]
+    assert b["method"] == "springs" and b["rank"] == 3 and b["unknowns"] == 3
+    assert set(b["design"]) == {"upper_arm_spring", "forearm_spring", "elbow_spring"}
+    assert b["design"]["forearm_spring"]["pulley_ratio"] == 4.0
+    # the published numbers (README): peak static torque over the 2000 poses, before and after
+    before, after = b["metrics"]["static_torque_before"], b["metrics"]["static_torque_after"]
+    assert before["shoulder_lift_joint"]["peak"] == pytest.approx(59.31, abs=0.01)
+    assert before["elbow_joint"]["peak"] == pytest.approx(15.86, abs=0.01)
+    for j in ("shoulder_lift_joint", "elbow_joint"):
+        assert after[j]["peak"] == pytest.approx(0.18, abs=0.005)
+    assert b["residual"] == pytest.approx(0.1797, abs=1e-3) and not b["exact"]
+    assert any(m.startswith("impossible") for m in b["limited_by"])
+    g = summary["before_after"]["gravity_torque"]
+    assert g["unbalanced"]["peak"][1] == pytest.approx(44.42, abs=0.01)
+    assert max(g["balanced"]["peak"][1:3]) < 0.18
+    assert all(b["metrics"]["catalogue"]["springs"][n] for n in b["design"])
+    assert not (out / "balanced.urdf").exists() and "no balanced.urdf" in summary["urdf"]
+    # balanced.toml: the arm with its springs, holding the arm as the balanced mechanism does
+    balanced = Mechanism.from_toml(out / "balanced.toml")
+    assert sorted(balanced.spring_names) == sorted(b["design"])
+    q = np.random.default_rng(4).uniform(-math.pi, math.pi, (300, balanced.dof))
+    assert np.max(np.abs(balanced.static_torque(q)[:, 1:3])) < 0.2
+    # the residual is wrist 3's centre of mass, 0.095 m off the wrist-1 axis: without it, exact
+    bc = load_case(str(urdf), str(design))
+    bodies = [x if x.name != "wrist_3_link" else _core.Body(x.name, x.link, 0.0, np.asarray(x.com),
+                                                             np.asarray(x.inertia), x.kind)
+              for x in bc.mechanism.model.description.bodies]
+    light = bc.mechanism.with_bodies(bodies, replace=True)
+    slots, samples, _ = sp.design_from_table(bc.table, light)
+    r = sp.balance(light, slots, samples)
+    assert r.exact and r.residual < 1e-9 and r.metrics["potential_energy_variation_after"] < 1e-9
+    assert np.max(np.abs(r.balanced.static_torque(q))) < 1e-9

@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pytest
 
+from mechbal.balance.springs import load_catalogue, select_springs
 from mechbal.cases import orthoglide as og
 from mechbal.config import ConfigError, load_case
 from mechbal.papers import orthoglide as paper
@@ -95,10 +96,12 @@ def test_static_balance_and_constant_potential_energy(machine, grid, rates, lump
 
 
 def test_static_forces_are_the_potential_gradient(machine, case, rates):
-    """C^T (G + dV_s/dq) = dV/drho by central differences along each slider (springs at 0.6 of
-    their balancing rates, so nothing cancels)."""
+    """C^T (G + K) = dV/drho by central differences along each slider, V the model's potential
+    energy with its springs (at 0.6 of their balancing rates, so nothing cancels)."""
     K = {n: 0.6 * k for n, k in rates.items()}
     springs = machine.springs(K)
+    sprung = machine.with_springs(springs)
+    assert sorted(sprung.spring_names) == sorted(rates)
     p0 = np.asarray(case.workspace.center) + np.array([0.05, -0.1, 0.08])
     F = machine.static_forces(p0[None], springs)[0]
     m, *_ = machine.solve(p0[None], with_coupling=False)
@@ -109,13 +112,59 @@ def test_static_forces_are_the_potential_gradient(machine, case, rates):
         for s in (+1, -1):
             rho = rho0.copy()
             rho[j] += s * h
-            mm = machine.mech.closed_motion(rho, q_guess=m.q[0], tolerance=og.CLOSURE_TOLERANCE)
-            com = machine.mech.body_motion(mm.q).com
-            mass = np.array([b.mass for b in machine.mech.bodies])
-            Vg = -np.einsum("b,bk,k->", mass, com, machine.mech.gravity)
-            terms = machine.spring_terms(mm.q[None])
-            V.append(Vg + sum(0.5 * sp.rate * np.sum(terms[sp.name][0] ** 2) for sp in springs))
+            mm = sprung.closed_motion(rho, q_guess=m.q[0], tolerance=og.CLOSURE_TOLERANCE)
+            V.append(sprung.potential_energy(mm.q))
         assert F[j] == pytest.approx((V[0] - V[1]) / (2 * h), rel=1e-6, abs=1e-5)
+
+
+def test_model_springs_are_the_papers_springs(machine, case, rates, lumped, grid):
+    """The springs on the model (lengths, tensions, energies) against the paper's zero-free-length
+    springs on the lumped model's points (eqs 6, 10: A = O_2 + a, B = P + b, N_1 = O_2 + n_1,
+    N_2 = S + n_2, V = K |r|^2 / 2), and the spring torque against finite differences of the
+    spring energy in the full coordinates."""
+    springs = machine.springs(rates)
+    sprung = machine.with_springs(springs)
+    m, *_ = machine.solve(grid, with_coupling=False)
+    rho = machine.rho(grid)
+    O2 = np.stack([np.zeros(len(grid)), rho[:, 1], np.zeros(len(grid))], 1)
+    S = lumped.support_kinematics(rho[:, 1])
+    d_paper = {case.roles.distal_spring: np.linalg.norm(grid + lumped.b - (O2 + lumped.a), axis=1),
+               case.roles.proximal_spring: np.linalg.norm(O2 + lumped.n1 - (S + lumped.n2), axis=1)}
+    d = sprung.spring_lengths(m.q)
+    T = sprung.spring_tension(m.q)
+    for k, name in enumerate(sprung.spring_names):
+        assert np.max(np.abs(d[:, k] - d_paper[name])) < 1e-12
+        assert np.max(np.abs(T[:, k] - rates[name] * d_paper[name])) < 1e-8
+    E = sprung.spring_energy(m.q)
+    E_paper = sum(0.5 * rates[n] * d_paper[n] ** 2 for n in d_paper)
+    assert np.max(np.abs(E - E_paper)) < 1e-8
+    # the springs' joint forces are the gradient of their energy (full tree coordinates)
+    q0, h = m.q[7], 1e-6
+    K0 = sprung.spring_torque(q0)
+    for i in range(sprung.dof):
+        dq = np.zeros(sprung.dof)
+        dq[i] = h
+        fd = (sprung.spring_energy(q0 + dq) - sprung.spring_energy(q0 - dq)) / (2 * h)
+        assert K0[i] == pytest.approx(fd, rel=1e-6, abs=1e-4)
+
+
+def test_published_spring_numbers_through_the_model(machine, case, grid):
+    """The runner's published Table 1 (theoretical row) from the general spring method with the
+    springs on the model: rates 2.510052 / 11.130577 N/mm (eqs 18-19) and the peak cable forces
+    2321.80 / 4471.77 N (the model's tension at the largest anchor distance over the cube)."""
+    result = machine.size(grid)
+    assert result.exact and result.rank == 2 and result.residual < 1e-9
+    assert result.balanced.spring_names == [s.name for s in case.springs]
+    published = {case.roles.distal_spring: (2.510052, 2321.798099958), case.roles.proximal_spring: (11.130576923, 4471.771447237)}
+    for name, (rate, peak) in published.items():
+        assert result.design[name]["rate"] / 1e3 == pytest.approx(rate, rel=1e-9)
+        d, where = og.peak_distance(machine, name, grid, case.workspace.center, case.workspace.edge)
+        sprung = machine.with_springs(machine.springs({n: v["rate"] for n, v in result.design.items()}))
+        m, *_ = machine.solve(np.asarray(where)[None], with_coupling=False)
+        tension = sprung.spring_tension(m.q)[0, sprung.spring_names.index(name)]
+        assert tension == pytest.approx(peak, rel=1e-6)
+    # the potential energy of the balanced model is constant (the method's own metric)
+    assert result.metrics["potential_energy_variation_after"] < 1e-9
 
 
 def _short_paths(case, dt=0.01):
@@ -168,7 +217,7 @@ def test_catalogue_selection_reproduces_tables_1_2(machine, grid, rates, lumped,
     for name, offset, key in ((case.roles.distal_spring, lumped.delta_y, "distal"),
                               (case.roles.proximal_spring, lumped.eps_y, "proximal")):
         d, _ = og.peak_distance(machine, name, grid, case.workspace.center, case.workspace.edge)
-        best = paper.select_springs(rates[name], rates[name] * d, anchor_offset=offset)[0]
+        best = select_springs(rates[name], rates[name] * d, anchor_offset=offset)[0]
         assert best.count == t2[key]["count"] and best.moving_pulleys == t2[key]["moving_pulleys"]
         assert best.spring.rate / 1e3 == pytest.approx(t2[key]["spring_rate_N_per_mm"])
         assert best.equivalent_rate * best.anchor_offset == pytest.approx(rates[name] * offset, rel=1e-12)
@@ -177,7 +226,7 @@ def test_catalogue_selection_reproduces_tables_1_2(machine, grid, rates, lumped,
         # the peak cable force of the chosen geometry is Table 1's to 0.1 %
         assert rates[name] * d == pytest.approx(t1["theoretical"][f"f_{letter}_max_N"], rel=1e-3)
     with pytest.raises(ValueError, match="rate_N_per_mm"):
-        paper.load_catalogue(__file__)
+        load_catalogue(__file__)
 
 
 def test_sensitivity_of_the_vertical_loads(machine, grid, rates, lumped, case):

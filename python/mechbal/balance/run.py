@@ -350,10 +350,12 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
     units = ["N" if types.get(n) == _core.JointType.prismatic else "N m" for n in joints]
     variants = {"unbalanced": before, "balanced": after}
     title = f"{bc.title}: {name} balancing"
+    sprung = bool(result.balanced.springs or bc.mechanism.springs)
     report.plot_series(out / "gravity_torque.png", bc.t, {k: v["gravity_torque"] for k, v in variants.items()},
-                       joints, [f"gravity torque [{u}]" for u in units], title=title,
-                       caption="Gravity torque (the actuator torque that holds each pose) along the "
-                               "trajectory, before and after balancing.")
+                       joints, [f"{'static' if sprung else 'gravity'} torque [{u}]" for u in units], title=title,
+                       caption=("Static torque (gravity + springs: the actuator torque that holds each pose)"
+                                if sprung else "Gravity torque (the actuator torque that holds each pose)")
+                               + " along the trajectory, before and after balancing.")
     report.plot_series(out / "joint_torques.png", bc.t, {k: v["torque"] for k, v in variants.items()},
                        joints, [f"torque [{u}]" for u in units], title=title,
                        caption="Actuator torque (revolute) or force (prismatic) along the trajectory, "

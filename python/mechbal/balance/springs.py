@@ -241,12 +241,12 @@ def spring_torque(mechanism: Mechanism, springs: Sequence[SpringSlot], q) -> np.
 # ------------------------------------------------------------------------------------------------
 # Sizing
 # ------------------------------------------------------------------------------------------------
-def _coupling_matrices(mechanism: Mechanism, samples: np.ndarray, q_guess=None):
+def _coupling_matrices(mechanism: Mechanism, samples: np.ndarray, q_guess=None, closure_tolerance: float = 1e-13):
     """Loop-solved configurations q (N, dof) and coupling matrices C (N, dof, na) of a closed
     mechanism over actuated samples (N, na)."""
     na = len(mechanism.model.actuated_coordinates)
     guess = None if q_guess is None else np.asarray(q_guess, float)
-    m = mechanism.closed_motion(samples, q_guess=guess)
+    m = mechanism.closed_motion(samples, q_guess=guess, tolerance=closure_tolerance)
     bad = np.asarray(m.status).astype(np.int64) & ~int(_core.Status.singular)
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
@@ -256,7 +256,7 @@ def _coupling_matrices(mechanism: Mechanism, samples: np.ndarray, q_guess=None):
     for k in range(na):
         e = np.zeros_like(samples)
         e[:, k] = 1.0
-        C[:, :, k] = mechanism.closed_motion(samples, e, q_guess=guess).v
+        C[:, :, k] = mechanism.closed_motion(samples, e, q_guess=guess, tolerance=closure_tolerance).v
     return np.asarray(m.q), C
 
 
@@ -289,7 +289,7 @@ def _bounds_of(slot: SpringSlot, side: str):
 
 
 def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: float = 1e-9,
-            max_nfev: int = 200, catalogue=None, **options) -> BalanceResult:
+            max_nfev: int = 200, catalogue=None, closure_tolerance: float = 1e-13, **options) -> BalanceResult:
     """Size springs so that gravity torque + spring torque = 0 over a workspace sample.
 
     ``design``: :class:`~mechbal.balance.result.SpringSlot` objects (or ``{"springs": [...]}``).
@@ -298,7 +298,8 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     bounds (coordinates with equal lower and upper bounds stay fixed).
     ``samples``: configurations (N, dof); for a closed mechanism the actuated positions (N, na)
     (solved with ``closed_motion`` from ``q_guess``, in the given order) and the balance holds in
-    the actuated coordinates.
+    the actuated coordinates; ``closure_tolerance`` [m] of that loop solve (stiff springs need a
+    tighter one: a closure error e leaves about K e on the actuators).
 
     Returns a :class:`BalanceResult`: ``design[name]`` with ``rate`` [N/m] (each spring),
     ``equivalent_rate`` [N/m] at the anchors, the anchors, ``peak_tension`` [N],
@@ -327,7 +328,7 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
         if samples.shape[1] != na:
             raise ValueError(f"samples: a closed mechanism is sampled by its {na} actuated positions "
                              f"(N, {na}), got {samples.shape}")
-        q, C = _coupling_matrices(mechanism, samples, q_guess)
+        q, C = _coupling_matrices(mechanism, samples, q_guess, closure_tolerance)
     else:
         if samples.shape[1] != mechanism.dof:
             raise ValueError(f"samples: must have shape (N, {mechanism.dof}), got {samples.shape}")

@@ -4,7 +4,9 @@
   inside them, numbers written to round-trip exactly, strings, booleans, arrays).
 * :func:`mechanism_table`: the ``[mechanism]`` table of a :class:`mechbal.Mechanism` from its
   model (joints as ``origin = {xyz, rpy}`` + ``axis`` in the parent link's frame, limits, gears,
-  every body with its centre of mass and full inertia in its link frame, frames, loops).
+  every body with its centre of mass and full inertia in its link frame, frames, loops, springs).
+  The root link is written ``base`` (a URDF's may be ``world``); a frame named ``base`` (a URDF
+  link of that name) is written ``base_frame``, since ``base`` is the TOML format's fixed base.
 * :func:`urdf_text`: URDF of a mechanism without loops: one ``<link>`` per joint (named after
   it, as mechbal names links), its bodies merged into one ``<inertial>`` (exact for dynamics),
   joints ``revolute`` (``continuous`` without limits), ``prismatic``, ``fixed``, gears as
@@ -103,10 +105,15 @@ _TYPES = {_core.JointType.revolute: "revolute", _core.JointType.prismatic: "pris
 def mechanism_table(mech) -> dict:
     """The ``[mechanism]`` table of ``mech`` (see the module docstring)."""
     d = mech.model.description
+    root = d.root_name
+
+    def link_name(link: str) -> str:  # the TOML format calls the root 'base' (a URDF's may be 'world')
+        return "base" if link == root else link
+
     joints = []
     for j in d.joints:
         T = np.asarray(j.placement)
-        entry: dict[str, Any] = {"name": j.name, "type": _TYPES[j.type], "parent": j.parent,
+        entry: dict[str, Any] = {"name": j.name, "type": _TYPES[j.type], "parent": link_name(j.parent),
                                  "origin": {"xyz": T[:3, 3].tolist(), "rpy": rpy_of(T[:3, :3])}}
         if j.type != _core.JointType.fixed:
             entry["axis"] = np.asarray(j.axis, float).tolist()
@@ -119,12 +126,12 @@ def mechanism_table(mech) -> dict:
                 entry["mimic"] = {"joint": j.mimic_joint, "ratio": float(j.mimic_ratio), "offset": float(j.mimic_offset)}
         joints.append(entry)
     bodies = [{"name": b.name, "kind": b.kind if b.kind in ("link", "counterweight", "motor", "disc", "payload")
-               else "other", "link": b.link, "mass": float(b.mass), "com": np.asarray(b.com, float).tolist(),
+               else "other", "link": link_name(b.link), "mass": float(b.mass), "com": np.asarray(b.com, float).tolist(),
                "inertia": _inertia6(b.inertia)} for b in d.bodies]
     frames = []
     for f in d.frames:
         T = np.asarray(f.placement)
-        frames.append({"name": f.name, "link": f.link, "origin": {"xyz": T[:3, 3].tolist(), "rpy": rpy_of(T[:3, :3])}})
+        frames.append({"name": "base_frame" if f.name == "base" else f.name, "link": link_name(f.link), "origin": {"xyz": T[:3, 3].tolist(), "rpy": rpy_of(T[:3, :3])}})
     out: dict[str, Any] = {"gravity": np.asarray(d.gravity, float).tolist(), "joints": joints}
     if bodies:
         out["bodies"] = bodies
@@ -132,7 +139,6 @@ def mechanism_table(mech) -> dict:
         out["frames"] = frames
     springs = list(d.springs)
     if springs:
-        root = d.root_name
         out["springs"] = [{"name": sp.name,
                            "link_a": "base" if sp.link_a == root else sp.link_a,
                            "anchor_a": np.asarray(sp.anchor_a, float).tolist(),

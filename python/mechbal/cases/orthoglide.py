@@ -2,16 +2,19 @@
 (Martini, Troncossi, Carricato & Rivola 2015), on the general model.
 
 Everything is computed by the general path on the mechanism of the case file (closed loops solved
-by the general loop solve, ``v = C v#``): the motor forces of the three sliders are
+by the general loop solve, ``v = C v#``). The case's ``[[springs]]`` are slots of the general spring
+method (:mod:`mechbal.balance.springs`, zero free length); their rates are sized by
+:func:`mechbal.balance.springs.balance` so that the static motor forces C^T (G + K) vanish over the
+workspace grid, and a set of springs with rates is put on the model (``Mechanism.with_springs``), so
+that the motor forces of the three sliders are
 
-    tau# = C^T (tau(q, v, a) + dV_s/dq - J_P^T f_cut)
+    tau# = C^T (tau(q, v, a) - J_P^T f_cut)
 
-with tau the tree's inverse dynamics (gravity included), V_s the springs' energy (zero free
-length: V = K |r_B - r_A|^2 / 2, dV/dq = K (J_B - J_A)^T (r_B - r_A)) and f_cut the cutting force
-on the tool frame P (J_P: its linear Jacobian). The spring rates are sized by least squares so that
-the static motor forces C^T (G + dV_s/dq) vanish over the workspace grid (rates from the chosen
-anchors, the general spring method). The paper's closed forms (:mod:`mechbal.papers.orthoglide`:
-eq 1, eqs 5-19, the platform's Newton equation) check the result in the summary and the tests.
+with tau the model's inverse dynamics (gravity and springs included: K = dV_s/dq, V_s = K |r_B -
+r_A|^2 / 2 for a zero-free-length spring) and f_cut the cutting force on the tool frame P (J_P: its
+linear Jacobian). Catalogue clusters come from :func:`mechbal.balance.springs.select_springs`. The
+paper's closed forms (:mod:`mechbal.papers.orthoglide`: eq 1, eqs 5-19 on the paper's lumped model,
+the platform's Newton equation) check the result in the summary and the tests.
 
 Platform paths are Cartesian (Section 5.1); the sliders' motion is eq 1 and its derivatives, and
 the general model's platform motion must reproduce the path (checked to 1e-9 m).
@@ -20,8 +23,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
 from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 
@@ -29,6 +32,8 @@ from mechbal import control
 from mechbal import progress, report
 from mechbal.cases import register
 from mechbal.config import ConfigError
+from mechbal.balance import springs as spring_method
+from mechbal.balance.result import BalanceResult, SpringSlot
 from mechbal.export import write_bodies, write_summary
 from mechbal.mechanism import Mechanism
 from mechbal.papers import orthoglide as paper
@@ -59,19 +64,14 @@ def coupling_matrix(mech: Mechanism, q) -> np.ndarray:
     return C
 
 
-@dataclass(frozen=True)
-class Spring:
-    """A zero-free-length spring between the frames ``frame_a`` and ``frame_b`` (added at its
-    anchors), rate [N/m]."""
-    name: str
-    frame_a: str
-    frame_b: str
-    rate: float
-
-
 class Orthoglide:
-    """The case's mechanism with a frame at every spring anchor, its springs, and the general-path
-    evaluations the tables need."""
+    """The case's mechanism, its springs as :class:`~mechbal.balance.result.SpringSlot` slots of
+    the general spring method (zero free length; ``rate`` None until sized), and the general-path
+    evaluations the tables need. A set of springs with rates is put on the model with
+    :meth:`with_springs`, so the static forces, the energy and the inverse dynamics are the
+    model's (``cpp/include/mechbal/algorithm/springs.hpp``). The spring anchors are also named
+    frames (``spring:<name>:a``, ``spring:<name>:b``): the paper's points A, B, N_1, N_2 that
+    :meth:`lumped` measures."""
 
     def __init__(self, case, *, masses: dict[str, float] | None = None,
                  anchors: dict[str, dict[str, tuple]] | None = None):
@@ -80,17 +80,23 @@ class Orthoglide:
         masses = masses or {}
         bodies = [dataclasses.replace(b, mass=masses.get(b.name, b.mass)) for b in spec.bodies]
         frames = list(spec.frames)
-        self.spring_specs = []
         for s in case.springs:
             over = (anchors or {}).get(s.name, {})
-            fa, fb = f"spring:{s.name}:a", f"spring:{s.name}:b"
-            for name, link, anchor in ((fa, s.link_a, over.get("a", s.anchor_a)), (fb, s.link_b, over.get("b", s.anchor_b))):
+            for side in ("a", "b"):
                 T = np.eye(4)
-                T[:3, 3] = anchor
-                frames.append(FrameSpec(name=name, link=link, placement=T))
-            self.spring_specs.append((s.name, fa, fb, s.rate))
+                T[:3, 3] = over.get(side, getattr(s, f"anchor_{side}"))
+                frames.append(FrameSpec(name=f"spring:{s.name}:{side}", link=getattr(s, f"link_{side}"), placement=T))
         self.mech = Mechanism.from_spec(dataclasses.replace(spec, bodies=bodies, frames=frames),
                                         name=case.case.name)
+        # the slots name the model's links (a fixed joint's link is merged into its parent's), the
+        # anchors in those links' frames: where the model put the anchor frames
+        at = {f.name: (f.link, tuple(map(float, np.asarray(f.placement)[:3, 3])))
+              for f in self.mech.model.description.frames}
+        self.slots: list[SpringSlot] = []
+        for s in case.springs:
+            (la, aa), (lb, ab) = at[f"spring:{s.name}:a"], at[f"spring:{s.name}:b"]
+            self.slots.append(SpringSlot(name=s.name, link_a=la, anchor_a=aa, link_b=lb, anchor_b=ab, rate=s.rate))
+        self._with: dict[tuple, Mechanism] = {}
         names = self.mech.joint_names
         self.q_guess = np.zeros(self.mech.dof)
         for jv in case.roles.initial_guess:
@@ -108,24 +114,18 @@ class Orthoglide:
         self.delta = np.array([self.mech.frame_placement(q0, f"D{j}")[:3, 3][j - 1] - P[j - 1] for j in (1, 2, 3)])
 
     # ---- springs ------------------------------------------------------------------------------
-    def springs(self, rates: dict[str, float] | None = None) -> list[Spring]:
+    def springs(self, rates: dict[str, float] | None = None) -> list[SpringSlot]:
+        """The spring slots with rates [N/m] (``rates`` over the case's; unsized ones at 0)."""
         rates = rates or {}
-        return [Spring(n, a, b, float(rates.get(n, r if r is not None else 0.0))) for n, a, b, r in self.spring_specs]
+        return [dataclasses.replace(s, rate=float(rates.get(s.name, s.rate if s.rate is not None else 0.0)))
+                for s in self.slots]
 
-    def spring_terms(self, q, v=None):
-        """Per spring: (r = r_B - r_A (N, 3), dV/dq per unit rate (N, dof), r . (v_B - v_A) (N,))."""
-        out = {}
-        for name, fa, fb, _ in self.spring_specs:
-            Xa = self.mech.frame_placement(q, fa)[..., :3, 3]
-            Xb = self.mech.frame_placement(q, fb)[..., :3, 3]
-            Ja = self.mech.frame_jacobian(q, fa)[..., :3, :]
-            Jb = self.mech.frame_jacobian(q, fb)[..., :3, :]
-            r = Xb - Xa
-            dJ = Jb - Ja
-            Q = np.einsum("nkd,nk->nd", dJ, r)
-            rate = None if v is None else np.einsum("nk,nk->n", r, np.einsum("nkd,nd->nk", dJ, v))
-            out[name] = (r, Q, rate)
-        return out
+    def with_springs(self, springs: Sequence[SpringSlot]) -> Mechanism:
+        """The mechanism with these springs as elements of its model (cached by their rates)."""
+        key = tuple((s.name, s.rate) for s in springs)
+        if key not in self._with:
+            self._with[key] = spring_method.with_springs(self.mech, springs)
+        return self._with[key]
 
     # ---- loop solve ---------------------------------------------------------------------------
     def rho(self, p, v=None, a=None):
@@ -155,38 +155,33 @@ class Orthoglide:
         return m, C, rho, rho_d, rho_dd
 
     # ---- forces -------------------------------------------------------------------------------
-    def static_forces(self, p, springs: list[Spring]) -> np.ndarray:
-        """Static motor forces C^T (G + dV_s/dq) (N, 3) at platform points p."""
+    def static_forces(self, p, springs: Sequence[SpringSlot]) -> np.ndarray:
+        """Static motor forces C^T (G + K) (N, 3) at platform points p: the model's static
+        torque (gravity and springs) in the actuated coordinates."""
         m, C, *_ = self.solve(p)
-        Q = self.mech.gravity_torque(m.q)
-        terms = self.spring_terms(m.q)
-        for s in springs:
-            Q = Q + s.rate * terms[s.name][1]
-        return np.einsum("nda,nd->na", C, Q)
+        return np.einsum("nda,nd->na", C, self.with_springs(springs).static_torque(m.q))
+
+    def size(self, p) -> BalanceResult:
+        """The general spring method (:func:`mechbal.balance.springs.balance`) over the platform
+        points p: rates [N/m] by least squares so that C^T (G + K) = 0 at the sliders' positions
+        of eq 1 (the slots' fixed rates kept)."""
+        rho = self.rho(np.atleast_2d(np.asarray(p, float)))
+        return spring_method.balance(self.mech, self.slots, rho, q_guess=self.q_guess,
+                                     closure_tolerance=CLOSURE_TOLERANCE)
 
     def size_rates(self, p) -> tuple[dict[str, float], float, int]:
-        """Rates [N/m] by least squares over the platform points p: C^T (G + sum K_k dV_k/dq) = 0.
-        Returns (rates, residual [N] max over samples and axes, rank)."""
-        m, C, *_ = self.solve(p)
-        G = np.einsum("nda,nd->na", C, self.mech.gravity_torque(m.q)).reshape(-1)
-        terms = self.spring_terms(m.q)
-        A = np.stack([np.einsum("nda,nd->na", C, terms[n][1]).reshape(-1) for n, *_ in self.spring_specs], 1)
-        K, *_, rank, _ = np.linalg.lstsq(A, -G, rcond=None)
-        residual = float(np.max(np.abs(A @ K + G)))
-        return {n: float(k) for (n, *_), k in zip(self.spring_specs, K)}, residual, int(rank)
+        """:meth:`size` as (rates [N/m], residual [N] max over samples and axes, rank)."""
+        r = self.size(p)
+        return {n: float(d["rate"]) for n, d in r.design.items()}, float(r.residual), int(r.rank or 0)
 
-    def dynamics(self, path: paper.PlatformPath, springs: list[Spring]) -> dict:
-        """Motor forces along a path and the terms of the virtual power balance."""
+    def dynamics(self, path: paper.PlatformPath, springs: Sequence[SpringSlot]) -> dict:
+        """Motor forces along a path (the model's inverse dynamics with the springs, projected
+        by C^T, minus the cutting force's share) and the terms of the virtual power balance."""
+        mech = self.with_springs(springs)
         m, C, rho, rho_d, rho_dd = self.solve(path.p, path.v, path.a)
-        tau = np.einsum("nda,nd->na", C, self.mech.inverse_dynamics(m.q, m.v, m.a))   # gravity included
-        terms = self.spring_terms(m.q, m.v)
-        spring_power = np.zeros(len(path.t))
-        spring_energy = np.zeros(len(path.t))
-        for s in springs:
-            r, Q, rate = terms[s.name]
-            tau += s.rate * np.einsum("nda,nd->na", C, Q)
-            spring_power += s.rate * rate
-            spring_energy += 0.5 * s.rate * np.sum(r * r, 1)
+        tau = np.einsum("nda,nd->na", C, mech.inverse_dynamics(m.q, m.v, m.a))   # gravity, springs included
+        spring_power = np.einsum("nd,nd->n", mech.spring_torque(m.q), m.v) if springs else np.zeros(len(path.t))
+        spring_energy = np.atleast_1d(mech.spring_energy(m.q)) if springs else np.zeros(len(path.t))
         J = self.mech.frame_jacobian(m.q, self.tool)[:, :3, :]
         tau -= np.einsum("nda,nkd,nk->na", C, J, path.f_cut)
         bm = self.mech.body_motion(m.q, m.v, m.a)
@@ -204,16 +199,16 @@ class Orthoglide:
                 "power_balance_error": float(np.max(np.abs(motor_power - (energy_rate - cutting_power)))) / scale,
                 "min_rcond": float(np.min(m.rcond))}
 
-    def potential_energy(self, p, springs: list[Spring]) -> np.ndarray:
-        """Gravity (-sum m g . c) plus springs' energy [J] at platform points p."""
+    def potential_energy(self, p, springs: Sequence[SpringSlot]) -> np.ndarray:
+        """Gravity (-sum m g . c) plus springs' energy [J] at platform points p (the model's)."""
         m, *_ = self.solve(p, with_coupling=False)
-        com = self.mech.body_motion(m.q).com
-        mass = np.array([b.mass for b in self.mech.bodies])
-        V = -np.einsum("b,nbk,k->n", mass, com, self.mech.gravity)
-        terms = self.spring_terms(m.q)
-        for s in springs:
-            V = V + 0.5 * s.rate * np.sum(terms[s.name][0] ** 2, 1)
-        return V
+        return np.atleast_1d(self.with_springs(springs).potential_energy(m.q))
+
+    def spring_lengths(self, p, name: str) -> np.ndarray:
+        """Anchor distance [m] of spring ``name`` at platform points p (the model's)."""
+        m, *_ = self.solve(p, with_coupling=False)
+        slot = next(s for s in self.slots if s.name == name)
+        return np.atleast_2d(spring_method.spring_lengths(self.mech, [slot], m.q))[:, 0]
 
     def lumped(self, p_ref) -> paper.LumpedModel:
         """Section 3's parameters measured on this model (for the closed-form checks)."""
@@ -292,14 +287,12 @@ def peak_distance(o: Orthoglide, spring: str, grid: np.ndarray, center, edge: fl
     bounded local maximisation from the best grid point (the peak may fall between grid points)."""
     from scipy.optimize import minimize
 
-    m, *_ = o.solve(grid, with_coupling=False)
-    d = np.linalg.norm(o.spring_terms(m.q)[spring][0], axis=1)
+    d = o.spring_lengths(grid, spring)
     k = int(np.argmax(d))
     lo, hi = np.asarray(center) - edge / 2, np.asarray(center) + edge / 2
 
     def f(x):
-        mm, *_ = o.solve(x[None], with_coupling=False)
-        return -float(np.linalg.norm(o.spring_terms(mm.q)[spring][0][0]))
+        return -float(o.spring_lengths(x[None], spring)[0])
 
     res = minimize(f, grid[k], bounds=list(zip(lo, hi)), method="L-BFGS-B")
     if -res.fun > d[k]:
@@ -333,7 +326,7 @@ def run(config, out: Path) -> dict:
     V_closed = paper.potential_energy(lm, grid, K_D, K_P)
 
     progress.stage("spring selection (Tables 1-2)")
-    cat = paper.load_catalogue(case.catalogue.file) if case.catalogue.file else paper.load_catalogue()
+    cat = spring_method.load_catalogue(case.catalogue.file or None)
     selection, table1 = {}, {"theoretical": {}, "off_the_shelf": {}}
     offsets = {roles.distal_spring: ("delta_y", lm.delta_y, +1.0), roles.proximal_spring: ("eps_y", lm.eps_y, -1.0)}
     chosen_anchor = {}
@@ -353,7 +346,7 @@ def run(config, out: Path) -> dict:
                 cache[round(shift, 12)] = peak_distance(o, sname, grid, ws.center, ws.edge)[0]
             return K * cache[round(shift, 12)]
 
-        cands = paper.select_springs(K0, K0 * d_peak, cat, anchor_offset=offset,
+        cands = spring_method.select_springs(K0, K0 * d_peak, cat, anchor_offset=offset,
                                      counts=range(case.catalogue.counts[0], case.catalogue.counts[1] + 1),
                                      pulley_ratios=case.catalogue.pulley_ratios,
                                      rate_tolerance=case.catalogue.rate_tolerance, peak_force_at=peak_at)
@@ -513,7 +506,8 @@ def run(config, out: Path) -> dict:
                                         "K_P": paper.PAPER_TABLE1["theoretical"]["K_P_N_per_mm"]},
         "closed_form_spring_rates_N_per_mm": {"K_D": K_D_eq18 / 1e3, "K_P": K_P_eq19 / 1e3},
         "anchor_offsets_mm": {"delta_y": lm.delta_y * 1e3, "eps_y": lm.eps_y * 1e3},
-        "rate_sizing": {"method": "least squares of C^T (G + sum K dV/dq) = 0 over the workspace grid",
+        "rate_sizing": {"method": "mechbal.balance.springs.balance: least squares of C^T (G + K) = 0 over the "
+                                  "workspace grid (springs on the model)",
                         "rank": rank, "residual_N": size_residual},
         "acceptance": {
             "static_motor_force_balanced_max_N": float(np.max(np.abs(F_sb))),

@@ -8,18 +8,24 @@ Frame of the paper: y vertical, gravity (0, -g, 0). Here:
 * :func:`linear_delta_ik` - eq 1 (with its typo corrected: the right-hand sides are the platform
   point's coordinates p, not the slider positions rho), with its time derivatives;
 * :func:`distal_rate`, :func:`proximal_rate` - eqs 18-19;
-* :class:`LumpedModel` and :func:`lumped_model` - the Section 3 parameters *measured* on the general
-  model (lengths between its named frames, masses of its bodies), so that the closed forms check
-  the model the case file describes;
-* :func:`potential_energy` - eqs 5, 6, 9, 10 (total, for any rates);
-* :func:`inverse_dynamics` - motor forces from the platform's Newton equation with the leg forces
-  along the parallelogram directions, the sliders' and the spring support's Newton equations (an
-  independent computation of what the general closed-loop inverse dynamics gives);
-* :func:`select_springs`, :func:`load_catalogue` - practical spring selection (Tables 1-2),
-  with the interface of ``mechbal.balance.springs`` (branch ``springs``), to be replaced by it;
+* :class:`LumpedModel` and :func:`lumped_model` - **the paper's model**, a deliberate
+  approximation of Section 3 (massless legs and links, lumped masses on the platform, the sliders
+  and the spring support), its parameters *measured* on the general model (lengths between its
+  named frames, masses of its bodies), so that the closed forms check the model the case file
+  describes;
+* :func:`potential_energy` - eqs 5, 6, 9, 10 on the lumped model (total, for any rates): checks
+  the general model's potential energy with its springs (``Mechanism.potential_energy``);
+* :func:`inverse_dynamics` - motor forces of the lumped model from the platform's Newton equation
+  with the leg forces along the parallelogram directions, the sliders' and the spring support's
+  Newton equations (an independent computation of what the general closed-loop inverse dynamics,
+  springs on the model, gives);
 * :func:`rest_to_rest`, :func:`helix_path`, :func:`cube_path`, :func:`machining_path` - the
   simulated trajectories of Section 5.1 (Paths A-F) and the cutting-force model;
 * ``PAPER_*`` - the paper's published numbers (Tables 1, 2, 4, 5, 6), for comparison only.
+
+The springs themselves are elements of the general model and are sized by the general method
+(:mod:`mechbal.balance.springs`: ``balance``, ``select_springs`` for Tables 1-2); the runner
+:mod:`mechbal.cases.orthoglide` uses them, and these closed forms are its fast-path checks.
 """
 from __future__ import annotations
 
@@ -31,8 +37,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 __all__ = ["linear_delta_ik", "distal_rate", "proximal_rate", "LumpedModel", "lumped_model",
-           "potential_energy", "inverse_dynamics", "CatalogueSpring", "SpringCluster", "load_catalogue",
-           "select_springs", "rest_to_rest", "PlatformPath", "helix_path", "cube_path", "machining_path",
+           "potential_energy", "inverse_dynamics", "rest_to_rest", "PlatformPath", "helix_path", "cube_path", "machining_path",
            "PAPER_TABLE1", "PAPER_TABLE2", "PAPER_TABLE4", "PAPER_TABLE5", "PAPER_TABLE6"]
 
 # ---- the paper's published numbers (for comparison only) ----------------------------------------
@@ -134,7 +139,8 @@ def proximal_rate(m_p: float, m_s2: float, m_w: float, m_t: float, g: float, eps
     return 2.0 * (m_p + m_s2 + m_w + m_t / 2.0) * g / eps_y
 
 
-# ---- the lumped model of Section 3, measured on the general model --------------------------------
+# ---- the paper's lumped model of Section 3 (an approximation: massless legs, lumped masses),
+# measured on the general model; checks of the general path, not a second model of the machine ----
 @dataclass(frozen=True)
 class LumpedModel:
     """Section 3's parameters in SI units and O's axes (y up). ``L`` leg length; ``delta`` (3, 3):
@@ -242,7 +248,7 @@ def _slider_points(lm: LumpedModel, rho):
 
 
 def potential_energy(lm: LumpedModel, p, K_D: float = 0.0, K_P: float = 0.0) -> np.ndarray:
-    """Total potential energy [J] at platform points p (..., 3): gravity of m_p, m_s2 + m_w (the
+    """The paper's lumped model (a check of the general path): total potential energy [J] at platform points p (..., 3): gravity of m_p, m_s2 + m_w (the
     vertical slider) and m_t plus the two zero-free-length springs (eqs 5, 6, 9, 10, written in
     positions rather than the angles phi_1, phi_2, gamma; the horizontal sliders' V_gH is
     constant and left out). Its zero differs from the general model's -sum m g . c by a constant."""
@@ -260,7 +266,7 @@ def potential_energy(lm: LumpedModel, p, K_D: float = 0.0, K_P: float = 0.0) -> 
 
 def inverse_dynamics(lm: LumpedModel, p, v, a, f_cut=None, K_D: float = 0.0, K_P: float = 0.0,
                      m_slider_extra=None) -> dict[str, np.ndarray]:
-    """Motor forces (..., 3) [N] along x, y, z of the lumped machine for the platform motion (p,
+    """The paper's lumped model (a check of the general path): motor forces (..., 3) [N] along x, y, z of the lumped machine for the platform motion (p,
     v, a) (..., 3) with the cutting force ``f_cut`` (..., 3) on the tool, by Newton's equations:
 
     * platform: m_p (a_P - g) = sum_j t_j w_j + f_cut + K_D (A - B): solves the leg forces t_j
@@ -299,10 +305,6 @@ def inverse_dynamics(lm: LumpedModel, p, v, a, f_cut=None, K_D: float = 0.0, K_P
         F[..., j] = M[j] * (rho_dd[..., j] - gv[j]) + t[..., j] * W[..., j, j]
     F[..., 1] -= on_slider2[..., 1]
     return {"motor_force": F, "leg_force": t, "rho": rho, "rho_d": rho_d, "rho_dd": rho_dd}
-
-
-# ---- practical spring selection (Tables 1-2): the general catalogue selection of the spring method
-from mechbal.balance.springs import CatalogueSpring, SpringCluster, load_catalogue, select_springs  # noqa: E402,F401
 
 
 def rest_to_rest(distance: float, v_max: float, a_max: float):
