@@ -404,22 +404,17 @@ void link_torque_regressor(const MechanismModel& model, MechanismData& data, int
     Y.block<3, 1>(3, col) = RF * n + p.cross(fw);
   }
   data.link_regressor.setZero();
-  for (int k = l; k >= 1; k = model.parent(k)) {
-    const int c = model.coordinate(k);
-    if (c < 0) continue;
-    const auto& K = data.work[static_cast<std::size_t>(k)];
-    const Vec3 z = K.world_rotation.col(2);
-    const double r = model.coordinate_ratio(k);
-    if (model.joint_type(k) == JointType::revolute) {
-      // z . (n_O - p_k x f) = z . n_O - (p_k x f) . z = z . n_O - (z x p_k) . f
-      const Vec3 zxp = z.cross(K.world_position);
+  detail::for_each_path_joint(model, data, l, [&](int c, const Vec3& s, const Vec3& pk, bool revolute) {
+    if (revolute) {
+      // s . (n_O - p_k x f) = s . n_O - (p_k x f) . s = s . n_O - (s x p_k) . f
+      const Vec3 sxp = s.cross(pk);
       for (int col = 0; col < 10; ++col) {
-        data.link_regressor(c, col) += r * (z.dot(Y.block<3, 1>(3, col)) - zxp.dot(Y.block<3, 1>(0, col)));
+        data.link_regressor(c, col) += s.dot(Y.block<3, 1>(3, col)) - sxp.dot(Y.block<3, 1>(0, col));
       }
     } else {
-      for (int col = 0; col < 10; ++col) data.link_regressor(c, col) += r * z.dot(Y.block<3, 1>(0, col));
+      for (int col = 0; col < 10; ++col) data.link_regressor(c, col) += s.dot(Y.block<3, 1>(0, col));
     }
-  }
+  });
 }
 
 template <bool Velocity, bool Acceleration>

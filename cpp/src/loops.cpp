@@ -40,20 +40,16 @@ struct RowFunctional {
 /// touched (no dense 6 x n frame Jacobians).
 void add_path_columns(const MechanismModel& model, const MechanismData& data, int link, const Vec3& p, double side,
                       const RowFunctional* f, int rows, int row0, Eigen::MatrixXd& jac) noexcept {
-  for (int k = link; k >= 1; k = model.parent(k)) {
-    const int c = model.coordinate(k);
-    if (c < 0) continue;
-    const auto& K = data.work[static_cast<std::size_t>(k)];
-    const Vec3 z = model.coordinate_ratio(k) * K.world_rotation.col(2);
-    if (model.joint_type(k) == JointType::revolute) {
-      const Vec3 lin = z.cross(p - K.world_position);
+  detail::for_each_path_joint(model, data, link, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
+    if (revolute) {
+      const Vec3 lin = z.cross(p - pk);
       for (int r = 0; r < rows; ++r) {
         jac(row0 + r, c) += side * f[r].a.dot(lin) + (side < 0.0 ? f[r].b : f[r].e).dot(z);
       }
     } else {
       for (int r = 0; r < rows; ++r) jac(row0 + r, c) += side * f[r].a.dot(z);
     }
-  }
+  });
 }
 
 /// Residual (and Jacobian) of every loop, from placed links (world poses computed).

@@ -275,6 +275,22 @@ inline FrameMotion frame_motion(const MechanismModel& model, const MechanismData
   return m;
 }
 
+/// Calls f(c, s, p_k, revolute) for every joint k with a coordinate on the path from `link` to the
+/// root (placed links): c its coordinate, s = ratio * z_k its axis in O scaled by the gear ratio
+/// (the joint's rate per unit rate of c), p_k its origin in O. A revolute joint moves a point p of
+/// the link by s x (p - p_k) and turns it by s; a prismatic one moves it by s. What the frame
+/// Jacobians, point forces, regressors and loop rows have in common.
+template <typename F>
+inline void for_each_path_joint(const MechanismModel& model, const MechanismData& data, int link, F&& f) noexcept {
+  for (int k = link; k >= 1; k = model.parent(k)) {
+    const int c = model.coordinate(k);
+    if (c < 0) continue;
+    const auto& K = data.work[static_cast<std::size_t>(k)];
+    f(c, Vec3(model.coordinate_ratio(k) * K.world_rotation.col(2)), K.world_position,
+      model.joint_type(k) == JointType::revolute);
+  }
+}
+
 /// Jacobian [v; w] (O axes) of the origin of `frame` into J (6 x dof), from placed links (world
 /// poses computed).
 template <typename Jac>
@@ -285,19 +301,14 @@ inline void frame_jacobian_placed(const MechanismModel& model, const MechanismDa
   const Vec3 origin = F.world_position + F.world_rotation * (model.link_constants(fl).aligned.transpose() *
                                                              model.frame(frame).placement.translation());
   J.setZero();
-  for (int k = fl; k >= 1; k = model.parent(k)) {
-    const int c = model.coordinate(k);
-    if (c < 0) continue;
-    const auto& K = data.work[static_cast<std::size_t>(k)];
-    const Vec3 z = K.world_rotation.col(2);
-    const double r = model.coordinate_ratio(k);
-    if (model.joint_type(k) == JointType::revolute) {
-      J.col(c).template head<3>() += r * z.cross(origin - K.world_position);
-      J.col(c).template tail<3>() += r * z;
+  for_each_path_joint(model, data, fl, [&](int c, const Vec3& s, const Vec3& pk, bool revolute) {
+    if (revolute) {
+      J.col(c).template head<3>() += s.cross(origin - pk);
+      J.col(c).template tail<3>() += s;
     } else {
-      J.col(c).template head<3>() += r * z;
+      J.col(c).template head<3>() += s;
     }
-  }
+  });
 }
 
 /// place<true> when the model has springs (their anchors need world positions), place<false>
@@ -315,18 +326,9 @@ inline void place_for_springs(const MechanismModel& model, MechanismData& data) 
 template <typename Tau>
 inline void add_point_force(const MechanismModel& model, const MechanismData& data, int link, const Vec3& p,
                             const Vec3& f, Tau& tau) noexcept {
-  for (int k = link; k >= 1; k = model.parent(k)) {
-    const int c = model.coordinate(k);
-    if (c < 0) continue;
-    const auto& K = data.work[static_cast<std::size_t>(k)];
-    const Vec3 z = K.world_rotation.col(2);
-    const double r = model.coordinate_ratio(k);
-    if (model.joint_type(k) == JointType::revolute) {
-      tau(c) += r * z.dot((p - K.world_position).cross(f));
-    } else {
-      tau(c) += r * z.dot(f);
-    }
-  }
+  for_each_path_joint(model, data, link, [&](int c, const Vec3& s, const Vec3& pk, bool revolute) {
+    tau(c) += revolute ? s.dot((p - pk).cross(f)) : s.dot(f);
+  });
 }
 
 /// Springs from placed links (world poses computed): data.spring_length, spring_tension,
