@@ -401,3 +401,67 @@ def test_rpsp_design_file_gives_only_balance(capsys, tmp_path):
                       '[trajectory]\nstart = [0.0, 0.0, 0.0]\nend = [0.1, 0.0, 0.0]\nduration = 1.0\n')
     assert main(["balance", "rpsp", "--method", "force", "--design", str(design), "--out", str(tmp_path / "o")]) == 2
     one_line_error(capsys, "trajectory", "[motion]")
+
+
+# ---- Orthoglide (Martini et al.): mechbal balance orthoglide --method springs --------------------
+
+def test_orthoglide_springs_reproduce_eqs_18_19_and_its_toml_runs(tmp_path):
+    """`mechbal balance orthoglide --method springs`: the case's [[springs]] sized over the
+    sliders' positions of its workspace grid (as its runner sizes them) give the runner's
+    published rates 2.510052 / 11.130577 N/mm (eqs 18-19); the static slider forces (gravity +
+    springs) along the rest-to-rest move are below 1e-9 of the unbalanced peak; balanced.toml is
+    the case with the sized rates and runs (its paths shortened here for speed)."""
+    import copy
+
+    out = tmp_path / "orthoglide"
+    assert main(["balance", "orthoglide", "--method", "springs", "--out", str(out), "-q"]) == 0
+    s = summary_of(out)
+    b = s["balance"]
+    assert s["kind"] == "orthoglide" and s["closed"] and b["exact"] and b["rank"] == b["unknowns"] == 2
+    published = {"distal": 2.510052, "proximal": 11.130576923}   # tests/python/test_orthoglide.py
+    for name, rate in published.items():
+        assert b["design"][name]["rate"] / 1e3 == pytest.approx(rate, rel=1e-9), name
+    assert s["case_notes"]["paper_spring_rates_N_per_mm"] == {"K_D": 2.510, "K_P": 11.131}
+    assert "11^3 workspace grid" in s["case_notes"]["sizing_samples"]
+    unb = read_bodies(out / "bodies_unbalanced.npz")
+    bal = read_bodies(out / "bodies_balanced.npz")
+    peak = float(np.max(np.abs(unb["gravity_torque"])))
+    assert peak > 100.0 and np.max(np.abs(bal["gravity_torque"])) < 1e-9 * peak
+    assert s["before_after"]["gravity_torque"]["balanced"]["peak"] == pytest.approx(
+        np.max(np.abs(bal["gravity_torque"]), axis=0).tolist(), abs=1e-12)
+    data = tomllib.loads((out / "balanced.toml").read_text())
+    assert data["case"]["kind"] == "orthoglide" and "balance" not in data
+    assert {x["name"]: x["rate"] for x in data["springs"]} == {n: b["design"][n]["rate"] for n in published}
+    small = copy.deepcopy(data)   # as test_orthoglide's run test: a coarse grid, few short paths
+    small["workspace"]["grid"] = 3
+    small["paths"].update(sample_period=0.05, helix_speeds=[0.8], cube_speeds=[1.0])
+    small["machining"]["tasks"] = small["machining"]["tasks"][-1:]
+    small["machining"]["holes"] = small["machining"]["holes"][:1]
+    from mechbal.balance.writers import toml_text
+
+    (tmp_path / "small.toml").write_text(toml_text(small))
+    assert main(["run", str(tmp_path / "small.toml"), "--out", str(tmp_path / "run"), "-q"]) == 0
+    ran = summary_of(tmp_path / "run")
+    for key, name in (("K_D", "distal"), ("K_P", "proximal")):
+        assert ran["spring_rates_N_per_mm"][key] == pytest.approx(b["design"][name]["rate"] / 1e3, rel=1e-14)
+    assert ran["acceptance"]["static_motor_force_balanced_max_N"] < 1e-9
+
+
+def test_orthoglide_design_springs_the_kind_cannot_carry_are_written_as_a_mechanism(tmp_path):
+    """A --design spring the orthoglide kind cannot carry (two springs in parallel): balanced.toml
+    is a kind `mechanism` case (the mechanism, its springs, the trajectory) and runs."""
+    design = tmp_path / "design.toml"
+    design.write_text('[balance]\nsamples = 60\nlower = [0.45, 0.45, 0.45]\nupper = [0.95, 0.95, 0.95]\n'
+                      '[[balance.springs]]\nname = "distal"\nlink_a = "slider2"\nanchor_a = [0.06, 0.10, 0.0]\n'
+                      'link_b = "platform_phi1"\nanchor_b = [0.06, -0.05, 0.0]\ncount = 2\n'
+                      '[[balance.springs]]\nname = "proximal"\nlink_a = "slider2"\nanchor_a = [0.20, -0.08, -0.15]\n'
+                      'link_b = "support"\nanchor_b = [0.05, 0.05, 0.0]\n')
+    out = tmp_path / "o"
+    assert main(["balance", "orthoglide", "--method", "springs", "--design", str(design), "--out", str(out),
+                 "-q"]) == 0
+    b = summary_of(out)["balance"]
+    assert b["exact"] and b["design"]["distal"]["count"] == 2
+    assert b["design"]["distal"]["rate"] == pytest.approx(2510.052 / 2, rel=1e-9)
+    data = tomllib.loads((out / "balanced.toml").read_text())
+    assert data["case"]["kind"] == "mechanism" and len(data["mechanism"]["springs"]) == 2
+    assert main(["run", str(out / "balanced.toml"), "--out", str(tmp_path / "run"), "-q"]) == 0

@@ -1,8 +1,9 @@
 """``mechbal balance CASE --method METHOD --out DIR``: balance a case's mechanism and write the run.
 
 CASE is a TOML case of kind ``mechanism`` / ``serial_chain`` (its ``[mechanism]``, ``[trajectory]``
-and ``[balance]`` tables), the built-in ``paminsa``, disc and ``rpsp`` cases (kinds ``paminsa``,
-``discs`` and ``rpsp``: :mod:`mechbal.balance.cases`), the built-in ``arm2dof`` (its arm as a mechanism with links
+and ``[balance]`` tables), the built-in ``paminsa``, disc, ``rpsp`` and ``orthoglide`` cases (kinds
+``paminsa``, ``discs``, ``rpsp`` and ``orthoglide``: :mod:`mechbal.balance.cases`; the Orthoglide's
+``--method springs`` sizes its ``[[springs]]`` over its workspace grid as its runner does), the built-in ``arm2dof`` (its arm as a mechanism with links
 ``shoulder`` and ``elbow``, x along each link; the counterweights of ``[counterweights]`` on the
 link extensions unless ``[balance]`` gives others; the minimum-energy cubic law of its
 ``[trajectory]``), or a URDF file (with ``--design FILE.toml`` holding a ``[balance]`` table and
@@ -41,7 +42,10 @@ DEFAULT_SAMPLES = {"static": 1000, "force": 200}
 class BalanceCase:
     """What a balance run needs: the mechanism, the validated ``[balance]`` table (or None),
     the trajectory (actuated joints: q, v, a (N, na) and t), its description for the TOML
-    written back, the assembly guess of a closed mechanism, and the source."""
+    written back, the assembly guess of a closed mechanism, and the source; ``default_design``:
+    per method of :data:`mechbal.balance.METHODS` outside the counterweight methods, the
+    (design, samples, options) it runs without a ``[balance]`` table (the case's own design
+    variables); ``notes``: what summary.json says about the case (``case_notes``)."""
 
     name: str
     title: str
@@ -54,6 +58,8 @@ class BalanceCase:
     raw: dict | None
     kind: str
     default_slots: list
+    default_design: dict | None = None
+    notes: dict | None = None
 
 
 def slots_from_table(table, field: str = "balance.counterweights") -> list[CounterweightSlot]:
@@ -157,13 +163,14 @@ def case_from_config(cfg, raw: dict | None = None, design_cfg=None, *, source: s
         t, motion, tt = _trajectory_motion(mech, {"start": tr.start, "end": tr.end, "duration": tr.duration,
                                                   "samples": tr.samples}, law="cubic")
         return BalanceCase(name, title, mech, table, t, motion, tt, None, raw, "arm2dof", slots)
-    if cfg.case.kind in ("paminsa", "discs", "rpsp"):
+    if cfg.case.kind in ("paminsa", "discs", "rpsp", "orthoglide"):
         from mechbal.balance import cases as builtin
 
-        make = {"paminsa": builtin.paminsa_case, "rpsp": builtin.rpsp_case}.get(cfg.case.kind, builtin.discs_case)
+        make = {"paminsa": builtin.paminsa_case, "rpsp": builtin.rpsp_case,
+                "orthoglide": builtin.orthoglide_case}.get(cfg.case.kind, builtin.discs_case)
         return make(cfg, raw, table, design_cfg)
     raise ConfigError("case.kind", f"mechbal balance reads cases of kind mechanism, serial_chain, arm2dof, "
-                                   f"paminsa, discs or rpsp, and URDF files ({cfg.case.kind!r}: its mechanism is not "
+                                   f"paminsa, discs, rpsp or orthoglide, and URDF files ({cfg.case.kind!r}: its mechanism is not "
                                    "on the general model yet)", cfg.case.kind)
 
 
@@ -229,7 +236,11 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
         if make is None:
             raise ConfigError("--method", f"mechbal.balance.{name} has no design_from_table(table, mechanism): "
                                           "mechbal balance cannot read its design", has_value=False)
-        design, samples, options = make(table, mech)
+        if table is None and bc.default_design is not None and name in bc.default_design:
+            design, samples, options = bc.default_design[name]
+            design, options = list(design), dict(options)
+        else:
+            design, samples, options = make(table, mech)
         import inspect
 
         if bc.q_guess is not None and "q_guess" in inspect.signature(module.balance).parameters:
@@ -280,6 +291,13 @@ def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
               + f".\nResidual {result.residual:.6g} {result.residual_units} (unbalanced {result.residual_before:.6g}).")
     case = {"name": f"{bc.name}-balanced", "kind": "mechanism", "title": f"{bc.title}, balanced ({method})"}
     tt = dict(bc.trajectory_table)
+    if bc.kind == "orthoglide" and bc.raw is not None:
+        from mechbal.balance.cases import orthoglide_written_back
+
+        data = orthoglide_written_back(bc, result)
+        if data is not None:   # the case itself, its [[springs]] with the sized rates
+            data["case"] = {**data["case"], **case, "kind": "orthoglide"}
+            return toml_text(data, header)
     if bc.kind in ("mechanism", "serial_chain", "rpsp") and bc.raw is not None:
         # the case itself with the balancing elements added (rpsp: its counterweight bodies, which
         # the case lists with the paper's masses, replaced by the sized ones)
@@ -386,6 +404,8 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
                "files": files}
     if urdf_note:
         summary["urdf"] = urdf_note
+    if bc.notes:
+        summary["case_notes"] = bc.notes
     write_summary(out / "summary.json", summary)
     rows = [[k, v["mass"], np.asarray(v["position"], float), ", ".join(v.get("active_bounds", [])) or "-"]
             for k, v in result.design.items() if "mass" in v]

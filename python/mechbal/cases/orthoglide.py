@@ -165,9 +165,16 @@ class Orthoglide:
         """The general spring method (:func:`mechbal.balance.springs.balance`) over the platform
         points p: rates [N/m] by least squares so that C^T (G + K) = 0 at the sliders' positions
         of eq 1 (the slots' fixed rates kept)."""
+        slots, rho, options = self.sizing(p)
+        return spring_method.balance(self.mech, slots, rho, **options)
+
+    def sizing(self, p) -> tuple[list[SpringSlot], np.ndarray, dict]:
+        """What :meth:`size` gives the general spring method for platform points p: (the slots,
+        the sliders' positions of eq 1 (N, 3), the options ``q_guess`` and ``closure_tolerance``);
+        ``mechbal balance orthoglide --method springs`` runs the same problem
+        (:func:`mechbal.balance.cases.orthoglide_case`)."""
         rho = self.rho(np.atleast_2d(np.asarray(p, float)))
-        return spring_method.balance(self.mech, self.slots, rho, q_guess=self.q_guess,
-                                     closure_tolerance=CLOSURE_TOLERANCE)
+        return list(self.slots), rho, {"q_guess": self.q_guess.copy(), "closure_tolerance": CLOSURE_TOLERANCE}
 
     def size_rates(self, p) -> tuple[dict[str, float], float, int]:
         """:meth:`size` as (rates [N/m], residual [N] max over samples and axes, rank)."""
