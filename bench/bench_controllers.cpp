@@ -11,25 +11,16 @@
 #include "bench_registry.hpp"
 #include "mechbal/paminsa.hpp"
 #include "mechbal/reactionless_wrist.hpp"
+#include "paminsa_motion.hpp"
 
 namespace mechbal::bench {
 namespace {
 
+using test::platform_at;
+using test::wrist_at;
+
 constexpr double kDt = 1e-3;  // 1 kHz
 constexpr int kTicks = 1024;  // a precomputed stretch of trajectory, cycled through (power of 2)
-
-// A smooth 3-D platform motion around the nominal pose (the PAMINSA tests' trajectory).
-PlatformMotion platform_at(double t) {
-  const Vec3 P0(0.48, 0.05, 0.6775), amp(0.04, 0.12, 0.03), om(3.0, 2.0, 5.0), ph(0.3, 1.1, 0.7);
-  PlatformMotion m;
-  for (int i = 0; i < 3; ++i) {
-    const double a = om(i) * t + ph(i);
-    m.position(i) = P0(i) + amp(i) * std::sin(a);
-    m.velocity(i) = amp(i) * om(i) * std::cos(a);
-    m.acceleration(i) = -amp(i) * om(i) * om(i) * std::sin(a);
-  }
-  return m;
-}
 
 const Vec3 kWristStart(M_PI / 2, M_PI / 2, M_PI / 2);  // away from the z-x-z gimbal lock
 
@@ -165,17 +156,6 @@ struct WrenchCase {
   Status status = Status::ok;
   int k = 0;
 };
-
-WristMotion wrist_at(double t) {
-  const Vec3 q0(0.4, 1.2, -0.5), amp(0.7, 0.5, 1.3), om(2.0, 3.0, 4.0);
-  WristMotion w;
-  for (int i = 0; i < 3; ++i) {
-    w.angles(i) = q0(i) + amp(i) * std::sin(om(i) * t);
-    w.rates(i) = amp(i) * om(i) * std::cos(om(i) * t);
-    w.accelerations(i) = -amp(i) * om(i) * om(i) * std::sin(om(i) * t);
-  }
-  return w;
-}
 
 Tick paminsa_wrench_case() {
   auto s = std::make_shared<WrenchCase>();

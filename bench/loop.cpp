@@ -32,6 +32,7 @@
 #include "mechbal/paminsa.hpp"
 #include "mechbal/rnea.hpp"
 #include "mechbal/trajectory.hpp"
+#include "paminsa_motion.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -123,19 +124,7 @@ struct PaminsaWorkload {
     c.integrator = mechbal::WristIntegrator::rk4;
     return c;
   }
-  // a smooth 3-D platform motion around the nominal pose (the PAMINSA tests' trajectory)
-  static mechbal::PlatformMotion platform_at(double t) noexcept {
-    const mechbal::Vec3 P0(0.48, 0.05, 0.6775), amp(0.04, 0.12, 0.03), om(3.0, 2.0, 5.0),
-        ph(0.3, 1.1, 0.7);
-    mechbal::PlatformMotion m;
-    for (int i = 0; i < 3; ++i) {
-      const double a = om(i) * t + ph(i);
-      m.position(i) = P0(i) + amp(i) * std::sin(a);
-      m.velocity(i) = amp(i) * om(i) * std::cos(a);
-      m.acceleration(i) = -amp(i) * om(i) * om(i) * std::sin(a);
-    }
-    return m;
-  }
+  static mechbal::PlatformMotion platform_at(double t) noexcept { return mechbal::test::platform_at(t); }
   mechbal::Status tick(double t) noexcept {
     return controller.tick(platform_at(t), platform_at(t + dt / 2), platform_at(t + dt));
   }

@@ -512,26 +512,30 @@ class Balance(Table):
         return self
 
 
+class _MechanismCase(Table):
+    """A case with a ``[mechanism]`` table: its :class:`mechbal.spec.MechanismSpec`, built once."""
+    _spec: Any = PrivateAttr(None)
+
+    @property
+    def spec(self):
+        """The :class:`mechbal.spec.MechanismSpec` of ``[mechanism]``."""
+        if self._spec is None:
+            from mechbal.spec import mechanism_spec
+
+            self._spec = mechanism_spec(self.mechanism)  # type: ignore[attr-defined]
+        return self._spec
+
+
 class SerialChainCaseHeader(CaseHeader):
     kind: Literal["serial_chain", "mechanism"]
 
 
-class SerialChainCase(Table):
+class SerialChainCase(_MechanismCase):
     """A mechanism moving along a rest-to-rest trajectory (kinds ``serial_chain``, ``mechanism``)."""
     case: SerialChainCaseHeader
     mechanism: Mechanism
     trajectory: ChainTrajectory
     balance: Optional[Balance] = None
-    _spec: Any = PrivateAttr(None)
-
-    @property
-    def spec(self):
-        """The :class:`mechbal.spec.MechanismSpec` of ``[mechanism]`` (built by validate_case)."""
-        if self._spec is None:
-            from mechbal.spec import mechanism_spec
-
-            self._spec = mechanism_spec(self.mechanism)
-        return self._spec
 
 
 # ---- rpsp (Heydari & Enferadi): the 3(RPSP)-S robot as data on the general model ----------------
@@ -602,7 +606,7 @@ class RpspCaseHeader(CaseHeader):
     kind: Literal["rpsp"]
 
 
-class RpspCase(Table):
+class RpspCase(_MechanismCase):
     """The 3(RPSP)-S robot (Heydari & Enferadi): the mechanism as data, sized and compared."""
     case: RpspCaseHeader
     mechanism: Mechanism
@@ -612,15 +616,6 @@ class RpspCase(Table):
     balance: Optional[Balance] = Field(
         None, description="mechbal balance: the design variables (default: the [balancing] counterweight "
                           "bodies as fixed-position slots)")
-    _spec: Any = PrivateAttr(None)
-
-    @property
-    def spec(self):
-        if self._spec is None:
-            from mechbal.spec import mechanism_spec
-
-            self._spec = mechanism_spec(self.mechanism)
-        return self._spec
 
 
 # ---- arm2dof (Arakelian, Le Baron & Mottu 2011) ---------------------------------------------------
@@ -1186,7 +1181,7 @@ class OrthoglideCaseHeader(CaseHeader):
     kind: Literal["orthoglide"]
 
 
-class OrthoglideCase(Table):
+class OrthoglideCase(_MechanismCase):
     """The Orthoglide 5-axis and its spring gravity compensation (Martini et al. 2015)."""
     case: OrthoglideCaseHeader
     mechanism: Mechanism
@@ -1197,16 +1192,6 @@ class OrthoglideCase(Table):
     paths: OrthoglidePaths = OrthoglidePaths()
     machining: OrthoglideMachining
     sensitivity: OrthoglideSensitivity = OrthoglideSensitivity()
-    _spec: Any = PrivateAttr(None)
-
-    @property
-    def spec(self):
-        """The :class:`mechbal.spec.MechanismSpec` of ``[mechanism]``."""
-        if self._spec is None:
-            from mechbal.spec import mechanism_spec
-
-            self._spec = mechanism_spec(self.mechanism)
-        return self._spec
 
 
 #: case kind -> model (discs: case.mechanism -> model)

@@ -146,7 +146,23 @@ def minimum_energy_cubic(start: ArrayLike, end: ArrayLike, duration: float) -> R
     return RestToRest(start, end, duration, "cubic")
 
 
-class ViaPoints:
+class _OverTimes:
+    """A motion defined over sample times ``self._t``: its duration and end."""
+
+    _t: np.ndarray
+
+    @property
+    def duration(self) -> float:
+        """``times[-1] - times[0]`` [s]."""
+        return float(self._t[-1] - self._t[0])
+
+    @property
+    def end_time(self) -> float:
+        """``times[-1]`` [s]: when the motion ends."""
+        return float(self._t[-1])
+
+
+class ViaPoints(_OverTimes):
     """Piecewise quintic through ``points`` at ``times``: continuous position, velocity and
     acceleration; at rest at the first and last point.
 
@@ -203,16 +219,6 @@ class ViaPoints:
         """Number of coordinates."""
         return int(self._points.shape[1])
 
-    @property
-    def duration(self) -> float:
-        """``times[-1] - times[0]`` [s]."""
-        return float(self._t[-1] - self._t[0])
-
-    @property
-    def end_time(self) -> float:
-        """``times[-1]`` [s]: when the motion ends."""
-        return float(self._t[-1])
-
     def evaluate(self, t: Times) -> Motion:
         """``(q, qd, qdd)`` at absolute times ``t`` [s]; held at rest outside ``times``."""
         single, ts = _times(t)
@@ -231,7 +237,7 @@ class ViaPoints:
         return q, qd, qdd
 
 
-class Sampled:
+class Sampled(_OverTimes):
     """A user's sampled motion (measured or planned elsewhere), interpolated by a cubic spline
     (``scipy.interpolate.CubicSpline``) per coordinate: q(t) the spline, qd and qdd its first
     and second derivatives.
@@ -270,16 +276,6 @@ class Sampled:
     def dof(self) -> int:
         """Number of coordinates."""
         return int(self._dof)
-
-    @property
-    def duration(self) -> float:
-        """``times[-1] - times[0]`` [s]."""
-        return float(self._t[-1] - self._t[0])
-
-    @property
-    def end_time(self) -> float:
-        """``times[-1]`` [s]: when the motion ends."""
-        return float(self._t[-1])
 
     def evaluate(self, t: Times) -> Motion:
         """``(q, qd, qdd)`` at absolute times ``t`` [s]; held at rest outside the samples."""

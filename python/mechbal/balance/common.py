@@ -40,7 +40,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from mechbal import _core
-from mechbal.balance.result import CounterweightSlot
+from mechbal.balance.result import BalanceResult, CounterweightSlot
 
 #: a least-squares residual below this fraction of the unbalanced one counts as exact
 EXACT_RTOL = 1e-9
@@ -375,6 +375,16 @@ class LinearSolution:
     limited_by: list[str]
     stage: str
     singular_values: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def result(self, method: str, slots: Sequence[Slot], design: dict, residual: float, units: str,
+               metrics: dict, balanced) -> BalanceResult:
+        """The :class:`BalanceResult` of a method that solved this linear problem (static, force):
+        its rank, bounds, undetermined combinations and tied groups."""
+        return BalanceResult(method=method, design=design, residual=residual,
+                             residual_before=self.residual_before, residual_units=units,
+                             rank=self.rank, unknowns=self.unknowns, limited_by=self.limited_by,
+                             metrics=metrics, balanced=balanced, active_bounds=self.active_bounds,
+                             undetermined=self.undetermined, tied=tied_groups(slots))
 
 
 def _rref(M: np.ndarray, tol: float = 1e-9) -> np.ndarray:

@@ -95,9 +95,5 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples=200, *, mass
         "added_mass": float(sum(m for _, m, _ in placed)),
         "total_mass_after": balanced.total_mass,
     }
-    return BalanceResult(method="force", design=design_out, residual=residual,
-                         residual_before=sol.residual_before,
-                         residual_units="kg m/s (RMS linear momentum over the sampled motions)",
-                         rank=sol.rank, unknowns=sol.unknowns, limited_by=sol.limited_by,
-                         metrics=metrics, balanced=balanced, active_bounds=sol.active_bounds,
-                         undetermined=sol.undetermined, tied=common.tied_groups(slots))
+    return sol.result("force", slots, design_out, residual,
+                      "kg m/s (RMS linear momentum over the sampled motions)", metrics, balanced)

@@ -98,9 +98,5 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples=1000, *, mas
         "solve": sol.stage,
         "added_mass": float(sum(m for _, m, _ in placed)),
     }
-    return BalanceResult(method="static", design=design_out, residual=residual,
-                         residual_before=sol.residual_before,
-                         residual_units="N m (RMS gravity torque over the sample)",
-                         rank=sol.rank, unknowns=sol.unknowns, limited_by=sol.limited_by,
-                         metrics=metrics, balanced=balanced, active_bounds=sol.active_bounds,
-                         undetermined=sol.undetermined, tied=common.tied_groups(slots))
+    return sol.result("static", slots, design_out, residual, "N m (RMS gravity torque over the sample)",
+                      metrics, balanced)
