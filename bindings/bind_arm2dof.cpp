@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 #include <type_traits>
+#include <utility>
 
 #include "array_checks.hpp"
 #include "bindings.hpp"
@@ -262,9 +263,15 @@ void bind_arm2dof(py::module_& m) {
   m.def(
       "pd_error_analytic",
       [](double e0, double ed0, double kp, double kd, const Array& t_arg) {
-        const Eigen::VectorXd t = vector_arg(t_arg, "t", -1);
+        const Eigen::VectorXd t = vector_arg(t_arg, "t", -1, true);
+        for (const auto& [name, x] : {std::pair<const char*, double>{"e0", e0}, {"ed0", ed0}, {"kp", kp}, {"kd", kd}}) {
+          if (!std::isfinite(x)) throw py::value_error(std::string("pd_error_analytic: ") + name + " must be finite, got " + std::to_string(x));
+        }
         Eigen::VectorXd e(t.size());
         for (Eigen::Index i = 0; i < t.size(); ++i) e(i) = pd_error_analytic(e0, ed0, kp, kd, t(i));
+        if (!e.allFinite()) {
+          throw py::value_error("pd_error_analytic: the error overflows (gains or times too large for a finite result)");
+        }
         return e;
       },
       py::arg("e0"), py::arg("ed0"), py::arg("kp"), py::arg("kd"), py::arg("t"),

@@ -1,13 +1,15 @@
 // pybind11 glue of the general mechanism model (model.hpp, data.hpp, algorithm/*.hpp): the
 // description types, the validated model, and every algorithm in batch over (N, dof) arrays in one
-// C++ call. Per-instant status arrays; an instant with bad input or a non-finite result gives zeros
-// and its flag, never memory that was not written. Python's mechbal.Mechanism wraps these.
+// C++ call. Per-instant status arrays; an instant with bad input or a non-finite result gives NaN
+// (rotations: the identity) and its flag, never zeros that pass for a result, never memory that was
+// not written. Python's mechbal.Mechanism wraps these.
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 
 #include "array_checks.hpp"
@@ -54,7 +56,7 @@ py::ssize_t batch_rows(const MechanismModel& model, const Array& a, const char* 
 }
 
 /// Runs `fn(k, data) -> Status` for each instant, then `write(k, data, ok)`; instants whose result
-/// is not finite are flagged out_of_range and written as zeros (write gets ok = false).
+/// is not finite are flagged out_of_range and written as NaN (write gets ok = false).
 template <typename Fn, typename Finite, typename Write>
 StatusArray run_batch(const MechanismModel& model, py::ssize_t N, Fn fn, Finite finite, Write write) {
   MechanismData data(model);
@@ -72,12 +74,17 @@ StatusArray run_batch(const MechanismModel& model, py::ssize_t N, Fn fn, Finite 
   return status;
 }
 
+/// What a failed instant's values read: NaN (never a zero that passes for a result).
+constexpr double kFailed = std::numeric_limits<double>::quiet_NaN();
+
 template <typename Matrix>
 void put(Array& out, py::ssize_t k, const Matrix& value, bool ok) {
   double* dst = out.mutable_data(k);
-  const auto n = value.size();
-  if (!ok) {
-    std::fill(dst, dst + n, 0.0);
+  // the whole row of `out`: a failed instant's value may never have been sized (a quadratic
+  // result whose algorithm refused the input before sizing it)
+  const py::ssize_t n = out.shape(0) > 0 ? out.size() / out.shape(0) : 0;
+  if (!ok || static_cast<py::ssize_t>(value.size()) != n) {
+    std::fill(dst, dst + n, kFailed);
     return;
   }
   // row-major copy of an Eigen (column-major) matrix
@@ -87,13 +94,13 @@ void put(Array& out, py::ssize_t k, const Matrix& value, bool ok) {
 
 void put3(Array& out, py::ssize_t k, py::ssize_t j, const Vec3& v, bool ok) {
   double* dst = out.mutable_data(k, j);
-  for (int i = 0; i < 3; ++i) dst[i] = ok ? v(i) : 0.0;
+  for (int i = 0; i < 3; ++i) dst[i] = ok ? v(i) : kFailed;
 }
 
 void put33(Array& out, py::ssize_t k, py::ssize_t j, const Mat3& R, bool ok) {
   double* dst = out.mutable_data(k, j);
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) dst[3 * r + c] = ok ? R(r, c) : 0.0;
+    for (int c = 0; c < 3; ++c) dst[3 * r + c] = ok ? R(r, c) : (r == c ? 1.0 : 0.0);  // identity
 }
 
 bool finite_wrench(const MechanismData& d) {
@@ -180,15 +187,15 @@ void bind_mechanism(py::module_& m) {
                     "One joint of a MechanismDescription; it moves the link of the same name "
                     "(model.hpp for frames and conventions)")
       .def(py::init([](const std::string& name, JointType type, const std::string& parent,
-                       const Eigen::Matrix4d& placement, const Eigen::Vector3d& axis, double lower,
+                       const Array& placement, const Array& axis, double lower,
                        double upper, double velocity_limit, double effort_limit,
                        const std::string& mimic_joint, double mimic_ratio, double mimic_offset) {
              Joint j;
              j.name = name;
              j.type = type;
              j.parent = parent;
-             j.placement = to_isometry(placement, "placement");
-             j.axis = axis;
+             j.placement = to_isometry(fixed_matrix<4, 4>(placement, "placement"), "placement");
+             j.axis = fixed_vector<3>(axis, "axis");
              j.lower = lower;
              j.upper = upper;
              j.velocity_limit = velocity_limit;
@@ -222,8 +229,8 @@ void bind_mechanism(py::module_& m) {
   py::class_<Body>(m, "Body", "A named rigid body on a link: mass [kg], centre of mass [m] and inertia "
                               "about it [kg m^2], both in the link frame")
       .def(py::init([](const std::string& name, const std::string& link, double mass,
-                       const Eigen::Vector3d& com, const Eigen::Matrix3d& inertia, const std::string& kind) {
-             return Body{name, kind, link, mass, com, inertia};
+                       const Array& com, const Array& inertia, const std::string& kind) {
+             return Body{name, kind, link, mass, fixed_vector<3>(com, "com"), fixed_matrix<3, 3>(inertia, "inertia")};
            }),
            py::arg("name"), py::arg("link"), py::arg("mass"), py::arg("com") = Eigen::Vector3d::Zero(),
            py::arg("inertia") = Eigen::Matrix3d::Zero(), py::arg("kind") = "link")
@@ -236,8 +243,8 @@ void bind_mechanism(py::module_& m) {
       .def("__repr__", [](const Body& b) { return "<Body " + b.name + " on " + b.link + ">"; });
 
   py::class_<Frame>(m, "Frame", "A named frame on a link (placement in the link frame)")
-      .def(py::init([](const std::string& name, const std::string& link, const Eigen::Matrix4d& placement) {
-             return Frame{name, link, to_isometry(placement, "placement")};
+      .def(py::init([](const std::string& name, const std::string& link, const Array& placement) {
+             return Frame{name, link, to_isometry(fixed_matrix<4, 4>(placement, "placement"), "placement")};
            }),
            py::arg("name"), py::arg("link"), py::arg("placement") = Eigen::Matrix4d::Identity())
       .def_readonly("name", &Frame::name)
@@ -265,10 +272,11 @@ void bind_mechanism(py::module_& m) {
                      "link frames [m]): count identical springs of rate [N/m] each, carrying preload [N] at "
                      "the anchor distance free_length [m], through a block and tackle of ratio pulley_ratio "
                      "(model.hpp)")
-      .def(py::init([](const std::string& name, const std::string& link_a, const Eigen::Vector3d& anchor_a,
-                       const std::string& link_b, const Eigen::Vector3d& anchor_b, double rate, double free_length,
+      .def(py::init([](const std::string& name, const std::string& link_a, const Array& anchor_a,
+                       const std::string& link_b, const Array& anchor_b, double rate, double free_length,
                        double preload, int count, double pulley_ratio) {
-             return Spring{name, link_a, anchor_a, link_b, anchor_b, rate, free_length, preload, count, pulley_ratio};
+             return Spring{name, link_a, fixed_vector<3>(anchor_a, "anchor_a"), link_b, fixed_vector<3>(anchor_b, "anchor_b"),
+                           rate, free_length, preload, count, pulley_ratio};
            }),
            py::arg("name"), py::arg("link_a"), py::arg("anchor_a"), py::arg("link_b"), py::arg("anchor_b"),
            py::arg("rate"), py::arg("free_length") = 0.0, py::arg("preload") = 0.0, py::arg("count") = 1,
@@ -291,7 +299,7 @@ void bind_mechanism(py::module_& m) {
                                    "Joints, bodies, frames, gravity and loop closures: what a MechanismModel "
                                    "is built from")
       .def(py::init([](std::vector<Joint> joints, std::vector<Body> bodies, std::vector<Frame> frames,
-                       const Eigen::Vector3d& gravity, const std::string& root_name,
+                       const Array& gravity, const std::string& root_name,
                        std::vector<LoopConstraint> loops, std::vector<std::string> actuated,
                        std::vector<Spring> springs) {
              MechanismDescription d;
@@ -299,7 +307,7 @@ void bind_mechanism(py::module_& m) {
              d.joints = std::move(joints);
              d.bodies = std::move(bodies);
              d.frames = std::move(frames);
-             d.gravity = gravity;
+             d.gravity = fixed_vector<3>(gravity, "gravity");
              d.root_name = root_name;
              d.loops = std::move(loops);
              d.actuated = std::move(actuated);
@@ -429,6 +437,9 @@ void bind_mechanism(py::module_& m) {
         {
           MechanismData d(mo);
           Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(q0.data(), n);
+          // rows are independent: each starts from the last good solution (or the guess), so a
+          // failed row never poisons the ones after it
+          Eigen::VectorXd last_good = q;
           auto st = status.mutable_unchecked<1>();
           auto rc = rcond.mutable_unchecked<1>();
           auto rs = residual.mutable_unchecked<1>();
@@ -436,6 +447,7 @@ void bind_mechanism(py::module_& m) {
           py::gil_scoped_release release;
           for (py::ssize_t k = 0; k < N; ++k) {
             const CVec qk(row(qa, k), na), vk(row(va, k), na), ak(row(aa, k), na);
+            q = last_good;
             Status s = dynamics ? closed_inverse_dynamics(mo, d, qk, vk, ak, q, opt)
                                 : closed_motion(mo, d, qk, vk, ak, q, opt);
             const bool solved = !has(s, Status::solver_error) && !has(s, Status::bad_size) &&
@@ -443,6 +455,7 @@ void bind_mechanism(py::module_& m) {
             bool finite = solved && d.closed_velocity.allFinite() && d.closed_acceleration.allFinite() &&
                           (!dynamics || d.actuated_force.allFinite());
             if (solved && !finite) s |= Status::out_of_range;
+            if (finite && q.allFinite()) last_good = q;
             st(k) = static_cast<std::uint32_t>(s);
             rc(k) = d.loop_rcond;
             rs(k) = d.loop_residual_norm;
@@ -451,12 +464,12 @@ void bind_mechanism(py::module_& m) {
             double* vo = V.mutable_data(k);
             double* ao = A.mutable_data(k);
             for (py::ssize_t i = 0; i < n; ++i) {
-              qo[i] = solved ? q(i) : 0.0;
-              vo[i] = finite ? d.closed_velocity(i) : 0.0;
-              ao[i] = finite ? d.closed_acceleration(i) : 0.0;
+              qo[i] = solved ? q(i) : kFailed;
+              vo[i] = finite ? d.closed_velocity(i) : kFailed;
+              ao[i] = finite ? d.closed_acceleration(i) : kFailed;
             }
             double* fo = F.mutable_data(k);
-            for (py::ssize_t i = 0; i < na; ++i) fo[i] = finite && dynamics ? d.actuated_force(i) : 0.0;
+            for (py::ssize_t i = 0; i < na; ++i) fo[i] = finite && dynamics ? d.actuated_force(i) : kFailed;
             put(Cm, k, d.loop_projection, finite);
           }
         }
@@ -491,11 +504,16 @@ void bind_mechanism(py::module_& m) {
         StatusArray status(N);
         MechanismData d(mo);
         Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(q0.data(), n);
+        Eigen::VectorXd last_good = q;  // rows independent, as in mechanism_closed_motion
         auto st = status.mutable_unchecked<1>();
         for (py::ssize_t k = 0; k < N; ++k) {
+          q = last_good;
           Status s = closed_mass_matrix(mo, d, CVec(row(qa, k), na), q);
-          const bool ok = !has(s, Status::solver_error) && !has(s, Status::bad_size) &&
-                          !has(s, Status::non_finite_input) && d.reduced_mass_matrix.allFinite();
+          const bool solved = !has(s, Status::solver_error) && !has(s, Status::bad_size) &&
+                              !has(s, Status::non_finite_input) && !has(s, Status::out_of_range);
+          const bool ok = solved && d.reduced_mass_matrix.allFinite() && d.actuated_gravity.allFinite();
+          if (solved && !ok) s |= Status::out_of_range;
+          if (ok && q.allFinite()) last_good = q;
           st(k) = static_cast<std::uint32_t>(s);
           put(Mr, k, d.reduced_mass_matrix, ok);
           put(G, k, d.actuated_gravity, ok);
@@ -510,8 +528,10 @@ void bind_mechanism(py::module_& m) {
 
   m.def(
       "mechanism_closed_forward_dynamics",
-      [](const MechanismModel& mo, const Eigen::VectorXd& qa, const Eigen::VectorXd& va, const Eigen::VectorXd& tau,
-         const Eigen::VectorXd& q0) {
+      [](const MechanismModel& mo, const Array& qa_arg, const Array& va_arg, const Array& tau_arg,
+         const Array& q0_arg) {
+        const Eigen::VectorXd qa = vector_arg(qa_arg, "q_actuated", -1), va = vector_arg(va_arg, "v_actuated", -1),
+                              tau = vector_arg(tau_arg, "tau_actuated", -1), q0 = vector_arg(q0_arg, "q_guess", -1);
         const auto na = mo.num_actuated();
         if (qa.size() != na || va.size() != na || tau.size() != na || q0.size() != mo.dof()) {
           throw py::value_error("q_actuated, v_actuated, tau_actuated must have " + std::to_string(na) +

@@ -35,9 +35,10 @@ void bind_rnea(py::module_& m) {
       "Joint-space dynamics of a MechanismModel (recursive Newton-Euler inverse dynamics with the "
       "base support wrench, composite rigid body mass matrix): the InverseDynamics back end of the "
       "general model, for ComputedTorque and the simulators")
-      .def(py::init([](const MechanismModel& model, const Eigen::VectorXd& q_guess) {
+      .def(py::init([](const MechanismModel& model, const Array& q_guess) {
+             const Eigen::VectorXd guess = vector_arg(q_guess, "q_guess", -1);
              try {
-               return new MechanismDynamics(model, q_guess);
+               return new MechanismDynamics(model, guess);
              } catch (const std::invalid_argument& e) {
                throw py::value_error(e.what());
              }

@@ -26,6 +26,8 @@ auto value_errors(Fn fn) -> decltype(fn()) {
 }
 
 void bind_urdf(py::module_& m) {
+  m.attr("MAX_URDF_BYTES") = kMaxUrdfBytes;
+  m.attr("MAX_URDF_DEPTH") = kMaxUrdfDepth;
   m.def(
       "mechanism_from_urdf",
       [](const std::string& path) { return value_errors([&] { return model_from_urdf_file(path); }); },

@@ -310,6 +310,7 @@ Status mass_matrix(const MechanismModel& model, MechanismData& data, const Const
   if (Status s = check_state(model, data, &q); s != Status::ok) return s;
   detail::joint_state<false, false>(model, data, q, q, q);
   detail::place<false>(model, data);
+  if (!MechanismData::size_dense(data.mass_matrix, model.dof(), model.dof())) return Status::out_of_range;
   detail::composite_inertias(model, data);
   Eigen::MatrixXd& M = data.mass_matrix;
   M.setZero();
@@ -437,6 +438,9 @@ void fill_torque_regressor(const MechanismModel& model, MechanismData& data, Eig
 Status torque_regressor(const MechanismModel& model, MechanismData& data, const ConstVector& q,
                         const ConstVector& v, const ConstVector& a) noexcept {
   if (Status s = check_state(model, data, &q, &v, &a); s != Status::ok) return s;
+  if (!MechanismData::size_dense(data.torque_regressor, model.dof(), 10 * model.num_bodies())) {
+    return Status::out_of_range;
+  }
   detail::joint_state<true, true>(model, data, q, v, a);
   fill_torque_regressor<true, true>(model, data, data.torque_regressor);
   return finite_result(data.torque_regressor);
@@ -444,6 +448,9 @@ Status torque_regressor(const MechanismModel& model, MechanismData& data, const 
 
 Status gravity_regressor(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
   if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  if (!MechanismData::size_dense(data.gravity_regressor, model.dof(), 10 * model.num_bodies())) {
+    return Status::out_of_range;
+  }
   detail::joint_state<false, false>(model, data, q, q, q);
   fill_torque_regressor<false, false>(model, data, data.gravity_regressor);
   return finite_result(data.gravity_regressor);

@@ -299,12 +299,13 @@ double column_dot(const MechanismData& data, Eigen::Index i, const double* y) no
   return sum;
 }
 
-Status check(const MechanismModel& model, const MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,
+Status check(const MechanismModel& model, MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,
              const Eigen::Ref<const Eigen::VectorXd>* qa, const Eigen::Ref<const Eigen::VectorXd>* va = nullptr,
              const Eigen::Ref<const Eigen::VectorXd>* aa = nullptr) noexcept {
   if (!detail::data_matches(model, data) || data.loop_residual.size() != model.num_constraints()) {
     return Status::bad_size;
   }
+  if (!data.size_actuated_buffers(model)) return Status::out_of_range;  // open model: first call
   const Eigen::Index na = model.num_actuated();
   if (q.size() != model.dof() || (qa && qa->size() != na) || (va && va->size() != na) || (aa && aa->size() != na)) {
     return Status::bad_size;
@@ -603,7 +604,9 @@ Status closed_mass_matrix(const MechanismModel& model, MechanismData& data, cons
   data.closed_position = q;
   data.actuated_force.setZero();  // v# = 0 for the projection only
   status |= project(model, data, q, data.actuated_force, options, true);
-  mass_matrix(model, data, q);
+  if (mass_matrix(model, data, q) != Status::ok && data.mass_matrix.rows() != model.dof()) {
+    return status | Status::out_of_range;  // no memory for M: nothing to project
+  }
   data.loop_reduced_work.noalias() = data.mass_matrix * data.loop_projection;
   data.reduced_mass_matrix.noalias() = data.loop_projection.transpose() * data.loop_reduced_work;
   static_torque(model, data, q);  // G and, with springs, K
@@ -624,7 +627,9 @@ Status closed_forward_dynamics(const MechanismModel& model, MechanismData& data,
   inverse_dynamics(model, data, q, data.closed_velocity, data.loop_acceleration_bias);
   data.actuated_acceleration.noalias() = -data.loop_projection.transpose() * data.joint_torque;
   data.actuated_acceleration += tau_actuated;
-  mass_matrix(model, data, q);
+  if (mass_matrix(model, data, q) != Status::ok && data.mass_matrix.rows() != model.dof()) {
+    return status | Status::out_of_range;  // no memory for M: nothing to project
+  }
   data.loop_reduced_work.noalias() = data.mass_matrix * data.loop_projection;
   data.reduced_mass_matrix.noalias() = data.loop_projection.transpose() * data.loop_reduced_work;
   data.reduced_ldlt.compute(data.reduced_mass_matrix);
@@ -634,6 +639,8 @@ Status closed_forward_dynamics(const MechanismModel& model, MechanismData& data,
   data.reduced_ldlt.solveInPlace(data.actuated_acceleration);
   data.closed_acceleration = data.loop_acceleration_bias;
   data.closed_acceleration.noalias() += data.loop_projection * data.actuated_acceleration;
+  // finite input can overflow (tau = 1.8e308): never an ok status on a non-finite result
+  if (!data.actuated_acceleration.allFinite() || !data.closed_acceleration.allFinite()) status |= Status::out_of_range;
   return status;
 }
 

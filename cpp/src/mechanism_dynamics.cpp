@@ -15,6 +15,7 @@ MechanismDynamics::MechanismDynamics(MechanismModel model, const Eigen::VectorXd
 
 MechanismDynamics::MechanismDynamics(std::shared_ptr<const MechanismModel> model, const Eigen::VectorXd& q_guess)
     : model_(std::move(model)), data_(*model_) {
+  data_.reserve_mass_matrix();  // the mass matrix is used from the loop: sized here, not there
   if (!model_->is_closed() && model_->num_passive() > 0) {
     throw std::invalid_argument("actuated: an open mechanism with passive joints ('" +
                                 model_->coordinate_name(model_->passive_coordinates()[0]) +
@@ -67,7 +68,7 @@ Status MechanismDynamics::forward_dynamics(const Eigen::Ref<const Eigen::VectorX
   if (!tau.allFinite()) return Status::non_finite_input;
   if (model_->is_closed()) {
     const Status s = closed_forward_dynamics(*model_, data_, q, qd, tau, q_, options_);
-    if (failed(s) || has(s, Status::singular)) return s;
+    if (failed(s) || has(s, Status::singular) || has(s, Status::out_of_range)) return s;  // qdd untouched
     qdd = data_.actuated_acceleration;
     return s;
   }
@@ -147,6 +148,7 @@ Status MechanismDynamics::coriolis(const Eigen::Ref<const Eigen::VectorXd>& q,
     s |= static_torque(q, c);
     if (failed(s)) return s;
     c = work_ - c;
+    if (!c.allFinite()) s |= Status::out_of_range;
     return s;
   }
   if (Status s = detail::check_state(*model_, data_, &q, &qd); s != Status::ok) return s;
@@ -154,7 +156,7 @@ Status MechanismDynamics::coriolis(const Eigen::Ref<const Eigen::VectorXd>& q,
   detail::place<false>(*model_, data_);
   detail::forward_pass<true, false, false, true>(*model_, data_);
   detail::backward_pass(*model_, data_, c);
-  return Status::ok;
+  return c.allFinite() ? Status::ok : Status::out_of_range;  // finite input can overflow (qd = 1e300)
 }
 
 }  // namespace mechbal

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <new>
 #include <sstream>
 #include <stdexcept>
 
@@ -498,6 +499,40 @@ int MechanismModel::frame_index(const std::string& name) const noexcept {
   return -1;
 }
 
+bool MechanismData::size_dense(Eigen::MatrixXd& buffer, Eigen::Index rows, Eigen::Index cols) noexcept {
+  if (buffer.rows() == rows && buffer.cols() == cols) return true;
+  try {
+    buffer.setZero(rows, cols);
+    return true;
+  } catch (...) {  // std::bad_alloc: the caller reports it as a Status
+    buffer.resize(0, 0);
+    return false;
+  }
+}
+
+void MechanismData::reserve_mass_matrix() { mass_matrix.setZero(dof, dof); }
+
+bool MechanismData::size_actuated_buffers(const MechanismModel& model) noexcept {
+  const Eigen::Index na = model.num_actuated();
+  if (loop_projection.rows() == dof && loop_projection.cols() == na && reduced_mass_matrix.rows() == na &&
+      loop_reduced_work.cols() == na) {
+    return true;
+  }
+  try {
+    loop_projection.setZero(dof, na);
+    for (Eigen::Index i = 0; i < na; ++i) loop_projection(model.actuated_coordinates()[static_cast<std::size_t>(i)], i) = 1.0;
+    reduced_mass_matrix.setZero(na, na);
+    loop_reduced_work.setZero(dof, na);
+    reduced_ldlt.compute(Eigen::MatrixXd::Identity(na, na));
+    return true;
+  } catch (...) {  // std::bad_alloc
+    loop_projection.resize(0, 0);
+    reduced_mass_matrix.resize(0, 0);
+    loop_reduced_work.resize(0, 0);
+    return false;
+  }
+}
+
 MechanismData::MechanismData(const MechanismModel& model)
     : dof(model.dof()),
       num_links(model.num_links()),
@@ -530,11 +565,8 @@ MechanismData::MechanismData(const MechanismModel& model)
   static_torque = Eigen::VectorXd::Zero(dof);
   spring_length = Eigen::VectorXd::Zero(num_springs);
   spring_tension = Eigen::VectorXd::Zero(num_springs);
-  mass_matrix = Eigen::MatrixXd::Zero(dof, dof);
   momentum_matrix = Eigen::MatrixXd::Zero(6, dof);
   frame_jacobian = Eigen::MatrixXd::Zero(6, dof);
-  torque_regressor = Eigen::MatrixXd::Zero(dof, 10 * num_bodies);
-  gravity_regressor = Eigen::MatrixXd::Zero(dof, 10 * num_bodies);
   momentum_regressor = Eigen::MatrixXd::Zero(6, 10 * num_bodies);
   link_regressor = Eigen::MatrixXd::Zero(dof, 10);
   link_momentum_regressor = Eigen::MatrixXd::Zero(6, 10);
@@ -551,13 +583,12 @@ MechanismData::MechanismData(const MechanismModel& model)
     w.composite_first_moment = Vec3::Zero();
     w.composite_inertia = Mat3::Zero();
   }
-  link_mass_matrix = Eigen::MatrixXd::Zero(num_links, num_links);
   const int m = model.num_constraints(), na = model.num_actuated(), np = model.num_passive();
   loop_residual = Eigen::VectorXd::Zero(m);
   loop_jacobian = Eigen::MatrixXd::Zero(m, dof);
   loop_bias = Eigen::VectorXd::Zero(m);
-  loop_projection = Eigen::MatrixXd::Zero(dof, na);
-  for (int i = 0; i < na; ++i) loop_projection(model.actuated_coordinates()[static_cast<std::size_t>(i)], i) = 1.0;
+  // dof x na buffers: for an open model na = dof, quadratic: sized by the first closed-loop call
+  if (model.is_closed() && !size_actuated_buffers(model)) throw std::bad_alloc();
   loop_acceleration_bias = Eigen::VectorXd::Zero(dof);
   closed_position = Eigen::VectorXd::Zero(dof);
   closed_velocity = Eigen::VectorXd::Zero(dof);
@@ -566,14 +597,12 @@ MechanismData::MechanismData(const MechanismModel& model)
   actuated_gravity = Eigen::VectorXd::Zero(na);
   actuated_static_torque = Eigen::VectorXd::Zero(na);
   actuated_acceleration = Eigen::VectorXd::Zero(na);
-  reduced_mass_matrix = Eigen::MatrixXd::Zero(na, na);
   loop_passive_jacobian = Eigen::MatrixXd::Zero(m, np);
   loop_actuated_jacobian = RowMajorMatrix::Zero(m, na);
   loop_block_residual = RowMajorMatrix::Zero(m, na);
   loop_block_step = RowMajorMatrix::Zero(np, na);
   loop_constraint_work = Eigen::VectorXd::Zero(m);
   loop_refine_solution = Eigen::VectorXd::Zero(np);
-  reduced_ldlt.compute(Eigen::MatrixXd::Identity(na, na));
   loop_normal = Eigen::MatrixXd::Identity(np, np);
   loop_passive_first = Eigen::VectorXi::Zero(np);
   loop_passive_last = Eigen::VectorXi::Zero(np);
@@ -583,7 +612,6 @@ MechanismData::MechanismData(const MechanismModel& model)
   loop_step = Eigen::VectorXd::Zero(np);
   loop_trial = Eigen::VectorXd::Zero(dof);
   loop_solution = RowMajorMatrix::Zero(np, na);
-  loop_reduced_work = Eigen::MatrixXd::Zero(dof, na);
   loop_vector_work = Eigen::VectorXd::Zero(dof);
   detail::loop_factor_structure(model, *this);
 }

@@ -296,7 +296,7 @@ Status PaminsaModel::forward_kinematics(double alpha1, double alpha3, double z_B
   const Vec2 A1 = M_h_[0] + l1 * g1;
   const Vec2 Ph = p_.nominal_platform.head<2>() - (p_.k - 1.0) * (A1 - A0_h_[0]);
   P << Ph(0), Ph(1), p_.z_A + p_.k * (z_B - p_.z_A) + p_.length_CJ;
-  return Status::ok;
+  return P.allFinite() ? Status::ok : Status::out_of_range;  // finite input can overflow (z_B = 1.8e308)
 }
 
 // ------------------------------------------------------------------------------ kinematics

@@ -211,6 +211,7 @@ TEST(Loops, TicksAllocateNothing) {
     const int na = model.num_actuated();
     Eigen::VectorXd q = c.guess, qa = c.qa, va(na), aa(na), tau(na);
     ASSERT_EQ(solve_loop_positions(model, data, qa, q), Status::ok);  // first assembly
+    data.reserve_mass_matrix();  // the real-time set-up of the closed dynamics (data.hpp)
     test::AllocationScope scope;
     for (int k = 0; k < 20; ++k) {
       // a different pose each tick, warm-started from the last one (Newton iterates every tick)

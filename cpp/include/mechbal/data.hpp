@@ -1,7 +1,12 @@
 #pragma once
 /// \file data.hpp
 /// MechanismData: every buffer the algorithms over a MechanismModel need, allocated once from the
-/// model (Pinocchio's Data). Algorithms write their results here; nothing allocates afterwards.
+/// model (Pinocchio's Data). Algorithms write their results here; nothing allocates afterwards,
+/// except the dense results whose size is quadratic in the model (the mass matrix, dof x dof, and
+/// the torque and gravity regressors, dof x 10 bodies): they are sized by the first call of their
+/// algorithm, so that a data for a 10,000-link chain is O(n) (a few MB, not GB) when only the O(n)
+/// algorithms run. A real-time user of the mass matrix calls reserve_mass_matrix() at set-up
+/// (MechanismDynamics does).
 /// All world quantities are in the base frame O; moments and angular momenta are about O.
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -15,6 +20,17 @@ namespace mechbal {
 
 struct MechanismData {
   explicit MechanismData(const MechanismModel& model);
+
+  /// Sizes mass_matrix (dof x dof) now, so that mass_matrix() and the closed-loop dynamics
+  /// allocate nothing on their first call (real-time set-up).
+  void reserve_mass_matrix();
+  /// Sizes `buffer` to rows x cols (zeros) when it has another size; false when the memory cannot
+  /// be had (the algorithm then returns Status::out_of_range). No allocation when already sized.
+  static bool size_dense(Eigen::MatrixXd& buffer, Eigen::Index rows, Eigen::Index cols) noexcept;
+  /// Sizes the dof x na buffers of the closed-loop algorithms (loop_projection, the reduced mass
+  /// matrix and its work): at construction for a closed model, by the first closed-loop call for
+  /// an open one (where na = dof would make them quadratic). False when the memory cannot be had.
+  bool size_actuated_buffers(const MechanismModel& model) noexcept;
 
   int dof;         ///< of the model this data was built for (checked by every algorithm)
   int num_links;
@@ -55,14 +71,14 @@ struct MechanismData {
   /// about O): the springs' part of the support wrench (which, the rate of momentum minus the
   /// weights, includes it).
   Vec3 spring_base_force = Vec3::Zero(), spring_base_moment = Vec3::Zero();
-  Eigen::MatrixXd mass_matrix;     ///< M(q), dof x dof, symmetric
+  Eigen::MatrixXd mass_matrix;     ///< M(q), dof x dof, symmetric (sized by the first mass_matrix())
   Eigen::MatrixXd momentum_matrix;  ///< 6 x dof: [P; H_O] = A(q) v (linear first)
   Eigen::MatrixXd frame_jacobian;   ///< 6 x dof: [v; w] of a frame's origin, O axes
   /// Regressors over each body's 10 inertial parameters, body b in columns 10b..10b+9:
   /// [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] with c and I (about the link frame
   /// origin) in the frame of the body's link (Pinocchio's ordering).
-  Eigen::MatrixXd torque_regressor;    ///< dof x 10 nb: tau = Y pi
-  Eigen::MatrixXd gravity_regressor;   ///< dof x 10 nb: G(q) = Y pi
+  Eigen::MatrixXd torque_regressor;    ///< dof x 10 nb: tau = Y pi (sized on first use)
+  Eigen::MatrixXd gravity_regressor;   ///< dof x 10 nb: G(q) = Y pi (sized on first use)
   Eigen::MatrixXd momentum_regressor;  ///< 6 x 10 nb: [P; H_O] = Y pi
 
   // ---- closed loops (algorithm/loops.hpp); sizes: m constraints, n = dof, na actuated ----
@@ -125,7 +141,6 @@ struct MechanismData {
     Mat3 composite_inertia;
   };
   std::vector<LinkWork> work;
-  Eigen::MatrixXd link_mass_matrix;  ///< per-link joint-space mass matrix (num_links^2)
   Eigen::MatrixXd link_regressor;           ///< dof x 10 scratch: one link's torque regressor
   Eigen::MatrixXd link_momentum_regressor;  ///< 6 x 10 scratch: one link's momentum regressor
 };

@@ -24,11 +24,23 @@
 /// `URDF joint 'shoulder': type floating is not supported (...)`, `URDF link 'forearm': inertial
 /// .mass must be a finite number >= 0, got -1`, `URDF: parent link 'bse' of joint 'j1' not found`;
 /// nothing is half-built.
+/// Before urdfdom reads the document, one streaming pass refuses (one-line messages): a document
+/// larger than kMaxUrdfBytes, elements nested deeper than kMaxUrdfDepth, a number mechbal reads
+/// (mass, inertia, origin, axis, limit, mimic, dynamics, safety_controller, calibration) that is
+/// not a finite number ("nan", "inf", "abc", "1e999"; the message names the link or joint, the
+/// element and the line), and joints that do not form a tree (a joint whose parent is its child,
+/// a link with two parent joints, a cycle: the message names the joints).
+#include <cstddef>
 #include <string>
 
 #include "mechbal/model.hpp"
 
 namespace mechbal {
+
+/// Largest URDF document read [bytes] (a 10,000-link chain is about 6 MB).
+inline constexpr std::size_t kMaxUrdfBytes = 64u << 20;
+/// Deepest element nesting read (a URDF needs 4: robot / link / inertial / origin).
+inline constexpr std::size_t kMaxUrdfDepth = 64;
 
 /// The description of the URDF document `xml`.
 MechanismDescription urdf_description_from_string(const std::string& xml);

@@ -12,7 +12,9 @@ namespace mechbal {
 
 using ConstVector = Eigen::Ref<const Eigen::VectorXd>;
 
-/// data.mass_matrix (dof x dof, both triangles).
+/// data.mass_matrix (dof x dof, both triangles). The first call sizes data.mass_matrix (the one
+/// allocation; none when MechanismData::reserve_mass_matrix() ran); Status::out_of_range when that
+/// memory cannot be had.
 Status mass_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept;
 
 }  // namespace mechbal

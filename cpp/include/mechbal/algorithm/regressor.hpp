@@ -19,6 +19,8 @@ using ConstVector = Eigen::Ref<const Eigen::VectorXd>;
 Status torque_regressor(const MechanismModel& model, MechanismData& data, const ConstVector& q,
                         const ConstVector& v, const ConstVector& a) noexcept;
 /// data.gravity_regressor: G(q) = Y pi.
+/// Both regressors are dof x 10 bodies: the first call of each sizes its buffer (the one
+/// allocation; Status::out_of_range when that memory cannot be had), later calls allocate nothing.
 Status gravity_regressor(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept;
 /// data.momentum_regressor: [P; H_O](q, v) = Y pi.
 Status momentum_regressor(const MechanismModel& model, MechanismData& data, const ConstVector& q,
