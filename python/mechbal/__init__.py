@@ -29,15 +29,16 @@ from mechbal._core import Status, __version__
 from mechbal._core import (  # the description objects of Mechanism.from_description
     Body, Frame, Joint, JointType, LoopConstraint, LoopType, MechanismDescription, MechanismModel, Spring)
 from mechbal.config import ConfigError, ConfigWarning, load_case
+from mechbal.errors import PlausibilityWarning
 from mechbal.mechanism import (
-    BaseReaction, BodyMotion, ClosedMotion, Mechanism, Momentum, ShakingWrench)
+    BaseReaction, BatchArray, BodyMotion, ClosedMotion, Mechanism, Momentum, ShakingWrench)
 from mechbal import balance, control, papers, simulate, trajectory
 
 __all__ = [
-    "Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion",
+    "Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion", "BatchArray",
     "Joint", "JointType", "Body", "Frame", "LoopConstraint", "LoopType", "MechanismDescription", "Spring",
-    "MechanismModel", "Status", "ConfigError", "ConfigWarning", "load_case",
-    "balance", "control", "trajectory", "simulate", "papers", "cases", "__version__",
+    "MechanismModel", "Status", "ConfigError", "ConfigWarning", "PlausibilityWarning",
+    "load_case", "balance", "control", "trajectory", "simulate", "papers", "cases", "__version__",
 ]
 
 # Names that lived here before the public modules existed (kept so that existing scripts run);

@@ -8,7 +8,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ChainModel', 'ComputedTorque', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointSpec', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'RneChainDynamics', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_chain_model', 'chain_description', 'chain_kinematics', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
+__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ChainModel', 'ComputedTorque', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointSpec', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MAX_URDF_BYTES', 'MAX_URDF_DEPTH', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'RneChainDynamics', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_chain_model', 'chain_description', 'chain_kinematics', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
 class Status:
     """
     Bit flags returned by real-time algorithms
@@ -315,7 +315,7 @@ class Joint:
     """
     One joint of a MechanismDescription; it moves the link of the same name (model.hpp for frames and conventions)
     """
-    def __init__(self, name: str, type: JointType = JointType.revolute, parent: str = 'base', placement: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] = ..., axis: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., lower: typing.SupportsFloat | typing.SupportsIndex = ..., upper: typing.SupportsFloat | typing.SupportsIndex = ..., velocity_limit: typing.SupportsFloat | typing.SupportsIndex = ..., effort_limit: typing.SupportsFloat | typing.SupportsIndex = ..., mimic_joint: str = '', mimic_ratio: typing.SupportsFloat | typing.SupportsIndex = 1.0, mimic_offset: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
+    def __init__(self, name: str, type: JointType = JointType.revolute, parent: str = 'base', placement: numpy.typing.ArrayLike = ..., axis: numpy.typing.ArrayLike = ..., lower: typing.SupportsFloat | typing.SupportsIndex = ..., upper: typing.SupportsFloat | typing.SupportsIndex = ..., velocity_limit: typing.SupportsFloat | typing.SupportsIndex = ..., effort_limit: typing.SupportsFloat | typing.SupportsIndex = ..., mimic_joint: str = '', mimic_ratio: typing.SupportsFloat | typing.SupportsIndex = 1.0, mimic_offset: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
         ...
     def __repr__(self) -> str:
         ...
@@ -359,7 +359,7 @@ class Body:
     """
     A named rigid body on a link: mass [kg], centre of mass [m] and inertia about it [kg m^2], both in the link frame
     """
-    def __init__(self, name: str, link: str, mass: typing.SupportsFloat | typing.SupportsIndex, com: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., inertia: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"] = ..., kind: str = 'link') -> None:
+    def __init__(self, name: str, link: str, mass: typing.SupportsFloat | typing.SupportsIndex, com: numpy.typing.ArrayLike = ..., inertia: numpy.typing.ArrayLike = ..., kind: str = 'link') -> None:
         ...
     def __repr__(self) -> str:
         ...
@@ -385,7 +385,7 @@ class Frame:
     """
     A named frame on a link (placement in the link frame)
     """
-    def __init__(self, name: str, link: str, placement: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] = ...) -> None:
+    def __init__(self, name: str, link: str, placement: numpy.typing.ArrayLike = ...) -> None:
         ...
     @property
     def link(self) -> str:
@@ -471,7 +471,7 @@ class Spring:
     """
     A linear spring between anchor A on link_a and anchor B on link_b (anchors in the link frames [m]): count identical springs of rate [N/m] each, carrying preload [N] at the anchor distance free_length [m], through a block and tackle of ratio pulley_ratio (model.hpp)
     """
-    def __init__(self, name: str, link_a: str, anchor_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], link_b: str, anchor_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], rate: typing.SupportsFloat | typing.SupportsIndex, free_length: typing.SupportsFloat | typing.SupportsIndex = 0.0, preload: typing.SupportsFloat | typing.SupportsIndex = 0.0, count: typing.SupportsInt | typing.SupportsIndex = 1, pulley_ratio: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> None:
+    def __init__(self, name: str, link_a: str, anchor_a: numpy.typing.ArrayLike, link_b: str, anchor_b: numpy.typing.ArrayLike, rate: typing.SupportsFloat | typing.SupportsIndex, free_length: typing.SupportsFloat | typing.SupportsIndex = 0.0, preload: typing.SupportsFloat | typing.SupportsIndex = 0.0, count: typing.SupportsInt | typing.SupportsIndex = 1, pulley_ratio: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> None:
         ...
     def __repr__(self) -> str:
         ...
@@ -512,7 +512,7 @@ class MechanismDescription:
     """
     Joints, bodies, frames, gravity and loop closures: what a MechanismModel is built from
     """
-    def __init__(self, joints: collections.abc.Sequence[Joint], bodies: collections.abc.Sequence[Body] = [], frames: collections.abc.Sequence[Frame] = [], gravity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., root_name: str = 'base', loops: collections.abc.Sequence[LoopConstraint] = [], actuated: collections.abc.Sequence[str] = [], springs: collections.abc.Sequence[Spring] = []) -> None:
+    def __init__(self, joints: collections.abc.Sequence[Joint], bodies: collections.abc.Sequence[Body] = [], frames: collections.abc.Sequence[Frame] = [], gravity: numpy.typing.ArrayLike = ..., root_name: str = 'base', loops: collections.abc.Sequence[LoopConstraint] = [], actuated: collections.abc.Sequence[str] = [], springs: collections.abc.Sequence[Spring] = []) -> None:
         ...
     @property
     def actuated(self) -> list[str]:
@@ -644,7 +644,7 @@ class MechanismDynamics(InverseDynamics, ForwardDynamics):
     """
     Joint-space dynamics of a MechanismModel (recursive Newton-Euler inverse dynamics with the base support wrench, composite rigid body mass matrix): the InverseDynamics back end of the general model, for ComputedTorque and the simulators
     """
-    def __init__(self, model: MechanismModel, q_guess: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"] = ...) -> None:
+    def __init__(self, model: MechanismModel, q_guess: numpy.typing.ArrayLike = ...) -> None:
         """
         Dynamics in the actuated coordinates (loops solved each call, warm-started from q_guess, the full coordinates near the assembly)
         """
@@ -1439,7 +1439,7 @@ def mechanism_bias_torque(model: MechanismModel, q: numpy.typing.ArrayLike, v: n
     ...
 def mechanism_center_of_mass(model: MechanismModel, q: numpy.typing.ArrayLike) -> dict:
     ...
-def mechanism_closed_forward_dynamics(model: MechanismModel, q_actuated: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], v_actuated: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], tau_actuated: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], q_guess: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> dict:
+def mechanism_closed_forward_dynamics(model: MechanismModel, q_actuated: numpy.typing.ArrayLike, v_actuated: numpy.typing.ArrayLike, tau_actuated: numpy.typing.ArrayLike, q_guess: numpy.typing.ArrayLike) -> dict:
     ...
 def mechanism_closed_mass_matrix(model: MechanismModel, q_actuated: numpy.typing.ArrayLike, q_guess: numpy.typing.ArrayLike) -> dict:
     ...
@@ -1538,5 +1538,7 @@ def wrist_momentum_matrix(J1: numpy.typing.ArrayLike, J2: numpy.typing.ArrayLike
     """
     N(q) of Briot & Arakelian 2009 eq 23 (corrected): wrist angular momentum = N qdot
     """
+MAX_URDF_BYTES: int = 67108864
+MAX_URDF_DEPTH: int = 64
 __version__: str = '0.1.0'
 simulate_computed_torque = simulate_closed_loop

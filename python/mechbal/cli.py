@@ -1,9 +1,12 @@
 """The ``mechbal`` command line.
 
 Exit codes: 0 success; 2 a user's mistake (bad case file or value, bad output folder, bad
-arguments), reported as one line ``mechbal: error: ...`` naming the field or path; 3 an internal
+arguments, a value outside the plausible ranges of :mod:`mechbal.plausibility` without
+``--force``), reported as one line ``mechbal: error: ...`` naming the field or path; 3 an internal
 error (a bug in mechbal), reported as one line with a request to report it (set
-``MECHBAL_DEBUG=1`` for the traceback); 130 interrupted. No traceback is ever shown otherwise.
+``MECHBAL_DEBUG=1`` for the traceback); 4 another run into the same ``--out`` finished at the same
+moment (this run's results were discarded, the other run's folder is whole); 130 interrupted. No
+traceback is ever shown otherwise.
 """
 from __future__ import annotations
 
@@ -12,14 +15,14 @@ import contextlib
 import io
 import json
 import os
-import stat
 import sys
+import warnings
 from pathlib import Path
 
 from mechbal.config import ConfigError
 
-#: refuse case files larger than this (a case is a few kB; anything huge is a mistake)
-MAX_CASE_BYTES = 4 * 1024 * 1024
+from mechbal.config import MAX_CASE_BYTES  # noqa: E402 (re-exported)
+
 ISSUES_HINT = ("this is a bug in mechbal: please report it with the command line and the case "
                "file (MECHBAL_DEBUG=1 shows the traceback)")
 
@@ -43,39 +46,14 @@ def check_case_file(name_or_path: str) -> Path:
     """Path of the case after the checks that the TOML reader does not do: a regular file, not a
     folder, of reasonable size, UTF-8 text, valid TOML of reasonable nesting (raises
     :class:`ConfigError` naming the path)."""
-    from mechbal.config import case_path, tomllib
+    from mechbal import _core
+    from mechbal.config import case_path, parse_toml, read_regular_file
 
     path = case_path(name_or_path)  # ConfigError for an unknown built-in name or a missing file
-    try:
-        st = path.stat()
-    except OSError as exc:
-        raise ConfigError("case", f"cannot be read: {exc.strerror}", str(path)) from None
-    if stat.S_ISDIR(st.st_mode):
-        raise ConfigError("case", "is a folder, not a case file", str(path))
-    if not stat.S_ISREG(st.st_mode):
-        raise ConfigError("case", "is not a regular file (a device, pipe or socket)", str(path))
-    if st.st_size > MAX_CASE_BYTES:
-        raise ConfigError("case", f"is {st.st_size} bytes, more than a case file can be "
-                                  f"({MAX_CASE_BYTES} bytes)", str(path))
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise ConfigError("case", f"cannot be read: {exc.strerror}", str(path)) from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = raw[:exc.start].count(b"\n") + 1
-        raise ConfigError(str(path), f"is not UTF-8 text (byte 0x{raw[exc.start]:02x} on line "
-                                     f"{line}): save it as UTF-8", has_value=False) from None
     if path.suffix.lower() == ".urdf":
-        return path  # XML: the URDF reader checks it
-    try:
-        tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(str(path), f"is not valid TOML: {exc}", has_value=False) from None
-    except RecursionError:
-        raise ConfigError(str(path), "nests arrays or tables too deeply to be a case file",
-                          has_value=False) from None
+        read_regular_file(path, "case", _core.MAX_URDF_BYTES)
+        return path  # XML: the URDF reader checks the rest
+    parse_toml(read_regular_file(path, "case", MAX_CASE_BYTES), str(path))
     return path
 
 
@@ -179,11 +157,15 @@ def build_parser() -> argparse.ArgumentParser:
         description="Balancing of mechanisms: shaking force and moment, counterweights, springs, "
                     "counter-rotating discs, and real-time controllers of balanced robots.",
         epilog="Exit codes: 0 ok, 2 a mistake in the input (one line names the field or path), "
-               "3 an internal error (please report it).")
+               "3 an internal error (please report it), 4 another run into the same --out finished "
+               "at the same moment (this run's results were discarded).")
     p.add_argument("--version", action="version", version=f"mechbal {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     s = sub.add_parser("cases", help="list the built-in case studies")
     s.set_defaults(func=_cmd_cases)
+    force = dict(action="store_true",
+                 help="run values outside the plausible ranges (a joint travel beyond 1e3 rad or m, "
+                      "a gravity beyond 1e3 m/s^2, a mass beyond 1e6 kg), which are refused otherwise")
     quiet = dict(action="store_true",
                  help="no progress bar and no tables: only warnings and errors (on stderr)")
     s = sub.add_parser("run", help="run a case study (built-in name or TOML file)",
@@ -199,6 +181,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--samples", type=int, metavar="N",
                    help="URDF files: number of instants of the default trajectory (default: 501)")
     s.add_argument("-q", "--quiet", **quiet)
+    s.add_argument("--force", **force)
     s.set_defaults(func=_cmd_run)
     s = sub.add_parser("balance", help="balance a mechanism by a method (static, force, moment, springs, rms)",
                        description="Size counterweights (static: gravity torque zero over the "
@@ -216,11 +199,13 @@ def build_parser() -> argparse.ArgumentParser:
                         "replaces the case's (required for a URDF)")
     s.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
     s.add_argument("-q", "--quiet", **quiet)
+    s.add_argument("--force", **force)
     s.set_defaults(func=_cmd_balance)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")
     s.add_argument("--out", default="out/demo", metavar="DIR", help="output folder")
     s.add_argument("-q", "--quiet", **quiet)
+    s.add_argument("--force", **force)
     s.set_defaults(func=_cmd_demo)
     s = sub.add_parser("sweep", help="sensitivity, tolerance Monte Carlo or grid over a case",
                        description="Run the [sweep] of a sweep file (or built-in sweep name) over a case: "
@@ -234,6 +219,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--workers", type=int, metavar="N", help="processes: number of local processes (default: all cores)")
     s.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 (implies --backend dask)")
     s.add_argument("-q", "--quiet", **quiet)
+    s.add_argument("--force", **force)
     s.set_defaults(func=_cmd_sweep)
     s = sub.add_parser("init", help="print a commented case template: mechbal init serial > my.toml",
                        description="Print a commented case file to standard output, to edit and "
@@ -252,7 +238,8 @@ def _one_line(exc: BaseException) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     from mechbal import progress
-    from mechbal.output import OutputError
+    from mechbal.errors import PlausibilityWarning
+    from mechbal.output import OutputError, OutputRaceError
 
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -262,7 +249,20 @@ def main(argv: list[str] | None = None) -> int:
     progress.configure(quiet=getattr(args, "quiet", False))
     debug = os.environ.get("MECHBAL_DEBUG", "") not in ("", "0")
     try:
-        return args.func(args)
+        with warnings.catch_warnings():
+            if not getattr(args, "force", False):  # implausible values: refused, not warned about
+                warnings.simplefilter("error", PlausibilityWarning)
+            return args.func(args)
+    except PlausibilityWarning as exc:
+        if debug:
+            raise
+        print(f"mechbal: error: {_one_line(exc)}; --force runs it anyway", file=sys.stderr)
+        return 2
+    except OutputRaceError as exc:
+        if debug:
+            raise
+        print(f"mechbal: error: {_one_line(exc)}", file=sys.stderr)
+        return 4
     except (ConfigError, OutputError, UserError) as exc:
         if debug:
             raise

@@ -10,6 +10,7 @@ constructed once every field has been read and checked. The helpers here (``numb
 from __future__ import annotations
 
 import math
+import os
 import sys
 from pathlib import Path
 from typing import Any, Mapping
@@ -114,15 +115,93 @@ def transform(value: Any, field: str) -> np.ndarray:
     return T
 
 
-def read_toml(path: str | Path) -> dict:
+#: refuse case files larger than this (a case is a few kB; anything huge is a mistake)
+MAX_CASE_BYTES = 4 * 1024 * 1024
+#: refuse case files whose tables and arrays nest deeper than this (a case needs a handful)
+MAX_CASE_DEPTH = 32
+
+
+def read_regular_file(path: str | Path, field: str = "case", max_bytes: int = MAX_CASE_BYTES) -> bytes:
+    """The bytes of ``path`` if it is a regular file of at most ``max_bytes``; otherwise a
+    :class:`ConfigError` naming ``field`` and the path, at once: a folder, a device (``/dev/zero``
+    would be read forever), a FIFO (would block), a socket, a missing or unreadable file. The file
+    is opened without blocking and checked on the open descriptor (no race with a rename)."""
+    import stat
+
     path = Path(path)
     try:
-        with path.open("rb") as f:
-            return tomllib.load(f)
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
     except FileNotFoundError:
-        raise ConfigError("case", "file not found", str(path)) from None
+        raise ConfigError(field, "file not found", str(path)) from None
+    except IsADirectoryError:
+        raise ConfigError(field, "is a folder, not a file", str(path)) from None
+    except OSError as exc:
+        raise ConfigError(field, f"cannot be read: {exc.strerror or exc}", str(path)) from None
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise ConfigError(field, "is a folder, not a file", str(path))
+        if not stat.S_ISREG(st.st_mode):
+            raise ConfigError(field, "is not a regular file (a device, pipe or socket)", str(path))
+        if st.st_size > max_bytes:
+            raise ConfigError(field, f"is {st.st_size} bytes, more than such a file can be "
+                                     f"({max_bytes} bytes)", str(path))
+        chunks, total = [], 0
+        while True:
+            chunk = os.read(fd, 1 << 20)
+            if not chunk:
+                break
+            total += len(chunk)
+            if total > max_bytes:  # grew while being read
+                raise ConfigError(field, f"is more than {max_bytes} bytes", str(path))
+            chunks.append(chunk)
+        return b"".join(chunks)
+    except OSError as exc:
+        raise ConfigError(field, f"cannot be read: {exc.strerror or exc}", str(path)) from None
+    finally:
+        os.close(fd)
+
+
+def _nesting_depth(node: Any) -> int:
+    """Deepest nesting of dicts and lists (iterative: any depth)."""
+    deepest, stack = 0, [(node, 1)]
+    while stack:
+        x, d = stack.pop()
+        if isinstance(x, dict):
+            x = list(x.values())
+        if isinstance(x, list):
+            deepest = max(deepest, d)
+            if d <= MAX_CASE_DEPTH + 1:
+                stack.extend((v, d + 1) for v in x if isinstance(v, (dict, list)))
+    return deepest
+
+
+def parse_toml(raw: bytes, source: str) -> dict:
+    """A TOML document (bytes of ``source``) as a dict, or a one-line :class:`ConfigError`: not
+    UTF-8 (names the line), invalid TOML, nested deeper than :data:`MAX_CASE_DEPTH`."""
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise ConfigError(source, f"is not UTF-8 text (byte 0x{raw[exc.start]:02x} on line "
+                                  f"{line}): save it as UTF-8", has_value=False) from None
+    try:
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(str(path), f"is not valid TOML: {exc}", has_value=False) from None
+        raise ConfigError(source, f"is not valid TOML: {exc}", has_value=False) from None
+    except RecursionError:
+        data = None
+    if data is None or _nesting_depth(data) > MAX_CASE_DEPTH:
+        raise ConfigError(source, f"nests arrays or tables more than {MAX_CASE_DEPTH} deep, too "
+                                  "deeply to be a case file", has_value=False)
+    return data
+
+
+def read_toml(path: str | Path) -> dict:
+    """A TOML case file as a dict: a regular file of at most :data:`MAX_CASE_BYTES`, UTF-8, valid
+    TOML nested at most :data:`MAX_CASE_DEPTH` deep; anything else is a :class:`ConfigError`."""
+    path = Path(path)
+    return parse_toml(read_regular_file(path, "case"), str(path))
 
 
 def case_path(name_or_path: str | Path) -> Path:

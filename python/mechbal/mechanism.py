@@ -7,8 +7,11 @@ joints, any number of named bodies on each link, gear couplings, named frames an
 Every method takes either one sample (1-D arrays of ``dof`` values) or a batch ((N, dof) arrays),
 evaluated in one C++ call. One sample returns plain arrays and raises :class:`ValueError` when the
 input is rejected (wrong size, non-finite, overflow); a batch returns arrays with a leading N axis
-and a per-instant ``status`` array (0 = ok; see :class:`mechbal.Status`): rejected instants are
-zeros, never garbage.
+and a per-instant status (0 = ok; see :class:`mechbal.Status`): the result dataclasses have a
+``status`` field, and the plain-array results are :class:`BatchArray` with a ``status``
+attribute. A rejected instant is flagged in its status and its values are NaN (rotations and
+placements: the identity), never zeros that would pass for a result. Arrays of real numbers
+only: complex, string, boolean and object arrays are a :class:`TypeError`.
 
 Units: SI throughout (m, kg, kg m^2, rad, N, N m); world quantities in the base frame O; moments
 and angular momenta about O's origin.
@@ -23,7 +26,39 @@ import numpy as np
 
 from mechbal import _core
 
-__all__ = ["Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion"]
+__all__ = ["Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion",
+           "BatchArray"]
+
+
+class BatchArray(np.ndarray):
+    """A batch result (N, ...) with its per-instant ``status`` (N,) (uint32 bit flags of
+    :class:`mechbal.Status`, 0 = ok); rows whose status is not 0 hold NaN. ``ok`` is the boolean
+    mask of the good rows. Slicing or arithmetic gives plain results: read ``status`` first."""
+
+    status: np.ndarray
+
+    def __new__(cls, values, status):
+        obj = np.asarray(values).view(cls)
+        obj.status = np.asarray(status)
+        return obj
+
+    def __array_finalize__(self, obj):
+        parent = getattr(obj, "status", None)
+        # a view of the whole batch keeps the statuses; anything else (a row, a product) has none
+        self.status = parent if parent is not None and self.shape[:1] == obj.shape[:1] else None
+
+    def __array_wrap__(self, obj, context=None, return_scalar=False):
+        # ufunc results are plain arrays (a status means "these rows as computed")
+        out = np.asarray(obj)
+        return out[()] if return_scalar else out
+
+    @property
+    def ok(self) -> np.ndarray:
+        """Boolean mask (N,) of the instants whose status is ok."""
+        return np.asarray(self.status) == 0
+
+    def __reduce__(self):  # pickled as a plain array and its status
+        return (BatchArray, (np.asarray(self), self.status))
 
 
 @dataclass(frozen=True)
@@ -93,6 +128,15 @@ class ClosedMotion:
     projection: np.ndarray | None = None
 
 
+def _real_array(value, name: str) -> np.ndarray:
+    """float64 array of ``value``; TypeError naming ``name`` for complex, string, boolean or object
+    values (no silent truncation or parsing)."""
+    a = np.asarray(value)
+    if a.dtype.kind not in "iuf":
+        raise TypeError(f"{name} must be an array of real numbers (int or float), got dtype {a.dtype}")
+    return np.asarray(a, dtype=float)
+
+
 def _status_text(code: int) -> str:
     names = [s.name for s in _core.Status.__members__.values() if int(s) and int(code) & int(s)]
     return " | ".join(names) or "ok"
@@ -114,6 +158,9 @@ class Mechanism:
         #: link -> (4, 4) placement in the link frame of the frame the user described the link in
         #: (see :meth:`user_frame`); absent links: the identity
         self.link_frames = {str(k): np.array(v, dtype=float) for k, v in (link_frames or {}).items()}
+        from mechbal import plausibility
+
+        plausibility.warn(plausibility.mechanism_problems(self))
 
     # ---- construction ------------------------------------------------------------------------
     @classmethod
@@ -128,7 +175,7 @@ class Mechanism:
         names of the actuated joints (required with loops). Raises ValueError naming the field on
         bad input."""
         desc = _core.MechanismDescription(list(joints), list(bodies), list(frames),
-                                          np.asarray(gravity, dtype=float), root_name, list(loops),
+                                          _real_array(gravity, "gravity"), root_name, list(loops),
                                           list(actuated), list(springs))
         return cls(_core.MechanismModel(desc), name=name)
 
@@ -140,12 +187,14 @@ class Mechanism:
         limits, one coordinate), ``mimic`` becomes a gear coupling, limits are kept, and every
         URDF link is a named frame (see ``cpp/include/mechbal/urdf.hpp`` for the mapping).
         Raises :class:`mechbal.config.ConfigError` (a ValueError) naming the URDF element."""
-        from mechbal.config import ConfigError
+        from mechbal.config import ConfigError, read_regular_file
 
         path = Path(path)
         field = f"URDF file '{path}'"
-        if not path.is_file():
+        if not path.exists():
             raise ConfigError(field, "not found", has_value=False)
+        # a regular file of bounded size, at once (not /dev/zero, a FIFO, a folder): ConfigError
+        read_regular_file(path, field, _core.MAX_URDF_BYTES)
         try:
             model = _core.mechanism_from_urdf(str(path))
         except ValueError as exc:
@@ -333,8 +382,9 @@ class Mechanism:
         single = None
         for name, value in zip(names, values):
             a = np.asarray(value)
-            if a.dtype.kind not in "biuf":
-                raise TypeError(f"{name} must be a real numeric array, got dtype {a.dtype}")
+            if a.dtype.kind not in "iuf":
+                raise TypeError(f"{name} must be an array of real numbers (int or float), got "
+                                f"dtype {a.dtype}")
             a = np.ascontiguousarray(a, dtype=float)
             if a.ndim == 1:
                 is_single = True
@@ -361,13 +411,14 @@ class Mechanism:
                 raise ValueError(f"{self.name}: input rejected ({_status_text(int(status[0]))}); "
                                  "q, v, a must be finite, of the right size, and give finite results")
             return [np.asarray(result[k])[0] for k in keys], status[0]
-        return [np.asarray(result[k]) for k in keys], status
+        return [BatchArray(result[k], status) for k in keys], status
 
     # ---- algorithms --------------------------------------------------------------------------
     def inverse_dynamics(self, q, v, a) -> np.ndarray:
         """Joint forces tau = M(q) a + C(q, v) v + G(q) + K(q) [N m or N] (K: the springs' joint
         forces, :meth:`spring_torque`), gear couplings projected.
-        A batch returns (N, dof); see :meth:`status_of` for per-instant statuses."""
+        A batch returns a :class:`BatchArray` (N, dof) whose ``status`` (N,) flags the rejected
+        instants (their rows are NaN)."""
         single, (q, v, a) = self._args(("q", "v", "a"), (q, v, a))
         (tau,), _ = self._finish(single, _core.mechanism_inverse_dynamics(self.model, q, v, a),
                                  ["joint_torque"])
@@ -467,14 +518,14 @@ class Mechanism:
 
     def body_motion(self, q, v=None, a=None) -> BodyMotion:
         """Every body's pose, velocity and acceleration in O (v and a default to zero)."""
-        q_arr = np.asarray(q, dtype=float)
+        q_arr = _real_array(q, "q")
         v = np.zeros_like(q_arr) if v is None else v
         a = np.zeros_like(q_arr) if a is None else a
         single, (q, v, a) = self._args(("q", "v", "a"), (q, v, a))
         keys = ["com", "rotation", "com_velocity", "com_acceleration", "angular_velocity",
                 "angular_acceleration", "link_rotation", "link_position", "frame_placement"]
         values, st = self._finish(single, _core.mechanism_kinematics(self.model, q, v, a), keys)
-        return BodyMotion(**dict(zip(keys, values)), status=st)
+        return BodyMotion(**{k: np.asarray(x) for k, x in zip(keys, values)}, status=st)
 
     def body_poses(self, q) -> tuple[np.ndarray, np.ndarray]:
         """(com, rotation) of every body: (B, 3) and (B, 3, 3), or with a leading N axis."""
@@ -530,11 +581,12 @@ class Mechanism:
         Returns the full q, v, a (the coupling-matrix method: v = C v#, a = C a# + c), the reciprocal
         condition of the passive Jacobian, the closure residual, Newton iterations, statuses
         (``singular`` near a parallel singularity; ``solver_error`` where the mechanism cannot be
-        assembled: that instant's q, v, a are zeros), and with ``with_forces`` the actuated forces
-        tau# = C^T tau [N m or N]."""
-        qa = np.asarray(q_actuated, dtype=float)
-        va = np.zeros_like(qa) if v_actuated is None else v_actuated
-        aa = np.zeros_like(qa) if a_actuated is None else a_actuated
+        assembled: that instant's q, v, a are NaN), and with ``with_forces`` the actuated forces
+        tau# = C^T tau [N m or N]. Rows are independent: a failed instant does not poison the next
+        ones, which start from the last good solution (or ``q_guess``)."""
+        qa = _real_array(q_actuated, "q_actuated")
+        va = np.zeros_like(qa) if v_actuated is None else _real_array(v_actuated, "v_actuated")
+        aa = np.zeros_like(qa) if a_actuated is None else _real_array(a_actuated, "a_actuated")
         na = len(self.model.actuated_coordinates)
         single = qa.ndim == 1
         arrays = []
@@ -547,7 +599,7 @@ class Mechanism:
                 raise ValueError(f"{name} must have shape ({na},) or (N, {na}) like q_actuated, got "
                                  f"{np.asarray(x).shape}")
             arrays.append(x)
-        guess = np.zeros(self.dof) if q_guess is None else np.ascontiguousarray(q_guess, dtype=float)
+        guess = np.zeros(self.dof) if q_guess is None else _real_array(q_guess, "q_guess")
         r = _core.mechanism_closed_motion(self.model, arrays[0], arrays[1], arrays[2], guess,
                                           max_iterations, tolerance, singular_rcond, with_forces)
         out = {k: np.asarray(v) for k, v in r.items()}
@@ -564,16 +616,24 @@ class Mechanism:
         if np.ndim(m.status) == 0 and (int(m.status) & ~int(_core.Status.singular)):
             raise ValueError(f"{self.name}: the loops cannot be solved here ({_status_text(int(m.status))})")
         assert m.actuated_force is not None  # asked for with_forces
-        return m.actuated_force
+        if np.ndim(m.status) == 0:
+            return m.actuated_force
+        return BatchArray(m.actuated_force, m.status)
 
     def reduced_mass_matrix(self, q_actuated, *, q_guess=None) -> tuple[np.ndarray, np.ndarray]:
-        """(C^T M C, C^T G): mass matrix and gravity forces in the actuated coordinates."""
-        qa = np.atleast_2d(np.asarray(q_actuated, dtype=float))
-        guess = np.zeros(self.dof) if q_guess is None else np.asarray(q_guess, dtype=float)
+        """(C^T M C, C^T G): mass matrix and gravity forces in the actuated coordinates. One
+        instant raises ValueError where the loops cannot be solved; a batch gives
+        :class:`BatchArray` results whose ``status`` flags the failed instants (NaN rows)."""
+        qa = np.atleast_2d(_real_array(q_actuated, "q_actuated"))
+        guess = np.zeros(self.dof) if q_guess is None else _real_array(q_guess, "q_guess")
         r = _core.mechanism_closed_mass_matrix(self.model, np.ascontiguousarray(qa), guess)
         if np.ndim(q_actuated) == 1:
+            st = int(np.asarray(r["status"])[0])
+            if st & ~int(_core.Status.singular):
+                raise ValueError(f"{self.name}: the loops cannot be solved here ({_status_text(st)})")
             return r["reduced_mass_matrix"][0], r["actuated_gravity"][0]
-        return r["reduced_mass_matrix"], r["actuated_gravity"]
+        return (BatchArray(r["reduced_mass_matrix"], r["status"]),
+                BatchArray(r["actuated_gravity"], r["status"]))
 
     def _frame(self, frame: str) -> int:
         i = self.model.frame_index(frame)

@@ -11,11 +11,22 @@ beside the new ones). The output path is checked before any computation:
 - the folder that will hold ``DIR`` must be writable (checked by creating the temporary folder).
 
 Every refusal is an :class:`OutputError` whose message names the path and the reason.
+
+Recovery after a run that died (SIGKILL, a crash, a timeout): the temporary folders carry the
+writing process's id (``.DIR.partial-<pid>-XXXX``, ``.DIR.old-<pid>-XXXX``). The next run into
+``DIR`` removes those whose process is gone, and only those (a live run's folders, and folders
+without a process id, are left alone). A run killed between its two renames leaves the old run in
+``.DIR.old-<pid>-*`` and no ``DIR``: the next run puts it back first (then replaces it as usual).
+A run that finds, at the final move, that another run has just put its own ``DIR`` in place
+(two runs into one ``--out`` at once) raises :class:`OutputRaceError` (the CLI's exit code 4):
+the other run's folder is kept whole, this run's results are discarded.
 """
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import re
 import shutil
 import tempfile
 from pathlib import Path
@@ -35,6 +46,11 @@ class OutputError(OSError):
 
     def __str__(self) -> str:  # OSError's own str() would print errno fields
         return f"--out {self.path}: {self.reason}"
+
+
+class OutputRaceError(OutputError):
+    """Another run moved its own folder into ``DIR`` while this one was finishing (two runs into one
+    ``--out`` at once): this run's results were discarded, the other run's folder is whole."""
 
 
 def _reason(exc: OSError) -> str:
@@ -70,16 +86,66 @@ def check_output_dir(out: str | Path) -> Path:
     return out
 
 
+def _pid_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError):
+        return pid > 0  # exists (another user's) / not a pid: leave it alone
+    return True
+
+
+def recover_stale(out: str | Path) -> list[Path]:
+    """Clean up after runs into ``out`` that died: restore a previous run left in
+    ``.out.old-<pid>-*`` when ``out`` is absent, and delete the other ``.out.partial-<pid>-*`` /
+    ``.out.old-<pid>-*`` folders whose process is gone. Returns what was removed or restored;
+    errors are ignored (the run goes on; a folder that cannot be removed stays)."""
+    out = Path(os.path.abspath(os.path.expanduser(str(out))))
+    parent = out.parent
+    pattern = re.compile(rf"^\.{re.escape(out.name)}\.(partial|old)-(\d+)-")
+    try:
+        entries = sorted(parent.iterdir(), key=lambda p: p.stat().st_mtime if p.exists() else 0.0,
+                         reverse=True)
+    except OSError:
+        return []
+    done: list[Path] = []
+    for entry in entries:
+        m = pattern.match(entry.name)
+        if not m or _pid_alive(int(m.group(2))):
+            continue
+        if m.group(1) == "old" and not (out.exists() or out.is_symlink()):
+            try:
+                os.rename(entry, out)  # killed between the renames: the old run comes back
+                done.append(out)
+                continue
+            except OSError:
+                if not out.exists():
+                    continue  # cannot restore it: keep it
+        try:
+            if entry.is_symlink() or not entry.is_dir():
+                entry.unlink()
+            else:
+                shutil.rmtree(entry)
+            done.append(entry)
+        except OSError:
+            pass
+    return done
+
+
 @contextlib.contextmanager
 def staged_output(out: str | Path) -> Iterator[Path]:
     """Yield a fresh temporary folder next to ``out``; when the block ends without an exception,
     move it to ``out`` (replacing a previous run), otherwise delete it. All checks happen before
     the block runs."""
     given = out
+    recover_stale(out)
     out = check_output_dir(out)
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-{os.getpid()}-", dir=out.parent))
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; DIR gets the usual mode
@@ -94,6 +160,10 @@ def staged_output(out: str | Path) -> Iterator[Path]:
         _replace(tmp, out)
     except OSError as exc:
         shutil.rmtree(tmp, ignore_errors=True)
+        if exc.errno in (errno.ENOTEMPTY, errno.EEXIST):
+            raise OutputRaceError(given, "another run moved its results into this folder while this "
+                                         "run was finishing; this run's results were discarded "
+                                         "(run again, or give each run its own --out)") from None
         raise OutputError(given, f"cannot move the finished run into place: {_reason(exc)}") from None
 
 
@@ -104,7 +174,7 @@ def _replace(tmp: Path, out: Path) -> None:
     if not (out.exists() or out.is_symlink()):
         os.rename(tmp, out)
         return
-    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
+    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-{os.getpid()}-", dir=out.parent))
     old.rmdir()
     os.rename(out, old)
     try:
@@ -119,4 +189,5 @@ def _replace(tmp: Path, out: Path) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
-__all__ = ["OutputError", "RUN_MARKER", "check_output_dir", "staged_output"]
+__all__ = ["OutputError", "OutputRaceError", "RUN_MARKER", "check_output_dir", "recover_stale",
+           "staged_output"]

@@ -1382,8 +1382,14 @@ def _message(err: dict, root: Any, prefix: str, data: Any = None) -> tuple[str, 
         return field, f"must be {op} {_fmt(ctx.get(key))}", True, value
     if typ in ("too_short", "too_long"):
         lo, hi = _lengths(root, loc)
+        lo = ctx.get("min_length") if lo is None else lo  # pydantic's own bounds when the
+        hi = ctx.get("max_length") if hi is None else hi  # field's constraint is not found
         if lo is not None and lo == hi:
             text = f"must have {lo} values"
+        elif typ == "too_short" and lo is None:
+            text = "has too few values"
+        elif typ == "too_long" and hi is None:
+            text = "has too many values"
         elif typ == "too_short":
             text = f"must have at least {lo} values"
         else:
@@ -1492,8 +1498,11 @@ def validate_case(config: Any, *, warn: bool = True):
     case = validate_table(model, config)
     _cross_checks(case)
     if warn:
+        from mechbal import plausibility
+
         for field, message in unit_warnings(case):
             warnings.warn(f"{field}: {message}", ConfigWarning, stacklevel=2)
+        plausibility.warn(plausibility.case_problems(config))
     return case
 
 

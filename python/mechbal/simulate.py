@@ -82,6 +82,32 @@ def _plant(mechanism_or_plant: Any, q_guess: npt.ArrayLike | None) -> Any:
     return mechanism_or_plant
 
 
+#: most RK4 steps of one closed_loop call (the log holds 5 arrays of steps x dof values)
+MAX_STEPS = 10_000_000
+
+
+def _check_timing(dt: Any, duration: Any) -> tuple[float, float]:
+    """(dt, duration) as floats, or ValueError / TypeError naming the argument: real numbers,
+    finite, dt > 0, duration >= dt, at most :data:`MAX_STEPS` steps."""
+    values = {}
+    for name, x in (("dt", dt), ("duration", duration)):
+        if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
+            raise TypeError(f"{name} must be a number of seconds, got {type(x).__name__}")
+        x = float(x)
+        if not np.isfinite(x) or x <= 0.0:
+            raise ValueError(f"{name} must be a finite number of seconds > 0, got {x!r}")
+        values[name] = x
+    dt, duration = values["dt"], values["duration"]
+    if duration < dt:
+        raise ValueError(f"duration must be >= dt, got duration={duration!r}, dt={dt!r}")
+    steps = duration / dt
+    if steps > MAX_STEPS:
+        raise ValueError(f"duration / dt = {steps:.4g} steps, more than the {MAX_STEPS} one "
+                         f"simulation may take (dt={dt!r}, duration={duration!r}): raise dt or "
+                         "shorten duration")
+    return dt, duration
+
+
 def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
                 q0: npt.ArrayLike | None = None, qd0: npt.ArrayLike | None = None, *,
                 dt: float = 1e-3, duration: float | None = None,
@@ -120,6 +146,7 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
     traj = as_trajectory(trajectory)
     if duration is None:  # until the motion ends (a trajectory may start after t = 0)
         duration = float(getattr(traj, "end_time", traj.duration))
+    dt, duration = _check_timing(dt, duration)
     q_start, qd_start, _ = traj.evaluate(0.0)
     q0 = q_start if q0 is None else q0
     qd0 = qd_start if qd0 is None else qd0
@@ -127,8 +154,6 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
         log = _core.simulate_closed_loop(plant, controller, traj.core, q0, qd0, dt, duration,
                                          sampling)
     else:
-        if not (np.isfinite(dt) and dt > 0 and np.isfinite(duration) and duration >= dt):
-            raise ValueError(f"dt must be > 0 and duration >= dt, got dt={dt}, duration={duration}")
         steps = int(round(duration / dt))
         q_des, qd_des, qdd_des = traj.evaluate(np.arange(2 * steps + 1) * (0.5 * dt))
         log = _core.simulate_closed_loop_sampled(plant, controller, q_des, qd_des, qdd_des, q0,

@@ -57,8 +57,8 @@ class Trajectory(Protocol):
 
 def _times(t: Times) -> tuple[bool, np.ndarray]:
     a = np.asarray(t)
-    if a.dtype.kind not in "biuf":
-        raise TypeError(f"t must be real numbers, got dtype {a.dtype}")
+    if a.dtype.kind not in "iuf":
+        raise TypeError(f"t must be real numbers (int or float), got dtype {a.dtype}")
     a = a.astype(float)
     if a.ndim > 1:
         raise ValueError(f"t must be a number or a 1-D array of times, got shape {a.shape}")
@@ -69,12 +69,23 @@ def _times(t: Times) -> tuple[bool, np.ndarray]:
 
 def _vector(name: str, value: ArrayLike) -> np.ndarray:
     a = np.asarray(value)
-    if a.dtype.kind not in "biuf":
-        raise TypeError(f"{name} must be real numbers, got dtype {a.dtype}")
+    if a.dtype.kind not in "iuf":
+        raise TypeError(f"{name} must be real numbers (int or float), got dtype {a.dtype}")
     a = np.array(a, dtype=float)
     if not np.all(np.isfinite(a)):
         raise ValueError(f"{name} must be finite")
     return a
+
+
+def _finite_motion(what: str, single: bool, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> Motion:
+    """The motion, or ValueError when finite input overflowed into a non-finite value."""
+    for name, x in (("q", q), ("qd", qd), ("qdd", qdd)):
+        if not np.all(np.isfinite(x)):
+            raise ValueError(f"{what}.evaluate: {name} is not finite (the points, velocities or "
+                             "times overflow: values too large or times too close)")
+    if single:
+        return q[0], qd[0], qdd[0]
+    return q, qd, qdd
 
 
 class RestToRest:
@@ -193,22 +204,27 @@ class ViaPoints(_OverTimes):
             raise ValueError(f"points must have shape ({t.size}, dof), got {np.shape(points)}")
         h = np.diff(t)[:, None]
         if velocities is None:
-            slope = np.diff(p, axis=0) / h
-            v = np.zeros_like(p)
-            inner = 0.5 * (slope[:-1] + slope[1:])
-            v[1:-1] = np.where(slope[:-1] * slope[1:] > 0, inner, 0.0)
+            with np.errstate(all="ignore"):  # an overflow is reported below
+                slope = np.diff(p, axis=0) / h
+                v = np.zeros_like(p)
+                inner = 0.5 * (slope[:-1] + slope[1:])
+                v[1:-1] = np.where(slope[:-1] * slope[1:] > 0, inner, 0.0)
         else:
             v = _vector("velocities", velocities).reshape(p.shape)
         a = np.zeros_like(p) if accelerations is None else _vector("accelerations",
                                                                    accelerations).reshape(p.shape)
         # quintic coefficients per segment in u = (t - t_i) / h, x(u) = sum c_k u^k
-        p0, p1, v0, v1, a0, a1 = p[:-1], p[1:], v[:-1] * h, v[1:] * h, a[:-1] * h**2, a[1:] * h**2
-        c0, c1, c2 = p0, v0, 0.5 * a0
-        d = p1 - p0 - v0 - 0.5 * a0
-        # c3, c4, c5 from position, velocity and acceleration at u = 1
-        A = np.array([[1.0, 1.0, 1.0], [3.0, 4.0, 5.0], [6.0, 12.0, 20.0]])
-        rhs = np.stack([d, v1 - v0 - a0, a1 - a0], axis=-1)  # (K-1, dof, 3)
-        c3, c4, c5 = np.moveaxis(rhs @ np.linalg.inv(A).T, -1, 0)
+        with np.errstate(all="ignore"):  # an overflow is reported below, not as a RuntimeWarning
+            p0, p1, v0, v1, a0, a1 = p[:-1], p[1:], v[:-1] * h, v[1:] * h, a[:-1] * h**2, a[1:] * h**2
+            c0, c1, c2 = p0, v0, 0.5 * a0
+            d = p1 - p0 - v0 - 0.5 * a0
+            # c3, c4, c5 from position, velocity and acceleration at u = 1
+            A = np.array([[1.0, 1.0, 1.0], [3.0, 4.0, 5.0], [6.0, 12.0, 20.0]])
+            rhs = np.stack([d, v1 - v0 - a0, a1 - a0], axis=-1)  # (K-1, dof, 3)
+            c3, c4, c5 = np.moveaxis(rhs @ np.linalg.inv(A).T, -1, 0)
+        if not all(np.all(np.isfinite(c)) for c in (c0, c1, c2, c3, c4, c5)):
+            raise ValueError("ViaPoints: the points, velocities or accelerations overflow over the "
+                             "given times (values too large or times too close)")
         self._t = t
         self._h = h[:, 0]
         self._c = np.stack([c0, c1, c2, c3, c4, c5], axis=0)  # (6, K-1, dof)
@@ -224,17 +240,16 @@ class ViaPoints(_OverTimes):
         single, ts = _times(t)
         i = np.clip(np.searchsorted(self._t, ts, side="right") - 1, 0, len(self._h) - 1)
         h = self._h[i][:, None]
-        u = np.clip((ts - self._t[i]) / self._h[i], 0.0, 1.0)[:, None]
-        c = self._c[:, i, :]  # (6, N, dof)
-        q = c[0] + u * (c[1] + u * (c[2] + u * (c[3] + u * (c[4] + u * c[5]))))
-        qd = (c[1] + u * (2 * c[2] + u * (3 * c[3] + u * (4 * c[4] + u * 5 * c[5])))) / h
-        qdd = (2 * c[2] + u * (6 * c[3] + u * (12 * c[4] + u * 20 * c[5]))) / h**2
+        with np.errstate(all="ignore"):  # an overflow is reported below, not as a RuntimeWarning
+            u = np.clip((ts - self._t[i]) / self._h[i], 0.0, 1.0)[:, None]
+            c = self._c[:, i, :]  # (6, N, dof)
+            q = c[0] + u * (c[1] + u * (c[2] + u * (c[3] + u * (c[4] + u * c[5]))))
+            qd = (c[1] + u * (2 * c[2] + u * (3 * c[3] + u * (4 * c[4] + u * 5 * c[5])))) / h
+            qdd = (2 * c[2] + u * (6 * c[3] + u * (12 * c[4] + u * 20 * c[5]))) / h**2
         outside = ((ts < self._t[0]) | (ts > self._t[-1]))[:, None]
         qd = np.where(outside, 0.0, qd)
         qdd = np.where(outside, 0.0, qdd)
-        if single:
-            return q[0], qd[0], qdd[0]
-        return q, qd, qdd
+        return _finite_motion("ViaPoints", single, q, qd, qdd)
 
 
 class Sampled(_OverTimes):
@@ -267,7 +282,17 @@ class Sampled(_OverTimes):
         if p.ndim != 2 or p.shape[0] != t.size:
             raise ValueError(f"positions must have shape ({t.size}, dof), got {np.shape(positions)}")
         self._t = t
-        self._spline = CubicSpline(t, p, axis=0, bc_type=bc_type)
+        overflow = False
+        with np.errstate(all="ignore"):  # an overflow is reported here, not as a RuntimeWarning
+            try:
+                self._spline = CubicSpline(t, p, axis=0, bc_type=bc_type)
+            except ValueError as exc:  # scipy's own check of its slopes
+                if "finite" not in str(exc):
+                    raise
+                overflow = True
+        if overflow or not np.all(np.isfinite(self._spline.c)):
+            raise ValueError("Sampled: the positions overflow over the given times (values too large "
+                             "or times too close)")
         self._d1 = self._spline.derivative(1)
         self._d2 = self._spline.derivative(2)
         self._dof = p.shape[1]
@@ -282,12 +307,11 @@ class Sampled(_OverTimes):
         single, ts = _times(t)
         tc = np.clip(ts, self._t[0], self._t[-1])
         outside = ((ts < self._t[0]) | (ts > self._t[-1]))[:, None]
-        q = self._spline(tc)
-        qd = np.where(outside, 0.0, self._d1(tc))
-        qdd = np.where(outside, 0.0, self._d2(tc))
-        if single:
-            return q[0], qd[0], qdd[0]
-        return q, qd, qdd
+        with np.errstate(all="ignore"):  # an overflow is reported below, not as a RuntimeWarning
+            q = self._spline(tc)
+            qd = np.where(outside, 0.0, self._d1(tc))
+            qdd = np.where(outside, 0.0, self._d2(tc))
+        return _finite_motion("Sampled", single, q, qd, qdd)
 
 
 def as_trajectory(obj: object) -> Trajectory:
