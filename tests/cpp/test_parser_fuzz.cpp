@@ -17,9 +17,9 @@
 #include "mechbal/algorithm/kinematics.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
 #include "mechbal/algorithm/momentum.hpp"
-#include "mechbal/data.hpp"
-#include "mechbal/rigid_body.hpp"
-#include "mechbal/urdf.hpp"
+#include "mechbal/io/urdf.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/rigid_body.hpp"
 
 using namespace mechbal;
 
