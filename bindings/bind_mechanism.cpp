@@ -621,8 +621,8 @@ void bind_mechanism(py::module_& m) {
               put(length, k, d.spring_length, ok);
               put(tension, k, d.spring_tension, ok);
               put(torque, k, d.spring_torque, ok);
-              energy.mutable_data()[k] = ok ? d.spring_energy : 0.0;
-              potential.mutable_data()[k] = ok ? d.potential_energy : 0.0;
+              energy.mutable_data()[k] = ok ? d.spring_energy : kFailed;
+              potential.mutable_data()[k] = ok ? d.potential_energy : kFailed;
             });
         py::dict out;
         out["spring_length"] = length;

@@ -530,12 +530,16 @@ class Mechanism:
     def body_poses(self, q) -> tuple[np.ndarray, np.ndarray]:
         """(com, rotation) of every body: (B, 3) and (B, 3, 3), or with a leading N axis."""
         m = self.body_motion(q)
-        return m.com, m.rotation
+        if np.ndim(m.status) == 0:
+            return m.com, m.rotation
+        return BatchArray(m.com, m.status), BatchArray(m.rotation, m.status)
 
     def frame_placement(self, q, frame: str) -> np.ndarray:
         """4x4 placement of a named frame in O."""
         i = self._frame(frame)
-        return self.body_motion(q).frame_placement[..., i, :, :]
+        m = self.body_motion(q)
+        T = m.frame_placement[..., i, :, :]
+        return T if np.ndim(m.status) == 0 else BatchArray(T, m.status)
 
     def frame_jacobian(self, q, frame: str) -> np.ndarray:
         """[v; w] = J(q) qdot of a named frame's origin, O's axes: (6, dof)."""

@@ -338,6 +338,41 @@ def test_every_batch_method_flags_a_failed_row(arm, name, nargs):
         assert np.array_equal(np.asarray(out[k]), np.asarray(single))
 
 
+@pytest.mark.parametrize("name, nargs", [("momentum", 2), ("shaking_wrench", 3), ("base_reaction", 3),
+                                         ("body_motion", 3), ("spring_energy", 1), ("potential_energy", 1),
+                                         ("spring_tension", 1), ("frame_jacobian", 1), ("frame_placement", 1),
+                                         ("body_poses", 1)])
+def test_every_other_batch_method_flags_a_failed_row(arm, name, nargs):
+    """Every public Mechanism method over a batch: the failed instant is flagged and holds no
+    finite number that could pass for a result (rotations and placements aside: identity)."""
+    q = np.array([[0.3, -0.2], [np.inf, 0.0]])
+    args = [q] + [np.full_like(q, 0.5)] * (nargs - 1)
+    if name in ("frame_jacobian", "frame_placement"):
+        args.append("b")
+    out = getattr(arm, name)(*args)
+    results = out if isinstance(out, tuple) else (out,)
+    for r in results:
+        status = r.status
+        assert list(np.asarray(status) != 0) == [False, True], (name, status)
+        arrays = [r] if isinstance(r, np.ndarray) else [np.asarray(v) for k, v in vars(r).items()
+                                                         if k != "status" and isinstance(v, np.ndarray)]
+        for a in arrays:
+            bad = np.asarray(a)[1]
+            if bad.shape[-2:] in ((3, 3), (4, 4)) and not np.isnan(bad).all():
+                assert np.array_equal(bad, np.broadcast_to(np.eye(bad.shape[-1]), bad.shape)), name
+            else:
+                assert np.all(np.isnan(bad)), (name, bad)
+
+
+def test_pose_batches_expose_the_status(arm):
+    q = [[np.nan, 0.0], [0.2, 0.1]]
+    T = arm.frame_placement(q, "a")
+    assert isinstance(T, BatchArray) and list(T.ok) == [False, True]
+    assert np.array_equal(T[0], np.eye(4))
+    com, R = arm.body_poses(q)
+    assert list(com.ok) == [False, True] and list(R.ok) == [False, True]
+
+
 def test_gravity_torque_of_the_issue(arm):
     g = arm.gravity_torque([[np.nan, 0], [0, 0]])
     assert np.all(np.isnan(g[0])) and np.all(np.isfinite(g[1]))

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -79,7 +80,12 @@ bool strict_number(std::string_view token) {
   if (token.empty()) return false;
   double value = 0.0;
   const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  return ec == std::errc() && end == token.data() + token.size() && std::isfinite(value);
+  if (end != token.data() + token.size()) return false;
+  if (ec == std::errc::result_out_of_range) {  // an underflow (1e-320) reads as ~0, an overflow refused
+    const std::string copy(token);
+    return std::isfinite(std::strtod(copy.c_str(), nullptr));
+  }
+  return ec == std::errc() && std::isfinite(value);
 }
 
 /// The numeric attributes of the elements mechbal reads (inside a <link> or a <joint>).
