@@ -1,5 +1,7 @@
 """Commented case templates printed by ``mechbal init KIND`` (a starting point to edit, accepted
-as is by ``mechbal run``; the tests run them)."""
+as is by ``mechbal run``; the tests run them).
+
+Layer: Python core (docs/architecture.md)."""
 
 SERIAL = '''\
 # A mechbal case: a serial chain (here a two-link arm in the vertical x-z plane) moving along a

@@ -6,6 +6,8 @@ chunk order: the table does not depend on the backend.
 On a cluster the plan is scattered once to every worker (each builds its regressors once and caches
 them), each chunk is one task, and results are gathered as they complete; a worker that dies loses
 nothing: the scheduler reruns its tasks elsewhere (Dask's own resilience), so the table is complete.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -1,6 +1,8 @@
 """Sweep definitions: :class:`Parameter` (a path and its distribution or grid) and :class:`Sweep`
 (a mechanism, its parameters, metrics, workspace sample and trajectory, and the kind of sweep),
-which generates every parameter set up front from its seed and runs them on a backend."""
+which generates every parameter set up front from its seed and runs them on a backend.
+
+Layer: methods (docs/architecture.md)."""
 from __future__ import annotations
 
 import itertools
