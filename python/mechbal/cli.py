@@ -7,6 +7,8 @@ error (a bug in mechbal), reported as one line with a request to report it (set
 ``MECHBAL_DEBUG=1`` for the traceback); 4 another run into the same ``--out`` finished at the same
 moment (this run's results were discarded, the other run's folder is whole); 130 interrupted. No
 traceback is ever shown otherwise.
+
+Layer: command line (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -19,9 +21,7 @@ import sys
 import warnings
 from pathlib import Path
 
-from mechbal.config import ConfigError
-
-from mechbal.config import MAX_CASE_BYTES  # noqa: E402 (re-exported)
+from mechbal.config import MAX_CASE_BYTES, ConfigError, check_case_file  # noqa: F401 (re-exported)
 
 ISSUES_HINT = ("this is a bug in mechbal: please report it with the command line and the case "
                "file (MECHBAL_DEBUG=1 shows the traceback)")
@@ -34,27 +34,27 @@ class UserError(Exception):
 # ---- commands ---------------------------------------------------------------------------------
 
 def _cmd_cases(args) -> int:
-    from mechbal.cases import DEFAULT_CASE, available
+    from mechbal.cases import available, default_case
 
-    for name, kind, title in available():
-        mark = " (default)" if name == DEFAULT_CASE else ""
-        print(f"{name:16s} {kind:14s} {title}{mark}")
+    default = default_case()
+    rows = available()
+    _print_table([(name, kind, title + (" (default)" if name == default else "")) for name, kind, title in rows])
     return 0
 
 
-def check_case_file(name_or_path: str) -> Path:
-    """Path of the case after the checks that the TOML reader does not do: a regular file, not a
-    folder, of reasonable size, UTF-8 text, valid TOML of reasonable nesting (raises
-    :class:`ConfigError` naming the path)."""
-    from mechbal import _core
-    from mechbal.config import case_path, parse_toml, read_regular_file
+def _print_table(rows: list[tuple[str, str, str]]) -> None:
+    """Rows of (name, kind, title), the first two columns as wide as their longest entry."""
+    w0 = max((len(r[0]) for r in rows), default=0)
+    w1 = max((len(r[1]) for r in rows), default=0)
+    for name, kind, title in rows:
+        print(f"{name:{w0}s}  {kind:{w1}s}  {title}".rstrip())
 
-    path = case_path(name_or_path)  # ConfigError for an unknown built-in name or a missing file
-    if path.suffix.lower() == ".urdf":
-        read_regular_file(path, "case", _core.MAX_URDF_BYTES)
-        return path  # XML: the URDF reader checks the rest
-    parse_toml(read_regular_file(path, "case", MAX_CASE_BYTES), str(path))
-    return path
+
+def _cmd_sweeps(args) -> int:
+    from mechbal.sweep.config import available
+
+    _print_table(available())
+    return 0
 
 
 def _cmd_run(args) -> int:
@@ -108,11 +108,11 @@ def _cmd_balance(args) -> int:
 
 
 def _cmd_demo(args) -> int:
-    from mechbal.cases import DEFAULT_CASE
+    from mechbal.cases import default_case
 
-    args.case = DEFAULT_CASE
+    args.case = default_case()
     if not args.quiet:
-        print(f"mechbal demo: running the default case '{DEFAULT_CASE}'")
+        print(f"mechbal demo: running the default case '{args.case}'")
     return _cmd_run(args)
 
 
@@ -166,6 +166,10 @@ def build_parser() -> argparse.ArgumentParser:
     force = dict(action="store_true",
                  help="run values outside the plausible ranges (a joint travel beyond 1e3 rad or m, "
                       "a gravity beyond 1e3 m/s^2, a mass beyond 1e6 kg), which are refused otherwise")
+    s = sub.add_parser("sweeps", help="list the built-in sweep files (mechbal sweep CASE --spec NAME)",
+                       description="List the built-in sweep files: name, kind and title. Run one with "
+                                   "'mechbal sweep CASE --spec NAME --out DIR'.")
+    s.set_defaults(func=_cmd_sweeps)
     quiet = dict(action="store_true",
                  help="no progress bar and no tables: only warnings and errors (on stderr)")
     s = sub.add_parser("run", help="run a case study (built-in name or TOML file)",
@@ -203,7 +207,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=_cmd_balance)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")
-    s.add_argument("--out", default="out/demo", metavar="DIR", help="output folder")
+    s.add_argument("--out", default="out/demo", metavar="DIR", help="output folder (default: out/demo)")
     s.add_argument("-q", "--quiet", **quiet)
     s.add_argument("--force", **force)
     s.set_defaults(func=_cmd_demo)
@@ -214,8 +218,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("case", help="built-in case name or path to a TOML or URDF file")
     s.add_argument("--spec", required=True, metavar="SWEEP", help="sweep file (TOML with [sweep]) or built-in sweep name")
     s.add_argument("--out", default="out/sweep", metavar="DIR", help="output folder (default: out/sweep)")
-    s.add_argument("--backend", choices=("serial", "processes", "dask"), default="processes",
-                   help="serial; processes: every local core (default); dask: a cluster (--scheduler)")
+    s.add_argument("--backend", choices=("auto", "serial", "processes", "dask"), default="auto",
+                   help="auto (default): serial unless the sweep would take more than a few seconds "
+                        "in one process, then every local core; serial; processes: every local core; "
+                        "dask: a cluster (--scheduler)")
     s.add_argument("--workers", type=int, metavar="N", help="processes: number of local processes (default: all cores)")
     s.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 (implies --backend dask)")
     s.add_argument("-q", "--quiet", **quiet)
@@ -226,7 +232,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "run with 'mechbal run my.toml'.")
     s.add_argument("kind", choices=("serial", "linkage"),
                    help="serial: a serial chain (joints, links, trajectory); linkage: a closed "
-                        "loop (four-bar with a counterweight), not available yet")
+                        "loop (four-bar with a counterweight)")
     s.set_defaults(func=_cmd_init)
     return p
 

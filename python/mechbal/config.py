@@ -6,6 +6,8 @@ error is a :class:`ConfigError` naming the offending field by its dotted path (f
 ``mechanism.joints[1].link.mass``) and the value found, and nothing is half-built: models are only
 constructed once every field has been read and checked. The helpers here (``number``, ``vector``,
 ...) remain for code that checks values outside case files.
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -22,7 +24,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-CASES_DIR = Path(__file__).resolve().parent / "cases"
+from mechbal.registry import GENERAL_CASES_DIR as CASES_DIR, case_dirs  # noqa: E402
 
 
 from mechbal.errors import ConfigError, ConfigWarning, short_repr  # noqa: F401 (re-exported)
@@ -204,6 +206,16 @@ def read_toml(path: str | Path) -> dict:
     return parse_toml(read_regular_file(path, "case"), str(path))
 
 
+def builtin_cases() -> dict[str, Path]:
+    """Every built-in case file by name: the general cases and each paper's (the registry's
+    folders, :mod:`mechbal.registry`)."""
+    out: dict[str, Path] = {}
+    for d in case_dirs():
+        for p in sorted(d.glob("*.toml")):
+            out.setdefault(p.stem, p)
+    return dict(sorted(out.items()))
+
+
 def case_path(name_or_path: str | Path) -> Path:
     """Path of a built-in case by name (``arm2link``) or of a user TOML file."""
     p = Path(name_or_path)
@@ -211,11 +223,24 @@ def case_path(name_or_path: str | Path) -> Path:
         if not p.exists():
             raise ConfigError("case", "file not found", str(p))
         return p
-    builtin = CASES_DIR / f"{name_or_path}.toml"
-    if not builtin.exists():
-        names = ", ".join(sorted(x.stem for x in CASES_DIR.glob("*.toml")))
-        raise ConfigError("case", f"no such built-in case (available: {names})", str(name_or_path))
-    return builtin
+    builtin = builtin_cases()
+    if str(name_or_path) not in builtin:
+        raise ConfigError("case", f"no such built-in case (available: {', '.join(builtin)})", str(name_or_path))
+    return builtin[str(name_or_path)]
+
+
+def check_case_file(name_or_path: str) -> Path:
+    """Path of the case after the checks that the TOML reader does not do: a regular file, not a
+    folder, of reasonable size, UTF-8 text, valid TOML of reasonable nesting (raises
+    :class:`ConfigError` naming the path)."""
+    from mechbal import _core
+
+    path = case_path(name_or_path)  # ConfigError for an unknown built-in name or a missing file
+    if path.suffix.lower() == ".urdf":
+        read_regular_file(path, "case", _core.MAX_URDF_BYTES)
+        return path  # XML: the URDF reader checks the rest
+    parse_toml(read_regular_file(path, "case", MAX_CASE_BYTES), str(path))
+    return path
 
 
 def load_case(name_or_path: str | Path) -> dict:

@@ -32,6 +32,8 @@ The dynamics back ends a :class:`ComputedTorque` computes over are here too:
 `MechanismDynamics` (the general model, any mechanism, closed loops included),
 `RneChainDynamics` and `KdlChainDynamics` (serial chains), and the papers' closed forms in
 `mechbal.papers`.
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 

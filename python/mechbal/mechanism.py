@@ -15,6 +15,8 @@ only: complex, string, boolean and object arrays are a :class:`TypeError`.
 
 Units: SI throughout (m, kg, kg m^2, rad, N, N m); world quantities in the base frame O; moments
 and angular momenta about O's origin.
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 

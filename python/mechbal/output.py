@@ -20,6 +20,7 @@ without a process id, are left alone). A run killed between its two renames leav
 A run that finds, at the final move, that another run has just put its own ``DIR`` in place
 (two runs into one ``--out`` at once) raises :class:`OutputRaceError` (the CLI's exit code 4):
 the other run's folder is kept whole, this run's results are discarded.
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -7,6 +7,8 @@ and the command line refuses the case (exit code 2) unless ``--force``:
   (1e3 rad, about 160 turns, or 1e3 m);
 - a gravity of norm beyond :data:`MAX_GRAVITY` (1e3 m/s^2, about 100 g);
 - a mass beyond :data:`MAX_MASS` (1e6 kg, a thousand tonnes).
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 

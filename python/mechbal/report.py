@@ -1,4 +1,6 @@
-"""Reports: plots (matplotlib, Agg) and terminal tables."""
+"""Reports: plots (matplotlib, Agg) and terminal tables.
+
+Layer: Python core (docs/architecture.md)."""
 from __future__ import annotations
 
 from pathlib import Path

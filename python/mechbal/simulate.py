@@ -8,6 +8,8 @@
   trajectory (open loop).
 
 Units: SI (s, rad or m, rad/s or m/s, N m or N).
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -18,6 +18,8 @@ last point at rest (zero velocity and acceleration), as the C++ ``RestToRestTraj
 
 All of them are accepted by `mechbal.simulate.closed_loop`; a `RestToRest` runs on the C++ path
 directly, the others are sampled every `dt / 2` first.
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -107,7 +107,7 @@ TOML_VALUES = st.one_of(
 
 @st.composite
 def case_files(draw):
-    text = (CASES_DIR / draw(st.sampled_from(["arm2link.toml", "four-bar.toml", "scara.toml"]))).read_text()
+    text = (CASES_DIR / draw(st.sampled_from(["arm2link.toml", "four-bar.toml", "ur5-dh.toml"]))).read_text()
     lines = text.splitlines()
     for _ in range(draw(st.integers(1, 4))):
         if not lines:

@@ -18,6 +18,8 @@ and mass budget) are :class:`~mechbal.balance.result.CounterweightSlot` /
 :class:`~mechbal.balance.result.SpringSlot` / :class:`~mechbal.balance.result.DiscSlot` /
 :class:`~mechbal.balance.result.InertiaSlot` objects (or the ``[balance]`` table of a case file);
 a result names what limited it (rank, an active bound, an impossibility).
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

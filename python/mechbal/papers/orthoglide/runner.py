@@ -18,6 +18,8 @@ the platform's Newton equation) check the result in the summary and the tests.
 
 Platform paths are Cartesian (Section 5.1); the sliders' motion is eq 1 and its derivatives, and
 the general model's platform motion must reproduce the path (checked to 1e-9 m).
+
+Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -172,7 +174,7 @@ class Orthoglide:
         """What :meth:`size` gives the general spring method for platform points p: (the slots,
         the sliders' positions of eq 1 (N, 3), the options ``q_guess`` and ``closure_tolerance``);
         ``mechbal balance orthoglide --method springs`` runs the same problem
-        (:func:`mechbal.balance.cases.orthoglide_case`)."""
+        (:func:`mechbal.balance.run.orthoglide_case`)."""
         rho = self.rho(np.atleast_2d(np.asarray(p, float)))
         return list(self.slots), rho, {"q_guess": self.q_guess.copy(), "closure_tolerance": CLOSURE_TOLERANCE}
 

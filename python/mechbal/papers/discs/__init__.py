@@ -27,7 +27,7 @@ link's mass and centre of mass, so the disc body carries only its central inerti
 diag(J_x, J_y, J_z) (disc frame, x = spin axis) and mass 0: where its axle sits then changes no
 force, torque or momentum, only the disc's reported pose. The unbalanced designs have no discs.
 
-The planar 5R five-bar is a closed loop: :mod:`mechbal.papers.five_bar` (its per-tick fast path
+The planar 5R five-bar is a closed loop: :mod:`mechbal.papers.discs.five_bar` (its per-tick fast path
 is ``mechbal.FiveBarDynamics``).
 
 **The paper's closed forms** (derivation and every correction: docs/discs_derivation.md): the
@@ -57,6 +57,8 @@ Link masses include the discs they carry (disc mass at its centre on the carrier
 subsystem carries only its central inertia.
 
 Corrections to the printed equations (CORRECTIONS below, each proved by tests/python/test_discs.py):
+
+Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -69,7 +71,12 @@ from mechbal import _core
 from mechbal import coupling as cp
 from mechbal.mechanism import Mechanism
 
-__all__ = ["disc_arm_mechanism", "disc_design_mechanism", "SERIAL_ARMS", "BALANCE", "CORRECTIONS", "MECHANISMS",
+# the closed forms of the C++ core (cpp/src/papers/five_bar/): fast paths of the general model
+FiveBarParameters = _core.FiveBarParameters
+FiveBarDynamics = _core.FiveBarDynamics
+
+__all__ = ["FiveBarParameters", "FiveBarDynamics",
+           "disc_arm_mechanism", "disc_design_mechanism", "SERIAL_ARMS", "BALANCE", "CORRECTIONS", "MECHANISMS",
            "design", "disc_mechanism", "evaluate", "metrics", "sensitivity", "fivebar_model", "fivebar_positions",
            "fivebar_dynamics", "is_parallelogram", "sample_states"]
 
@@ -140,13 +147,13 @@ def disc_design_mechanism(kind: str, design: Mapping[str, Any], *, name: str | N
 def disc_arm_mechanism(case_config: Mapping[str, Any] | str | Path, balanced: bool = True) -> Mechanism:
     """The arm of a disc case (``discs-3r``, ``discs-spatial``, ``scara``: a case name, path or
     the loaded TOML dict) as a :class:`mechbal.Mechanism`, built from the runner's parameters
-    (``mechbal.cases.discs.parameters_from_config``).
+    (``mechbal.papers.discs.runner.parameters_from_config``).
 
     ``balanced=True``: static balancing (eqs 8, 18, 29 generalised), the discs with the gear
     ratios of eqs 14, 25, 35 and, for the spatial arm, the corrected inertia conditions of eq 25:
     the mass matrix is then diagonal and constant (k_i of eqs 16, 27, 37) and the gravity torque
     zero. ``balanced=False``: the case's ``[unbalanced]`` baseline, no discs."""
-    from mechbal.cases.discs import parameters_from_config
+    from mechbal.papers.discs.runner import parameters_from_config
     from mechbal.config import load_case, require, string
 
     config = load_case(case_config) if isinstance(case_config, (str, Path)) else case_config
@@ -515,3 +522,6 @@ def sensitivity(kind: str, p: dict, parameters, errors, q, qd) -> list[dict]:
 
 __doc__ += "\n".join(f"  {c['id']} (eq {c['eq']}): printed {c['printed']}; correct: {c['correct']}."
                      for c in CORRECTIONS)
+
+# importing the schema registers this paper's case kind (mechbal.registry imports this package)
+from mechbal.papers.discs import schema as _schema  # noqa: E402,F401

@@ -10,6 +10,8 @@ balancing l_g of eqs 8, 18, 29), the mass-matrix metrics
 before/after over random configurations, the peak gravity torque, the sensitivity table, the
 joint torques on a rest-to-rest trajectory (unbalanced vs balanced), and the decoupled controller
 (tau_i = k_i (q''_d + Kp e + Kd e')) against computed torque over the balanced model.
+
+Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 

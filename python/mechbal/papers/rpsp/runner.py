@@ -18,6 +18,8 @@ comparison. Variants:
 The survey stage follows the robot over the whole period of the paper's motion, reporting the
 reciprocal condition of the loop solve, its statuses, the legs' lengths and the instants where the
 extra linkage cannot be assembled (|A_iC_i| > |A_iD_i| + |D_iC_i|).
+
+Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 

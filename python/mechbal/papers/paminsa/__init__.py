@@ -4,7 +4,7 @@ mechanism model: three pantograph legs, their guides and columns, the platform, 
 counterweights, the vertical counter-mass and the z-x-z wrist, as one tree closed by nine loops.
 
 The geometry is the closed form's (``mechbal.PaminsaModel``, cpp/include/mechbal/papers/paminsa/paminsa.hpp and
-the assumptions A1-A11 of python/mechbal/cases/paminsa.toml): the same layout (A8), the same
+the assumptions A1-A11 of python/mechbal/papers/paminsa/cases/paminsa.toml): the same layout (A8), the same
 38 bodies with the same names, masses, centres of mass and principal inertias. What the general
 model adds is the joints the closed form only implies.
 
@@ -51,6 +51,8 @@ Actuated: ``leg1_guide``, ``leg3_guide``, ``leg1_slider`` (the paper's M_1, M_3,
 three wrist joints. Every other coordinate is passive. The closed forms (``PaminsaModel``,
 ``paminsa_kinematics``, ``paminsa_mechanism_wrench``) stay the 1 kHz fast path; they equal this
 model to 1e-10 along the paper's cycle (tests/python/test_papers_loops.py).
+
+Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -62,7 +64,17 @@ import numpy as np
 from mechbal import _core
 from mechbal.mechanism import Mechanism
 
-__all__ = ["paminsa_mechanism", "paminsa_layout", "paminsa_initial_guess", "paminsa_actuated_motion",
+# the closed forms of the C++ core (cpp/src/papers/paminsa/): fast paths of the general model
+PaminsaParameters = _core.PaminsaParameters
+PaminsaCounterweights = _core.PaminsaCounterweights
+PaminsaModel = _core.PaminsaModel
+paminsa_kinematics = _core.paminsa_kinematics
+paminsa_reactionless_run = _core.paminsa_reactionless_run
+wrist_momentum_matrix = _core.wrist_momentum_matrix
+wrist_momentum_bias = _core.wrist_momentum_bias
+
+__all__ = ["PaminsaParameters", "PaminsaCounterweights", "PaminsaModel", "paminsa_kinematics", "paminsa_reactionless_run", "wrist_momentum_matrix", "wrist_momentum_bias",
+           "paminsa_mechanism", "paminsa_layout", "paminsa_initial_guess", "paminsa_actuated_motion",
            "paminsa_case_toml", "ACTUATED", "body_names", "CounterweightSet", "closed_form_counterweights",
            "printed_counterweights", "reported_counterweights", "counterweights_from_design",
            "REPORTED_COUNTERWEIGHTS_KG", "copy_parameters"]
@@ -270,7 +282,7 @@ def _balanced(params):
 
 def paminsa_mechanism(params, balanced: bool = True, *, name: str | None = None) -> Mechanism:
     """PAMINSA as a closed :class:`mechbal.Mechanism` (module docstring) from
-    ``mechbal.PaminsaParameters`` (``mechbal.cases.paminsa.parameters_from_config``).
+    ``mechbal.PaminsaParameters`` (``mechbal.papers.paminsa.runner.parameters_from_config``).
     ``balanced=True``: the closed-form counterweights (eqs 11, 14-16 corrected:
     :func:`closed_form_counterweights`) replace the parameters' own;
     ``balanced=False``: the parameters' counterweights as given (none in the case file)."""
@@ -406,11 +418,11 @@ def paminsa_actuated_motion(mech: Mechanism, params, P, Pd, Pdd, wrist=None, wri
 
 def paminsa_case_toml(config="paminsa", balanced: bool = True, samples: int = 501) -> str:
     """The ``kind = "mechanism"`` case file of a ``paminsa`` case's mechanism (balanced: the
-    closed-form counterweights): what ``python/mechbal/cases/paminsa-linkage.toml`` holds for the
+    closed-form counterweights): what ``python/mechbal/papers/paminsa/cases/paminsa-linkage.toml`` holds for the
     shipped case. Its trajectory is rest-to-rest in the actuated joints between the actuator
     positions of the case's start and end platform positions (the case itself moves P on a straight
     line: the same end points, not the same path), wrist still at the case's initial angles."""
-    from mechbal.cases.paminsa import parameters_from_config
+    from mechbal.papers.paminsa.runner import parameters_from_config
     from mechbal.config import load_case
     from mechbal.papers._toml import case_toml
 
@@ -445,3 +457,6 @@ paper's start and end platform positions (the paminsa case moves P on a straight
     comments["trajectory.start"] = "actuated joints in the model's order: " + ", ".join(mech.actuated_names)
     return case_toml(mech, name="paminsa-linkage", title=f"PAMINSA ({variant}) on the general model",
                      header=header, trajectory=traj, comments=comments)
+
+# importing the schema registers this paper's case kind (mechbal.registry imports this package)
+from mechbal.papers.paminsa import schema as _schema  # noqa: E402,F401

@@ -23,6 +23,8 @@ planar motion about y only sees I. Frames: ``B`` (the elbow axis point on link 1
 The general model's inverse dynamics, mass matrix and gravity torque equal the corrected closed
 form of eqs 14-31 (``mechbal.Arm2DofDynamics``, the fast path) to 1e-12 relative along the
 paper's trajectories (tests/python/test_papers.py).
+
+Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -36,7 +38,14 @@ from mechbal.balance.rms import cubic_real_roots, squared_sum, stationarity_cubi
 from mechbal import _core
 from mechbal.mechanism import Mechanism
 
-__all__ = ["arm2dof_mechanism", "arm_torques", "static_balancing_radii", "cw_coefficients",
+# the closed forms of the C++ core (cpp/src/papers/arm2dof/): fast paths of the general model
+Arm2DofParameters = _core.Arm2DofParameters
+Arm2DofCounterweights = _core.Arm2DofCounterweights
+Arm2DofDynamics = _core.Arm2DofDynamics
+pd_error_analytic = _core.pd_error_analytic
+
+__all__ = ["Arm2DofParameters", "Arm2DofCounterweights", "Arm2DofDynamics", "pd_error_analytic",
+           "arm2dof_mechanism", "arm_torques", "static_balancing_radii", "cw_coefficients",
            "RadiiResult", "rms_optimal_radii", "rms_optimal_radii_numerical"]
 
 _ARM_KEYS = ("m1", "m2", "l1", "l_s1", "l_s2", "i_s1", "i_s2", "g")
@@ -230,3 +239,6 @@ def rms_optimal_radii_numerical(arm, m_cw1: float, m_cw2: float, q, qd, qdd,
     r2 = argmin(lambda r: ms(1, 0.0, r))
     r1 = argmin(lambda r: ms(0, r, r2))
     return r1, r2
+
+# importing the schema registers this paper's case kind (mechbal.registry imports this package)
+from mechbal.papers.arm2dof import schema as _schema  # noqa: E402,F401

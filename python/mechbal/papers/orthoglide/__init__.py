@@ -1,7 +1,7 @@
 """The Orthoglide 5-axis of Martini, Troncossi, Carricato & Rivola 2015 ("Static balancing of a
 parallel kinematics machine with Linear-Delta architecture", Mech. Mach. Theory 90:128-141): the
 paper's closed forms, kept as **checks** of the general path (the mechanism itself is data:
-``python/mechbal/cases/orthoglide.toml``; the runner is :mod:`mechbal.cases.orthoglide`).
+``python/mechbal/papers/orthoglide/cases/orthoglide.toml``; the runner is :mod:`mechbal.papers.orthoglide.runner`).
 
 Frame of the paper: y vertical, gravity (0, -g, 0). Here:
 
@@ -25,7 +25,9 @@ Frame of the paper: y vertical, gravity (0, -g, 0). Here:
 
 The springs themselves are elements of the general model and are sized by the general method
 (:mod:`mechbal.balance.springs`: ``balance``, ``select_springs`` for Tables 1-2); the runner
-:mod:`mechbal.cases.orthoglide` uses them, and these closed forms are its fast-path checks.
+:mod:`mechbal.papers.orthoglide.runner` uses them, and these closed forms are its fast-path checks.
+
+Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -488,3 +490,6 @@ def machining_path(center, operation: str, feed: float, force: float, pockets, h
             rapid(corner + up)
     rapid(c)
     return _sample(segs, dt, name, {"operation": operation, "feed_m_per_s": feed, "force_N": force})
+
+# importing the schema registers this paper's case kind (mechbal.registry imports this package)
+from mechbal.papers.orthoglide import schema as _schema  # noqa: E402,F401

@@ -1,7 +1,7 @@
 """The 3(RPSP)-S spherical parallel robot of Heydari & Enferadi ("Complete dynamic shaking force
 balancing of a 3(RPSP)-S spherical parallel robot using extra linkage", Persian, research note):
 the paper's closed forms, kept as *checks* of the general model (the mechanism itself is data,
-``python/mechbal/cases/rpsp.toml``, solved by :meth:`mechbal.Mechanism.closed_motion`).
+``python/mechbal/papers/rpsp/cases/rpsp.toml``, solved by :meth:`mechbal.Mechanism.closed_motion`).
 
 * :func:`inverse_kinematics`: eqs 1-13 (platform orientation -> b_i, l_i, e_i, theta_i) with
   their first and second time derivatives in closed form, and the degenerate configurations
@@ -19,6 +19,8 @@ sin lambda_i, 0) is the axis of the actuated revolute joint at A_i = a_i u_i; v_
 sin alpha_i, 0) the direction of the platform's slider i; R = Rz(phi_z) Ry(phi_y) Rx(phi_x)
 (eq 1); the leg's spherical joint is at h + b_i v_i = A_i + l_i e_i (eq 2), with
 e_i = cos(theta_i) k + sin(theta_i) (u_i x k) (eq 12).
+
+Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -223,3 +225,6 @@ def table_consistency(tables=PAPER_TABLES, tolerance_pct=0.005):
                      "mean_printed_pct": float(np.mean([r["printed_pct"] for r in checked])),
                      "mean_recomputed_pct": float(np.mean([r["recomputed_pct"] for r in checked]))}
     return out
+
+# importing the schema registers this paper's case kind (mechbal.registry imports this package)
+from mechbal.papers.rpsp import schema as _schema  # noqa: E402,F401

@@ -8,6 +8,8 @@ closed loop (eqs 2-6) with an exact and a +-20 % perturbed model.
 
 Discrepancies with the paper are computed, not asserted: they land in summary.json
 ``discrepancies`` with the numbers that show them.
+
+Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -17,20 +19,21 @@ from pathlib import Path
 import numpy as np
 
 from mechbal import control
-from mechbal import papers
+from mechbal.papers import arm2dof as papers
 from mechbal import simulate
 from mechbal import trajectory
 from mechbal import progress, report
 from mechbal.cases import register
 from mechbal.config import ConfigError
-from mechbal.schema import Arm2DofArm, validate_case, validate_table
+from mechbal.papers.arm2dof.schema import Arm2DofArm
+from mechbal.schema import validate_case, validate_table
 from mechbal.export import write_bodies, write_summary
-from mechbal.papers import arm2dof_mechanism
+from mechbal.papers.arm2dof import arm2dof_mechanism
 from mechbal.papers import arm2dof as closed_forms
 
 
 def arm_from_config(table) -> "papers.Arm2DofParameters":
-    """The arm of an ``[arm]`` table (a dict or a validated :class:`mechbal.schema.Arm2DofArm`)."""
+    """The arm of an ``[arm]`` table (a dict or a validated :class:`mechbal.papers.arm2dof.schema.Arm2DofArm`)."""
     arm = table if isinstance(table, Arm2DofArm) else validate_table(Arm2DofArm, table, "arm")
     return papers.Arm2DofParameters(**arm.model_dump())
 

@@ -12,6 +12,8 @@ same about every point, but the unbalanced moment is not (M_Q = M_O - OQ x F, wi
 ~27 N). About O of the reconstructed layout M_z drops; about the base centre (centroid of the B_i)
 it rises by ~38 %, the paper's pattern: the heavy counterweights at A_i, moving opposite to the
 platform at the far ends of the legs, form a z-couple that force balancing does not remove.
+
+Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -35,7 +37,7 @@ def parameters_from_config(config):
     """mechbal.PaminsaParameters (without counterweights) from the [geometry], [masses],
     [inertias] tables of a case (validated, or a dict validated here); ConfigError names the
     field. The C++ model validates the rest (ValueError naming the field)."""
-    from mechbal.papers import PaminsaParameters
+    from mechbal.papers.paminsa import PaminsaParameters
 
     case = validate_case(config, warn=False)
     p = PaminsaParameters()
@@ -157,7 +159,7 @@ def pose_wrench(model, t, P, Pd, Pdd, wrist_angles):
     own truncation error at 1 kHz)."""
     from scipy.interpolate import make_interp_spline
 
-    from mechbal.papers import paminsa_kinematics
+    from mechbal.papers.paminsa import paminsa_kinematics
 
     spline = make_interp_spline(t, wrist_angles, k=5)
     return paminsa_kinematics(model, P, Pd, Pdd, wrist_angles, spline(t, 1), spline(t, 2))
@@ -170,7 +172,7 @@ def moment_about(M, F, point):
 
 @register("paminsa", stages=5)
 def run(config, out: Path) -> dict:
-    from mechbal.papers import PaminsaModel, paminsa_kinematics, paminsa_reactionless_run
+    from mechbal.papers.paminsa import PaminsaModel, paminsa_kinematics, paminsa_reactionless_run
 
     config = validate_case(config, warn=False)
     params = parameters_from_config(config)
