@@ -135,7 +135,7 @@ def _real_array(value, name: str) -> np.ndarray:
     values (no silent truncation or parsing)."""
     a = np.asarray(value)
     if a.dtype.kind not in "iuf":
-        raise TypeError(f"{name} must be an array of real numbers (int or float), got dtype {a.dtype}")
+        raise TypeError(f"{name} must be a real numeric array (int or float values), got dtype {a.dtype}")
     return np.asarray(a, dtype=float)
 
 
@@ -385,7 +385,7 @@ class Mechanism:
         for name, value in zip(names, values):
             a = np.asarray(value)
             if a.dtype.kind not in "iuf":
-                raise TypeError(f"{name} must be an array of real numbers (int or float), got "
+                raise TypeError(f"{name} must be a real numeric array (int or float values), got "
                                 f"dtype {a.dtype}")
             a = np.ascontiguousarray(a, dtype=float)
             if a.ndim == 1:

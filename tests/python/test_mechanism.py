@@ -201,9 +201,11 @@ def test_batch_equals_single_samples_and_flags_bad_instants():
     V[3, :] = 1e300  # finite but overflows the dynamics
     tau = mech.inverse_dynamics(Q, V, A)
     status = _core.mechanism_inverse_dynamics(mech.model, Q, V, A)["status"]
+    assert np.array_equal(tau.status, status)  # the batch result carries its statuses
     assert status[0] == 0 and status[2] == int(_core.Status.non_finite_input)
     assert status[3] == int(_core.Status.out_of_range)
-    assert np.all(tau[2] == 0) and np.all(tau[3] == 0) and np.isfinite(tau).all()
+    # a failed instant is NaN, never zeros that pass for a result (issue 24); the others finite
+    assert np.all(np.isnan(tau[2])) and np.all(np.isnan(tau[3])) and np.isfinite(tau[tau.ok]).all()
     for k in (0, 1, 4):
         assert np.array_equal(tau[k], mech.inverse_dynamics(Q[k], V[k], A[k]))
     with pytest.raises(ValueError, match="non_finite_input"):
