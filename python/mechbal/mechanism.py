@@ -47,7 +47,8 @@ class BatchArray(np.ndarray):
     def __array_finalize__(self, obj):
         parent = getattr(obj, "status", None)
         # a view of the whole batch keeps the statuses; anything else (a row, a product) has none
-        self.status = parent if parent is not None and self.shape[:1] == obj.shape[:1] else None
+        self.status = (parent if parent is not None and self.shape[:1] == obj.shape[:1]  # type: ignore[assignment]
+                       else None)
 
     def __array_wrap__(self, obj, context=None, return_scalar=False):
         # ufunc results are plain arrays (a status means "these rows as computed")
