@@ -6,7 +6,8 @@ root after ``root_name``); a URDF read by mechbal also has every URDF link as a 
 placement on its link. :func:`link_labels` gives each link the name of such a frame when there is
 one (so ``upper_arm_link`` stays ``upper_arm_link``, not ``shoulder_lift_joint``; a link with a
 frame of its own name keeps it: a URDF's root ``world``), the link's own name otherwise; names
-are unique.
+are unique. Only a mechanism whose root is a frame of identity placement of the same name (what
+mechbal's URDF reader makes) is renamed so: a TOML mechanism's links keep their joints' names.
 """
 from __future__ import annotations
 
@@ -82,6 +83,8 @@ def link_labels(mech) -> dict[str, str]:
     labels = {n: n for n in links}
     taken = set(links)
     named = {f.link for f in d.frames if f.name == f.link and _identity(f.placement)}
+    if d.root_name not in named:   # not read from a URDF (whose every link is a frame, the root's too)
+        return labels
     for f in d.frames:
         if f.link in named or labels[f.link] != f.link or not _identity(f.placement):
             continue

@@ -21,6 +21,8 @@ What is written, for a :class:`mechbal.Mechanism`:
   ``planar_point`` loop (the origin of B on the z axis of A) a ``connect`` between A's site and
   the point of B's link at A's origin in the assembled pose: exact when the loop moves in the
   plane normal to z_A, which is what the closure describes (MuJoCo has no point-on-line equality).
+* **Constraint softness.** Loops and gears get ``solimp`` :data:`SOLIMP` (nearly hard; MuJoCo's
+  constraints are soft, which shows as a residual shaking force of a balanced linkage).
 * **Springs.** A spatial ``<tendon>`` between two sites at the anchors, ``stiffness`` = the
   equivalent rate count rate / pulley_ratio^2, ``springlength`` = free_length - preload tension /
   stiffness (MuJoCo's spring force is -stiffness (length - springlength): the same tension as
@@ -62,6 +64,10 @@ AXIS_LENGTH = 0.1
 #: would refuse (no mass, or a zero principal moment: a point mass, a massless rotor's link), at
 #: the link origin: 100 times MuJoCo's mjMINVAL, far below what the comparisons resolve
 MINIMUM = 1e-13
+#: impedance of the loop and gear constraints (MuJoCo's solimp d0, d_width, width): near 1 so that
+#: they are nearly hard (MuJoCo's default 0.9 0.95 lets a loaded linkage accelerate off its
+#: closure: 6 % of a four-bar's unbalanced shaking force at the start of a motion, 5e-5 with this)
+SOLIMP = (0.9999, 0.9999, 0.001)
 #: density of the counterweight spheres drawn [kg/m^3] (steel)
 DENSITY = 7850.0
 
@@ -220,6 +226,8 @@ def _build(mech, q, q_guess, timestep, *, name=None, names_only=False):
     eq_name = _Unique()
     scale = max([float(np.linalg.norm(np.asarray(j.placement)[:3, 3])) for j in d.joints] + [0.05])
 
+    imp = f' solimp="{_v(SOLIMP)}"'
+
     def add_site(link: str, nm: str, p) -> str:
         s = site_name(nm)
         extra_sites.setdefault(link, []).append(f'<site name={quoteattr(s)} pos="{_v(p)}" size="{_f(0.004 * scale)}" group="3"/>')
@@ -233,27 +241,27 @@ def _build(mech, q, q_guess, timestep, *, name=None, names_only=False):
         sa, sb = names.sites[fa.name], names.sites[fb.name]
         Ta, Tb = frame_T[fa.name], frame_T[fb.name]
         if lp.type == _core.LoopType.point:
-            equality.append(f"<connect name={quoteattr(eq_name(lp.name))} site1={quoteattr(sa)} site2={quoteattr(sb)}/>")
+            equality.append(f"<connect name={quoteattr(eq_name(lp.name))} site1={quoteattr(sa)} site2={quoteattr(sb)}{imp}/>")
         elif lp.type == _core.LoopType.weld:
-            equality.append(f"<weld name={quoteattr(eq_name(lp.name))} site1={quoteattr(sa)} site2={quoteattr(sb)}/>")
+            equality.append(f"<weld name={quoteattr(eq_name(lp.name))} site1={quoteattr(sa)} site2={quoteattr(sb)}{imp}/>")
         elif lp.type == _core.LoopType.planar_point:
             sb2 = add_site(fb.link, f"{lp.name}_b", in_link(fb.link, Ta[:3, 3]))
-            equality.append(f"<connect name={quoteattr(eq_name(lp.name))} site1={quoteattr(sa)} site2={quoteattr(sb2)}/>")
+            equality.append(f"<connect name={quoteattr(eq_name(lp.name))} site1={quoteattr(sa)} site2={quoteattr(sb2)}{imp}/>")
         elif lp.type == _core.LoopType.axis:
             za, zb = Ta[:3, 2], Tb[:3, 2]
             sign = 1.0 if za @ zb >= 0.0 else -1.0
             sa2 = add_site(fa.link, f"{lp.name}_axis_a", in_link(fa.link, Ta[:3, 3] + AXIS_LENGTH * za))
             sb2 = add_site(fb.link, f"{lp.name}_axis_b", in_link(fb.link, Tb[:3, 3] + sign * AXIS_LENGTH * zb))
-            equality.append(f"<connect name={quoteattr(eq_name(lp.name))} site1={quoteattr(sa)} site2={quoteattr(sb)}/>")
+            equality.append(f"<connect name={quoteattr(eq_name(lp.name))} site1={quoteattr(sa)} site2={quoteattr(sb)}{imp}/>")
             equality.append(f"<connect name={quoteattr(eq_name(lp.name + '_axis'))} site1={quoteattr(sa2)} "
-                            f"site2={quoteattr(sb2)}/>")
+                            f"site2={quoteattr(sb2)}{imp}/>")
         else:  # pragma: no cover - every LoopType is handled above
             raise ExportError(f"loop '{lp.name}': type {lp.type} has no MJCF equivalent")
     for j in d.joints:
         if j.mimic_joint:
             equality.append(f"<joint name={quoteattr(eq_name(j.name + '_gear'))} joint1={quoteattr(j.name)} "
                             f"joint2={quoteattr(j.mimic_joint)} polycoef=\"{_f(j.mimic_offset)} "
-                            f"{_f(j.mimic_ratio)} 0 0 0\"/>")
+                            f"{_f(j.mimic_ratio)} 0 0 0\"{imp}/>")
 
     tendons = []
     tendon_name = _Unique()

@@ -109,7 +109,28 @@ class MujocoMechanism:
         self.world_children = [b for b in range(1, m.nbody) if m.body_parentid[b] == 0]
         self.moving_bodies = [b for b in range(1, m.nbody) if m.body_weldid[b] != 0]
         self.key = mj.mj_name2id(m, mj.mjtObj.mjOBJ_KEY, "assembled")
+        self.light_bodies = self._weigh_light_bodies()
         self.reset()
+
+    def _weigh_light_bodies(self) -> list[str]:
+        """MuJoCo makes a constraint the softer the lighter the bodies it joins (its impedance
+        scales with their inverse weights ``body_invweight0``): a massless link of mechbal's (a
+        kinematic guide, with :data:`~mechbal.export.mjcf.MINIMUM` mass in MJCF) makes its loop
+        1e13 times softer than the others, and a closed mechanism driven through it drifts off its
+        closure. Such bodies (inverse weight over 1e3 times the median of the bodies with mass)
+        get the median: the constraints' softness changes, not the dynamics. Returns their names."""
+        m = self.model
+        heavy = [b for b in range(1, m.nbody) if m.body_mass[b] > 1e-9]
+        if not heavy:
+            return []
+        ref = np.median(m.body_invweight0[heavy], axis=0)
+        light = [b for b in range(1, m.nbody) if m.body_invweight0[b, 0] > 1e3 * ref[0]]
+        for b in light:
+            m.body_invweight0[b] = ref
+        if m.nv:
+            dref = float(np.median(m.dof_invweight0))
+            m.dof_invweight0[:] = np.minimum(m.dof_invweight0, 1e3 * dref)
+        return [self.mj.mj_id2name(m, self.mj.mjtObj.mjOBJ_BODY, b) for b in light]
 
     # ---- state --------------------------------------------------------------------------------
     def reset(self) -> None:
@@ -251,13 +272,15 @@ class CoSimulation:
 
 def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 1e-3,
                 duration: float | None = None, q_guess=None, substeps: int = 1,
-                integrator: str = "RK4", solref: tuple[float, float] | None = None) -> CoSimulation:
+                integrator: str = "RK4", solref: tuple[float, float] | None = None,
+                solimp: tuple[float, ...] | None = None) -> CoSimulation:
     """Tick ``controller`` (any mechbal joint controller, in the actuated coordinates of a closed
     mechanism) every ``dt`` against MuJoCo integrating ``mech``'s MJCF export, ``substeps``
     MuJoCo steps of dt / substeps per tick, torque held over the tick (zero-order hold).
     ``integrator``: MuJoCo's (``RK4``, ``Euler``, ``implicitfast``, ``implicit``); ``solref``:
     (time constant [s], damping ratio) of the loop and gear constraints (MuJoCo's default
-    (0.02, 1) when None). The state starts on the trajectory at t = 0 (or ``q0``, ``qd0``)."""
+    (0.02, 1) when None); ``solimp``: their impedance (d0, d_width, width[, mid, power]), MuJoCo's
+    default (0.9, 0.95, 0.001) when None: the closer d to 1, the harder the constraint. The state starts on the trajectory at t = 0 (or ``q0``, ``qd0``)."""
     from mechbal.trajectory import as_trajectory
 
     traj = as_trajectory(trajectory)
@@ -286,6 +309,9 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
     m.opt.integrator = int(getattr(mj.mjtIntegrator, f"mjINT_{integrator.upper()}"))
     if solref is not None:
         m.eq_solref[:] = np.asarray(solref, float)
+    if solimp is not None:
+        imp = np.asarray(solimp, float)
+        m.eq_solimp[:, :imp.size] = imp
     q_start, v_start = Q[0], V[0]
     if q0 is not None or qd0 is not None:   # a given start (controller coordinates)
         qa0 = q_des[0] if q0 is None else np.asarray(q0, float)
