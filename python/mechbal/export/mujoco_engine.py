@@ -173,8 +173,14 @@ class MujocoMechanism:
         finally:
             m.opt.disableflags = flags
         tree = np.array(d.qfrc_inverse)
+        # through the joints (cfrc_int of the moving roots) plus what reaches the moving bodies
+        # otherwise (cfrc_ext: the springs anchored to the base, as MuJoCo counts tendon forces)
         F, M = self._wrench_at_O(self.moving_roots, d.cfrc_int)
+        Fe, Me = self._wrench_at_O(self.moving_bodies, d.cfrc_ext)
+        F, M = F + Fe, M + Me
         Fs, Ms = self._wrench_at_O(self.world_children, d.cfrc_int)
+        Fe, Me = self._wrench_at_O(range(1, m.nbody), d.cfrc_ext)
+        Fs, Ms = Fs + Fe, Ms + Me
         return MujocoInverse(self.G.T @ tree, tree, F, M, Fs, Ms)
 
     def gravity_torque(self, q) -> np.ndarray:
