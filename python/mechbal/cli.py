@@ -86,6 +86,8 @@ def _cmd_run(args) -> int:
     out = Path(args.out)
     check_output_dir(out)           # before anything else: a bad --out fails in the first second
     check_case_file(args.case)
+    if getattr(args, "engine", "mechbal") == "mujoco":
+        return _run_mujoco(args, out)
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer):  # the runner's tables, printed after its bar closes
         summary = run_case(args.case, out, duration=getattr(args, "duration", None),
@@ -101,6 +103,22 @@ def _cmd_run(args) -> int:
               f"{out}/summary.json (listed under non_finite_values)", file=sys.stderr)
     if not args.quiet:
         print(f"wrote {out}/summary.json and the plots and bodies files beside it")
+    return 0
+
+
+def _run_mujoco(args, out: Path) -> int:
+    from mechbal.output import staged_output
+    from mechbal.verify import run_cosimulation
+
+    buffer = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(buffer), staged_output(out) as tmp:
+            run_cosimulation(args.case, tmp)
+    except ImportError as exc:  # the optional 'mujoco' extra is missing: the message names it
+        raise UserError(str(exc)) from None
+    if not args.quiet:
+        sys.stdout.write(buffer.getvalue())
+        print(f"wrote {out}/summary.json, base_reaction.png (MuJoCo beside mechbal) and the files beside them")
     return 0
 
 
@@ -253,6 +271,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="URDF files: duration of the default trajectory [s] (default: 2)")
     s.add_argument("--samples", type=int, metavar="N",
                    help="URDF files: number of instants of the default trajectory (default: 501)")
+    s.add_argument("--engine", choices=("mechbal", "mujoco"), default="mechbal",
+                   help="mechbal: the case's own runner (default); mujoco: mechbal's computed-torque "
+                        "controller ticked at 1 kHz against MuJoCo integrating the case's MJCF export, "
+                        "MuJoCo's base reaction beside mechbal's (needs the 'mujoco' extra)")
     s.add_argument("-q", "--quiet", **quiet)
     s.set_defaults(func=_cmd_run)
     s = sub.add_parser("balance", help="balance a mechanism by a method (static, force, moment, springs, rms)",

@@ -332,3 +332,19 @@ def test_verify_four_bar(tmp_path):
     assert s["variants"]["balanced"]["shaking_force"]["simulated_peak_fraction_of_unbalanced"] < 1e-4
     assert (out / "shaking_wrench.png").stat().st_size > 10_000
     assert math.isfinite(s["variants"]["unbalanced"]["simulation"]["max_constraint_violation"])
+
+
+def test_run_with_the_mujoco_engine(tmp_path):
+    from mechbal.cli import main
+
+    out = tmp_path / "r"
+    assert main(["run", "four-bar", "--engine", "mujoco", "--out", str(out), "-q"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["ok"] and s["engine"] == "mujoco"
+    br = s["base_reaction"]
+    # MuJoCo's simulated base reaction is mechbal's prediction up to the tracking error
+    assert br["max_force_difference_N"] < 0.02 * br["peak_force_mechbal_N"]
+    data = np.load(out / "cosimulation.npz")
+    assert data["base_reaction_force"].shape == (1001, 3)
+    assert (out / "base_reaction.png").stat().st_size > 10_000
+    mujoco.MjModel.from_xml_path(str(out / "mechanism.xml"))
