@@ -32,6 +32,20 @@ from mechbal.export import write_summary
 KP, KD = 400.0, 40.0
 
 
+def case_trajectory(bc, n: int):
+    """The case's trajectory as a :mod:`mechbal.trajectory` object: its ``[trajectory]`` law, or
+    the case's sampled motion (a paper's own law) through a cubic spline."""
+    from mechbal.config import trajectory_from_config
+    from mechbal.errors import ConfigError
+    from mechbal.trajectory import Sampled
+
+    table = {k: v for k, v in bc.trajectory_table.items() if k != "initial_guess"}
+    try:
+        return trajectory_from_config(table, n)[0]
+    except (ConfigError, ValueError, KeyError, TypeError):
+        return Sampled(bc.t, bc.motion[0], bc_type="not-a-knot")
+
+
 def _peak(x) -> float:
     return float(np.max(np.abs(np.asarray(x)))) if np.size(x) else 0.0
 
@@ -70,11 +84,8 @@ def check_variant(bc, mech, *, simulate: bool = True, reference: dict | None = N
                  "mujoco_inverse": {"shaking_force": F, "shaking_moment": M, "actuator_force": tau,
                                     "gravity_torque": G}}
     if simulate:
-        from mechbal.config import trajectory_from_config
-
         n = len(mech.actuated_names) if closed else mech.dof
-        table = {k: v for k, v in bc.trajectory_table.items() if k != "initial_guess"}
-        traj, _ = trajectory_from_config(table, n)
+        traj = case_trajectory(bc, n)
         ctrl = ComputedTorque(mech, [KP] * n, [KD] * n, q_guess=bc.q_guess)
         cs = co_simulate(mech, ctrl, traj, q_guess=bc.q_guess)
         out["mujoco_simulated"] = {"t": cs.t, "shaking_force": cs.shaking_force,
@@ -199,7 +210,6 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3) -> dict:
     base reaction beside mechbal's prediction along the desired motion), ``tracking.png``,
     ``cosimulation.npz`` (every series) and ``mechanism.xml``."""
     from mechbal.balance.run import load_case
-    from mechbal.config import trajectory_from_config
     from mechbal.control import ComputedTorque
     from mechbal.export.mujoco_engine import co_simulate
 
@@ -208,8 +218,7 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3) -> dict:
     bc = load_case(case)
     mech = bc.mechanism
     n = len(mech.actuated_names) if mech.is_closed else mech.dof
-    table = {k: v for k, v in bc.trajectory_table.items() if k != "initial_guess"}
-    traj, _ = trajectory_from_config(table, n)
+    traj = case_trajectory(bc, n)
     progress.stage("co-simulation (MuJoCo, 1 kHz)")
     ctrl = ComputedTorque(mech, [KP] * n, [KD] * n, q_guess=bc.q_guess)
     cs = co_simulate(mech, ctrl, traj, q_guess=bc.q_guess, dt=dt)

@@ -95,6 +95,7 @@ class MjcfNames:
     moving_roots: list[str] = field(default_factory=list)
     still: list[str] = field(default_factory=list)
     minimum: list[str] = field(default_factory=list)
+    minimum_links: dict[str, str] = field(default_factory=dict)
 
 
 class _Unique:
@@ -148,14 +149,27 @@ def mjcf_names(mech) -> MjcfNames:
     return _build(mech, None, None, 1e-3, names_only=True)[1]
 
 
-def mjcf_text(mech, name: str | None = None, *, q=None, q_guess=None, timestep: float = 1e-3) -> str:
+def minimum_bodies(mech, minimum_mass: float = MINIMUM) -> list:
+    """The bodies (``mechbal.Body``) the export adds so that MuJoCo accepts every moving link
+    (:attr:`MjcfNames.minimum`): ``minimum_mass`` kg at each such link's origin, principal
+    moments ``minimum_mass`` x (0.1 m)^2 (``MINIMUM`` kg m^2 at the default). ``mech.with_bodies``
+    of them is the mechanism MuJoCo integrates."""
+    names = mjcf_names(mech)
+    inertia = MINIMUM if minimum_mass == MINIMUM else minimum_mass * 0.01
+    return [_core.Body(n, link, float(minimum_mass), np.zeros(3), inertia * np.eye(3), "other")
+            for link, n in names.minimum_links.items()]
+
+
+def mjcf_text(mech, name: str | None = None, *, q=None, q_guess=None, timestep: float = 1e-3,
+              minimum_mass: float = MINIMUM) -> str:
     """MJCF of ``mech`` (module docstring). ``q``: the pose of the keyframe (dof,); a closed
     mechanism is assembled from ``q`` or ``q_guess`` (:func:`mechbal.export.common.assembled_pose`).
+    ``minimum_mass``: of the body added to a link MuJoCo would refuse (:func:`minimum_bodies`).
     ExportError (a ValueError, one line) when a part has no MuJoCo equivalent."""
-    return _build(mech, q, q_guess, timestep, name=name)[0]
+    return _build(mech, q, q_guess, timestep, name=name, minimum_mass=minimum_mass)[0]
 
 
-def _build(mech, q, q_guess, timestep, *, name=None, names_only=False):
+def _build(mech, q, q_guess, timestep, *, name=None, names_only=False, minimum_mass: float = MINIMUM):
     d = mech.model.description
     labels = link_labels(mech)
     still = fixed_to_root(mech)
@@ -210,6 +224,7 @@ def _build(mech, q, q_guess, timestep, *, name=None, names_only=False):
         if _needs_minimum(group):
             minimum_of[j.name] = body_name(f"{labels[j.name]}_minimum")
             names.minimum.append(minimum_of[j.name])
+            names.minimum_links[j.name] = minimum_of[j.name]
     if names_only:
         return "", names
 
@@ -344,7 +359,8 @@ def _build(mech, q, q_guess, timestep, *, name=None, names_only=False):
         if link in minimum_of:
             lines.append(f"{ind}<!-- MuJoCo refuses a moving body without mass or with a zero principal moment -->")
             lines.append(f'{ind}<body name={quoteattr(minimum_of[link])}>')
-            lines.append(f'{ind}  {_inertial(MINIMUM, np.zeros(3), MINIMUM * np.eye(3))}')
+            inertia = MINIMUM if minimum_mass == MINIMUM else minimum_mass * 0.01
+            lines.append(f'{ind}  {_inertial(minimum_mass, np.zeros(3), inertia * np.eye(3))}')
             lines.append(f'{ind}</body>')
         return lines
 

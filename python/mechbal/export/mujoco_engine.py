@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from mechbal import _core
-from mechbal.export.mjcf import _build
+from mechbal.export.mjcf import MINIMUM, _build, minimum_bodies
 
 __all__ = ["MujocoMechanism", "MujocoInverse", "require_mujoco"]
 
@@ -76,13 +76,19 @@ def _cross_force(v: np.ndarray, f: np.ndarray) -> np.ndarray:
 
 class MujocoMechanism:
     """``mech`` exported to MJCF and loaded in MuJoCo (module docstring). ``q`` / ``q_guess``:
-    the assembled pose of the keyframe (closed mechanisms); ``timestep`` [s]."""
+    the assembled pose of the keyframe (closed mechanisms); ``timestep`` [s]; ``minimum_mass``:
+    of the bodies added to the links MuJoCo would refuse (:func:`mechbal.export.mjcf.minimum_bodies`;
+    ``exported`` is ``mech`` with them: the mechanism MuJoCo integrates); ``constraint_weight``:
+    factor on MuJoCo's inverse weights of bodies, dofs and tendons, which set how much its soft
+    constraints give under load (1: MuJoCo's own)."""
 
-    def __init__(self, mech, *, q=None, q_guess=None, timestep: float = 1e-3):
+    def __init__(self, mech, *, q=None, q_guess=None, timestep: float = 1e-3, minimum_mass: float = MINIMUM,
+                 constraint_weight: float = 1.0):
         mj = require_mujoco()
         self.mj = mj
         self.mech = mech
-        self.xml, self.names = _build(mech, q, q_guess, timestep, name=mech.name)
+        self.xml, self.names = _build(mech, q, q_guess, timestep, name=mech.name, minimum_mass=minimum_mass)
+        self.exported = mech.with_bodies(minimum_bodies(mech, minimum_mass)) if self.names.minimum else mech
         self.model = mj.MjModel.from_xml_string(self.xml)
         self.data = mj.MjData(self.model)
         m = self.model
@@ -110,6 +116,10 @@ class MujocoMechanism:
         self.moving_bodies = [b for b in range(1, m.nbody) if m.body_weldid[b] != 0]
         self.key = mj.mj_name2id(m, mj.mjtObj.mjOBJ_KEY, "assembled")
         self.light_bodies = self._weigh_light_bodies()
+        if constraint_weight != 1.0:
+            m.body_invweight0[:] *= constraint_weight
+            m.dof_invweight0[:] *= constraint_weight
+            m.tendon_invweight0[:] *= constraint_weight
         self.reset()
 
     def _weigh_light_bodies(self) -> list[str]:
@@ -224,6 +234,12 @@ def load(mech, **kw: Any) -> MujocoMechanism:
     return MujocoMechanism(mech, **kw)
 
 
+#: co-simulation: the mass given to a massless moving link, as a fraction of the total mass
+MINIMUM_FRACTION = 1e-6
+#: co-simulation: factor on MuJoCo's inverse weights (its constraints' give under load)
+CONSTRAINT_WEIGHT = 1e-4
+
+
 @dataclass(frozen=True)
 class CoSimulation:
     """A 1 kHz co-simulation (:func:`co_simulate`): the controller's log, one row per tick
@@ -279,14 +295,20 @@ class CoSimulation:
 def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 1e-3,
                 duration: float | None = None, q_guess=None, substeps: int = 1,
                 integrator: str = "RK4", solref: tuple[float, float] | None = None,
-                solimp: tuple[float, ...] | None = None) -> CoSimulation:
+                solimp: tuple[float, ...] | None = None, minimum_mass: float | None = None,
+                constraint_weight: float = CONSTRAINT_WEIGHT) -> CoSimulation:
     """Tick ``controller`` (any mechbal joint controller, in the actuated coordinates of a closed
     mechanism) every ``dt`` against MuJoCo integrating ``mech``'s MJCF export, ``substeps``
     MuJoCo steps of dt / substeps per tick, torque held over the tick (zero-order hold).
     ``integrator``: MuJoCo's (``RK4``, ``Euler``, ``implicitfast``, ``implicit``); ``solref``:
     (time constant [s], damping ratio) of the loop and gear constraints (MuJoCo's default
     (0.02, 1) when None); ``solimp``: their impedance (d0, d_width, width[, mid, power]), MuJoCo's
-    default (0.9, 0.95, 0.001) when None: the closer d to 1, the harder the constraint. The state starts on the trajectory at t = 0 (or ``q0``, ``qd0``)."""
+    default (0.9, 0.95, 0.001) when None: the closer d to 1, the harder the constraint (MuJoCo
+    caps d at 0.9999). ``minimum_mass`` [kg]: of the bodies added to massless moving links
+    (default :data:`MINIMUM_FRACTION` of the total mass: MuJoCo's solver fails on a link of 1e-13
+    kg; mechbal's prediction is of the mechanism with them, ``MujocoMechanism.exported``);
+    ``constraint_weight``: factor on MuJoCo's inverse weights (:data:`CONSTRAINT_WEIGHT`: a
+    constraint under load gives (1 - d) / d x weight x force in acceleration). The state starts on the trajectory at t = 0 (or ``q0``, ``qd0``)."""
     from mechbal.trajectory import as_trajectory
 
     traj = as_trajectory(trajectory)
@@ -309,8 +331,12 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
         Q, V, A = motion.q, motion.v, motion.a
     else:
         Q, V, A = q_des, qd_des, qdd_des
-    br = mech.base_reaction(Q, V, A)
-    sim = MujocoMechanism(mech, q=Q[0], q_guess=q_guess, timestep=dt / int(substeps))
+    if minimum_mass is None:
+        minimum_mass = max(MINIMUM_FRACTION * mech.total_mass, MINIMUM)
+    sim = MujocoMechanism(mech, q=Q[0], q_guess=q_guess, timestep=dt / int(substeps), minimum_mass=minimum_mass,
+                          constraint_weight=constraint_weight)
+    model = sim.exported   # the mechanism MuJoCo integrates (mech with the minimum bodies)
+    br = model.base_reaction(Q, V, A)
     mj, m, d = sim.mj, sim.model, sim.data
     m.opt.integrator = int(getattr(mj.mjtIntegrator, f"mjINT_{integrator.upper()}"))
     if solref is not None:
@@ -364,9 +390,9 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
             completed = k
             status[k + 1:] = int(_core.Status.out_of_range)
             break
-    bm = mech.body_motion(Q)
-    still_bodies = _still_bodies(mech)
-    masses = np.array([0.0 if b.name in still_bodies else float(b.mass) for b in mech.bodies])
+    bm = model.body_motion(Q)
+    still_bodies = _still_bodies(model)
+    masses = np.array([0.0 if b.name in still_bodies else float(b.mass) for b in model.bodies])
     mc_pred = np.einsum("b,nbi->ni", masses, bm.com)
     return CoSimulation(t=t, q=log["q"], qd=log["qd"], q_des=q_des, qd_des=qd_des, joint_torque=log["tau"],
                         status=status, saturated_ticks=saturated, steps_completed=completed,
