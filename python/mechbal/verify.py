@@ -18,6 +18,8 @@ design), along the case's trajectory:
 
 DIR receives ``summary.json``, ``shaking_wrench.png`` (mechbal and MuJoCo, simulated) and the
 MJCF files ``unbalanced.xml``, ``balanced.xml``; the table is printed. Needs ``mechbal[mujoco]``.
+
+Layer: methods (docs/architecture.md): uses the balance methods and the MuJoCo engine.
 """
 from __future__ import annotations
 

@@ -9,6 +9,8 @@
   link of that name) is written ``base_frame``, since ``base`` is the TOML format's fixed base.
 * :func:`urdf_text`: URDF of a tree without springs, :func:`mechbal.export.urdf.urdf_text`
   (imported here for the callers of this module).
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -9,6 +9,9 @@
   link names, frames and every body's inertia kept (:meth:`mechbal.Mechanism.to_urdf`).
 * :mod:`mechbal.export.mujoco`: the exported model in MuJoCo (optional extra ``mechbal[mujoco]``):
   inverse dynamics and base reaction on mechbal's motion, forward simulation.
+
+Layer: core (docs/architecture.md): files of the core's objects, below ``Mechanism.to_mjcf`` and
+``simulate.closed_loop(engine="mujoco")``; nothing here imports a method or a paper.
 """
 from __future__ import annotations
 
