@@ -117,10 +117,12 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
         q_guess: full coordinates near the assembly, for a closed-loop Mechanism.
         engine: ``"mechbal"`` (the C++ RK4 above) or ``"mujoco"``: the controller ticked every
             ``dt`` from Python against MuJoCo integrating the mechanism's MJCF export (a
-            :class:`mechbal.Mechanism` only; zero-order hold; needs ``mechbal[mujoco]``);
-            ``engine_options`` go to :func:`mechbal.export.mujoco_engine.co_simulate`
-            (``substeps``, ``integrator``, ``solref``). The result's ``mujoco`` holds MuJoCo's
-            base reaction at every tick beside mechbal's prediction.
+            :class:`mechbal.Mechanism` only; zero-order hold; needs ``mechbal[mujoco]``). The
+            result's ``mujoco`` holds MuJoCo's base reaction at every tick beside mechbal's
+            prediction.
+        **engine_options: with ``engine="mujoco"``, the options of
+            :func:`mechbal.export.mujoco_engine.co_simulate` (``substeps``, ``integrator``,
+            ``solref``, ``solimp``, ``minimum_mass``, ``constraint_weight``).
 
     Returns:
         :class:`ClosedLoopResult`. A plant failure (an unassemblable pose, a non-finite state)
