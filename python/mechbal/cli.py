@@ -201,7 +201,7 @@ def _cmd_verify(args) -> int:
     buffer = io.StringIO()
     try:
         with contextlib.redirect_stdout(buffer), staged_output(out) as tmp:
-            run_verify(args.case, tmp, simulate=not args.no_simulation)
+            run_verify(args.case, tmp, simulate=not args.no_simulation, method=args.method)
     except ImportError as exc:  # the optional 'mujoco' extra is missing: the message names it
         raise UserError(str(exc)) from None
     if not args.quiet:
@@ -291,6 +291,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "table and plots. Needs the 'mujoco' extra.")
     s.add_argument("case", help="built-in case name or path to a TOML case file")
     s.add_argument("--out", default="out/verify", metavar="DIR", help="output folder (default: out/verify)")
+    s.add_argument("--method", choices=("static", "force", "moment", "springs", "rms"), default=None,
+                   help="balancing method of the balanced variant (default: balance.method of the case)")
     s.add_argument("--no-simulation", action="store_true",
                    help="only the inverse dynamics on the trajectory (no forward simulation)")
     s.add_argument("-q", "--quiet", **quiet)

@@ -140,15 +140,18 @@ def _rows(label: str, res: dict, scale: dict, unbalanced: dict) -> tuple[list, d
     return rows, summary
 
 
-def run_verify(case: str, out: Path, *, simulate: bool = True) -> dict:
-    """The whole check into ``out`` (module docstring); returns the summary."""
+def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | None = None) -> dict:
+    """The whole check into ``out`` (module docstring); ``method``: the balancing method of the
+    balanced variant (default: the case's ``balance.method``, or its default design's); returns
+    the summary."""
     from mechbal.balance.run import load_case, run_method
 
     out = Path(out)
     progress.stage("reading the case")
     bc = load_case(case)
     variants = {"unbalanced": bc.mechanism}
-    method = bc.table.method if bc.table is not None and getattr(bc.table, "method", None) else None
+    if method is None and bc.table is not None and getattr(bc.table, "method", None):
+        method = bc.table.method
     if method is None and bc.default_design:
         method = next(iter(bc.default_design))
     notes = {}
