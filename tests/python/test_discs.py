@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mechbal import _core
-from mechbal import coupling as cp
+from mechbal.papers.discs import coupling as cp
 from mechbal.papers.discs.runner import parameters_from_config
 from mechbal.config import ConfigError, load_case
 from mechbal.papers import discs as dz

@@ -68,7 +68,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from mechbal import _core
-from mechbal import coupling as cp
+from mechbal.papers.discs import coupling as cp
 from mechbal.mechanism import Mechanism
 
 # the closed forms of the C++ core (cpp/src/papers/five_bar/): fast paths of the general model
@@ -318,7 +318,7 @@ def _J(d, i):
 
 
 def serial_structure(kind: str, d: dict):
-    """(joints, links, discs) of a serial mechanism (mechbal.coupling types)."""
+    """(joints, links, discs) of a serial mechanism (mechbal.papers.discs.coupling types)."""
     y = lambda L: np.array([0.0, L, 0.0])  # noqa: E731
     if kind == "planar3r":
         joints = [cp.Joint("R", EX, y(0)), cp.Joint("R", EX, y(d["l1"])), cp.Joint("R", EX, y(d["l2"]))]
