@@ -229,7 +229,7 @@ def test_unbalanced_arm_links_match_pinocchio_and_kdl(kind):
     d = dz.design(kind, params(kind), False)
     joints, links, discs = dz.serial_structure(kind, d)
     assert discs == []
-    chain = dz.chain_model(joints, links)
+    chain = dz.arm_mechanism(joints, links).model
     pm = pin.Model()
     parent = 0
     for j, b in zip(joints, links):

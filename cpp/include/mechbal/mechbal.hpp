@@ -24,11 +24,9 @@
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/algorithm/springs.hpp"
 #include "mechbal/control/mechanism_dynamics.hpp"
-/// Serial chains, trajectories, dynamics back ends
-#include "mechbal/model/serial_chain.hpp"
+/// Trajectories, dynamics back ends
 #include "mechbal/control/trajectory.hpp"
 #include "mechbal/control/dynamics.hpp"
-#include "mechbal/control/rnea.hpp"
 #include "mechbal/control/kdl_chain.hpp"
 /// Controllers and closed-loop simulation
 #include "mechbal/control/joint_controller.hpp"

@@ -342,15 +342,20 @@ def serial_structure(kind: str, d: dict):
     return joints, links, (discs if d.get("discs", True) else [])
 
 
-def chain_model(joints, links):
-    """The arm links as a mechbal ChainModel (for KDL and Pinocchio)."""
-    specs = []
+def arm_mechanism(joints, links) -> Mechanism:
+    """The arm links alone (no discs) on the general model: joint i + 1 ``joint<i+1>`` carries body
+    ``link<i+1>``, one after the other (for the bodies' motion, KDL and Pinocchio)."""
+    jts, bodies, parent = [], [], "base"
     for i, (j, b) in enumerate(zip(joints, links)):
         T = np.eye(4)
         T[:3, 3] = j.offset
         jt = _core.JointType.revolute if j.type == "R" else _core.JointType.prismatic
-        specs.append(_core.JointSpec(f"joint{i + 1}", jt, T, j.axis, b.mass, b.com, b.inertia))
-    return _core.ChainModel(specs)
+        name = f"joint{i + 1}"
+        jts.append(_core.Joint(name, jt, parent, T, np.asarray(j.axis, float)))
+        bodies.append(_core.Body(f"link{i + 1}", name, float(b.mass), np.asarray(b.com, float),
+                                 np.asarray(b.inertia, float)))
+        parent = name
+    return Mechanism.from_description(jts, bodies, name="arm")
 
 
 def disc_mechanism(kind: str, d: dict):
