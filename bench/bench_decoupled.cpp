@@ -35,7 +35,7 @@ namespace {
 MechanismModel disc_arm_6() {
   std::vector<test::Disc> discs;
   for (int i = 0; i < 6; ++i) discs.push_back({i, (i + 1) % 6, -2.0, 0.002 + 0.001 * i});
-  return test::disc_arm(bench_chain(6), discs);
+  return test::disc_arm(bench_chain(6).description(), discs);
 }
 
 // The constant diagonal of the balanced mass matrix, k = diag(M(q)), read from the model at one

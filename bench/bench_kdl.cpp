@@ -14,7 +14,7 @@
 #include "bench_ct.hpp"
 #include "bench_registry.hpp"
 #include "mechbal/control/kdl_chain.hpp"
-#include "mechbal/control/rnea.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
 
 namespace mechbal::bench {
 namespace {
@@ -27,25 +27,26 @@ KDL::Frame to_kdl(const Eigen::Isometry3d& T) {
                     KDL::Vector(p.x(), p.y(), p.z()));
 }
 
-// The plain KDL chain of a ChainModel (same construction as kdl_chain.cpp without the virtual
-// base joints): segment i's tip is the next joint's origin, inertia re-expressed there.
-KDL::Chain plain_chain(const ChainModel& model) {
+// The plain KDL chain of the bench chain (a serial MechanismModel, body l - 1 on link l; same
+// construction as kdl_chain.cpp without the virtual base joints): segment i's tip is the next
+// joint's placement, inertia re-expressed there.
+KDL::Chain plain_chain(const MechanismModel& model) {
   KDL::Chain chain;
-  const std::size_t n = model.joints().size();
-  chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::Fixed),
-                                to_kdl(model.base() * model.joints()[0].origin)));
-  for (std::size_t i = 0; i < n; ++i) {
-    const JointSpec& j = model.joints()[i];
-    const Eigen::Isometry3d next =
-        i + 1 < n ? model.joints()[i + 1].origin : Eigen::Isometry3d::Identity();
-    const Mat3& I = j.link.inertia_body;
+  const int n = model.dof();
+  chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::Fixed), to_kdl(model.placement(1))));
+  for (int l = 1; l <= n; ++l) {
+    const Body& b = model.body(l - 1);
+    const Vec3 axis = model.axis(l);
+    const std::string& name = model.link_name(l);
+    const Eigen::Isometry3d next = l < n ? model.placement(l + 1) : Eigen::Isometry3d::Identity();
+    const Mat3& I = b.inertia;
     const KDL::RigidBodyInertia in_F(
-        j.link.mass, KDL::Vector(j.com.x(), j.com.y(), j.com.z()),
+        b.mass, KDL::Vector(b.com.x(), b.com.y(), b.com.z()),
         KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
-    const KDL::Joint joint(j.name, KDL::Vector::Zero(), KDL::Vector(j.axis.x(), j.axis.y(), j.axis.z()),
-                           j.type == JointType::revolute ? KDL::Joint::RotAxis
-                                                         : KDL::Joint::TransAxis);
-    chain.addSegment(KDL::Segment(j.name, joint, to_kdl(next), to_kdl(next.inverse()) * in_F));
+    const KDL::Joint joint(name, KDL::Vector::Zero(), KDL::Vector(axis.x(), axis.y(), axis.z()),
+                           model.joint_type(l) == JointType::revolute ? KDL::Joint::RotAxis
+                                                                      : KDL::Joint::TransAxis);
+    chain.addSegment(KDL::Segment(name, joint, to_kdl(next), to_kdl(next.inverse()) * in_F));
   }
   return chain;
 }
@@ -82,13 +83,13 @@ struct Raw {
       qdd.push_back(to_jnt(x.qdd[k]));
     }
     // the chain must be the same chain: compare with mechbal once
-    RneChainDynamics ref(model);
+    MechanismDynamics ref(model);
     Eigen::VectorXd t(dof);
     ref.inverse_dynamics(x.q[0], x.qd[0], x.qdd[0], t);
     rne.CartToJnt(q[0], qd[0], qdd[0], f_ext, tau);
     check_close("raw KDL ChainIdSolver_RNE", tau.data, t);
   }
-  ChainModel model;
+  MechanismModel model;
   KDL::Chain chain;
   KDL::Vector grav;
   KDL::ChainIdSolver_RNE rne;
@@ -136,7 +137,7 @@ Tick raw_mass_case(int dof) {
 struct Wrapper {
   explicit Wrapper(int dof)
       : model(bench_chain(dof)), kdl(model), x(bench_states(dof)), v(dof), tau(dof) {}
-  ChainModel model;
+  MechanismModel model;
   KdlChainDynamics kdl;
   JointStates x;
   Eigen::VectorXd v, tau;
@@ -156,9 +157,9 @@ Tick wrapper_id_case(int dof) {
 // mechbal's ComputedTorque controller over the KdlChainDynamics back end (checked against the
 // inline law through mechbal's RNE).
 Tick wrapper_ct_case(int dof) {
-  const ChainModel model = bench_chain(dof);
+  const MechanismModel model = bench_chain(dof);
   auto s = std::make_shared<Ct<KdlChainDynamics>>(dof, model);
-  RneChainDynamics reference(model);
+  MechanismDynamics reference(model);
   check_ct("ComputedTorque<KdlChainDynamics>", *s, reference);
   return ct_tick(s);
 }

@@ -17,9 +17,9 @@
 
 namespace mechbal::bench {
 
-ChainModel bench_chain(int dof) {
+MechanismModel bench_chain(int dof) {
   std::mt19937 rng(1000u + static_cast<unsigned>(dof));
-  return test::random_chain(rng, std::string(static_cast<std::size_t>(dof), 'R').c_str());
+  return MechanismModel(test::random_chain(rng, std::string(static_cast<std::size_t>(dof), 'R').c_str()));
 }
 
 JointStates bench_states(int dof, unsigned seed) {

@@ -1,6 +1,7 @@
-// mechbal's own real-time paths: shaking wrench of a body set, chain kinematics, recursive
-// Newton-Euler inverse dynamics, the computed-torque tick (the real ComputedTorque controller over
-// RneChainDynamics and over the closed-form Arm2DofDynamics) and the CRBA mass matrix.
+// mechbal's own real-time paths: shaking wrench of a body set, chain kinematics (the model's
+// forward kinematics: every body's motion), recursive Newton-Euler inverse dynamics, the
+// computed-torque tick (the real ComputedTorque controller over MechanismDynamics and over the
+// closed-form Arm2DofDynamics) and the CRBA mass matrix.
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -9,8 +10,9 @@
 #include "bench_registry.hpp"
 #include "mechbal/papers/arm2dof/arm2dof.hpp"
 #include "mechbal/model/rigid_body.hpp"
-#include "mechbal/control/rnea.hpp"
-#include "mechbal/model/serial_chain.hpp"
+#include "mechbal/algorithm/kinematics.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
+#include "mechbal/model/data.hpp"
 #include "test_support.hpp"
 
 namespace mechbal::bench {
@@ -45,8 +47,8 @@ Tick shaking_wrench_case(int count) {
 
 struct ChainKin {
   explicit ChainKin(int dof) : model(bench_chain(dof)), ws(model), x(bench_states(dof)) {}
-  ChainModel model;
-  ChainWorkspace ws;
+  MechanismModel model;
+  MechanismData ws;
   JointStates x;
   int k = 0;
 };
@@ -55,8 +57,8 @@ Tick chain_kinematics_case(int dof) {
   auto s = std::make_shared<ChainKin>(dof);
   return [s] {
     const int k = s->k = (s->k + 1) & (JointStates::count - 1);
-    chain_kinematics(s->model, s->x.q[k], s->x.qd[k], s->x.qdd[k], s->ws);
-    benchmark::DoNotOptimize(s->ws.states.data());
+    forward_kinematics(s->model, s->ws, s->x.q[k], s->x.qd[k], s->x.qdd[k]);
+    benchmark::DoNotOptimize(s->ws.body_states.data());
     benchmark::ClobberMemory();
   };
 }
@@ -64,8 +66,8 @@ Tick chain_kinematics_case(int dof) {
 struct Rne {
   explicit Rne(int dof)
       : model(bench_chain(dof)), rne(model), x(bench_states(dof)), v(dof), tau(dof), M(dof, dof) {}
-  ChainModel model;
-  RneChainDynamics rne;
+  MechanismModel model;
+  MechanismDynamics rne;
   JointStates x;
   Eigen::VectorXd v, tau;
   Eigen::MatrixXd M;
@@ -98,19 +100,19 @@ Tick ct_inline_case(int dof) {
 }
 
 Tick ct_case(int dof) {
-  const ChainModel model = bench_chain(dof);
-  auto s = std::make_shared<Ct<RneChainDynamics>>(dof, model);
-  RneChainDynamics reference(model);
-  check_ct("ComputedTorque<RneChainDynamics>", *s, reference);
+  const MechanismModel model = bench_chain(dof);
+  auto s = std::make_shared<Ct<MechanismDynamics>>(dof, model);
+  MechanismDynamics reference(model);
+  check_ct("ComputedTorque<MechanismDynamics>", *s, reference);
   return ct_tick(s);
 }
 
 // 2-DOF closed form (Arakelian et al. 2011, Sec. 4 parameters), checked against mechbal's RNE on
-// the equivalent serial chain (arm2dof_chain_model): an independent model of the same arm.
+// the equivalent serial chain (arm2dof_description): an independent model of the same arm.
 Tick ct2_case() {
   const Arm2DofParameters arm{};
   auto s = std::make_shared<Ct<Arm2DofDynamics>>(2, arm);
-  RneChainDynamics reference(arm2dof_chain_model(arm));
+  MechanismDynamics reference{MechanismModel(arm2dof_description(arm))};
   check_ct("ComputedTorque<Arm2DofDynamics>", *s, reference);
   return ct_tick(s);
 }

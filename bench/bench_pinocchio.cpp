@@ -9,35 +9,36 @@
 #include <pinocchio/multibody.hpp>
 
 #include "bench_registry.hpp"
-#include "mechbal/control/rnea.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
 
 namespace mechbal::bench {
 namespace {
 
-/// The ChainModel as a Pinocchio model: unaligned revolute/prismatic joints, placement = joint
-/// origin (base folded into the first), one body per joint with Inertia(mass, com, I_com).
-pinocchio::Model to_pinocchio(const ChainModel& chain) {
+/// The bench chain (a serial MechanismModel, body l - 1 on link l) as a Pinocchio model: unaligned
+/// revolute/prismatic joints, placement = joint placement (base folded into the first), one body
+/// per joint with Inertia(mass, com, I_com).
+pinocchio::Model to_pinocchio(const MechanismModel& chain) {
   pinocchio::Model model;
   pinocchio::JointIndex parent = 0;
-  for (int i = 0; i < chain.dof(); ++i) {
-    const JointSpec& j = chain.joints()[static_cast<std::size_t>(i)];
-    const Eigen::Isometry3d origin = i == 0 ? chain.base() * j.origin : j.origin;
+  for (int l = 1; l <= chain.dof(); ++l) {
+    const Eigen::Isometry3d origin = chain.placement(l);
+    const Vec3 axis = chain.axis(l);
+    const Body& b = chain.body(l - 1);
     const pinocchio::SE3 placement(origin.linear(), origin.translation());
     pinocchio::JointIndex id;
-    if (j.type == JointType::revolute) {
-      id = model.addJoint(parent, pinocchio::JointModelRevoluteUnaligned(j.axis), placement, j.name);
+    if (chain.joint_type(l) == JointType::revolute) {
+      id = model.addJoint(parent, pinocchio::JointModelRevoluteUnaligned(axis), placement, chain.link_name(l));
     } else {
-      id = model.addJoint(parent, pinocchio::JointModelPrismaticUnaligned(j.axis), placement, j.name);
+      id = model.addJoint(parent, pinocchio::JointModelPrismaticUnaligned(axis), placement, chain.link_name(l));
     }
-    model.appendBodyToJoint(id, pinocchio::Inertia(j.link.mass, j.com, j.link.inertia_body),
-                            pinocchio::SE3::Identity());
+    model.appendBodyToJoint(id, pinocchio::Inertia(b.mass, b.com, b.inertia), pinocchio::SE3::Identity());
     parent = id;
   }
   model.gravity.linear(chain.gravity());
   return model;
 }
 
-/// The same chain given to Pinocchio in joint-aligned frames (the trick RneChainDynamics uses
+/// The same chain given to Pinocchio in joint-aligned frames (the trick MechanismDynamics uses
 /// internally): link i is expressed in L_i = F_i A_i with A_i e_z = axis_i, so every joint is a
 /// JointModelRZ / JointModelPZ. Pinocchio's best case for this chain.
 Mat3 aligned_with_z(const Vec3& axis) {
@@ -48,25 +49,25 @@ Mat3 aligned_with_z(const Vec3& axis) {
   return A;
 }
 
-pinocchio::Model to_pinocchio_aligned(const ChainModel& chain) {
+pinocchio::Model to_pinocchio_aligned(const MechanismModel& chain) {
   pinocchio::Model model;
   pinocchio::JointIndex parent = 0;
   Mat3 A_parent = Mat3::Identity();
-  for (int i = 0; i < chain.dof(); ++i) {
-    const JointSpec& j = chain.joints()[static_cast<std::size_t>(i)];
-    const Eigen::Isometry3d origin = i == 0 ? chain.base() * j.origin : j.origin;
-    const Mat3 A = aligned_with_z(j.axis);
+  for (int l = 1; l <= chain.dof(); ++l) {
+    const Eigen::Isometry3d origin = chain.placement(l);
+    const Body& b = chain.body(l - 1);
+    const Mat3 A = aligned_with_z(chain.axis(l));
     const pinocchio::SE3 placement(A_parent.transpose() * origin.linear() * A,
                                    A_parent.transpose() * origin.translation());
     pinocchio::JointIndex id;
-    if (j.type == JointType::revolute) {
-      id = model.addJoint(parent, pinocchio::JointModelRZ(), placement, j.name);
+    if (chain.joint_type(l) == JointType::revolute) {
+      id = model.addJoint(parent, pinocchio::JointModelRZ(), placement, chain.link_name(l));
     } else {
-      id = model.addJoint(parent, pinocchio::JointModelPZ(), placement, j.name);
+      id = model.addJoint(parent, pinocchio::JointModelPZ(), placement, chain.link_name(l));
     }
     model.appendBodyToJoint(id,
-                            pinocchio::Inertia(j.link.mass, A.transpose() * j.com,
-                                               A.transpose() * j.link.inertia_body * A),
+                            pinocchio::Inertia(b.mass, A.transpose() * b.com,
+                                               A.transpose() * b.inertia * A),
                             pinocchio::SE3::Identity());
     parent = id;
     A_parent = A;
@@ -82,7 +83,7 @@ struct Pin {
         data(model),
         x(bench_states(dof)),
         v(dof) {
-    RneChainDynamics ref(chain);
+    MechanismDynamics ref(chain);
     Eigen::VectorXd t(dof);
     ref.inverse_dynamics(x.q[0], x.qd[0], x.qdd[0], t);
     pinocchio::rnea(model, data, x.q[0], x.qd[0], x.qdd[0]);
@@ -93,7 +94,7 @@ struct Pin {
       std::abort();
     }
   }
-  ChainModel chain;
+  MechanismModel chain;
   pinocchio::Model model;
   pinocchio::Data data;
   JointStates x;

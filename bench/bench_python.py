@@ -1,7 +1,7 @@
 """Python-side timings of mechbal (issue 6).
 
 1. Per-call cost of a single-instant call through the bindings (arrays of one instant in, a dict of
-   arrays out): RneChainDynamics.inverse_dynamics (6 joints), shaking_wrench (10 bodies). The
+   arrays out): MechanismDynamics.inverse_dynamics (6 joints), shaking_wrench (10 bodies). The
    binding overhead is this minus the C++ tick time of mechbal-bench (the merge script subtracts).
    Also one controller tick through the bindings: ComputedTorque.step (6-joint RNE back end, and
    the 2-DOF closed form), ReactionlessWrist.step (Euler, RK4), DecoupledJointController.step (3 joints).
@@ -243,7 +243,7 @@ def main(argv=None):
 
     # ---- 1. single-instant calls through the bindings ----------------------------------------
     model = chain_from_specs(random_chain_specs(rng, "RRRRRR"))
-    rne = mechbal.control.RneChainDynamics(model)
+    rne = mechbal.control.MechanismDynamics(model)
     q, qd, qdd = (rng.uniform(-1, 1, (1, 6)) for _ in range(3))
     med, p99 = median_per_call_ns(lambda: rne.inverse_dynamics(q, qd, qdd), calls)
     results["per_call"]["id6_mechbal"] = {"median_ns": med, "p99_ns": p99}

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "mechbal/model/serial_chain.hpp"
+#include "mechbal/model/model.hpp"
 
 namespace mechbal::bench {
 
@@ -40,8 +40,9 @@ struct RegisterCase {
 };
 
 /// The chains every library is compared on: all-revolute serial chains with arbitrary joint axes
-/// and origins (deterministic seeds), dof = 6 or 7 (any dof >= 1 works).
-ChainModel bench_chain(int dof);
+/// and origins (deterministic seeds), dof = 6 or 7 (any dof >= 1 works), one body per link (body
+/// l - 1 on link l) as general models.
+MechanismModel bench_chain(int dof);
 
 /// A fixed set of joint states (cycled through by the ticks so that no single input is cached).
 struct JointStates {

@@ -4,7 +4,7 @@
 // next release time).
 //
 // Workloads (--workload):
-//   ct6 (default): the real controller, ComputedTorque over RneChainDynamics on the 6-joint bench
+//   ct6 (default): the real controller, ComputedTorque over MechanismDynamics on the 6-joint bench
 //     chain, tracking a quintic rest-to-rest trajectory (back and forth) evaluated every tick;
 //   paminsa: the whole PAMINSA tick (PaminsaController::tick: mechanism kinematics at t, t + dt/2,
 //     t + dt, D, the reactionless wrist with RK4, wrist kinematics, shaking wrench of 38 bodies),
@@ -30,7 +30,7 @@
 
 #include "mechbal/control/computed_torque.hpp"
 #include "mechbal/papers/paminsa/paminsa.hpp"
-#include "mechbal/control/rnea.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
 #include "mechbal/control/trajectory.hpp"
 #include "paminsa_motion.hpp"
 #include "test_support.hpp"
@@ -69,7 +69,7 @@ void usage() {
 struct ComputedTorqueWorkload {
   static constexpr const char* name = "ct6";
   static constexpr const char* description =
-      "ct6: trajectory evaluate + ComputedTorque::step over RneChainDynamics (6 joints)";
+      "ct6: trajectory evaluate + ComputedTorque::step over MechanismDynamics (6 joints)";
   ComputedTorqueWorkload()
       : model(make_chain()),
         dynamics(model),
@@ -78,9 +78,9 @@ struct ComputedTorqueWorkload {
                    mechbal::TimeLaw::quintic),
         q_ref(6), qd_ref(6), qdd_ref(6), q(6), qd(6), tau(6) {}
 
-  static mechbal::ChainModel make_chain() {
+  static mechbal::MechanismModel make_chain() {
     std::mt19937 rng(1006u);  // the same 6-joint chain as mechbal-bench's ct6 cases
-    return mechbal::test::random_chain(rng, "RRRRRR");
+    return mechbal::MechanismModel(mechbal::test::random_chain(rng, "RRRRRR"));
   }
 
   mechbal::Status tick(double t) noexcept {
@@ -97,8 +97,8 @@ struct ComputedTorqueWorkload {
   }
 
   static constexpr double kp = 100.0, kd = 20.0;
-  mechbal::ChainModel model;
-  mechbal::RneChainDynamics dynamics;
+  mechbal::MechanismModel model;
+  mechbal::MechanismDynamics dynamics;
   mechbal::ComputedTorque controller;
   mechbal::RestToRestTrajectory trajectory;
   Eigen::VectorXd q_ref, qd_ref, qdd_ref, q, qd, tau;

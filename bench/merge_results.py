@@ -100,13 +100,13 @@ def main(argv=None):
 
     ratios = {
         # ct6 = one computed-torque tick on the 6-joint chain: mechbal = the ComputedTorque
-        # controller over RneChainDynamics; KDL raw / Pinocchio = the same law inline with their
+        # controller over MechanismDynamics; KDL raw / Pinocchio = the same law inline with their
         # own inverse dynamics. The other library's time over mechbal's, same chain, same run.
         "kdl_over_mechbal_ct6": ratio(cases, "ct6_kdl_raw", "ct6_mechbal"),
         "pinocchio_over_mechbal_ct6": ratio(cases, "ct6_pinocchio", "ct6_mechbal"),
         "kdl_over_mechbal_ct7": ratio(cases, "ct7_kdl_raw", "ct7_mechbal"),
         "pinocchio_over_mechbal_ct7": ratio(cases, "ct7_pinocchio", "ct7_mechbal"),
-        # ComputedTorque over KdlChainDynamics vs over RneChainDynamics (same controller)
+        # ComputedTorque over KdlChainDynamics vs over MechanismDynamics (same controller)
         "kdl_wrapper_over_mechbal_ct6": ratio(cases, "ct6_kdl_wrapper", "ct6_mechbal"),
         "kdl_wrapper_over_mechbal_ct7": ratio(cases, "ct7_kdl_wrapper", "ct7_mechbal"),
         # Pinocchio given the chain in joint-aligned frames (RZ joints): its best case
@@ -204,7 +204,7 @@ def main(argv=None):
                          "the same two controllers at 6 joints on an unbalanced disc arm (cost "
                          "only)",
             "ct": "computed torque on the 6-/7-joint chain: *_mechbal and *_kdl_wrapper run the "
-                  "ComputedTorque controller (computed_torque.hpp) over RneChainDynamics / "
+                  "ComputedTorque controller (computed_torque.hpp) over MechanismDynamics / "
                   "KdlChainDynamics; *_kdl_raw and *_pinocchio compute the same law inline, "
                   "v = qdd_d + Kp (q_d - q) + Kd (qd_d - qd), tau = ID(q, qd, v); "
                   "ct6_mechbal_inline is mechbal's RNE with the inline law; ct2_closed_form is "

@@ -1,5 +1,5 @@
 // pybind11 glue for the InverseDynamics interface (dynamics.hpp): bound as the common base class
-// of every joint-space dynamics back end (Arm2DofDynamics, KdlChainDynamics, RneChainDynamics), so
+// of every joint-space dynamics back end (Arm2DofDynamics, KdlChainDynamics, MechanismDynamics), so
 // that controllers taking an InverseDynamics (ComputedTorque) accept any of them. No logic.
 #include "bindings.hpp"
 #include "mechbal/control/dynamics.hpp"
@@ -14,7 +14,7 @@ namespace {
 void bind_dynamics(py::module_& m) {
   py::class_<InverseDynamics>(m, "InverseDynamics",
                               "Joint-space inverse dynamics back end (base class of "
-                              "Arm2DofDynamics, KdlChainDynamics, RneChainDynamics)")
+                              "Arm2DofDynamics, KdlChainDynamics, MechanismDynamics)")
       .def_property_readonly("dof", &InverseDynamics::dof);
   py::class_<ForwardDynamics>(m, "ForwardDynamics",
                               "Forward dynamics of a plant for closed-loop simulation (base class of "

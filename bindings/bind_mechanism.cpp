@@ -26,7 +26,6 @@
 #include "mechbal/algorithm/springs.hpp"
 #include "mechbal/model/data.hpp"
 #include "mechbal/model/model.hpp"
-#include "mechbal/model/serial_chain.hpp"
 
 namespace py = pybind11;
 
@@ -183,6 +182,11 @@ py::dict matrix_batch(const MechanismModel& model, py::ssize_t N, py::ssize_t ro
 }
 
 void bind_mechanism(py::module_& m) {
+  py::enum_<JointType>(m, "JointType")
+      .value("revolute", JointType::revolute)
+      .value("prismatic", JointType::prismatic)
+      .value("fixed", JointType::fixed);
+
   py::class_<Joint>(m, "Joint",
                     "One joint of a MechanismDescription; it moves the link of the same name "
                     "(model.hpp for frames and conventions)")
@@ -547,9 +551,6 @@ void bind_mechanism(py::module_& m) {
         return out;
       },
       py::arg("model"), py::arg("q_actuated"), py::arg("v_actuated"), py::arg("tau_actuated"), py::arg("q_guess"));
-
-  m.def("chain_description", &chain_description, py::arg("chain"),
-        "A serial ChainModel as a general MechanismDescription (base folded into the first joint)");
 
   // ---- batch algorithms: arguments (N, dof); results (N, ...) and `status` (N,) ----
   m.def("mechanism_kinematics", &kinematics_batch, py::arg("model"), py::arg("q"), py::arg("v"),

@@ -47,11 +47,10 @@ _MOVED = {
     "ComputedTorque": "control", "DecoupledJointController": "control",
     "ReactionlessWrist": "control", "ReactionlessWristConfig": "control",
     "WristIntegrator": "control", "InverseDynamics": "control", "MechanismDynamics": "control",
-    "RneChainDynamics": "control", "KdlChainDynamics": "control", "TimeLaw": "trajectory",
+    "KdlChainDynamics": "control", "TimeLaw": "trajectory",
     "Arm2DofDynamics": "papers", "Arm2DofParameters": "papers", "PaminsaModel": "papers",
     "PaminsaParameters": "papers", "paminsa_kinematics": "papers",
-    "paminsa_reactionless_run": "papers", "ChainModel": "papers", "JointSpec": "papers",
-    "chain_kinematics": "papers", "shaking_wrench": "papers", "FiveBarDynamics": "papers",
+    "paminsa_reactionless_run": "papers", "shaking_wrench": "papers", "FiveBarDynamics": "papers",
 }
 _LEGACY_CORE = {"RestToRestTrajectory", "validate_rigid_body"}
 

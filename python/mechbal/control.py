@@ -30,8 +30,8 @@ raises in a tick: it returns the held (last safe) command and a non-ok status.
 
 The dynamics back ends a :class:`ComputedTorque` computes over are here too:
 `MechanismDynamics` (the general model, any mechanism, closed loops included),
-`RneChainDynamics` and `KdlChainDynamics` (serial chains), and the papers' closed forms in
-`mechbal.papers`.
+`KdlChainDynamics` (Orocos KDL on a serial MechanismModel, the independent engine), and the
+papers' closed forms in `mechbal.papers`.
 
 Layer: Python core (docs/architecture.md).
 """
@@ -49,7 +49,7 @@ __all__ = [
     "ComputedTorque", "DecoupledJointController", "ReactionlessWrist", "ReactionlessWristConfig",
     "WristIntegrator", "WristCommand", "PaminsaController", "JointController", "JointCommand",
     "ControlRun", "WristRun", "PaminsaRun", "InverseDynamics", "ForwardDynamics",
-    "MechanismDynamics", "RneChainDynamics", "KdlChainDynamics", "Status", "status_text",
+    "MechanismDynamics", "KdlChainDynamics", "Status", "status_text",
 ]
 
 Status = _core.Status
@@ -57,7 +57,6 @@ JointController = _core.JointController
 InverseDynamics = _core.InverseDynamics
 ForwardDynamics = _core.ForwardDynamics
 MechanismDynamics = _core.MechanismDynamics
-RneChainDynamics = _core.RneChainDynamics
 KdlChainDynamics = _core.KdlChainDynamics
 ReactionlessWristConfig = _core.ReactionlessWristConfig
 WristIntegrator = _core.WristIntegrator
@@ -148,7 +147,7 @@ class ComputedTorque(_core.ComputedTorque):
 
     Args:
         model: a :class:`mechbal.Mechanism` (its :class:`MechanismDynamics` is built and kept) or
-            any dynamics back end: :class:`MechanismDynamics`, :class:`RneChainDynamics`,
+            any dynamics back end: :class:`MechanismDynamics`,
             :class:`KdlChainDynamics`, ``Arm2DofDynamics``,
             ``FiveBarDynamics`` (:mod:`mechbal.papers`). The model may differ from the plant.
         kp: proportional gains [1/s^2], one per joint.

@@ -4,8 +4,8 @@
   (a :class:`mechbal.Mechanism`, closed loops included, or any forward-dynamics plant such as
   ``Arm2DofDynamics``) along any trajectory (:mod:`mechbal.trajectory`), integrated by RK4 at the
   controller period.
-* :func:`run_chain`: kinematics, shaking wrench and inverse dynamics of a serial chain along a
-  trajectory (open loop).
+* open-loop evaluation along a trajectory: :class:`mechbal.Mechanism` (``shaking_wrench``,
+  ``base_reaction``, ``inverse_dynamics`` over ``(N, n)`` samples of a trajectory).
 
 Units: SI (s, rad or m, rad/s or m/s, N m or N).
 
@@ -13,7 +13,7 @@ Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -25,9 +25,8 @@ from mechbal import _core
 simulate_closed_loop = _core.simulate_closed_loop
 simulate_computed_torque = _core.simulate_computed_torque
 
-__all__ = ["closed_loop", "ClosedLoopResult", "ForwardDynamics", "MechanismDynamics", "run_chain",
-           "simulate_closed_loop", "simulate_computed_torque",
-           "ChainRun"]
+__all__ = ["closed_loop", "ClosedLoopResult", "ForwardDynamics", "MechanismDynamics",
+           "simulate_closed_loop", "simulate_computed_torque"]
 
 ForwardDynamics = _core.ForwardDynamics
 MechanismDynamics = _core.MechanismDynamics
@@ -210,74 +209,3 @@ def _closed_loop_mujoco(mech: Any, controller: Any, trajectory: Any, q0, qd0, *,
                             joint_torque=r.joint_torque, status=r.status,
                             saturated_ticks=r.saturated_ticks, steps_completed=r.steps_completed,
                             mujoco=r)
-
-
-@dataclass
-class ChainRun:
-    """One serial chain evaluated along a trajectory (all arrays in the base frame, SI units):
-    times ``t`` [s], the motion ``q``, ``qd``, ``qdd``, every link's ``bodies`` motion, the
-    ``wrench`` of the bodies and the KDL joint ``torque`` with the base ``support_force`` /
-    ``support_moment``; ``shaking_force``, ``shaking_moment``, ``joint_torque``,
-    ``base_reaction_force`` and ``base_reaction_moment`` name them as elsewhere in mechbal."""
-
-    t: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    names: list[str]
-    mass: np.ndarray
-    inertia_body: np.ndarray
-    bodies: dict  # com, com_velocity, com_acceleration, rotation, angular_velocity, ...
-    wrench: dict  # force, moment, linear_momentum, angular_momentum
-    torque: np.ndarray
-    support_force: np.ndarray
-    support_moment: np.ndarray
-    extra: dict = field(default_factory=dict)
-
-    # the names used everywhere else in mechbal (Mechanism, ClosedLoopResult, summaries, files)
-    @property
-    def shaking_force(self) -> np.ndarray:
-        """dP/dt of the chain's bodies (N, 3) [N] (``wrench["force"]``)."""
-        return np.asarray(self.wrench["force"])
-
-    @property
-    def shaking_moment(self) -> np.ndarray:
-        """dH_O/dt about the base origin (N, 3) [N m] (``wrench["moment"]``)."""
-        return np.asarray(self.wrench["moment"])
-
-    @property
-    def joint_torque(self) -> np.ndarray:
-        """Joint torques or forces (N, n) [N m or N] (``torque``)."""
-        return self.torque
-
-    @property
-    def base_reaction_force(self) -> np.ndarray:
-        """Force the base exerts on the chain, gravity included (N, 3) [N] (``support_force``)."""
-        return self.support_force
-
-    @property
-    def base_reaction_moment(self) -> np.ndarray:
-        """Its moment about the base origin (N, 3) [N m] (``support_moment``)."""
-        return self.support_moment
-
-
-def run_chain(model: _core.ChainModel, trajectory: Any, t: np.ndarray) -> ChainRun:
-    """Kinematics, shaking wrench (eqs 1-4 of Briot & Arakelian 2009) and KDL inverse dynamics of
-    a serial chain along ``trajectory`` (a C++ ``RestToRestTrajectory`` or a
-    :class:`mechbal.trajectory.RestToRest`) sampled at ``t`` [s]: forces [N], moments about the
-    base origin [N m], joint torques [N m or N]."""
-    if hasattr(trajectory, "core"):
-        trajectory = trajectory.core
-    t = np.asarray(t, float)
-    q, qd, qdd = trajectory.evaluate_batch(t)
-    bodies = _core.chain_kinematics(model, q, qd, qdd)
-    names = [j.name for j in model.joints]
-    mass = np.array([j.mass for j in model.joints])
-    inertia_body = np.array([j.inertia for j in model.joints])
-    wrench = _core.shaking_wrench(mass, inertia_body, bodies["com"], bodies["com_velocity"],
-                                  bodies["com_acceleration"], bodies["rotation"],
-                                  bodies["angular_velocity"], bodies["angular_acceleration"])
-    dyn = _core.KdlChainDynamics(model).inverse_dynamics(q, qd, qdd)
-    return ChainRun(t=t, q=q, qd=qd, qdd=qdd, names=names, mass=mass, inertia_body=inertia_body,
-                    bodies=bodies, wrench=wrench, torque=dyn["tau"],
-                    support_force=dyn["support_force"], support_moment=dyn["support_moment"])

@@ -1,7 +1,7 @@
 """A mechanism as plain data: :class:`MechanismSpec`, built from a validated ``[mechanism]`` table.
 
-This is what the general C++ ``MechanismModel`` (and, for serial chains, ``ChainModel``) is built
-from. Everything the TOML format lets a user say in several ways is settled here:
+This is what the general C++ ``MechanismModel`` is built from. Everything the TOML format lets a
+user say in several ways is settled here:
 
 * **Placements.** ``JointSpec.placement`` is the constant transform from the parent link's frame
   (the frame right after the parent joint's motion) to the joint frame at q = 0. For a root joint

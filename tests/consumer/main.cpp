@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 namespace {
@@ -17,17 +18,21 @@ void check(bool ok, const char* what) {
   }
 }
 
-mechbal::ChainModel two_link_arm() {
-  std::vector<mechbal::JointSpec> joints(2);
+mechbal::MechanismModel two_link_arm() {
+  mechbal::MechanismDescription d;
+  std::string parent = d.root_name;
   for (int i = 0; i < 2; ++i) {
-    joints[i].name = i == 0 ? "shoulder" : "elbow";
-    joints[i].axis = mechbal::Vec3(0.0, -1.0, 0.0);
-    joints[i].link.mass = i == 0 ? 4.0 : 2.0;
-    joints[i].link.inertia_body = mechbal::Vec3(0.004, 0.09, 0.09).asDiagonal();
-    joints[i].com = mechbal::Vec3(0.2, 0.0, 0.0);
+    mechbal::Joint j;
+    j.name = i == 0 ? "shoulder" : "elbow";
+    j.parent = parent;
+    j.axis = mechbal::Vec3(0.0, -1.0, 0.0);
+    if (i == 1) j.placement.translation() = mechbal::Vec3(0.5, 0.0, 0.0);
+    d.joints.push_back(j);
+    d.bodies.push_back(mechbal::Body{j.name, "link", j.name, i == 0 ? 4.0 : 2.0, mechbal::Vec3(0.2, 0.0, 0.0),
+                                     mechbal::Vec3(0.004, 0.09, 0.09).asDiagonal()});
+    parent = j.name;
   }
-  joints[1].origin.translation() = mechbal::Vec3(0.5, 0.0, 0.0);
-  return mechbal::ChainModel(joints);
+  return mechbal::MechanismModel(d);
 }
 
 // One computed-torque tick at rest on the desired pose: the command is the gravity torque.
@@ -60,10 +65,10 @@ int main() {
   check(s == mechbal::Status::ok && std::abs(w.force.z() + 19.62) < 1e-12, "shaking_wrench");
 
   // ComputedTorque over every back end of the same arm
-  const mechbal::ChainModel arm = two_link_arm();
-  mechbal::RneChainDynamics rnea(arm);
+  const mechbal::MechanismModel arm = two_link_arm();
+  mechbal::MechanismDynamics general(arm);
   mechbal::KdlChainDynamics kdl(arm);
-  computed_torque_over(rnea, "RneChainDynamics");
+  computed_torque_over(general, "MechanismDynamics (two-link arm)");
   computed_torque_over(kdl, "KdlChainDynamics");
   mechbal::Arm2DofDynamics arm2dof{mechbal::Arm2DofParameters{}};
   computed_torque_over(arm2dof, "Arm2DofDynamics");

@@ -6,7 +6,6 @@
 #include <vector>
 
 #include "mechbal/model/model.hpp"
-#include "mechbal/model/serial_chain.hpp"
 
 namespace mechbal::test {
 
@@ -20,8 +19,7 @@ struct Disc {
   double J = 0.0;
 };
 
-inline MechanismModel disc_arm(const ChainModel& chain, const std::vector<Disc>& discs) {
-  MechanismDescription d = chain_description(chain);
+inline MechanismModel disc_arm(MechanismDescription d, const std::vector<Disc>& discs) {
   const std::size_t links = d.joints.size();
   for (std::size_t i = 0; i < discs.size(); ++i) {
     const Disc& s = discs[i];
@@ -46,15 +44,16 @@ struct Planar3R {
   double X() const { return J2 + J3 + J4 + J6 + J7 + m3 * l2 * l2 + m3 * m3 * l2 * l2 / m2; }
 };
 
-inline JointSpec planar_link(const char* name, double offset, double m, double lg, double Jx) {
-  JointSpec j;
+/// Appends a link of the planar arm (joint about x, `offset` along the parent's y axis) to `d`.
+inline void planar_link(MechanismDescription& d, const char* name, double offset, double m, double lg, double Jx) {
+  Joint j;
   j.name = name;
-  j.origin = Eigen::Isometry3d(Eigen::Translation3d(0.0, offset, 0.0));
+  j.parent = d.joints.empty() ? d.root_name : d.joints.back().name;
+  j.placement = Eigen::Isometry3d(Eigen::Translation3d(0.0, offset, 0.0));
   j.axis = Vec3::UnitX();
-  j.link.mass = m;
-  j.link.inertia_body = Vec3(Jx, 0.6 * Jx, 0.6 * Jx).asDiagonal();  // thin plate, physical
-  j.com = Vec3(0.0, lg, 0.0);
-  return j;
+  d.joints.push_back(j);
+  // thin plate, physical
+  d.bodies.push_back(Body{name, "link", name, m, Vec3(0.0, lg, 0.0), Vec3(Jx, 0.6 * Jx, 0.6 * Jx).asDiagonal()});
 }
 
 /// The balanced planar 3R, eqs 8 and 14 written here from the paper (independently of Python):
@@ -63,8 +62,10 @@ inline JointSpec planar_link(const char* name, double offset, double m, double l
 inline MechanismModel balanced_planar_3r(const Planar3R& p = {}, double beta_scale = 1.0) {
   const double lg1 = -p.l1 * (p.m2 + p.m3) / p.m1, lg2 = -p.l2 * p.m3 / p.m2;
   const double beta = -p.X() / p.J5 * beta_scale, gamma = -(p.J3 + p.J6) / p.J7;
-  const ChainModel chain({planar_link("j1", 0.0, p.m1, lg1, p.J1), planar_link("j2", p.l1, p.m2, lg2, p.J2),
-                          planar_link("j3", p.l2, p.m3, 0.0, p.J3)});
+  MechanismDescription chain;
+  planar_link(chain, "j1", 0.0, p.m1, lg1, p.J1);
+  planar_link(chain, "j2", p.l1, p.m2, lg2, p.J2);
+  planar_link(chain, "j3", p.l2, p.m3, 0.0, p.J3);
   return disc_arm(chain, {{0, 1, 1.0, p.J4}, {0, 1, beta, p.J5}, {1, 2, 1.0, p.J6}, {1, 2, gamma, p.J7}});
 }
 

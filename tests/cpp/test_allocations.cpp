@@ -9,9 +9,11 @@
 #include "mechbal/control/decoupled_control.hpp"
 #include "mechbal/control/kdl_chain.hpp"
 #include "mechbal/papers/paminsa/paminsa.hpp"
-#include "mechbal/control/rnea.hpp"
-#include "mechbal/model/rigid_body.hpp"
-#include "mechbal/model/serial_chain.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
+#include "mechbal/algorithm/kinematics.hpp"
+#include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/control/trajectory.hpp"
 #include "test_support.hpp"
 
@@ -27,9 +29,9 @@ TEST(Allocations, CounterSeesAnAllocation) {
 
 TEST(Allocations, SingleInstantFunctionsAllocateNothing) {
   std::mt19937 rng(5);
-  const ChainModel model = test::random_chain(rng, "RRPRRR");
+  const MechanismModel model(test::random_chain(rng, "RRPRRR"));
   const int n = model.dof();
-  ChainWorkspace ws(model);
+  MechanismData ws(model);
   KdlChainDynamics kdl(model);
   const Eigen::VectorXd q = test::random_vector(rng, n, 1.0),
                         qd = test::random_vector(rng, n, 1.0),
@@ -37,8 +39,6 @@ TEST(Allocations, SingleInstantFunctionsAllocateNothing) {
   Eigen::VectorXd tau(n), c(n), g(n), qt(n), qdt(n), qddt(n);
   Eigen::MatrixXd M(n, n);
   RestToRestTrajectory traj(q, qd, 0.5, TimeLaw::quintic);
-  ShakingWrench sw;
-  BaseReaction br;
   Vec3 F, Mo;
   // warm up once (lazy initialisation inside libraries is allowed before the loop starts)
   kdl.inverse_dynamics(q, qd, qdd, tau, &F, &Mo);
@@ -50,12 +50,9 @@ TEST(Allocations, SingleInstantFunctionsAllocateNothing) {
   for (int tick = 0; tick < 100; ++tick) {
     const double t = tick * 1e-3;
     EXPECT_EQ(traj.evaluate(t, qt, qdt, qddt), Status::ok);
-    EXPECT_EQ(chain_kinematics(model, qt, qdt, qddt, ws), Status::ok);
-    EXPECT_EQ(shaking_wrench(model.bodies().data(), ws.states.data(), ws.states.size(), sw),
-              Status::ok);
-    EXPECT_EQ(base_reaction(model.bodies().data(), ws.states.data(), ws.states.size(),
-                            model.gravity(), sw, br),
-              Status::ok);
+    EXPECT_EQ(forward_kinematics(model, ws, qt, qdt, qddt), Status::ok);
+    EXPECT_EQ(shaking_wrench(model, ws, qt, qdt, qddt), Status::ok);
+    EXPECT_EQ(base_reaction(model, ws, qt, qdt, qddt), Status::ok);
     EXPECT_EQ(kdl.inverse_dynamics(qt, qdt, qddt, tau, &F, &Mo), Status::ok);
     EXPECT_EQ(kdl.mass_matrix(qt, M), Status::ok);
     EXPECT_EQ(kdl.coriolis(qt, qdt, c), Status::ok);
@@ -68,11 +65,11 @@ TEST(Allocations, SingleInstantFunctionsAllocateNothing) {
 // closed-form damped least squares at the singularity are reachable from a tick: no allocation.
 TEST(Allocations, RejectionAndSingularPathsAllocateNothing) {
   std::mt19937 rng(8);
-  const ChainModel model = test::random_chain(rng, "RRPR");
+  const MechanismModel model(test::random_chain(rng, "RRPR"));
   const int n = model.dof();
-  ChainWorkspace ws(model);
+  MechanismData ws(model);
   KdlChainDynamics kdl(model);
-  RneChainDynamics rne(model);
+  MechanismDynamics rne(model);
   Arm2DofDynamics arm(Arm2DofParameters{});
   ComputedTorque ct(arm, Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20));
   DecoupledJointController dc(Eigen::Vector2d(1, 2), Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20));
@@ -91,15 +88,14 @@ TEST(Allocations, RejectionAndSingularPathsAllocateNothing) {
   Eigen::VectorXd tau(n), c(n), tau2(2);
   Eigen::MatrixXd M(n, n);
   const Eigen::Vector2d z2 = Eigen::Vector2d::Zero(), absurd(1e6, 0.0);
-  ShakingWrench sw;
   Vec3 F, Mo;
   kdl.inverse_dynamics(q, q, q, tau, &F, &Mo);  // warm up
   kdl.coriolis(q, q, c);
 
   test::AllocationScope scope;
   for (int tick = 0; tick < 50; ++tick) {
-    EXPECT_EQ(chain_kinematics(model, q, huge, q, ws), Status::out_of_range);
-    EXPECT_EQ(shaking_wrench(model.bodies().data(), ws.states.data(), ws.states.size(), sw), Status::ok);
+    EXPECT_EQ(forward_kinematics(model, ws, q, huge, q), Status::out_of_range);
+    EXPECT_EQ(shaking_wrench(model, ws, q, q, q), Status::ok);
     EXPECT_EQ(rne.inverse_dynamics(q, huge, q, tau, &F, &Mo), Status::out_of_range);
     EXPECT_EQ(rne.mass_matrix(q, M), Status::ok);
     EXPECT_EQ(kdl.inverse_dynamics(q, huge, q, tau, &F, &Mo), Status::out_of_range);

@@ -49,7 +49,7 @@ TEST(Arm2Dof, ClosedFormMatchesKdlOnRandomArmsAndStates) {
     const Arm2DofParameters arm = a == 0 ? Arm2DofParameters{} : random_arm(rng);
     const Arm2DofCounterweights cw = a % 2 ? random_cw(rng) : Arm2DofCounterweights{};
     Arm2DofDynamics closed(arm, cw);
-    KdlChainDynamics kdl(arm2dof_chain_model(arm, cw));
+    KdlChainDynamics kdl{MechanismModel(arm2dof_description(arm, cw))};
     for (int k = 0; k < 20; ++k) {
       const Vec2 q = rvec(rng, 3.0), qd = rvec(rng, 2.0), qdd = rvec(rng, 5.0);
       Eigen::VectorXd t_kdl(2), t_cf(2);
@@ -142,7 +142,7 @@ TEST(Arm2Dof, BadParametersNameTheField) {
 
 TEST(ComputedTorque, TickAllocatesNothingWithEitherBackEnd) {
   Arm2DofDynamics closed(Arm2DofParameters{});
-  KdlChainDynamics kdl(arm2dof_chain_model(Arm2DofParameters{}));
+  KdlChainDynamics kdl{MechanismModel(arm2dof_description(Arm2DofParameters{}))};
   const Eigen::Vector2d kp(100, 100), kd(20, 20);
   ComputedTorque c1(closed, kp, kd), c2(kdl, kp, kd, Eigen::Vector2d(50, 5));
   RestToRestTrajectory traj(kStart, kEnd, 1.0, TimeLaw::cubic);
@@ -224,7 +224,7 @@ TEST(ClosedLoop, ExactModelErrorFollowsEq6) {
   const Arm2DofParameters arm;
   for (const auto& cw : {Arm2DofCounterweights{}, Arm2DofCounterweights{7.4, 2.0, 0.2509, 0.1913}}) {
     Arm2DofDynamics plant(arm, cw), model(arm, cw);
-    KdlChainDynamics kdl(arm2dof_chain_model(arm, cw));
+    KdlChainDynamics kdl{MechanismModel(arm2dof_description(arm, cw))};
     for (InverseDynamics* back_end : {static_cast<InverseDynamics*>(&model),
                                       static_cast<InverseDynamics*>(&kdl)}) {
       ComputedTorque ctrl(*back_end, Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20));

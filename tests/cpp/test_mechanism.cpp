@@ -55,11 +55,10 @@ using test::rel;
 TEST(Mechanism, ChainMatchesKdl) {
   std::mt19937 rng(21);
   for (const char* types : {"RRRRRR", "RPRRPR", "R", "PP"}) {
-    const ChainModel chain = test::random_chain(rng, types);
-    const MechanismModel model(chain_description(chain));
+    const MechanismModel model(test::random_chain(rng, types));
     ASSERT_TRUE(model.is_serial_chain());
     MechanismData data(model);
-    KdlChainDynamics kdl(chain);
+    KdlChainDynamics kdl(model);
     const int n = model.dof();
     for (int k = 0; k < 5; ++k) {
       const Eigen::VectorXd q = test::random_vector(rng, n, 2.0), v = test::random_vector(rng, n, 1.0),

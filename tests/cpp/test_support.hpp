@@ -6,7 +6,7 @@
 
 #include "mechbal/model/model.hpp"
 #include "mechbal/model/rigid_body.hpp"
-#include "mechbal/model/serial_chain.hpp"
+#include <string>
 
 namespace mechbal::test {
 
@@ -30,21 +30,29 @@ inline Eigen::Isometry3d random_pose(std::mt19937& rng, double scale = 0.4) {
   return T;
 }
 
-/// A random chain; `types` pattern: 'R' revolute, 'P' prismatic.
-inline ChainModel random_chain(std::mt19937& rng, const char* types) {
-  std::vector<JointSpec> joints;
+/// A random serial chain in the general format, one body per link (kind "link", named after its
+/// joint); `types` pattern: 'R' revolute, 'P' prismatic. A random base pose is folded into the
+/// first joint's placement; gravity (0, 0, -9.81).
+inline MechanismDescription random_chain(std::mt19937& rng, const char* types) {
+  MechanismDescription d;
   std::uniform_real_distribution<double> u(-0.3, 0.3);
+  std::string parent = d.root_name;
   for (int i = 0; types[i]; ++i) {
-    JointSpec j;
+    Joint j;
     j.name = "j" + std::to_string(i + 1);
     j.type = types[i] == 'P' ? JointType::prismatic : JointType::revolute;
-    j.origin = random_pose(rng);
+    j.parent = parent;
+    j.placement = random_pose(rng);
     j.axis = Vec3(u(rng), u(rng), u(rng)).normalized();
-    j.link = random_body(rng);
-    j.com = Vec3(u(rng), u(rng), u(rng));
-    joints.push_back(j);
+    const RigidBody link = random_body(rng);
+    const Vec3 com(u(rng), u(rng), u(rng));
+    d.joints.push_back(j);
+    d.bodies.push_back(Body{j.name, "link", j.name, link.mass, com, link.inertia_body});
+    parent = j.name;
   }
-  return ChainModel(joints, Vec3(0.0, 0.0, -9.81), random_pose(rng, 0.2));
+  d.gravity = Vec3(0.0, 0.0, -9.81);
+  d.joints.front().placement = random_pose(rng, 0.2) * d.joints.front().placement;
+  return d;
 }
 
 inline Eigen::VectorXd random_vector(std::mt19937& rng, int n, double scale) {

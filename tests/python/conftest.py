@@ -27,11 +27,20 @@ def random_chain_specs(rng: np.random.Generator, types: str):
 
 
 def chain_from_specs(specs, gravity=(0.0, 0.0, -9.81), base=None):
-    joints = [mechbal.JointSpec(s["name"],
-                                mechbal.JointType.prismatic if s["prismatic"] else mechbal.JointType.revolute,
-                                s["origin"], s["axis"], s["mass"], s["com"], s["inertia"])
-              for s in specs]
-    return mechbal.ChainModel(joints, np.array(gravity), np.eye(4) if base is None else base)
+    """The serial chain of ``specs`` as a general :class:`mechbal.MechanismModel`: joint i's parent
+    is joint i - 1, one body per link (named after its joint), ``base`` (4x4) folded into the
+    first joint's placement."""
+    joints, bodies, parent = [], [], "base"
+    for k, s in enumerate(specs):
+        placement = np.asarray(s["origin"], float)
+        if k == 0 and base is not None:
+            placement = np.asarray(base, float) @ placement
+        kind = mechbal.JointType.prismatic if s["prismatic"] else mechbal.JointType.revolute
+        joints.append(mechbal.Joint(s["name"], kind, parent, placement, np.asarray(s["axis"], float)))
+        bodies.append(mechbal.Body(s["name"], s["name"], float(s["mass"]), np.asarray(s["com"], float),
+                                   np.asarray(s["inertia"], float)))
+        parent = s["name"]
+    return mechbal.MechanismModel(mechbal.MechanismDescription(joints, bodies, [], np.asarray(gravity, float)))
 
 
 @pytest.fixture(scope="session")

@@ -354,13 +354,3 @@ def test_closed_loop_on_a_closed_linkage_from_toml():
     # exact model, control law at every RK4 stage: the error follows eq 6
     expected = papers.pd_error_analytic(-0.02, 0.0, 100.0, 20.0, r.t)
     np.testing.assert_allclose(r.tracking_error[:, 0], expected, atol=1e-8)
-
-
-def test_run_chain_still_works():
-    from conftest import chain_from_specs, random_chain_specs
-
-    model = chain_from_specs(random_chain_specs(np.random.default_rng(2), "RR"))
-    motion = trajectory.quintic([0.0, 0.0], [0.5, -0.5], 1.0)
-    run = simulate.run_chain(model, motion, np.linspace(0, 1, 11))
-    assert run.torque.shape == (11, 2) and run.wrench["force"].shape == (11, 3)
-    assert run.shaking_force is not None and run.base_reaction_force is run.support_force

@@ -23,12 +23,13 @@ def random_arm(rng):
 
 
 def pin_model_of_chain(chain):
+    """Pinocchio model of a serial MechanismDescription with one body per joint, in joint order."""
     m = pin.Model()
     parent = 0
-    for j in chain.joints:
+    for j, b in zip(chain.joints, chain.bodies):
         jid = m.addJoint(parent, pin.JointModelRevoluteUnaligned(np.asarray(j.axis)),
-                         pin.SE3(j.origin[:3, :3], j.origin[:3, 3]), j.name)
-        m.appendBodyToJoint(jid, pin.Inertia(j.mass, np.asarray(j.com), np.asarray(j.inertia)),
+                         pin.SE3(j.placement[:3, :3], j.placement[:3, 3]), j.name)
+        m.appendBodyToJoint(jid, pin.Inertia(b.mass, np.asarray(b.com), np.asarray(b.inertia)),
                             pin.SE3.Identity())
         parent = jid
     m.gravity.linear = np.asarray(chain.gravity)
@@ -47,13 +48,13 @@ def test_closed_form_kdl_and_pinocchio_agree(seed):
     cw = _core.Arm2DofCounterweights(rng.uniform(0, 8), rng.uniform(0, 3), rng.uniform(-0.1, 0.4),
                                      rng.uniform(-0.1, 0.4))
     for c in (_core.Arm2DofCounterweights(), cw):
-        chain = _core.arm2dof_chain_model(arm, c)
+        chain = _core.arm2dof_description(arm, c)
         pm = pin_model_of_chain(chain)
         pd = pm.createData()
         N = 25
         q, qd, qdd = rng.uniform(-3, 3, (N, 2)), rng.uniform(-2, 2, (N, 2)), rng.uniform(-5, 5, (N, 2))
         t_cf = _core.Arm2DofDynamics(arm, c).inverse_dynamics(q, qd, qdd)["tau"]
-        t_kdl = _core.KdlChainDynamics(chain).inverse_dynamics(q, qd, qdd)["tau"]
+        t_kdl = _core.KdlChainDynamics(_core.MechanismModel(chain)).inverse_dynamics(q, qd, qdd)["tau"]
         t_pin = np.array([pin.rnea(pm, pd, q[k], qd[k], qdd[k]) for k in range(N)])
         scale = np.maximum(1.0, np.linalg.norm(t_pin, axis=1))
         assert np.max(np.linalg.norm(t_cf - t_pin, axis=1) / scale) < 1e-9
@@ -181,10 +182,11 @@ def test_cubic_with_three_real_roots_keeps_the_least_rms():
 
 
 def chain_mechanism(chain):
-    """The general model of a ChainModel (its base placement included)."""
+    """A serial chain's general model (its base placement folded into the first joint) as a
+    Mechanism."""
     import mechbal
 
-    return mechbal.Mechanism(_core.MechanismModel(_core.chain_description(chain)), name="chain")
+    return mechbal.Mechanism(chain, name="chain")
 
 
 def mean_square_torque(mech, slots, design, q, qd, qdd):
@@ -224,7 +226,7 @@ def test_rms_method_with_mass_budget_on_a_3_joint_chain():
 
 def test_rms_method_honours_the_chain_base_placement():
     """Issue 11: the old n-joint sizing ignored the chain's base transform. On the general model
-    (chain_description) a tilted base changes the gravity torques; the RMS method's torques before
+    (the base folded into the first joint) a tilted base changes the gravity torques; the RMS method's torques before
     and after are those of KDL on the same (tilted) chain, without and with the counterweight."""
     from conftest import chain_from_specs, random_chain_specs
     from mechbal.balance import CounterweightSlot

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mechbal import _core
-from mechbal import coupling as cp
+from mechbal.papers.discs import coupling as cp
 from mechbal.papers.discs.runner import parameters_from_config
 from mechbal.config import ConfigError, load_case
 from mechbal.papers import discs as dz
@@ -229,7 +229,7 @@ def test_unbalanced_arm_links_match_pinocchio_and_kdl(kind):
     d = dz.design(kind, params(kind), False)
     joints, links, discs = dz.serial_structure(kind, d)
     assert discs == []
-    chain = dz.chain_model(joints, links)
+    chain = dz.arm_mechanism(joints, links).model
     pm = pin.Model()
     parent = 0
     for j, b in zip(joints, links):

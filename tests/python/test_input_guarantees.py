@@ -65,7 +65,7 @@ def test_complex_string_bool_object_and_ragged_arrays_are_refused_naming_the_arg
         ct.step(z, z, z, z, np.array([object(), object()]))
     with pytest.raises(TypeError, match=r"qd_des must be .*not an array of numbers"):
         ct.step(z, z, z, [[1.0], [1.0, 2.0]], z)
-    rne = _core.RneChainDynamics(chain)
+    rne = _core.MechanismDynamics(chain)
     n = chain.dof
     with pytest.raises(TypeError, match=r"qdd must be .*complex"):
         rne.inverse_dynamics(np.zeros((1, n)), np.zeros((1, n)), np.zeros((1, n), complex))
@@ -185,10 +185,12 @@ def test_batch_functions_return_a_status_per_instant_and_never_ok_on_overflow(ch
     qdd = np.ones((3, n))
     expect = [flags(S.ok), flags(S.non_finite_input), flags(S.out_of_range)]
     outs = {
-        "RneChainDynamics.inverse_dynamics": _core.RneChainDynamics(chain).inverse_dynamics(q, qd, qdd),
+        "MechanismDynamics.inverse_dynamics (chain)": _core.MechanismDynamics(chain).inverse_dynamics(q, qd, qdd),
         "KdlChainDynamics.inverse_dynamics": _core.KdlChainDynamics(chain).inverse_dynamics(q, qd, qdd),
-        "chain_kinematics": _core.chain_kinematics(chain, q, qd, qdd),
     }
+    # the model's batch kinematics (every body's motion) reports its status per instant in `status`
+    kin = _core.mechanism_kinematics(chain, q, qd, qdd)
+    assert list(kin["status"]) == expect and all_finite(kin)
     arm = _core.Arm2DofDynamics(_core.Arm2DofParameters())
     q2, qd2 = _three_rows(2, np.array([0.3, -0.4]))
     outs["Arm2DofDynamics.inverse_dynamics"] = arm.inverse_dynamics(q2, qd2, np.ones((3, 2)))
@@ -242,13 +244,19 @@ def test_construction_refuses_what_would_give_infinite_or_zero_results(chain):
     # an axis of 1e300 is normalised (its norm overflowed to inf, and the axis to zero)
     specs = random_chain_specs(np.random.default_rng(11), "RR")
     big = [dict(s, axis=s["axis"] * 1e300) for s in specs]
-    tau_unit = _core.RneChainDynamics(chain_from_specs(specs)).inverse_dynamics(
+    tau_unit = _core.MechanismDynamics(chain_from_specs(specs)).inverse_dynamics(
         np.ones((1, 2)), np.ones((1, 2)), np.ones((1, 2)))
-    tau_big = _core.RneChainDynamics(chain_from_specs(big)).inverse_dynamics(
+    tau_big = _core.MechanismDynamics(chain_from_specs(big)).inverse_dynamics(
         np.ones((1, 2)), np.ones((1, 2)), np.ones((1, 2)))
     assert tau_big["status"] == S.ok and np.allclose(tau_big["tau"], tau_unit["tau"], rtol=1e-12)
-    with pytest.raises(ValueError, match=r"axis"):
-        chain_from_specs([dict(specs[0], axis=np.array([1e-300, 0.0, 0.0]))])
+    # the model scales an axis by its largest component before normalising: an axis of 1e-300 is
+    # the unit axis (no underflow to zero); a zero axis is refused, naming the field
+    tiny = [dict(s, axis=s["axis"] * 1e-300) for s in specs]
+    tau_tiny = _core.MechanismDynamics(chain_from_specs(tiny)).inverse_dynamics(
+        np.ones((1, 2)), np.ones((1, 2)), np.ones((1, 2)))
+    assert tau_tiny["status"] == S.ok and np.allclose(tau_tiny["tau"], tau_unit["tau"], rtol=1e-12)
+    with pytest.raises(ValueError, match=r"joints\[0\] \(j1\)\.axis"):
+        chain_from_specs([dict(specs[0], axis=np.zeros(3))])
     assert _core.status_name(S.out_of_range) == "out_of_range"
 
 
@@ -387,7 +395,7 @@ def test_property_paminsa_controller_tick(paminsa, dP, Pd, Pdd, rk4):
 def test_property_batch_inverse_dynamics(chain, rows):
     a = np.array(rows)
     q, qd, qdd = a[:, :4], a[:, 4:8], a[:, 8:]
-    for dyn in (_core.RneChainDynamics(chain), _core.KdlChainDynamics(chain)):
+    for dyn in (_core.MechanismDynamics(chain), _core.KdlChainDynamics(chain)):
         out = dyn.inverse_dynamics(q, qd, qdd)
         assert all_finite(out)
         per = out["status_per_instant"]

@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[2]
 INCLUDE = ROOT / "cpp" / "include" / "mechbal"
 SRC = ROOT / "cpp" / "src"
 
-#: bottom up; the top-level headers (status, version, the pre-model ones being removed) sit with
+#: bottom up; the top-level headers (status, version) sit with
 #: ``model``; ``mechbal.hpp`` includes everything and is checked by the install test instead
 LAYERS = ["model", "algorithm", "control", "io", "papers"]
 _INCLUDE = re.compile(r'#\s*include\s*[<"]mechbal/([^">]+)[">]')
@@ -29,7 +29,7 @@ def _layer_of_header(rel: str) -> int:
     head = rel.split("/", 1)[0] if "/" in rel else ""
     if head in LAYERS:
         return LAYERS.index(head)
-    return 0  # status.hpp, version.hpp, detail/, the top-level pre-model headers
+    return 0  # status.hpp, version.hpp, detail/
 
 
 def _files():

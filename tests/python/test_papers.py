@@ -1,7 +1,7 @@
 """The papers' mechanisms as data on the general model (mechbal.papers) against their closed forms,
 kept as fast paths: the 2-DOF arm (Arakelian, Le Baron & Mottu 2011) against Arm2DofDynamics and
 the disc arms (Coutinho & Hess Coelho) against the paper's two-stage coupling
-(mechbal.coupling), along each case's trajectory; and the papers' claims re-checked on the
+(mechbal.papers.discs.coupling), along each case's trajectory; and the papers' claims re-checked on the
 general model (balanced disc arms: mass matrix diagonal and constant, no gravity or velocity
 torque; statically balanced 2-DOF arm: no gravity torque)."""
 from functools import lru_cache
@@ -11,7 +11,7 @@ import pytest
 
 import mechbal
 from mechbal import _core
-from mechbal import coupling as cp
+from mechbal.papers.discs import coupling as cp
 from mechbal.papers.arm2dof.runner import arm_from_config
 from mechbal.papers.discs.runner import _disc_bodies, parameters_from_config
 from mechbal.config import load_case

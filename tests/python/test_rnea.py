@@ -1,4 +1,4 @@
-"""mechbal's own recursive Newton-Euler / CRBA (RneChainDynamics) against Pinocchio, an independent
+"""mechbal's own recursive Newton-Euler / CRBA (MechanismDynamics on serial chains) against Pinocchio, an independent
 engine, on random 3-, 6- and 7-joint chains (revolute and prismatic, arbitrary axes): torques, base
 support wrench, mass matrix, gravity, bias and Coriolis terms to 1e-9 relative."""
 import numpy as np
@@ -29,7 +29,7 @@ def test_rnea_matches_pinocchio(types, seed):
     model = chain_from_specs(specs, gravity, base)
     pm = pin_model(specs, gravity, base)
     pd = pm.createData()
-    rne = mechbal.RneChainDynamics(model)
+    rne = mechbal.MechanismDynamics(model)
     n = len(types)
     N = 15
     q, qd, qdd = (rng.uniform(-2, 2, (N, n)), rng.uniform(-1.5, 1.5, (N, n)),
@@ -55,7 +55,7 @@ def test_rnea_matches_pinocchio(types, seed):
 
 def test_rnea_bad_input_names_the_argument():
     rng = np.random.default_rng(3)
-    rne = mechbal.RneChainDynamics(chain_from_specs(random_chain_specs(rng, "RRR")))
+    rne = mechbal.MechanismDynamics(chain_from_specs(random_chain_specs(rng, "RRR")))
     with pytest.raises(ValueError, match="qd"):
         rne.inverse_dynamics(np.zeros((2, 3)), np.zeros((2, 4)), np.zeros((2, 3)))
     with pytest.raises(ValueError, match=r"q must have shape \(3,\).*got \(2,\)"):
@@ -75,7 +75,7 @@ def test_computed_torque_over_rne_agrees_with_kdl(types, seed):
     chain = chain_from_specs(random_chain_specs(rng, types))
     n = len(types)
     kp, kd = rng.uniform(50.0, 150.0, n), rng.uniform(10.0, 30.0, n)
-    rne, kdl = mechbal.RneChainDynamics(chain), mechbal.KdlChainDynamics(chain)
+    rne, kdl = mechbal.MechanismDynamics(chain), mechbal.KdlChainDynamics(chain)
     assert isinstance(rne, mechbal.InverseDynamics) and isinstance(kdl, mechbal.InverseDynamics)
     ct_rne = mechbal.ComputedTorque(rne, kp, kd)
     ct_kdl = mechbal.ComputedTorque(kdl, kp, kd)

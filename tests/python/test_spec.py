@@ -1,5 +1,5 @@
 """The general mechanism format -> MechanismSpec: trees, extra bodies, gear couplings, frames,
-spherical joints, DH frames; cross-reference errors; serial specs -> ChainModel."""
+spherical joints, DH frames; cross-reference errors; serial specs on the general model and KDL."""
 import copy
 import math
 
@@ -7,8 +7,13 @@ import numpy as np
 import pytest
 
 import mechbal
-from mechbal.config import ConfigError, chain_from_config, chain_model, load_case
+from mechbal.config import ConfigError, load_case
 from mechbal.spec import dh_origin, mechanism_spec, rotation_rpy, transform_xyz_rpy
+
+
+def chain_from_config(table):
+    """The general model of a ``[mechanism]`` table."""
+    return mechbal.Mechanism.from_spec(mechanism_spec(table, "mechanism"))
 
 INERTIA = [0.01, 0.02, 0.025]
 
@@ -79,8 +84,9 @@ def test_two_branch_tree_with_bodies_frames_and_a_gear():
     elbow = np.array([0.2 * c - 0.1 * s, 0.2 * s + 0.1 * c, 0.5])
     np.testing.assert_allclose(tool[:3, 3], elbow + 0.3 * np.array([math.cos(-0.1), math.sin(-0.1), 0]),
                                atol=1e-12)
-    with pytest.raises(ConfigError, match=r"branches from 'hip'.*serial chains"):
-        chain_model(spec)
+    # KDL (the independent engine) takes serial chains only and names the branch
+    with pytest.raises(ValueError, match=r"hangs from 'hip'.*tree with branches"):
+        mechbal.KdlChainDynamics(mechbal.Mechanism.from_spec(spec).model)
 
 
 def test_dh_carry_with_a_body_and_a_frame_on_the_dh_link():
@@ -117,11 +123,11 @@ def test_dh_carry_with_a_body_and_a_frame_on_the_dh_link():
                                atol=1e-12)
     flange = F["j2"] @ spec.frames[0].placement
     np.testing.assert_allclose(flange, A2 @ transform_xyz_rpy([0, 0, 0.01]), atol=1e-12)
-    # and the ChainModel built from it (KDL path) agrees
-    kin = mechbal.chain_kinematics(chain_from_config({"joints": [
+    # and the general model built from it agrees
+    kin = chain_from_config({"joints": [
         {"name": "j1", "dh": p1, "link": {"mass": 2.0, "com": com.tolist(), "inertia": inertia.tolist()}},
-        {"name": "j2", "dh": p2, "link": link()}]}), np.array([q]), np.zeros((1, 2)), np.zeros((1, 2)))
-    np.testing.assert_allclose(kin["com"][0, 0], A1[:3, :3] @ com + A1[:3, 3], atol=1e-12)
+        {"name": "j2", "dh": p2, "link": link()}]}).body_motion(np.array([q]), np.zeros((1, 2)), np.zeros((1, 2)))
+    np.testing.assert_allclose(kin.com[0, 0], A1[:3, :3] @ com + A1[:3, 3], atol=1e-12)
 
 
 def test_spherical_joint_expands_into_three_revolutes():
@@ -146,16 +152,21 @@ def test_spherical_joint_expands_into_three_revolutes():
     F = forward_kinematics(spec, [0.2, 0.3, -0.4, 0.5])
     R = F["arm"][:3, :3] @ rotation_rpy([0.5, -0.4, 0.3])  # Rz(a) Ry(b) Rx(c) = rpy (c, b, a)
     np.testing.assert_allclose(F["wrist_x"][:3, :3], R, atol=1e-12)
-    # a serial chain with a fixed joint: ChainModel folds the tool into the wrist's last link
-    model = chain_model(spec)
-    assert model.dof == 4
-    kin = mechbal.chain_kinematics(model, np.array([[0.2, 0.3, -0.4, 0.5]]), np.zeros((1, 4)), np.zeros((1, 4)))
+    # a serial chain with a fixed joint: the general model carries the tool on the wrist's last
+    # link; the bodies that move with wrist_x (wrist, tool, camera) have their centre of mass there
+    mech = mechbal.Mechanism.from_spec(spec)
+    assert mech.dof == 4
+    kin = mech.body_motion(np.array([[0.2, 0.3, -0.4, 0.5]]), np.zeros((1, 4)), np.zeros((1, 4)))
     Fx = F["wrist_x"]
     parts = [(1.0, Fx[:3, :3] @ [0.05, 0, 0] + Fx[:3, 3]), (0.2, (Fx @ transform_xyz_rpy([0.1, 0, 0]))[:3, 3]),
              (0.1, Fx[:3, 3])]
     com = sum(m * c for m, c in parts) / sum(m for m, _ in parts)
-    np.testing.assert_allclose(kin["com"][0, 3], com, atol=1e-12)
-    np.testing.assert_allclose(model.masses, [2.0, 0.0, 0.0, 1.3])
+    names = mech.body_names
+    on_wrist = [names.index(b) for b in ("wrist", "tool", "camera")]
+    masses = np.array([b.mass for b in mech.bodies])
+    np.testing.assert_allclose(masses[on_wrist] @ kin.com[0, on_wrist] / masses[on_wrist].sum(), com, atol=1e-12)
+    np.testing.assert_allclose(masses[on_wrist].sum(), 1.3)
+    np.testing.assert_allclose(masses[names.index("arm")], 2.0)
 
 
 def test_merged_bodies_give_the_same_dynamics_as_one_body():
@@ -174,7 +185,7 @@ def test_merged_bodies_give_the_same_dynamics_as_one_body():
     merged["joints"][0]["link"] = {"mass": m, "com": c.tolist(), "inertia": I.tolist()}
     q = np.array([[0.3, -0.5], [1.0, 0.2]])
     qd, qdd = np.ones_like(q), -np.ones_like(q)
-    tau = [mechbal.KdlChainDynamics(chain_from_config(x)).inverse_dynamics(q, qd, qdd)["tau"]
+    tau = [mechbal.KdlChainDynamics(chain_from_config(x).model).inverse_dynamics(q, qd, qdd)["tau"]
            for x in (extra, merged)]
     np.testing.assert_allclose(tau[0], tau[1], rtol=1e-12, atol=1e-12)
 

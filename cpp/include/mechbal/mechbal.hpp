@@ -24,13 +24,10 @@
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/algorithm/springs.hpp"
 #include "mechbal/control/mechanism_dynamics.hpp"
-/// Serial chains, trajectories, dynamics back ends
-#include "mechbal/model/serial_chain.hpp"
+/// Trajectories, dynamics back ends
 #include "mechbal/control/trajectory.hpp"
 #include "mechbal/control/dynamics.hpp"
-#include "mechbal/control/rnea.hpp"
 #include "mechbal/control/kdl_chain.hpp"
-#include "mechbal/algorithm/coupled_model.hpp"
 /// Controllers and closed-loop simulation
 #include "mechbal/control/joint_controller.hpp"
 #include "mechbal/control/computed_torque.hpp"
@@ -40,5 +37,6 @@
 #include "mechbal/control/closed_loop.hpp"
 /// Fast paths of the papers' mechanisms
 #include "mechbal/papers/arm2dof/arm2dof.hpp"
+#include "mechbal/papers/five_bar/coupled_projection.hpp"
 #include "mechbal/papers/five_bar/five_bar.hpp"
 #include "mechbal/papers/paminsa/paminsa.hpp"

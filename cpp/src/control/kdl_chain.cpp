@@ -17,8 +17,19 @@ namespace {
   throw std::invalid_argument("KdlChainDynamics: the model is not a serial chain: " + why);
 }
 
-// The general model as a ChainModel (joint k moves link k + 1), bodies lumped per link.
-ChainModel chain_of(const MechanismModel& model) {
+// One moving link of the chain as KDL sees it: the joint that moves it and its lumped inertia.
+struct ChainLink {
+  std::string name;
+  JointType type = JointType::revolute;
+  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< parent link frame -> joint frame
+  Vec3 axis = Vec3::UnitZ();
+  double mass = 0.0;
+  Vec3 com = Vec3::Zero();        ///< in the link frame
+  Mat3 inertia = Mat3::Zero();    ///< about the centre of mass, in the link frame
+};
+
+// The general model's links 1..n (joint k moves link k + 1), bodies lumped per link.
+std::vector<ChainLink> chain_of(const MechanismModel& model) {
   const int nl = model.num_links();
   if (nl < 2) not_a_chain("it has no joint");
   if (model.num_springs() > 0) not_a_chain("it has springs, which KDL does not model (use MechanismDynamics)");
@@ -42,7 +53,7 @@ ChainModel chain_of(const MechanismModel& model) {
     }
     not_a_chain("its coordinates are not one per joint in link order");
   }
-  std::vector<JointSpec> specs(static_cast<std::size_t>(nl - 1));
+  std::vector<ChainLink> links(static_cast<std::size_t>(nl - 1));
   std::vector<double> mass(static_cast<std::size_t>(nl), 0.0);
   std::vector<Vec3> first_moment(static_cast<std::size_t>(nl), Vec3::Zero());
   for (int b = 0; b < model.num_bodies(); ++b) {
@@ -51,26 +62,25 @@ ChainModel chain_of(const MechanismModel& model) {
     first_moment[l] += model.body(b).mass * model.body(b).com;
   }
   for (int l = 1; l < nl; ++l) {
-    JointSpec& s = specs[static_cast<std::size_t>(l - 1)];
+    ChainLink& s = links[static_cast<std::size_t>(l - 1)];
     s.name = model.link_name(l);
     s.type = model.joint_type(l);
     s.origin = model.placement(l);
     s.axis = model.axis(l);
     const auto k = static_cast<std::size_t>(l);
-    s.link.mass = mass[k];
+    s.mass = mass[k];
     s.com = mass[k] > 0.0 ? Vec3(first_moment[k] / mass[k]) : Vec3::Zero();
-    s.link.inertia_body.setZero();
   }
   for (int b = 0; b < model.num_bodies(); ++b) {
     const int l = model.body_link(b);
     if (l == 0) continue;
-    JointSpec& s = specs[static_cast<std::size_t>(l - 1)];
+    ChainLink& s = links[static_cast<std::size_t>(l - 1)];
     const Body& body = model.body(b);
     const Vec3 d = body.com - s.com;  // parallel axes to the lumped centre of mass
-    s.link.inertia_body += body.inertia + body.mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
+    s.inertia += body.inertia + body.mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
   }
-  for (JointSpec& s : specs) s.link.inertia_body = 0.5 * (s.link.inertia_body + s.link.inertia_body.transpose()).eval();
-  return ChainModel(std::move(specs), model.gravity());
+  for (ChainLink& s : links) s.inertia = 0.5 * (s.inertia + s.inertia.transpose()).eval();
+  return links;
 }
 
 KDL::Frame to_kdl(const Eigen::Isometry3d& T) {
@@ -82,19 +92,19 @@ KDL::Frame to_kdl(const Eigen::Isometry3d& T) {
 }
 
 // Link inertia given in F_i, re-expressed in the KDL segment's tip frame T_tip (relative to F_i).
-KDL::RigidBodyInertia to_kdl_inertia(const JointSpec& j, const Eigen::Isometry3d& F_to_tip) {
-  const Mat3& I = j.link.inertia_body;
+KDL::RigidBodyInertia to_kdl_inertia(const ChainLink& j, const Eigen::Isometry3d& F_to_tip) {
+  const Mat3& I = j.inertia;
   const KDL::RigidBodyInertia in_F(
-      j.link.mass, KDL::Vector(j.com.x(), j.com.y(), j.com.z()),
+      j.mass, KDL::Vector(j.com.x(), j.com.y(), j.com.z()),
       KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
   return to_kdl(F_to_tip) * in_F;
 }
 
 // Builds the KDL chain; with `virtual_base` six motionless joints come first.
-KDL::Chain build_chain(const ChainModel& model, bool virtual_base) {
+KDL::Chain build_chain(const std::vector<ChainLink>& links, bool virtual_base) {
   KDL::Chain chain;
-  const std::size_t n = model.joints().size();
-  KDL::Frame first_tip = to_kdl(model.base() * model.joints()[0].origin);
+  const std::size_t n = links.size();
+  KDL::Frame first_tip = to_kdl(links[0].origin);
   if (virtual_base) {
     const KDL::Joint::JointType types[6] = {KDL::Joint::TransX, KDL::Joint::TransY,
                                             KDL::Joint::TransZ, KDL::Joint::RotX,
@@ -107,9 +117,9 @@ KDL::Chain build_chain(const ChainModel& model, bool virtual_base) {
     chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::Fixed), first_tip));
   }
   for (std::size_t i = 0; i < n; ++i) {
-    const JointSpec& j = model.joints()[i];
+    const ChainLink& j = links[i];
     const Eigen::Isometry3d next =
-        i + 1 < n ? model.joints()[i + 1].origin : Eigen::Isometry3d::Identity();
+        i + 1 < n ? links[i + 1].origin : Eigen::Isometry3d::Identity();
     const KDL::Vector axis(j.axis.x(), j.axis.y(), j.axis.z());
     const KDL::Joint joint(j.name, KDL::Vector::Zero(), axis,
                            j.type == JointType::revolute ? KDL::Joint::RotAxis
@@ -122,10 +132,10 @@ KDL::Chain build_chain(const ChainModel& model, bool virtual_base) {
 }  // namespace
 
 struct KdlChainDynamics::Impl {
-  Impl(const ChainModel& model)
-      : full(build_chain(model, true)),
-        plain(build_chain(model, false)),
-        grav(model.gravity().x(), model.gravity().y(), model.gravity().z()),
+  Impl(const std::vector<ChainLink>& links, const Vec3& gravity)
+      : full(build_chain(links, true)),
+        plain(build_chain(links, false)),
+        grav(gravity.x(), gravity.y(), gravity.z()),
         rne(full, grav),
         dyn(plain, grav),
         q_full(full.getNrOfJoints()),
@@ -147,10 +157,8 @@ struct KdlChainDynamics::Impl {
   KDL::JntSpaceInertiaMatrix M;
 };
 
-KdlChainDynamics::KdlChainDynamics(const ChainModel& model)
-    : impl_(std::make_unique<Impl>(model)), dof_(model.dof()) {}
-
-KdlChainDynamics::KdlChainDynamics(const MechanismModel& model) : KdlChainDynamics(chain_of(model)) {}
+KdlChainDynamics::KdlChainDynamics(const MechanismModel& model)
+    : impl_(std::make_unique<Impl>(chain_of(model), model.gravity())), dof_(model.dof()) {}
 
 KdlChainDynamics::~KdlChainDynamics() = default;
 

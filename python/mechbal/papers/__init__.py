@@ -21,9 +21,8 @@ paper and nothing else (tests/python/test_layers.py checks it).
 
 A paper's closed-form classes (``PaminsaModel``, ``Arm2DofDynamics``, ``FiveBarDynamics``, ...)
 are attributes of its package; ``mechbal.papers.<Name>`` finds them in whichever paper has them.
-The serial-chain evaluator of the first case runners (:class:`ChainModel`, :class:`JointSpec`,
-:func:`chain_kinematics`, :func:`shaking_wrench`) is here until the general model replaces its
-last users.
+:func:`shaking_wrench` (the shaking wrench of a set of bodies given their motion, batched) is
+here for the runners that write the bodies of a closed-form motion (the discs' five-bar).
 
 Layer: papers (docs/architecture.md).
 """
@@ -33,12 +32,9 @@ from typing import Any
 
 from mechbal import _core
 
-ChainModel = _core.ChainModel
-JointSpec = _core.JointSpec
-chain_kinematics = _core.chain_kinematics
 shaking_wrench = _core.shaking_wrench
 
-__all__ = ["ChainModel", "JointSpec", "chain_kinematics", "shaking_wrench"]
+__all__ = ["shaking_wrench"]
 
 
 def __getattr__(name: str) -> Any:

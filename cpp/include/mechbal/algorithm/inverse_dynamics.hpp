@@ -1,7 +1,7 @@
 #pragma once
 /// \file algorithm/inverse_dynamics.hpp
 /// Inverse dynamics of the tree by the recursive Newton-Euler algorithm (Luh, Walker & Paul 1980;
-/// Featherstone 2008, alg. 5.1 on 3-vectors, joint-aligned frames as in rnea.hpp), with gear
+/// Featherstone 2008, alg. 5.1 on 3-vectors, joint-aligned frames as in detail/tree.hpp), with gear
 /// couplings projected: tau = G^T tau_joint, where joint positions are G q + offset.
 #include <Eigen/Core>
 

@@ -8,21 +8,20 @@
 /// rotations about x, y, z): their generalised forces are exactly the support force and the support
 /// moment about O that the base exerts on the chain (gravity included).
 ///
-/// Built from a ChainModel, or from the general MechanismModel when that is a serial chain
-/// (`model.is_serial_chain()`): KDL is then an independent engine beside MechanismDynamics on the
-/// same description, and its check (tests/cpp/test_kdl_general.cpp).
+/// Built from the general MechanismModel when that is a serial chain (`model.is_serial_chain()`):
+/// KDL is then an independent engine beside MechanismDynamics on the same description, and its
+/// check (tests/cpp/test_kdl_general.cpp).
 #include <Eigen/Core>
 #include <memory>
 
 #include "mechbal/control/dynamics.hpp"
-#include "mechbal/model/serial_chain.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {
 
 class KdlChainDynamics final : public InverseDynamics {
  public:
-  explicit KdlChainDynamics(const ChainModel& model);
   /// From the general model when it is a serial chain: joint k moves link k + 1 whose parent is
   /// link k, every joint revolute or prismatic with its own coordinate (no fixed joint, no gear
   /// coupling). The bodies on each link are lumped into one rigid body (same mass, first moment

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace mechbal {
@@ -76,35 +77,36 @@ Arm2DofLumped arm2dof_lumped(const Arm2DofParameters& arm, const Arm2DofCounterw
 namespace {
 
 // A link and an optional point mass on its local x axis, merged into one rigid body.
-JointSpec planar_link(const char* name, const Eigen::Isometry3d& origin, double mass, double l_com,
-                      double inertia_com, double m_cw, double r_cw) {
-  JointSpec j;
+void planar_link(MechanismDescription& d, const char* name, const std::string& parent,
+                 const Eigen::Isometry3d& origin, double mass, double l_com, double inertia_com,
+                 double m_cw, double r_cw) {
+  Joint j;
   j.name = name;
   j.type = JointType::revolute;
-  j.origin = origin;
+  j.parent = parent;
+  j.placement = origin;
   j.axis = Vec3(0.0, -1.0, 0.0);  // positive rotation lifts +x towards +z
   const double M = mass + m_cw;
   const double x = (mass * l_com - m_cw * r_cw) / M;
   // slender-rod tensor diag(0, I, I) about the link's own centre of mass, then parallel axes
   const double d_link = l_com - x, d_cw = -r_cw - x;
   const double I = inertia_com + mass * d_link * d_link + m_cw * d_cw * d_cw;
-  j.link.mass = M;
-  j.link.inertia_body = Vec3(0.0, I, I).asDiagonal();
-  j.com = Vec3(x, 0.0, 0.0);
-  return j;
+  d.joints.push_back(j);
+  d.bodies.push_back(Body{name, "link", name, M, Vec3(x, 0.0, 0.0), Vec3(0.0, I, I).asDiagonal()});
 }
 
 }  // namespace
 
-ChainModel arm2dof_chain_model(const Arm2DofParameters& arm, const Arm2DofCounterweights& cw) {
+MechanismDescription arm2dof_description(const Arm2DofParameters& arm, const Arm2DofCounterweights& cw) {
   arm2dof_lumped(arm, cw);  // validates
   Eigen::Isometry3d elbow = Eigen::Isometry3d::Identity();
   elbow.translation() = Vec3(arm.l1, 0.0, 0.0);
-  std::vector<JointSpec> joints;
-  joints.push_back(planar_link("shoulder", Eigen::Isometry3d::Identity(), arm.m1, arm.l_s1,
-                               arm.i_s1, cw.m_cw1, cw.r_cw1));
-  joints.push_back(planar_link("elbow", elbow, arm.m2, arm.l_s2, arm.i_s2, cw.m_cw2, cw.r_cw2));
-  return ChainModel(std::move(joints), Vec3(0.0, 0.0, -arm.g));
+  MechanismDescription d;
+  d.gravity = Vec3(0.0, 0.0, -arm.g);
+  planar_link(d, "shoulder", d.root_name, Eigen::Isometry3d::Identity(), arm.m1, arm.l_s1, arm.i_s1,
+              cw.m_cw1, cw.r_cw1);
+  planar_link(d, "elbow", "shoulder", elbow, arm.m2, arm.l_s2, arm.i_s2, cw.m_cw2, cw.r_cw2);
+  return d;
 }
 
 Arm2DofDynamics::Arm2DofDynamics(const Arm2DofParameters& arm, const Arm2DofCounterweights& cw)

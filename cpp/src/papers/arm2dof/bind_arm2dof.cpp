@@ -122,10 +122,10 @@ void bind_arm2dof(py::module_& m) {
       .def_readwrite("r_cw1", &Arm2DofCounterweights::r_cw1)
       .def_readwrite("r_cw2", &Arm2DofCounterweights::r_cw2);
 
-  m.def("arm2dof_chain_model", &arm2dof_chain_model, py::arg("arm"),
+  m.def("arm2dof_description", &arm2dof_description, py::arg("arm"),
         py::arg_v("counterweights", Arm2DofCounterweights{}, "Arm2DofCounterweights()"),
-        "The 2-DOF arm (counterweights merged into the links) as a ChainModel: x-z plane, joint "
-        "axes along -y, gravity (0, 0, -g)");
+        "The 2-DOF arm (counterweights merged into the links) as a general MechanismDescription: "
+        "x-z plane, joints 'shoulder' and 'elbow' with axes along -y, gravity (0, 0, -g)");
 
   py::class_<Arm2DofDynamics, InverseDynamics, ForwardDynamics>(m, "Arm2DofDynamics",
                               "Closed-form dynamics of the 2-DOF arm, eqs 14-31 (corrected)")
@@ -202,7 +202,7 @@ void bind_arm2dof(py::module_& m) {
            py::arg("kd"), py::arg("torque_limit") = py::none(), MECHBAL_JOINT_RANGE_ARGS,
            py::keep_alive<1, 2>(),
            "model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, "
-           "RneChainDynamics). torque_limit: one value per joint (default and +inf: "
+           "MechanismDynamics). torque_limit: one value per joint (default and +inf: "
            "mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the "
            "input range of a tick (beyond it: the held command and Status.out_of_range)")
       .def_property_readonly("torque_limit", &ComputedTorque::torque_limit)

@@ -68,7 +68,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from mechbal import _core
-from mechbal import coupling as cp
+from mechbal.papers.discs import coupling as cp
 from mechbal.mechanism import Mechanism
 
 # the closed forms of the C++ core (cpp/src/papers/five_bar/): fast paths of the general model
@@ -318,7 +318,7 @@ def _J(d, i):
 
 
 def serial_structure(kind: str, d: dict):
-    """(joints, links, discs) of a serial mechanism (mechbal.coupling types)."""
+    """(joints, links, discs) of a serial mechanism (mechbal.papers.discs.coupling types)."""
     y = lambda L: np.array([0.0, L, 0.0])  # noqa: E731
     if kind == "planar3r":
         joints = [cp.Joint("R", EX, y(0)), cp.Joint("R", EX, y(d["l1"])), cp.Joint("R", EX, y(d["l2"]))]
@@ -342,15 +342,20 @@ def serial_structure(kind: str, d: dict):
     return joints, links, (discs if d.get("discs", True) else [])
 
 
-def chain_model(joints, links):
-    """The arm links as a mechbal ChainModel (for KDL and Pinocchio)."""
-    specs = []
+def arm_mechanism(joints, links) -> Mechanism:
+    """The arm links alone (no discs) on the general model: joint i + 1 ``joint<i+1>`` carries body
+    ``link<i+1>``, one after the other (for the bodies' motion, KDL and Pinocchio)."""
+    jts, bodies, parent = [], [], "base"
     for i, (j, b) in enumerate(zip(joints, links)):
         T = np.eye(4)
         T[:3, 3] = j.offset
         jt = _core.JointType.revolute if j.type == "R" else _core.JointType.prismatic
-        specs.append(_core.JointSpec(f"joint{i + 1}", jt, T, j.axis, b.mass, b.com, b.inertia))
-    return _core.ChainModel(specs)
+        name = f"joint{i + 1}"
+        jts.append(_core.Joint(name, jt, parent, T, np.asarray(j.axis, float)))
+        bodies.append(_core.Body(f"link{i + 1}", name, float(b.mass), np.asarray(b.com, float),
+                                 np.asarray(b.inertia, float)))
+        parent = name
+    return Mechanism.from_description(jts, bodies, name="arm")
 
 
 def disc_mechanism(kind: str, d: dict):

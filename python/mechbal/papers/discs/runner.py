@@ -195,7 +195,8 @@ def _disc_bodies(kind, d, q, qd, qdd):
     """Every body of a design along (q, qd, qdd) (N, n): names, mass (B,), inertia_body (B,3,3)
     and the motion arrays (N, B, ...) of mechbal.shaking_wrench.
 
-    Serial arms: the links from mechbal.chain_kinematics; each disc spins at ratio * q[joint]
+    Serial arms: the links from the general model's body motion (the arm alone,
+    :func:`mechbal.papers.discs.arm_mechanism`); each disc spins at ratio * q[joint]
     about its axis through the carrier's frame origin (rotation R_c Rot(axis, ratio q_j),
     omega = omega_c + ratio q_j' a, alpha = alpha_c + ratio q_j'' a + omega_c x ratio q_j' a).
     As in the model, a disc's mass is lumped into its carrier link (the link masses of the case
@@ -257,9 +258,13 @@ def _disc_bodies(kind, d, q, qd, qdd):
                     angular_acceleration=stack(alp))
 
     joints, links, discs = dz.serial_structure(kind, d)
-    kin = papers.chain_kinematics(dz.chain_model(joints, links), q, qd, qdd)
-    if kin["status"] != control.Status.ok:
-        raise RuntimeError(f"chain kinematics failed: {kin['status']}")
+    m = dz.arm_mechanism(joints, links).body_motion(q, qd, qdd)
+    if np.any(np.asarray(m.status) != 0):
+        raise RuntimeError(f"arm kinematics failed: {np.asarray(m.status).max()}")
+    # link c's frame is the model's link c + 1 (link 0 is the base)
+    kin = dict(com=m.com, com_velocity=m.com_velocity, com_acceleration=m.com_acceleration,
+               rotation=m.rotation, angular_velocity=m.angular_velocity,
+               angular_acceleration=m.angular_acceleration)
     names = [f"link{i + 1}" for i in range(len(links))]
     mass = [b.mass for b in links]
     inertia = [np.asarray(b.inertia, float) for b in links]
@@ -268,7 +273,7 @@ def _disc_bodies(kind, d, q, qd, qdd):
                      "angular_acceleration")}
     for k, ds in enumerate(discs):
         c = ds.carrier
-        Rc, o = kin["frames"][:, c, :3, :3], kin["frames"][:, c, :3, 3]
+        Rc, o = m.link_rotation[:, c + 1], m.link_position[:, c + 1]
         axis = np.asarray(ds.axis, float) / np.linalg.norm(ds.axis)
         a = Rc @ axis
         ang = ds.ratio * q[:, ds.joint]

@@ -32,7 +32,7 @@
 #include <Eigen/Core>
 
 #include "mechbal/control/dynamics.hpp"
-#include "mechbal/model/serial_chain.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {
@@ -76,12 +76,14 @@ struct Arm2DofLumped {
 Arm2DofLumped arm2dof_lumped(const Arm2DofParameters& arm,
                              const Arm2DofCounterweights& cw = Arm2DofCounterweights{});
 
-/// The same arm (and counterweights, merged into the link bodies) as a ChainModel for KDL:
-/// joint 1 at the origin, joint 2 at (l1, 0, 0) of link frame 1, both axes along -y, link
-/// centres of mass on the local +x axis, counterweights at (-r, 0, 0), gravity (0, 0, -g).
-/// Link inertias are slender-rod-like tensors diag(0, I, I) about the centre of mass.
-ChainModel arm2dof_chain_model(const Arm2DofParameters& arm,
-                               const Arm2DofCounterweights& cw = Arm2DofCounterweights{});
+/// The same arm (and counterweights, merged into the link bodies) as a general serial
+/// MechanismDescription (for MechanismDynamics and KDL): joint 1 "shoulder" at the origin, joint 2
+/// "elbow" at (l1, 0, 0) of link frame 1, both axes along -y, one body per link (kind "link",
+/// named after its joint) with its centre of mass on the local +x axis, counterweights at
+/// (-r, 0, 0), gravity (0, 0, -g). Link inertias are slender-rod-like tensors diag(0, I, I) about
+/// the centre of mass.
+MechanismDescription arm2dof_description(const Arm2DofParameters& arm,
+                                         const Arm2DofCounterweights& cw = Arm2DofCounterweights{});
 
 
 /// Closed-form 2-DOF dynamics, eq 1: tau = A(q) qdd + C(q, qd) qd + Q(q) (eqs 14-31 corrected).

@@ -22,7 +22,7 @@
 /// b_1 + b_2] (cannot be assembled) is also Status::singular.
 #include <Eigen/Core>
 
-#include "mechbal/algorithm/coupled_model.hpp"
+#include "mechbal/papers/five_bar/coupled_projection.hpp"
 #include "mechbal/control/dynamics.hpp"
 #include "mechbal/status.hpp"
 

@@ -1,12 +1,16 @@
-// Serial chains: own closed-form kinematics against finite differences; KDL's joint torques and
-// base wrench against the rigid-body (momentum) computation on the same motion.
+// Serial chains on the general model: forward kinematics (every body's motion) against finite
+// differences; KDL's joint torques and base wrench against the momentum balance of the bodies'
+// motion from the model on the same motion.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
 #include <limits>
 
 #include "mechbal/control/kdl_chain.hpp"
-#include "mechbal/model/serial_chain.hpp"
+#include "mechbal/algorithm/kinematics.hpp"
+#include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
 #include "test_support.hpp"
 
 using namespace mechbal;
@@ -31,20 +35,21 @@ class ChainTest : public ::testing::TestWithParam<ChainCase> {};
 
 TEST_P(ChainTest, KinematicsMatchFiniteDifferences) {
   std::mt19937 rng(GetParam().seed);
-  const ChainModel model = test::random_chain(rng, GetParam().types);
+  const MechanismModel model(test::random_chain(rng, GetParam().types));
   const int n = model.dof();
-  ChainWorkspace ws(model), wp(model), wm(model);
+  MechanismData ws(model), wp(model), wm(model);
   const VectorXd q0 = test::random_vector(rng, n, 1.5), qd = test::random_vector(rng, n, 1.0),
                  qdd = test::random_vector(rng, n, 2.0);
   // q(t) = q0 + qd t + qdd t^2 / 2 around t = 0
   const double h = 1e-5;
   auto q_at = [&](double t) { VectorXd q = q0 + qd * t + 0.5 * qdd * t * t; return q; };
   auto qd_at = [&](double t) { VectorXd v = qd + qdd * t; return v; };
-  ASSERT_EQ(chain_kinematics(model, q0, qd, qdd, ws), Status::ok);
-  ASSERT_EQ(chain_kinematics(model, q_at(h), qd_at(h), qdd, wp), Status::ok);
-  ASSERT_EQ(chain_kinematics(model, q_at(-h), qd_at(-h), qdd, wm), Status::ok);
+  ASSERT_EQ(forward_kinematics(model, ws, q0, qd, qdd), Status::ok);
+  ASSERT_EQ(forward_kinematics(model, wp, q_at(h), qd_at(h), qdd), Status::ok);
+  ASSERT_EQ(forward_kinematics(model, wm, q_at(-h), qd_at(-h), qdd), Status::ok);
+  ASSERT_EQ(model.num_bodies(), n);  // one body per link, in joint order
   for (int i = 0; i < n; ++i) {
-    const BodyState &s = ws.states[i], &sp = wp.states[i], &sm = wm.states[i];
+    const BodyState &s = ws.body_states[i], &sp = wp.body_states[i], &sm = wm.body_states[i];
     EXPECT_LT(((sp.com - sm.com) / (2 * h) - s.com_velocity).norm(), 1e-8) << "link " << i;
     EXPECT_LT(((sp.com_velocity - sm.com_velocity) / (2 * h) - s.com_acceleration).norm(), 1e-7)
         << "link " << i;
@@ -61,24 +66,21 @@ TEST_P(ChainTest, KinematicsMatchFiniteDifferences) {
 
 TEST_P(ChainTest, KdlTorquesAndBaseWrenchMatchMomentumBalance) {
   std::mt19937 rng(GetParam().seed + 100);
-  const ChainModel model = test::random_chain(rng, GetParam().types);
+  const MechanismModel model(test::random_chain(rng, GetParam().types));
   const int n = model.dof();
   KdlChainDynamics kdl(model);
-  ChainWorkspace ws(model);
+  MechanismData ws(model);
   for (int trial = 0; trial < 10; ++trial) {
     const VectorXd q = test::random_vector(rng, n, 2.0), qd = test::random_vector(rng, n, 1.5),
                    qdd = test::random_vector(rng, n, 3.0);
     VectorXd tau(n);
     Vec3 F, M;
     ASSERT_EQ(kdl.inverse_dynamics(q, qd, qdd, tau, &F, &M), Status::ok);
-    ASSERT_EQ(chain_kinematics(model, q, qd, qdd, ws), Status::ok);
+    ASSERT_EQ(forward_kinematics(model, ws, q, qd, qdd), Status::ok);
 
     // Base wrench: support = dP/dt - m g, dH_O/dt - sum c x m g over all links.
-    ShakingWrench sw;
-    ASSERT_EQ(shaking_wrench(model.bodies().data(), ws.states.data(), n, sw), Status::ok);
-    BaseReaction br;
-    ASSERT_EQ(base_reaction(model.bodies().data(), ws.states.data(), n, model.gravity(), sw, br),
-              Status::ok);
+    ASSERT_EQ(base_reaction(model, ws, q, qd, qdd), Status::ok);
+    const BaseReaction br = ws.base_reaction;
     const double fs = 1.0 + br.force.norm(), ms = 1.0 + br.moment.norm();
     EXPECT_LT((F - br.force).norm() / fs, 1e-9);
     EXPECT_LT((M - br.moment).norm() / ms, 1e-9);
@@ -86,22 +88,20 @@ TEST_P(ChainTest, KdlTorquesAndBaseWrenchMatchMomentumBalance) {
     // Joint i carries the subtree i..n: tau_i = axis . (moment about the joint of the subtree's
     // momentum rate minus gravity) for revolute joints, axis . force for prismatic ones.
     for (int i = 0; i < n; ++i) {
-      const JointSpec& j = model.joints()[i];
-      const Eigen::Isometry3d Fprev = i == 0 ? model.base() : ws.frames[i - 1];
-      const Eigen::Isometry3d P = Fprev * j.origin;
-      const Vec3 z = P.linear() * j.axis;
-      const Vec3 p = ws.frames[i].translation();
+      // joint i moves link i + 1; its axis is fixed in that link's frame (F_i)
+      const Vec3 z = ws.link_rotation[i + 1] * model.axis(i + 1);
+      const Vec3 p = ws.link_position[i + 1];
       Vec3 force = Vec3::Zero(), moment = Vec3::Zero();
       for (int k = i; k < n; ++k) {
-        const BodyState& s = ws.states[k];
-        const RigidBody& b = model.bodies()[k];
-        const Mat3 I = s.rotation * b.inertia_body * s.rotation.transpose();
+        const BodyState& s = ws.body_states[k];
+        const Body& b = model.body(k);
+        const Mat3 I = s.rotation * b.inertia * s.rotation.transpose();
         const Vec3 f = b.mass * (s.com_acceleration - model.gravity());
         force += f;
         moment += (s.com - p).cross(f) + I * s.angular_acceleration +
                   s.angular_velocity.cross(I * s.angular_velocity);
       }
-      const double expected = j.type == JointType::revolute ? z.dot(moment) : z.dot(force);
+      const double expected = model.joint_type(i + 1) == JointType::revolute ? z.dot(moment) : z.dot(force);
       EXPECT_NEAR(tau(i), expected, 1e-9 * (1.0 + std::abs(expected))) << "joint " << i;
     }
 
@@ -126,38 +126,43 @@ INSTANTIATE_TEST_SUITE_P(RandomChains, ChainTest,
                          });
 
 TEST(ChainModel, BadInputNamesTheJointAndField) {
-  std::vector<JointSpec> joints(2);
-  joints[0].name = "shoulder";
-  joints[0].link.mass = 1.0;
-  joints[0].link.inertia_body = Mat3::Identity() * 0.01;
-  joints[1] = joints[0];
-  joints[1].name = "elbow";
-  joints[1].axis = Vec3::Zero();
+  MechanismDescription d;
+  Joint j;
+  j.name = "shoulder";
+  j.parent = d.root_name;
+  d.joints.push_back(j);
+  j.name = "elbow";
+  j.parent = "shoulder";
+  j.axis = Vec3::Zero();
+  d.joints.push_back(j);
+  for (const char* link : {"shoulder", "elbow"}) {
+    d.bodies.push_back(Body{link, "link", link, 1.0, Vec3::Zero(), Mat3::Identity() * 0.01});
+  }
   try {
-    ChainModel m(joints);
+    MechanismModel m(d);
     FAIL() << "zero axis accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("joints[1] (elbow).axis"), std::string::npos) << e.what();
   }
-  joints[1].axis = Vec3::UnitZ();
-  joints[1].link.mass = std::numeric_limits<double>::quiet_NaN();
+  d.joints[1].axis = Vec3::UnitZ();
+  d.bodies[1].mass = std::numeric_limits<double>::quiet_NaN();
   try {
-    ChainModel m(joints);
+    MechanismModel m(d);
     FAIL() << "NaN mass accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("joints[1] (elbow).link.mass"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("bodies[1] (elbow).mass"), std::string::npos)
         << e.what();
   }
 }
 
 TEST(ChainKinematics, BadSizeAndNonFiniteGiveStatus) {
   std::mt19937 rng(3);
-  const ChainModel model = test::random_chain(rng, "RR");
-  ChainWorkspace ws(model);
+  const MechanismModel model(test::random_chain(rng, "RR"));
+  MechanismData ws(model);
   VectorXd q = VectorXd::Zero(3), ok = VectorXd::Zero(2);
-  EXPECT_EQ(chain_kinematics(model, q, ok, ok, ws), Status::bad_size);
+  EXPECT_EQ(forward_kinematics(model, ws, q, ok, ok), Status::bad_size);
   ok(0) = std::numeric_limits<double>::infinity();
-  EXPECT_EQ(chain_kinematics(model, ok, VectorXd::Zero(2), VectorXd::Zero(2), ws),
+  EXPECT_EQ(forward_kinematics(model, ws, ok, VectorXd::Zero(2), VectorXd::Zero(2)),
             Status::non_finite_input);
   KdlChainDynamics kdl(model);
   VectorXd tau(2);

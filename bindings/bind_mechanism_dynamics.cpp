@@ -1,11 +1,14 @@
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 
+#include <memory>
+#include <stdexcept>
+
 #include "array_checks.hpp"
 #include "batch_inverse_dynamics.hpp"
 #include "bindings.hpp"
 #include "mechbal/control/kdl_chain.hpp"
-#include "mechbal/control/rnea.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
 
 namespace py = pybind11;
 
@@ -17,19 +20,7 @@ Eigen::VectorXd one_state(const MechanismDynamics& d, const Array& v, const char
   return vector_arg(v, name, d.dof(), false, "one value per joint");
 }
 
-void bind_rnea(py::module_& m) {
-  // KdlChainDynamics is bound in bind_chain.cpp (20); its general-model constructor is added here.
-  auto kdl = py::reinterpret_borrow<py::class_<KdlChainDynamics, InverseDynamics>>(m.attr("KdlChainDynamics"));
-  kdl.def(py::init([](const MechanismModel& model) {
-             try {
-               return std::make_unique<KdlChainDynamics>(model);
-             } catch (const std::invalid_argument& e) {
-               throw py::value_error(e.what());
-             }
-           }),
-           py::arg("model"),
-           "From the general MechanismModel when it is a serial chain (bodies lumped per link); "
-           "ValueError naming the link or joint otherwise");
+void bind_mechanism_dynamics(py::module_& m) {
   py::class_<MechanismDynamics, InverseDynamics, ForwardDynamics>(
       m, "MechanismDynamics",
       "Joint-space dynamics of a MechanismModel (recursive Newton-Euler inverse dynamics with the "
@@ -114,15 +105,61 @@ void bind_rnea(py::module_& m) {
           },
           py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques C(q, qd) qd");
 
-  py::class_<RneChainDynamics, MechanismDynamics>(
-      m, "RneChainDynamics",
-      "MechanismDynamics of a serial ChainModel (the chain as a general mechanism)")
-      .def(py::init<const ChainModel&>(), py::arg("model"));
+  py::class_<KdlChainDynamics, InverseDynamics>(
+      m, "KdlChainDynamics",
+      "Joint-space dynamics of a serial MechanismModel through Orocos KDL (the independent engine)")
+      .def(py::init([](const MechanismModel& model) {
+             try {
+               return std::make_unique<KdlChainDynamics>(model);
+             } catch (const std::invalid_argument& e) {
+               throw py::value_error(e.what());
+             }
+           }),
+           py::arg("model"),
+           "From the general MechanismModel when it is a serial chain (bodies lumped per link); "
+           "ValueError naming the link or joint otherwise")
+      .def_property_readonly("dof", &KdlChainDynamics::dof)
+      .def(
+          "inverse_dynamics",
+          [](KdlChainDynamics& d, const Array& q, const Array& qd, const Array& qdd) {
+            return batch_inverse_dynamics(d, q, qd, qdd);
+          },
+          py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          "Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, "
+          "support_moment about the base origin, (N, 3)) by KDL's ChainIdSolver_RNE.")
+      .def(
+          "mass_matrix",
+          [](KdlChainDynamics& d, const Array& q) {
+            const Eigen::VectorXd q_ = vector_arg(q, "q", d.dof(), false, "one value per joint");
+            Eigen::MatrixXd M = Eigen::MatrixXd::Zero(d.dof(), d.dof());
+            raise_unless_ok(d.mass_matrix(q_, M), "KdlChainDynamics.mass_matrix");
+            return M;
+          },
+          py::arg("q"), "Mass matrix M(q) (dof, dof); ValueError for non-finite or overflowing q")
+      .def(
+          "coriolis",
+          [](KdlChainDynamics& d, const Array& q, const Array& qd) {
+            const Eigen::VectorXd q_ = vector_arg(q, "q", d.dof(), false, "one value per joint");
+            const Eigen::VectorXd qd_ = vector_arg(qd, "qd", d.dof(), false, "one value per joint");
+            Eigen::VectorXd c = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.coriolis(q_, qd_, c), "KdlChainDynamics.coriolis");
+            return c;
+          },
+          py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques C(q, qd) qd")
+      .def(
+          "gravity",
+          [](KdlChainDynamics& d, const Array& q) {
+            const Eigen::VectorXd q_ = vector_arg(q, "q", d.dof(), false, "one value per joint");
+            Eigen::VectorXd g = Eigen::VectorXd::Zero(d.dof());
+            raise_unless_ok(d.gravity(q_, g), "KdlChainDynamics.gravity");
+            return g;
+          },
+          py::arg("q"), "Gravity torques G(q)");
 }
 
 }  // namespace
 
 // after bind_mechanism (30): the signatures name MechanismModel, so it must be bound first
-MECHBAL_REGISTER_BINDINGS(32, rnea, bind_rnea);
+MECHBAL_REGISTER_BINDINGS(32, mechanism_dynamics, bind_mechanism_dynamics);
 
 }  // namespace mechbal::pyb

@@ -1,5 +1,5 @@
 #pragma once
-/// \file coupled_model.hpp
+/// \file coupled_projection.hpp
 /// The coupling-matrix projection of Coutinho & Hess Coelho, "A new approach for designing
 /// dynamic balanced serial mechanisms" (eqs 1-3, 11-13, 22-24, 32-34), for mechanisms whose
 /// redundant-coordinate constraints are solved per tick (closed chains: A° is a matrix, not 1).
@@ -11,7 +11,8 @@
 ///   C = [1; -(A°)^-1 A#],   p = C p#,   p' = C p#' + cbar,   cbar = [0; -(A°)^-1 (A' p)],
 /// and, projecting with C^T (constraint forces do no work on admissible motions),
 ///   M' = C^T M# C,   v' = C^T (M# cbar + v#),   g' = C^T g#.
-/// This is the C++ twin of mechbal.coupling.couple (Python), with fixed sizes.
+/// This is the C++ twin of mechbal.papers.discs.coupling.couple (Python), with fixed sizes: the
+/// five-bar fast path's private projection (the general path is the loop solve, algorithm/loops.hpp).
 ///
 /// Use per tick: (1) fill `a_independent` (A#) and `a_dependent` (A°), call factor(): it checks A° (reciprocal condition number sigma_min / sigma_max from a
 /// fixed-size SVD) and computes C; (2) with the dependent rates p = C p# now known, fill the

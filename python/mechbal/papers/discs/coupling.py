@@ -21,12 +21,12 @@ planar discs and after balancing but gives wrong Coriolis terms otherwise (eq 24
 The serial arms with discs are data on the general model (``mechbal.papers.discs``: each disc a
 gear-coupled joint, evaluated by MechanismDynamics, whose projection tau = G^T tau_joint is this
 one with A° = 1). The per-tick C++ evaluator of the paper's form is
-``mechbal._core.FiveBarDynamics`` (the 5R five-bar, A° a 4x4 matrix, over the general fixed-size
-``mechbal::CoupledProjection``); this module is its independent Python reference
+``mechbal._core.FiveBarDynamics`` (the 5R five-bar, A° a 4x4 matrix, over the paper's fixed-size
+``mechbal::CoupledProjection``, papers/five_bar/coupled_projection.hpp); this module is its independent Python reference
 (mechbal.papers.discs.fivebar_model) and builds the two-stage model of the paper (arm model
 first, then discs coupled to it) that cross-checks the general model's single-stage form.
 
-Layer: Python core (docs/architecture.md).
+Layer: papers (the discs paper's own method; docs/architecture.md).
 """
 from __future__ import annotations
 
