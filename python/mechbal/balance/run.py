@@ -235,7 +235,7 @@ def evaluate(bc: BalanceCase, mech) -> dict:
         G = mech.static_torque(q)              # gravity plus springs (gravity alone without springs)
     sw = mech.shaking_wrench(q, v, a)
     bm = mech.body_motion(q, v, a)
-    return dict(q=q, v=v, a=a, torque=tau, gravity_torque=G, shaking_force=sw.shaking_force,
+    return dict(q=q, v=v, a=a, torque=tau, gravity_torque=G, static_torque=G, shaking_force=sw.shaking_force,
                 shaking_moment=sw.shaking_moment, com=bm.com, rotation=bm.rotation)
 
 
@@ -245,13 +245,17 @@ def _stats(x: np.ndarray) -> dict:
 
 def _comparison(before: dict, after: dict) -> dict:
     out = {}
-    for key, unit in (("gravity_torque", "N m or N"), ("torque", "N m or N"), ("shaking_force", "N"),
+    for key, unit in (("static_torque", "N m or N"), ("torque", "N m or N"), ("shaking_force", "N"),
                       ("shaking_moment", "N m")):
         b, a = _stats(before[key]), _stats(after[key])
         name = "actuator_torque" if key == "torque" else key
         out[name] = {"unit": unit, "unbalanced": b, "balanced": a,
                      "peak_reduction_pct": common.reduction_pct(b["peak"], a["peak"]),
                      "rms_reduction_pct": common.reduction_pct(b["rms"], a["rms"])}
+    # the static torque (gravity + springs: what holds each pose) was labelled gravity_torque;
+    # the old key stays one release as a deprecated copy
+    out["gravity_torque"] = dict(out["static_torque"], deprecated=(
+        "renamed static_torque (gravity + springs); this copy goes in the next release"))
     return out
 
 
