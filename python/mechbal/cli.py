@@ -44,9 +44,23 @@ def _cmd_cases(args) -> int:
     from mechbal.cases import available, default_case
 
     default = default_case()
-    for name, kind, title in available():
-        mark = " (default)" if name == default else ""
-        print(f"{name:16s} {kind:14s} {title}{mark}")
+    rows = available()
+    _print_table([(name, kind, title + (" (default)" if name == default else "")) for name, kind, title in rows])
+    return 0
+
+
+def _print_table(rows: list[tuple[str, str, str]]) -> None:
+    """Rows of (name, kind, title), the first two columns as wide as their longest entry."""
+    w0 = max((len(r[0]) for r in rows), default=0)
+    w1 = max((len(r[1]) for r in rows), default=0)
+    for name, kind, title in rows:
+        print(f"{name:{w0}s}  {kind:{w1}s}  {title}".rstrip())
+
+
+def _cmd_sweeps(args) -> int:
+    from mechbal.sweep.config import available
+
+    _print_table(available())
     return 0
 
 
@@ -59,8 +73,8 @@ def _cmd_run(args) -> int:
     check_case_file(args.case)
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer):  # the runner's tables, printed after its bar closes
-        summary = run_case(args.case, out, duration=getattr(args, "duration", None),
-                           samples=getattr(args, "samples", None))
+        summary = run_case(args.case, out, animate=getattr(args, "animate", False),
+                           duration=getattr(args, "duration", None), samples=getattr(args, "samples", None))
     if not args.quiet:
         sys.stdout.write(buffer.getvalue())
     notes = summary.get("non_finite_values") if isinstance(summary, dict) else None
@@ -175,6 +189,10 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     s = sub.add_parser("cases", help="list the built-in case studies")
     s.set_defaults(func=_cmd_cases)
+    s = sub.add_parser("sweeps", help="list the built-in sweep files (mechbal sweep CASE --spec NAME)",
+                       description="List the built-in sweep files: name, kind and title. Run one with "
+                                   "'mechbal sweep CASE --spec NAME --out DIR'.")
+    s.set_defaults(func=_cmd_sweeps)
     quiet = dict(action="store_true",
                  help="no progress bar and no tables: only warnings and errors (on stderr)")
     s = sub.add_parser("run", help="run a case study (built-in name or TOML file)",
@@ -189,6 +207,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="URDF files: duration of the default trajectory [s] (default: 2)")
     s.add_argument("--samples", type=int, metavar="N",
                    help="URDF files: number of instants of the default trajectory (default: 501)")
+    s.add_argument("--animate", action="store_true",
+                   help="also write DIR/animation_<variant>.gif: the mechanism moving, with the "
+                        "shaking force and moment drawn at its base")
     s.add_argument("-q", "--quiet", **quiet)
     _urdf_flags(s)
     s.set_defaults(func=_cmd_run)
@@ -215,7 +236,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=_cmd_balance)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")
-    s.add_argument("--out", default="out/demo", metavar="DIR", help="output folder")
+    s.add_argument("--out", default="out/demo", metavar="DIR", help="output folder (default: out/demo)")
     s.add_argument("-q", "--quiet", **quiet)
     s.set_defaults(func=_cmd_demo)
     s = sub.add_parser("sweep", help="sensitivity, tolerance Monte Carlo or grid over a case",
@@ -225,8 +246,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("case", help="built-in case name or path to a TOML or URDF file")
     s.add_argument("--spec", required=True, metavar="SWEEP", help="sweep file (TOML with [sweep]) or built-in sweep name")
     s.add_argument("--out", default="out/sweep", metavar="DIR", help="output folder (default: out/sweep)")
-    s.add_argument("--backend", choices=("serial", "processes", "dask"), default="processes",
-                   help="serial; processes: every local core (default); dask: a cluster (--scheduler)")
+    s.add_argument("--backend", choices=("auto", "serial", "processes", "dask"), default="auto",
+                   help="auto (default): serial unless the sweep would take more than a few seconds "
+                        "in one process, then every local core; serial; processes: every local core; "
+                        "dask: a cluster (--scheduler)")
     s.add_argument("--workers", type=int, metavar="N", help="processes: number of local processes (default: all cores)")
     s.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 (implies --backend dask)")
     s.add_argument("-q", "--quiet", **quiet)
@@ -237,7 +260,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "run with 'mechbal run my.toml'.")
     s.add_argument("kind", choices=("serial", "linkage"),
                    help="serial: a serial chain (joints, links, trajectory); linkage: a closed "
-                        "loop (four-bar with a counterweight), not available yet")
+                        "loop (four-bar with a counterweight)")
     s.set_defaults(func=_cmd_init)
     return p
 

@@ -55,8 +55,7 @@ duration = 1.0                # s
 samples = 501                 # instants evaluated (at least 3)
 '''
 
-LINKAGE = '''\
-# A mechbal case: a closed linkage (here a four-bar in the vertical x-z plane with a
+LINKAGE = r'''# A mechbal case: a closed linkage (here a four-bar in the vertical x-z plane with a
 # counterweight on its crank) moving along a rest-to-rest motion of its actuated joint. Run it with
 #     mechbal run my.toml --out out/my
 # to get out/my/summary.json (peak shaking force and moment, actuator and base-reaction torques),

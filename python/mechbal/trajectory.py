@@ -85,7 +85,8 @@ class RestToRest:
     ``q(t) = start + (end - start) s(t / duration)``.
 
     Args:
-        start, end: positions [rad or m], one per coordinate.
+        start: initial positions [rad or m], one per coordinate.
+        end: final positions [rad or m], one per coordinate.
         duration: motion time [s], > 0.
         law: ``"quintic"`` (zero velocity and acceleration at both ends) or ``"cubic"``
             (minimum energy: least integral of squared acceleration; its acceleration jumps at

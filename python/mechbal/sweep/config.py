@@ -84,7 +84,7 @@ def from_toml(spec_file: str | Path, case) -> "Sweep":  # noqa: F821
         raise ConfigError(field, message, has_value=False) from None
 
 
-def run_file(case, spec_file, out, *, backend: str = "serial", workers: int | None = None,
+def run_file(case, spec_file, out, *, backend: str = "auto", workers: int | None = None,
              scheduler=None, progress: bool = True):
     """Run a sweep file over a case into the folder ``out`` (a whole run or none: results.parquet
     or .csv, summary.json, plots); returns the :class:`mechbal.sweep.results.SweepResult`."""

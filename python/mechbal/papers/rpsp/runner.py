@@ -396,7 +396,7 @@ def run(config, out: Path) -> dict:
                        {"survey": np.column_stack([cf["l"], s_unbal.rcond, rc_motor])},
                        ["leg 1 length l_1", "leg 2 length l_2", "leg 3 length l_3",
                         "rcond, platform driven (inverse kinematics)", "rcond, motors driven (direct kinematics)"],
-                       ["m", "m", "m", "-", "-"],
+                       ["length [m]", "length [m]", "length [m]", "rcond (dimensionless)", "rcond (dimensionless)"],
                        title=f"{name}: conditioning over the whole period",
                        caption=f"Leg lengths (eq 9) and the reciprocal condition of the loop solve of the robot "
                                f"(without the extra linkage) with the platform or the motors as inputs. The "
