@@ -163,3 +163,35 @@ def test_every_example_robot_that_pinocchio_loads_loads():
         assert mech.total_mass == pytest.approx(total, rel=1e-4, abs=1e-9), path
     assert not refused, "\n".join(refused)
     assert loaded > 30
+
+
+# ---- the default motion respects the URDF's limits ----------------------------------------------
+
+def test_default_motions_respect_velocity_and_effort_limits(tmp_path):
+    """run and balance on a URDF without a [trajectory]: the move is lengthened to the velocity
+    limit (3 rad/s) and the effort limit; summary.json echoes the limits and the peaks, checked
+    here against the written trajectory."""
+    import json
+
+    from mechbal.export import read_bodies
+
+    text = _urdf().replace('effort="20" velocity="3"', 'effort="12" velocity="0.5"')
+    path = tmp_path / "r.urdf"
+    path.write_text(text)
+    design = tmp_path / "design.toml"
+    design.write_text('[balance]\nmethod = "static"\nsamples = 50\n[[balance.counterweights]]\n'
+                      'name = "cw"\nlink = "arm"\nmass_max = 20.0\nmax_radius = 0.3\n')
+    out = tmp_path / "b"
+    assert main(["balance", str(path), "--design", str(design), "--out", str(out), "-q", "--allow-partial"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    dm = s["case_notes"]["default_motion"]
+    assert dm["velocity_limit"] == [0.5] and dm["effort_limit"] == [12.0] and dm["respected"]
+    b = read_bodies(out / "bodies_unbalanced.npz")
+    assert np.max(np.abs(b["qd"])) <= 0.5 * (1 + 1e-6)
+    assert np.max(np.abs(b["torque"])) <= 12.0
+    assert s["trajectory"]["duration"] == pytest.approx(dm["duration"]) and dm["duration"] >= 1.0
+    out = tmp_path / "r"
+    assert main(["run", str(path), "--out", str(out), "-q", "--duration", "0.2"]) == 0
+    dm = json.loads((out / "summary.json").read_text())["default_motion"]
+    assert dm["respected"] and dm["duration"] > 0.2
+    assert max(dm["peak_velocity"]) <= 0.5 * (1 + 1e-6) and max(dm["peak_torque"]) <= 12.0

@@ -174,12 +174,21 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
         if design_cfg.trajectory is not None:
             t, motion, tt = _trajectory_motion(mech, design_cfg.trajectory)
         else:
+            # the default motion: a quintic move between two random poses of the sample box
+            # (joint limits), over 1 s or longer where the URDF's velocity or effort limits need it
+            from mechbal.trajectory import quintic_within_limits
+
             lo, hi = common.sample_box(mech, design_cfg.balance.lower, design_cfg.balance.upper)
             start, end = lo + (hi - lo) * rng.random(len(lo)), lo + (hi - lo) * rng.random(len(lo))
-            t, motion, tt = _trajectory_motion(mech, {"law": "quintic", "start": start.tolist(),
-                                                      "end": end.tolist(), "duration": 1.0, "samples": 501})
-        return BalanceCase(mech.name, f"{mech.name} (URDF)", mech, design_cfg.balance, t, motion, tt,
-                           None, None, "urdf", [])
+            duration, limits = quintic_within_limits(mech, start, end, 1.0)
+            t, motion, tt = _trajectory_motion(mech, {"law": "quintic", "start": limits["start"],
+                                                      "end": limits["end"], "duration": duration,
+                                                      "samples": 501})
+        bc = BalanceCase(mech.name, f"{mech.name} (URDF)", mech, design_cfg.balance, t, motion, tt,
+                         None, None, "urdf", [])
+        if design_cfg.trajectory is None:
+            bc.notes = {"default_motion": limits}
+        return bc
     path = check_case_file(case)
     raw = load_toml_case(path)
     return case_from_config(validate_case(raw), raw, design_cfg, source=str(path))
