@@ -637,8 +637,8 @@ def lightest_within_bounds(dsg: "_Design", y0: np.ndarray, Z: np.ndarray, mscale
     ``scipy.optimize.linprog``) is solved, a tangent plane is added at each cone the solution
     leaves (u = d / |d|), until every cone is met to CONE_RTOL of the mass scale. Each linear
     program is a relaxation, so its optimum is a lower bound of the true one (the dual of the last
-    one is a dual certificate of the convex program); the last solution, with each d pulled onto
-    its cone (the objective counts masses only, so this leaves it unchanged), is feasible.
+    one is a dual certificate of the convex program); the last solution, polished on the exact cones
+    by SLSQP, meets them to CONE_RTOL and stays on the least-squares set.
 
     Returns (y, lower bound [kg]) or None when no least-squares solution meets the bounds (or the
     solver fails)."""
@@ -704,14 +704,10 @@ def lightest_within_bounds(dsg: "_Design", y0: np.ndarray, Z: np.ndarray, mscale
         if (dsg.violation(to_y(zp), mscale) <= 1e-11
                 and float(dsg.mass_row @ to_y(zp)) <= bound + 1e-9 * mscale):
             z = zp
+    # y stays on the least-squares set (y0 + Z z): each cone is met to CONE_RTOL of the mass scale
+    # (a radius beyond its bound by that fraction), which is kept rather than pulling d onto the
+    # cone and leaving the least squares
     y = y0 + Z @ z
-    for k in dsg.cones:              # onto the cone (the masses, hence the objective, unchanged)
-        m, _ = dsg._mass(k, y)
-        idx = dsg.d_vars[k]
-        nd = float(np.linalg.norm(y[idx]))
-        R = dsg.slots[k].max_radius
-        if nd > R * max(m, 0.0):
-            y[idx] *= R * max(m, 0.0) / nd
     if dsg.violation(y, mscale) > 1e-9:
         return None
     return y, bound
