@@ -335,16 +335,16 @@ def quintic_within_limits(mech, start: ArrayLike, end: ArrayLike, duration: floa
     upper = np.asarray(mech.model.upper_limits, float)
     vmax = np.asarray(mech.model.velocity_limits, float)
     emax = np.asarray(mech.model.effort_limits, float)
-    start = np.clip(np.asarray(start, float), lower, upper)
-    end = np.clip(np.asarray(end, float), lower, upper)
-    step = np.abs(end - start)
+    q0 = np.clip(np.asarray(start, float), lower, upper)
+    q1 = np.clip(np.asarray(end, float), lower, upper)
+    step = np.abs(q1 - q0)
     need = np.where(np.isfinite(vmax) & (vmax > 0), QUINTIC_PEAK_VELOCITY * step / np.where(vmax > 0, vmax, 1.0), 0.0)
     T = max(float(duration), float(np.max(need, initial=0.0)))
     reason = "the requested duration" if T == float(duration) else "the velocity limits"
     respected = True
     tau = static = None
     for _ in range(max_doublings + 1):
-        q, v, a = quintic(start, end, T).evaluate(np.linspace(0.0, T, samples))
+        q, v, a = quintic(q0, q1, T).evaluate(np.linspace(0.0, T, samples))
         tau = np.atleast_2d(mech.inverse_dynamics(q, v, a))
         over = np.abs(tau) > emax
         if not np.any(over):
@@ -356,11 +356,11 @@ def quintic_within_limits(mech, start: ArrayLike, end: ArrayLike, duration: floa
         T, reason = 2.0 * T, "the effort limits"
     else:
         respected = False
-    q, v, a = quintic(start, end, T).evaluate(np.linspace(0.0, T, samples))
+    q, v, a = quintic(q0, q1, T).evaluate(np.linspace(0.0, T, samples))
     tau = np.atleast_2d(mech.inverse_dynamics(q, v, a))
     report = {
         "law": "quintic", "duration": T, "duration_set_by": reason,
-        "start": start.tolist(), "end": end.tolist(),
+        "start": q0.tolist(), "end": q1.tolist(),
         "position_limits": [_limit_list(lower), _limit_list(upper)],
         "velocity_limit": _limit_list(vmax), "peak_velocity": np.max(np.abs(v), axis=0).tolist(),
         "effort_limit": _limit_list(emax), "peak_torque": np.max(np.abs(tau), axis=0).tolist(),
