@@ -591,27 +591,6 @@ def _slsqp(fun, starts, cons, violation, tol, maxiter=1000, ftol=1e-16):
     return best
 
 
-def _feasible_point(cons, start, violation, tol):
-    """A point meeting every constraint, by minimising a slack t >= every constraint's deficit
-    (SLSQP from a feasible (z, t)); None when there is none."""
-    from scipy.optimize import minimize
-
-    def lifted(c):
-        return {"type": c["type"], "fun": (lambda w, f=c["fun"]: f(w[:-1]) + w[-1]),
-                "jac": (lambda w, j=c["jac"]: np.hstack([np.atleast_2d(j(w[:-1])),
-                                                         np.ones((np.atleast_1d(c["fun"](w[:-1])).size, 1))]))}
-
-    if violation(start) <= tol:
-        return start
-    t0 = max(1.0, max(float(np.max(-np.atleast_1d(c["fun"](start)), initial=0.0)) for c in cons) * 1.1)
-    w0 = np.append(start, t0)
-    obj = lambda w: (w[-1], np.append(np.zeros(len(w) - 1), 1.0))  # noqa: E731
-    r = minimize(obj, w0, jac=True, method="SLSQP", constraints=[lifted(c) for c in cons],
-                 bounds=[(None, None)] * len(start) + [(0.0, None)], options=dict(ftol=1e-16, maxiter=1000))
-    z = r.x[:-1]
-    return z if violation(z) <= tol else None
-
-
 #: the cone cuts stop when every cone |d| <= R m is met to this fraction of the mass scale
 CONE_RTOL = 1e-11
 #: at most this many rounds of cone cuts (each one linear program)
