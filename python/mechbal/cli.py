@@ -3,7 +3,7 @@
 Exit codes (the table is in README.md, "Exit codes"): 0 success; 2 a user's mistake (bad case
 file or value, bad output folder, bad arguments), reported as one line ``mechbal: error: ...``
 naming the field or path; 3 an internal error (a bug in mechbal), reported as one line with a
-request to report it (set ``MECHBAL_DEBUG=1`` for the traceback); 4 (``mechbal balance`` only) the
+request to report it (set ``MECHBAL_DEBUG=1`` for the traceback); 5 (``mechbal balance`` only) the
 requested balance was not reached: the balance is not exact within mechbal's tolerance
 (``limited_by`` of summary.json is not empty); the results are written all the same, and
 ``--allow-partial`` makes this exit 0; 130 interrupted. No traceback is ever shown otherwise.
@@ -30,7 +30,7 @@ ISSUES_HINT = ("this is a bug in mechbal: please report it with the command line
 EXIT_OK = 0
 EXIT_USER_ERROR = 2
 EXIT_INTERNAL_ERROR = 3
-EXIT_PARTIAL_BALANCE = 4
+EXIT_PARTIAL_BALANCE = 5
 EXIT_INTERRUPTED = 130
 
 
@@ -256,7 +256,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Balancing of mechanisms: shaking force and moment, counterweights, springs, "
                     "counter-rotating discs, and real-time controllers of balanced robots.",
         epilog="Exit codes: 0 ok, 2 a mistake in the input (one line names the field or path), "
-               "3 an internal error (please report it), 4 balance: the requested balance was not "
+               "3 an internal error (please report it), 5 balance: the requested balance was not "
                "reached (results written; --allow-partial: 0), 130 interrupted.")
     p.add_argument("--version", action="version", version=f"mechbal {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)

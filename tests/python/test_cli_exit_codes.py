@@ -1,6 +1,6 @@
 """`mechbal balance` exit codes (README "Exit codes"): one test per code, each from a real run of
 the command (the four-bar of the built-in cases), so a script can tell a reached balance (0), a
-mistake in the input (2), a bug (3), a balance that is not reached (4, or 0 with
+mistake in the input (2), a bug (3), a balance that is not reached (5, or 0 with
 --allow-partial) and an interruption (130) apart without parsing summary.json."""
 from __future__ import annotations
 
@@ -53,7 +53,7 @@ def crank_only(tmp_path):
 
 def test_exit_4_balance_not_reached(tmp_path, capsys, crank_only):
     out = tmp_path / "partial"
-    assert main(["balance", "four-bar", "--design", str(crank_only), "--out", str(out), "-q"]) == 4
+    assert main(["balance", "four-bar", "--design", str(crank_only), "--out", str(out), "-q"]) == 5
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.startswith("mechbal: balance not reached"), err
     assert "--allow-partial" in err and "impossible" in err
