@@ -40,6 +40,20 @@ void bind_urdf(py::module_& m) {
       [](const std::string& xml) { return value_errors([&] { return model_from_urdf_string(xml); }); },
       py::arg("xml"), "The MechanismModel of a URDF document given as a string.");
   m.def(
+      "read_urdf",
+      [](const std::string& path, bool strict, bool allow_massless) {
+        return value_errors([&] {
+          UrdfReading r = read_urdf_file(path, UrdfOptions{strict, allow_massless});
+          std::vector<std::string> warnings = r.warnings;
+          return py::make_tuple(model_from_urdf_reading(std::move(r), "URDF file '" + path + "'"),
+                                warnings);
+        });
+      },
+      py::arg("path"), py::arg("strict") = false, py::arg("allow_massless") = false,
+      "(MechanismModel, warnings) of a URDF file: strict refuses the defects that the lenient "
+      "reading repairs with one warning each (mechbal/io/urdf.hpp, UrdfOptions); a URDF with no "
+      "<inertial> on any moving link is refused unless allow_massless.");
+  m.def(
       "urdf_description",
       [](const std::string& path) { return value_errors([&] { return urdf_description_from_file(path); }); },
       py::arg("path"), "The MechanismDescription of a URDF file (before validation by the model).");

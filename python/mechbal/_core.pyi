@@ -8,7 +8,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ComputedTorque', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_description', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
+__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ChainModel', 'ComputedTorque', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointSpec', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'RneChainDynamics', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_chain_model', 'chain_description', 'chain_kinematics', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'read_urdf', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
 class Status:
     """
     Bit flags returned by real-time algorithms
@@ -167,7 +167,7 @@ class RestToRestTrajectory:
         ...
 class InverseDynamics:
     """
-    Joint-space inverse dynamics back end (base class of Arm2DofDynamics, KdlChainDynamics, MechanismDynamics)
+    Joint-space inverse dynamics back end (base class of Arm2DofDynamics, KdlChainDynamics, RneChainDynamics)
     """
     @property
     def dof(self) -> int:
@@ -230,6 +230,86 @@ class JointType:
         ...
     @property
     def value(self) -> int:
+        ...
+class JointSpec:
+    """
+    One joint of a serial chain and the link it moves
+    """
+    def __init__(self, name: str, type: JointType, origin: numpy.typing.ArrayLike, axis: numpy.typing.ArrayLike, mass: typing.SupportsFloat | typing.SupportsIndex, com: numpy.typing.ArrayLike, inertia: numpy.typing.ArrayLike) -> None:
+        """
+        origin: 4x4 transform previous link frame -> joint frame at q=0; axis in the joint frame; com and inertia (about the centre of mass) in the link frame
+        """
+    @property
+    def axis(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def com(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def inertia(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+        ...
+    @property
+    def mass(self) -> float:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def origin(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+        ...
+    @property
+    def type(self) -> JointType:
+        ...
+class ChainModel:
+    """
+    Immutable, validated serial chain
+    """
+    def __init__(self, joints: collections.abc.Sequence[JointSpec], gravity: typing.Any = None, base: typing.Any = None) -> None:
+        """
+        gravity: (3,) [m/s^2], default (0, 0, -9.81); base: 4x4 transform, default identity
+        """
+    @property
+    def dof(self) -> int:
+        ...
+    @property
+    def gravity(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def joints(self) -> list[JointSpec]:
+        ...
+    @property
+    def masses(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+class KdlChainDynamics(InverseDynamics):
+    """
+    Joint-space dynamics of a ChainModel through Orocos KDL
+    """
+    @typing.overload
+    def __init__(self, model: ChainModel) -> None:
+        ...
+    @typing.overload
+    def __init__(self, model: MechanismModel) -> None:
+        """
+        From the general MechanismModel when it is a serial chain (bodies lumped per link); ValueError naming the link or joint otherwise
+        """
+    def coriolis(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Coriolis and centrifugal torques C(q, qd) qd
+        """
+    def gravity(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Gravity torques G(q)
+        """
+    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+        """
+        Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, support_moment about the base origin, (N, 3)) by KDL's ChainIdSolver_RNE.
+        """
+    def mass_matrix(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Mass matrix M(q) (dof, dof); ValueError for non-finite or overflowing q
+        """
+    @property
+    def dof(self) -> int:
         ...
 class Joint:
     """
@@ -602,32 +682,11 @@ class MechanismDynamics(InverseDynamics, ForwardDynamics):
     @property
     def solved_position(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
-class KdlChainDynamics(InverseDynamics):
+class RneChainDynamics(MechanismDynamics):
     """
-    Joint-space dynamics of a serial MechanismModel through Orocos KDL (the independent engine)
+    MechanismDynamics of a serial ChainModel (the chain as a general mechanism)
     """
-    def __init__(self, model: MechanismModel) -> None:
-        """
-        From the general MechanismModel when it is a serial chain (bodies lumped per link); ValueError naming the link or joint otherwise
-        """
-    def coriolis(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        """
-        Coriolis and centrifugal torques C(q, qd) qd
-        """
-    def gravity(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        """
-        Gravity torques G(q)
-        """
-    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
-        """
-        Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, support_moment about the base origin, (N, 3)) by KDL's ChainIdSolver_RNE.
-        """
-    def mass_matrix(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
-        """
-        Mass matrix M(q) (dof, dof); ValueError for non-finite or overflowing q
-        """
-    @property
-    def dof(self) -> int:
+    def __init__(self, model: ChainModel) -> None:
         ...
 class PaminsaCounterweights:
     """
@@ -1151,7 +1210,7 @@ class ComputedTorque(JointController):
     @typing.overload
     def __init__(self, model: InverseDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
         """
-        model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, MechanismDynamics). torque_limit: one value per joint (default and +inf: mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range of a tick (beyond it: the held command and Status.out_of_range)
+        model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, RneChainDynamics). torque_limit: one value per joint (default and +inf: mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range of a tick (beyond it: the held command and Status.out_of_range)
         """
     @typing.overload
     def __init__(self, model: FiveBarDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
@@ -1364,9 +1423,17 @@ class FiveBarDynamics:
     @property
     def reciprocal_condition(self) -> float:
         ...
-def arm2dof_description(arm: Arm2DofParameters, counterweights: Arm2DofCounterweights = ...) -> MechanismDescription:
+def arm2dof_chain_model(arm: Arm2DofParameters, counterweights: Arm2DofCounterweights = ...) -> ChainModel:
     """
-    The 2-DOF arm (counterweights merged into the links) as a general MechanismDescription: x-z plane, joints 'shoulder' and 'elbow' with axes along -y, gravity (0, 0, -g)
+    The 2-DOF arm (counterweights merged into the links) as a ChainModel: x-z plane, joint axes along -y, gravity (0, 0, -g)
+    """
+def chain_description(chain: ChainModel) -> MechanismDescription:
+    """
+    A serial ChainModel as a general MechanismDescription (base folded into the first joint)
+    """
+def chain_kinematics(model: ChainModel, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+    """
+    Every link's motion in the base frame for N joint states (q, qd, qdd each (N, dof)). Returns a dict of arrays (N, dof, 3) / (N, dof, 3, 3) / frames (N, dof, 4, 4), status_per_instant (N,) and their OR, status; a failed instant (non-finite input, or motion that overflows: out_of_range) gives identity poses and zero motion.
     """
 def mechanism_bias_torque(model: MechanismModel, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> dict:
     ...
@@ -1431,6 +1498,10 @@ def paminsa_reactionless_run(model: PaminsaModel, config: ReactionlessWristConfi
 def pd_error_analytic(e0: typing.SupportsFloat | typing.SupportsIndex, ed0: typing.SupportsFloat | typing.SupportsIndex, kp: typing.SupportsFloat | typing.SupportsIndex, kd: typing.SupportsFloat | typing.SupportsIndex, t: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
     """
     Solution of e'' + kd e' + kp e = 0 (Arakelian et al. 2011, eq 6) at times t
+    """
+def read_urdf(path: str, strict: bool = False, allow_massless: bool = False) -> tuple[MechanismModel, list[str]]:
+    """
+    (MechanismModel, warnings) of a URDF file: strict refuses the defects that the lenient reading repairs with one warning each (mechbal/io/urdf.hpp, UrdfOptions); a URDF with no <inertial> on any moving link is refused unless allow_massless.
     """
 def shaking_wrench(mass: numpy.typing.ArrayLike, inertia_body: numpy.typing.ArrayLike, com: numpy.typing.ArrayLike, com_velocity: numpy.typing.ArrayLike, com_acceleration: numpy.typing.ArrayLike, rotation: numpy.typing.ArrayLike, angular_velocity: numpy.typing.ArrayLike, angular_acceleration: numpy.typing.ArrayLike) -> dict:
     """

@@ -1,12 +1,15 @@
 """The ``mechbal`` command line.
 
-Exit codes: 0 success; 2 a user's mistake (bad case file or value, bad output folder, bad
-arguments, a value outside the plausible ranges of :mod:`mechbal.plausibility` without
-``--force``), reported as one line ``mechbal: error: ...`` naming the field or path; 3 an internal
-error (a bug in mechbal), reported as one line with a request to report it (set
-``MECHBAL_DEBUG=1`` for the traceback); 4 another run into the same ``--out`` finished at the same
-moment (this run's results were discarded, the other run's folder is whole); 130 interrupted. No
-traceback is ever shown otherwise.
+Exit codes (the table is in README.md, "Exit codes"): 0 success; 2 a user's mistake (bad case
+file or value, bad output folder, bad arguments, a value outside the plausible ranges of
+:mod:`mechbal.plausibility` without ``--force``), reported as one line ``mechbal: error: ...``
+naming the field or path; 3 an internal error (a bug in mechbal), reported as one line with a
+request to report it (set ``MECHBAL_DEBUG=1`` for the traceback); 4 another run into the same
+``--out`` finished at the same moment (this run's results were discarded, the other run's folder
+is whole); 5 (``mechbal balance`` only) the requested balance was not reached: the balance is not
+exact within mechbal's tolerance (``limited_by`` of summary.json is not empty); the results are
+written all the same, and ``--allow-partial`` makes this exit 0; 130 interrupted. No traceback is
+ever shown otherwise.
 
 Layer: command line (docs/architecture.md).
 """
@@ -25,6 +28,15 @@ from mechbal.config import MAX_CASE_BYTES, ConfigError, check_case_file  # noqa:
 
 ISSUES_HINT = ("this is a bug in mechbal: please report it with the command line and the case "
                "file (MECHBAL_DEBUG=1 shows the traceback)")
+
+
+#: the exit codes of the command line (README.md, "Exit codes", lists the same)
+EXIT_OK = 0
+EXIT_USER_ERROR = 2
+EXIT_INTERNAL_ERROR = 3
+EXIT_OUTPUT_RACE = 4
+EXIT_PARTIAL_BALANCE = 5
+EXIT_INTERRUPTED = 130
 
 
 class UserError(Exception):
@@ -122,7 +134,16 @@ def _cmd_balance(args) -> int:
         print(f"wrote {out}/summary.json, the balanced mechanism (balanced.toml"
               f"{', balanced.urdf' if 'balanced.urdf' in summary.get('files', []) else ''}), plots and "
               "bodies files beside it")
-    return 0
+    b = summary.get("balance", {}) if isinstance(summary, dict) else {}
+    if not b.get("exact", True):
+        why = "; ".join(b.get("limited_by") or []) or "not exact"
+        if args.allow_partial:
+            print(f"mechbal: warning: partial balance (--allow-partial): {_one_line(why)}", file=sys.stderr)
+            return EXIT_OK
+        print(f"mechbal: balance not reached (exit {EXIT_PARTIAL_BALANCE}; results written to {out}; "
+              f"--allow-partial accepts them): {_one_line(why)}", file=sys.stderr)
+        return EXIT_PARTIAL_BALANCE
+    return EXIT_OK
 
 
 def _cmd_demo(args) -> int:
@@ -222,6 +243,16 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
+def _urdf_flags(s) -> None:
+    s.add_argument("--strict", action="store_true",
+                   help="URDF input: refuse the harmless defects that are otherwise repaired with a "
+                        "warning each (a <mimic> on a fixed joint, a negligible body's non-physical "
+                        "inertia, such a placeholder on the fixed root)")
+    s.add_argument("--allow-massless", action="store_true",
+                   help="URDF input: load a file with no <inertial> on any moving link, for "
+                        "kinematics only (every mass and torque is then zero)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from mechbal import __version__
 
@@ -231,7 +262,8 @@ def build_parser() -> argparse.ArgumentParser:
                     "counter-rotating discs, and real-time controllers of balanced robots.",
         epilog="Exit codes: 0 ok, 2 a mistake in the input (one line names the field or path), "
                "3 an internal error (please report it), 4 another run into the same --out finished "
-               "at the same moment (this run's results were discarded).")
+               "at the same moment (this run's results were discarded), 5 balance: the requested "
+               "balance was not reached (results written; --allow-partial: 0), 130 interrupted.")
     p.add_argument("--version", action="version", version=f"mechbal {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     s = sub.add_parser("cases", help="list the built-in case studies")
@@ -266,6 +298,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "shaking force and moment drawn at its base")
     s.add_argument("-q", "--quiet", **quiet)
     s.add_argument("--force", **force)
+    _urdf_flags(s)
     s.set_defaults(func=_cmd_run)
     s = sub.add_parser("balance", help="balance a mechanism by a method (static, force, moment, springs, rms)",
                        description="Size counterweights (static: gravity torque zero over the "
@@ -282,8 +315,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a TOML file with a [balance] table (and optionally a [trajectory]) that "
                         "replaces the case's (required for a URDF)")
     s.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    s.add_argument("--allow-partial", action="store_true",
+                   help=f"exit 0 when the requested balance is not reached (default: exit "
+                        f"{EXIT_PARTIAL_BALANCE}; the results are written either way)")
     s.add_argument("-q", "--quiet", **quiet)
     s.add_argument("--force", **force)
+    _urdf_flags(s)
     s.set_defaults(func=_cmd_balance)
     s = sub.add_parser("export", help="write a case's mechanism as MJCF (MuJoCo) or URDF",
                        description="Write the mechanism of a case (built-in name, TOML or URDF file) "
@@ -331,6 +368,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 (implies --backend dask)")
     s.add_argument("-q", "--quiet", **quiet)
     s.add_argument("--force", **force)
+    _urdf_flags(s)
     s.set_defaults(func=_cmd_sweep)
     s = sub.add_parser("init", help="print a commented case template: mechbal init serial > my.toml",
                        description="Print a commented case file to standard output, to edit and "
@@ -340,6 +378,26 @@ def build_parser() -> argparse.ArgumentParser:
                         "loop (four-bar with a counterweight)")
     s.set_defaults(func=_cmd_init)
     return p
+
+
+def _with_urdf_reading(args) -> int:
+    """Run the command with its URDF options, each URDF repair one warning line on stderr."""
+    import warnings
+
+    from mechbal.mechanism import UrdfRepairWarning, urdf_reading
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, UrdfRepairWarning):
+            print(f"mechbal: warning: {_one_line(Exception(str(message)))}", file=sys.stderr)
+        else:
+            previous(message, category, filename, lineno, file, line)
+
+    previous = warnings.showwarning
+    with warnings.catch_warnings(), urdf_reading(strict=getattr(args, "strict", False),
+                                                 allow_massless=getattr(args, "allow_massless", False)):
+        warnings.simplefilter("always", UrdfRepairWarning)
+        warnings.showwarning = show
+        return args.func(args)
 
 
 def _one_line(exc: BaseException) -> str:
@@ -356,14 +414,14 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
-        return 2
+        return EXIT_USER_ERROR
     progress.configure(quiet=getattr(args, "quiet", False))
     debug = os.environ.get("MECHBAL_DEBUG", "") not in ("", "0")
     try:
         with warnings.catch_warnings():
             if not getattr(args, "force", False):  # implausible values: refused, not warned about
                 warnings.simplefilter("error", PlausibilityWarning)
-            return args.func(args)
+            return _with_urdf_reading(args)
     except PlausibilityWarning as exc:
         if debug:
             raise
@@ -373,18 +431,18 @@ def main(argv: list[str] | None = None) -> int:
         if debug:
             raise
         print(f"mechbal: error: {_one_line(exc)}", file=sys.stderr)
-        return 4
+        return EXIT_OUTPUT_RACE
     except (ConfigError, OutputError, UserError) as exc:
         if debug:
             raise
         print(f"mechbal: error: {_one_line(exc)}", file=sys.stderr)
-        return 2
+        return EXIT_USER_ERROR
     except MemoryError:
         if debug:
             raise
         print("mechbal: error: out of memory: the case asks for too many samples or "
               "configurations (reduce trajectory.samples or the like)", file=sys.stderr)
-        return 2
+        return EXIT_USER_ERROR
     except (ValueError, RuntimeError, OverflowError, ArithmeticError) as exc:
         # raised by the core's validation (std::invalid_argument names the field) or by a runner
         # on values it cannot use: a mistake in the case, not in mechbal
@@ -392,16 +450,16 @@ def main(argv: list[str] | None = None) -> int:
             raise
         kind = "" if type(exc) in (ValueError, RuntimeError) else f"{type(exc).__name__}: "
         print(f"mechbal: error: {kind}{_one_line(exc)}", file=sys.stderr)
-        return 2
+        return EXIT_USER_ERROR
     except KeyboardInterrupt:
         print("mechbal: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
     except Exception as exc:  # noqa: BLE001 - the last line of defence: no traceback
         if debug:
             raise
         print(f"mechbal: internal error: {type(exc).__name__}: {_one_line(exc)}; {ISSUES_HINT}",
               file=sys.stderr)
-        return 3
+        return EXIT_INTERNAL_ERROR
 
 
 if __name__ == "__main__":  # pragma: no cover

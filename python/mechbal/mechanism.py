@@ -20,6 +20,8 @@ Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
+import contextlib as _contextlib
+import contextvars as _contextvars
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
@@ -29,7 +31,7 @@ import numpy as np
 from mechbal import _core
 
 __all__ = ["Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion",
-           "BatchArray"]
+           "BatchArray", "UrdfRepairWarning", "urdf_reading"]
 
 
 class BatchArray(np.ndarray):
@@ -62,6 +64,25 @@ class BatchArray(np.ndarray):
 
     def __reduce__(self):  # pickled as a plain array and its status
         return (BatchArray, (np.asarray(self), self.status))
+
+class UrdfRepairWarning(UserWarning):
+    """A harmless defect of a URDF file that the lenient reading repaired (the message names the
+    URDF element and the repair); ``strict=True`` refuses the file instead."""
+
+
+_URDF_READING = _contextvars.ContextVar("urdf_reading", default={"strict": False, "allow_massless": False})
+
+
+@_contextlib.contextmanager
+def urdf_reading(*, strict: bool = False, allow_massless: bool = False):
+    """Defaults of :meth:`Mechanism.from_urdf` within the block (the CLI's ``--strict`` and
+    ``--allow-massless`` reach every URDF a command reads this way)."""
+    token = _URDF_READING.set({"strict": bool(strict), "allow_massless": bool(allow_massless)})
+    try:
+        yield
+    finally:
+        _URDF_READING.reset(token)
+
 
 
 @dataclass(frozen=True)
@@ -189,13 +210,26 @@ class Mechanism:
         return cls(_core.MechanismModel(desc), name=name)
 
     @classmethod
-    def from_urdf(cls, path: str | Path) -> "Mechanism":
+    def from_urdf(cls, path: str | Path, *, strict: bool | None = None,
+                  allow_massless: bool | None = None) -> "Mechanism":
         """Read a URDF file through urdfdom in C++ (the same reader an embedded controller uses):
         links with inertials become bodies named after the links, revolute / continuous /
         prismatic / fixed joints keep their names (continuous = revolute without position
         limits, one coordinate), ``mimic`` becomes a gear coupling, limits are kept, and every
         URDF link is a named frame (see ``cpp/include/mechbal/io/urdf.hpp`` for the mapping).
+
+        By default the reading is lenient: it loads what Pinocchio loads, repairing harmless
+        defects with one :class:`UrdfRepairWarning` each, naming the URDF element and the repair
+        (a ``<mimic>`` on a fixed joint, or of a joint that does not exist, ignored; a body's
+        non-physical inertia replaced by the nearest physical one, the warning saying whether the
+        body is negligible -- mass at most 1e-4 of the URDF's total -- or the dynamics change; a
+        negligible non-physical placeholder on the fixed root dropped). ``strict=True`` refuses them. A URDF with no
+        ``<inertial>`` on any moving link is refused unless ``allow_massless=True`` (kinematics
+        only). None: the defaults of :func:`urdf_reading` (False unless set, e.g. by the CLI's
+        ``--strict`` / ``--allow-massless``).
         Raises :class:`mechbal.config.ConfigError` (a ValueError) naming the URDF element."""
+        import warnings
+
         from mechbal.config import ConfigError, read_regular_file
 
         path = Path(path)
@@ -204,8 +238,13 @@ class Mechanism:
             raise ConfigError(field, "not found", has_value=False)
         # a regular file of bounded size, at once (not /dev/zero, a FIFO, a folder): ConfigError
         read_regular_file(path, field, _core.MAX_URDF_BYTES)
+        defaults = _URDF_READING.get()
+        strict = defaults["strict"] if strict is None else bool(strict)
+        allow_massless = defaults["allow_massless"] if allow_massless is None else bool(allow_massless)
         try:
-            model = _core.mechanism_from_urdf(str(path))
+            model, repairs = _core.read_urdf(str(path), strict=strict, allow_massless=allow_massless)
+            for text in repairs:
+                warnings.warn(UrdfRepairWarning(f"{field}: {text}"), stacklevel=2)
         except ValueError as exc:
             message = str(exc)
             if message.startswith(field + ": "):

@@ -328,3 +328,67 @@ def as_trajectory(obj: object) -> Trajectory:
                         f"mechbal.trajectory), got {type(obj).__name__}")
     return obj
 
+
+
+#: peak |velocity| and |acceleration| of the quintic rest-to-rest law, in units of
+#: |end - start| / duration and |end - start| / duration^2
+QUINTIC_PEAK_VELOCITY = 15.0 / 8.0
+QUINTIC_PEAK_ACCELERATION = 10.0 / np.sqrt(3.0)
+
+
+def _limit_list(x: np.ndarray) -> list:
+    return [float(v) if np.isfinite(v) else None for v in x]
+
+
+def quintic_within_limits(mech, start: ArrayLike, end: ArrayLike, duration: float, *,
+                          samples: int = 101, max_doublings: int = 10) -> tuple[float, dict]:
+    """``(duration, report)`` of a quintic rest-to-rest move of an open mechanism from ``start``
+    to ``end`` that respects the joints' limits where the model has them (URDF <limit>):
+
+    * positions: ``start`` and ``end`` are clipped into [lower, upper] (a quintic stays between
+      them);
+    * velocities: the duration is at least ``15/8 |end - start| / velocity_limit`` per joint;
+    * efforts: the duration is doubled (at most ``max_doublings`` times) while the inverse-dynamics
+      torque of some joint exceeds its effort limit at a sample where the static torque alone is
+      within it (slower moves need less inertial torque; the static torque does not change).
+
+    ``report`` (echoed in summary.json as ``default_motion``) holds the limits, the peaks reached,
+    the duration, and ``respected`` (False when an effort limit is exceeded by the static torque
+    alone, or after the doublings)."""
+    lower = np.asarray(mech.model.lower_limits, float)
+    upper = np.asarray(mech.model.upper_limits, float)
+    vmax = np.asarray(mech.model.velocity_limits, float)
+    emax = np.asarray(mech.model.effort_limits, float)
+    q0 = np.clip(np.asarray(start, float), lower, upper)
+    q1 = np.clip(np.asarray(end, float), lower, upper)
+    step = np.abs(q1 - q0)
+    need = np.where(np.isfinite(vmax) & (vmax > 0), QUINTIC_PEAK_VELOCITY * step / np.where(vmax > 0, vmax, 1.0), 0.0)
+    T = max(float(duration), float(np.max(need, initial=0.0)))
+    reason = "the requested duration" if T == float(duration) else "the velocity limits"
+    respected = True
+    tau = static = None
+    for _ in range(max_doublings + 1):
+        q, v, a = quintic(q0, q1, T).evaluate(np.linspace(0.0, T, samples))
+        tau = np.atleast_2d(mech.inverse_dynamics(q, v, a))
+        over = np.abs(tau) > emax
+        if not np.any(over):
+            break
+        static = np.atleast_2d(mech.static_torque(q))
+        if np.any(over & (np.abs(static) > emax)):   # the static torque alone exceeds it
+            respected = False
+            break
+        T, reason = 2.0 * T, "the effort limits"
+    else:
+        respected = False
+    q, v, a = quintic(q0, q1, T).evaluate(np.linspace(0.0, T, samples))
+    tau = np.atleast_2d(mech.inverse_dynamics(q, v, a))
+    report = {
+        "law": "quintic", "duration": T, "duration_set_by": reason,
+        "start": q0.tolist(), "end": q1.tolist(),
+        "position_limits": [_limit_list(lower), _limit_list(upper)],
+        "velocity_limit": _limit_list(vmax), "peak_velocity": np.max(np.abs(v), axis=0).tolist(),
+        "effort_limit": _limit_list(emax), "peak_torque": np.max(np.abs(tau), axis=0).tolist(),
+        "respected": bool(respected and np.all(np.abs(tau) <= emax * (1 + 1e-9))
+                          and np.all(np.max(np.abs(v), axis=0) <= vmax * (1 + 1e-9))),
+    }
+    return T, report

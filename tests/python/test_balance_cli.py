@@ -131,7 +131,7 @@ def test_ur5_dh_static_case(tmp_path):
     the balance is a least squares: its residual is the recomputed one, said so in limited_by;
     positions are in the DH frames (beyond the shoulder and elbow axes)."""
     out = tmp_path / "ur5"
-    assert main(["balance", "ur5-dh", "--out", str(out), "-q"]) == 0
+    assert main(["balance", "ur5-dh", "--out", str(out), "-q"]) == 5      # not reached: exit 5, results written
     s = summary_of(out)
     b = s["balance"]
     assert not b["exact"] and b["limited_by"][0].startswith("impossible")
@@ -190,7 +190,7 @@ def test_ur5_urdf_with_a_design_file(tmp_path):
     urdf = _robot_file(*ROBOTS["ur5"])
     design = Path(__file__).parents[2] / "docs" / "examples" / "ur5_balance.toml"
     out = tmp_path / "ur5"
-    assert main(["balance", str(urdf), "--design", str(design), "--out", str(out), "-q"]) == 0
+    assert main(["balance", str(urdf), "--design", str(design), "--out", str(out), "-q"]) == 5   # the wrist cannot be held: exit 5
     b = summary_of(out)["balance"]
     assert b["design"]["upper_arm_counterweight"]["position"] == pytest.approx([0, 0, -0.25], abs=1e-9)
     assert b["design"]["upper_arm_counterweight"]["frame"].startswith("frame 'upper_arm_link'")
@@ -217,7 +217,7 @@ def test_ur5_urdf_balanced_by_springs(tmp_path):
     urdf = _robot_file(*ROBOTS["ur5"])
     design = Path(__file__).parents[2] / "docs" / "examples" / "ur5_springs.toml"
     out = tmp_path / "ur5"
-    assert main(["balance", str(urdf), "--design", str(design), "--method", "springs", "--out", str(out), "-q"]) == 0
+    assert main(["balance", str(urdf), "--design", str(design), "--method", "springs", "--out", str(out), "-q"]) == 5   # exit 5: a residual
     summary = summary_of(out)
     b = summary["balance"]
     assert b["method"] == "springs" and b["rank"] == 3 and b["unknowns"] == 3

@@ -318,10 +318,12 @@ _GOOD = """<robot name="two">
 
 
 def _error(tmp_path, text):
+    """The error of the strict reading (the lenient one repairs some of these with a warning:
+    tests/python/test_urdf_robots.py)."""
     path = tmp_path / "bad.urdf"
     path.write_text(text)
     with pytest.raises(ConfigError) as info:
-        mechbal.Mechanism.from_urdf(path)
+        mechbal.Mechanism.from_urdf(path, strict=True)
     message = str(info.value)
     assert "\n" not in message and message.startswith(f"URDF file '{path}': "), message
     return message

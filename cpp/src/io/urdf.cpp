@@ -14,13 +14,17 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
 #include <mutex>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
 #include <vector>
+
+#include <Eigen/Eigenvalues>
 
 #include "mechbal/model/rigid_body.hpp"
 
@@ -408,17 +412,138 @@ Body to_body(const urdf::Link& link, const std::string& carrier) {
   return b;
 }
 
+// ---- lenient reading (issue 23): the repairs of UrdfOptions, each with its warning ----------
+
+/// The nearest physical inertia (see UrdfOptions): S = tr(I)/2 1 - I clipped to S >= 0.
+Mat3 nearest_physical_inertia(const Mat3& I_in) {
+  const Mat3 I = 0.5 * (I_in + I_in.transpose());
+  const Mat3 S = 0.5 * I.trace() * Mat3::Identity() - I;
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(S);
+  const Vec3 lam = eig.eigenvalues().cwiseMax(0.0);
+  const Mat3 Sp = eig.eigenvectors() * lam.asDiagonal() * eig.eigenvectors().transpose();
+  Mat3 out = Sp.trace() * Mat3::Identity() - Sp;
+  return 0.5 * (out + out.transpose());
+}
+
+std::string matrix_text(const Mat3& I) {
+  std::ostringstream m;
+  m << "[" << I.format(Eigen::IOFormat(4, 0, ", ", "; ")) << "]";
+  return m.str();
+}
+
+double total_mass(const urdf::ModelInterface& model) {
+  double total = 0.0;
+  for (const auto& [name, link] : model.links_) {
+    if (link && link->inertial && std::isfinite(link->inertial->mass) && link->inertial->mass > 0.0) {
+      total += link->inertial->mass;
+    }
+  }
+  return total;
+}
+
+/// The body of `link` under the options: validated; a negligible body with a non-physical inertia
+/// regularised (lenient) or, on the root, dropped (returns false). Warnings appended.
+bool lenient_body(const urdf::Link& link, const std::string& carrier, bool is_root, double total,
+                  const UrdfOptions& options, std::vector<std::string>& warnings, Body& out) {
+  try {
+    out = to_body(link, carrier);
+    return true;
+  } catch (const std::invalid_argument& e) {
+    const urdf::Inertial& in = *link.inertial;
+    const bool negligible = std::isfinite(in.mass) && in.mass >= 0.0 &&
+                            in.mass <= kNegligibleMassFraction * total;
+    if (options.strict) throw;
+    std::ostringstream w;
+    if (is_root && negligible) {
+      w << "URDF link '" << link.name << "' <inertial>: dropped (a negligible placeholder of "
+        << in.mass << " kg on the fixed root, whose inertia is not physical: " << e.what() << ")";
+      warnings.push_back(w.str());
+      return false;
+    }
+    urdf::Link fixed = link;
+    auto inertial = std::make_shared<urdf::Inertial>(in);
+    Mat3 I;
+    I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+    if (!I.allFinite()) throw;
+    const Mat3 P = nearest_physical_inertia(I);
+    inertial->ixx = P(0, 0), inertial->iyy = P(1, 1), inertial->izz = P(2, 2);
+    inertial->ixy = P(0, 1), inertial->ixz = P(0, 2), inertial->iyz = P(1, 2);
+    fixed.inertial = inertial;
+    out = to_body(fixed, carrier);  // throws if still not physical (not expected)
+    w << "URDF link '" << link.name << "' <inertial>: inertia " << matrix_text(I) << " is not physical";
+    if (negligible) {
+      w << " on a negligible body (" << in.mass << " kg <= " << kNegligibleMassFraction
+        << " of the total " << total << " kg)";
+    } else {
+      w << " (a body of " << in.mass << " kg, not negligible: the dynamics differ from the file's; "
+        << "correct the file)";
+    }
+    w << ": replaced by the nearest physical one " << matrix_text(P);
+    warnings.push_back(w.str());
+    return true;
+  }
+}
+
+/// Fixed joints with a <mimic>: ignored with a warning (lenient) or refused (strict).
+void check_fixed_mimic(const urdf::ModelInterface& model, const UrdfOptions& options,
+                       std::vector<std::string>& warnings) {
+  for (const auto& [name, uj] : model.joints_) {
+    if (!uj || !uj->mimic || uj->type != urdf::Joint::FIXED) continue;
+    const std::string what = "URDF joint '" + name + "': <mimic joint=\"" + uj->mimic->joint_name +
+                             "\"> on a fixed joint";
+    if (options.strict) {
+      throw std::invalid_argument(what + " (a fixed joint has no coordinate to couple; the lenient "
+                                         "reading ignores it)");
+    }
+    warnings.push_back(what + ": ignored (a fixed joint has no coordinate to couple)");
+  }
+}
+
+/// No <inertial> on any link that moves: refused unless allow_massless.
+void check_massless(const urdf::ModelInterface& model, const MechanismDescription& d,
+                    const UrdfOptions& options, std::vector<std::string>& warnings) {
+  bool moves = false;
+  for (const auto& j : d.joints) moves = moves || j.type != JointType::fixed;
+  if (!moves) return;
+  for (const auto& b : d.bodies) {
+    if (b.link != d.root_name) return;  // a body on a moving link
+  }
+  (void)model;
+  const std::string what = "no <inertial> on any moving link: every mass, gravity and inertia "
+                           "torque would be zero";
+  if (!options.allow_massless) {
+    throw std::invalid_argument("URDF: " + what + " (give --allow-massless, or allow_massless=True "
+                                "in Python, to load it for kinematics only)");
+  }
+  warnings.push_back("URDF: " + what + ": loaded for kinematics only (allow_massless)");
+}
+
+MechanismDescription describe(const urdf::ModelInterface& model, const UrdfOptions& options,
+                              std::vector<std::string>& warnings);
+
 MechanismDescription describe(const urdf::ModelInterface& model) {
+  std::vector<std::string> warnings;
+  return describe(model, UrdfOptions{true, true}, warnings);
+}
+
+MechanismDescription describe(const urdf::ModelInterface& model, const UrdfOptions& options,
+                              std::vector<std::string>& warnings) {
   const urdf::LinkConstSharedPtr root = model.getRoot();
   if (!root) throw std::invalid_argument("URDF: no root link");
   MechanismDescription d;
   d.root_name = root->name;
+  check_fixed_mimic(model, options, warnings);
+  const double total = total_mass(model);
 
   // mimic targets first, with a URDF-level message (the model would name a description index)
+  std::vector<std::string> orphan_mimics;  // lenient: a mimic of a missing joint is dropped
   for (const auto& [name, uj] : model.joints_) {
     if (uj && uj->mimic && !model.getJoint(uj->mimic->joint_name)) {
-      throw std::invalid_argument("URDF joint '" + name + "': mimic joint '" + uj->mimic->joint_name +
-                                  "' does not exist");
+      const std::string what = "URDF joint '" + name + "': mimic joint '" + uj->mimic->joint_name +
+                               "' does not exist";
+      if (options.strict) throw std::invalid_argument(what);
+      warnings.push_back(what + ": <mimic> ignored (an independent joint, as Pinocchio reads it)");
+      orphan_mimics.push_back(name);
     }
   }
 
@@ -432,7 +557,10 @@ MechanismDescription describe(const urdf::ModelInterface& model) {
       throw std::invalid_argument("URDF link '" + link->name + "' is reached twice from the root (joint '" +
                                   carrier + "'): a URDF is a tree");
     }
-    if (link->inertial) d.bodies.push_back(to_body(*link, carrier));
+    if (link->inertial) {
+      Body b;
+      if (lenient_body(*link, carrier, link == root, total, options, warnings, b)) d.bodies.push_back(b);
+    }
     d.frames.push_back(Frame{link->name, carrier, Eigen::Isometry3d::Identity()});
     // siblings in urdfdom's order (MechanismModel keeps the description's order among siblings);
     // pushed in reverse so that the first child is visited first
@@ -447,22 +575,41 @@ MechanismDescription describe(const urdf::ModelInterface& model) {
       stack.emplace_back(child, uj.name);
     }
   }
+  for (auto& j : d.joints) {  // mimics ignored above (lenient): not couplings
+    if (j.type == JointType::fixed) j.mimic_joint.clear();
+    for (const auto& o : orphan_mimics) {
+      if (j.name == o) j.mimic_joint.clear();
+    }
+  }
+  check_massless(model, d, options, warnings);
   return d;
 }
 
-}  // namespace
-
-MechanismDescription urdf_description_from_string(const std::string& xml) {
-  try {
-    const urdf::ModelInterfaceSharedPtr model = parse(xml);
-    return describe(*model);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(one_line(e.what()));  // names and values may hold line breaks
+/// "joints[3]" -> "URDF joint 'elbow'", "bodies[2]" -> "URDF link 'x' <inertial>", "frames[1]"
+/// -> "URDF link 'y'": the model's messages in the URDF's words.
+std::string urdf_words(const std::string& message, const MechanismDescription& d) {
+  static const std::regex index(R"((joints|bodies|frames)\[(\d+)\])");
+  std::string out;
+  auto begin = std::sregex_iterator(message.begin(), message.end(), index);
+  std::size_t last = 0;
+  for (auto it = begin; it != std::sregex_iterator(); ++it) {
+    const std::smatch& m = *it;
+    out += message.substr(last, static_cast<std::size_t>(m.position(0)) - last);
+    const std::string kind = m[1];
+    const std::size_t i = std::stoul(m[2]);
+    std::string name;
+    if (kind == "joints" && i < d.joints.size()) name = "URDF joint '" + d.joints[i].name + "'";
+    if (kind == "bodies" && i < d.bodies.size()) name = "URDF link '" + d.bodies[i].name + "' <inertial>";
+    if (kind == "frames" && i < d.frames.size()) name = "URDF link '" + d.frames[i].name + "'";
+    out += name.empty() ? m.str(0) : name;
+    last = static_cast<std::size_t>(m.position(0) + m.length(0));
   }
+  return out + message.substr(last);
 }
 
-MechanismDescription urdf_description_from_file(const std::string& path) {
-  // a regular file of bounded size only: /dev/zero would be read forever, a FIFO would block
+/// The text of a URDF file: a regular file of bounded size only (/dev/zero would be read forever,
+/// a FIFO would block).
+std::string read_checked_file(const std::string& path) {
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
@@ -483,8 +630,55 @@ MechanismDescription urdf_description_from_file(const std::string& path) {
   }
   std::ostringstream text;
   text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+UrdfReading read_urdf_string(const std::string& xml, const UrdfOptions& options) {
   try {
-    return urdf_description_from_string(text.str());
+    const urdf::ModelInterfaceSharedPtr model = parse(xml);
+    UrdfReading r;
+    r.description = describe(*model, options, r.warnings);
+    return r;
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(one_line(e.what()));  // names and values may hold line breaks
+  }
+}
+
+UrdfReading read_urdf_file(const std::string& path, const UrdfOptions& options) {
+  const std::string text = read_checked_file(path);
+  try {
+    return read_urdf_string(text, options);
+  } catch (const std::invalid_argument& e) {
+    std::string what = e.what();
+    if (what.rfind("URDF: ", 0) == 0) what.erase(0, 6);
+    throw std::invalid_argument("URDF file '" + path + "': " + what);
+  }
+}
+
+MechanismModel model_from_urdf_reading(UrdfReading reading, const std::string& source) {
+  const MechanismDescription copy = reading.description;
+  try {
+    return MechanismModel(std::move(reading.description));
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(source + ": " + urdf_words(e.what(), copy));
+  }
+}
+
+MechanismDescription urdf_description_from_string(const std::string& xml) {
+  try {
+    const urdf::ModelInterfaceSharedPtr model = parse(xml);
+    return describe(*model);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(one_line(e.what()));  // names and values may hold line breaks
+  }
+}
+
+MechanismDescription urdf_description_from_file(const std::string& path) {
+  const std::string text = read_checked_file(path);
+  try {
+    return urdf_description_from_string(text);
   } catch (const std::invalid_argument& e) {
     std::string what = e.what();
     if (what.rfind("URDF: ", 0) == 0) what.erase(0, 6);

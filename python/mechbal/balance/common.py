@@ -377,6 +377,11 @@ class LinearSolution:
     limited_by: list[str]
     stage: str
     singular_values: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: the minimum-norm least-squares solution without bounds, per slot (mass, position)
+    unconstrained: dict = field(default_factory=dict)
+    #: a lower bound of the lightest design's added mass [kg] (the last relaxation's optimum);
+    #: None when no least-squares solution meets the bounds
+    lower_bound: float | None = None
 
     def result(self, method: str, slots: Sequence[Slot], design: dict, residual: float, units: str,
                metrics: dict, balanced) -> BalanceResult:
@@ -386,7 +391,8 @@ class LinearSolution:
                              residual_before=self.residual_before, residual_units=units,
                              rank=self.rank, unknowns=self.unknowns, limited_by=self.limited_by,
                              metrics=metrics, balanced=balanced, active_bounds=self.active_bounds,
-                             undetermined=self.undetermined, tied=tied_groups(slots))
+                             undetermined=self.undetermined, tied=tied_groups(slots),
+                             unconstrained=self.unconstrained)
 
 
 def _rref(M: np.ndarray, tol: float = 1e-9) -> np.ndarray:
@@ -585,33 +591,116 @@ def _slsqp(fun, starts, cons, violation, tol, maxiter=1000, ftol=1e-16):
     return best
 
 
-def _feasible_point(cons, start, violation, tol):
-    """A point meeting every constraint, by minimising a slack t >= every constraint's deficit
-    (SLSQP from a feasible (z, t)); None when there is none."""
-    from scipy.optimize import minimize
+#: the cone cuts stop when every cone |d| <= R m is met to this fraction of the mass scale
+CONE_RTOL = 1e-11
+#: at most this many rounds of cone cuts (each one linear program)
+MAX_CUT_ROUNDS = 200
 
-    def lifted(c):
-        return {"type": c["type"], "fun": (lambda w, f=c["fun"]: f(w[:-1]) + w[-1]),
-                "jac": (lambda w, j=c["jac"]: np.hstack([np.atleast_2d(j(w[:-1])),
-                                                         np.ones((np.atleast_1d(c["fun"](w[:-1])).size, 1))]))}
 
-    if violation(start) <= tol:
-        return start
-    t0 = max(1.0, max(float(np.max(-np.atleast_1d(c["fun"](start)), initial=0.0)) for c in cons) * 1.1)
-    w0 = np.append(start, t0)
-    obj = lambda w: (w[-1], np.append(np.zeros(len(w) - 1), 1.0))  # noqa: E731
-    r = minimize(obj, w0, jac=True, method="SLSQP", constraints=[lifted(c) for c in cons],
-                 bounds=[(None, None)] * len(start) + [(0.0, None)], options=dict(ftol=1e-16, maxiter=1000))
-    z = r.x[:-1]
-    return z if violation(z) <= tol else None
+def _start_directions() -> np.ndarray:
+    """The 14 unit directions of the first outer approximation of a 3-D cone: +-axes and the
+    eight diagonals (a polytope circumscribing the cone's cross-section ball)."""
+    diag = np.array([[a, b, c] for a in (-1, 1) for b in (-1, 1) for c in (-1, 1)], float) / math.sqrt(3.0)
+    return np.vstack([np.eye(3), -np.eye(3), diag])
+
+
+def lightest_within_bounds(dsg: "_Design", y0: np.ndarray, Z: np.ndarray, mscale: float):
+    """The lightest design among the least-squares solutions y = y0 + Z z that meet the bounds:
+
+        min  sum_k count_k m_k   over z
+        s.t. G y + g >= 0                 (mass ranges, mass budget, radius along a line)
+             |d_k| <= R_k m_k              (radius around a centre: a second-order cone)
+
+    a convex program. It is solved by outer approximation: each cone is replaced by the tangent
+    planes u . d <= R m of a set of unit directions u (14 at first); the linear program (HiGHS,
+    ``scipy.optimize.linprog``) is solved, a tangent plane is added at each cone the solution
+    leaves (u = d / |d|), until every cone is met to CONE_RTOL of the mass scale. Each linear
+    program is a relaxation, so its optimum is a lower bound of the true one (the dual of the last
+    one is a dual certificate of the convex program); the last solution, polished on the exact cones
+    by SLSQP, meets them to CONE_RTOL and stays on the least-squares set.
+
+    Returns (y, lower bound [kg]) or None when no least-squares solution meets the bounds (or the
+    solver fails)."""
+    from scipy.optimize import linprog
+
+    ny = len(y0)
+    c = (dsg.mass_row @ Z) / mscale
+    rows, rhs = [], []
+    if len(dsg.g):               # G (y0 + Z z) + g >= 0  ->  -G Z z <= G y0 + g, in kg
+        sc = (dsg.lin_scale * mscale)[:, None]
+        rows.append(-(dsg.G @ Z) / sc)
+        rhs.append((dsg.G @ y0 + dsg.g) / sc[:, 0])
+
+    def cut(k, u):
+        """u . d - R m <= 0 as a row over z (in kg)."""
+        s = dsg.slots[k]
+        j = dsg.mass_var[k]
+        a = u @ Z[dsg.d_vars[k]]
+        r = -(u @ y0[dsg.d_vars[k]])
+        if j is not None:
+            a = a - s.max_radius / dsg.L * Z[j]
+            r = r + s.max_radius / dsg.L * y0[j]
+        else:
+            r = r + s.max_radius * s.mass_min
+        return a / (dsg.L * mscale), r / (dsg.L * mscale)
+
+    for k in dsg.cones:
+        for u in _start_directions():
+            a, r = cut(k, u)
+            rows.append(a[None, :]), rhs.append(np.array([r]))
+    bound = None
+    for _ in range(MAX_CUT_ROUNDS):
+        A_ub = np.vstack(rows) if rows else None
+        b_ub = np.concatenate(rhs) if rhs else None
+        res = linprog(c, A_ub=A_ub, b_ub=b_ub, bounds=[(None, None)] * Z.shape[1], method="highs",
+                      options=dict(primal_feasibility_tolerance=1e-10, dual_feasibility_tolerance=1e-10))
+        if res.status != 0:
+            return None
+        z = res.x
+        y = y0 + Z @ z
+        bound = float(dsg.mass_row @ y)
+        worst, added = 0.0, False
+        for k in dsg.cones:
+            m, _ = dsg._mass(k, y)
+            dk = y[dsg.d_vars[k]]
+            nd = float(np.linalg.norm(dk))
+            over = (nd - dsg.slots[k].max_radius * m) / (dsg.L * mscale)
+            worst = max(worst, over)
+            if over > CONE_RTOL and nd > 0:
+                a, r = cut(k, dk / nd)
+                rows.append(a[None, :]), rhs.append(np.array([r]))
+                added = True
+        if not added:
+            break
+    if dsg.cones:
+        # the cuts meet the cones to CONE_RTOL in mass, which leaves an error of its square root in
+        # a position along a flat direction: polish on the exact cones from the relaxation's
+        # optimum (SLSQP, starting at the optimal active set), kept when it is as light and feasible
+        to_y = lambda zz: y0 + Z @ zz  # noqa: E731
+        g = c.copy()
+        zp = _slsqp(lambda zz: (float(c @ zz), g), [z], dsg.scipy(to_y, Z),
+                    lambda zz: dsg.violation(to_y(zz), mscale), 1e-12)
+        if (dsg.violation(to_y(zp), mscale) <= 1e-11
+                and float(dsg.mass_row @ to_y(zp)) <= bound + 1e-9 * mscale):
+            z = zp
+    # y stays on the least-squares set (y0 + Z z): each cone is met to CONE_RTOL of the mass scale
+    # (a radius beyond its bound by that fraction), which is kept rather than pulling d onto the
+    # cone and leaving the least squares
+    y = y0 + Z @ z
+    if dsg.violation(y, mscale) > 1e-9:
+        return None
+    return y, bound
 
 
 def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
                        mass_budget: float | None = None, L: float = 1.0,
-                       what: str = "the balancing condition") -> LinearSolution:
+                       what: str = "the balancing condition",
+                       components: Sequence[str] | None = None) -> LinearSolution:
     """The two stages of the module docstring for ``A x + b = 0`` (rows: every sample and
     component; x: (m, h_user) per slot). The least squares is over the design's free variables
-    (a fixed mass is not an unknown; a slot with a direction has one moment along it)."""
+    (a fixed mass is not an unknown; a slot with a direction has one moment along it).
+    ``components``: the names of the components of one sample (the rows are sample-major), e.g.
+    "gravity torque of joint 'elbow'": ``limited_by`` names those the slots cannot cancel."""
     A = np.asarray(A, float)
     b = np.asarray(b, float).reshape(-1)
     if A.shape[0] == 0:
@@ -637,24 +726,20 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
     mscale = max([1.0] + [abs(s.mass_min) for s in roots] + [abs(v) / L for v in y0])
     tol = 1e-9
 
-    # stage 2a: the lightest least-squares solution within the bounds
+    # stage 2a: the lightest least-squares solution within the bounds: a convex program (linear
+    # objective, linear bounds, second-order cones), solved by HiGHS on polyhedral outer
+    # approximations of the cones (:func:`lightest_within_bounds`)
     d = Z.shape[1]
     y = y0
+    lower_bound = None
     if d:
-        to_y = lambda z: y0 + Z @ z  # noqa: E731
-        g_mass = (dsg.mass_row @ Z) / mscale
-        mu = 0.0  # (flat directions: SLSQP stays near the minimum-norm start)
-
-        def f(z):
-            return float(dsg.mass_row @ to_y(z)) / mscale + mu * float(z @ z), g_mass + 2 * mu * z
-
-        cons_z = dsg.scipy(to_y, Z)
-        z = _feasible_point(cons_z, np.zeros(d), lambda z: dsg.violation(to_y(z), mscale), tol)
-        if z is not None:
-            z = _slsqp(f, [z], cons_z, lambda z: dsg.violation(to_y(z), mscale), tol)
+        found = lightest_within_bounds(dsg, y0, Z, mscale)
+        if found is not None:
+            y, lower_bound = found
         else:
-            z = np.zeros(d)
-        y = to_y(z)
+            y = y0
+    elif dsg.violation(y0, mscale) <= tol:
+        lower_bound = float(dsg.mass_row @ y0)
     stage = "least squares within the bounds"
     if dsg.violation(y, mscale) > tol:
         # stage 2b: no least-squares solution meets the bounds: constrained least squares, on the
@@ -676,14 +761,53 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
     active = dsg.active(y, mscale)
     limited = []
     scale = max(before, 1e-300)
+    x0 = E @ dsg.x(y0)
+    unconstrained = unconstrained_design(x0, slots)
     if ls > EXACT_RTOL * scale:
+        left = uncancelled(Ay @ y0 + by, components, EXACT_RTOL * scale)
         limited.append(f"impossible: rank {rank} of {ny} unknowns and a least-squares residual of "
                        f"{ls:.6g} (RMS; {100 * ls / scale:.3g} % of the unbalanced {before:.6g}): these "
-                       f"slots cannot make {what} zero over the samples")
+                       f"slots cannot make {what} zero over the samples"
+                       + (f"; not cancelled: {left}" if left else ""))
     if residual > max(ls * (1 + 1e-6), EXACT_RTOL * scale):
         limited += [f"bound: {a}" for a in active] or ["bound: the solver could not meet the bounds "
                                                       f"(violation {dsg.violation(y, mscale):.3g})"]
-    return LinearSolution(x, residual, before, ls, rank, ny, undetermined, active, limited, stage, sv)
+        limited.append(f"unconstrained: without the bounds the least squares (residual {ls:.6g}) asks "
+                       f"for {describe_unconstrained(unconstrained)}")
+    return LinearSolution(x, residual, before, ls, rank, ny, undetermined, active, limited, stage, sv,
+                          unconstrained=unconstrained, lower_bound=lower_bound)
+
+
+def uncancelled(r: np.ndarray, components: Sequence[str] | None, floor: float) -> str:
+    """The components of the residual rows ``r`` (sample-major) that are not cancelled, largest
+    first, with their RMS: "gravity torque of joint 'rocker' (RMS 0.31), ...". Components below
+    1e-6 of the largest (or ``floor``) are cancelled."""
+    if not components:
+        return ""
+    n = len(components)
+    r = np.asarray(r, float).reshape(-1, n)
+    per = np.sqrt(np.mean(r ** 2, axis=0))
+    top = float(per.max()) if per.size else 0.0
+    keep = [i for i in np.argsort(-per) if per[i] > max(1e-6 * top, floor)]
+    return ", ".join(f"{components[i]} (RMS {per[i]:.3g})" for i in keep)
+
+
+def unconstrained_design(x: np.ndarray, slots: Sequence[Slot]) -> dict:
+    """{slot: {mass, mass_moment, position}} of the (minimum-norm) least-squares solution without
+    any bound: what the balance asks for, before the mass ranges, radii and budget."""
+    out = {}
+    for k, s in enumerate(slots):
+        m, h = float(x[4 * k]), np.array(x[4 * k + 1:4 * k + 4])
+        p = s.center.copy() if s.fixed_position or abs(m) <= 1e-12 else h / m
+        out[s.name] = {"mass": m, "mass_moment": h, "position": p,
+                       "radius": float(np.linalg.norm(p - s.center))}
+    return out
+
+
+def describe_unconstrained(design: dict) -> str:
+    """The mass moments m p (what the balance fixes) and masses of the minimum-norm solution."""
+    return "; ".join(f"{n} mass moment [{', '.join(f'{v:.4g}' for v in d['mass_moment'])}] kg m "
+                     f"(minimum-norm mass {d['mass']:.4g} kg)" for n, d in design.items())
 
 
 def design_from_solution(x: np.ndarray, slots: Sequence[Slot], active: Sequence[str]) -> tuple[dict, list]:

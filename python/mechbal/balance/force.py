@@ -78,7 +78,8 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples=200, *, mass
     b = mech.momentum(q, v).linear_momentum
     sol = common.solve_mass_moments(A.reshape(-1, A.shape[-1]), b.reshape(-1), slots,
                                     mass_budget=mass_budget, L=common.length_scale(mech),
-                                    what="the linear momentum (shaking force)")
+                                    what="the linear momentum (shaking force)",
+                                    components=[f"linear momentum {a}" for a in "xyz"])
     design_out, placed = common.design_from_solution(sol.x, slots, sol.active_bounds)
     balanced = common.balanced_mechanism(mech, placed)
     after = balanced.momentum(q, v).linear_momentum

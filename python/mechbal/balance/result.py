@@ -138,6 +138,9 @@ class BalanceResult:
     active_bounds: list[str] = field(default_factory=list)
     undetermined: list[str] = field(default_factory=list)
     tied: dict[str, list[str]] = field(default_factory=dict)
+    #: the design without bounds (counterweights: the minimum-norm least-squares solution per
+    #: slot; springs: the least-squares rates and anchors), what ``limited_by`` compares with
+    unconstrained: dict[str, Any] = field(default_factory=dict)
 
     @property
     def exact(self) -> bool:
@@ -160,4 +163,5 @@ class BalanceResult:
                       "residual_before": self.residual_before, "residual_units": self.residual_units,
                       "rank": self.rank, "unknowns": self.unknowns, "limited_by": self.limited_by,
                       "exact": self.exact, "active_bounds": self.active_bounds,
-                      "undetermined": self.undetermined, "tied": self.tied, "metrics": self.metrics})
+                      "undetermined": self.undetermined, "tied": self.tied,
+                      "unconstrained": self.unconstrained, "metrics": self.metrics})

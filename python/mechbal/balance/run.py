@@ -176,12 +176,21 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
         if design_cfg.trajectory is not None:
             t, motion, tt = _trajectory_motion(mech, design_cfg.trajectory)
         else:
+            # the default motion: a quintic move between two random poses of the sample box
+            # (joint limits), over 1 s or longer where the URDF's velocity or effort limits need it
+            from mechbal.trajectory import quintic_within_limits
+
             lo, hi = common.sample_box(mech, design_cfg.balance.lower, design_cfg.balance.upper)
             start, end = lo + (hi - lo) * rng.random(len(lo)), lo + (hi - lo) * rng.random(len(lo))
-            t, motion, tt = _trajectory_motion(mech, {"law": "quintic", "start": start.tolist(),
-                                                      "end": end.tolist(), "duration": 1.0, "samples": 501})
-        return BalanceCase(mech.name, f"{mech.name} (URDF)", mech, design_cfg.balance, t, motion, tt,
-                           None, None, "urdf", [])
+            duration, limits = quintic_within_limits(mech, start, end, 1.0)
+            t, motion, tt = _trajectory_motion(mech, {"law": "quintic", "start": limits["start"],
+                                                      "end": limits["end"], "duration": duration,
+                                                      "samples": 501})
+        bc = BalanceCase(mech.name, f"{mech.name} (URDF)", mech, design_cfg.balance, t, motion, tt,
+                         None, None, "urdf", [])
+        if design_cfg.trajectory is None:
+            bc.notes = {"default_motion": limits}
+        return bc
     path = check_case_file(case)
     raw = load_toml_case(path)
     return case_from_config(validate_case(raw), raw, design_cfg, source=str(path))
@@ -237,7 +246,7 @@ def evaluate(bc: BalanceCase, mech) -> dict:
         G = mech.static_torque(q)              # gravity plus springs (gravity alone without springs)
     sw = mech.shaking_wrench(q, v, a)
     bm = mech.body_motion(q, v, a)
-    return dict(q=q, v=v, a=a, torque=tau, gravity_torque=G, shaking_force=sw.shaking_force,
+    return dict(q=q, v=v, a=a, torque=tau, gravity_torque=G, static_torque=G, shaking_force=sw.shaking_force,
                 shaking_moment=sw.shaking_moment, com=bm.com, rotation=bm.rotation)
 
 
@@ -247,13 +256,17 @@ def _stats(x: np.ndarray) -> dict:
 
 def _comparison(before: dict, after: dict) -> dict:
     out = {}
-    for key, unit in (("gravity_torque", "N m or N"), ("torque", "N m or N"), ("shaking_force", "N"),
+    for key, unit in (("static_torque", "N m or N"), ("torque", "N m or N"), ("shaking_force", "N"),
                       ("shaking_moment", "N m")):
         b, a = _stats(before[key]), _stats(after[key])
         name = "actuator_torque" if key == "torque" else key
         out[name] = {"unit": unit, "unbalanced": b, "balanced": a,
                      "peak_reduction_pct": common.reduction_pct(b["peak"], a["peak"]),
                      "rms_reduction_pct": common.reduction_pct(b["rms"], a["rms"])}
+    # the static torque (gravity + springs: what holds each pose) was labelled gravity_torque;
+    # the old key stays one release as a deprecated copy
+    out["gravity_torque"] = dict(out["static_torque"], deprecated=(
+        "renamed static_torque (gravity + springs); this copy goes in the next release"))
     return out
 
 

@@ -478,6 +478,14 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     V = np.atleast_1d(balanced.potential_energy(q))
     exact_tol = tolerance * max(1.0, residual_before)
     limited += active
+    # the rates the least squares asks for without bounds (anchors as chosen), and what stops them
+    unconstrained = _unconstrained_rates(A, rhs, springs, free, Klo, Khi)
+    for name, u in unconstrained["springs"].items():
+        for i, a in enumerate(limited):
+            if a.startswith(f"bound: {name}.rate"):
+                limited[i] = f"{a} ({u['stopped_by']})"
+    active_bounds = [a[len("bound: "):].split(" ")[0].rsplit(".rate", 1)[0]
+                     + (".rate_min" if ">= rate_min" in a else ".rate_max") for a in active]
     notes = []
     if unknowns and rank < unknowns:
         msg = (f"rank {rank} < {unknowns} unknowns: some spring rates act alike over the sample "
@@ -487,10 +495,13 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
         val = chosen[springs[i].name][0 if side == "a" else 1][c]
         if residual > exact_tol and (abs(val - lo) <= 1e-9 * max(1, abs(lo)) or abs(val - hi) <= 1e-9 * max(1, abs(hi))):
             limited.append(f"bound: {springs[i].name}.anchor_{side}[{c}] at {'lower' if abs(val - lo) <= abs(val - hi) else 'upper'} bound {val:.6g}")
+            active_bounds.append(f"{springs[i].name}.anchor_{side}_bounds[{c}]")
     if residual > exact_tol:
         limited.append(f"impossible: gravity + spring torque {residual:.3g} N m remains (relative "
                        f"{residual / max(residual_before, 1e-300):.2e}); these slots cannot make the "
-                       "potential energy constant over the sample")
+                       "potential energy constant over the sample; without bounds the least squares "
+                       f"asks for {_describe_rates(unconstrained)} (peak static torque "
+                       f"{unconstrained['residual']:.3g} N m)")
     names = mechanism.actuated_names if closed else mechanism.joint_names
 
     def per_joint(x):
@@ -511,7 +522,8 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     result = BalanceResult(method="springs", design=design_out, residual=residual,
                            residual_before=residual_before, residual_units="N m (N on prismatic joints)",
                            rank=rank if unknowns else None, unknowns=unknowns, limited_by=limited,
-                           metrics=metrics, balanced=balanced, elements=sized)
+                           metrics=metrics, balanced=balanced, elements=sized,
+                           active_bounds=list(dict.fromkeys(active_bounds)), unconstrained=unconstrained)
     if catalogue is not None:
         springs_cat = catalogue if isinstance(catalogue, Sequence) and not isinstance(catalogue, str) \
             else load_catalogue(None if str(catalogue) == "shipped" else catalogue)
@@ -815,3 +827,40 @@ def select_for_result(mechanism: Mechanism, result: BalanceResult, samples, cata
         out[s.name] = select_springs(K0, float(result.design[s.name]["peak_tension"]), catalogue,
                                      anchor_offset=offset, peak_force_at=peak_with_cluster, **select_options)
     return out
+
+
+def _unconstrained_rates(A, rhs, springs, free, Klo, Khi) -> dict:
+    """The least-squares rates without bounds for the chosen anchors: {"springs": {name: {rate,
+    equivalent_rate, stopped_by}}, "residual": peak static torque they leave [N m]}. ``stopped_by``
+    says what keeps the bounded solution from it: the sign (a negative rate is a spring that pushes:
+    its anchors are on the wrong side of the joint it should hold, move anchor_a or anchor_b across
+    it), rate_min or rate_max, or nothing."""
+    out: dict[str, Any] = {"springs": {}, "residual": 0.0}
+    if A.shape[1] == 0:
+        out["residual"] = float(np.max(np.abs(rhs))) if rhs.size else 0.0
+        return out
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    z, *_ = np.linalg.lstsq(A / scale, rhs, rcond=None)
+    K = z / scale
+    out["residual"] = float(np.max(np.abs(A @ K - rhs))) if rhs.size else 0.0
+    for j, i in enumerate(free):
+        s = springs[i]
+        rate = float(K[j] * s.pulley_ratio ** 2 / _count(s))
+        tol = 1e-9 * max(1.0, abs(K[j]))
+        if K[j] < 0 and Klo[j] <= 0:
+            why = (f"the sign: {s.name} would need a negative rate {rate:.6g} N/m (a spring that pushes): "
+                   f"its anchors (anchor_a on '{s.link_a}', anchor_b on '{s.link_b}') pull the wrong way; "
+                   "move one across the joint it should hold, or let the method move it (anchor bounds)")
+        elif K[j] < Klo[j] - tol:
+            why = f"rate_min: {s.name} would need {rate:.6g} N/m, below rate_min = {getattr(s, 'rate_min', 0.0):.6g}"
+        elif K[j] > Khi[j] + tol:
+            why = f"rate_max: {s.name} would need {rate:.6g} N/m, above rate_max = {s.rate_max:.6g}"
+        else:
+            why = "nothing"
+        out["springs"][s.name] = {"rate": rate, "equivalent_rate": float(K[j]), "stopped_by": why}
+    return out
+
+
+def _describe_rates(unconstrained: dict) -> str:
+    return ", ".join(f"{n} {u['rate']:.6g} N/m" for n, u in unconstrained["springs"].items()) or "no free rate"

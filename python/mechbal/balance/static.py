@@ -85,7 +85,9 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples=1000, *, mas
         b = np.einsum("nij,ni->nj", C, b)
     sol = common.solve_mass_moments(A.reshape(-1, A.shape[-1]), b.reshape(-1), slots,
                                     mass_budget=mass_budget, L=common.length_scale(mech),
-                                    what="the gravity torque")
+                                    what="the gravity torque",
+                                    components=[f"gravity torque of joint '{n}'" for n in
+                                                (mech.joint_names if C is None else mech.actuated_names)])
     design_out, placed = common.design_from_solution(sol.x, slots, sol.active_bounds)
     balanced = common.balanced_mechanism(mech, placed)
     after = gravity_rows(balanced, q, C)

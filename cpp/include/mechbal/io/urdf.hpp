@@ -32,6 +32,7 @@
 /// a link with two parent joints, a cycle: the message names the joints).
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "mechbal/model/model.hpp"
 
@@ -41,6 +42,43 @@ namespace mechbal {
 inline constexpr std::size_t kMaxUrdfBytes = 64u << 20;
 /// Deepest element nesting read (a URDF needs 4: robot / link / inertial / origin).
 inline constexpr std::size_t kMaxUrdfDepth = 64;
+/// How the reader treats harmless defects that Pinocchio loads (issue 23).
+///  - strict: refuse them (the functions without options read strictly).
+///  - lenient (strict = false): repair each with one warning naming the URDF element and the repair:
+///    * a <mimic> on a fixed joint is ignored (a fixed joint has no coordinate to couple);
+///    * a <mimic> of a joint that does not exist is ignored (Pinocchio reads an independent joint);
+///    * a body whose inertia is not physical (not positive semi-definite, or breaking the triangle
+///      inequality; Pinocchio loads it) gets the nearest physical one: the second moment of mass
+///      S = tr(I)/2 1 - I has its negative eigenvalues set to zero (S >= 0 is exactly
+///      "physical"), and I = tr(S) 1 - S. The warning says whether the body is negligible (mass
+///      <= kNegligibleMassFraction of the URDF's total mass) or not (then the dynamics differ from
+///      the file's, and the warning asks for the file to be corrected);
+///    * a negligible, non-physical <inertial> on the root link (a placeholder on the fixed base,
+///      which never moves) is dropped.
+///  - allow_massless: load a URDF with no <inertial> on any moving link (kinematics only: every
+///    dynamic quantity is zero), with a warning; otherwise it is refused in both modes, naming the
+///    option.
+struct UrdfOptions {
+  bool strict = true;
+  bool allow_massless = false;
+};
+
+/// A body is negligible when its mass is at most this fraction of the URDF's total mass.
+inline constexpr double kNegligibleMassFraction = 1e-4;
+
+/// A description read under UrdfOptions, with one warning per repair.
+struct UrdfReading {
+  MechanismDescription description;
+  std::vector<std::string> warnings;
+};
+
+/// The description of the URDF document `xml` / file `path` under `options`.
+UrdfReading read_urdf_string(const std::string& xml, const UrdfOptions& options);
+UrdfReading read_urdf_file(const std::string& path, const UrdfOptions& options);
+/// The validated model of a description read by read_urdf_*: errors of the model name URDF
+/// elements (URDF joint 'x', URDF link 'y' <inertial>), not description indices. `source` prefixes
+/// them (e.g. "URDF file 'arm.urdf'").
+MechanismModel model_from_urdf_reading(UrdfReading reading, const std::string& source);
 
 /// The description of the URDF document `xml`.
 MechanismDescription urdf_description_from_string(const std::string& xml);
