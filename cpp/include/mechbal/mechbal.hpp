@@ -1,12 +1,12 @@
 #pragma once
 /// \file mechbal.hpp
 /// Umbrella header of the mechbal C++ core: includes every public header in
-/// cpp/include/mechbal/ and cpp/include/mechbal/algorithm/ (the ctest `install_and_consume` fails
+/// cpp/include/mechbal/ and its folders (the ctest `install_and_consume` fails
 /// when one is missing here; detail/ is private).
 ///
 /// The general mechanism model and its algorithms (one header each)
+#include "mechbal/build_config.hpp"
 #include "mechbal/status.hpp"
-#include "mechbal/urdf.hpp"
 #include "mechbal/version.hpp"
 #include "mechbal/rigid_body.hpp"
 #include "mechbal/joint_type.hpp"
@@ -28,7 +28,9 @@
 #include "mechbal/trajectory.hpp"
 #include "mechbal/dynamics.hpp"
 #include "mechbal/rnea.hpp"
+#if MECHBAL_WITH_KDL
 #include "mechbal/kdl_chain.hpp"
+#endif
 #include "mechbal/coupled_model.hpp"
 /// Controllers and closed-loop simulation
 #include "mechbal/joint_controller.hpp"
@@ -37,6 +39,13 @@
 #include "mechbal/joint_limits.hpp"
 #include "mechbal/reactionless_wrist.hpp"
 #include "mechbal/closed_loop.hpp"
+#include "mechbal/control/config.hpp"
+#include "mechbal/control/factory.hpp"
+/// Reading mechbal's case format (TOML) and URDF
+#include "mechbal/io/case.hpp"
+#if MECHBAL_WITH_URDF
+#include "mechbal/urdf.hpp"
+#endif
 /// Fast paths of the papers' mechanisms
 #include "mechbal/arm2dof.hpp"
 #include "mechbal/five_bar.hpp"

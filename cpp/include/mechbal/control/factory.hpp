@@ -1,0 +1,22 @@
+#pragma once
+/// \file control/factory.hpp
+/// make_controller: the controller a ControlConfig describes, over a MechanismModel.
+///  - computed_torque: ComputedTorque over MechanismDynamics (the general model, closed loops
+///    through the loop projection), gains kp, kd, torque_limit;
+///  - decoupled: DecoupledJointController with k (the constant diagonal of the balanced mass
+///    matrix; from the model at q = 0 when the config leaves it empty), kp, kd, torque_limit;
+///  - reactionless: not in this build yet (std::invalid_argument saying so).
+/// Construction time only: throws std::invalid_argument naming the `control.` field and the value.
+/// The returned controller owns everything it uses (its own copy of the model); step() is
+/// noexcept and allocation-free as the controller's own.
+#include <memory>
+
+#include "mechbal/control/config.hpp"
+#include "mechbal/joint_controller.hpp"
+#include "mechbal/model.hpp"
+
+namespace mechbal {
+
+std::unique_ptr<JointController> make_controller(const MechanismModel& model, const ControlConfig& control);
+
+}  // namespace mechbal
