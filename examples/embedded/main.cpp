@@ -83,17 +83,20 @@ int main(int argc, char** argv) {
   using namespace mechbal;
   // ---- load time: everything that can throw ----
   Options opt;
-  LoadedCase c{MechanismModel(MechanismDescription{"base", {Joint{"j"}}, {}, {}, Vec3::Zero(), {}, {}, {}}), {}, {}, {}};
+  std::unique_ptr<LoadedCase> loaded;
   std::unique_ptr<JointController> controller;
   try {
     opt = parse(argc, argv);
-    c = load_case(opt.case_path);
-    if (!opt.control_path.empty()) c.control = load_control(opt.control_path, c.model);
-    controller = make_controller(c.model, c.control);
+    loaded = std::make_unique<LoadedCase>(load_case(opt.case_path));
+    if (!opt.control_path.empty()) loaded->control = load_control(opt.control_path, loaded->model);
+    const auto& guess = loaded->trajectory.initial_guess;  // the assembly mode of a closed mechanism
+    controller = make_controller(loaded->model, loaded->control,
+                                 Eigen::Map<const Eigen::VectorXd>(guess.data(), static_cast<Eigen::Index>(guess.size())));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mechbal_embedded: %s\n", e.what());
     return 2;
   }
+  const LoadedCase& c = *loaded;
   const MechanismModel& model = c.model;
   const int na = model.num_actuated(), n = model.dof();
   const double rate = c.control.rate_hz;
@@ -120,7 +123,8 @@ int main(int argc, char** argv) {
   std::vector<double> trace;
   if (!opt.trace_path.empty()) trace.reserve(static_cast<std::size_t>(ticks) * static_cast<std::size_t>(na + 6));
   Vec3 peak_force = Vec3::Zero(), peak_moment = Vec3::Zero();
-  long bad_ticks = 0, saturated = 0, singular = 0, misses = 0;
+  long bad_ticks = 0, saturated = 0, singular = 0, misses = 0, first_bad = -1;
+  Status first_bad_status = Status::ok;
 
   // ---- real-time setup where permitted ----
   const bool locked = mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
@@ -167,6 +171,7 @@ int main(int argc, char** argv) {
     if (opt.sleep && compute + late > 1e6 / rate) ++misses;
     if (has(s, Status::bad_size) || has(s, Status::non_finite_input) || has(s, Status::solver_error) ||
         has(w, Status::solver_error)) {
+      if (bad_ticks == 0) first_bad = k, first_bad_status = s | w;
       ++bad_ticks;
     }
     saturated += has(s, Status::saturated);
@@ -190,6 +195,7 @@ int main(int argc, char** argv) {
                 percentile(late_us, 1.0), misses);
   }
   std::printf("\nstatus: %ld failed, %ld saturated, %ld near a singularity\n", bad_ticks, saturated, singular);
+  if (bad_ticks) std::printf("first failed tick %ld: status %s\n", first_bad, status_name(first_bad_status));
   std::printf("predicted peak shaking force  |F| per axis [N]:   %.6g %.6g %.6g\n", peak_force[0], peak_force[1],
               peak_force[2]);
   std::printf("predicted peak shaking moment |M_O| per axis [N m]: %.6g %.6g %.6g\n", peak_moment[0], peak_moment[1],

@@ -127,7 +127,7 @@ TEST(CaseReader, ErrorsNameTheField) {
   EXPECT_EQ(field_of("[mechanism\n"), "string");  // not TOML: the source is named
   const std::string msg = message_of(with("mass = 1.25", "mass = -1.25"));
   EXPECT_NE(msg.find("mechanism.joints[1].link.mass: must be >= 0 (got -1.25)"), std::string::npos) << msg;
-  EXPECT_NE(message_of(with("orign", "orgin")).find("did you mean"), std::string::npos);
+  EXPECT_NE(message_of(with("origin =", "orgin =")).find("did you mean"), std::string::npos);
 }
 
 TEST(CaseReader, ControlTable) {

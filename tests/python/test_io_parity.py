@@ -420,3 +420,18 @@ def test_cpp_messages_name_the_value():
     assert msg("unknown parent") == "mechanism.joints[1].parent: unknown parent joint (allowed: a, b, s_z, s_y, s_x, s, base) (got 'c')" \
         or "(got 'c')" in msg("unknown parent")
     assert "(got 'revolut')" in msg("joint type") and "did you mean 'revolute'" in msg("joint type")
+
+
+# ---- [control] through the C++ reader ---------------------------------------------------------------
+
+def test_load_case_file_reads_control(tmp_path):
+    model, control, name = _core.load_case_file(str(PKG / "cases" / "paminsa-linkage.toml"))
+    assert name == "paminsa-linkage" and control.kind == "none" and len(model.actuated_coordinates) == 6
+    path = tmp_path / "c.toml"
+    path.write_text(invalid_text(lambda m: None) + '\n[control]\nkind = "computed_torque"\nrate_hz = 500\n'
+                    'kp = [100.0, 100.0, 100.0, 100.0, 100.0]\nkd = [20, 20, 20, 20, 20]\n')
+    model, control, name = _core.load_case_file(str(path))
+    assert (control.kind, control.rate_hz, control.kp, control.kd) == ("computed_torque", 500.0, [100.0] * 5, [20.0] * 5)
+    path.write_text(path.read_text().replace("kd = [20, 20, 20, 20, 20]", "kd = [20, 20]"))
+    with pytest.raises(ValueError, match=r"^control\.kd: must have 5 values"):
+        _core.load_case_file(str(path))

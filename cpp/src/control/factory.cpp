@@ -31,8 +31,8 @@ Eigen::VectorXd vec(const std::vector<double>& v) {
 /// ComputedTorque over its own MechanismDynamics (the controller holds a reference to it).
 class OwnedComputedTorque : public JointController {
  public:
-  OwnedComputedTorque(const MechanismModel& model, const ControlConfig& c)
-      : dynamics_(model), controller_(dynamics_, vec(c.kp), vec(c.kd), vec(c.torque_limit)) {}
+  OwnedComputedTorque(const MechanismModel& model, const ControlConfig& c, const Eigen::VectorXd& q_guess)
+      : dynamics_(model, q_guess), controller_(dynamics_, vec(c.kp), vec(c.kd), vec(c.torque_limit)) {}
   int dof() const noexcept override { return controller_.dof(); }
   Status step(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& qd,
               const Eigen::Ref<const Eigen::VectorXd>& q_des, const Eigen::Ref<const Eigen::VectorXd>& qd_des,
@@ -52,8 +52,8 @@ void check_size(const std::vector<double>& v, int n, const char* field, bool may
 }
 
 /// decoupled without k: the diagonal of M#(0), which must be diagonal (a dynamically balanced design).
-std::vector<double> balanced_diagonal(const MechanismModel& model) {
-  MechanismDynamics dyn(model);
+std::vector<double> balanced_diagonal(const MechanismModel& model, const Eigen::VectorXd& q_guess) {
+  MechanismDynamics dyn(model, q_guess);
   const int n = dyn.dof();
   Eigen::MatrixXd M(n, n);
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
@@ -76,21 +76,22 @@ std::vector<double> balanced_diagonal(const MechanismModel& model) {
 
 }  // namespace
 
-std::unique_ptr<JointController> make_controller(const MechanismModel& model, const ControlConfig& control) {
+std::unique_ptr<JointController> make_controller(const MechanismModel& model, const ControlConfig& control,
+                                                 const Eigen::VectorXd& q_guess) {
   const int n = model.num_actuated();
   switch (control.kind) {
     case ControlKind::computed_torque: {
       check_size(control.kp, n, "kp", false);
       check_size(control.kd, n, "kd", false);
       check_size(control.torque_limit, n, "torque_limit", true);
-      return std::make_unique<OwnedComputedTorque>(model, control);
+      return std::make_unique<OwnedComputedTorque>(model, control, q_guess);
     }
     case ControlKind::decoupled: {
       check_size(control.kp, n, "kp", false);
       check_size(control.kd, n, "kd", false);
       check_size(control.torque_limit, n, "torque_limit", true);
       check_size(control.k, n, "k", true);
-      const std::vector<double> k = control.k.empty() ? balanced_diagonal(model) : control.k;
+      const std::vector<double> k = control.k.empty() ? balanced_diagonal(model, q_guess) : control.k;
       return std::make_unique<DecoupledJointController>(vec(k), vec(control.kp), vec(control.kd),
                                                         vec(control.torque_limit));
     }

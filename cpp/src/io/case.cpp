@@ -428,10 +428,6 @@ DHIn read_dh(const toml::node& n, const std::string& f) {
   return d;
 }
 
-std::string vec_repr(const Vec3& v) {
-  return "[" + float_repr(v[0]) + ", " + float_repr(v[1]) + ", " + float_repr(v[2]) + "]";
-}
-
 JointIn read_joint(const toml::node& n, const std::string& f) {
   const auto& t = table_of(n, f);
   allow_keys(t, f, {"name", "type", "parent", "origin", "mdh", "dh", "axis", "limits", "mimic", "link"});

@@ -8,7 +8,10 @@
 ///  - reactionless: not in this build yet (std::invalid_argument saying so).
 /// Construction time only: throws std::invalid_argument naming the `control.` field and the value.
 /// The returned controller owns everything it uses (its own copy of the model); step() is
-/// noexcept and allocation-free as the controller's own.
+/// noexcept and allocation-free as the controller's own. `q_guess` (model.dof() values, or empty
+/// for zeros): the full coordinates near the assembly the loops of a closed mechanism start from
+/// (the assembly mode; a case's `[trajectory] initial_guess`).
+#include <Eigen/Core>
 #include <memory>
 
 #include "mechbal/control/config.hpp"
@@ -17,6 +20,7 @@
 
 namespace mechbal {
 
-std::unique_ptr<JointController> make_controller(const MechanismModel& model, const ControlConfig& control);
+std::unique_ptr<JointController> make_controller(const MechanismModel& model, const ControlConfig& control,
+                                                 const Eigen::VectorXd& q_guess = Eigen::VectorXd());
 
 }  // namespace mechbal
