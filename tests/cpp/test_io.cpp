@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "alloc_counter.hpp"
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
 #include "mechbal/control/factory.hpp"
@@ -186,4 +187,40 @@ TEST(MakeController, DecoupledTakesTheBalancedDiagonal) {
   // the 2R arm's mass matrix is not diagonal: decoupled needs k then
   const LoadedCase a = case_from_string(arm("origin") + "[control]\nkind = \"decoupled\"\nkp = [1, 1]\nkd = [1, 1]\n");
   EXPECT_THROW(make_controller(a.model, a.control), std::invalid_argument);
+}
+
+TEST(MakeController, MadeControllersStepWithoutAllocating) {
+  // the closed PAMINSA under computed torque (loops solved every tick) and a decoupled rotor
+  const LoadedCase p = load_case(cases_dir + "paminsa-linkage.toml");
+  ControlConfig config;
+  config.kind = ControlKind::computed_torque;
+  config.kp.assign(6, 400.0);
+  config.kd.assign(6, 40.0);
+  const Eigen::VectorXd guess = Eigen::Map<const Eigen::VectorXd>(p.trajectory.initial_guess.data(), p.model.dof());
+  auto ct = make_controller(p.model, config, guess);
+  const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(p.trajectory.start.data(), 6);
+  const Eigen::VectorXd z = Eigen::VectorXd::Zero(6);
+  Eigen::VectorXd tau(6), bad = q;
+  bad[0] = std::nan("");
+  ASSERT_EQ(ct->step(q, z, q, z, z, tau), Status::ok);  // first tick: assembles from the guess
+  // the case's motion, sampled before counting
+  const RestToRestTrajectory motion(q, Eigen::Map<const Eigen::VectorXd>(p.trajectory.end.data(), 6),
+                                    p.trajectory.duration, p.trajectory.law);
+  Eigen::MatrixXd Q(6, 50), V(6, 50), A(6, 50);
+  for (int k = 0; k < 50; ++k) {
+    Eigen::VectorXd qk(6), vk(6), ak(6);
+    motion.evaluate(p.trajectory.duration * k / 49.0, qk, vk, ak);
+    Q.col(k) = qk, V.col(k) = vk, A.col(k) = ak;
+  }
+  int ok = 0;
+  {
+    test::AllocationScope scope;
+    for (int k = 0; k < 50; ++k) {
+      ok += ct->step(Q.col(k), V.col(k), Q.col(k), V.col(k), A.col(k), tau) == Status::ok;
+      ct->step(bad, z, q, z, z, tau);  // held output, status
+    }
+    EXPECT_EQ(scope.count(), 0u);
+  }
+  EXPECT_EQ(ok, 50);
+  EXPECT_TRUE(tau.allFinite());
 }
