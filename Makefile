@@ -145,7 +145,8 @@ test-sanitize: $(SAN_BUILD)/build.ninja
 # ---- embedded: the minimal core (no KDL, no urdfdom: Eigen + toml++ only) and examples/embedded,
 # built natively and cross-built for aarch64 (Debian's g++-aarch64-linux-gnu), installed, then the
 # example runs the balanced PAMINSA under computed torque for EMBEDDED_TICKS ticks natively and
-# under qemu-user; the two tick traces (torques, shaking wrench) must agree to 1e-12.
+# under qemu-user; the two tick traces must agree to 1e-12 of the scale of the 6 torques and of the
+# shaking wrench (force and moment together: the balanced design's shaking force is rounding noise).
 EMBEDDED_BUILD := build/embedded
 EMBEDDED_TICKS ?= 300
 EMBEDDED_CASE := python/mechbal/cases/paminsa-linkage.toml examples/embedded/paminsa-control.toml
@@ -176,7 +177,7 @@ test-embedded: | $(VENV)/.stamp-venv
 	  --trace $(EMBEDDED_BUILD)/native.trace
 	qemu-aarch64 -L /usr/aarch64-linux-gnu $(EMBEDDED_BUILD)/aarch64/example/mechbal_embedded $(EMBEDDED_CASE) \
 	  --ticks $(EMBEDDED_TICKS) --no-sleep --trace $(EMBEDDED_BUILD)/aarch64.trace
-	python3 tools/compare_traces.py $(EMBEDDED_BUILD)/native.trace $(EMBEDDED_BUILD)/aarch64.trace 1e-12
+	python3 tools/compare_traces.py $(EMBEDDED_BUILD)/native.trace $(EMBEDDED_BUILD)/aarch64.trace 1e-12 6,6
 	@echo "    test-embedded took $$(( $$(date +%s) - $$(cat $(EMBEDDED_BUILD).start) )) s"
 
 # ---- benchmarks (never part of `make test`; own build dir so test and bench builds don't fight) --
