@@ -9,8 +9,8 @@
 #include <Eigen/Geometry>
 #include <string>
 
-#include "mechbal/model.hpp"
-#include "mechbal/paminsa.hpp"
+#include "mechbal/model/model.hpp"
+#include "mechbal/papers/paminsa/paminsa.hpp"
 
 namespace mechbal::bench {
 

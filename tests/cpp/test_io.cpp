@@ -12,7 +12,7 @@
 #include "mechbal/algorithm/mass_matrix.hpp"
 #include "mechbal/control/factory.hpp"
 #include "mechbal/io/case.hpp"
-#include "mechbal/mechanism_dynamics.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
 
 using namespace mechbal;
 

@@ -6,9 +6,9 @@
 #include <string>
 #include <utility>
 
-#include "mechbal/computed_torque.hpp"
-#include "mechbal/decoupled_control.hpp"
-#include "mechbal/mechanism_dynamics.hpp"
+#include "mechbal/control/computed_torque.hpp"
+#include "mechbal/control/decoupled_control.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
 
 namespace mechbal {
 

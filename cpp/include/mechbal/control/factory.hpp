@@ -15,8 +15,8 @@
 #include <memory>
 
 #include "mechbal/control/config.hpp"
-#include "mechbal/joint_controller.hpp"
-#include "mechbal/model.hpp"
+#include "mechbal/control/joint_controller.hpp"
+#include "mechbal/model/model.hpp"
 
 namespace mechbal {
 

@@ -19,8 +19,8 @@
 #include <string>
 
 #include "mechbal/control/config.hpp"
-#include "mechbal/model.hpp"
-#include "mechbal/trajectory.hpp"
+#include "mechbal/model/model.hpp"
+#include "mechbal/control/trajectory.hpp"
 
 namespace mechbal {
 
