@@ -127,8 +127,9 @@ test-python: install $(VENV)/.stamp-install-test
 	$(PY) -m pytest -q tests/python
 
 # ---- sanitizers: the C++ tests built with ASan + UBSan in their own build dir (Debug, so Eigen's
-# assertions are on; -O1 keeps the run short). Any report fails the run. The consumer test
-# (install + find_package from a plain build) is not instrumented and is left to `make test`.
+# assertions are on; -O1 keeps the run short). Any report fails the run. The consumer tests
+# (install + find_package from a plain build: install_and_consume, embedded_example) are not
+# instrumented and are left to `make test`.
 SAN_BUILD := build/sanitize
 SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 $(SAN_BUILD)/build.ninja: | $(VENV)/.stamp-venv
@@ -140,7 +141,7 @@ $(SAN_BUILD)/build.ninja: | $(VENV)/.stamp-venv
 test-sanitize: $(SAN_BUILD)/build.ninja
 	$(VENV)/bin/cmake --build $(SAN_BUILD) -j $(JOBS)
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-	  $(VENV)/bin/ctest --test-dir $(SAN_BUILD) --output-on-failure -j $(JOBS) -E install_and_consume
+	  $(VENV)/bin/ctest --test-dir $(SAN_BUILD) --output-on-failure -j $(JOBS) -E "install_and_consume|embedded_example"
 
 # ---- embedded: the minimal core (no KDL, no urdfdom: Eigen + toml++ only) and examples/embedded,
 # built natively and cross-built for aarch64 (Debian's g++-aarch64-linux-gnu), installed, then the
