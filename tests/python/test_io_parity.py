@@ -188,8 +188,9 @@ def random_mechanism(seed: int) -> dict:
     n = int(rng.integers(2, 7))
     joints, names = [], []
     for i in range(n):
-        name = f"j{i}"
-        j: dict = {"name": name}
+        unnamed = rng.uniform() < 0.2  # the default name joint<i>
+        name = f"joint{i + 1}" if unnamed else f"j{i}"
+        j: dict = {} if unnamed else {"name": name}
         kinds = ["revolute", "prismatic", "fixed", "spherical"]
         t = kinds[int(rng.choice(4, p=[0.55, 0.2, 0.1, 0.15]))] if i > 0 else "revolute"
         j["type"] = t
@@ -208,7 +209,7 @@ def random_mechanism(seed: int) -> dict:
                        "d": float(rng.uniform(-0.3, 0.3)), "theta": float(rng.uniform(-1, 1))}
         if t in ("revolute", "prismatic") and rng.uniform() < 0.3:
             j["limits"] = {"lower": -1.0, "upper": float(rng.uniform(0, 2)), "velocity": 3.0, "effort": 40.0}
-        movers = [x["name"] for x in joints if x["type"] in ("revolute", "prismatic") and "mimic" not in x]
+        movers = [names[k] for k, x in enumerate(joints) if x["type"] in ("revolute", "prismatic") and "mimic" not in x]
         if t in ("revolute", "prismatic") and movers and rng.uniform() < 0.25:
             j["mimic"] = {"joint": str(rng.choice(movers)), "ratio": float(rng.uniform(-3, 3)),
                           "offset": float(rng.uniform(-0.5, 0.5))}
@@ -216,7 +217,7 @@ def random_mechanism(seed: int) -> dict:
             j["link"] = {"mass": float(rng.uniform(0.1, 3)), "com": _vec(rng, -0.3, 0.3), "inertia": _inertia(rng)}
         joints.append(j)
         names.append(name)
-    links = ["base"] + names + [f"{j['name']}_y" for j in joints if j["type"] == "spherical"]
+    links = ["base"] + names + [f"{names[k]}_y" for k, j in enumerate(joints) if j["type"] == "spherical"]
     table: dict = {"gravity": _vec(rng, -10, 10), "joints": joints}
     if rng.uniform() < 0.5:
         table["base"] = {"xyz": _vec(rng, -1, 1), "rpy": _vec(rng, -1, 1)}
@@ -264,9 +265,10 @@ def test_the_random_corpus_covers_the_format():
         m = random_mechanism(seed)
         for j in m["joints"]:
             seen.add(j["type"])
+            seen.update(["unnamed"] if "name" not in j else [])
             seen.update(k for k in ("origin", "mdh", "dh", "axis", "mimic", "limits", "parent") if k in j)
         seen.update(k for k in ("base", "bodies", "frames", "loops", "springs", "actuated") if k in m)
-    assert seen >= {"revolute", "prismatic", "fixed", "spherical", "origin", "mdh", "dh", "axis", "mimic",
+    assert seen >= {"unnamed", "revolute", "prismatic", "fixed", "spherical", "origin", "mdh", "dh", "axis", "mimic",
                     "limits", "parent", "base", "bodies", "frames", "loops", "springs", "actuated"}, seen
 
 
