@@ -137,13 +137,16 @@ def balanced_files(tmp_path_factory):
     from mechbal.cli import main
 
     root = tmp_path_factory.mktemp("balanced")
-    cases = sorted({p.stem for p in (PKG / "cases").glob("*.toml")})
-    out = []
+    # every built-in case file (cases/ or a paper's package), by path
+    cases = [p for p in sorted(PKG.rglob("*.toml")) if "sweeps" not in p.parts
+             and isinstance(tomllib.loads(p.read_text()).get("case"), dict)]
+    out, stems = [], [c.stem for c in cases]
     for case in cases:
+        label = case.stem if stems.count(case.stem) == 1 else f"{case.parent.name}-{case.stem}"
         for method in METHODS:
-            d = root / f"{case}-{method}"
+            d = root / f"{label}-{method}"
             try:
-                rc = main(["balance", case, "--method", method, "--out", str(d), "-q"])
+                rc = main(["balance", str(case), "--method", method, "--out", str(d), "-q"])
             except SystemExit as exc:  # argparse refusals
                 rc = exc.code
             if rc == 0 and (d / "balanced.toml").exists():
