@@ -12,5 +12,5 @@ run(${CMAKE_COMMAND} --install ${MECHBAL_BUILD_DIR} --prefix ${WORK_DIR}/prefix)
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/embedded -B ${WORK_DIR}/build
     -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=Release)
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
-run(${WORK_DIR}/build/mechbal_embedded ${SOURCE_DIR}/python/mechbal/cases/paminsa-linkage.toml
+run(${WORK_DIR}/build/mechbal_embedded ${SOURCE_DIR}/python/mechbal/papers/paminsa/cases/paminsa-linkage.toml
     ${SOURCE_DIR}/examples/embedded/paminsa-control.toml --ticks 300)

@@ -61,6 +61,7 @@ std::string message_of(const std::string& toml) {
 }
 
 const std::string cases_dir = MECHBAL_SOURCE_DIR "/python/mechbal/cases/";
+const std::string papers_dir = MECHBAL_SOURCE_DIR "/python/mechbal/papers/";
 
 }  // namespace
 
@@ -94,7 +95,7 @@ TEST(CaseReader, BuiltInClosedCases) {
   const MechanismModel fb = load_mechanism(cases_dir + "four-bar.toml");
   EXPECT_TRUE(fb.is_closed());
   EXPECT_EQ(fb.num_actuated(), 1);
-  const LoadedCase p = load_case(cases_dir + "paminsa-linkage.toml");
+  const LoadedCase p = load_case(papers_dir + "paminsa/cases/paminsa-linkage.toml");
   EXPECT_EQ(p.name, "paminsa-linkage");
   EXPECT_EQ(p.model.num_bodies(), 38);
   EXPECT_EQ(p.model.num_loops(), 9);
@@ -191,7 +192,7 @@ TEST(MakeController, DecoupledTakesTheBalancedDiagonal) {
 
 TEST(MakeController, MadeControllersStepWithoutAllocating) {
   // the closed PAMINSA under computed torque (loops solved every tick) and a decoupled rotor
-  const LoadedCase p = load_case(cases_dir + "paminsa-linkage.toml");
+  const LoadedCase p = load_case(papers_dir + "paminsa/cases/paminsa-linkage.toml");
   ControlConfig config;
   config.kind = ControlKind::computed_torque;
   config.kp.assign(6, 400.0);

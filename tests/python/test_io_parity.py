@@ -116,7 +116,7 @@ def test_builtin_case(path):
 
 def test_bodies_without_rotation_are_bitwise_equal():
     """Where no rotation or DH frame applies, the two readers do the same arithmetic: bit for bit."""
-    path = PKG / "cases" / "paminsa-linkage.toml"
+    path = PKG / "papers" / "paminsa" / "cases" / "paminsa-linkage.toml"
     dp, dc = Mechanism.from_toml(path).model.description, _core.load_mechanism_file(str(path)).description
     n = 0
     for bc, bp in zip(dc.bodies, dp.bodies):
@@ -429,7 +429,7 @@ def test_cpp_messages_name_the_value():
 # ---- [control] through the C++ reader ---------------------------------------------------------------
 
 def test_load_case_file_reads_control(tmp_path):
-    model, control, name = _core.load_case_file(str(PKG / "cases" / "paminsa-linkage.toml"))
+    model, control, name = _core.load_case_file(str(PKG / "papers" / "paminsa" / "cases" / "paminsa-linkage.toml"))
     assert name == "paminsa-linkage" and control.kind == "none" and len(model.actuated_coordinates) == 6
     path = tmp_path / "c.toml"
     path.write_text(invalid_text(lambda m: None) + '\n[control]\nkind = "computed_torque"\nrate_hz = 500\n'
