@@ -8,7 +8,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 PIP := $(PY) -m pip --disable-pip-version-check
 APT_PYTHON_PACKAGES := python3-venv
-APT_PACKAGES := libeigen3-dev liborocos-kdl-dev liburdfdom-dev g++ make python3-venv python3-dev
+APT_PACKAGES := libeigen3-dev libtomlplusplus-dev liborocos-kdl-dev liburdfdom-dev g++ make python3-venv python3-dev
 APT_TEST_PACKAGES := libgtest-dev libbenchmark-dev
 CPP_BUILD := build/cpp
 JOBS ?= 2
@@ -26,12 +26,14 @@ print('\n'.join(p['dependencies'] if sys.argv[1] == 'runtime' else p['optional-d
 endef
 say = @printf '\n==> %s\n' $(1)
 
-.PHONY: demo test test-cpp test-python test-sanitize bench docs stubs apt apt-test venv install install-test install-docs clean help
+.PHONY: demo test test-cpp test-python test-sanitize test-embedded bench docs stubs apt apt-test venv install install-test install-docs clean help
 
 help:
 	@echo "make demo   - install what is missing, then run 'mechbal demo' (output in out/demo)"
 	@echo "make test   - install what is missing, then run the C++ tests (ctest) and pytest"
 	@echo "make test-sanitize - the C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer"
+	@echo "make test-embedded - cross-build the minimal core + examples/embedded for aarch64, run it under"
+	@echo "             qemu-user on the PAMINSA case and compare with the native build (1e-12)"
 	@echo "make bench  - build and run the benchmarks"
 	@echo "make docs   - build the user guide and API reference into build/site (MkDocs, offline)"
 	@echo "make stubs  - regenerate python/mechbal/_core.pyi from the bindings (pybind11-stubgen)"
@@ -136,8 +138,9 @@ test-python: install $(VENV)/.stamp-install-test
 	$(PY) -m pytest -q tests/python
 
 # ---- sanitizers: the C++ tests built with ASan + UBSan in their own build dir (Debug, so Eigen's
-# assertions are on; -O1 keeps the run short). Any report fails the run. The consumer test
-# (install + find_package from a plain build) is not instrumented and is left to `make test`.
+# assertions are on; -O1 keeps the run short). Any report fails the run. The consumer tests
+# (install + find_package from a plain build: install_and_consume, embedded_example) are not
+# instrumented and are left to `make test`.
 SAN_BUILD := build/sanitize
 SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 $(SAN_BUILD)/build.ninja: | $(VENV)/.stamp-venv $(VENV)/.stamp-apt
@@ -149,7 +152,45 @@ $(SAN_BUILD)/build.ninja: | $(VENV)/.stamp-venv $(VENV)/.stamp-apt
 test-sanitize: $(SAN_BUILD)/build.ninja
 	$(VENV)/bin/cmake --build $(SAN_BUILD) -j $(JOBS)
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-	  $(VENV)/bin/ctest --test-dir $(SAN_BUILD) --output-on-failure -j $(JOBS) -E install_and_consume
+	  $(VENV)/bin/ctest --test-dir $(SAN_BUILD) --output-on-failure -j $(JOBS) -E "install_and_consume|embedded_example"
+
+# ---- embedded: the minimal core (no KDL, no urdfdom: Eigen + toml++ only) and examples/embedded,
+# built natively and cross-built for aarch64 (Debian's g++-aarch64-linux-gnu), installed, then the
+# example runs the balanced PAMINSA under computed torque for EMBEDDED_TICKS ticks natively and
+# under qemu-user; the two tick traces must agree to 1e-12 of the scale of the 6 torques and of the
+# shaking wrench (force and moment together: the balanced design's shaking force is rounding noise).
+EMBEDDED_BUILD := build/embedded
+EMBEDDED_TICKS ?= 300
+EMBEDDED_CASE := python/mechbal/papers/paminsa/cases/paminsa-linkage.toml examples/embedded/paminsa-control.toml
+APT_EMBEDDED_PACKAGES := g++-aarch64-linux-gnu qemu-user
+define embedded_build
+	$(VENV)/bin/cmake -S . -B $(EMBEDDED_BUILD)/$(1)/core -G Ninja -DCMAKE_BUILD_TYPE=Release \
+	  -DCMAKE_MAKE_PROGRAM=$(abspath $(VENV)/bin/ninja) $(2) -DMECHBAL_WITH_KDL=OFF \
+	  -DMECHBAL_WITH_URDF=OFF -DMECHBAL_BUILD_TESTS=OFF -DMECHBAL_BUILD_PYTHON=OFF >/dev/null
+	$(VENV)/bin/cmake --build $(EMBEDDED_BUILD)/$(1)/core -j $(JOBS)
+	$(VENV)/bin/cmake --install $(EMBEDDED_BUILD)/$(1)/core --prefix $(abspath $(EMBEDDED_BUILD)/$(1)/prefix) >/dev/null
+	$(VENV)/bin/cmake -S examples/embedded -B $(EMBEDDED_BUILD)/$(1)/example -G Ninja \
+	  -DCMAKE_MAKE_PROGRAM=$(abspath $(VENV)/bin/ninja) $(2) \
+	  -DCMAKE_PREFIX_PATH=$(abspath $(EMBEDDED_BUILD)/$(1)/prefix) >/dev/null
+	$(VENV)/bin/cmake --build $(EMBEDDED_BUILD)/$(1)/example -j $(JOBS)
+endef
+
+test-embedded: | $(VENV)/.stamp-venv
+	$(call apt_install,$(APT_EMBEDDED_PACKAGES))
+	@start=$$(date +%s); echo "$$start" > $(EMBEDDED_BUILD).start 2>/dev/null || { mkdir -p build; echo "$$start" > $(EMBEDDED_BUILD).start; }
+	$(call say,"Native minimal core (KDL and URDF off) and examples/embedded")
+	$(call embedded_build,native,)
+	$(call say,"aarch64 cross-build of the same")
+	$(call embedded_build,aarch64,-DCMAKE_TOOLCHAIN_FILE=$(abspath cmake/aarch64-linux-gnu.cmake))
+	@readelf -h $(EMBEDDED_BUILD)/aarch64/example/mechbal_embedded 2>/dev/null | grep -q AArch64 \
+	  || { echo "the cross-built example is not an aarch64 executable"; exit 1; }
+	$(call say,"Running $(EMBEDDED_TICKS) ticks of the balanced PAMINSA natively and under qemu-aarch64")
+	$(EMBEDDED_BUILD)/native/example/mechbal_embedded $(EMBEDDED_CASE) --ticks $(EMBEDDED_TICKS) --no-sleep \
+	  --trace $(EMBEDDED_BUILD)/native.trace
+	qemu-aarch64 -L /usr/aarch64-linux-gnu $(EMBEDDED_BUILD)/aarch64/example/mechbal_embedded $(EMBEDDED_CASE) \
+	  --ticks $(EMBEDDED_TICKS) --no-sleep --trace $(EMBEDDED_BUILD)/aarch64.trace
+	python3 tools/compare_traces.py $(EMBEDDED_BUILD)/native.trace $(EMBEDDED_BUILD)/aarch64.trace 1e-12 6,6
+	@echo "    test-embedded took $$(( $$(date +%s) - $$(cat $(EMBEDDED_BUILD).start) )) s"
 
 # ---- benchmarks (never part of `make test`; own build dir so test and bench builds don't fight) --
 BENCH_BUILD := build/bench

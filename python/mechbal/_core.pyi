@@ -8,7 +8,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ChainModel', 'ComputedTorque', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointSpec', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'RneChainDynamics', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_chain_model', 'chain_description', 'chain_kinematics', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'read_urdf', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
+__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ChainModel', 'ComputedTorque', 'ControlConfig', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointSpec', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'RneChainDynamics', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_chain_model', 'chain_description', 'chain_kinematics', 'load_case_file', 'load_mechanism_file', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_toml', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
 class Status:
     """
     Bit flags returned by real-time algorithms
@@ -687,6 +687,43 @@ class RneChainDynamics(MechanismDynamics):
     MechanismDynamics of a serial ChainModel (the chain as a general mechanism)
     """
     def __init__(self, model: ChainModel) -> None:
+        ...
+class ControlConfig:
+    """
+    The [control] table as the C++ reader checked it (read only)
+    """
+    @property
+    def balancing_joints(self) -> list[str]:
+        ...
+    @property
+    def cancel(self) -> list[str]:
+        ...
+    @property
+    def damping(self) -> float:
+        ...
+    @property
+    def integrator(self) -> str:
+        ...
+    @property
+    def k(self) -> list[float]:
+        ...
+    @property
+    def kd(self) -> list[float]:
+        ...
+    @property
+    def kind(self) -> str:
+        ...
+    @property
+    def kp(self) -> list[float]:
+        ...
+    @property
+    def rate_hz(self) -> float:
+        ...
+    @property
+    def task_frame(self) -> str:
+        ...
+    @property
+    def torque_limit(self) -> list[float]:
         ...
 class PaminsaCounterweights:
     """
@@ -1435,6 +1472,14 @@ def chain_kinematics(model: ChainModel, q: numpy.typing.ArrayLike, qd: numpy.typ
     """
     Every link's motion in the base frame for N joint states (q, qd, qdd each (N, dof)). Returns a dict of arrays (N, dof, 3) / (N, dof, 3, 3) / frames (N, dof, 4, 4), status_per_instant (N,) and their OR, status; a failed instant (non-finite input, or motion that overflows: out_of_range) gives identity poses and zero motion.
     """
+def load_case_file(path: str) -> tuple[MechanismModel, ControlConfig, str]:
+    """
+    (model, control, name) of a case file read by the C++ reader (mechbal::load_case): the [mechanism] model, the [control] table checked against it (kind 'none' without one) and [case] name.
+    """
+def load_mechanism_file(path: str) -> MechanismModel:
+    """
+    The MechanismModel of the [mechanism] table of a case file or balanced.toml, read by the C++ reader (mechbal::load_mechanism). ValueError naming the dotted field and the value.
+    """
 def mechanism_bias_torque(model: MechanismModel, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> dict:
     ...
 def mechanism_center_of_mass(model: MechanismModel, q: numpy.typing.ArrayLike) -> dict:
@@ -1449,6 +1494,10 @@ def mechanism_closed_motion(model: MechanismModel, q_actuated: numpy.typing.Arra
     """
 def mechanism_frame_jacobian(model: MechanismModel, q: numpy.typing.ArrayLike, frame: str) -> dict:
     ...
+def mechanism_from_toml(text: str, source: str = 'string') -> MechanismModel:
+    """
+    As load_mechanism_file, from TOML text (the whole document).
+    """
 def mechanism_from_urdf(path: str) -> MechanismModel:
     """
     The MechanismModel of a URDF file (urdfdom): links with inertials as bodies, revolute / continuous / prismatic / fixed joints, mimic as gear couplings, limits, a frame per link. ValueError names the URDF element and the value.
@@ -1498,10 +1547,6 @@ def paminsa_reactionless_run(model: PaminsaModel, config: ReactionlessWristConfi
 def pd_error_analytic(e0: typing.SupportsFloat | typing.SupportsIndex, ed0: typing.SupportsFloat | typing.SupportsIndex, kp: typing.SupportsFloat | typing.SupportsIndex, kd: typing.SupportsFloat | typing.SupportsIndex, t: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
     """
     Solution of e'' + kd e' + kp e = 0 (Arakelian et al. 2011, eq 6) at times t
-    """
-def read_urdf(path: str, strict: bool = False, allow_massless: bool = False) -> tuple[MechanismModel, list[str]]:
-    """
-    (MechanismModel, warnings) of a URDF file: strict refuses the defects that the lenient reading repairs with one warning each (mechbal/io/urdf.hpp, UrdfOptions); a URDF with no <inertial> on any moving link is refused unless allow_massless.
     """
 def shaking_wrench(mass: numpy.typing.ArrayLike, inertia_body: numpy.typing.ArrayLike, com: numpy.typing.ArrayLike, com_velocity: numpy.typing.ArrayLike, com_acceleration: numpy.typing.ArrayLike, rotation: numpy.typing.ArrayLike, angular_velocity: numpy.typing.ArrayLike, angular_acceleration: numpy.typing.ArrayLike) -> dict:
     """

@@ -6,8 +6,8 @@
 /// private.
 ///
 /// The general mechanism model and its algorithms (one header each)
+#include "mechbal/build_config.hpp"
 #include "mechbal/status.hpp"
-#include "mechbal/io/urdf.hpp"
 #include "mechbal/version.hpp"
 #include "mechbal/model/rigid_body.hpp"
 #include "mechbal/model/joint_type.hpp"
@@ -27,7 +27,9 @@
 /// Trajectories, dynamics back ends
 #include "mechbal/control/trajectory.hpp"
 #include "mechbal/control/dynamics.hpp"
+#if MECHBAL_WITH_KDL
 #include "mechbal/control/kdl_chain.hpp"
+#endif
 /// Controllers and closed-loop simulation
 #include "mechbal/control/joint_controller.hpp"
 #include "mechbal/control/computed_torque.hpp"
@@ -35,6 +37,13 @@
 #include "mechbal/control/joint_limits.hpp"
 #include "mechbal/papers/paminsa/reactionless_wrist.hpp"
 #include "mechbal/control/closed_loop.hpp"
+#include "mechbal/control/config.hpp"
+#include "mechbal/control/factory.hpp"
+/// Reading mechbal's case format (TOML) and URDF
+#include "mechbal/io/case.hpp"
+#if MECHBAL_WITH_URDF
+#include "mechbal/io/urdf.hpp"
+#endif
 /// Fast paths of the papers' mechanisms
 #include "mechbal/papers/arm2dof/arm2dof.hpp"
 #include "mechbal/papers/five_bar/coupled_projection.hpp"

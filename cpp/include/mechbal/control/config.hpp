@@ -1,0 +1,42 @@
+#pragma once
+/// \file control/config.hpp
+/// ControlConfig: the `[control]` table of a case file as plain data (no parsing, no model).
+/// io/case.hpp reads it from a file (load_case) and checks it against the model; control/factory.hpp
+/// builds the configured controller from it (make_controller). Construction-time data only: nothing
+/// here is used inside a control tick.
+#include <string>
+#include <vector>
+
+namespace mechbal {
+
+/// Which controller the `[control]` table asks for (`kind = "..."`); `none` when the file has no
+/// `[control]` table.
+enum class ControlKind { none, computed_torque, decoupled, reactionless };
+
+/// The `kind` string of a ControlKind ("none", "computed_torque", "decoupled", "reactionless").
+const char* control_kind_name(ControlKind kind) noexcept;
+
+/// The `[control]` table. Per-joint vectors follow the model's actuated coordinates
+/// (MechanismModel::actuated_coordinates(): every coordinate of an open mechanism).
+struct ControlConfig {
+  ControlKind kind = ControlKind::none;
+  double rate_hz = 1000.0;  ///< the controller's tick rate [Hz]
+  /// Diagonal gains of the outer loop (computed_torque, decoupled; optional computed-torque stage
+  /// of reactionless), one value > 0 per actuated coordinate.
+  std::vector<double> kp, kd;
+  /// Command limits (one value > 0 per actuated coordinate); empty: default_torque_limit.
+  std::vector<double> torque_limit;
+  /// decoupled: the constant diagonal of the balanced mass matrix; empty: taken from the model
+  /// (the diagonal of M# at q = 0, which must then be diagonal).
+  std::vector<double> k;
+
+  // ---- reactionless (issue 21's controller) ----
+  std::vector<std::string> balancing_joints;  ///< joints whose motion cancels the momentum
+  /// Cancelled momentum components: "moment", "force", "moment_x|y|z", "force_x|y|z".
+  std::vector<std::string> cancel{"moment"};
+  std::string integrator = "rk4";  ///< "rk4" or "euler"
+  double damping = 1e-3;           ///< damped least squares near singularities
+  std::string task_frame;          ///< operational-space mode: the frame following [trajectory]
+};
+
+}  // namespace mechbal

@@ -1,0 +1,1114 @@
+// The case-format reader (io/case.hpp): toml++ -> the checked tables -> the same
+// MechanismDescription as python/mechbal/spec.py. The order of the checks and the field names
+// follow the Python reader (schema.py for one table at a time, spec.py for the cross references),
+// so that both readers refuse the same files naming the same field.
+#include "mechbal/io/case.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <charconv>
+#include <fstream>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <utility>
+
+#define TOML_EXCEPTIONS 1
+#include <toml++/toml.h>
+
+namespace mechbal {
+
+ConfigError::ConfigError(std::string field, const std::string& message)
+    : std::invalid_argument(field.empty() ? message : field + ": " + message), field_(std::move(field)) {}
+
+namespace {
+
+using Mat4 = Eigen::Matrix4d;
+constexpr double kMaxAbs = 1e12;           // schema.MAX_ABS
+constexpr std::size_t kMaxJoints = 256;    // schema.MAX_JOINTS
+constexpr std::size_t kMaxBodies = 1024;   // schema.MAX_BODIES
+constexpr std::size_t kMaxFrames = 1024;   // schema.MAX_FRAMES
+constexpr std::size_t kMaxName = 128;
+const std::string kBase = "base";
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// ---- messages ---------------------------------------------------------------------------------
+
+/// Python's repr of a float: the shortest round trip, "1.0" for integral values.
+std::string float_repr(double x) {
+  if (std::isnan(x)) return "nan";
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof buf, x);
+  std::string s(buf, r.ptr);
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
+}
+
+/// schema._fmt: bounds as the Python reader prints them (1e+12, 0, 1000).
+std::string bound_repr(double x) {
+  if (std::floor(x) == x && std::abs(x) < 1e7) return std::to_string(static_cast<long long>(x));
+  std::ostringstream os;
+  os << x;
+  return os.str();
+}
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+void repr_into(const toml::node& n, std::string& out, int depth) {
+  if (out.size() > 200 || depth > 8) {
+    out += "...";
+    return;
+  }
+  if (auto v = n.as_string()) {
+    out += quote(v->get());
+  } else if (auto i = n.as_integer()) {
+    out += std::to_string(i->get());
+  } else if (auto d = n.as_floating_point()) {
+    out += float_repr(d->get());
+  } else if (auto b = n.as_boolean()) {
+    out += b->get() ? "True" : "False";
+  } else if (auto a = n.as_array()) {
+    out += "[";
+    for (std::size_t k = 0; k < a->size(); ++k) {
+      if (k) out += ", ";
+      repr_into(*a->get(k), out, depth + 1);
+    }
+    out += "]";
+  } else if (auto t = n.as_table()) {
+    out += "{";
+    bool first = true;
+    for (auto&& [key, value] : *t) {
+      if (!first) out += ", ";
+      first = false;
+      out += quote(std::string(key.str())) + ": ";
+      repr_into(value, out, depth + 1);
+    }
+    out += "}";
+  } else {
+    std::ostringstream os;  // dates and times: the Python reader shows them as datetime objects
+    os << "<" << n.type() << ">";
+    out += os.str();
+  }
+}
+
+/// errors.short_repr: the value as the Python reader shows it, cut at 80 characters.
+std::string repr(const toml::node& n) {
+  std::string s;
+  repr_into(n, s, 0);
+  if (s.size() > 80) s = s.substr(0, 77) + "...";
+  return s;
+}
+
+[[noreturn]] void fail(const std::string& field, const std::string& message) { throw ConfigError(field, message); }
+[[noreturn]] void fail(const std::string& field, const std::string& message, const std::string& value_repr) {
+  throw ConfigError(field, message + " (got " + value_repr + ")");
+}
+[[noreturn]] void fail(const std::string& field, const std::string& message, const toml::node& value) {
+  fail(field, message, repr(value));
+}
+
+/// difflib.SequenceMatcher's matching characters (longest common block, then both sides).
+std::size_t matching(const std::string& a, const std::string& b) {
+  std::size_t best = 0, ia = 0, ib = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t j = 0; j < b.size(); ++j) {
+      std::size_t k = 0;
+      while (i + k < a.size() && j + k < b.size() && a[i + k] == b[j + k]) ++k;
+      if (k > best) best = k, ia = i, ib = j;
+    }
+  }
+  if (best == 0) return 0;
+  return best + matching(a.substr(0, ia), b.substr(0, ib)) + matching(a.substr(ia + best), b.substr(ib + best));
+}
+
+double similarity(const std::string& a, const std::string& b) {
+  if (a.size() > 256 || b.size() > 256) return 0.0;
+  const double total = static_cast<double>(a.size() + b.size());
+  return total == 0.0 ? 1.0 : 2.0 * static_cast<double>(matching(a, b)) / total;
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+/// schema.did_you_mean: " (did you mean 'x'?)" for the nearest allowed word, else the list.
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& allowed) {
+  const std::string* best = nullptr;
+  double best_ratio = 0.6;
+  for (const auto& a : allowed) {
+    const double r = std::max(similarity(word, a), similarity(lower(word), lower(a)));
+    if (r >= best_ratio && (best == nullptr || r > best_ratio)) best = &a, best_ratio = r;
+  }
+  if (best) return " (did you mean " + quote(*best) + "?)";
+  if (allowed.empty()) return "";
+  std::string out = " (allowed: ";
+  for (std::size_t k = 0; k < allowed.size(); ++k) out += (k ? ", " : "") + allowed[k];
+  return out + ")";
+}
+
+std::string join(const std::string& prefix, const std::string& key) { return prefix.empty() ? key : prefix + "." + key; }
+std::string item(const std::string& prefix, std::size_t i) { return prefix + "[" + std::to_string(i) + "]"; }
+
+// ---- values -----------------------------------------------------------------------------------
+
+const toml::table& table_of(const toml::node& n, const std::string& f) {
+  if (!n.is_table()) fail(f, "must be a table", n);
+  return *n.as_table();
+}
+
+/// Unknown keys are errors naming the nearest allowed key (the Python reader's extra_forbidden).
+void allow_keys(const toml::table& t, const std::string& f, const std::vector<std::string>& allowed) {
+  for (auto&& [k, v] : t) {
+    const std::string key(k.str());
+    if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+    std::vector<std::string> absent;
+    for (const auto& a : allowed)
+      if (!t.contains(a)) absent.push_back(a);
+    std::string hint = did_you_mean(key, absent);
+    if (hint.find("did you") == std::string::npos) hint = did_you_mean(key, allowed);
+    fail(join(f, key), std::string(v.is_table() ? "unknown table" : "unknown key") + hint);
+  }
+}
+
+const toml::node* get(const toml::table& t, const char* key) { return t.get(key); }
+
+const toml::node& required(const toml::table& t, const char* key, const std::string& f) {
+  const toml::node* n = t.get(key);
+  if (!n) fail(join(f, key), "is required");
+  return *n;
+}
+
+enum class Lo { ge, gt };
+
+/// A finite number (TOML integer or float, not a boolean) within [lo, hi] (or (lo, hi]).
+double number(const toml::node& n, const std::string& f, double lo = -kMaxAbs, double hi = kMaxAbs,
+              Lo lo_kind = Lo::ge) {
+  double x;
+  if (auto i = n.as_integer()) {
+    x = static_cast<double>(i->get());
+  } else if (auto d = n.as_floating_point()) {
+    x = d->get();
+  } else {
+    fail(f, "must be a number", n);
+  }
+  if (!std::isfinite(x)) fail(f, "must be finite", n);
+  if (lo_kind == Lo::gt ? !(x > lo) : !(x >= lo)) fail(f, std::string("must be ") + (lo_kind == Lo::gt ? ">" : ">=") + " " + bound_repr(lo), n);
+  if (!(x <= hi)) fail(f, "must be <= " + bound_repr(hi), n);
+  return x;
+}
+
+long long integer(const toml::node& n, const std::string& f, long long lo, long long hi) {
+  auto i = n.as_integer();
+  if (!i) fail(f, "must be an integer", n);
+  const long long x = i->get();
+  if (x < lo) fail(f, "must be >= " + std::to_string(lo), n);
+  if (x > hi) fail(f, "must be <= " + std::to_string(hi), n);
+  return x;
+}
+
+std::size_t utf8_length(const std::string& s) {
+  std::size_t n = 0;
+  for (unsigned char c : s) n += (c & 0xC0) != 0x80;
+  return n;
+}
+
+/// A name: a string of 1..128 characters.
+std::string name(const toml::node& n, const std::string& f) {
+  auto s = n.as_string();
+  if (!s) fail(f, "must be a string", n);
+  const std::string v = s->get();
+  if (v.empty()) fail(f, "must not be empty", n);
+  if (utf8_length(v) > kMaxName) fail(f, "must have at most 128 characters", n);
+  return v;
+}
+
+std::string choice(const toml::node& n, const std::string& f, const std::vector<std::string>& choices) {
+  auto s = n.as_string();
+  std::string text = "must be one of ";
+  for (std::size_t k = 0; k < choices.size(); ++k) text += (k ? ", " : "") + choices[k];
+  if (!s) fail(f, text, n);
+  const std::string v = s->get();
+  if (std::find(choices.begin(), choices.end(), v) != choices.end()) return v;
+  std::string hint = did_you_mean(v, choices);
+  if (hint.rfind(" (allowed", 0) == 0) hint.clear();
+  fail(f, text + hint, n);
+}
+
+const toml::array& array_of(const toml::node& n, const std::string& f, std::size_t min_len, std::size_t max_len) {
+  auto a = n.as_array();
+  if (!a) fail(f, "must be a list", n);
+  if (min_len == max_len && a->size() != min_len) fail(f, "must have " + std::to_string(min_len) + " values", n);
+  if (a->size() < min_len) fail(f, "must have at least " + std::to_string(min_len) + " values", n);
+  if (a->size() > max_len) fail(f, "must have at most " + std::to_string(max_len) + " values", n);
+  return *a;
+}
+
+Vec3 vec3(const toml::node& n, const std::string& f, double lo = -kMaxAbs, double hi = kMaxAbs, Lo lo_kind = Lo::ge) {
+  const toml::array& a = array_of(n, f, 3, 3);
+  Vec3 v;
+  for (std::size_t k = 0; k < 3; ++k) v[static_cast<int>(k)] = number(*a.get(k), item(f, k), lo, hi, lo_kind);
+  return v;
+}
+
+Vec3 vec3_or(const toml::table& t, const char* key, const std::string& f, const Vec3& fallback) {
+  const toml::node* n = get(t, key);
+  return n ? vec3(*n, join(f, key)) : fallback;
+}
+
+std::string fmt6(double x) {
+  std::ostringstream os;
+  os.precision(6);
+  os << x;
+  return os.str();
+}
+
+/// schema.inertia_matrix: 3x3, [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]; symmetric,
+/// positive semi-definite, triangle inequality.
+Mat3 inertia_matrix(const toml::node& n, const std::string& f) {
+  const char* shape = "must be a 3x3 matrix, [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]";
+  auto a = n.as_array();
+  if (!a) fail(f, shape, n);
+  std::size_t rows = 0;
+  for (auto&& x : *a) rows += x.is_array();
+  if (rows && (a->size() != 3 || rows != 3)) fail(f, shape, n);
+  if (rows) {
+    for (auto&& r : *a)
+      if (r.as_array()->size() != 3) fail(f, shape, n);
+  } else if (a->size() != 3 && a->size() != 6) {
+    fail(f, shape, n);
+  }
+  std::vector<std::pair<std::string, const toml::node*>> entries;
+  if (rows) {
+    for (std::size_t i = 0; i < 3; ++i)
+      for (std::size_t k = 0; k < 3; ++k)
+        entries.emplace_back("[" + std::to_string(i) + "][" + std::to_string(k) + "]", a->get(i)->as_array()->get(k));
+  } else {
+    for (std::size_t i = 0; i < a->size(); ++i) entries.emplace_back("[" + std::to_string(i) + "]", a->get(i));
+  }
+  std::vector<double> v;
+  for (auto& [sub, x] : entries) {
+    double d;
+    if (auto i = x->as_integer()) {
+      d = static_cast<double>(i->get());
+    } else if (auto fp = x->as_floating_point()) {
+      d = fp->get();
+    } else {
+      fail(f + sub, "must be a number", *x);
+    }
+    if (!std::isfinite(d)) fail(f + sub, "must be finite", *x);
+    if (std::abs(d) > kMaxAbs) fail(f + sub, "must be between -1e+12 and 1e+12", *x);
+    v.push_back(d);
+  }
+  Mat3 I = Mat3::Zero();
+  if (rows) {
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) I(i, k) = v[static_cast<std::size_t>(3 * i + k)];
+  } else {
+    I.diagonal() << v[0], v[1], v[2];
+    if (v.size() == 6) {
+      I(0, 1) = I(1, 0) = v[3];
+      I(0, 2) = I(2, 0) = v[4];
+      I(1, 2) = I(2, 1) = v[5];
+    }
+  }
+  const double scale = std::max(1.0, I.cwiseAbs().maxCoeff());
+  if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) fail(f, "must be symmetric", n);
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(I, Eigen::EigenvaluesOnly);
+  const Vec3 p = eig.eigenvalues();
+  const double tol = 1e-12 * scale;
+  if (p[0] < -tol) fail(f, "must be positive semi-definite, smallest principal moment is " + fmt6(p[0]), n);
+  if (p[2] > p[0] + p[1] + tol) {
+    fail(f, "violates the triangle inequality of a physical body: principal moments " + fmt6(p[0]) + ", " +
+                fmt6(p[1]) + ", " + fmt6(p[2]), n);
+  }
+  return I;
+}
+
+// ---- transforms (spec.py) ---------------------------------------------------------------------
+
+Mat3 rotation_rpy(const Vec3& rpy) {
+  const double cr = std::cos(rpy[0]), sr = std::sin(rpy[0]), cp = std::cos(rpy[1]), sp = std::sin(rpy[1]),
+               cy = std::cos(rpy[2]), sy = std::sin(rpy[2]);
+  Mat3 Rx, Ry, Rz;
+  Rx << 1, 0, 0, 0, cr, -sr, 0, sr, cr;
+  Ry << cp, 0, sp, 0, 1, 0, -sp, 0, cp;
+  Rz << cy, -sy, 0, sy, cy, 0, 0, 0, 1;
+  return Rz * Ry * Rx;
+}
+
+Mat4 transform(const Vec3& xyz, const Vec3& rpy) {
+  Mat4 T = Mat4::Identity();
+  T.topLeftCorner<3, 3>() = rotation_rpy(rpy);
+  T.topRightCorner<3, 1>() = xyz;
+  return T;
+}
+
+Mat4 rx(double t) { return transform(Vec3::Zero(), Vec3(t, 0.0, 0.0)); }
+Mat4 rz(double t) { return transform(Vec3::Zero(), Vec3(0.0, 0.0, t)); }
+Mat4 tr(double x, double y, double z) { return transform(Vec3(x, y, z), Vec3::Zero()); }
+
+// ---- the [mechanism] table as read (schema.py's models) ---------------------------------------
+
+struct OriginIn {
+  Vec3 xyz = Vec3::Zero(), rpy = Vec3::Zero();
+};
+struct DHIn {
+  double a = 0, alpha = 0, d = 0, theta = 0;
+};
+struct MimicIn {
+  std::string joint;
+  double ratio = 1.0, offset = 0.0;
+};
+struct LinkIn {
+  double mass = 0;
+  Vec3 com = Vec3::Zero();
+  Mat3 inertia = Mat3::Zero();
+};
+struct JointIn {
+  std::optional<std::string> name, parent;
+  std::string type = "revolute";
+  std::optional<OriginIn> origin;
+  std::optional<DHIn> mdh, dh;
+  std::optional<Vec3> axis;
+  std::optional<double> lower, upper, velocity, effort;
+  std::optional<MimicIn> mimic;
+  std::optional<LinkIn> link;
+};
+struct BodyIn {
+  std::string name, kind = "other", link;
+  double mass = 0;
+  Vec3 com = Vec3::Zero(), rpy = Vec3::Zero();
+  Mat3 inertia = Mat3::Zero();
+};
+struct FrameIn {
+  std::string name, link;
+  OriginIn origin;
+};
+struct LoopIn {
+  std::string name, type = "point", frame_a, frame_b;
+};
+struct SpringIn {
+  std::string name, link_a, link_b;
+  Vec3 anchor_a = Vec3::Zero(), anchor_b = Vec3::Zero();
+  double rate = 0, free_length = 0, preload = 0, pulley_ratio = 1.0;
+  int count = 1;
+};
+struct MechanismIn {
+  Vec3 gravity = Vec3(0.0, 0.0, -9.81);
+  std::optional<OriginIn> base;
+  std::vector<JointIn> joints;
+  std::vector<BodyIn> bodies;
+  std::vector<FrameIn> frames;
+  std::vector<LoopIn> loops;
+  std::vector<std::string> actuated;
+  std::vector<SpringIn> springs;
+};
+
+OriginIn read_origin(const toml::node& n, const std::string& f) {
+  const auto& t = table_of(n, f);
+  allow_keys(t, f, {"xyz", "rpy"});
+  OriginIn o;
+  o.xyz = vec3_or(t, "xyz", f, Vec3::Zero());
+  o.rpy = vec3_or(t, "rpy", f, Vec3::Zero());
+  return o;
+}
+
+DHIn read_dh(const toml::node& n, const std::string& f) {
+  const auto& t = table_of(n, f);
+  allow_keys(t, f, {"a", "alpha", "d", "theta"});
+  DHIn d;
+  d.a = number(required(t, "a", f), join(f, "a"));
+  d.alpha = number(required(t, "alpha", f), join(f, "alpha"));
+  if (auto x = get(t, "d")) d.d = number(*x, join(f, "d"));
+  if (auto x = get(t, "theta")) d.theta = number(*x, join(f, "theta"));
+  return d;
+}
+
+JointIn read_joint(const toml::node& n, const std::string& f) {
+  const auto& t = table_of(n, f);
+  allow_keys(t, f, {"name", "type", "parent", "origin", "mdh", "dh", "axis", "limits", "mimic", "link"});
+  JointIn j;
+  if (auto x = get(t, "name")) j.name = name(*x, join(f, "name"));
+  if (auto x = get(t, "type")) j.type = choice(*x, join(f, "type"), {"revolute", "prismatic", "fixed", "spherical"});
+  if (auto x = get(t, "parent")) j.parent = name(*x, join(f, "parent"));
+  if (auto x = get(t, "origin")) j.origin = read_origin(*x, join(f, "origin"));
+  if (auto x = get(t, "mdh")) j.mdh = read_dh(*x, join(f, "mdh"));
+  if (auto x = get(t, "dh")) j.dh = read_dh(*x, join(f, "dh"));
+  if (auto x = get(t, "axis")) j.axis = vec3(*x, join(f, "axis"));
+  if (auto x = get(t, "limits")) {
+    const std::string fl = join(f, "limits");
+    const auto& l = table_of(*x, fl);
+    allow_keys(l, fl, {"lower", "upper", "velocity", "effort"});
+    if (auto y = get(l, "lower")) j.lower = number(*y, join(fl, "lower"));
+    if (auto y = get(l, "upper")) j.upper = number(*y, join(fl, "upper"));
+    if (auto y = get(l, "velocity")) j.velocity = number(*y, join(fl, "velocity"), 0.0, kMaxAbs, Lo::gt);
+    if (auto y = get(l, "effort")) j.effort = number(*y, join(fl, "effort"), 0.0, kMaxAbs, Lo::gt);
+    if (j.lower && j.upper && *j.lower > *j.upper) {
+      fail(join(fl, "upper"), "must be >= lower = " + float_repr(*j.lower), *get(l, "upper"));
+    }
+  }
+  if (auto x = get(t, "mimic")) {
+    const std::string fm = join(f, "mimic");
+    const auto& m = table_of(*x, fm);
+    allow_keys(m, fm, {"joint", "ratio", "offset"});
+    MimicIn mi;
+    mi.joint = name(required(m, "joint", fm), join(fm, "joint"));
+    if (auto y = get(m, "ratio")) mi.ratio = number(*y, join(fm, "ratio"));
+    if (auto y = get(m, "offset")) mi.offset = number(*y, join(fm, "offset"));
+    j.mimic = mi;
+  }
+  if (auto x = get(t, "link")) {
+    const std::string fk = join(f, "link");
+    const auto& l = table_of(*x, fk);
+    allow_keys(l, fk, {"mass", "com", "inertia"});
+    LinkIn li;
+    li.mass = number(required(l, "mass", fk), join(fk, "mass"), 0.0);
+    li.com = vec3_or(l, "com", fk, Vec3::Zero());
+    li.inertia = inertia_matrix(required(l, "inertia", fk), join(fk, "inertia"));
+    j.link = li;
+  }
+  // Joint._consistent
+  std::vector<std::string> given;
+  if (j.origin) given.push_back("origin");
+  if (j.mdh) given.push_back("mdh");
+  if (j.dh) given.push_back("dh");
+  if (given.size() > 1) {
+    std::string v = "[";
+    for (std::size_t k = 0; k < given.size(); ++k) v += (k ? ", " : "") + quote(given[k]);
+    fail(f, "give only one of origin, mdh, dh", v + "]");
+  }
+  if (j.axis) {
+    if (!given.empty() && given[0] != "origin") fail(join(f, "axis"), "DH joints move along/about z; drop axis", *get(t, "axis"));
+    if (j.type == "fixed" || j.type == "spherical") {
+      fail(join(f, "axis"), "a " + j.type + " joint has no axis; drop it", *get(t, "axis"));
+    }
+    const double scale = j.axis->cwiseAbs().maxCoeff();
+    if (scale == 0.0 || (*j.axis / scale).norm() * scale < 1e-12) {
+      fail(join(f, "axis"), "must be a non-zero vector", *get(t, "axis"));
+    }
+  }
+  for (const char* key : {"limits", "mimic"}) {
+    if (get(t, key) && (j.type == "fixed" || j.type == "spherical")) {
+      fail(join(f, key), "a " + j.type + " joint cannot have " + key, *get(t, key));
+    }
+  }
+  return j;
+}
+
+BodyIn read_body(const toml::node& n, const std::string& f) {
+  const auto& t = table_of(n, f);
+  allow_keys(t, f, {"name", "kind", "link", "mass", "com", "inertia", "rpy"});
+  BodyIn b;
+  b.name = name(required(t, "name", f), join(f, "name"));
+  if (auto x = get(t, "kind")) {
+    b.kind = choice(*x, join(f, "kind"), {"link", "counterweight", "motor", "disc", "payload", "other"});
+  }
+  b.link = name(required(t, "link", f), join(f, "link"));
+  b.mass = number(required(t, "mass", f), join(f, "mass"), 0.0);
+  b.com = vec3_or(t, "com", f, Vec3::Zero());
+  b.inertia = inertia_matrix(required(t, "inertia", f), join(f, "inertia"));
+  b.rpy = vec3_or(t, "rpy", f, Vec3::Zero());
+  return b;
+}
+
+FrameIn read_frame(const toml::node& n, const std::string& f) {
+  const auto& t = table_of(n, f);
+  allow_keys(t, f, {"name", "link", "origin"});
+  FrameIn fr;
+  fr.name = name(required(t, "name", f), join(f, "name"));
+  fr.link = name(required(t, "link", f), join(f, "link"));
+  if (auto x = get(t, "origin")) fr.origin = read_origin(*x, join(f, "origin"));
+  return fr;
+}
+
+LoopIn read_loop(const toml::node& n, const std::string& f) {
+  const auto& t = table_of(n, f);
+  allow_keys(t, f, {"name", "type", "frame_a", "frame_b"});
+  LoopIn l;
+  l.name = name(required(t, "name", f), join(f, "name"));
+  if (auto x = get(t, "type")) l.type = choice(*x, join(f, "type"), {"point", "planar_point", "axis", "weld"});
+  l.frame_a = name(required(t, "frame_a", f), join(f, "frame_a"));
+  l.frame_b = name(required(t, "frame_b", f), join(f, "frame_b"));
+  return l;
+}
+
+SpringIn read_spring(const toml::node& n, const std::string& f) {
+  const auto& t = table_of(n, f);
+  allow_keys(t, f, {"name", "link_a", "anchor_a", "link_b", "anchor_b", "rate", "free_length", "preload", "count",
+                    "pulley_ratio"});
+  SpringIn s;
+  s.name = name(required(t, "name", f), join(f, "name"));
+  s.link_a = name(required(t, "link_a", f), join(f, "link_a"));
+  s.anchor_a = vec3(required(t, "anchor_a", f), join(f, "anchor_a"));
+  s.link_b = name(required(t, "link_b", f), join(f, "link_b"));
+  s.anchor_b = vec3(required(t, "anchor_b", f), join(f, "anchor_b"));
+  s.rate = number(required(t, "rate", f), join(f, "rate"), 0.0);
+  if (auto x = get(t, "free_length")) s.free_length = number(*x, join(f, "free_length"), 0.0);
+  if (auto x = get(t, "preload")) s.preload = number(*x, join(f, "preload"), 0.0);
+  if (auto x = get(t, "count")) s.count = static_cast<int>(integer(*x, join(f, "count"), 1, 1000));
+  if (auto x = get(t, "pulley_ratio")) s.pulley_ratio = number(*x, join(f, "pulley_ratio"), 0.0, 1000.0, Lo::gt);
+  return s;
+}
+
+template <typename T, typename Read>
+std::vector<T> read_list(const toml::table& t, const char* key, const std::string& f, std::size_t min_len,
+                         std::size_t max_len, Read read) {
+  std::vector<T> out;
+  const toml::node* n = get(t, key);
+  if (!n) {
+    if (min_len > 0) fail(join(f, key), "is required");
+    return out;
+  }
+  const std::string fl = join(f, key);
+  const toml::array& a = array_of(*n, fl, min_len, max_len);
+  for (std::size_t k = 0; k < a.size(); ++k) out.push_back(read(*a.get(k), item(fl, k)));
+  return out;
+}
+
+MechanismIn read_mechanism(const toml::node& n, const std::string& f) {
+  const auto& t = table_of(n, f);
+  allow_keys(t, f, {"gravity", "base", "joints", "bodies", "frames", "loops", "actuated", "springs"});
+  MechanismIn m;
+  m.gravity = vec3_or(t, "gravity", f, m.gravity);
+  if (auto x = get(t, "base")) m.base = read_origin(*x, join(f, "base"));
+  m.joints = read_list<JointIn>(t, "joints", f, 1, kMaxJoints, read_joint);
+  m.bodies = read_list<BodyIn>(t, "bodies", f, 0, kMaxBodies, read_body);
+  m.frames = read_list<FrameIn>(t, "frames", f, 0, kMaxFrames, read_frame);
+  m.loops = read_list<LoopIn>(t, "loops", f, 0, kMaxFrames, read_loop);
+  m.actuated = read_list<std::string>(t, "actuated", f, 0, kMaxJoints, name);
+  m.springs = read_list<SpringIn>(t, "springs", f, 0, kMaxBodies, read_spring);
+  return m;
+}
+
+// ---- cross references and placements (spec.mechanism_spec) -------------------------------------
+
+std::string list_repr(const std::vector<std::string>& names) {
+  std::string v = "[";
+  for (std::size_t k = 0; k < names.size(); ++k) v += (k ? ", " : "") + quote(names[k]);
+  return v + "]";
+}
+
+std::pair<Vec3, Mat3> move_body(const Mat4& T, const Vec3& com, const Mat3& inertia) {
+  const Mat3 R = T.topLeftCorner<3, 3>();
+  return {R * com + T.topRightCorner<3, 1>(), R * inertia * R.transpose()};
+}
+
+MechanismDescription build_description(const MechanismIn& m, const std::string& field) {
+  const Mat4 base = m.base ? transform(m.base->xyz, m.base->rpy) : Mat4::Identity();
+  const std::size_t nj = m.joints.size();
+  auto jf = [&](std::size_t i) { return item(join(field, "joints"), i); };
+
+  // names, spherical expansions, what each name a user may refer to means
+  std::vector<std::string> names(nj);
+  for (std::size_t i = 0; i < nj; ++i) names[i] = m.joints[i].name ? *m.joints[i].name : "joint" + std::to_string(i + 1);
+  std::map<std::string, std::string> declared;    // spec joint name -> field declaring it
+  std::map<std::string, std::string> link_joint;  // a name a user may refer to -> spec joint of its link
+  std::vector<std::string> reference_order;       // link_joint's keys in insertion order
+  std::vector<std::vector<std::string>> expansions(nj);
+  for (std::size_t i = 0; i < nj; ++i) {
+    const std::string& nm = names[i];
+    const std::string f = join(jf(i), "name");
+    if (nm == kBase) fail(f, "'base' is the name of the fixed base; choose another", quote(nm));
+    std::vector<std::string> parts =
+        m.joints[i].type == "spherical" ? std::vector<std::string>{nm + "_z", nm + "_y", nm + "_x"} : std::vector<std::string>{nm};
+    std::vector<std::string> check = parts;
+    if (std::find(check.begin(), check.end(), nm) == check.end()) check.push_back(nm);
+    for (const auto& n : check) {
+      if (declared.count(n) || link_joint.count(n)) {
+        const std::string other = declared.count(n) ? declared[n] : declared[link_joint[n]];
+        const std::string what =
+            "the joint " + quote(n) + (n != nm ? " of the spherical joint " + quote(nm) : std::string());
+        fail(f, "duplicate name: " + what + " is also declared by " + other, quote(nm));
+      }
+    }
+    for (const auto& n : parts) {
+      declared[n] = n == nm ? jf(i) : jf(i) + " (spherical " + quote(nm) + ")";
+      link_joint[n] = n;
+      reference_order.push_back(n);
+    }
+    if (!link_joint.count(nm)) reference_order.push_back(nm);
+    link_joint[nm] = parts.back();
+    expansions[i] = parts;
+  }
+  std::vector<std::string> references = reference_order;
+  references.push_back(kBase);
+
+  auto resolve = [&](const std::string& ref, const std::string& f, const std::string& what) -> std::string {
+    if (ref == kBase) return kBase;
+    auto it = link_joint.find(ref);
+    if (it == link_joint.end()) fail(f, "unknown " + what + did_you_mean(ref, references), quote(ref));
+    return it->second;
+  };
+
+  // parents (default: the previous joint), cycles
+  std::map<std::string, std::size_t> index_of;
+  for (std::size_t i = 0; i < nj; ++i) {
+    for (const auto& n : expansions[i]) index_of[n] = i;
+    index_of[names[i]] = i;
+  }
+  constexpr std::size_t none = static_cast<std::size_t>(-1);
+  std::vector<std::size_t> parent_index(nj, none);
+  std::vector<std::string> parent_name(nj);
+  for (std::size_t i = 0; i < nj; ++i) {
+    const auto& j = m.joints[i];
+    const std::string ref = j.parent ? *j.parent : (i > 0 ? names[i - 1] : kBase);
+    const std::string parent = resolve(ref, join(jf(i), "parent"), "parent joint");
+    parent_name[i] = parent;
+    const std::size_t k = parent == kBase ? none : index_of[parent];
+    if (k == i && std::find(expansions[i].begin(), expansions[i].end(), parent) != expansions[i].end()) {
+      fail(join(jf(i), "parent"), "a joint cannot be its own parent", quote(ref));
+    }
+    parent_index[i] = k;
+  }
+  for (std::size_t i = 0; i < nj; ++i) {
+    std::vector<std::size_t> path{i};
+    std::size_t k = parent_index[i];
+    while (k != none) {
+      auto at = std::find(path.begin(), path.end(), k);
+      if (at != path.end()) {
+        std::vector<std::size_t> cycle(at, path.end());
+        cycle.push_back(k);
+        const std::size_t start = *std::min_element(cycle.begin(), cycle.end());
+        std::string text = "joints form a cycle: ";
+        for (std::size_t c = 0; c < cycle.size(); ++c) text += (c ? " -> " : "") + names[cycle[c]];
+        fail(join(jf(start), "parent"), text, quote(parent_name[start]));
+      }
+      path.push_back(k);
+      k = parent_index[k];
+    }
+  }
+
+  // parents first, the file's order where it already is
+  std::vector<std::size_t> order;
+  std::vector<bool> placed(nj, false);
+  while (order.size() < nj) {
+    for (std::size_t i = 0; i < nj; ++i) {
+      if (!placed[i] && (parent_index[i] == none || placed[parent_index[i]])) {
+        order.push_back(i);
+        placed[i] = true;
+      }
+    }
+  }
+
+  // placements and carries
+  std::vector<Mat4> origin_of(nj), carry_of(nj);
+  for (std::size_t i = 0; i < nj; ++i) {
+    const auto& j = m.joints[i];
+    if (j.mdh || j.dh) {
+      const DHIn& d = j.mdh ? *j.mdh : *j.dh;
+      if (j.mdh) {
+        origin_of[i] = rx(d.alpha) * tr(d.a, 0, 0) * tr(0, 0, d.d) * rz(d.theta);
+        carry_of[i] = Mat4::Identity();
+      } else {
+        origin_of[i] = rz(d.theta);
+        carry_of[i] = tr(0, 0, d.d) * tr(d.a, 0, 0) * rx(d.alpha);
+      }
+    } else {
+      origin_of[i] = j.origin ? transform(j.origin->xyz, j.origin->rpy) : Mat4::Identity();
+      carry_of[i] = Mat4::Identity();
+    }
+  }
+  std::map<std::string, Mat4> carry_by_joint;
+  for (std::size_t i = 0; i < nj; ++i)
+    for (const auto& n : expansions[i]) carry_by_joint[n] = n == expansions[i].back() ? carry_of[i] : Mat4::Identity();
+  auto frame_of_link = [&](const std::string& link) -> Mat4 { return link == kBase ? base : carry_by_joint.at(link); };
+  auto iso = [](const Mat4& T) {
+    Eigen::Isometry3d X;
+    X.matrix() = T;
+    return X;
+  };
+
+  MechanismDescription desc;
+  desc.root_name = kBase;
+  desc.gravity = m.gravity;
+  for (std::size_t i : order) {
+    const auto& j = m.joints[i];
+    const std::string& parent = parent_name[i];
+    const Mat4 placement = frame_of_link(parent) * origin_of[i];
+    if (j.type == "spherical") {
+      const auto& parts = expansions[i];
+      const std::string parents[3] = {parent, parts[0], parts[1]};
+      const Vec3 axes[3] = {Vec3::UnitZ(), Vec3::UnitY(), Vec3::UnitX()};
+      for (int k = 0; k < 3; ++k) {
+        Joint out;
+        out.name = parts[static_cast<std::size_t>(k)];
+        out.type = JointType::revolute;
+        out.parent = parents[k];
+        out.placement = iso(k == 0 ? placement : Mat4::Identity());
+        out.axis = axes[k];
+        desc.joints.push_back(out);
+      }
+      continue;
+    }
+    Joint out;
+    out.name = names[i];
+    out.type = j.type == "revolute" ? JointType::revolute : j.type == "prismatic" ? JointType::prismatic : JointType::fixed;
+    out.parent = parent;
+    out.placement = iso(placement);
+    Vec3 axis = j.axis ? *j.axis : Vec3::UnitZ();
+    axis = axis / axis.cwiseAbs().maxCoeff();
+    out.axis = axis / axis.norm();
+    out.lower = j.lower ? *j.lower : -kInf;
+    out.upper = j.upper ? *j.upper : kInf;
+    out.velocity_limit = j.velocity ? *j.velocity : kInf;
+    out.effort_limit = j.effort ? *j.effort : kInf;
+    if (j.mimic) {
+      const std::string f = join(join(jf(i), "mimic"), "joint");
+      const std::string& ref = j.mimic->joint;
+      auto k = index_of.find(ref);
+      if (k != index_of.end() && m.joints[k->second].type == "spherical" && ref == names[k->second]) {
+        const auto& e = expansions[k->second];
+        fail(f, quote(ref) + " is a spherical joint: name one of " + e[0] + ", " + e[1] + ", " + e[2], quote(ref));
+      }
+      const std::string master = resolve(ref, f, "joint");
+      if (master == kBase) fail(f, "the base does not move: name a joint", quote(ref));
+      if (master == names[i]) fail(f, "a joint cannot mimic itself", quote(ref));
+      const JointIn& mj = m.joints[index_of[master]];
+      if (mj.type == "fixed") fail(f, "mimics a fixed joint, which does not move", quote(ref));
+      if (mj.mimic) {
+        fail(f, "mimics " + quote(master) + ", itself a mimic of " + quote(mj.mimic->joint) + ": couple to " +
+                    quote(mj.mimic->joint) + " directly", quote(ref));
+      }
+      out.mimic_joint = master;
+      out.mimic_ratio = j.mimic->ratio;
+      out.mimic_offset = j.mimic->offset;
+    }
+    desc.joints.push_back(out);
+  }
+
+  // bodies: each joint's own link, then the extra bodies
+  std::map<std::string, std::string> body_field;
+  auto add_body = [&](const std::string& nm, const std::string& kind, const std::string& link, double mass,
+                      const Vec3& com, const Mat3& inertia, const std::string& f) {
+    auto it = body_field.find(nm);
+    if (it != body_field.end()) fail(f, "duplicate body name: " + quote(nm) + " is also " + it->second, quote(nm));
+    body_field[nm] = f;
+    auto [c, I] = move_body(frame_of_link(link), com, inertia);
+    Body b;
+    b.name = nm;
+    b.kind = kind;
+    b.link = link;
+    b.mass = mass;
+    b.com = c;
+    b.inertia = 0.5 * (I + I.transpose());
+    desc.bodies.push_back(b);
+  };
+  for (std::size_t i : order) {
+    const auto& j = m.joints[i];
+    if (j.link) add_body(names[i], "link", expansions[i].back(), j.link->mass, j.link->com, j.link->inertia, join(jf(i), "link"));
+  }
+  for (std::size_t k = 0; k < m.bodies.size(); ++k) {
+    const auto& b = m.bodies[k];
+    const std::string f = item(join(field, "bodies"), k);
+    const std::string link = resolve(b.link, join(f, "link"), "link");
+    const Mat3 R = rotation_rpy(b.rpy);
+    add_body(b.name, b.kind, link, b.mass, b.com, R * b.inertia * R.transpose(), join(f, "name"));
+  }
+
+  std::map<std::string, std::string> frame_field;
+  std::vector<std::string> frame_names;
+  for (std::size_t k = 0; k < m.frames.size(); ++k) {
+    const auto& fr = m.frames[k];
+    const std::string f = item(join(field, "frames"), k);
+    auto it = frame_field.find(fr.name);
+    if (it != frame_field.end()) fail(join(f, "name"), "duplicate frame name: also " + it->second, quote(fr.name));
+    if (fr.name == kBase) fail(join(f, "name"), "'base' is the name of the fixed base; choose another", quote(fr.name));
+    frame_field[fr.name] = f;
+    frame_names.push_back(fr.name);
+    const std::string link = resolve(fr.link, join(f, "link"), "link");
+    Frame out;
+    out.name = fr.name;
+    out.link = link;
+    out.placement = iso(frame_of_link(link) * transform(fr.origin.xyz, fr.origin.rpy));
+    desc.frames.push_back(out);
+  }
+
+  std::map<std::string, std::string> loop_field;
+  for (std::size_t k = 0; k < m.loops.size(); ++k) {
+    const auto& lp = m.loops[k];
+    const std::string f = item(join(field, "loops"), k);
+    auto it = loop_field.find(lp.name);
+    if (it != loop_field.end()) fail(join(f, "name"), "duplicate loop name: also " + it->second, quote(lp.name));
+    loop_field[lp.name] = f;
+    for (const auto* key : {"frame_a", "frame_b"}) {
+      const std::string& nm = std::string(key) == "frame_a" ? lp.frame_a : lp.frame_b;
+      if (!frame_field.count(nm)) {
+        fail(join(f, key), "no such frame (define it in [[mechanism.frames]])" + did_you_mean(nm, frame_names), quote(nm));
+      }
+    }
+    LoopConstraint out;
+    out.name = lp.name;
+    out.type = lp.type == "point" ? LoopType::point
+               : lp.type == "planar_point" ? LoopType::planar_point
+               : lp.type == "axis" ? LoopType::axis
+                                   : LoopType::weld;
+    out.frame_a = lp.frame_a;
+    out.frame_b = lp.frame_b;
+    desc.loops.push_back(out);
+  }
+
+  std::map<std::string, std::string> spring_field;
+  for (std::size_t k = 0; k < m.springs.size(); ++k) {
+    const auto& sp = m.springs[k];
+    const std::string f = item(join(field, "springs"), k);
+    auto it = spring_field.find(sp.name);
+    if (it != spring_field.end()) fail(join(f, "name"), "duplicate spring name: also " + it->second, quote(sp.name));
+    spring_field[sp.name] = f;
+    Spring out;
+    out.name = sp.name;
+    out.link_a = resolve(sp.link_a, join(f, "link_a"), "link");
+    Mat4 T = frame_of_link(out.link_a);
+    out.anchor_a = T.topLeftCorner<3, 3>() * sp.anchor_a + T.topRightCorner<3, 1>();
+    out.link_b = resolve(sp.link_b, join(f, "link_b"), "link");
+    T = frame_of_link(out.link_b);
+    out.anchor_b = T.topLeftCorner<3, 3>() * sp.anchor_b + T.topRightCorner<3, 1>();
+    if (out.link_a == out.link_b) {
+      fail(join(f, "link_b"), "both anchors are on the same link, so the spring never changes length", quote(sp.link_b));
+    }
+    out.rate = sp.rate;
+    out.free_length = sp.free_length;
+    out.preload = sp.preload;
+    out.count = sp.count;
+    out.pulley_ratio = sp.pulley_ratio;
+    desc.springs.push_back(out);
+  }
+
+  std::vector<std::string> independent;
+  for (const auto& j : desc.joints)
+    if (j.type != JointType::fixed && j.mimic_joint.empty()) independent.push_back(j.name);
+  for (std::size_t k = 0; k < m.actuated.size(); ++k) {
+    const auto& nm = m.actuated[k];
+    if (std::find(independent.begin(), independent.end(), nm) == independent.end()) {
+      fail(item(join(field, "actuated"), k), "not a joint with its own coordinate" + did_you_mean(nm, independent), quote(nm));
+    }
+  }
+  {
+    std::vector<std::string> sorted = m.actuated;
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+      fail(join(field, "actuated"), "names a joint twice", list_repr(m.actuated));
+    }
+  }
+  if (!desc.loops.empty() && m.actuated.empty()) {
+    fail(join(field, "actuated"), "a mechanism with loops must name its actuated joints");
+  }
+  desc.actuated = m.actuated;
+  return desc;
+}
+
+// ---- documents ------------------------------------------------------------------------------
+
+toml::table parse(const std::string& text, const std::string& source) {
+  try {
+    return toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream os;
+    os << "is not valid TOML: " << e.description() << " (line " << e.source().begin.line << ", column "
+       << e.source().begin.column << ")";
+    fail(source, os.str());
+  }
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail("case", "file not found", quote(path));
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+MechanismDescription description_of(const toml::table& doc) {
+  const toml::node* m = doc.get("mechanism");
+  if (!m) fail("mechanism", "is required");
+  return build_description(read_mechanism(*m, "mechanism"), "mechanism");
+}
+
+MechanismModel model_of(MechanismDescription desc) {
+  try {
+    return MechanismModel(std::move(desc));
+  } catch (const ConfigError&) {
+    throw;
+  } catch (const std::invalid_argument& e) {
+    fail("mechanism", e.what());
+  }
+}
+
+// ---- [control] --------------------------------------------------------------------------------
+
+std::vector<double> numbers(const toml::node& n, const std::string& f, std::size_t max_len, double lo, Lo lo_kind) {
+  const toml::array& a = array_of(n, f, 1, max_len);
+  std::vector<double> out;
+  for (std::size_t k = 0; k < a.size(); ++k) out.push_back(number(*a.get(k), item(f, k), lo, kMaxAbs, lo_kind));
+  return out;
+}
+
+std::vector<std::string> names_list(const toml::node& n, const std::string& f, std::size_t max_len) {
+  const toml::array& a = array_of(n, f, 1, max_len);
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k < a.size(); ++k) out.push_back(name(*a.get(k), item(f, k)));
+  return out;
+}
+
+ControlConfig read_control(const toml::node& n, const MechanismModel& model) {
+  const std::string f = "control";
+  const auto& t = table_of(n, f);
+  const std::vector<std::string> common{"kind", "rate_hz", "kp", "kd", "torque_limit"};
+  const std::vector<std::string> decoupled{"k"};
+  const std::vector<std::string> reactionless{"balancing_joints", "cancel", "integrator", "damping", "task_frame"};
+  std::vector<std::string> all = common;
+  all.insert(all.end(), decoupled.begin(), decoupled.end());
+  all.insert(all.end(), reactionless.begin(), reactionless.end());
+  allow_keys(t, f, all);
+  ControlConfig c;
+  const std::string kind = choice(required(t, "kind", f), join(f, "kind"), {"computed_torque", "decoupled", "reactionless"});
+  c.kind = kind == "computed_torque" ? ControlKind::computed_torque
+           : kind == "decoupled"     ? ControlKind::decoupled
+                                     : ControlKind::reactionless;
+  for (auto&& [k, v] : t) {
+    const std::string key(k.str());
+    const bool is_decoupled = std::find(decoupled.begin(), decoupled.end(), key) != decoupled.end();
+    const bool is_reactionless = std::find(reactionless.begin(), reactionless.end(), key) != reactionless.end();
+    if ((is_decoupled && c.kind != ControlKind::decoupled) || (is_reactionless && c.kind != ControlKind::reactionless)) {
+      fail(join(f, key), std::string("is only for kind = '") + (is_decoupled ? "decoupled" : "reactionless") + "'", v);
+    }
+  }
+  if (auto x = get(t, "rate_hz")) c.rate_hz = number(*x, join(f, "rate_hz"), 1.0, 1e6);
+  const std::size_t na = static_cast<std::size_t>(model.num_actuated());
+  std::string actuated;
+  for (int i : model.actuated_coordinates()) actuated += (actuated.empty() ? "" : ", ") + model.coordinate_name(i);
+  auto per_joint = [&](const char* key, bool needed) {
+    const toml::node* x = get(t, key);
+    if (!x) {
+      if (needed) fail(join(f, key), "is required for kind = '" + kind + "'");
+      return std::vector<double>();
+    }
+    std::vector<double> v = numbers(*x, join(f, key), kMaxJoints, 0.0, Lo::gt);
+    if (v.size() != na) {
+      fail(join(f, key), "must have " + std::to_string(na) + " values (one per actuated joint: " + actuated + ")", *x);
+    }
+    return v;
+  };
+  const bool gains_needed = c.kind != ControlKind::reactionless;
+  c.kp = per_joint("kp", gains_needed);
+  c.kd = per_joint("kd", gains_needed);
+  if (c.kp.empty() != c.kd.empty()) fail(join(f, c.kp.empty() ? "kp" : "kd"), "is required with " + std::string(c.kp.empty() ? "kd" : "kp"));
+  c.torque_limit = per_joint("torque_limit", false);
+  c.k = per_joint("k", false);
+  if (c.kind == ControlKind::reactionless) {
+    const std::string fb = join(f, "balancing_joints");
+    c.balancing_joints = names_list(required(t, "balancing_joints", f), fb, kMaxJoints);
+    const auto& coords = model.coordinate_names();
+    for (std::size_t k = 0; k < c.balancing_joints.size(); ++k) {
+      const auto& nm = c.balancing_joints[k];
+      if (std::find(coords.begin(), coords.end(), nm) == coords.end()) {
+        fail(item(fb, k), "not a joint with its own coordinate" + did_you_mean(nm, coords), quote(nm));
+      }
+      if (std::find(c.balancing_joints.begin(), c.balancing_joints.begin() + static_cast<long>(k), nm) !=
+          c.balancing_joints.begin() + static_cast<long>(k)) {
+        fail(item(fb, k), "names a joint twice", quote(nm));
+      }
+    }
+    if (auto x = get(t, "cancel")) {
+      const std::string fc = join(f, "cancel");
+      const toml::array& a = array_of(*x, fc, 1, 6);
+      c.cancel.clear();
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        c.cancel.push_back(choice(*a.get(k), item(fc, k), {"moment", "force", "moment_x", "moment_y", "moment_z",
+                                                           "force_x", "force_y", "force_z"}));
+      }
+    }
+    if (auto x = get(t, "integrator")) c.integrator = choice(*x, join(f, "integrator"), {"rk4", "euler"});
+    if (auto x = get(t, "damping")) c.damping = number(*x, join(f, "damping"), 0.0);
+    if (auto x = get(t, "task_frame")) {
+      c.task_frame = name(*x, join(f, "task_frame"));
+      if (model.frame_index(c.task_frame) < 0) {
+        std::vector<std::string> frames;
+        for (int k = 0; k < model.num_frames(); ++k) frames.push_back(model.frame(k).name);
+        fail(join(f, "task_frame"), "no such frame" + did_you_mean(c.task_frame, frames), *x);
+      }
+    }
+  }
+  return c;
+}
+
+// ---- [trajectory] of a mechanism case (schema.ChainTrajectory) --------------------------------
+
+std::vector<double> joint_values(const toml::node& n, const std::string& f) {
+  const toml::array& a = array_of(n, f, 1, kMaxJoints);
+  std::vector<double> out;
+  for (std::size_t k = 0; k < a.size(); ++k) out.push_back(number(*a.get(k), item(f, k)));
+  return out;
+}
+
+TrajectoryConfig read_trajectory(const toml::node& n, const MechanismModel& model) {
+  const std::string f = "trajectory";
+  const auto& t = table_of(n, f);
+  allow_keys(t, f, {"law", "start", "end", "duration", "samples", "initial_guess"});
+  TrajectoryConfig tr;
+  tr.present = true;
+  if (auto x = get(t, "law")) tr.law = choice(*x, join(f, "law"), {"quintic", "cubic"}) == "cubic" ? TimeLaw::cubic : TimeLaw::quintic;
+  tr.start = joint_values(required(t, "start", f), join(f, "start"));
+  tr.end = joint_values(required(t, "end", f), join(f, "end"));
+  tr.duration = number(required(t, "duration", f), join(f, "duration"), 1e-3, 1e6);
+  if (auto x = get(t, "samples")) tr.samples = static_cast<int>(integer(*x, join(f, "samples"), 3, 1000000));
+  if (auto x = get(t, "initial_guess")) tr.initial_guess = joint_values(*x, join(f, "initial_guess"));
+  const std::size_t na = static_cast<std::size_t>(model.num_actuated());
+  for (const char* key : {"start", "end"}) {
+    const auto& v = std::string(key) == "start" ? tr.start : tr.end;
+    if (v.size() != na) fail(join(f, key), "must have " + std::to_string(na) + " values (one per actuated joint)", *get(t, key));
+  }
+  if (!tr.initial_guess.empty() && tr.initial_guess.size() != static_cast<std::size_t>(model.dof())) {
+    fail(join(f, "initial_guess"), "must have " + std::to_string(model.dof()) + " values (every joint coordinate)",
+         *get(t, "initial_guess"));
+  }
+  return tr;
+}
+
+LoadedCase case_of(const toml::table& doc) {
+  MechanismModel model = model_of(description_of(doc));
+  ControlConfig control;
+  if (const toml::node* c = doc.get("control")) control = read_control(*c, model);
+  std::string case_name, kind;
+  if (const toml::node* h = doc.get("case")) {
+    if (h->is_table()) {
+      if (auto nm = h->as_table()->get("name"); nm && nm->is_string()) case_name = nm->as_string()->get();
+      if (auto k = h->as_table()->get("kind"); k && k->is_string()) kind = k->as_string()->get();
+    }
+  }
+  TrajectoryConfig trajectory;
+  if (kind.empty() || kind == "mechanism" || kind == "serial_chain") {
+    if (const toml::node* t = doc.get("trajectory")) trajectory = read_trajectory(*t, model);
+  }
+  return LoadedCase{std::move(model), std::move(control), std::move(trajectory), std::move(case_name)};
+}
+
+}  // namespace
+
+MechanismDescription mechanism_description_from_string(const std::string& toml_text, const std::string& source) {
+  return description_of(parse(toml_text, source));
+}
+
+MechanismModel mechanism_from_string(const std::string& toml_text, const std::string& source) {
+  return model_of(mechanism_description_from_string(toml_text, source));
+}
+
+MechanismModel load_mechanism(const std::string& path) { return mechanism_from_string(read_file(path), path); }
+
+LoadedCase case_from_string(const std::string& toml_text, const std::string& source) {
+  return case_of(parse(toml_text, source));
+}
+
+LoadedCase load_case(const std::string& path) { return case_from_string(read_file(path), path); }
+
+ControlConfig load_control(const std::string& path, const MechanismModel& model) {
+  const toml::table doc = parse(read_file(path), path);
+  const toml::node* c = doc.get("control");
+  if (!c) fail("control", "is required");
+  return read_control(*c, model);
+}
+
+}  // namespace mechbal

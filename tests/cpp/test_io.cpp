@@ -1,0 +1,227 @@
+// The C++ case-format reader (io/case.hpp) and make_controller (control/factory.hpp): the three
+// joint forms (origin, mdh, dh) of a planar 2R arm against its closed-form mass matrix and gravity
+// torque, the built-in closed cases, the errors naming the field, [control] and the controllers.
+// Parity with the Python reader is tested in tests/python/test_io_parity.py.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "alloc_counter.hpp"
+#include "mechbal/algorithm/inverse_dynamics.hpp"
+#include "mechbal/algorithm/mass_matrix.hpp"
+#include "mechbal/control/factory.hpp"
+#include "mechbal/io/case.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
+
+using namespace mechbal;
+
+namespace {
+
+constexpr double l1 = 0.7, l2 = 0.45, m1 = 2.5, m2 = 1.25, g0 = 9.81;
+
+/// A vertical planar 2R arm (joints about z, gravity along -y) with point masses at the link
+/// ends, in one of the three joint forms.
+std::string arm(const std::string& form) {
+  std::string s = "[mechanism]\ngravity = [0.0, -9.81, 0.0]\n";
+  if (form == "origin") {
+    s += "[[mechanism.joints]]\nname = \"a\"\nlink = {mass = 2.5, com = [0.7, 0.0, 0.0], inertia = [0, 0, 0]}\n";
+    s += "[[mechanism.joints]]\nname = \"b\"\norigin = {xyz = [0.7, 0, 0]}\n"
+         "link = {mass = 1.25, com = [0.45, 0.0, 0.0], inertia = [0, 0, 0]}\n";
+  } else if (form == "mdh") {
+    s += "[[mechanism.joints]]\nname = \"a\"\nmdh = {a = 0.0, alpha = 0.0}\n"
+         "link = {mass = 2.5, com = [0.7, 0.0, 0.0], inertia = [0, 0, 0]}\n";
+    s += "[[mechanism.joints]]\nname = \"b\"\nmdh = {a = 0.7, alpha = 0.0}\n"
+         "link = {mass = 1.25, com = [0.45, 0.0, 0.0], inertia = [0, 0, 0]}\n";
+  } else {  // standard DH: the link frame is at the link's far end
+    s += "[[mechanism.joints]]\nname = \"a\"\ndh = {a = 0.7, alpha = 0.0}\n"
+         "link = {mass = 2.5, com = [0.0, 0.0, 0.0], inertia = [0, 0, 0]}\n";
+    s += "[[mechanism.joints]]\nname = \"b\"\ndh = {a = 0.45, alpha = 0.0}\n"
+         "link = {mass = 1.25, com = [0.0, 0.0, 0.0], inertia = [0, 0, 0]}\n";
+  }
+  return s;
+}
+
+std::string field_of(const std::string& toml) {
+  try {
+    mechanism_from_string(toml);
+  } catch (const ConfigError& e) {
+    return e.field();
+  }
+  return "(accepted)";
+}
+
+std::string message_of(const std::string& toml) {
+  try {
+    case_from_string(toml);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+const std::string cases_dir = MECHBAL_SOURCE_DIR "/python/mechbal/cases/";
+const std::string papers_dir = MECHBAL_SOURCE_DIR "/python/mechbal/papers/";
+
+}  // namespace
+
+TEST(CaseReader, ThreeJointFormsGiveTheClosedFormArm) {
+  for (const char* form : {"origin", "mdh", "dh"}) {
+    SCOPED_TRACE(form);
+    const MechanismModel model = mechanism_from_string(arm(form));
+    ASSERT_EQ(model.dof(), 2);
+    MechanismData data(model);
+    for (double q1 : {-1.1, 0.3, 2.0}) {
+      for (double q2 : {-2.5, 0.0, 0.8}) {
+        const Eigen::Vector2d q(q1, q2);
+        ASSERT_EQ(mass_matrix(model, data, q), Status::ok);
+        const double c2 = std::cos(q2);
+        Eigen::Matrix2d M;
+        M(0, 0) = m1 * l1 * l1 + m2 * (l1 * l1 + l2 * l2 + 2 * l1 * l2 * c2);
+        M(0, 1) = M(1, 0) = m2 * (l2 * l2 + l1 * l2 * c2);
+        M(1, 1) = m2 * l2 * l2;
+        EXPECT_LT((data.mass_matrix - M).cwiseAbs().maxCoeff(), 1e-12);
+        ASSERT_EQ(gravity_torque(model, data, q), Status::ok);
+        const Eigen::VectorXd& gq = data.gravity_torque;
+        const Eigen::Vector2d g((m1 + m2) * g0 * l1 * std::cos(q1) + m2 * g0 * l2 * std::cos(q1 + q2),
+                                m2 * g0 * l2 * std::cos(q1 + q2));
+        EXPECT_LT((gq - g).cwiseAbs().maxCoeff(), 1e-12);
+      }
+    }
+  }
+}
+
+TEST(CaseReader, BuiltInClosedCases) {
+  const MechanismModel fb = load_mechanism(cases_dir + "four-bar.toml");
+  EXPECT_TRUE(fb.is_closed());
+  EXPECT_EQ(fb.num_actuated(), 1);
+  const LoadedCase p = load_case(papers_dir + "paminsa/cases/paminsa-linkage.toml");
+  EXPECT_EQ(p.name, "paminsa-linkage");
+  EXPECT_EQ(p.model.num_bodies(), 38);
+  EXPECT_EQ(p.model.num_loops(), 9);
+  EXPECT_EQ(p.model.num_actuated(), 6);
+  ASSERT_TRUE(p.trajectory.present);
+  EXPECT_EQ(p.trajectory.start.size(), 6u);
+  EXPECT_EQ(p.trajectory.initial_guess.size(), static_cast<std::size_t>(p.model.dof()));
+  EXPECT_EQ(p.control.kind, ControlKind::none);
+}
+
+TEST(CaseReader, ErrorsNameTheField) {
+  const std::string ok = arm("origin");
+  EXPECT_EQ(field_of(ok), "(accepted)");
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = ok;
+    const auto at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return s.replace(at, from.size(), to);
+  };
+  EXPECT_EQ(field_of(with("mass = 1.25", "mass = -1.25")), "mechanism.joints[1].link.mass");
+  EXPECT_EQ(field_of(with("mass = 1.25", "mass = nan")), "mechanism.joints[1].link.mass");
+  EXPECT_EQ(field_of(with("mass = 1.25", "mass = true")), "mechanism.joints[1].link.mass");
+  EXPECT_EQ(field_of(with("mass = 1.25, ", "")), "mechanism.joints[1].link.mass");
+  EXPECT_EQ(field_of(with("origin =", "orign =")), "mechanism.joints[1].orign");
+  EXPECT_EQ(field_of(with("xyz = [0.7, 0, 0]", "xyz = [0.7, 0]")), "mechanism.joints[1].origin.xyz");
+  EXPECT_EQ(field_of(with("xyz = [0.7, 0, 0]", "xyz = [0.7, 0, 1e13]")), "mechanism.joints[1].origin.xyz[2]");
+  EXPECT_EQ(field_of(with("name = \"b\"", "name = \"b\"\nparent = \"c\"")), "mechanism.joints[1].parent");
+  EXPECT_EQ(field_of(with("inertia = [0, 0, 0]}\n[[mechanism.joints]]", "inertia = [1, 1, 3]}\n[[mechanism.joints]]")),
+            "mechanism.joints[0].link.inertia");
+  EXPECT_EQ(field_of("[case]\nname = \"x\"\n"), "mechanism");
+  EXPECT_EQ(field_of("[mechanism\n"), "string");  // not TOML: the source is named
+  const std::string msg = message_of(with("mass = 1.25", "mass = -1.25"));
+  EXPECT_NE(msg.find("mechanism.joints[1].link.mass: must be >= 0 (got -1.25)"), std::string::npos) << msg;
+  EXPECT_NE(message_of(with("origin =", "orgin =")).find("did you mean"), std::string::npos);
+}
+
+TEST(CaseReader, ControlTable) {
+  const std::string base = arm("origin");
+  const LoadedCase c = case_from_string(base + "[control]\nkind = \"computed_torque\"\nkp = [100, 100]\nkd = [20, 20]\n");
+  EXPECT_EQ(c.control.kind, ControlKind::computed_torque);
+  EXPECT_EQ(c.control.rate_hz, 1000.0);
+  EXPECT_NE(message_of(base + "[control]\nkind = \"computed_torque\"\nkp = [100]\nkd = [20, 20]\n").find("control.kp: must have 2 values"),
+            std::string::npos);
+  EXPECT_NE(message_of(base + "[control]\nkind = \"computed_torque\"\nkp = [1, 1]\nkd = [2, 2]\nk = [1, 1]\n")
+                .find("control.k: is only for kind = 'decoupled'"),
+            std::string::npos);
+  EXPECT_NE(message_of(base + "[control]\nkind = \"computed\"\n").find("control.kind: must be one of"), std::string::npos);
+  EXPECT_NE(message_of(base + "[control]\nkind = \"decoupled\"\nkp = [1, 1]\nkd = [0, 1]\n").find("control.kd[0]: must be > 0"),
+            std::string::npos);
+  const LoadedCase r = case_from_string(base + "[control]\nkind = \"reactionless\"\nbalancing_joints = [\"b\"]\n"
+                                               "cancel = [\"moment_z\"]\nintegrator = \"euler\"\n");
+  EXPECT_EQ(r.control.balancing_joints, std::vector<std::string>{"b"});
+  EXPECT_EQ(r.control.cancel, std::vector<std::string>{"moment_z"});
+  EXPECT_EQ(r.control.integrator, "euler");
+  EXPECT_NE(message_of(base + "[control]\nkind = \"reactionless\"\nbalancing_joints = [\"c\"]\n").find("control.balancing_joints[0]"),
+            std::string::npos);
+  try {
+    make_controller(r.model, r.control);
+    ADD_FAILURE() << "reactionless built";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("reactionless"), std::string::npos);
+  }
+}
+
+TEST(MakeController, ComputedTorqueIsTheInverseDynamicsOnTrack) {
+  const LoadedCase c = case_from_string(arm("mdh") + "[control]\nkind = \"computed_torque\"\nkp = [100, 100]\nkd = [20, 20]\n");
+  auto controller = make_controller(c.model, c.control);
+  ASSERT_EQ(controller->dof(), 2);
+  const Eigen::Vector2d q(0.3, -0.7), qd(0.5, -0.2), qdd(1.0, 2.0);
+  Eigen::Vector2d tau;
+  ASSERT_EQ(controller->step(q, qd, q, qd, qdd, tau), Status::ok);
+  MechanismData data(c.model);
+  ASSERT_EQ(inverse_dynamics(c.model, data, q, qd, qdd), Status::ok);
+  EXPECT_LT((tau - data.joint_torque).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(MakeController, DecoupledTakesTheBalancedDiagonal) {
+  // a rotor about the vertical: M = Izz, constant, and no gravity torque
+  const std::string rotor =
+      "[mechanism]\n[[mechanism.joints]]\nname = \"r\"\nlink = {mass = 3.0, inertia = [0.2, 0.2, 0.35]}\n"
+      "[control]\nkind = \"decoupled\"\nkp = [50]\nkd = [10]\n";
+  const LoadedCase c = case_from_string(rotor);
+  auto controller = make_controller(c.model, c.control);
+  Eigen::VectorXd q(1), qd(1), qdd(1), tau(1);
+  q << 0.1;
+  qd << 0.0;
+  qdd << 2.0;
+  ASSERT_EQ(controller->step(q, qd, q, qd, qdd, tau), Status::ok);
+  EXPECT_NEAR(tau[0], 0.35 * 2.0, 1e-12);
+  // the 2R arm's mass matrix is not diagonal: decoupled needs k then
+  const LoadedCase a = case_from_string(arm("origin") + "[control]\nkind = \"decoupled\"\nkp = [1, 1]\nkd = [1, 1]\n");
+  EXPECT_THROW(make_controller(a.model, a.control), std::invalid_argument);
+}
+
+TEST(MakeController, MadeControllersStepWithoutAllocating) {
+  // the closed PAMINSA under computed torque (loops solved every tick) and a decoupled rotor
+  const LoadedCase p = load_case(papers_dir + "paminsa/cases/paminsa-linkage.toml");
+  ControlConfig config;
+  config.kind = ControlKind::computed_torque;
+  config.kp.assign(6, 400.0);
+  config.kd.assign(6, 40.0);
+  const Eigen::VectorXd guess = Eigen::Map<const Eigen::VectorXd>(p.trajectory.initial_guess.data(), p.model.dof());
+  auto ct = make_controller(p.model, config, guess);
+  const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(p.trajectory.start.data(), 6);
+  const Eigen::VectorXd z = Eigen::VectorXd::Zero(6);
+  Eigen::VectorXd tau(6), bad = q;
+  bad[0] = std::nan("");
+  ASSERT_EQ(ct->step(q, z, q, z, z, tau), Status::ok);  // first tick: assembles from the guess
+  // the case's motion, sampled before counting
+  const RestToRestTrajectory motion(q, Eigen::Map<const Eigen::VectorXd>(p.trajectory.end.data(), 6),
+                                    p.trajectory.duration, p.trajectory.law);
+  Eigen::MatrixXd Q(6, 50), V(6, 50), A(6, 50);
+  for (int k = 0; k < 50; ++k) {
+    Eigen::VectorXd qk(6), vk(6), ak(6);
+    motion.evaluate(p.trajectory.duration * k / 49.0, qk, vk, ak);
+    Q.col(k) = qk, V.col(k) = vk, A.col(k) = ak;
+  }
+  int ok = 0;
+  {
+    test::AllocationScope scope;
+    for (int k = 0; k < 50; ++k) {
+      ok += ct->step(Q.col(k), V.col(k), Q.col(k), V.col(k), A.col(k), tau) == Status::ok;
+      ct->step(bad, z, q, z, z, tau);  // held output, status
+    }
+    EXPECT_EQ(scope.count(), 0u);
+  }
+  EXPECT_EQ(ok, 50);
+  EXPECT_TRUE(tau.allFinite());
+}

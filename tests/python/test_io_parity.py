@@ -1,0 +1,441 @@
+"""One format, two readers (issue 27): the C++ case reader (mechbal::load_mechanism, toml++) and
+the Python reader (mechbal.spec + Mechanism.from_spec) build the same model from every built-in
+case with a [mechanism] table, every balanced.toml that `mechbal balance` writes, and a corpus of
+random valid cases (every joint form, spherical joints, gears, bodies with rpy, frames, loops,
+springs, base, gravity): the same names, types, parents, gear couplings, limits, masses and kinds
+exactly; placements, axes, centres of mass, inertias and spring anchors to a few ulps (numpy's
+BLAS sums the 3x3 / 4x4 products with FMA in a CPU-dependent order; the C++ reader with plain
+products), exactly where no rotation or DH frame applies; the mass matrix and gravity torque at
+random states to 1e-15 relative. Both readers refuse the same invalid corpus, naming the same
+field."""
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mechbal
+from mechbal import _core
+from mechbal.balance.writers import toml_text
+from mechbal.errors import ConfigError
+from mechbal.mechanism import Mechanism
+from mechbal.spec import mechanism_spec
+
+PKG = Path(mechbal.__file__).resolve().parent
+EPS = np.finfo(float).eps
+#: a few ulps of the largest entry (see the module docstring)
+ULPS = 8
+
+
+def builtin_mechanism_cases() -> list[Path]:
+    """Every TOML file of the package with a [mechanism] table (cases/ and the papers' packages)."""
+    out = []
+    for p in sorted(PKG.rglob("*.toml")):
+        try:
+            data = tomllib.loads(p.read_text())
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError):
+            continue
+        if isinstance(data.get("mechanism"), dict):
+            out.append(p)
+    return out
+
+
+def close(a, b, what: str, scale: float | None = None) -> None:
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    assert a.shape == b.shape, what
+    s = max(1.0, float(np.max(np.abs(a)))) if scale is None else scale
+    err = float(np.max(np.abs(a - b))) if a.size else 0.0
+    assert err <= ULPS * EPS * s, f"{what}: differs by {err:.3g} (scale {s:.3g})"
+
+
+def assert_same_model(py_model, cpp_model, rng: np.random.Generator, exact_geometry: bool = False) -> None:
+    dp, dc = py_model.description, cpp_model.description
+    assert dc.root_name == dp.root_name
+    assert np.array_equal(np.asarray(dc.gravity), np.asarray(dp.gravity))
+    geometry = (lambda a, b, what: np.testing.assert_array_equal(a, b, what)) if exact_geometry else close
+    assert [j.name for j in dc.joints] == [j.name for j in dp.joints]
+    for jc, jp in zip(dc.joints, dp.joints):
+        assert (jc.type, jc.parent, jc.mimic_joint, jc.mimic_ratio, jc.mimic_offset) == \
+            (jp.type, jp.parent, jp.mimic_joint, jp.mimic_ratio, jp.mimic_offset), jp.name
+        assert (jc.lower, jc.upper, jc.velocity_limit, jc.effort_limit) == \
+            (jp.lower, jp.upper, jp.velocity_limit, jp.effort_limit), jp.name
+        geometry(jc.placement, jp.placement, f"joint {jp.name} placement")
+        geometry(jc.axis, jp.axis, f"joint {jp.name} axis")
+    assert [(b.name, b.kind, b.link) for b in dc.bodies] == [(b.name, b.kind, b.link) for b in dp.bodies]
+    for bc, bp in zip(dc.bodies, dp.bodies):
+        assert bc.mass == bp.mass, bp.name
+        geometry(bc.com, bp.com, f"body {bp.name} com")
+        geometry(bc.inertia, bp.inertia, f"body {bp.name} inertia")
+    assert [(f.name, f.link) for f in dc.frames] == [(f.name, f.link) for f in dp.frames]
+    for fc, fp in zip(dc.frames, dp.frames):
+        geometry(fc.placement, fp.placement, f"frame {fp.name}")
+    assert [(lp.name, lp.type, lp.frame_a, lp.frame_b) for lp in dc.loops] == \
+        [(lp.name, lp.type, lp.frame_a, lp.frame_b) for lp in dp.loops]
+    assert list(dc.actuated) == list(dp.actuated)
+    key = lambda s: (s.name, s.link_a, s.link_b, s.rate, s.free_length, s.preload, s.count, s.pulley_ratio)  # noqa: E731
+    assert [key(s) for s in dc.springs] == [key(s) for s in dp.springs]
+    for sc, sp in zip(dc.springs, dp.springs):
+        geometry(sc.anchor_a, sp.anchor_a, f"spring {sp.name} anchor_a")
+        geometry(sc.anchor_b, sp.anchor_b, f"spring {sp.name} anchor_b")
+    # the dynamics of the two models at random states
+    mp, mc = Mechanism(py_model), Mechanism(cpp_model)
+    assert mc.dof == mp.dof and list(cpp_model.coordinate_names) == list(py_model.coordinate_names)
+    q = rng.uniform(-1.5, 1.5, size=(12, mp.dof))
+    for name, fp, fc in (("mass matrix", mp.mass_matrix, mc.mass_matrix),
+                         ("gravity torque", mp.gravity_torque, mc.gravity_torque)):
+        a, b = fp(q), fc(q)
+        scale = float(np.max(np.abs(a)))
+        if scale == 0.0:
+            assert np.array_equal(a, b), name
+            continue
+        err = float(np.max(np.abs(a - b)))
+        assert err <= 1e-15 * scale, f"{name}: relative difference {err / scale:.3g}"
+
+
+# ---- built-in cases ------------------------------------------------------------------------------
+
+BUILTIN = builtin_mechanism_cases()
+
+
+def test_the_builtin_corpus_is_found():
+    names = {p.stem for p in BUILTIN}
+    assert {"four-bar", "paminsa-linkage", "ur5-dh", "orthoglide", "rpsp"} <= names, names
+
+
+@pytest.mark.parametrize("path", BUILTIN, ids=lambda p: p.stem)
+def test_builtin_case(path):
+    rng = np.random.default_rng(sum(path.stem.encode()))
+    py = Mechanism.from_toml(path)
+    cpp = _core.load_mechanism_file(str(path))
+    assert_same_model(py.model, cpp, rng)
+
+
+def test_bodies_without_rotation_are_bitwise_equal():
+    """Where no rotation or DH frame applies, the two readers do the same arithmetic: bit for bit."""
+    path = PKG / "papers" / "paminsa" / "cases" / "paminsa-linkage.toml"
+    dp, dc = Mechanism.from_toml(path).model.description, _core.load_mechanism_file(str(path)).description
+    n = 0
+    for bc, bp in zip(dc.bodies, dp.bodies):
+        assert bc.mass == bp.mass
+        np.testing.assert_array_equal(bc.com, bp.com)
+        np.testing.assert_array_equal(bc.inertia, bp.inertia)
+        n += 1
+    assert n == 38
+
+
+# ---- balanced.toml of `mechbal balance` (every method that applies to a built-in case) ----------
+
+METHODS = ("static", "force", "moment", "springs", "rms")
+
+
+@pytest.fixture(scope="module")
+def balanced_files(tmp_path_factory):
+    from mechbal.cli import main
+
+    root = tmp_path_factory.mktemp("balanced")
+    # every built-in case file (cases/ or a paper's package), by path
+    cases = [p for p in sorted(PKG.rglob("*.toml")) if "sweeps" not in p.parts
+             and isinstance(tomllib.loads(p.read_text()).get("case"), dict)]
+    out, stems = [], [c.stem for c in cases]
+    for case in cases:
+        label = case.stem if stems.count(case.stem) == 1 else f"{case.parent.name}-{case.stem}"
+        for method in METHODS:
+            d = root / f"{label}-{method}"
+            try:
+                rc = main(["balance", str(case), "--method", method, "--out", str(d), "-q"])
+            except SystemExit as exc:  # argparse refusals
+                rc = exc.code
+            if rc == 0 and (d / "balanced.toml").exists():
+                out.append(d / "balanced.toml")
+    return out
+
+
+def test_every_balanced_toml(balanced_files):
+    written = {p.parent.name for p in balanced_files}
+    # the methods of the built-in cases (test_balance_cli.py, test_balance_cases.py)
+    assert {"arm2dof-rms", "four-bar-force", "paminsa-force", "rpsp-force", "orthoglide-springs",
+            "discs-3r-moment", "ur5-dh-static"} <= written, written
+    rng = np.random.default_rng(27)
+    for path in balanced_files:
+        assert "mechanism" in tomllib.loads(path.read_text()), path.parent.name
+        assert_same_model(Mechanism.from_toml(path).model, _core.load_mechanism_file(str(path)), rng)
+
+
+# ---- random valid cases --------------------------------------------------------------------------
+
+def _inertia(rng) -> list:
+    a, c = rng.uniform(1.0, 2.0, 2)  # largest <= the sum of the two others
+    p = np.array([a, c, 0.5 * (a + c)]) * 0.05
+    form = rng.integers(3)
+    if form == 0:
+        return p.tolist()
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    I = Q @ np.diag(p) @ Q.T
+    I = 0.5 * (I + I.T)
+    if form == 1:
+        return [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
+    return I.tolist()
+
+
+def _vec(rng, lo, hi) -> list:
+    return rng.uniform(lo, hi, 3).tolist()
+
+
+def random_mechanism(seed: int) -> dict:
+    """A random valid [mechanism] table using every form of the format."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(2, 7))
+    joints, names = [], []
+    for i in range(n):
+        unnamed = rng.uniform() < 0.2  # the default name joint<i>
+        name = f"joint{i + 1}" if unnamed else f"j{i}"
+        j: dict = {} if unnamed else {"name": name}
+        kinds = ["revolute", "prismatic", "fixed", "spherical"]
+        t = kinds[int(rng.choice(4, p=[0.55, 0.2, 0.1, 0.15]))] if i > 0 else "revolute"
+        j["type"] = t
+        if i > 0 and rng.uniform() < 0.4:
+            j["parent"] = str(rng.choice(["base"] + names))
+        form = int(rng.integers(4))
+        if form == 0:
+            j["origin"] = {"xyz": _vec(rng, -0.4, 0.4), "rpy": _vec(rng, -1.5, 1.5)}
+            if t in ("revolute", "prismatic") and rng.uniform() < 0.8:
+                j["axis"] = rng.normal(size=3).tolist()
+        elif form == 1:
+            j["mdh"] = {"a": float(rng.uniform(-0.4, 0.4)), "alpha": float(rng.uniform(-1.5, 1.5)),
+                        "d": float(rng.uniform(-0.3, 0.3)), "theta": float(rng.uniform(-1, 1))}
+        elif form == 2:
+            j["dh"] = {"a": float(rng.uniform(-0.4, 0.4)), "alpha": float(rng.uniform(-1.5, 1.5)),
+                       "d": float(rng.uniform(-0.3, 0.3)), "theta": float(rng.uniform(-1, 1))}
+        if t in ("revolute", "prismatic") and rng.uniform() < 0.3:
+            j["limits"] = {"lower": -1.0, "upper": float(rng.uniform(0, 2)), "velocity": 3.0, "effort": 40.0}
+        movers = [names[k] for k, x in enumerate(joints) if x["type"] in ("revolute", "prismatic") and "mimic" not in x]
+        if t in ("revolute", "prismatic") and movers and rng.uniform() < 0.25:
+            j["mimic"] = {"joint": str(rng.choice(movers)), "ratio": float(rng.uniform(-3, 3)),
+                          "offset": float(rng.uniform(-0.5, 0.5))}
+        if rng.uniform() < 0.85:
+            j["link"] = {"mass": float(rng.uniform(0.1, 3)), "com": _vec(rng, -0.3, 0.3), "inertia": _inertia(rng)}
+        joints.append(j)
+        names.append(name)
+    links = ["base"] + names + [f"{names[k]}_y" for k, j in enumerate(joints) if j["type"] == "spherical"]
+    table: dict = {"gravity": _vec(rng, -10, 10), "joints": joints}
+    if rng.uniform() < 0.5:
+        table["base"] = {"xyz": _vec(rng, -1, 1), "rpy": _vec(rng, -1, 1)}
+    table["bodies"] = [{"name": f"b{k}", "kind": str(rng.choice(["counterweight", "motor", "disc", "payload", "other"])),
+                        "link": str(rng.choice(links)), "mass": float(rng.uniform(0, 2)), "com": _vec(rng, -0.5, 0.5),
+                        "inertia": _inertia(rng), "rpy": _vec(rng, -2, 2)} for k in range(int(rng.integers(0, 4)))]
+    table["frames"] = [{"name": f"f{k}", "link": str(rng.choice(links)),
+                        "origin": {"xyz": _vec(rng, -0.5, 0.5), "rpy": _vec(rng, -1, 1)}}
+                       for k in range(int(rng.integers(0, 4)))]
+    spring_links = list(links)
+    table["springs"] = []
+    for k in range(int(rng.integers(0, 3))):
+        la, lb = rng.choice(spring_links, 2, replace=False)
+        table["springs"].append({"name": f"s{k}", "link_a": str(la), "anchor_a": _vec(rng, -0.3, 0.3),
+                                 "link_b": str(lb), "anchor_b": _vec(rng, -0.3, 0.3),
+                                 "rate": float(rng.uniform(0, 500)), "free_length": float(rng.uniform(0, 0.2)),
+                                 "preload": float(rng.uniform(0, 10)), "count": int(rng.integers(1, 4)),
+                                 "pulley_ratio": float(rng.uniform(0.5, 3))})
+    if len(table["frames"]) >= 2 and rng.uniform() < 0.5:
+        if table["frames"][1]["link"] == table["frames"][0]["link"]:  # a loop closes two links
+            table["frames"][1]["link"] = "base" if table["frames"][0]["link"] != "base" else names[-1]
+        table["loops"] = [{"name": "loop", "type": str(rng.choice(["point", "planar_point", "axis", "weld"])),
+                           "frame_a": "f0", "frame_b": "f1"}]
+        spec = mechanism_spec({k: v for k, v in copy.deepcopy(table).items() if k != "loops"})
+        table["actuated"] = spec.independent_joints[:1]
+    return {k: v for k, v in table.items() if v != []}
+
+
+def write_case(tmp_path: Path, mechanism: dict, name: str = "case") -> Path:
+    path = tmp_path / f"{name}.toml"
+    path.write_text(toml_text({"case": {"name": name, "kind": "mechanism"}, "mechanism": mechanism}))
+    return path
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_random_valid_case(tmp_path, seed):
+    path = write_case(tmp_path, random_mechanism(seed))
+    assert_same_model(Mechanism.from_toml(path).model, _core.load_mechanism_file(str(path)),
+                      np.random.default_rng(seed))
+
+
+def test_the_random_corpus_covers_the_format():
+    seen = set()
+    for seed in range(40):
+        m = random_mechanism(seed)
+        for j in m["joints"]:
+            seen.add(j["type"])
+            seen.update(["unnamed"] if "name" not in j else [])
+            seen.update(k for k in ("origin", "mdh", "dh", "axis", "mimic", "limits", "parent") if k in j)
+        seen.update(k for k in ("base", "bodies", "frames", "loops", "springs", "actuated") if k in m)
+    assert seen >= {"unnamed", "revolute", "prismatic", "fixed", "spherical", "origin", "mdh", "dh", "axis", "mimic",
+                    "limits", "parent", "base", "bodies", "frames", "loops", "springs", "actuated"}, seen
+
+
+# ---- the invalid corpus: both readers refuse it, naming the same field ---------------------------
+
+NAN, INF = "__nan__", "__inf__"
+
+
+def _set(path: tuple, value):
+    def mutate(m):
+        t = m
+        for k in path[:-1]:
+            t = t[k]
+        t[path[-1]] = value
+    return mutate
+
+
+def _drop(path: tuple):
+    def mutate(m):
+        t = m
+        for k in path[:-1]:
+            t = t[k]
+        del t[path[-1]]
+    return mutate
+
+
+def _append(key: str, item):
+    return lambda m: m.setdefault(key, []).append(item)
+
+
+def base_table() -> dict:
+    return {"joints": [{"name": "a", "link": {"mass": 1.0, "com": [0.1, 0, 0], "inertia": [0.01, 0.02, 0.02]}},
+                       {"name": "b", "origin": {"xyz": [0.3, 0, 0]}, "axis": [0, 1, 0],
+                        "link": {"mass": 0.5, "inertia": [0.01, 0.01, 0.01]}},
+                       {"name": "s", "type": "spherical", "parent": "b"}],
+            "frames": [{"name": "fa", "link": "a"}, {"name": "fb", "link": "s"}]}
+
+
+SPRING = {"name": "k", "link_a": "base", "anchor_a": [0, 0, 1], "link_b": "a", "anchor_b": [0.1, 0, 0], "rate": 10.0}
+BODY = {"name": "cw", "link": "a", "mass": 1.0, "inertia": [0, 0, 0]}
+
+INVALID = {
+    "unknown key": _set(("joints", 0, "nme"), "x"),
+    "unknown table key": _set(("bodys",), []),
+    "misspelled nested": _set(("joints", 1, "origin", "xzy"), [0, 0, 0]),
+    "mass negative": _set(("joints", 0, "link", "mass"), -1.0),
+    "mass a string": _set(("joints", 0, "link", "mass"), "1.0"),
+    "mass a boolean": _set(("joints", 0, "link", "mass"), True),
+    "mass nan": _set(("joints", 0, "link", "mass"), NAN),
+    "mass inf": _set(("joints", 0, "link", "mass"), INF),
+    "mass absurd": _set(("joints", 0, "link", "mass"), 1e13),
+    "mass missing": _drop(("joints", 0, "link", "mass")),
+    "inertia missing": _drop(("joints", 0, "link", "inertia")),
+    "inertia shape": _set(("joints", 0, "link", "inertia"), [1.0, 2.0]),
+    "inertia not symmetric": _set(("joints", 0, "link", "inertia"), [[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]),
+    "inertia negative": _set(("joints", 0, "link", "inertia"), [-1.0, 1.0, 1.0]),
+    "inertia triangle": _set(("joints", 0, "link", "inertia"), [1.0, 1.0, 3.0]),
+    "inertia entry nan": _set(("joints", 0, "link", "inertia"), [1.0, NAN, 1.0]),
+    "com short": _set(("joints", 0, "link", "com"), [0.1, 0.0]),
+    "com entry string": _set(("joints", 0, "link", "com"), [0.1, "x", 0.0]),
+    "xyz absurd": _set(("joints", 1, "origin", "xyz"), [0.3, 0, 2e12]),
+    "rpy inf": _set(("joints", 1, "origin", "rpy"), [0, INF, 0]),
+    "joint type": _set(("joints", 0, "type"), "revolut"),
+    "joint name empty": _set(("joints", 0, "name"), ""),
+    "joint name long": _set(("joints", 0, "name"), "x" * 129),
+    "joint name base": _set(("joints", 0, "name"), "base"),
+    "joint name duplicate": _set(("joints", 1, "name"), "a"),
+    "spherical name clash": _set(("joints", 1, "name"), "s_y"),
+    "unknown parent": _set(("joints", 1, "parent"), "c"),
+    "own parent": _set(("joints", 1, "parent"), "b"),
+    "cycle": lambda m: (m["joints"][0].__setitem__("parent", "b")),
+    "origin and mdh": _set(("joints", 1, "mdh"), {"a": 0.1, "alpha": 0.0}),
+    "axis on dh": lambda m: m["joints"][0].update({"dh": {"a": 0.1, "alpha": 0.0}, "axis": [1, 0, 0]}),
+    "axis zero": _set(("joints", 1, "axis"), [0, 0, 0]),
+    "axis on spherical": _set(("joints", 2, "axis"), [0, 0, 1]),
+    "dh missing alpha": _set(("joints", 0, "mdh"), {"a": 0.1}),
+    "limits reversed": _set(("joints", 0, "limits"), {"lower": 1.0, "upper": 0.0}),
+    "velocity limit zero": _set(("joints", 0, "limits"), {"velocity": 0.0}),
+    "limits on spherical": _set(("joints", 2, "limits"), {"lower": -1.0}),
+    "mimic unknown": _set(("joints", 1, "mimic"), {"joint": "zz"}),
+    "mimic itself": _set(("joints", 1, "mimic"), {"joint": "b"}),
+    "mimic base": _set(("joints", 1, "mimic"), {"joint": "base"}),
+    "mimic spherical": _set(("joints", 1, "mimic"), {"joint": "s"}),
+    "mimic of a mimic": lambda m: (m["joints"][1].__setitem__("mimic", {"joint": "a"}),
+                                   m["joints"].append({"name": "c", "mimic": {"joint": "b"}})),
+    "mimic ratio string": _set(("joints", 1, "mimic"), {"joint": "a", "ratio": "2"}),
+    "no joints": _set(("joints",), []),
+    "joints not a list": _set(("joints",), {"name": "a"}),
+    "gravity short": _set(("gravity",), [0, -9.81]),
+    "base unknown key": _set(("base",), {"xyz": [0, 0, 0], "rot": [0, 0, 0]}),
+    "body kind": _append("bodies", {**BODY, "kind": "weight"}),
+    "body link unknown": _append("bodies", {**BODY, "link": "zz"}),
+    "body name duplicate": _append("bodies", {**BODY, "name": "a"}),
+    "body mass missing": _append("bodies", {k: v for k, v in BODY.items() if k != "mass"}),
+    "frame duplicate": _append("frames", {"name": "fa", "link": "b"}),
+    "frame named base": _append("frames", {"name": "base", "link": "b"}),
+    "frame link unknown": _append("frames", {"name": "fc", "link": "q"}),
+    "loop frame unknown": _append("loops", {"name": "l", "frame_a": "fa", "frame_b": "fz"}),
+    "loop type": _append("loops", {"name": "l", "type": "hinge", "frame_a": "fa", "frame_b": "fb"}),
+    "loop without actuated": _append("loops", {"name": "l", "frame_a": "fa", "frame_b": "fb"}),
+    "loop on one link": lambda m: (m["frames"].append({"name": "fc", "link": "a"}), m.update(actuated=["a"]),
+                                   m.setdefault("loops", []).append({"name": "l", "frame_a": "fa", "frame_b": "fc"})),
+    "actuated unknown": _set(("actuated",), ["zz"]),
+    "actuated twice": _set(("actuated",), ["a", "a"]),
+    "spring same link": _append("springs", {**SPRING, "link_b": "base"}),
+    "spring count float": _append("springs", {**SPRING, "count": 2.0}),
+    "spring count zero": _append("springs", {**SPRING, "count": 0}),
+    "spring rate negative": _append("springs", {**SPRING, "rate": -1.0}),
+    "spring pulley zero": _append("springs", {**SPRING, "pulley_ratio": 0.0}),
+    "spring anchor missing": _append("springs", {k: v for k, v in SPRING.items() if k != "anchor_b"}),
+    "spring link unknown": _append("springs", {**SPRING, "link_a": "zz"}),
+    "spring duplicate": lambda m: m.update(springs=[SPRING, dict(SPRING)]),
+}
+
+
+def invalid_text(mutate) -> str:
+    m = base_table()
+    mutate(m)
+    text = toml_text({"case": {"name": "bad", "kind": "mechanism"}, "mechanism": m})
+    return text.replace(f'"{NAN}"', "nan").replace(f'"{INF}"', "inf")
+
+
+def test_the_base_of_the_invalid_corpus_is_valid(tmp_path):
+    text = invalid_text(lambda m: None)
+    (tmp_path / "ok.toml").write_text(text)
+    assert_same_model(Mechanism.from_toml(tmp_path / "ok.toml").model, _core.mechanism_from_toml(text),
+                      np.random.default_rng(0))
+
+
+@pytest.mark.parametrize("name", list(INVALID))
+def test_both_readers_refuse(tmp_path, name):
+    text = invalid_text(INVALID[name])
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as py_exc:
+        Mechanism.from_toml(path)
+    with pytest.raises(ValueError) as cpp_exc:
+        _core.load_mechanism_file(str(path))
+    py_field, cpp_message = py_exc.value.field, str(cpp_exc.value)
+    assert cpp_message.startswith(py_field + ": "), f"Python: {py_exc.value}\nC++:    {cpp_message}"
+    assert "\n" not in cpp_message
+
+
+def test_cpp_messages_name_the_value():
+    msg = lambda name: str(pytest.raises(ValueError, _core.mechanism_from_toml, invalid_text(INVALID[name])).value)  # noqa: E731
+    assert msg("mass negative") == "mechanism.joints[0].link.mass: must be >= 0 (got -1.0)"
+    assert msg("mass nan") == "mechanism.joints[0].link.mass: must be finite (got nan)"
+    assert msg("unknown key").startswith("mechanism.joints[0].nme: unknown key (did you mean 'name'?)") or \
+        msg("unknown key").startswith("mechanism.joints[0].nme: unknown key")
+    assert msg("unknown parent") == "mechanism.joints[1].parent: unknown parent joint (allowed: a, b, s_z, s_y, s_x, s, base) (got 'c')" \
+        or "(got 'c')" in msg("unknown parent")
+    assert "(got 'revolut')" in msg("joint type") and "did you mean 'revolute'" in msg("joint type")
+
+
+# ---- [control] through the C++ reader ---------------------------------------------------------------
+
+def test_load_case_file_reads_control(tmp_path):
+    model, control, name = _core.load_case_file(str(PKG / "papers" / "paminsa" / "cases" / "paminsa-linkage.toml"))
+    assert name == "paminsa-linkage" and control.kind == "none" and len(model.actuated_coordinates) == 6
+    path = tmp_path / "c.toml"
+    path.write_text(invalid_text(lambda m: None) + '\n[control]\nkind = "computed_torque"\nrate_hz = 500\n'
+                    'kp = [100.0, 100.0, 100.0, 100.0, 100.0]\nkd = [20, 20, 20, 20, 20]\n')
+    model, control, name = _core.load_case_file(str(path))
+    assert (control.kind, control.rate_hz, control.kp, control.kd) == ("computed_torque", 500.0, [100.0] * 5, [20.0] * 5)
+    path.write_text(path.read_text().replace("kd = [20, 20, 20, 20, 20]", "kd = [20, 20]"))
+    with pytest.raises(ValueError, match=r"^control\.kd: must have 5 values"):
+        _core.load_case_file(str(path))
