@@ -37,6 +37,7 @@
 #include "mechbal/joint_limits.hpp"
 #include "mechbal/reactionless_wrist.hpp"
 #include "mechbal/closed_loop.hpp"
+#include "mechbal/control/reactionless.hpp"
 /// Fast paths of the papers' mechanisms
 #include "mechbal/arm2dof.hpp"
 #include "mechbal/five_bar.hpp"
