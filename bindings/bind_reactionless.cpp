@@ -4,7 +4,9 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <utility>
 #include <memory>
 #include <string>
 #include <vector>
@@ -86,7 +88,7 @@ std::vector<std::string> names_of(const ReactionlessController& c, const std::ve
 }
 
 #define MECHBAL_REACTIONLESS_ARGS                                                                   \
-  py::arg("balancing_joints"), py::arg("cancel") = std::vector<std::string>{"moment"},              \
+  py::arg("cancel") = std::vector<std::string>{"moment"},                                           \
       py::arg("integrator") = "euler", py::arg("rate_hz") = ReactionlessConfig{}.rate_hz,           \
       py::arg("damping") = ReactionlessConfig{}.damping,                                            \
       py::arg("max_condition") = ReactionlessConfig{}.max_condition,                                \
@@ -154,7 +156,98 @@ py::dict run(ReactionlessController& c, const Array& q, const Array& v, const Ar
   return d;
 }
 
+std::uint32_t task_mask(const std::vector<std::string>& rows) {
+  static const std::pair<const char*, std::uint32_t> names[] = {
+      {"linear", cancel_force}, {"angular", cancel_moment}, {"all", cancel_both}, {"v_x", force_x},
+      {"v_y", force_y},         {"v_z", force_z},          {"w_x", moment_x},  {"w_y", moment_y},
+      {"w_z", moment_z}};
+  if (rows.empty()) throw py::value_error("task_rows must name at least one twist component");
+  std::uint32_t mask = 0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    std::uint32_t bit = 0;
+    for (const auto& n : names)
+      if (rows[i] == n.first) bit = n.second;
+    if (bit == 0)
+      throw py::value_error("task_rows[" + std::to_string(i) + "]: '" + rows[i] +
+                            "' is not a twist component (linear, angular, all, v_x, v_y, v_z, w_x, w_y, w_z)");
+    mask |= bit;
+  }
+  return mask;
+}
+
+void bind_task_controller(py::module_& m) {
+  py::class_<ReactionlessTaskController>(
+      m, "ReactionlessTaskController",
+      "Operational-space reactionless control: a redundant open mechanism follows a desired twist of a "
+      "frame, v = J^+ x' + N z, with z minimising the selected momentum components in the null space")
+      .def(py::init([](const MechanismModel& model, const std::string& frame, const std::vector<std::string>& task_rows,
+                       const std::vector<std::string>& cancel, const std::string& integrator, double rate_hz,
+                       double damping, double max_condition, double max_rate, const py::object& q0,
+                       const py::object& v0) {
+             TaskSpaceConfig c;
+             c.frame = frame;
+             c.task_rows = task_mask(task_rows);
+             c.cancel = cancel_mask(cancel);
+             c.integrator = integrator_of(integrator);
+             c.rate_hz = rate_hz;
+             c.damping = damping;
+             c.max_condition = max_condition;
+             c.max_rate = max_rate;
+             const Eigen::VectorXd q = q0.is_none() ? Eigen::VectorXd(Eigen::VectorXd::Zero(model.dof()))
+                                                    : vector_arg(to_real_array(q0), "q0", model.dof(), true);
+             const Eigen::VectorXd v = optional_vector(v0, "v0", model.dof());
+             return translate<ReactionlessTaskController*>([&] {
+               return new ReactionlessTaskController(std::make_shared<const MechanismModel>(model), c, q, v);
+             });
+           }),
+           py::arg("model"), py::arg("task_frame"), py::arg("task_rows") = std::vector<std::string>{"all"},
+           py::arg("cancel") = std::vector<std::string>{"moment"}, py::arg("integrator") = "euler",
+           py::arg("rate_hz") = TaskSpaceConfig{}.rate_hz, py::arg("damping") = TaskSpaceConfig{}.damping,
+           py::arg("max_condition") = TaskSpaceConfig{}.max_condition,
+           py::arg("max_rate") = TaskSpaceConfig{}.max_rate, py::arg("q0") = py::none(), py::arg("v0") = py::none())
+      .def_property_readonly("dof", &ReactionlessTaskController::dof)
+      .def_property_readonly("dt", &ReactionlessTaskController::dt)
+      .def_property_readonly("target", &ReactionlessTaskController::target)
+      .def(
+          "run",
+          [](ReactionlessTaskController& c, const Array& twist) {
+            require_shape(twist, "twist", {-1, 6});
+            const auto rows = twist.shape(0);
+            if (rows < 1 || rows % 2 == 0)
+              throw py::value_error("twist must have 2 steps + 1 rows (the half-step grid t_j = j dt/2), got " +
+                                    std::to_string(rows));
+            const py::ssize_t steps = (rows - 1) / 2, N = steps + 1, n = c.dof();
+            OutArray Q = make_array({N, n}), V = make_array({N, n}), H = make_array({N, 6}), X = make_array({N, 6});
+            auto status = make_status_array(N);
+            {
+              py::gil_scoped_release release;
+              for (py::ssize_t k = 0; k < N; ++k) {
+                const py::ssize_t j = std::min<py::ssize_t>(2 * k, rows - 1);
+                const py::ssize_t jh = std::min<py::ssize_t>(j + 1, rows - 1), jn = std::min<py::ssize_t>(j + 2, rows - 1);
+                const Status s = c.step(Eigen::Map<const Vec6>(twist.data(j, 0)), Eigen::Map<const Vec6>(twist.data(jh, 0)),
+                                        Eigen::Map<const Vec6>(twist.data(jn, 0)));
+                Eigen::Map<Eigen::VectorXd>(Q.mutable_data(k, 0), n) = c.q();
+                Eigen::Map<Eigen::VectorXd>(V.mutable_data(k, 0), n) = c.v();
+                Eigen::Map<Vec6>(H.mutable_data(k, 0)) = c.momentum();
+                Eigen::Map<Vec6>(X.mutable_data(k, 0)) = c.frame_twist();
+                status.mutable_data()[k] = static_cast<std::uint32_t>(s);
+              }
+            }
+            py::dict d;
+            d["q"] = Q;
+            d["v"] = V;
+            d["momentum"] = H;
+            d["frame_twist"] = X;
+            d["status"] = status;
+            return d;
+          },
+          py::arg("twist"),
+          "Ticks along the desired frame twist [v; w] (O axes) sampled every dt/2 ((2 steps + 1, 6)): q, v "
+          "(steps + 1, dof), momentum, frame_twist (steps + 1, 6), status.");
+}
+
 void bind_reactionless(py::module_& m) {
+  bind_task_controller(m);
   py::class_<ReactionlessCommand>(m, "ReactionlessCommand",
                                   "One reactionless tick's command: actuated q, v, a (task as given, "
                                   "balancing computed), every coordinate q_full, v_full, a_full, the "
@@ -177,25 +270,28 @@ void bind_reactionless(py::module_& m) {
       m, "ReactionlessController",
       "Reactionless control of any MechanismModel (C++ mechbal::ReactionlessController): balancing joints "
       "keep the selected momentum components at their target")
-      .def(py::init([](const MechanismModel& model, const std::vector<std::string>& balancing,
+      .def(py::init([](const MechanismModel& model, const std::vector<std::string>& balancing, const py::object& q0,
                        const std::vector<std::string>& cancel, const std::string& integrator, double rate_hz,
                        double damping, double max_condition, double max_rate, double max_acceleration,
                        bool position_limits, double home_gain, double limit_gain, const py::object& home,
-                       double max_position, double max_speed, double max_task_acceleration, const Array& q0,
+                       double max_position, double max_speed, double max_task_acceleration,
                        const py::object& v0, const py::object& q_guess) {
              const ReactionlessConfig c =
                  make_config(balancing, cancel, integrator, rate_hz, damping, max_condition, max_rate, max_acceleration,
                              position_limits, home_gain, limit_gain, home, max_position, max_speed,
                              max_task_acceleration);
-             const Eigen::VectorXd q0_ = vector_arg(q0, "q0", model.num_actuated(), true);
+             const Eigen::VectorXd q0_ =
+                 q0.is_none() ? Eigen::VectorXd(Eigen::VectorXd::Zero(model.num_actuated()))
+                              : vector_arg(to_real_array(q0), "q0", model.num_actuated(), true);
              const Eigen::VectorXd v0_ = optional_vector(v0, "v0", model.num_actuated());
              const Eigen::VectorXd guess = optional_vector(q_guess, "q_guess", model.dof());
              return translate<ReactionlessController*>([&] {
                return new ReactionlessController(std::make_shared<const MechanismModel>(model), c, q0_, v0_, guess);
              });
            }),
-           py::arg("model"), MECHBAL_REACTIONLESS_ARGS, py::arg("q0"), py::arg("v0") = py::none(),
-           py::arg("q_guess") = py::none())
+           py::arg("model"), py::arg("balancing_joints"), py::arg("q0") = py::none(), MECHBAL_REACTIONLESS_ARGS,
+           py::arg("v0") = py::none(), py::arg("q_guess") = py::none(),
+           "q0: the actuated coordinates at the start (default zeros); v0: their rates (default rest)")
       .def_property_readonly("num_actuated", &ReactionlessController::num_actuated)
       .def_property_readonly("num_task", &ReactionlessController::num_task)
       .def_property_readonly("num_balancing", &ReactionlessController::num_balancing)
@@ -273,12 +369,12 @@ void bind_reactionless(py::module_& m) {
       m, "ReactionlessJointController",
       "The reactionless controller followed by computed torque over the model: a JointController over the "
       "actuated coordinates (the balancing joints' desired entries are ignored)");
-  jc.def(py::init([](const MechanismModel& model, const std::vector<std::string>& balancing,
-                     const std::vector<std::string>& cancel, const std::string& integrator, double rate_hz,
-                     double damping, double max_condition, double max_rate, double max_acceleration,
-                     bool position_limits, double home_gain, double limit_gain, const py::object& home,
-                     double max_position, double max_speed, double max_task_acceleration, const Array& q0,
-                     const Array& kp, const Array& kd, const py::object& torque_limit, const py::object& q_guess) {
+  jc.def(py::init([](const MechanismModel& model, const std::vector<std::string>& balancing, const Array& q0,
+                     const Array& kp, const Array& kd, const std::vector<std::string>& cancel,
+                     const std::string& integrator, double rate_hz, double damping, double max_condition,
+                     double max_rate, double max_acceleration, bool position_limits, double home_gain,
+                     double limit_gain, const py::object& home, double max_position, double max_speed,
+                     double max_task_acceleration, const py::object& torque_limit, const py::object& q_guess) {
            const ReactionlessConfig c =
                make_config(balancing, cancel, integrator, rate_hz, damping, max_condition, max_rate, max_acceleration,
                            position_limits, home_gain, limit_gain, home, max_position, max_speed, max_task_acceleration);
@@ -291,8 +387,8 @@ void bind_reactionless(py::module_& m) {
                                                     limit, JointInputRange{}, guess);
            });
          }),
-         py::arg("model"), MECHBAL_REACTIONLESS_ARGS, py::arg("q0"), py::arg("kp"), py::arg("kd"),
-         py::arg("torque_limit") = py::none(), py::arg("q_guess") = py::none())
+         py::arg("model"), py::arg("balancing_joints"), py::arg("q0"), py::arg("kp"), py::arg("kd"),
+         MECHBAL_REACTIONLESS_ARGS, py::arg("torque_limit") = py::none(), py::arg("q_guess") = py::none())
       .def_property_readonly("dof", &ReactionlessJointController::dof)
       .def_property_readonly("last_command", &ReactionlessJointController::last_command)
       .def_property_readonly(

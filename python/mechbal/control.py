@@ -53,6 +53,7 @@ __all__ = [
     "ControlRun", "WristRun", "PaminsaRun", "InverseDynamics", "ForwardDynamics",
     "MechanismDynamics", "RneChainDynamics", "KdlChainDynamics", "Status", "status_text",
     "ReactionlessController", "ReactionlessCommand", "ReactionlessRun", "ReactionlessJointController",
+    "ReactionlessTaskController", "TaskSpaceRun",
 ]
 
 Status = _core.Status
@@ -416,3 +417,48 @@ class ReactionlessController(_core.ReactionlessController):
         return self.run(np.ascontiguousarray(np.atleast_2d(q)[:, task]),
                         np.ascontiguousarray(np.atleast_2d(v)[:, task]),
                         np.ascontiguousarray(np.atleast_2d(a)[:, task]))
+
+
+@dataclass(frozen=True)
+class TaskSpaceRun:
+    """Ticks t_n = n dt of an operational-space run: ``t`` (N,) [s], the command ``q``, ``v``
+    (N, dof), its ``momentum`` [P; H_O] (N, 6), the frame's commanded ``frame_twist`` [v; w]
+    (N, 6) and ``status`` (N,)."""
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    momentum: np.ndarray
+    frame_twist: np.ndarray
+    status: np.ndarray
+
+
+class ReactionlessTaskController(_core.ReactionlessTaskController):
+    """Operational-space reactionless control (the reaction null space): a redundant open
+    mechanism follows a desired twist of ``task_frame`` with ``v = J^+ x' + N z``, where ``z``
+    minimises the ``cancel``-ed momentum components (their departure from the momentum at the
+    start) within the task's null space (C++ ``mechbal::ReactionlessTaskController``).
+
+    Args:
+        mechanism: a :class:`mechbal.Mechanism` (open, every joint actuated).
+        task_frame: a named frame of the mechanism.
+        task_rows: the tracked twist components: ``"all"``, ``"linear"``, ``"angular"`` or
+            ``"v_x"``, ..., ``"w_z"`` (a name or a list; O axes).
+        cancel, integrator, rate_hz, damping: as :class:`ReactionlessController`.
+        q0, v0: every coordinate at the start [rad or m] (default zeros, rest).
+    """
+
+    def __init__(self, mechanism: Any, task_frame: str, task_rows: Any = "all", cancel: Any = "moment",
+                 integrator: str = "euler", rate_hz: float = 1000.0, damping: float = 1e-2, *,
+                 q0: npt.ArrayLike | None = None, v0: npt.ArrayLike | None = None, **options: Any):
+        model = getattr(mechanism, "model", mechanism)
+        q0 = np.zeros(model.dof) if q0 is None else q0
+        super().__init__(model, task_frame, _cancel_list(task_rows), _cancel_list(cancel), integrator,
+                         rate_hz, damping, q0=q0, v0=v0, **options)
+
+    def run(self, twist: npt.ArrayLike) -> TaskSpaceRun:  # type: ignore[override]
+        """Ticks along the desired frame twist [v (m/s); w (rad/s)] (O axes) sampled every dt/2
+        ((2 steps + 1, 6)): :class:`TaskSpaceRun` at the steps + 1 ticks."""
+        r = super().run(twist)
+        N = np.asarray(r["q"]).shape[0]
+        return TaskSpaceRun(t=np.arange(N) * self.dt, **{k: np.asarray(v) for k, v in r.items()})

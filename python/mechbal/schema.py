@@ -547,8 +547,8 @@ class Control(Table):
         1e-2, description="damped least squares near singularity, relative to the largest "
                           "singular value")
     max_rate: Pos = Field(100.0, description="balancing joints' rate limit (rad/s or m/s)")
-    home_gain: NonNeg = Field(0.0, description="null-space return to the start pose (1/s)")
-    limit_gain: NonNeg = Field(0.0, description="null-space push away from the joint limits")
+    home_gain: NonNeg = Field(0.0, description="redundant balancing joints: pull towards the start pose (1/s)")
+    limit_gain: NonNeg = Field(0.0, description="redundant balancing joints: push away from the joint limits")
     task_frame: Optional[Name] = Field(
         None, description="operational-space mode: [trajectory] is then the frame's path "
                           "(not yet supported by mechbal run)")

@@ -421,3 +421,52 @@ TEST(Reactionless, TickAllocatesNothing) {
   }
   EXPECT_EQ(scope.count(), 0u);
 }
+
+// Operational-space mode: a planar 3R arm carrying a disc joint (4 joints) moves its tool (on the
+// third link) along a circle (v_x, v_y) while its redundancy keeps the angular momentum about z
+// at zero: the commanded tool twist is the desired one and H_z stays on target (4 joints = 2 task
+// rows + 1 cancelled component + 1 spare); allocation-free ticks.
+TEST(Reactionless, OperationalSpaceKeepsToolPathAndMomentum) {
+  MechanismDescription d;
+  const char* names[4] = {"j1", "j2", "j3", "j4"};
+  for (int i = 0; i < 4; ++i) {
+    d.joints.push_back(revolute(names[i], i == 0 ? "base" : names[i - 1], at(i == 0 ? 0.0 : 0.4)));
+    // j4 carries a disc on its axis (its redundancy is a reaction wheel for the arm)
+    d.bodies.push_back(i < 3 ? Body{std::string("b") + names[i], "link", names[i], 1.0 + 0.2 * i, Vec3(0.2, 0, 0),
+                                    diag(0.001 + 0.01 * i, 0.015, 0.015 + 0.01 * i)}
+                             : Body{"disc", "disc", names[i], 1.5, Vec3::Zero(), diag(0.1, 0.1, 0.2)});
+  }
+  d.frames.push_back(Frame{"tool", "j3", at(0.4)});
+  const auto model = std::make_shared<const MechanismModel>(d);
+  for (auto integrator : {ReactionlessIntegrator::euler, ReactionlessIntegrator::rk4}) {
+    TaskSpaceConfig c;
+    c.frame = "tool";
+    c.task_rows = force_x | force_y;  // v_x, v_y of the tool
+    c.cancel = moment_z;
+    c.integrator = integrator;
+    ReactionlessTaskController ctrl(model, c, Eigen::Vector4d(0.3, 0.8, 0.6, 0.4));
+    const auto twist_at = [](double t) {
+      Vec6 x = Vec6::Zero();
+      x(0) = -0.2 * std::sin(2.0 * t);
+      x(1) = 0.2 * std::cos(2.0 * t);
+      return x;
+    };
+    double twist_err = 0.0, h_err = 0.0;
+    Status all = Status::ok;
+    for (int n = 0; n < 1000; ++n) {
+      const double t = n * 1e-3;
+      all |= ctrl.step(twist_at(t), twist_at(t + 5e-4), twist_at(t + 1e-3));
+      twist_err = std::max(twist_err, (ctrl.frame_twist().head<2>() - twist_at(t).head<2>()).cwiseAbs().maxCoeff());
+      h_err = std::max(h_err, std::abs(ctrl.momentum()(5) - ctrl.target()(5)));
+    }
+    EXPECT_EQ(all, Status::ok);
+    EXPECT_LT(twist_err, 1e-12);
+    EXPECT_LT(h_err, 1e-12);
+    test::AllocationScope scope;
+    for (int n = 0; n < 10; ++n) ctrl.step(twist_at(1.0), twist_at(1.0), twist_at(1.0));
+    const Vec6 bad = Vec6::Constant(std::nan(""));
+    EXPECT_EQ(ctrl.step(bad, bad, bad), Status::non_finite_input);
+    EXPECT_EQ(ctrl.v().norm(), 0.0);
+    EXPECT_EQ(scope.count(), 0u);
+  }
+}

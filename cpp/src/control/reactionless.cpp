@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "mechbal/algorithm/jacobian.hpp"
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 
@@ -191,7 +192,6 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
   const int g = wide_ ? k_ : nb_;
   if (g > 6) fail("reactionless: internal size error");
   gram_ = Small::Identity(g, g);
-  eig_ = Eigen::SelfAdjointEigenSolver<Small>(g);
   eig_.compute(gram_, Eigen::EigenvaluesOnly);
   llt_.compute(gram_);
   if (square_) lu_.compute(Small(Small::Identity(k_, k_)));
@@ -289,6 +289,23 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
   for (int i = 0; i < k_; ++i)
     for (int j = 0; j < nb_; ++j) Kb_(i, j) = K_(rows_[static_cast<std::size_t>(i)], balancing_[static_cast<std::size_t>(j)]);
   return st;
+}
+
+Status ReactionlessController::rebalance(const Eigen::VectorXd& q_b) noexcept {
+  // same task pose as the last evaluate(): the loops' solution and C do not depend on the
+  // balancing coordinates (they move no loop frame), only A does
+  for (int j = 0; j < nb_; ++j) {
+    q_act_(balancing_[static_cast<std::size_t>(j)]) = q_b(j);
+    q_full_(balancing_coord_[static_cast<std::size_t>(j)]) = q_b(j);
+    // the loop solve's warm start follows (its tangent predictor needs q == closed_position)
+    data_.closed_position(balancing_coord_[static_cast<std::size_t>(j)]) = q_b(j);
+  }
+  const Status st = momentum_matrix(*model_, data_, q_full_);
+  if (st != Status::ok) return st;
+  K_.noalias() = data_.momentum_matrix * data_.loop_projection;
+  for (int i = 0; i < k_; ++i)
+    for (int j = 0; j < nb_; ++j) Kb_(i, j) = K_(rows_[static_cast<std::size_t>(i)], balancing_[static_cast<std::size_t>(j)]);
+  return Status::ok;
 }
 
 Status ReactionlessController::factorise(double& condition) noexcept {
@@ -551,7 +568,7 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
     ss |= evaluate(*q_half, q_stage_);
     if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k2_, nullptr);
     q_stage_ = q_b_ + (0.5 * dt_) * k2_;
-    if (!failed(ss)) ss |= evaluate(*q_half, q_stage_);
+    if (!failed(ss)) ss |= closed_ && !balancing_in_loops_ ? rebalance(q_stage_) : evaluate(*q_half, q_stage_);
     if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k3_, nullptr);
     q_stage_ = q_b_ + dt_ * k3_;
     if (!failed(ss)) ss |= evaluate(*q_next, q_stage_);
@@ -641,6 +658,176 @@ Status ReactionlessJointController::step(const Eigen::Ref<const Eigen::VectorXd>
   Status s = reactionless_.step(q_t_, v_t_, a_t_, q_h_, v_h_, q_n_, v_n_);
   const ReactionlessCommand& c = reactionless_.command();
   return s | ct_.step(q, qd, c.q, c.v, c.a, tau);
+}
+
+// ---- operational-space mode -----------------------------------------------------------------
+
+ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const MechanismModel> model,
+                                                       const TaskSpaceConfig& config, const Eigen::VectorXd& q0,
+                                                       const Eigen::VectorXd& v0)
+    : model_(std::move(model)), config_(config), data_(*model_) {
+  const MechanismModel& m = *model_;
+  if (m.is_closed() || m.num_passive() > 0)
+    fail("task_frame: the operational-space mode drives open mechanisms with every joint actuated");
+  frame_ = m.frame_index(config_.frame);
+  if (frame_ < 0) {
+    std::string known;
+    for (int f = 0; f < m.num_frames(); ++f) known += (known.empty() ? "" : ", ") + m.frame(f).name;
+    fail("task_frame: '" + config_.frame + "' is not a frame of the mechanism (frames: " + known + ")");
+  }
+  if (config_.task_rows == 0u || (config_.task_rows & ~cancel_both) != 0u)
+    fail("task_rows", "must select at least one of the six twist components (bit mask 1..63)",
+         static_cast<double>(config_.task_rows));
+  if (config_.cancel == 0u || (config_.cancel & ~cancel_both) != 0u)
+    fail("reactionless.cancel", "must select at least one of the six momentum components (bit mask 1..63)",
+         static_cast<double>(config_.cancel));
+  if (!(config_.rate_hz >= 1.0 && config_.rate_hz <= 1e6)) fail("reactionless.rate_hz", "must be in [1, 1e6] Hz", config_.rate_hz);
+  if (!(config_.damping > 0.0 && config_.damping < 1.0)) fail("reactionless.damping", "must be in (0, 1)", config_.damping);
+  if (!(std::isfinite(config_.max_condition) && config_.max_condition > 1.0))
+    fail("reactionless.max_condition", "must be finite and > 1", config_.max_condition);
+  if (!(std::isfinite(config_.max_rate) && config_.max_rate > 0.0))
+    fail("reactionless.max_rate", "must be finite and > 0", config_.max_rate);
+  if (!(std::isfinite(config_.max_twist) && config_.max_twist > 0.0))
+    fail("max_twist", "must be finite and > 0", config_.max_twist);
+  n_ = m.dof();
+  dt_ = 1.0 / config_.rate_hz;
+  for (int r = 0; r < 6; ++r) {
+    if (config_.task_rows & (1u << r)) task_rows_.push_back(r);
+    if (config_.cancel & (1u << r)) rows_.push_back(r);
+  }
+  if (q0.size() != n_ || !q0.allFinite())
+    fail("q0 must have " + std::to_string(n_) + " finite values (every coordinate), got " + std::to_string(q0.size()));
+  if (v0.size() != 0 && (v0.size() != n_ || !v0.allFinite()))
+    fail("v0 must have " + std::to_string(n_) + " finite values, got " + std::to_string(v0.size()));
+  const int nt = static_cast<int>(task_rows_.size()), k = static_cast<int>(rows_.size());
+  for (Eigen::VectorXd* v : {&q_, &q_cmd_, &v_cmd_, &k1_, &k2_, &k3_, &k4_, &q_stage_, &v0_, &z_, &w_})
+    *v = Eigen::VectorXd::Zero(n_);
+  rate_limit_ = m.velocity_limits().cwiseMin(config_.max_rate);
+  J_ = Eigen::MatrixXd::Zero(nt, n_);
+  Jt_ = Eigen::MatrixXd::Zero(n_, 6);
+  JpJ_ = Eigen::MatrixXd::Zero(n_, n_);
+  N_ = Eigen::MatrixXd::Zero(n_, n_);
+  M_ = Eigen::MatrixXd::Zero(k, n_);
+  rt_ = Eigen::VectorXd::Zero(nt);
+  rm_ = Eigen::VectorXd::Zero(k);
+  gram_ = Small::Identity(6, 6);
+  eig_.compute(gram_, Eigen::EigenvaluesOnly);
+  llt_.compute(gram_);
+  y_ = SmallVector::Zero(6);
+  q_ = q0;
+  q_cmd_ = q0;
+  const Eigen::VectorXd v_start = v0.size() ? v0 : Eigen::VectorXd(Eigen::VectorXd::Zero(n_));
+  if (mechbal::momentum(m, data_, q0, v_start) != Status::ok) fail("q0, v0: the momentum at the start is not finite");
+  target_ << data_.shaking.linear_momentum, data_.shaking.angular_momentum;
+}
+
+Status ReactionlessTaskController::min_norm(const Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::VectorXd>& r,
+                                            Eigen::VectorXd& x) noexcept {
+  const Eigen::Index rows = M.rows();
+  gram_.resize(rows, rows);
+  gram_.noalias() = M * M.transpose();
+  if (!gram_.allFinite()) {
+    x.setZero();
+    return Status::out_of_range;
+  }
+  eig_.compute(gram_, Eigen::EigenvaluesOnly);
+  const double lmax = eig_.eigenvalues()(rows - 1), lmin = eig_.eigenvalues()(0);
+  Status st = Status::ok;
+  if (!(lmax > 0.0)) {
+    x.setZero();
+    return Status::singular;
+  }
+  const double cond = lmin > 0.0 ? std::sqrt(lmax / lmin) : huge;
+  if (cond > config_.max_condition) {
+    gram_.diagonal().array() += config_.damping * config_.damping * lmax;
+    st = Status::singular;
+  }
+  llt_.compute(gram_);
+  SmallVector rr(rows);
+  for (Eigen::Index i = 0; i < rows; ++i) rr(i) = r(i);
+  y_ = llt_.solve(rr);
+  x.noalias() = M.transpose() * y_;
+  return st;
+}
+
+Status ReactionlessTaskController::rates(const Eigen::VectorXd& q, const Vec6& twist, Eigen::VectorXd& v) noexcept {
+  const MechanismModel& m = *model_;
+  if (frame_jacobian(m, data_, q, frame_) != Status::ok) return Status::out_of_range;
+  for (std::size_t i = 0; i < task_rows_.size(); ++i) {
+    J_.row(static_cast<Eigen::Index>(i)) = data_.frame_jacobian.row(task_rows_[i]);
+    rt_(static_cast<Eigen::Index>(i)) = twist(task_rows_[i]);
+  }
+  Status st = min_norm(J_, rt_, v0_);  // v0 = J^+ x'
+  // N = I - J^+ J, J^+ J = J^T (J J^T + lambda^2)^-1 J: columns of J^+ from the same factorisation
+  const Eigen::Index nt = J_.rows();
+  const Small G_inv = llt_.solve(Small(Small::Identity(nt, nt)));
+  Jt_.leftCols(nt).noalias() = J_.transpose() * G_inv;  // J^+ = J^T (J J^T + lambda^2)^-1
+  JpJ_.noalias() = Jt_.leftCols(nt) * J_;
+  N_ = -JpJ_;
+  N_.diagonal().array() += 1.0;
+  if (momentum_matrix(m, data_, q) != Status::ok) return Status::out_of_range;
+  for (std::size_t i = 0; i < rows_.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    M_.row(r).noalias() = data_.momentum_matrix.row(rows_[i]) * N_;
+    rm_(r) = target_(rows_[i]) - data_.momentum_matrix.row(rows_[i]).dot(v0_);
+  }
+  st |= min_norm(M_, rm_, z_);
+  v = v0_;
+  v.noalias() += N_ * z_;
+  if (!v.allFinite()) {
+    v.setZero();
+    return st | Status::out_of_range;
+  }
+  double peak = 0.0;
+  for (int j = 0; j < n_; ++j) peak = std::max(peak, std::abs(v(j)) / rate_limit_(j));
+  if (peak > 1.0) {
+    v *= 1.0 / peak;
+    st |= Status::saturated;
+  }
+  return st;
+}
+
+Status ReactionlessTaskController::step(const Vec6& twist, const Vec6& twist_half, const Vec6& twist_next) noexcept {
+  const bool rk4 = config_.integrator == ReactionlessIntegrator::rk4;
+  const auto hold = [this](Status why) {
+    q_cmd_ = q_;
+    v_cmd_.setZero();
+    h_.setZero();
+    twist_cmd_.setZero();
+    status_ = why;
+    return why;
+  };
+  if (!twist.allFinite() || (rk4 && (!twist_half.allFinite() || !twist_next.allFinite())))
+    return hold(Status::non_finite_input);
+  if (twist.cwiseAbs().maxCoeff() > config_.max_twist ||
+      (rk4 && (twist_half.cwiseAbs().maxCoeff() > config_.max_twist || twist_next.cwiseAbs().maxCoeff() > config_.max_twist)))
+    return hold(Status::out_of_range);
+  Status st = rates(q_, twist, k1_);
+  if (has(st, Status::out_of_range)) return hold(Status::out_of_range);
+  // the command at t_n: momentum and twist of the commanded rates (data_ is at q_)
+  h_.noalias() = data_.momentum_matrix * k1_;
+  twist_cmd_.noalias() = data_.frame_jacobian * k1_;
+  Eigen::VectorXd& next = q_stage_;
+  if (rk4) {
+    Status ss = Status::ok;
+    w_ = q_ + (0.5 * dt_) * k1_;
+    ss |= rates(w_, twist_half, k2_);
+    w_ = q_ + (0.5 * dt_) * k2_;
+    ss |= rates(w_, twist_half, k3_);
+    w_ = q_ + dt_ * k3_;
+    ss |= rates(w_, twist_next, k4_);
+    if (has(ss, Status::out_of_range)) return hold(Status::out_of_range);
+    st |= ss;
+    next = q_ + (dt_ / 6.0) * (k1_ + 2.0 * k2_ + 2.0 * k3_ + k4_);
+  } else {
+    next = q_ + dt_ * k1_;
+  }
+  if (!next.allFinite()) return hold(Status::out_of_range);
+  q_cmd_ = q_;
+  v_cmd_ = k1_;
+  q_ = next;
+  status_ = st;
+  return st;
 }
 
 }  // namespace mechbal

@@ -188,6 +188,9 @@ class ReactionlessController {
   /// K = A C at actuated positions (q_t, q_b) (loops solved into q_full_); v_hint: actuated
   /// velocities for the loops' projection. Fills K_, Kb_, Kt_.
   Status evaluate(const Eigen::Ref<const Eigen::VectorXd>& q_t, const Eigen::VectorXd& q_b) noexcept;
+  /// evaluate() at the same task positions with other balancing positions, for a closed
+  /// mechanism whose loops the balancing joints do not move (no loop solve).
+  Status rebalance(const Eigen::VectorXd& q_b) noexcept;
   /// Factorise S K_b (cond, damping); then solve() applies the operator.
   Status factorise(double& condition) noexcept;
   void solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::VectorXd& x) noexcept;
@@ -268,6 +271,82 @@ class ReactionlessJointController : public JointController {
   ReactionlessController reactionless_;
   ComputedTorque ct_;
   Eigen::VectorXd q_t_, v_t_, a_t_, q_h_, v_h_, q_n_, v_n_;
+};
+
+/// Operational-space reactionless control (the reaction null space): a redundant open mechanism
+/// follows a desired twist of a named frame while its redundancy minimises the selected momentum
+/// components' departure from their target. With J the task rows of the frame Jacobian
+/// ([v; w] of the frame's origin, O axes; algorithm/jacobian.hpp), K = A the momentum matrix and
+/// S the cancelled rows, each tick:
+///
+///     v0 = J^+ x'                      (minimum-norm task rates; damped near singularity)
+///     N  = I - J^+ J                   (the task's null space)
+///     z  = (S K N)^+ (S h* - S K v0)   (least squares in the null space; damped)
+///     v  = v0 + N z
+///
+/// so the frame follows x' exactly (while J has full row rank) and the momentum components are
+/// cancelled as far as the null space allows (exactly when it is rich enough: n >= task rows +
+/// cancelled rows at a regular pose). Positions are integrated (Euler, or RK4 with the twist at
+/// t + dt/2 and t + dt). The command carries no acceleration feed-forward. Real time as
+/// ReactionlessController (noexcept, allocation-free, held command on bad input).
+struct TaskSpaceConfig {
+  std::string frame;                    ///< the task frame (a named frame of the model)
+  std::uint32_t task_rows = cancel_both;  ///< rows of [v; w] tracked (MomentumComponent bit order:
+                                          ///< force_* = v_x..v_z, moment_* = w_x..w_z)
+  std::uint32_t cancel = cancel_moment;   ///< momentum rows minimised in the null space
+  ReactionlessIntegrator integrator = ReactionlessIntegrator::euler;
+  double rate_hz = 1000.0;
+  double damping = 1e-2;       ///< relative to sigma_max, used when cond exceeds max_condition
+  double max_condition = 1e4;
+  double max_rate = 100.0;     ///< per joint [rad/s or m/s]: scaled down, Status::saturated
+  double max_twist = 1e2;      ///< input range of the desired twist (per component)
+};
+
+class ReactionlessTaskController {
+ public:
+  /// `q0`: every coordinate at the start (open mechanisms only: every coordinate actuated); the
+  /// target momentum is that of (q0, v0) (v0 empty: rest). Throws std::invalid_argument naming
+  /// the field.
+  ReactionlessTaskController(std::shared_ptr<const MechanismModel> model, const TaskSpaceConfig& config,
+                             const Eigen::VectorXd& q0, const Eigen::VectorXd& v0 = Eigen::VectorXd());
+
+  int dof() const noexcept { return n_; }
+  double dt() const noexcept { return dt_; }
+  int frame() const noexcept { return frame_; }
+  const Vec6& target() const noexcept { return target_; }
+  /// One tick: the desired twist of the frame at t_n (and, for RK4, at t_n + dt/2 and t_n + dt).
+  Status step(const Vec6& twist, const Vec6& twist_half, const Vec6& twist_next) noexcept;
+  /// The command at t_n: q (positions), v (rates), the momentum h = A v, the frame's twist J v;
+  /// next: q at t_n + dt.
+  const Eigen::VectorXd& q() const noexcept { return q_cmd_; }
+  const Eigen::VectorXd& v() const noexcept { return v_cmd_; }
+  const Eigen::VectorXd& next() const noexcept { return q_; }
+  const Vec6& momentum() const noexcept { return h_; }
+  const Vec6& frame_twist() const noexcept { return twist_cmd_; }
+  Status status() const noexcept { return status_; }
+
+ private:
+  Status rates(const Eigen::VectorXd& q, const Vec6& twist, Eigen::VectorXd& v) noexcept;
+  /// x = M^T (M M^T + lambda^2)^-1 r (lambda = 0 while cond(M) <= max_condition), M (rows x n).
+  Status min_norm(const Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::VectorXd& x) noexcept;
+
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+  using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
+  std::shared_ptr<const MechanismModel> model_;
+  TaskSpaceConfig config_;
+  MechanismData data_;
+  int n_ = 0, frame_ = -1;
+  double dt_ = 1e-3;
+  std::vector<int> task_rows_, rows_;
+  Eigen::VectorXd q_, q_cmd_, v_cmd_, k1_, k2_, k3_, k4_, q_stage_, v0_, z_, w_, rate_limit_;
+  Eigen::MatrixXd J_, JpJ_, N_, M_, Jt_;
+  Eigen::VectorXd rt_, rm_;
+  Small gram_;
+  SmallVector y_;
+  Eigen::SelfAdjointEigenSolver<Small> eig_;
+  Eigen::LLT<Small> llt_;
+  Vec6 target_ = Vec6::Zero(), h_ = Vec6::Zero(), twist_cmd_ = Vec6::Zero();
+  Status status_ = Status::ok;
 };
 
 }  // namespace mechbal
