@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "bench_registry.hpp"
-#include "mechbal/paminsa.hpp"
-#include "mechbal/reactionless_wrist.hpp"
+#include "mechbal/papers/paminsa/paminsa.hpp"
+#include "mechbal/papers/paminsa/reactionless_wrist.hpp"
 #include "paminsa_motion.hpp"
 
 namespace mechbal::bench {

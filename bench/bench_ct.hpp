@@ -8,8 +8,8 @@
 #include <utility>
 
 #include "bench_registry.hpp"
-#include "mechbal/computed_torque.hpp"
-#include "mechbal/dynamics.hpp"
+#include "mechbal/control/computed_torque.hpp"
+#include "mechbal/control/dynamics.hpp"
 
 namespace mechbal::bench {
 

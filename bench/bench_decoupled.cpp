@@ -19,10 +19,10 @@
 #include "bench_registry.hpp"
 #include "disc_arms.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
-#include "mechbal/computed_torque.hpp"
-#include "mechbal/data.hpp"
-#include "mechbal/decoupled_control.hpp"
-#include "mechbal/mechanism_dynamics.hpp"
+#include "mechbal/control/computed_torque.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/control/decoupled_control.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
 
 namespace mechbal::bench {
 namespace {

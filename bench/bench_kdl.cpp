@@ -13,8 +13,8 @@
 
 #include "bench_ct.hpp"
 #include "bench_registry.hpp"
-#include "mechbal/kdl_chain.hpp"
-#include "mechbal/rnea.hpp"
+#include "mechbal/control/kdl_chain.hpp"
+#include "mechbal/control/rnea.hpp"
 
 namespace mechbal::bench {
 namespace {

@@ -17,7 +17,7 @@
 #include "bench_registry.hpp"
 #include "mechbal/algorithm/loops.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
-#include "mechbal/paminsa.hpp"
+#include "mechbal/papers/paminsa/paminsa.hpp"
 #include "paminsa_general.hpp"
 #include "paminsa_motion.hpp"
 

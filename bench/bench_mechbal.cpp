@@ -7,10 +7,10 @@
 
 #include "bench_ct.hpp"
 #include "bench_registry.hpp"
-#include "mechbal/arm2dof.hpp"
-#include "mechbal/rigid_body.hpp"
-#include "mechbal/rnea.hpp"
-#include "mechbal/serial_chain.hpp"
+#include "mechbal/papers/arm2dof/arm2dof.hpp"
+#include "mechbal/model/rigid_body.hpp"
+#include "mechbal/control/rnea.hpp"
+#include "mechbal/model/serial_chain.hpp"
 #include "test_support.hpp"
 
 namespace mechbal::bench {

@@ -9,7 +9,7 @@
 #include <pinocchio/multibody.hpp>
 
 #include "bench_registry.hpp"
-#include "mechbal/rnea.hpp"
+#include "mechbal/control/rnea.hpp"
 
 namespace mechbal::bench {
 namespace {

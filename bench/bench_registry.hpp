@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "mechbal/serial_chain.hpp"
+#include "mechbal/model/serial_chain.hpp"
 
 namespace mechbal::bench {
 

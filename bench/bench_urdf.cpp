@@ -10,8 +10,8 @@
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
-#include "mechbal/data.hpp"
-#include "mechbal/urdf.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/io/urdf.hpp"
 
 namespace mechbal::bench {
 

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "bench_registry.hpp"
-#include "mechbal/model.hpp"
+#include "mechbal/model/model.hpp"
 
 namespace mechbal::bench {
 

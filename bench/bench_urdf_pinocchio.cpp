@@ -25,7 +25,7 @@
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
-#include "mechbal/data.hpp"
+#include "mechbal/model/data.hpp"
 
 namespace mechbal::bench {
 namespace {

@@ -28,10 +28,10 @@
 #include <string>
 #include <vector>
 
-#include "mechbal/computed_torque.hpp"
-#include "mechbal/paminsa.hpp"
-#include "mechbal/rnea.hpp"
-#include "mechbal/trajectory.hpp"
+#include "mechbal/control/computed_torque.hpp"
+#include "mechbal/papers/paminsa/paminsa.hpp"
+#include "mechbal/control/rnea.hpp"
+#include "mechbal/control/trajectory.hpp"
 #include "paminsa_motion.hpp"
 #include "test_support.hpp"
 

@@ -11,8 +11,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "mechbal/model.hpp"
-#include "mechbal/paminsa.hpp"
+#include "mechbal/model/model.hpp"
+#include "mechbal/papers/paminsa/paminsa.hpp"
 
 namespace mechbal::bench {
 

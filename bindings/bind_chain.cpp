@@ -5,8 +5,8 @@
 #include "array_checks.hpp"
 #include "batch_inverse_dynamics.hpp"
 #include "bindings.hpp"
-#include "mechbal/kdl_chain.hpp"
-#include "mechbal/serial_chain.hpp"
+#include "mechbal/control/kdl_chain.hpp"
+#include "mechbal/model/serial_chain.hpp"
 
 namespace py = pybind11;
 

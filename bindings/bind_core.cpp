@@ -7,7 +7,7 @@
 
 #include "array_checks.hpp"
 #include "bindings.hpp"
-#include "mechbal/rigid_body.hpp"
+#include "mechbal/model/rigid_body.hpp"
 #include "mechbal/status.hpp"
 
 namespace py = pybind11;

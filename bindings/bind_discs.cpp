@@ -10,8 +10,8 @@
 #include "array_checks.hpp"
 #include "bindings.hpp"
 #include "controller_step.hpp"
-#include "mechbal/computed_torque.hpp"
-#include "mechbal/decoupled_control.hpp"
+#include "mechbal/control/computed_torque.hpp"
+#include "mechbal/control/decoupled_control.hpp"
 
 namespace py = pybind11;
 

@@ -2,8 +2,8 @@
 // of every joint-space dynamics back end (Arm2DofDynamics, KdlChainDynamics, RneChainDynamics), so
 // that controllers taking an InverseDynamics (ComputedTorque) accept any of them. No logic.
 #include "bindings.hpp"
-#include "mechbal/dynamics.hpp"
-#include "mechbal/joint_controller.hpp"
+#include "mechbal/control/dynamics.hpp"
+#include "mechbal/control/joint_controller.hpp"
 
 namespace py = pybind11;
 

@@ -22,9 +22,9 @@
 #include "mechbal/algorithm/regressor.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/algorithm/springs.hpp"
-#include "mechbal/data.hpp"
-#include "mechbal/model.hpp"
-#include "mechbal/serial_chain.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
+#include "mechbal/model/serial_chain.hpp"
 
 namespace py = pybind11;
 

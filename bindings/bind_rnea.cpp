@@ -4,8 +4,8 @@
 #include "array_checks.hpp"
 #include "batch_inverse_dynamics.hpp"
 #include "bindings.hpp"
-#include "mechbal/kdl_chain.hpp"
-#include "mechbal/rnea.hpp"
+#include "mechbal/control/kdl_chain.hpp"
+#include "mechbal/control/rnea.hpp"
 
 namespace py = pybind11;
 

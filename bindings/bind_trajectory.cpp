@@ -6,7 +6,7 @@
 
 #include "array_checks.hpp"
 #include "bindings.hpp"
-#include "mechbal/trajectory.hpp"
+#include "mechbal/control/trajectory.hpp"
 
 namespace py = pybind11;
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "bindings.hpp"
-#include "mechbal/urdf.hpp"
+#include "mechbal/io/urdf.hpp"
 
 namespace py = pybind11;
 

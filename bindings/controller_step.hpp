@@ -12,8 +12,8 @@
 
 #include "array_checks.hpp"
 #include "mechbal/status.hpp"
-#include "mechbal/computed_torque.hpp"
-#include "mechbal/joint_limits.hpp"
+#include "mechbal/control/computed_torque.hpp"
+#include "mechbal/control/joint_limits.hpp"
 
 namespace mechbal::pyb {
 

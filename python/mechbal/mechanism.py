@@ -2,7 +2,7 @@
 
 A :class:`Mechanism` wraps the C++ ``MechanismModel`` (a tree of revolute, prismatic and fixed
 joints, any number of named bodies on each link, gear couplings, named frames and gravity; see
-``cpp/include/mechbal/model.hpp`` for the frame conventions) and exposes every algorithm over it.
+``cpp/include/mechbal/model/model.hpp`` for the frame conventions) and exposes every algorithm over it.
 
 Every method takes either one sample (1-D arrays of ``dof`` values) or a batch ((N, dof) arrays),
 evaluated in one C++ call. One sample returns plain arrays and raises :class:`ValueError` when the
@@ -138,7 +138,7 @@ class Mechanism:
         links with inertials become bodies named after the links, revolute / continuous /
         prismatic / fixed joints keep their names (continuous = revolute without position
         limits, one coordinate), ``mimic`` becomes a gear coupling, limits are kept, and every
-        URDF link is a named frame (see ``cpp/include/mechbal/urdf.hpp`` for the mapping).
+        URDF link is a named frame (see ``cpp/include/mechbal/io/urdf.hpp`` for the mapping).
         Raises :class:`mechbal.config.ConfigError` (a ValueError) naming the URDF element."""
         from mechbal.config import ConfigError
 

@@ -133,7 +133,7 @@ class SpringSpec:
     """A spring between anchor ``anchor_a`` (3,) on the link of joint ``link_a`` (or ``base``) and
     ``anchor_b`` on ``link_b``, both in the link frames (DH frames and ``mechanism.base`` already
     applied); ``rate`` [N/m] each, ``free_length`` [m], ``preload`` [N], ``count``,
-    ``pulley_ratio`` (see ``cpp/include/mechbal/model.hpp``, ``Spring``)."""
+    ``pulley_ratio`` (see ``cpp/include/mechbal/model/model.hpp``, ``Spring``)."""
     name: str
     link_a: str
     anchor_a: np.ndarray

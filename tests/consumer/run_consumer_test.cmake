@@ -12,7 +12,7 @@ endfunction()
 if(HEADER_DIR)
   file(READ ${HEADER_DIR}/mechbal.hpp umbrella)
   file(GLOB_RECURSE headers RELATIVE ${HEADER_DIR} ${HEADER_DIR}/*.hpp ${HEADER_DIR}/*.hpp.in)
-  list(FILTER headers EXCLUDE REGEX "^detail/")  # private headers
+  list(FILTER headers EXCLUDE REGEX "(^|/)detail/")  # private headers
   set(missing "")
   foreach(h IN LISTS headers)
     string(REGEX REPLACE "\\.in$" "" h "${h}")

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "mechbal/model.hpp"
-#include "mechbal/serial_chain.hpp"
+#include "mechbal/model/model.hpp"
+#include "mechbal/model/serial_chain.hpp"
 
 namespace mechbal::test {
 

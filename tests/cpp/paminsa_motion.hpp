@@ -4,7 +4,7 @@
 // term of the kinematics is exercised, not just the paper's cycle.
 #include <cmath>
 
-#include "mechbal/paminsa.hpp"
+#include "mechbal/papers/paminsa/paminsa.hpp"
 
 namespace mechbal::test {
 

@@ -5,7 +5,7 @@
 #include <Eigen/Geometry>
 #include <string>
 
-#include "mechbal/model.hpp"
+#include "mechbal/model/model.hpp"
 
 namespace mechbal::test {
 

@@ -4,15 +4,15 @@
 #include <cmath>
 
 #include "alloc_counter.hpp"
-#include "mechbal/arm2dof.hpp"
-#include "mechbal/computed_torque.hpp"
-#include "mechbal/decoupled_control.hpp"
-#include "mechbal/kdl_chain.hpp"
-#include "mechbal/paminsa.hpp"
-#include "mechbal/rnea.hpp"
-#include "mechbal/rigid_body.hpp"
-#include "mechbal/serial_chain.hpp"
-#include "mechbal/trajectory.hpp"
+#include "mechbal/papers/arm2dof/arm2dof.hpp"
+#include "mechbal/control/computed_torque.hpp"
+#include "mechbal/control/decoupled_control.hpp"
+#include "mechbal/control/kdl_chain.hpp"
+#include "mechbal/papers/paminsa/paminsa.hpp"
+#include "mechbal/control/rnea.hpp"
+#include "mechbal/model/rigid_body.hpp"
+#include "mechbal/model/serial_chain.hpp"
+#include "mechbal/control/trajectory.hpp"
 #include "test_support.hpp"
 
 using namespace mechbal;

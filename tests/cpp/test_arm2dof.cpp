@@ -7,10 +7,10 @@
 #include <random>
 
 #include "alloc_counter.hpp"
-#include "mechbal/arm2dof.hpp"
-#include "mechbal/closed_loop.hpp"
-#include "mechbal/computed_torque.hpp"
-#include "mechbal/kdl_chain.hpp"
+#include "mechbal/papers/arm2dof/arm2dof.hpp"
+#include "mechbal/control/closed_loop.hpp"
+#include "mechbal/control/computed_torque.hpp"
+#include "mechbal/control/kdl_chain.hpp"
 
 using namespace mechbal;
 

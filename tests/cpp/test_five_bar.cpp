@@ -13,9 +13,9 @@
 #include <Eigen/Eigenvalues>
 
 #include "alloc_counter.hpp"
-#include "mechbal/computed_torque.hpp"
-#include "mechbal/decoupled_control.hpp"
-#include "mechbal/five_bar.hpp"
+#include "mechbal/control/computed_torque.hpp"
+#include "mechbal/control/decoupled_control.hpp"
+#include "mechbal/papers/five_bar/five_bar.hpp"
 
 using namespace mechbal;
 

@@ -8,8 +8,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "mechbal/kdl_chain.hpp"
-#include "mechbal/mechanism_dynamics.hpp"
+#include "mechbal/control/kdl_chain.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
 #include "test_support.hpp"
 
 using namespace mechbal;

@@ -14,7 +14,7 @@
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/regressor.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
-#include "mechbal/kdl_chain.hpp"
+#include "mechbal/control/kdl_chain.hpp"
 #include "test_support.hpp"
 
 using namespace mechbal;

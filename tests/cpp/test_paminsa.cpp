@@ -11,8 +11,8 @@
 #include <string>
 
 #include "alloc_counter.hpp"
-#include "mechbal/paminsa.hpp"
-#include "mechbal/reactionless_wrist.hpp"
+#include "mechbal/papers/paminsa/paminsa.hpp"
+#include "mechbal/papers/paminsa/reactionless_wrist.hpp"
 #include "paminsa_motion.hpp"
 
 using namespace mechbal;

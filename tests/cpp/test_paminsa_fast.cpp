@@ -8,8 +8,8 @@
 #include <cmath>
 #include <random>
 
-#include "mechbal/paminsa.hpp"
-#include "mechbal/reactionless_wrist.hpp"
+#include "mechbal/papers/paminsa/paminsa.hpp"
+#include "mechbal/papers/paminsa/reactionless_wrist.hpp"
 
 using namespace mechbal;
 using Idx = PaminsaBodyIndex;

@@ -16,8 +16,8 @@
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/control/reactionless.hpp"
-#include "mechbal/paminsa.hpp"
-#include "mechbal/reactionless_wrist.hpp"
+#include "mechbal/papers/paminsa/paminsa.hpp"
+#include "mechbal/papers/paminsa/reactionless_wrist.hpp"
 #include "paminsa_motion.hpp"
 #include "reaction_wheel_arm.hpp"
 

@@ -6,7 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "mechbal/rigid_body.hpp"
+#include "mechbal/model/rigid_body.hpp"
 #include "test_support.hpp"
 
 using namespace mechbal;

@@ -7,8 +7,8 @@
 #include <limits>
 
 #include "alloc_counter.hpp"
-#include "mechbal/kdl_chain.hpp"
-#include "mechbal/rnea.hpp"
+#include "mechbal/control/kdl_chain.hpp"
+#include "mechbal/control/rnea.hpp"
 #include "test_support.hpp"
 
 using namespace mechbal;

@@ -5,8 +5,8 @@
 #include <Eigen/Eigenvalues>
 #include <limits>
 
-#include "mechbal/kdl_chain.hpp"
-#include "mechbal/serial_chain.hpp"
+#include "mechbal/control/kdl_chain.hpp"
+#include "mechbal/model/serial_chain.hpp"
 #include "test_support.hpp"
 
 using namespace mechbal;

@@ -14,7 +14,7 @@
 #include "mechbal/algorithm/loops.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/algorithm/springs.hpp"
-#include "mechbal/mechanism_dynamics.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
 #include "test_support.hpp"
 
 using namespace mechbal;

@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <random>
 
-#include "mechbal/model.hpp"
-#include "mechbal/rigid_body.hpp"
-#include "mechbal/serial_chain.hpp"
+#include "mechbal/model/model.hpp"
+#include "mechbal/model/rigid_body.hpp"
+#include "mechbal/model/serial_chain.hpp"
 
 namespace mechbal::test {
 

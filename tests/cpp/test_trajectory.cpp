@@ -2,7 +2,7 @@
 
 #include <limits>
 
-#include "mechbal/trajectory.hpp"
+#include "mechbal/control/trajectory.hpp"
 
 using namespace mechbal;
 

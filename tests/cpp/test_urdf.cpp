@@ -16,7 +16,7 @@
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/regressor.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
-#include "mechbal/urdf.hpp"
+#include "mechbal/io/urdf.hpp"
 
 using namespace mechbal;
 

@@ -11,8 +11,8 @@
 
 #include <cmath>
 
-#include "mechbal/paminsa.hpp"
-#include "mechbal/reactionless_wrist.hpp"
+#include "mechbal/papers/paminsa/paminsa.hpp"
+#include "mechbal/papers/paminsa/reactionless_wrist.hpp"
 
 using namespace mechbal;
 

@@ -3,7 +3,7 @@ position-orientation decoupled PAMINSA manipulator", AIM 2009, Section II) on th
 mechanism model: three pantograph legs, their guides and columns, the platform, the
 counterweights, the vertical counter-mass and the z-x-z wrist, as one tree closed by nine loops.
 
-The geometry is the closed form's (``mechbal.PaminsaModel``, cpp/include/mechbal/paminsa.hpp and
+The geometry is the closed form's (``mechbal.PaminsaModel``, cpp/include/mechbal/papers/paminsa/paminsa.hpp and
 the assumptions A1-A11 of python/mechbal/cases/paminsa.toml): the same layout (A8), the same
 38 bodies with the same names, masses, centres of mass and principal inertias. What the general
 model adds is the joints the closed form only implies.

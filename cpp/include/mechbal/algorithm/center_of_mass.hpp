@@ -3,8 +3,8 @@
 /// Centre of mass of all bodies (the base's included) in O: data.center_of_mass, data.mass.
 #include <Eigen/Core>
 
-#include "mechbal/data.hpp"
-#include "mechbal/model.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {

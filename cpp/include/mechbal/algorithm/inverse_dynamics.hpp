@@ -5,8 +5,8 @@
 /// couplings projected: tau = G^T tau_joint, where joint positions are G q + offset.
 #include <Eigen/Core>
 
-#include "mechbal/data.hpp"
-#include "mechbal/model.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {

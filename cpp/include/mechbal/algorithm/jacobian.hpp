@@ -4,8 +4,8 @@
 /// angular velocity, both in O's axes (Pinocchio's LOCAL_WORLD_ALIGNED).
 #include <Eigen/Core>
 
-#include "mechbal/data.hpp"
-#include "mechbal/model.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {

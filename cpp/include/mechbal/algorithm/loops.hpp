@@ -22,8 +22,8 @@
 /// Real time: noexcept, allocation-free, bounded (LoopSolveOptions::max_iterations).
 #include <Eigen/Core>
 
-#include "mechbal/data.hpp"
-#include "mechbal/model.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {
@@ -85,12 +85,5 @@ Status closed_mass_matrix(const MechanismModel& model, MechanismData& data, cons
 Status closed_forward_dynamics(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
                                const ConstVector& v_actuated, const ConstVector& tau_actuated,
                                Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options = {}) noexcept;
-
-namespace detail {
-/// Fills data.loop_elimination and data.loop_factor_start / loop_factor_rows from the model's
-/// structure (which coordinates each loop's frames depend on). Called by MechanismData's
-/// constructor; allocates.
-void loop_factor_structure(const MechanismModel& model, MechanismData& data);
-}  // namespace detail
 
 }  // namespace mechbal

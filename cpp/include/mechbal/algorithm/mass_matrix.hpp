@@ -4,8 +4,8 @@
 /// the tree, projected through the gear couplings (M = G^T M_joint G).
 #include <Eigen/Core>
 
-#include "mechbal/data.hpp"
-#include "mechbal/model.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {

@@ -4,8 +4,8 @@
 /// bodies (Briot & Arakelian 2009, eqs 1-4), and the momentum matrix A(q) with [P; H_O] = A(q) v.
 #include <Eigen/Core>
 
-#include "mechbal/data.hpp"
-#include "mechbal/model.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {

@@ -7,8 +7,8 @@
 /// have zero columns. These are what balancing by counterweights, discs and springs is sized on.
 #include <Eigen/Core>
 
-#include "mechbal/data.hpp"
-#include "mechbal/model.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {

@@ -19,8 +19,8 @@
 /// allocation-free, Status::bad_size / non_finite_input with nothing written.
 #include <Eigen/Core>
 
-#include "mechbal/data.hpp"
-#include "mechbal/model.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {

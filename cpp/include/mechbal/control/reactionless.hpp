@@ -50,13 +50,13 @@
 #include <vector>
 
 #include "mechbal/algorithm/loops.hpp"
-#include "mechbal/computed_torque.hpp"
-#include "mechbal/data.hpp"
-#include "mechbal/joint_controller.hpp"
-#include "mechbal/joint_limits.hpp"
-#include "mechbal/mechanism_dynamics.hpp"
-#include "mechbal/model.hpp"
-#include "mechbal/rigid_body.hpp"
+#include "mechbal/control/computed_torque.hpp"
+#include "mechbal/control/joint_controller.hpp"
+#include "mechbal/control/joint_limits.hpp"
+#include "mechbal/control/mechanism_dynamics.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
+#include "mechbal/model/rigid_body.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {

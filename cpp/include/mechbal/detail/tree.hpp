@@ -8,8 +8,8 @@
 #include <Eigen/Core>
 #include <cmath>
 
-#include "mechbal/data.hpp"
-#include "mechbal/model.hpp"
+#include "mechbal/model/data.hpp"
+#include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal::detail {

@@ -1,0 +1,42 @@
+#pragma once
+/// \file detail/joint_control.hpp
+/// Shared by the joint controllers (ComputedTorque, DecoupledJointController): construction-time
+/// checks of gain and limit vectors, and the real-time clipping of a command to per-joint limits.
+#include <Eigen/Core>
+
+#include "mechbal/control/joint_limits.hpp"
+#include "mechbal/status.hpp"
+
+namespace mechbal::detail {
+
+/// Construction time (throws): `v` must have `n` values, each > 0 and finite (or > 0, possibly
+/// +infinity, when `allow_inf`); the std::invalid_argument names `field`, the index and the value.
+void check_positive_vector(const Eigen::VectorXd& v, const char* field, Eigen::Index n,
+                           bool allow_inf);
+
+/// Construction time (throws): the torque limit of n joints into `out`: empty gives
+/// default_torque_limit for every joint, +infinity entries are replaced by it, other entries must
+/// be finite and > 0.
+void check_torque_limit(const Eigen::VectorXd& limit, const char* field, Eigen::Index n,
+                        Eigen::VectorXd& out);
+
+/// Clips x(i) to [-limit(i), limit(i)] for the first n entries (limits may be +infinity).
+/// Returns Status::saturated when any entry was clipped, Status::ok otherwise. noexcept, no
+/// allocation.
+template <typename Command, typename Limit>
+inline Status clip_to_limits(Eigen::DenseBase<Command>& x, const Eigen::DenseBase<Limit>& limit,
+                             Eigen::Index n) noexcept {
+  Status status = Status::ok;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (x(i) > limit(i)) {
+      x(i) = limit(i);
+      status = Status::saturated;
+    } else if (x(i) < -limit(i)) {
+      x(i) = -limit(i);
+      status = Status::saturated;
+    }
+  }
+  return status;
+}
+
+}  // namespace mechbal::detail

@@ -1,0 +1,133 @@
+#pragma once
+/// \file data.hpp
+/// MechanismData: every buffer the algorithms over a MechanismModel need, allocated once from the
+/// model (Pinocchio's Data). Algorithms write their results here; nothing allocates afterwards.
+/// All world quantities are in the base frame O; moments and angular momenta are about O.
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "mechbal/model/model.hpp"
+#include "mechbal/model/rigid_body.hpp"
+
+namespace mechbal {
+
+struct MechanismData {
+  explicit MechanismData(const MechanismModel& model);
+
+  int dof;         ///< of the model this data was built for (checked by every algorithm)
+  int num_links;
+  int num_bodies;
+  int num_frames;
+  int num_springs;
+
+  // ---- joint positions (every link's joint, gear couplings applied) ----
+  std::vector<double> joint_position, joint_velocity, joint_acceleration;
+
+  // ---- forward kinematics: link frames F_i in O (index 0 = base) ----
+  std::vector<Mat3> link_rotation;               ///< F_i -> O
+  std::vector<Vec3> link_position;               ///< origin of F_i in O
+  std::vector<Vec3> link_angular_velocity;       ///< in O
+  std::vector<Vec3> link_velocity;               ///< of F_i's origin, in O
+  std::vector<Vec3> link_angular_acceleration;   ///< in O
+  std::vector<Vec3> link_acceleration;           ///< of F_i's origin, in O (gravity excluded)
+  std::vector<BodyState> body_states;            ///< every body's motion (com, rotation, ...), in O
+  std::vector<RigidBody> body_inertias;          ///< mass and inertia about com, body = link axes
+  std::vector<Eigen::Isometry3d> frame_placements;  ///< named frames in O
+
+  // ---- results ----
+  double mass = 0.0;                   ///< total mass [kg]
+  Vec3 center_of_mass = Vec3::Zero();  ///< in O [m]
+  ShakingWrench shaking;   ///< momenta about O and their rates (shaking force and moment)
+  BaseReaction base_reaction;  ///< wrench the base exerts on the mechanism (gravity included)
+  Eigen::VectorXd joint_torque;    ///< inverse dynamics, springs included [N m or N], size dof
+  Eigen::VectorXd gravity_torque;  ///< G(q)
+  Eigen::VectorXd bias_torque;     ///< C(q, v) v + G(q) + K(q) (springs included)
+  /// K(q) = dV_springs/dq: the joint forces that hold the springs still (algorithm/springs.hpp)
+  Eigen::VectorXd spring_torque;
+  Eigen::VectorXd static_torque;   ///< G(q) + K(q): the joint forces that hold the mechanism still
+  Eigen::VectorXd spring_length;   ///< anchor distance d of each spring [m]
+  Eigen::VectorXd spring_tension;  ///< tension T at each spring's anchors [N]
+  double spring_energy = 0.0;      ///< elastic energy of all springs [J]
+  double potential_energy = 0.0;   ///< gravity (zero at O) plus springs [J]
+  /// Wrench the base exerts on the moving links through the springs anchored to it (in O, moment
+  /// about O): the springs' part of the support wrench (which, the rate of momentum minus the
+  /// weights, includes it).
+  Vec3 spring_base_force = Vec3::Zero(), spring_base_moment = Vec3::Zero();
+  Eigen::MatrixXd mass_matrix;     ///< M(q), dof x dof, symmetric
+  Eigen::MatrixXd momentum_matrix;  ///< 6 x dof: [P; H_O] = A(q) v (linear first)
+  Eigen::MatrixXd frame_jacobian;   ///< 6 x dof: [v; w] of a frame's origin, O axes
+  /// Regressors over each body's 10 inertial parameters, body b in columns 10b..10b+9:
+  /// [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] with c and I (about the link frame
+  /// origin) in the frame of the body's link (Pinocchio's ordering).
+  Eigen::MatrixXd torque_regressor;    ///< dof x 10 nb: tau = Y pi
+  Eigen::MatrixXd gravity_regressor;   ///< dof x 10 nb: G(q) = Y pi
+  Eigen::MatrixXd momentum_regressor;  ///< 6 x 10 nb: [P; H_O] = Y pi
+
+  // ---- closed loops (algorithm/loops.hpp); sizes: m constraints, n = dof, na actuated ----
+  Eigen::VectorXd loop_residual;           ///< closure equations Phi(q) (m)
+  Eigen::MatrixXd loop_jacobian;           ///< A = dPhi/dq (m x n)
+  Eigen::VectorXd loop_bias;               ///< gamma = dA/dt v: A a + gamma = 0 (m)
+  Eigen::MatrixXd loop_projection;         ///< C: v = C v# (n x na), C = [I; -(A°)^-1 A#] reordered
+  Eigen::VectorXd loop_acceleration_bias;  ///< c: a = C a# + c (n)
+  double loop_rcond = 1.0;         ///< reciprocal condition estimate of the passive Jacobian A°
+  int loop_iterations = 0;         ///< Newton iterations of the last position solve
+  double loop_residual_norm = 0.0; ///< max |Phi| after the last position solve [m or rad]
+  Eigen::VectorXd closed_position, closed_velocity, closed_acceleration;  ///< q, v, a (n)
+  Eigen::VectorXd actuated_force;          ///< tau# = C^T tau (na)
+  Eigen::VectorXd actuated_gravity;        ///< C^T G (na)
+  Eigen::VectorXd actuated_static_torque;  ///< C^T (G + K): gravity and springs (na)
+  Eigen::VectorXd actuated_acceleration;   ///< a# of the forward dynamics (na)
+  Eigen::MatrixXd reduced_mass_matrix;     ///< C^T M C (na x na)
+  // scratch of the loop algorithms
+  Eigen::MatrixXd loop_passive_jacobian;   ///< A° (m x np)
+  using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  RowMajorMatrix loop_actuated_jacobian;   ///< A# (m x na), row-major: the solves run over all columns at once
+  RowMajorMatrix loop_block_residual;      ///< m x na
+  RowMajorMatrix loop_block_step;          ///< np x na
+  Eigen::VectorXd loop_constraint_work;    ///< m
+  Eigen::VectorXd loop_refine_solution;    ///< np
+  Eigen::LDLT<Eigen::MatrixXd> reduced_ldlt;  ///< of C^T M C (na x na)
+  Eigen::MatrixXd loop_normal;             ///< A°^T A° + damping (np x np)
+  Eigen::VectorXi loop_passive_first, loop_passive_last;  ///< rows of A° holding each column's nonzeros (np)
+  Eigen::MatrixXi loop_passive_rows;  ///< m x np: column j lists the rows of A°'s nonzeros in column j
+  Eigen::VectorXi loop_passive_count; ///< np: how many (the rest of loop_passive_rows' column is unused)
+  /// The passive coordinates in the elimination order of N = A°^T A° (a minimum-degree ordering of
+  /// the loops' structure, fixed at construction: PAMINSA's legs before the platform they share, so
+  /// that the factor keeps the legs' blocks apart); A°'s columns, the Newton step and the solution
+  /// rows are in this order.
+  std::vector<int> loop_elimination;
+  /// Structure of L in N = L D L^T: the rows (elimination positions, increasing) that column k may
+  /// fill are loop_factor_rows[loop_factor_start[k] .. loop_factor_start[k + 1]).
+  std::vector<int> loop_factor_start, loop_factor_rows;
+  /// Each named frame in its link's joint-aligned frame L (model.hpp): the loop equations place the
+  /// closure frames with one product each.
+  std::vector<Mat3> frame_rotation_in_link;
+  std::vector<Vec3> frame_position_in_link;
+  Eigen::VectorXd loop_normal_pivots;      ///< D of N = L D L^T (L in loop_normal's lower triangle) (np)
+  Eigen::VectorXd loop_step, loop_trial;   ///< np, n
+  RowMajorMatrix loop_solution;            ///< np x na (elimination order)
+  Eigen::MatrixXd loop_reduced_work;       ///< n x na
+  Eigen::VectorXd loop_vector_work;        ///< n
+
+  // ---- internal buffers (per link, in the joint-aligned frames L_i of model.hpp) ----
+  struct LinkWork {
+    Mat3 rotation;     ///< L_i relative to L_parent at the current q
+    Vec3 translation;  ///< origin of L_i in L_parent
+    Vec3 w, alpha, acc;    ///< angular velocity, angular acceleration, origin acceleration (in L_i)
+    Vec3 vel;              ///< origin velocity (in L_i)
+    Vec3 force, moment;    ///< wrench from the parent on link i (moment about L_i's origin)
+    Mat3 world_rotation;   ///< L_i -> O
+    Vec3 world_position;   ///< origin of L_i in O
+    double composite_mass;
+    Vec3 composite_first_moment;
+    Mat3 composite_inertia;
+  };
+  std::vector<LinkWork> work;
+  Eigen::MatrixXd link_mass_matrix;  ///< per-link joint-space mass matrix (num_links^2)
+  Eigen::MatrixXd link_regressor;           ///< dof x 10 scratch: one link's torque regressor
+  Eigen::MatrixXd link_momentum_regressor;  ///< 6 x 10 scratch: one link's momentum regressor
+};
+
+}  // namespace mechbal

@@ -1,0 +1,640 @@
+// Closed loops on the general model (algorithm/loops.hpp).
+#include "mechbal/algorithm/loops.hpp"
+#include "mechbal/algorithm/springs.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "mechbal/algorithm/inverse_dynamics.hpp"
+#include "mechbal/algorithm/mass_matrix.hpp"
+#include "mechbal/detail/tree.hpp"
+
+namespace mechbal {
+
+namespace {
+
+/// Position and orientation (O axes) of a named frame, from placed links.
+struct FramePose {
+  Vec3 position;
+  Mat3 rotation;
+};
+
+FramePose frame_pose(const MechanismModel& model, const MechanismData& data, int frame) noexcept {
+  const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
+  const auto f = static_cast<std::size_t>(frame);
+  return {W.world_position + W.world_rotation * data.frame_position_in_link[f],
+          W.world_rotation * data.frame_rotation_in_link[f]};
+}
+
+/// Each closure row is a linear function of the frames' relative motion:
+/// row = a . (v_B - v_A) + b . w_A + e . w_B (v: origin velocities, w: angular velocities, O axes).
+struct RowFunctional {
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero(), e = Vec3::Zero();
+};
+
+/// Adds the columns of the joints on the path from `link` to the root to the loop's rows:
+/// joint k moves the frame's origin p by r z x (p - p_k) (revolute) or r z (prismatic) and turns
+/// it by r z (revolute); `side` -1 for frame A, +1 for frame B. Only the loop's own coordinates are
+/// touched (no dense 6 x n frame Jacobians).
+void add_path_columns(const MechanismModel& model, const MechanismData& data, int link, const Vec3& p, double side,
+                      const RowFunctional* f, int rows, int row0, Eigen::MatrixXd& jac) noexcept {
+  detail::for_each_path_joint(model, data, link, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
+    if (revolute) {
+      const Vec3 lin = z.cross(p - pk);
+      for (int r = 0; r < rows; ++r) {
+        jac(row0 + r, c) += side * f[r].a.dot(lin) + (side < 0.0 ? f[r].b : f[r].e).dot(z);
+      }
+    } else {
+      for (int r = 0; r < rows; ++r) jac(row0 + r, c) += side * f[r].a.dot(z);
+    }
+  });
+}
+
+/// Residual (and Jacobian) of every loop, from placed links (world poses computed).
+void constraint_rows(const MechanismModel& model, MechanismData& data, bool jacobian) noexcept {
+  Eigen::MatrixXd& jac = data.loop_jacobian;
+  if (jacobian) jac.setZero();
+  for (int i = 0; i < model.num_loops(); ++i) {
+    const int row = model.loop_row(i), fa = model.loop_frame_a(i), fb = model.loop_frame_b(i);
+    const FramePose A = frame_pose(model, data, fa);
+    const FramePose B = frame_pose(model, data, fb);
+    const Vec3 d = B.position - A.position;
+    const LoopType type = model.loop(i).type;
+    RowFunctional f[6];
+    int rows = 0;
+    if (type == LoopType::planar_point) {
+      // x_k . d: its rate is x_k . (v_B - v_A) + (w_A x x_k) . d = x_k . (v_B - v_A) + (x_k x d) . w_A
+      for (int k = 0; k < 2; ++k) {
+        const Vec3 x = A.rotation.col(k);
+        data.loop_residual(row + k) = x.dot(d);
+        f[k].a = x;
+        f[k].b = x.cross(d);
+      }
+      rows = 2;
+    } else {
+      // point part of point, axis and weld
+      data.loop_residual.segment<3>(row) = d;
+      for (int k = 0; k < 3; ++k) f[k].a = Vec3::Unit(k);
+      rows = 3;
+      if (type == LoopType::axis) {
+        // z_A . e_k (e_k = x_B, y_B): its rate is (z x e_k) . (w_A - w_B)
+        const Vec3 z = A.rotation.col(2);
+        for (int k = 0; k < 2; ++k) {
+          const Vec3 e = B.rotation.col(k);
+          data.loop_residual(row + 3 + k) = z.dot(e);
+          f[3 + k].b = z.cross(e);
+          f[3 + k].e = -f[3 + k].b;
+        }
+        rows = 5;
+      } else if (type == LoopType::weld) {
+        // rotation vector of R_B R_A^T: its rate at the solution is w_B - w_A
+        const Eigen::AngleAxisd err(Mat3(B.rotation * A.rotation.transpose()));
+        data.loop_residual.segment<3>(row + 3) = err.angle() * err.axis();
+        for (int k = 0; k < 3; ++k) {
+          f[3 + k].b = -Vec3::Unit(k);
+          f[3 + k].e = Vec3::Unit(k);
+        }
+        rows = 6;
+      }
+    }
+    if (jacobian) {
+      add_path_columns(model, data, model.frame_link(fa), A.position, -1.0, f, rows, row, jac);
+      add_path_columns(model, data, model.frame_link(fb), B.position, 1.0, f, rows, row, jac);
+    }
+  }
+}
+
+/// gamma = dA/dt v from a forward pass with velocities (accelerations at a = 0).
+void constraint_bias(const MechanismModel& model, MechanismData& data) noexcept {
+  for (int i = 0; i < model.num_loops(); ++i) {
+    const int row = model.loop_row(i);
+    const detail::FrameMotion A = detail::frame_motion(model, data, model.loop_frame_a(i));
+    const detail::FrameMotion B = detail::frame_motion(model, data, model.loop_frame_b(i));
+    const Vec3 d = B.position - A.position, dd = B.velocity - A.velocity, ddd = B.acceleration - A.acceleration;
+    const LoopType type = model.loop(i).type;
+    if (type == LoopType::planar_point) {
+      for (int k = 0; k < 2; ++k) {
+        const Vec3 x = A.rotation.col(k);
+        const Vec3 xd = A.angular_velocity.cross(x);
+        const Vec3 xdd = A.angular_acceleration.cross(x) + A.angular_velocity.cross(xd);
+        data.loop_bias(row + k) = xdd.dot(d) + 2.0 * xd.dot(dd) + x.dot(ddd);
+      }
+      continue;
+    }
+    data.loop_bias.segment<3>(row) = ddd;
+    if (type == LoopType::axis) {
+      const Vec3 z = A.rotation.col(2);
+      const Vec3 dw = A.angular_velocity - B.angular_velocity;
+      const Vec3 dal = A.angular_acceleration - B.angular_acceleration;
+      for (int k = 0; k < 2; ++k) {
+        const Vec3 e = B.rotation.col(k);
+        const Vec3 rate = A.angular_velocity.cross(z).cross(e) + z.cross(B.angular_velocity.cross(e));
+        data.loop_bias(row + 3 + k) = rate.dot(dw) + z.cross(e).dot(dal);
+      }
+    } else if (type == LoopType::weld) {
+      data.loop_bias.segment<3>(row + 3) = B.angular_acceleration - A.angular_acceleration;
+    }
+  }
+}
+
+/// Residual (and Jacobian) at q (full coordinates).
+void evaluate(const MechanismModel& model, MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,
+              bool jacobian) noexcept {
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place(model, data);
+  constraint_rows(model, data, jacobian);
+}
+
+/// N = L D L^T in place, without pivoting, over the structure of data.loop_factor_rows (N is
+/// symmetric positive semi-definite: the normal matrix of A° plus a small damping; its rows and
+/// columns in the elimination order): L in N's strict lower triangle (unit diagonal implied, only
+/// the structural entries are read or written), D in `D`. Written out for the small, sparse
+/// systems of loop closures, where a dense LDLT (pivot search, blocked triangular solves) costs
+/// several times more. A pivot that is not positive (a singular A°) is kept as is and its
+/// component is zeroed by ldl_solve, as Eigen's LDLT does (pseudo-inverse of D).
+void ldl_factor(MechanismData& data) noexcept {
+  Eigen::MatrixXd& N = data.loop_normal;
+  Eigen::VectorXd& D = data.loop_normal_pivots;
+  const int* rows = data.loop_factor_rows.data();
+  const Eigen::Index n = N.rows();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double d = N(k, k);
+    D(k) = d;
+    const int begin = data.loop_factor_start[static_cast<std::size_t>(k)];
+    const int end = data.loop_factor_start[static_cast<std::size_t>(k) + 1];
+    double* lk = N.data() + k * n;
+    if (!(d > 0.0)) {
+      for (int p = begin; p < end; ++p) lk[rows[p]] = 0.0;
+      continue;
+    }
+    for (int p = begin; p < end; ++p) {
+      const int j = rows[p];
+      const double f = lk[j] / d;
+      if (f == 0.0) continue;
+      double* nj = N.data() + j * n;
+      for (int r = p; r < end; ++r) nj[rows[r]] -= f * lk[rows[r]];
+    }
+    for (int p = begin; p < end; ++p) lk[rows[p]] /= d;
+  }
+}
+
+/// x = (L D L^T)^-1 x with the factors of ldl_factor.
+void ldl_solve(const MechanismData& data, Eigen::Ref<Eigen::VectorXd> x) noexcept {
+  const Eigen::MatrixXd& L = data.loop_normal;
+  const Eigen::VectorXd& D = data.loop_normal_pivots;
+  const int* rows = data.loop_factor_rows.data();
+  const int* start = data.loop_factor_start.data();
+  const Eigen::Index n = L.rows();
+  double* const v = x.data();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double xk = v[k];
+    if (xk == 0.0) continue;
+    const double* l = L.data() + k * n;
+    for (int p = start[k]; p < start[k + 1]; ++p) v[rows[p]] -= xk * l[rows[p]];
+  }
+  for (Eigen::Index k = 0; k < n; ++k) v[k] = D(k) > 0.0 ? v[k] / D(k) : 0.0;
+  for (Eigen::Index k = n - 1; k >= 0; --k) {
+    const double* l = L.data() + k * n;
+    double sum = 0.0;
+    for (int p = start[k]; p < start[k + 1]; ++p) sum += l[rows[p]] * v[rows[p]];
+    v[k] -= sum;
+  }
+}
+
+/// y += a x over n contiguous entries (rows of the row-major blocks: a handful of actuated columns,
+/// too short for Eigen's dynamic-size expressions to pay off).
+inline void axpy(double* y, double a, const double* x, Eigen::Index n) noexcept {
+  for (Eigen::Index j = 0; j < n; ++j) y[j] += a * x[j];
+}
+
+/// X = (L D L^T)^-1 X for a block of right-hand sides (np x na, row-major): one pass over L for
+/// all of them (the columns of C).
+void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
+  const Eigen::MatrixXd& L = data.loop_normal;
+  const Eigen::VectorXd& D = data.loop_normal_pivots;
+  const int* rows = data.loop_factor_rows.data();
+  const int* start = data.loop_factor_start.data();
+  const Eigen::Index n = L.rows(), w = X.cols();
+  double* x = X.data();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double* l = L.data() + k * n;
+    for (int p = start[k]; p < start[k + 1]; ++p) axpy(x + rows[p] * w, -l[rows[p]], x + k * w, w);
+  }
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double inv = D(k) > 0.0 ? 1.0 / D(k) : 0.0;
+    for (Eigen::Index j = 0; j < w; ++j) x[k * w + j] *= inv;
+  }
+  for (Eigen::Index k = n - 1; k >= 0; --k) {
+    const double* l = L.data() + k * n;
+    for (int p = start[k]; p < start[k + 1]; ++p) axpy(x + k * w, -l[rows[p]], x + rows[p] * w, w);
+  }
+}
+
+/// Relative damping of the normal equations: keeps the solves bounded at a singular A° (Status::singular).
+constexpr double kDamping = 1e-16;
+
+/// N = A°^T A° + damping from data.loop_jacobian, factorised; returns the rcond estimate of A°.
+double factor_passive(MechanismData& data) noexcept {
+  const auto& order = data.loop_elimination;
+  const auto np = static_cast<Eigen::Index>(order.size());
+  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
+  const auto m = static_cast<int>(Ap.rows());
+  // A°'s columns in the elimination order, and the rows holding each column's nonzeros (a loop's
+  // rows involve only the coordinates of its two frames' branches)
+  for (Eigen::Index j = 0; j < np; ++j) {
+    data.loop_passive_jacobian.col(j) = data.loop_jacobian.col(order[static_cast<std::size_t>(j)]);
+    const double* a = Ap.data() + j * m;
+    int first = 0, last = m - 1;
+    while (first < m && a[first] == 0.0) ++first;
+    while (last > first && a[last] == 0.0) --last;
+    if (first == m) last = -1;
+    int count = 0;
+    for (int r = first; r <= last; ++r) {
+      if (a[r] != 0.0) data.loop_passive_rows(count++, j) = r;
+    }
+    data.loop_passive_count(j) = count;
+    data.loop_passive_first(j) = first;
+    data.loop_passive_last(j) = last;
+  }
+  // N = A°^T A° on the structure of L (which holds N's), each entry a dot product over the rows
+  // where both columns can be nonzero
+  Eigen::MatrixXd& N = data.loop_normal;
+  const auto dot = [&](Eigen::Index i, Eigen::Index j) {
+    const int lo = std::max(data.loop_passive_first(i), data.loop_passive_first(j));
+    const int hi = std::min(data.loop_passive_last(i), data.loop_passive_last(j));
+    const double* ai = Ap.data() + i * m;
+    const double* aj = Ap.data() + j * m;
+    double sum = 0.0;
+    for (int r = lo; r <= hi; ++r) sum += ai[r] * aj[r];
+    return sum;
+  };
+  double scale = 1.0;
+  for (Eigen::Index i = 0; i < np; ++i) {
+    N(i, i) = dot(i, i);
+    scale = std::max(scale, N(i, i));
+    const int end = data.loop_factor_start[static_cast<std::size_t>(i) + 1];
+    for (int p = data.loop_factor_start[static_cast<std::size_t>(i)]; p < end; ++p) {
+      const int j = data.loop_factor_rows[static_cast<std::size_t>(p)];
+      N(j, i) = dot(i, j);
+    }
+  }
+  for (Eigen::Index i = 0; i < np; ++i) N(i, i) += kDamping * scale;
+  ldl_factor(data);
+  const Eigen::VectorXd& D = data.loop_normal_pivots;
+  if (np == 0) return 1.0;
+  const double dmax = D.cwiseAbs().maxCoeff(), dmin = D.cwiseAbs().minCoeff();
+  return dmax > 0.0 ? std::sqrt(std::max(0.0, dmin - kDamping * scale) / dmax) : 0.0;
+}
+
+/// (A°^T y)_i: column i of A° (elimination order) against y, over the rows holding the column's
+/// nonzeros (data.loop_passive_rows, from factor_passive).
+double column_dot(const MechanismData& data, Eigen::Index i, const double* y) noexcept {
+  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
+  const double* a = Ap.data() + i * Ap.rows();
+  double sum = 0.0;
+  const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+  for (int p = 0; p < data.loop_passive_count(i); ++p) sum += a[rows[p]] * y[rows[p]];
+  return sum;
+}
+
+Status check(const MechanismModel& model, const MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,
+             const Eigen::Ref<const Eigen::VectorXd>* qa, const Eigen::Ref<const Eigen::VectorXd>* va = nullptr,
+             const Eigen::Ref<const Eigen::VectorXd>* aa = nullptr) noexcept {
+  if (!detail::data_matches(model, data) || data.loop_residual.size() != model.num_constraints()) {
+    return Status::bad_size;
+  }
+  const Eigen::Index na = model.num_actuated();
+  if (q.size() != model.dof() || (qa && qa->size() != na) || (va && va->size() != na) || (aa && aa->size() != na)) {
+    return Status::bad_size;
+  }
+  if (!q.allFinite() || (qa && !qa->allFinite()) || (va && !va->allFinite()) || (aa && !aa->allFinite())) {
+    return Status::non_finite_input;
+  }
+  return Status::ok;
+}
+
+}  // namespace
+
+Status loop_constraints(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
+  if (Status s = check(model, data, q, nullptr); s != Status::ok) return s;
+  evaluate(model, data, q, true);
+  return Status::ok;
+}
+
+Status solve_loop_positions(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                            Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
+  if (Status s = check(model, data, q, &q_actuated); s != Status::ok) return s;
+  const auto& actuated = model.actuated_coordinates();
+  const auto& passive = model.passive_coordinates();
+  Eigen::VectorXd& trial = data.loop_trial;
+  trial = q;
+  // Warm start from the last solved motion (q is where data.loop_projection was computed: the
+  // usual tick, which passes back the q it got): follow the closure manifold to second order,
+  // q + C d + (s^2 / 2) c with d = q#_new - q# and s = d . v# / |v#|^2 (d = s v# to first order
+  // along a motion, and c, the acceleration bias of the last projection, is quadratic in v#), so
+  // that Newton starts O(|d|^3) from the solution instead of O(|d|) (two iterations fewer at
+  // 1 kHz). Only a starting point: Newton then converges as before. Not when the step would
+  // exceed options.max_step.
+  const bool tangent = model.is_closed() && q == data.closed_position;
+  double vv = 0.0, dv = 0.0;
+  for (std::size_t i = 0; i < actuated.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    const double step = q_actuated(k) - q(actuated[i]), rate = data.closed_velocity(actuated[i]);
+    if (tangent) trial.noalias() += data.loop_projection.col(k) * step;
+    trial(actuated[i]) = q_actuated(k);
+    vv += rate * rate;
+    dv += step * rate;
+  }
+  if (tangent && vv > 0.0) {
+    const double s = dv / vv;
+    trial.noalias() += (0.5 * s * s) * data.loop_acceleration_bias;  // zero on the actuated rows
+  }
+  if (tangent && !((trial - q).cwiseAbs().maxCoeff() <= options.max_step)) {
+    trial = q;
+    for (std::size_t i = 0; i < actuated.size(); ++i) trial(actuated[i]) = q_actuated(static_cast<Eigen::Index>(i));
+  }
+  data.loop_iterations = 0;
+  if (!model.is_closed()) {
+    data.loop_residual_norm = 0.0;
+    data.loop_rcond = 1.0;
+    q = trial;
+    return Status::ok;
+  }
+  // Newton on Phi(q) = 0 over the passive coordinates. On a warm-started tick the factorisation of
+  // the last solve (at data.closed_position, a few micrometres away) is reused: chord steps, which
+  // need only the residual at each trial point, no Jacobian and no factorisation; the Jacobian is
+  // evaluated and factorised once, at the solution (the projection needs it there). When a chord
+  // step does not reduce the residual fourfold, the solve switches to full Newton (Jacobian and
+  // factorisation at every iterate), as it does from the start without a warm start.
+  bool chord = tangent;
+  bool jacobian_at_trial = false;  // data.loop_jacobian is that of `trial`
+  bool placed_at_trial = true;     // the links are placed at `trial` (the last evaluation)
+  evaluate(model, data, trial, false);
+  double norm = data.loop_residual.cwiseAbs().maxCoeff();
+  Eigen::VectorXd& candidate = data.loop_vector_work;
+  for (int it = 0; it < options.max_iterations && norm > options.tolerance && !passive.empty(); ++it) {
+    data.loop_iterations = it + 1;
+    if (!chord) {
+      if (!jacobian_at_trial) {
+        if (placed_at_trial) {
+          constraint_rows(model, data, true);
+        } else {
+          evaluate(model, data, trial, true);
+        }
+        jacobian_at_trial = placed_at_trial = true;
+      }
+      factor_passive(data);
+    } else if (!placed_at_trial) {
+      evaluate(model, data, trial, false);  // the residual at trial (the step needs it)
+      placed_at_trial = true;
+    }
+    for (Eigen::Index i = 0; i < data.loop_step.size(); ++i) {
+      data.loop_step(i) = -column_dot(data, i, data.loop_residual.data());
+    }
+    ldl_solve(data, data.loop_step);
+    const double biggest = data.loop_step.cwiseAbs().maxCoeff();
+    if (!(biggest < 1e300)) {  // non-finite step: cannot assemble here
+      if (chord) {
+        chord = false;
+        continue;
+      }
+      break;
+    }
+    if (biggest > options.max_step) data.loop_step *= options.max_step / biggest;
+    bool improved = false;
+    for (int halving = 0; halving <= 8; ++halving) {
+      candidate = trial;
+      for (std::size_t j = 0; j < passive.size(); ++j) {
+        candidate(data.loop_elimination[j]) += data.loop_step(static_cast<Eigen::Index>(j));
+      }
+      evaluate(model, data, candidate, false);
+      const double n = data.loop_residual.cwiseAbs().maxCoeff();
+      if (n < norm) {
+        if (chord && !(n <= 0.25 * norm)) chord = false;  // slow: full Newton from here
+        trial = candidate;
+        norm = n;
+        improved = true;
+        jacobian_at_trial = false;
+        placed_at_trial = true;
+        break;
+      }
+      placed_at_trial = false;
+      if (chord) break;  // a stale factorisation: retry this iterate with full Newton
+      data.loop_step *= 0.5;
+    }
+    if (!improved) {
+      if (chord) {
+        chord = false;
+        continue;
+      }
+      break;
+    }
+  }
+  data.loop_residual_norm = norm;
+  // the Jacobian at the result, and the links placed there (project relies on both)
+  if (!placed_at_trial) {
+    evaluate(model, data, trial, true);
+  } else if (!jacobian_at_trial && !passive.empty()) {
+    constraint_rows(model, data, true);
+  }
+  data.loop_rcond = passive.empty() ? 1.0 : factor_passive(data);
+  if (!(norm <= options.tolerance)) return Status::solver_error;
+  q = trial;
+  return data.loop_rcond < options.singular_rcond ? Status::singular : Status::ok;
+}
+
+namespace {
+
+/// One step of iterative refinement of x, the least-squares solution of A° x = -b from the factored
+/// normal equations: x += (A°^T A°)^-1 A°^T (-(b + A° x)). The normal equations square A°'s
+/// condition and carry a small damping; one step brings x back to the accuracy of A° itself (a
+/// machine's internal spring forces of thousands of newtons multiply C's error: Orthoglide).
+template <typename B, typename X>
+void refine(MechanismData& data, const B& b, X&& x) noexcept {
+  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
+  Eigen::VectorXd& r = data.loop_constraint_work;
+  r = -b;
+  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+    const double xi = x(i);
+    const double* a = Ap.data() + i * Ap.rows();
+    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+    for (int p = 0; p < data.loop_passive_count(i); ++p) r(rows[p]) -= a[rows[p]] * xi;
+  }
+  Eigen::VectorXd& step = data.loop_step;
+  for (Eigen::Index i = 0; i < Ap.cols(); ++i) step(i) = column_dot(data, i, r.data());
+  ldl_solve(data, step);
+  x += step;
+}
+
+/// loop_projection at q (checked); `solved`: q is where solve_loop_positions just converged, so
+/// data.loop_jacobian, the factorisation of A° and data.loop_rcond are already those of q (its last
+/// evaluation) and are not recomputed.
+Status project(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+               const ConstVector& v_actuated, const LoopSolveOptions& options, bool solved) noexcept {
+  const auto& actuated = model.actuated_coordinates();
+  const auto& passive = model.passive_coordinates();
+  Status status = Status::ok;
+  data.loop_acceleration_bias.setZero();
+  data.closed_position = q;
+  if (!model.is_closed()) {
+    data.loop_rcond = 1.0;
+    data.closed_velocity.noalias() = data.loop_projection * v_actuated;
+    return Status::ok;
+  }
+  if (!solved) {
+    evaluate(model, data, q, true);
+    data.loop_rcond = factor_passive(data);
+  }
+  if (data.loop_rcond < options.singular_rcond) status = Status::singular;
+  // C: passive rows -(A°^T A°)^-1 A°^T A#
+  for (std::size_t i = 0; i < actuated.size(); ++i) {
+    data.loop_actuated_jacobian.col(static_cast<Eigen::Index>(i)) = data.loop_jacobian.col(actuated[i]);
+  }
+  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
+  // X = -A°^T A# (each column of A° over its nonzero rows), solved for all columns at once, then
+  // one step of iterative refinement (see refine): R = -A# - A° X, X += (A°^T A°)^-1 A°^T R
+  MechanismData::RowMajorMatrix& X = data.loop_solution;
+  MechanismData::RowMajorMatrix& R = data.loop_block_residual;
+  MechanismData::RowMajorMatrix& S = data.loop_block_step;
+  const MechanismData::RowMajorMatrix& Aa = data.loop_actuated_jacobian;
+  const Eigen::Index w = X.cols();
+  const auto column = [&](Eigen::Index i) { return Ap.data() + i * Ap.rows(); };
+  X.setZero();
+  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+    const double* a = column(i);
+    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+    for (int p = 0; p < data.loop_passive_count(i); ++p) {
+      const int r = rows[p];
+      axpy(X.data() + i * w, -a[r], Aa.data() + r * w, w);
+    }
+  }
+  ldl_solve_block(data, X);
+  const bool refine_solves = data.loop_rcond < options.refine_rcond;
+  if (refine_solves) {
+    R = -Aa;
+    S.setZero();
+    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+      const double* a = column(i);
+      const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+      for (int p = 0; p < data.loop_passive_count(i); ++p) {
+        const int r = rows[p];
+        axpy(R.data() + r * w, -a[r], X.data() + i * w, w);
+      }
+    }
+    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+      const double* a = column(i);
+      const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+      for (int p = 0; p < data.loop_passive_count(i); ++p) {
+        const int r = rows[p];
+        axpy(S.data() + i * w, a[r], R.data() + r * w, w);
+      }
+    }
+    ldl_solve_block(data, S);
+    X += S;
+  }
+  for (std::size_t j = 0; j < passive.size(); ++j) {
+    data.loop_projection.row(data.loop_elimination[j]) = data.loop_solution.row(static_cast<Eigen::Index>(j));
+  }
+  data.closed_velocity.noalias() = data.loop_projection * v_actuated;
+  // the loops must accept the actuated velocities (A v = 0); they do not at a serial singularity of
+  // the closure or when the actuators over-constrain the mechanism
+  data.loop_constraint_work.noalias() = data.loop_jacobian * data.closed_velocity;
+  const double scale = 1.0 + data.loop_jacobian.cwiseAbs().maxCoeff() * data.closed_velocity.cwiseAbs().maxCoeff();
+  if (!(data.loop_constraint_work.cwiseAbs().maxCoeff() <= 1e-8 * scale)) status = Status::singular;
+  // gamma at (q, v), then c = [0; -(A°^T A°)^-1 A°^T gamma]
+  detail::joint_state<true, false>(model, data, q, data.closed_velocity, data.closed_velocity);
+  // (the links are placed at q: by the solve's last evaluation, or by evaluate above)
+  detail::forward_pass<true, false, false, false>(model, data);
+  constraint_bias(model, data);
+  for (Eigen::Index i = 0; i < Ap.cols(); ++i) data.loop_step(i) = -column_dot(data, i, data.loop_bias.data());
+  ldl_solve(data, data.loop_step);
+  data.loop_refine_solution = data.loop_step;
+  if (refine_solves) refine(data, data.loop_bias, data.loop_refine_solution);
+  for (std::size_t j = 0; j < passive.size(); ++j) {
+    data.loop_acceleration_bias(data.loop_elimination[j]) = data.loop_refine_solution(static_cast<Eigen::Index>(j));
+  }
+  if (!data.loop_projection.allFinite() || !data.loop_acceleration_bias.allFinite()) {
+    return status | Status::singular;
+  }
+  return status;
+}
+
+}  // namespace
+
+Status loop_projection(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                       const ConstVector& v_actuated, const LoopSolveOptions& options) noexcept {
+  if (Status s = check(model, data, q, &v_actuated); s != Status::ok) return s;
+  return project(model, data, q, v_actuated, options, false);
+}
+
+Status closed_motion(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                     const ConstVector& v_actuated, const ConstVector& a_actuated, Eigen::Ref<Eigen::VectorXd> q,
+                     const LoopSolveOptions& options) noexcept {
+  if (Status s = check(model, data, q, &q_actuated, &v_actuated, &a_actuated); s != Status::ok) return s;
+  Status status = solve_loop_positions(model, data, q_actuated, q, options);
+  if (has(status, Status::solver_error)) return status;
+  data.closed_position = q;
+  status |= project(model, data, q, v_actuated, options, true);
+  data.closed_acceleration = data.loop_acceleration_bias;
+  data.closed_acceleration.noalias() += data.loop_projection * a_actuated;
+  return status;
+}
+
+Status closed_inverse_dynamics(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                               const ConstVector& v_actuated, const ConstVector& a_actuated,
+                               Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
+  Status status = closed_motion(model, data, q_actuated, v_actuated, a_actuated, q, options);
+  if (has(status, Status::solver_error) || has(status, Status::bad_size) || has(status, Status::non_finite_input)) {
+    return status;
+  }
+  status |= inverse_dynamics(model, data, data.closed_position, data.closed_velocity, data.closed_acceleration);
+  data.actuated_force.noalias() = data.loop_projection.transpose() * data.joint_torque;
+  if (!data.actuated_force.allFinite()) status |= Status::out_of_range;
+  return status;
+}
+
+Status closed_mass_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                          Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
+  if (Status s = check(model, data, q, &q_actuated); s != Status::ok) return s;
+  Status status = solve_loop_positions(model, data, q_actuated, q, options);
+  if (has(status, Status::solver_error)) return status;
+  data.closed_position = q;
+  data.actuated_force.setZero();  // v# = 0 for the projection only
+  status |= project(model, data, q, data.actuated_force, options, true);
+  mass_matrix(model, data, q);
+  data.loop_reduced_work.noalias() = data.mass_matrix * data.loop_projection;
+  data.reduced_mass_matrix.noalias() = data.loop_projection.transpose() * data.loop_reduced_work;
+  static_torque(model, data, q);  // G and, with springs, K
+  data.actuated_gravity.noalias() = data.loop_projection.transpose() * data.gravity_torque;
+  data.actuated_static_torque.noalias() = data.loop_projection.transpose() * data.static_torque;
+  return status;
+}
+
+Status closed_forward_dynamics(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                               const ConstVector& v_actuated, const ConstVector& tau_actuated,
+                               Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
+  if (Status s = check(model, data, q, &q_actuated, &v_actuated, &tau_actuated); s != Status::ok) return s;
+  Status status = solve_loop_positions(model, data, q_actuated, q, options);
+  if (has(status, Status::solver_error)) return status;
+  data.closed_position = q;
+  status |= project(model, data, q, v_actuated, options, true);
+  // C^T (M c + b) = C^T tau(q, v, c)
+  inverse_dynamics(model, data, q, data.closed_velocity, data.loop_acceleration_bias);
+  data.actuated_acceleration.noalias() = -data.loop_projection.transpose() * data.joint_torque;
+  data.actuated_acceleration += tau_actuated;
+  mass_matrix(model, data, q);
+  data.loop_reduced_work.noalias() = data.mass_matrix * data.loop_projection;
+  data.reduced_mass_matrix.noalias() = data.loop_projection.transpose() * data.loop_reduced_work;
+  data.reduced_ldlt.compute(data.reduced_mass_matrix);
+  if (data.reduced_ldlt.info() != Eigen::Success || !(data.reduced_ldlt.vectorD().minCoeff() > 0.0)) {
+    return status | Status::singular;
+  }
+  data.reduced_ldlt.solveInPlace(data.actuated_acceleration);
+  data.closed_acceleration = data.loop_acceleration_bias;
+  data.closed_acceleration.noalias() += data.loop_projection * data.actuated_acceleration;
+  return status;
+}
+
+}  // namespace mechbal
