@@ -7,6 +7,7 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 PIP := $(PY) -m pip --disable-pip-version-check
+APT_PYTHON_PACKAGES := python3-venv
 APT_PACKAGES := libeigen3-dev liborocos-kdl-dev liburdfdom-dev g++ make python3-venv python3-dev
 APT_TEST_PACKAGES := libgtest-dev libbenchmark-dev
 CPP_BUILD := build/cpp
@@ -56,8 +57,14 @@ define apt_install
 	fi
 endef
 
+# What a virtual environment needs (enough for `make docs`, which compiles nothing), then the
+# compilers and libraries of the core.
+$(VENV)/.stamp-apt-python:
+	$(call apt_install,$(APT_PYTHON_PACKAGES))
+	@mkdir -p $(VENV) && touch $@
+
 apt: $(VENV)/.stamp-apt
-$(VENV)/.stamp-apt:
+$(VENV)/.stamp-apt: | $(VENV)/.stamp-apt-python
 	$(call apt_install,$(APT_PACKAGES))
 	@mkdir -p $(VENV) && touch $@
 
@@ -67,7 +74,7 @@ $(VENV)/.stamp-apt-test: | $(VENV)/.stamp-apt
 	@touch $@
 
 venv: $(VENV)/.stamp-venv
-$(VENV)/.stamp-venv: pyproject.toml | $(VENV)/.stamp-apt
+$(VENV)/.stamp-venv: pyproject.toml | $(VENV)/.stamp-apt-python
 	$(call say,"Creating $(VENV) with the build tools (pip, scikit-build-core, pybind11, cmake, ninja)")
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PIP) install -q --upgrade pip
@@ -78,7 +85,7 @@ $(VENV)/.stamp-venv: pyproject.toml | $(VENV)/.stamp-apt
 
 # The build shows each compile step ([k/n] from ninja, through pip -v) and keeps the whole log.
 install: $(VENV)/.stamp-install
-$(VENV)/.stamp-install: $(SOURCES) | $(VENV)/.stamp-venv
+$(VENV)/.stamp-install: $(SOURCES) | $(VENV)/.stamp-venv $(VENV)/.stamp-apt
 	$(call say,"Building the C++ core and its Python module with $(JOBS) jobs (log: build/pip-install.log)")
 	@mkdir -p build; set -o pipefail; start=$$(date +%s); \
 	CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PIP) install -v --no-build-isolation . 2>&1 \
@@ -103,9 +110,13 @@ $(VENV)/.stamp-install-docs: pyproject.toml | $(VENV)/.stamp-venv
 
 # ---- docs and stubs ---------------------------------------------------------------------------
 # The site is built from the sources and the checked-in stubs (no compiled module needed).
+# No compiler and no network: the site reads the sources and the checked-in stubs, and loads
+# nothing from elsewhere when viewed (the check below fails on a script or stylesheet from a URL).
 docs: $(VENV)/.stamp-install-docs
 	$(call say,"Building the user guide and API reference: build/site/index.html")
-	$(VENV)/bin/mkdocs build --strict --quiet -f mkdocs.yml
+	$(VENV)/bin/mkdocs build --strict -f mkdocs.yml 2>&1 | grep -v '^INFO ' ; test $${PIPESTATUS[0]} -eq 0
+	@! grep -rlE '<(script|link)[^>]+(src|href)="(https?:)?//' build/site --include='*.html' \
+	  || { echo "the site loads scripts or stylesheets from the network (files above)"; exit 1; }
 
 # After changing a binding: regenerate the checked-in stubs (tests/python/test_typing.py fails
 # until they match the bindings).
@@ -129,7 +140,7 @@ test-python: install $(VENV)/.stamp-install-test
 # (install + find_package from a plain build) is not instrumented and is left to `make test`.
 SAN_BUILD := build/sanitize
 SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
-$(SAN_BUILD)/build.ninja: | $(VENV)/.stamp-venv
+$(SAN_BUILD)/build.ninja: | $(VENV)/.stamp-venv $(VENV)/.stamp-apt
 	$(VENV)/bin/cmake -S . -B $(SAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Debug \
 	  -DCMAKE_MAKE_PROGRAM=$(abspath $(VENV)/bin/ninja) -DMECHBAL_BUILD_TESTS=ON \
 	  -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" -DCMAKE_CXX_FLAGS="$(SAN_FLAGS)" \
@@ -148,7 +159,7 @@ BENCH_FLAGS ?= --benchmark_repetitions=7 --benchmark_min_time=0.05 \
 LOOP_SECONDS ?= 5
 LOOP_PAMINSA_SECONDS ?= 2
 
-$(BENCH_BUILD)/build.ninja: | $(VENV)/.stamp-venv
+$(BENCH_BUILD)/build.ninja: | $(VENV)/.stamp-venv $(VENV)/.stamp-apt
 	$(VENV)/bin/cmake -S . -B $(BENCH_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release \
 	  -DCMAKE_MAKE_PROGRAM=$(abspath $(VENV)/bin/ninja) -DMECHBAL_BUILD_TESTS=OFF \
 	  -DMECHBAL_BUILD_BENCH=ON

@@ -4,6 +4,8 @@ Exit codes: 0 success; 2 a user's mistake (bad case file or value, bad output fo
 arguments), reported as one line ``mechbal: error: ...`` naming the field or path; 3 an internal
 error (a bug in mechbal), reported as one line with a request to report it (set
 ``MECHBAL_DEBUG=1`` for the traceback); 130 interrupted. No traceback is ever shown otherwise.
+
+Layer: command line (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -12,14 +14,11 @@ import contextlib
 import io
 import json
 import os
-import stat
 import sys
 from pathlib import Path
 
-from mechbal.config import ConfigError
+from mechbal.config import MAX_CASE_BYTES, ConfigError, check_case_file  # noqa: F401 (re-exported)
 
-#: refuse case files larger than this (a case is a few kB; anything huge is a mistake)
-MAX_CASE_BYTES = 4 * 1024 * 1024
 ISSUES_HINT = ("this is a bug in mechbal: please report it with the command line and the case "
                "file (MECHBAL_DEBUG=1 shows the traceback)")
 
@@ -31,52 +30,27 @@ class UserError(Exception):
 # ---- commands ---------------------------------------------------------------------------------
 
 def _cmd_cases(args) -> int:
-    from mechbal.cases import DEFAULT_CASE, available
+    from mechbal.cases import available, default_case
 
-    for name, kind, title in available():
-        mark = " (default)" if name == DEFAULT_CASE else ""
-        print(f"{name:16s} {kind:14s} {title}{mark}")
+    default = default_case()
+    rows = available()
+    _print_table([(name, kind, title + (" (default)" if name == default else "")) for name, kind, title in rows])
     return 0
 
 
-def check_case_file(name_or_path: str) -> Path:
-    """Path of the case after the checks that the TOML reader does not do: a regular file, not a
-    folder, of reasonable size, UTF-8 text, valid TOML of reasonable nesting (raises
-    :class:`ConfigError` naming the path)."""
-    from mechbal.config import case_path, tomllib
+def _print_table(rows: list[tuple[str, str, str]]) -> None:
+    """Rows of (name, kind, title), the first two columns as wide as their longest entry."""
+    w0 = max((len(r[0]) for r in rows), default=0)
+    w1 = max((len(r[1]) for r in rows), default=0)
+    for name, kind, title in rows:
+        print(f"{name:{w0}s}  {kind:{w1}s}  {title}".rstrip())
 
-    path = case_path(name_or_path)  # ConfigError for an unknown built-in name or a missing file
-    try:
-        st = path.stat()
-    except OSError as exc:
-        raise ConfigError("case", f"cannot be read: {exc.strerror}", str(path)) from None
-    if stat.S_ISDIR(st.st_mode):
-        raise ConfigError("case", "is a folder, not a case file", str(path))
-    if not stat.S_ISREG(st.st_mode):
-        raise ConfigError("case", "is not a regular file (a device, pipe or socket)", str(path))
-    if st.st_size > MAX_CASE_BYTES:
-        raise ConfigError("case", f"is {st.st_size} bytes, more than a case file can be "
-                                  f"({MAX_CASE_BYTES} bytes)", str(path))
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise ConfigError("case", f"cannot be read: {exc.strerror}", str(path)) from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = raw[:exc.start].count(b"\n") + 1
-        raise ConfigError(str(path), f"is not UTF-8 text (byte 0x{raw[exc.start]:02x} on line "
-                                     f"{line}): save it as UTF-8", has_value=False) from None
-    if path.suffix.lower() == ".urdf":
-        return path  # XML: the URDF reader checks it
-    try:
-        tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(str(path), f"is not valid TOML: {exc}", has_value=False) from None
-    except RecursionError:
-        raise ConfigError(str(path), "nests arrays or tables too deeply to be a case file",
-                          has_value=False) from None
-    return path
+
+def _cmd_sweeps(args) -> int:
+    from mechbal.sweep.config import available
+
+    _print_table(available())
+    return 0
 
 
 def _cmd_run(args) -> int:
@@ -130,11 +104,11 @@ def _cmd_balance(args) -> int:
 
 
 def _cmd_demo(args) -> int:
-    from mechbal.cases import DEFAULT_CASE
+    from mechbal.cases import default_case
 
-    args.case = DEFAULT_CASE
+    args.case = default_case()
     if not args.quiet:
-        print(f"mechbal demo: running the default case '{DEFAULT_CASE}'")
+        print(f"mechbal demo: running the default case '{args.case}'")
     return _cmd_run(args)
 
 
@@ -185,6 +159,10 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     s = sub.add_parser("cases", help="list the built-in case studies")
     s.set_defaults(func=_cmd_cases)
+    s = sub.add_parser("sweeps", help="list the built-in sweep files (mechbal sweep CASE --spec NAME)",
+                       description="List the built-in sweep files: name, kind and title. Run one with "
+                                   "'mechbal sweep CASE --spec NAME --out DIR'.")
+    s.set_defaults(func=_cmd_sweeps)
     quiet = dict(action="store_true",
                  help="no progress bar and no tables: only warnings and errors (on stderr)")
     s = sub.add_parser("run", help="run a case study (built-in name or TOML file)",
@@ -220,7 +198,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=_cmd_balance)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")
-    s.add_argument("--out", default="out/demo", metavar="DIR", help="output folder")
+    s.add_argument("--out", default="out/demo", metavar="DIR", help="output folder (default: out/demo)")
     s.add_argument("-q", "--quiet", **quiet)
     s.set_defaults(func=_cmd_demo)
     s = sub.add_parser("sweep", help="sensitivity, tolerance Monte Carlo or grid over a case",
@@ -230,8 +208,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("case", help="built-in case name or path to a TOML or URDF file")
     s.add_argument("--spec", required=True, metavar="SWEEP", help="sweep file (TOML with [sweep]) or built-in sweep name")
     s.add_argument("--out", default="out/sweep", metavar="DIR", help="output folder (default: out/sweep)")
-    s.add_argument("--backend", choices=("serial", "processes", "dask"), default="processes",
-                   help="serial; processes: every local core (default); dask: a cluster (--scheduler)")
+    s.add_argument("--backend", choices=("auto", "serial", "processes", "dask"), default="auto",
+                   help="auto (default): serial unless the sweep would take more than a few seconds "
+                        "in one process, then every local core; serial; processes: every local core; "
+                        "dask: a cluster (--scheduler)")
     s.add_argument("--workers", type=int, metavar="N", help="processes: number of local processes (default: all cores)")
     s.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 (implies --backend dask)")
     s.add_argument("-q", "--quiet", **quiet)
@@ -241,8 +221,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "run with 'mechbal run my.toml'.")
     s.add_argument("kind", choices=("serial", "linkage", "reactionless"),
                    help="serial: a serial chain (joints, links, trajectory); linkage: a closed "
-                        "loop (four-bar with a counterweight), not available yet; reactionless: "
-                        "an arm with a reaction wheel under the reactionless controller")
+                        "loop (four-bar with a counterweight); reactionless: an arm with a "
+                        "reaction wheel under the reactionless controller ([control] table)")
     s.set_defaults(func=_cmd_init)
     return p
 

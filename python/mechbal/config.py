@@ -6,10 +6,13 @@ error is a :class:`ConfigError` naming the offending field by its dotted path (f
 ``mechanism.joints[1].link.mass``) and the value found, and nothing is half-built: models are only
 constructed once every field has been read and checked. The helpers here (``number``, ``vector``,
 ...) remain for code that checks values outside case files.
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
 import math
+import stat
 import sys
 from pathlib import Path
 from typing import Any, Mapping
@@ -21,7 +24,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-CASES_DIR = Path(__file__).resolve().parent / "cases"
+from mechbal.registry import GENERAL_CASES_DIR as CASES_DIR, case_dirs  # noqa: E402
 
 
 from mechbal.errors import ConfigError, ConfigWarning, short_repr  # noqa: F401 (re-exported)
@@ -125,6 +128,16 @@ def read_toml(path: str | Path) -> dict:
         raise ConfigError(str(path), f"is not valid TOML: {exc}", has_value=False) from None
 
 
+def builtin_cases() -> dict[str, Path]:
+    """Every built-in case file by name: the general cases and each paper's (the registry's
+    folders, :mod:`mechbal.registry`)."""
+    out: dict[str, Path] = {}
+    for d in case_dirs():
+        for p in sorted(d.glob("*.toml")):
+            out.setdefault(p.stem, p)
+    return dict(sorted(out.items()))
+
+
 def case_path(name_or_path: str | Path) -> Path:
     """Path of a built-in case by name (``arm2link``) or of a user TOML file."""
     p = Path(name_or_path)
@@ -132,11 +145,52 @@ def case_path(name_or_path: str | Path) -> Path:
         if not p.exists():
             raise ConfigError("case", "file not found", str(p))
         return p
-    builtin = CASES_DIR / f"{name_or_path}.toml"
-    if not builtin.exists():
-        names = ", ".join(sorted(x.stem for x in CASES_DIR.glob("*.toml")))
-        raise ConfigError("case", f"no such built-in case (available: {names})", str(name_or_path))
-    return builtin
+    builtin = builtin_cases()
+    if str(name_or_path) not in builtin:
+        raise ConfigError("case", f"no such built-in case (available: {', '.join(builtin)})", str(name_or_path))
+    return builtin[str(name_or_path)]
+
+
+#: refuse case files larger than this (a case is a few kB; anything huge is a mistake)
+MAX_CASE_BYTES = 4 * 1024 * 1024
+
+
+def check_case_file(name_or_path: str) -> Path:
+    """Path of the case after the checks that the TOML reader does not do: a regular file, not a
+    folder, of reasonable size, UTF-8 text, valid TOML of reasonable nesting (raises
+    :class:`ConfigError` naming the path)."""
+    path = case_path(name_or_path)  # ConfigError for an unknown built-in name or a missing file
+    try:
+        st = path.stat()
+    except OSError as exc:
+        raise ConfigError("case", f"cannot be read: {exc.strerror}", str(path)) from None
+    if stat.S_ISDIR(st.st_mode):
+        raise ConfigError("case", "is a folder, not a case file", str(path))
+    if not stat.S_ISREG(st.st_mode):
+        raise ConfigError("case", "is not a regular file (a device, pipe or socket)", str(path))
+    if st.st_size > MAX_CASE_BYTES:
+        raise ConfigError("case", f"is {st.st_size} bytes, more than a case file can be "
+                                  f"({MAX_CASE_BYTES} bytes)", str(path))
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ConfigError("case", f"cannot be read: {exc.strerror}", str(path)) from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise ConfigError(str(path), f"is not UTF-8 text (byte 0x{raw[exc.start]:02x} on line "
+                                     f"{line}): save it as UTF-8", has_value=False) from None
+    if path.suffix.lower() == ".urdf":
+        return path  # XML: the URDF reader checks it
+    try:
+        tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(str(path), f"is not valid TOML: {exc}", has_value=False) from None
+    except RecursionError:
+        raise ConfigError(str(path), "nests arrays or tables too deeply to be a case file",
+                          has_value=False) from None
+    return path
 
 
 def load_case(name_or_path: str | Path) -> dict:

@@ -36,6 +36,8 @@ The dynamics back ends a :class:`ComputedTorque` computes over are here too:
 `MechanismDynamics` (the general model, any mechanism, closed loops included),
 `RneChainDynamics` and `KdlChainDynamics` (serial chains), and the papers' closed forms in
 `mechbal.papers`.
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -159,9 +161,9 @@ class ComputedTorque(_core.ComputedTorque):
         kp: proportional gains [1/s^2], one per joint.
         kd: derivative gains [1/s], one per joint.
         torque_limit: |tau| limit per joint [N m or N] (default and +inf: 1e4).
-        max_position, max_speed, max_acceleration: the input range of a tick (|q| [rad or m],
-            |qd|, |qdd_des|); beyond it the tick holds the last command with
-            ``Status.out_of_range``.
+        **input_range: ``max_position``, ``max_speed``, ``max_acceleration``: the input range of a
+            tick (|q| [rad or m], |qd|, |qdd_des|); beyond it the tick holds the last command
+            with ``Status.out_of_range``.
         q_guess: with a closed-loop Mechanism, every joint coordinate near the assembly [rad or
             m] (picks the assembly mode the loop solve follows; default zeros).
 
@@ -193,8 +195,12 @@ class DecoupledJointController(_core.DecoupledJointController):
 
     Args:
         k: the constant diagonal of the mass matrix [kg m^2 or kg], one per joint.
-        kp: proportional gains [1/s^2]; kd: derivative gains [1/s].
-        torque_limit, max_position, max_speed, max_acceleration: as :class:`ComputedTorque`.
+        kp: proportional gains [1/s^2].
+        kd: derivative gains [1/s].
+        torque_limit: as :class:`ComputedTorque`.
+
+    The keywords ``max_position``, ``max_speed`` and ``max_acceleration`` bound the input of a
+    tick as for :class:`ComputedTorque`.
     """
 
     def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
@@ -215,8 +221,9 @@ class ReactionlessWrist(_core.ReactionlessWrist):
     about O stays ``target_momentum``, which makes the shaking moment zero.
 
     Args:
-        J1, J2, J3: inertia matrices of the three wrist links about their centres [kg m^2]
-            (3, 3), link frames.
+        J1: inertia matrix of the first wrist link about its centre [kg m^2] (3, 3), link frame.
+        J2: the same for the second wrist link.
+        J3: the same for the third wrist link.
         config: :class:`ReactionlessWristConfig` (rate [Hz], integrator, limits, damping).
         initial_angles: wrist angles at the start [rad] (3,).
         target_momentum: H_target [kg m^2/s] (3,), usually D at the rest the motion starts from.

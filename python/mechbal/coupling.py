@@ -25,6 +25,8 @@ one with A° = 1). The per-tick C++ evaluator of the paper's form is
 ``mechbal::CoupledProjection``); this module is its independent Python reference
 (mechbal.papers.discs.fivebar_model) and builds the two-stage model of the paper (arm model
 first, then discs coupled to it) that cross-checks the general model's single-stage form.
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -1,5 +1,7 @@
 """The configuration's error and warning types (shared by config, schema and spec, which import
-each other lazily; this module imports nothing of mechbal)."""
+each other lazily; this module imports nothing of mechbal).
+
+Layer: Python core (docs/architecture.md)."""
 from __future__ import annotations
 
 from typing import Any

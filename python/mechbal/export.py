@@ -9,6 +9,8 @@ From these arrays alone the shaking wrench can be recomputed by finite differenc
 
 ``summary.json`` is strict JSON (:func:`write_summary`): non-finite numbers are written as null and
 listed under ``non_finite_values``.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

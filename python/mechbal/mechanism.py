@@ -12,6 +12,8 @@ zeros, never garbage.
 
 Units: SI throughout (m, kg, kg m^2, rad, N, N m); world quantities in the base frame O; moments
 and angular momenta about O's origin.
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 

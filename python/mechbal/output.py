@@ -11,6 +11,8 @@ beside the new ones). The output path is checked before any computation:
 - the folder that will hold ``DIR`` must be writable (checked by creating the temporary folder).
 
 Every refusal is an :class:`OutputError` whose message names the path and the reason.
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -8,6 +8,8 @@ terminal that does not say it is one).
 - :func:`run_bar` / :func:`stage`: one bar per case run, advanced by the runner at each stage
   ("sizing counterweights", "simulating", "plots", ...);
 - :func:`track`: wraps a loop whose length is known (sweeps, per-tick Python loops).
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 

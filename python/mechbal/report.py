@@ -1,4 +1,12 @@
-"""Reports: plots (matplotlib, Agg) and terminal tables."""
+"""Reports: plots (matplotlib, Agg) and terminal tables.
+
+Plots follow three rules. A panel whose every series stays below :data:`ROUNDOFF_FLOOR` (SI units:
+N, N m, rad, ...) is round-off, not a signal: it is drawn as a flat zero marked "0 (below 1e-12)"
+instead of being autoscaled to look like one. A wrench plot shows only the components that carry a
+signal, and its caption names those left out. A legend is drawn only when it tells series apart
+(two or more); a single series is named in the title or caption.
+
+Layer: Python core (docs/architecture.md)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -23,6 +31,29 @@ _STYLES = [dict(linestyle="-", linewidth=2.6), dict(linestyle="--", linewidth=1.
            dict(linestyle=(0, (5, 1, 1, 1)), linewidth=1.1)]
 
 
+#: the largest value still drawn as round-off zero (absolute, in the plotted SI unit)
+ROUNDOFF_FLOOR = 1e-12
+
+
+def _is_roundoff(*arrays: np.ndarray) -> bool:
+    """Every finite value of every array is below :data:`ROUNDOFF_FLOOR` in magnitude."""
+    for a in arrays:
+        a = np.asarray(a, float)
+        finite = a[np.isfinite(a)]
+        if finite.size and np.max(np.abs(finite)) >= ROUNDOFF_FLOOR:
+            return False
+    return True
+
+
+def _zero_panel(ax) -> None:
+    """A panel whose series are all round-off: a fixed scale and the note, not an autoscale."""
+    for line in ax.get_lines():
+        line.set_ydata(np.zeros_like(np.asarray(line.get_ydata(), float)))
+    ax.set_ylim(-1.0, 1.0)
+    ax.text(0.5, 0.5, f"0 (below {ROUNDOFF_FLOOR:g})", transform=ax.transAxes, ha="center",
+            va="center", fontsize=10, color="0.3")
+
+
 def _style(i: int) -> dict:
     return dict(_STYLES[i % len(_STYLES)], zorder=2 + i)
 
@@ -42,13 +73,13 @@ def _finish(plt, fig, axes, path: str | Path, title: str, caption: str) -> Path:
     top = 0.96 if title else 0.995
     if title:
         fig.suptitle(title, y=0.995, va="top", fontsize=12)
-    if len(labels) > 1 or labels and not labels[0].startswith("_"):
+    if len(labels) > 1:
         fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, top),
                    ncol=min(len(labels), 4), fontsize=9, frameon=False)
         top -= 0.035 * (1 + (len(labels) - 1) // 4) * (6.5 / fig.get_figheight())
     bottom = 0.0
     if caption:
-        width = int(fig.get_figwidth() * 17)
+        width = int(fig.get_figwidth() * 14)   # characters of 8.5 pt per inch, with a margin
         text = "\n".join(textwrap.wrap(caption, width))
         fig.text(0.01, 0.005, text, ha="left", va="bottom", fontsize=8.5, color="0.25")
         bottom = (0.03 + 0.022 * text.count("\n")) * (6.5 / fig.get_figheight())
@@ -64,24 +95,43 @@ def plot_wrench(path: str | Path, t: np.ndarray,
                 variants: Mapping[str, tuple[np.ndarray, np.ndarray]], title: str = "",
                 caption: str = "", force: str = "shaking force",
                 moment: str = "shaking moment") -> Path:
-    """Force x, y, z (top row) [N] and moment x, y, z (bottom row) [N m], one line per variant
-    (successive variants dashed, dotted, ... over the previous ones)."""
+    """Force x, y, z [N] and moment x, y, z [N m], one line per variant (successive variants
+    dashed, dotted, ... over the previous ones), one panel per component that carries a signal in
+    some variant; the components that are round-off (below :data:`ROUNDOFF_FLOOR`) in every
+    variant are named in the caption instead of drawn (a planar case: force z, moment x, y)."""
     plt = _pyplot()
-    fig, axes = plt.subplots(2, 3, figsize=(13, 6.8), sharex=True)
-    for i, (name, (F, M)) in enumerate(variants.items()):
-        for k in range(3):
-            axes[0, k].plot(t, F[:, k], label=name, **_style(i))
-            axes[1, k].plot(t, M[:, k], label=name, **_style(i))
-    for k, axis in enumerate("xyz"):
-        axes[0, k].set_title(f"{force} {axis}", fontsize=10)
-        axes[1, k].set_title(f"{moment} {axis}", fontsize=10)
-        axes[0, k].set_ylabel("force [N]")
-        axes[1, k].set_ylabel("moment [N m]")
-        for r in range(2):
-            axes[r, k].set_xlabel("t [s]")
-            axes[r, k].xaxis.set_tick_params(labelbottom=True)
-            axes[r, k].grid(True, alpha=0.3)
-    return _finish(plt, fig, axes.ravel(), path, title, caption)
+    comps = [(f"{force} {axis}", "force [N]", 0, k) for k, axis in enumerate("xyz")] + \
+        [(f"{moment} {axis}", "moment [N m]", 1, k) for k, axis in enumerate("xyz")]
+    shown, zero = [], []
+    for c in comps:
+        (zero if _is_roundoff(*(v[c[2]][:, c[3]] for v in variants.values())) else shown).append(c)
+    if not shown:   # everything balanced to round-off: one panel says so
+        shown = comps[:1]
+    left_out = [c for c in zero if c not in shown]
+    if left_out:
+        caption = (f"{caption} " if caption else "") + (
+            ", ".join(c[0] for c in left_out) + f": 0 (below {ROUNDOFF_FLOOR:g}) in every variant, not drawn.")
+    # forces on the first row, moments on the second (a row only when it has a panel)
+    by_row = [[c for c in shown if c[2] == r] for r in (0, 1)]
+    by_row = [r for r in by_row if r]
+    cols = max(len(r) for r in by_row)
+    fig, axes = plt.subplots(len(by_row), cols, figsize=(4.4 * cols + 0.2, 3.2 * len(by_row) + 0.4),
+                             sharex=True, squeeze=False)
+    slots = [axes[i, j] for i, r in enumerate(by_row) for j in range(len(r))]
+    shown = [c for r in by_row for c in r]
+    for ax in axes.ravel():
+        ax.set_visible(any(ax is s for s in slots))
+    for ax, (name, ylabel, row, k) in zip(slots, shown):
+        for i, (vname, FM) in enumerate(variants.items()):
+            ax.plot(t, FM[row][:, k], label=vname, **_style(i))
+        ax.set_title(name, fontsize=10)
+        ax.set_ylabel(ylabel)
+        ax.set_xlabel("t [s]")
+        ax.xaxis.set_tick_params(labelbottom=True)
+        ax.grid(True, alpha=0.3)
+        if (name, ylabel, row, k) in zero:
+            _zero_panel(ax)
+    return _finish(plt, fig, slots, path, title, caption)
 
 
 def plot_series(path: str | Path, t: np.ndarray, series: Mapping[str, np.ndarray],
@@ -111,6 +161,8 @@ def plot_series(path: str | Path, t: np.ndarray, series: Mapping[str, np.ndarray
         flat[k].set_ylabel(ylabels[k])
         flat[k].grid(True, alpha=0.3)
         flat[k].xaxis.set_tick_params(labelbottom=True)
+        if _is_roundoff(*(np.asarray(y).reshape(len(t), -1)[:, k] for y in series.values())):
+            _zero_panel(flat[k])
     for ax in flat[n:]:
         ax.set_visible(False)
     return _finish(plt, fig, flat[:n], path, title, caption)

@@ -8,6 +8,8 @@
   trajectory (open loop).
 
 Units: SI (s, rad or m, rad/s or m/s, N m or N).
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -101,7 +103,8 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
         trajectory: any :mod:`mechbal.trajectory` object, evaluated at the simulation time
             t = 0 .. duration [s]. A rest-to-rest trajectory runs on the C++ path; any other is
             sampled every dt/2 first.
-        q0, qd0: initial state [rad or m, rad/s or m/s]; default: the trajectory at t = 0.
+        q0: initial positions [rad or m]; default: the trajectory at t = 0.
+        qd0: initial velocities [rad/s or m/s]; default: the trajectory at t = 0.
         dt: controller period = RK4 step [s].
         duration: simulated time [s]; default the trajectory's ``end_time`` (or ``duration``).
         sampling: ``"zero_order_hold"`` (a digital controller: the torque of tick k is held over

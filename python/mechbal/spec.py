@@ -28,6 +28,8 @@ from. Everything the TOML format lets a user say in several ways is settled here
 Cross references are checked with errors naming the field: unknown parent, mimic joint, body
 link or frame link (with the nearest name), duplicate names, cycles, a mimic of a fixed joint, of
 itself or of another mimic.
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -185,7 +187,7 @@ class MechanismSpec:
 
 
 def _hint(word: str, allowed: list[str]) -> str:
-    from mechbal.schema import did_you_mean
+    from mechbal.tables import did_you_mean
 
     return did_you_mean(word, allowed)
 
@@ -197,8 +199,8 @@ def _move_body(T: np.ndarray, com: np.ndarray, inertia: np.ndarray) -> tuple[np.
 
 def mechanism_spec(mechanism: Any, field: str = "mechanism") -> MechanismSpec:
     """The :class:`MechanismSpec` of a ``[mechanism]`` table (a dict, validated here, or a
-    validated :class:`mechbal.schema.Mechanism`); ConfigError naming the field otherwise."""
-    from mechbal.schema import Mechanism, inertia_matrix, validate_table
+    validated :class:`mechbal.tables.Mechanism`); ConfigError naming the field otherwise."""
+    from mechbal.tables import Mechanism, inertia_matrix, validate_table
 
     m = mechanism if isinstance(mechanism, Mechanism) else validate_table(Mechanism, mechanism, field)
     base = transform_xyz_rpy(m.base.xyz, m.base.rpy) if m.base is not None else np.eye(4)

@@ -1,5 +1,7 @@
 """Commented case templates printed by ``mechbal init KIND`` (a starting point to edit, accepted
-as is by ``mechbal run``; the tests run them)."""
+as is by ``mechbal run``; the tests run them).
+
+Layer: Python core (docs/architecture.md)."""
 
 SERIAL = '''\
 # A mechbal case: a serial chain (here a two-link arm in the vertical x-z plane) moving along a
@@ -53,8 +55,7 @@ duration = 1.0                # s
 samples = 501                 # instants evaluated (at least 3)
 '''
 
-LINKAGE = '''\
-# A mechbal case: a closed linkage (here a four-bar in the vertical x-z plane with a
+LINKAGE = r'''# A mechbal case: a closed linkage (here a four-bar in the vertical x-z plane with a
 # counterweight on its crank) moving along a rest-to-rest motion of its actuated joint. Run it with
 #     mechbal run my.toml --out out/my
 # to get out/my/summary.json (peak shaking force and moment, actuator and base-reaction torques),

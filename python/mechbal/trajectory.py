@@ -18,6 +18,8 @@ last point at rest (zero velocity and acceleration), as the C++ ``RestToRestTraj
 
 All of them are accepted by `mechbal.simulate.closed_loop`; a `RestToRest` runs on the C++ path
 directly, the others are sampled every `dt / 2` first.
+
+Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -83,7 +85,8 @@ class RestToRest:
     ``q(t) = start + (end - start) s(t / duration)``.
 
     Args:
-        start, end: positions [rad or m], one per coordinate.
+        start: initial positions [rad or m], one per coordinate.
+        end: final positions [rad or m], one per coordinate.
         duration: motion time [s], > 0.
         law: ``"quintic"`` (zero velocity and acceleration at both ends) or ``"cubic"``
             (minimum energy: least integral of squared acceleration; its acceleration jumps at

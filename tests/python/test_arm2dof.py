@@ -337,9 +337,9 @@ def test_case_bodies_files_follow_the_schema(arm2dof_run):
 
 def test_case_config_errors_name_the_field(tmp_path):
     from mechbal.cases import run_case
-    from mechbal.config import CASES_DIR, ConfigError
+    from mechbal.config import ConfigError, case_path
 
-    text = (CASES_DIR / "arm2dof.toml").read_text()
+    text = case_path("arm2dof").read_text()
     for old, new, field in (("m1 = 2.5", "m1 = -2.5", "arm.m1"),
                             ("kp = [100.0, 100.0]", "kp = [100.0]", "controller.kp")):
         bad = tmp_path / f"bad_{field}.toml"

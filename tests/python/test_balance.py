@@ -231,7 +231,7 @@ def test_force_paminsa_counterweights_from_the_momentum_regressor():
     Without the identical-legs tie the system is rank-deficient: legs 1 and 2 share an actuator, so
     combinations of their counterweights move no momentum (the paper's design is one member of
     that family)."""
-    from mechbal.cases.paminsa import parameters_from_config
+    from mechbal.papers.paminsa.runner import parameters_from_config
     from mechbal.config import case_path, read_toml
     from mechbal.papers.paminsa import paminsa_mechanism
     from mechbal.schema import validate_case

@@ -190,7 +190,7 @@ DISC_CASES = {"planar3r": "discs-3r", "spatial3r": "discs-spatial", "scara": "sc
 
 
 def params(kind):
-    from mechbal.cases.discs import parameters_from_config
+    from mechbal.papers.discs.runner import parameters_from_config
 
     return parameters_from_config(kind, load_case(DISC_CASES.get(kind, "five-bar")))
 
@@ -385,7 +385,7 @@ def test_rpsp_force_reproduces_eqs_29_31_and_its_toml_runs(tmp_path):
     data = tomllib.loads((out / "balanced.toml").read_text())
     assert data["case"]["kind"] == "rpsp" and "balance" not in data
     assert sum(x["name"] == "P_1" for x in data["mechanism"]["bodies"]) == 1   # replaced, not added
-    from mechbal.cases import rpsp as runner
+    from mechbal.papers.rpsp import runner as runner
 
     written = validate_case(data, warn=False)
     mech = Mechanism.from_spec(runner.driven_by_platform(written.spec, written.motion.platform))

@@ -342,3 +342,36 @@ def test_progress_track_is_transparent(monkeypatch):
         assert not progress.enabled()
     finally:
         progress.configure(quiet=False)
+
+
+def test_init_linkage_template_keeps_its_drawing(capsys):
+    # the ASCII drawing's backslashes end lines: they must not join them
+    assert main(["init", "linkage"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert "#            /         \\" in lines and "#        /                 \\" in lines
+    assert lines[0].startswith("# A mechbal case")
+
+
+def test_cases_and_sweeps_print_aligned_columns(capsys):
+    from mechbal.cases import available
+    from mechbal.sweep.config import available as sweeps
+
+    for cmd, rows in (("cases", available()), ("sweeps", sweeps())):
+        assert main([cmd]) == 0
+        out = capsys.readouterr().out.splitlines()
+        assert len(out) == len(rows) and rows
+        # every kind starts in the same column, whatever the length of the name
+        starts = {line.index(kind, len(name)) for line, (name, kind, _) in zip(out, rows)}
+        assert len(starts) == 1, out
+    names = [n for n, _, _ in sweeps()]
+    assert "arm2link-balanced-tolerance" in names and "paminsa-tolerance" in names
+
+
+def test_help_of_init_and_demo_says_what_they_do(capsys):
+    with pytest.raises(SystemExit):
+        main(["init", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "not available yet" not in text and "linkage: a closed loop" in text
+    with pytest.raises(SystemExit):
+        main(["demo", "--help"])
+    assert "default: out/demo" in capsys.readouterr().out

@@ -10,7 +10,7 @@ import pytest
 
 from mechbal import _core
 from mechbal import coupling as cp
-from mechbal.cases.discs import parameters_from_config
+from mechbal.papers.discs.runner import parameters_from_config
 from mechbal.config import ConfigError, load_case
 from mechbal.papers import discs as dz
 

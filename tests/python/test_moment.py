@@ -14,7 +14,7 @@ import mechbal
 from mechbal import _core
 from mechbal.balance import DiscSlot, InertiaSlot
 from mechbal.balance import moment
-from mechbal.cases.discs import parameters_from_config
+from mechbal.papers.discs.runner import parameters_from_config
 from mechbal.config import load_case
 from mechbal.papers import discs as dz
 

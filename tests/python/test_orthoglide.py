@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from mechbal.balance.springs import load_catalogue, select_springs
-from mechbal.cases import orthoglide as og
+from mechbal.papers.orthoglide import runner as og
 from mechbal.config import ConfigError, load_case
 from mechbal.papers import orthoglide as paper
 from mechbal.schema import validate_case
@@ -287,7 +287,7 @@ def test_table6_runs_through_the_sweep_api():
     the static loads computed directly with the changed mass, rate or anchor."""
     import numpy as np
 
-    from mechbal.cases import orthoglide as og
+    from mechbal.papers.orthoglide import runner as og
     from mechbal.config import case_path, read_toml
     from mechbal.schema import validate_case
 

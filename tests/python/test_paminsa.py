@@ -115,7 +115,7 @@ def test_summary_schema(paminsa_run):
 # ---------------------------------------------------------------------------- counterweights
 @pytest.fixture(scope="module")
 def params():
-    from mechbal.cases.paminsa import parameters_from_config
+    from mechbal.papers.paminsa.runner import parameters_from_config
 
     return parameters_from_config(load_case("paminsa"))
 
@@ -139,7 +139,7 @@ def test_runner_sizes_by_the_general_method_and_reports_the_closed_form(paminsa_
 def test_runner_refuses_slots_that_disagree_with_the_closed_form():
     """Slots no longer at the paper's points (here CP2 off F): the general method balances another
     design, which the closed form does not check: the runner stops and says why."""
-    from mechbal.cases.paminsa import check_against_closed_form, general_counterweights
+    from mechbal.papers.paminsa.runner import check_against_closed_form, general_counterweights
 
     cfg = load_case("paminsa")
     cfg["balance"]["counterweights"][3]["position"] = [0.2, 0.0, 0.0]
@@ -150,7 +150,7 @@ def test_runner_refuses_slots_that_disagree_with_the_closed_form():
 
 
 def parameters_of(cfg):
-    from mechbal.cases.paminsa import parameters_from_config
+    from mechbal.papers.paminsa.runner import parameters_from_config
 
     return parameters_from_config(cfg)
 
@@ -242,7 +242,7 @@ def test_bad_parameters_name_the_field(params):
     p.link_mass = [0.622, 0.406, 0.406, -0.1, 0.436, 0.921, 1.2, 0.305]
     with pytest.raises(ValueError, match=r"link_mass\[3\]"):
         _core.PaminsaModel(p)
-    from mechbal.cases.paminsa import parameters_from_config
+    from mechbal.papers.paminsa.runner import parameters_from_config
 
     cfg = load_case("paminsa")
     cfg["masses"]["links"] = cfg["masses"]["links"][:7]
@@ -250,7 +250,7 @@ def test_bad_parameters_name_the_field(params):
         parameters_from_config(cfg)
     cfg = load_case("paminsa")
     cfg["wrist"]["rate_hz"] = -5.0
-    from mechbal.cases.paminsa import wrist_config_from_config
+    from mechbal.papers.paminsa.runner import wrist_config_from_config
 
     with pytest.raises(ConfigError, match=r"wrist.rate_hz"):
         wrist_config_from_config(cfg)

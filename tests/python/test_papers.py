@@ -12,8 +12,8 @@ import pytest
 import mechbal
 from mechbal import _core
 from mechbal import coupling as cp
-from mechbal.cases.arm2dof import arm_from_config
-from mechbal.cases.discs import _disc_bodies, parameters_from_config
+from mechbal.papers.arm2dof.runner import arm_from_config
+from mechbal.papers.discs.runner import _disc_bodies, parameters_from_config
 from mechbal.config import load_case
 from mechbal.papers import arm2dof_mechanism, disc_arm_mechanism, disc_design_mechanism
 from mechbal.papers import discs as dz

@@ -1,5 +1,5 @@
 """The existing closed loops as data (issue 10): the five-bar of the discs case and PAMINSA on the
-general model (mechbal.papers.five_bar, mechbal.papers.paminsa: trees + loop closures, solved by
+general model (mechbal.papers.discs.five_bar, mechbal.papers.paminsa: trees + loop closures, solved by
 the general loop solve) against their closed forms (FiveBarDynamics and the discs runner's
 five-bar motion; PaminsaModel / paminsa_kinematics), to 1e-10 relative along the cases'
 trajectories; and the shipped TOML files are exactly what the generators produce."""
@@ -8,12 +8,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+
+from mechbal.config import case_path
 import pytest
 
 from mechbal import Mechanism, _core
 from mechbal.config import load_case
 
-CASES_DIR = Path(__file__).resolve().parents[2] / "python/mechbal/cases"
 TOL = 1e-10
 _ROTATIONAL = ("rotation", "angular_velocity", "angular_acceleration")
 _MOTION = ("com", "com_velocity", "com_acceleration") + _ROTATIONAL
@@ -52,8 +53,8 @@ def _compare_bodies(mech: Mechanism, motion, closed: dict, names, inertia) -> di
 # five-bar
 # ------------------------------------------------------------------------------------------------
 def _five_bar_run(balanced: bool):
-    from mechbal.cases.discs import _disc_bodies, _torques, parameters_from_config
-    from mechbal.papers.five_bar import five_bar_design_mechanism, five_bar_initial_guess
+    from mechbal.papers.discs.runner import _disc_bodies, _torques, parameters_from_config
+    from mechbal.papers.discs.five_bar import five_bar_design_mechanism, five_bar_initial_guess
     from mechbal.papers import discs as dz
 
     config = load_case("five-bar")
@@ -106,9 +107,9 @@ def test_five_bar_linkage_toml_is_the_generated_mechanism_and_runs(tmp_path):
 
     from mechbal.cases import run_case
     from mechbal.papers._toml import same_model
-    from mechbal.papers.five_bar import five_bar_case_toml, five_bar_mechanism
+    from mechbal.papers.discs.five_bar import five_bar_case_toml, five_bar_mechanism
 
-    path = CASES_DIR / "five-bar-linkage.toml"
+    path = case_path("five-bar-linkage")
     assert path.read_text() == five_bar_case_toml("five-bar"), "regenerate five-bar-linkage.toml"
     assert same_model(Mechanism.from_toml(path), five_bar_mechanism("five-bar", balanced=True)) == []
     run_case("five-bar-linkage", tmp_path / "out")
@@ -123,7 +124,7 @@ def test_five_bar_linkage_toml_is_the_generated_mechanism_and_runs(tmp_path):
 # PAMINSA
 # ------------------------------------------------------------------------------------------------
 def _paminsa_run(balanced: bool, samples: int = 251):
-    from mechbal.cases.paminsa import parameters_from_config, trajectory_from_config
+    from mechbal.papers.paminsa.runner import parameters_from_config, trajectory_from_config
     from mechbal.papers import paminsa as pp
 
     config = load_case("paminsa")
@@ -213,11 +214,11 @@ def test_paminsa_linkage_toml_is_the_generated_mechanism_and_force_balanced(tmp_
     import json
 
     from mechbal.cases import run_case
-    from mechbal.cases.paminsa import parameters_from_config
+    from mechbal.papers.paminsa.runner import parameters_from_config
     from mechbal.papers._toml import same_model
     from mechbal.papers.paminsa import paminsa_case_toml, paminsa_mechanism
 
-    path = CASES_DIR / "paminsa-linkage.toml"
+    path = case_path("paminsa-linkage")
     assert path.read_text() == paminsa_case_toml("paminsa"), "regenerate paminsa-linkage.toml"
     generated = paminsa_mechanism(parameters_from_config(load_case("paminsa")), balanced=True)
     assert same_model(Mechanism.from_toml(path), generated) == []

@@ -88,3 +88,34 @@ def test_serial_chain_base_reaction_with_gravity(demo_run):
     summary = json.loads((out / "summary.json").read_text())
     assert np.allclose(summary["peak_base_reaction_force_N"]["nominal"], np.abs(R_F).max(axis=0))
     assert (out / "base_reaction.png").stat().st_size > 10_000
+
+
+def test_roundoff_is_drawn_as_zero_not_autoscaled(tmp_path, saved_figures):
+    t = np.linspace(0.0, 1.0, 40)
+    noise = 1e-15 * np.sin(7 * t)[:, None]
+    report.plot_series(tmp_path / "s.png", t, {"balanced": np.hstack([noise, np.sin(t)[:, None]])},
+                       ["joint 1", "joint 2"], "torque [N m]")
+    ax0, ax1 = [a for a in saved_figures[-1].axes if a.get_visible()]
+    assert ax0.get_ylim() == (-1.0, 1.0) and any("below 1e-12" in x.get_text() for x in ax0.texts)
+    assert ax1.get_ylim()[1] < 1.5 and not ax1.texts   # a real signal keeps its scale
+
+
+def test_wrench_plot_shows_only_components_with_a_signal(tmp_path, saved_figures):
+    # a planar mechanism: force x, y and moment z; round-off elsewhere
+    t = np.linspace(0.0, 1.0, 30)
+    F = np.column_stack([np.sin(t), np.cos(t), 1e-14 * t])
+    M = np.column_stack([1e-16 * t, -1e-15 * t, 2 * t])
+    report.plot_wrench(tmp_path / "w.png", t, {"unbalanced": (F, M), "balanced": (1e-13 * F, 1e-13 * M)},
+                       caption="Planar arm.")
+    fig = saved_figures[-1]
+    titles = sorted(a.get_title() for a in fig.axes if a.get_visible())
+    assert titles == ["shaking force x", "shaking force y", "shaking moment z"]
+    caption = " ".join(x.get_text() for x in fig.texts)
+    assert "shaking force z, shaking moment x, shaking moment y: 0 (below 1e-12)" in " ".join(caption.split())
+    assert fig.legends   # two variants: a legend
+
+
+def test_a_single_series_gets_no_legend(tmp_path, saved_figures):
+    t = np.linspace(0.0, 1.0, 10)
+    report.plot_series(tmp_path / "one.png", t, {"general model": np.sin(t)[:, None]}, ["joint 1"], "q [rad]")
+    assert not saved_figures[-1].legends

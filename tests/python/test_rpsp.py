@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from mechbal import _core
-from mechbal.cases import rpsp as runner
+from mechbal.papers.rpsp import runner as runner
 from mechbal.config import ConfigError, load_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from mechbal.mechanism import Mechanism

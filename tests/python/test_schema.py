@@ -10,11 +10,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from mechbal.config import CASES_DIR, ConfigError, load_case
+from mechbal.config import CASES_DIR, ConfigError, builtin_cases, load_case
 from mechbal.errors import ConfigWarning
 from mechbal.schema import KINDS, SCHEMA_FILE, json_schema, schema_text, validate_case
 
-CASE_FILES = sorted(CASES_DIR.glob("*.toml"))
+CASE_FILES = sorted(builtin_cases().values())
 CASES = {p.stem: load_case(p) for p in CASE_FILES}
 
 
@@ -29,7 +29,9 @@ def test_every_shipped_case_validates_without_warnings():
 
 def test_every_shipped_case_points_editors_at_the_schema():
     for p in CASE_FILES:
-        assert p.read_text().splitlines()[0] == "#:schema ./mechbal.schema.json", p
+        first = p.read_text().splitlines()[0]
+        assert first.startswith("#:schema "), p
+        assert (p.parent / first.removeprefix("#:schema ")).resolve() == SCHEMA_FILE.resolve(), p
 
 
 def test_schema_kinds_are_the_runners_kinds():

@@ -338,9 +338,9 @@ def test_builtin_sweep_files_match_the_json_schema():
     jsonschema = pytest.importorskip("jsonschema")
     from mechbal.config import read_toml
     from mechbal.schema import json_schema
-    from mechbal.sweep.config import SWEEPS_DIR
+    from mechbal.sweep.config import builtin_sweeps
 
-    files = sorted(SWEEPS_DIR.glob("*.toml"))
+    files = sorted(builtin_sweeps().values())
     assert len(files) >= 2
     for p in files:
         jsonschema.validate(read_toml(p), json_schema())
@@ -454,10 +454,10 @@ def test_paminsa_counterweight_tolerance_brings_shaking_force_back():
     """The issue's example on PAMINSA as data (38 bodies, 9 loops, geared counter-mass): balanced
     at nominal, +-2 % counterweights bring shaking force back; batched sets equal the linkage
     rebuilt and solved directly."""
-    from mechbal.sweep.config import SWEEPS_DIR, from_toml
+    from mechbal.sweep.config import from_toml
     from mechbal.sweep.parameters import apply_values
 
-    full = from_toml(SWEEPS_DIR / "paminsa-tolerance.toml", "paminsa-linkage")
+    full = from_toml("paminsa-tolerance", "paminsa-linkage")
     assert len(full.parameters) == 10 and full.evaluations == 10_000
     sweep = Sweep(full.base, [Parameter(p.path, tolerance=0.02) for p in full.parameters],
                   ["shaking_force_peak", "actuator_torque_rms"], kind="monte_carlo", evaluations=5,
@@ -499,3 +499,49 @@ def test_a_balancing_method_is_a_metric():
     np.testing.assert_allclose(t["static.cw2"], cw2, rtol=1e-9)
     np.testing.assert_allclose(t["static.cw1"], (m1 * 0.25 + (m2 + cw2) * 0.5) / 0.5, rtol=1e-9)
     assert (t["static.residual"] < 1e-9).all()
+
+
+def test_auto_backend_runs_small_sweeps_serially_and_gives_the_same_table(serial_table, monkeypatch):
+    from mechbal.sweep import backends
+
+    started = []
+
+    def pool(plan, chunks, workers, bar):   # stands in for the local processes, records the hand-over
+        started.append(len(chunks))
+        return [backends.evaluate_chunk(plan, start, values) for start, values in chunks]
+
+    monkeypatch.setattr(backends, "_processes", pool)
+    table = _mixed_sweep().run(progress=False).table   # the default backend is auto
+    assert not started   # 60 evaluations: far below AUTO_SERIAL_SECONDS in one process
+    pd.testing.assert_frame_equal(serial_table, table, check_exact=True)
+    # a sweep judged long from its first chunk hands the rest to local processes
+    monkeypatch.setattr(backends, "AUTO_SERIAL_SECONDS", 0.0)
+    table = _mixed_sweep().run(progress=False, workers=2).table
+    assert started == [7]   # 8 chunks of 8: the first here, seven to the pool
+    pd.testing.assert_frame_equal(serial_table, table, check_exact=True)
+
+
+def test_losing_the_cluster_names_the_finished_evaluations_and_keeps_them():
+    from mechbal.sweep.backends import SweepIncomplete
+
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                       dashboard_address=None, silence_logs=50)
+    client = distributed.Client(cluster, set_as_default=False)
+    done = {}
+
+    def stop_cluster(n, total):
+        if not done:
+            done.update(n=n, total=total)
+            cluster.close()   # every worker and the scheduler gone
+
+    try:
+        with pytest.raises(SweepIncomplete) as e:
+            _mixed_sweep(delay=0.02).run("dask", scheduler=client, progress=False, callback=stop_cluster)
+    finally:
+        client.close()
+        cluster.close()
+    exc = e.value
+    assert exc.rows_total == 60 and 8 <= exc.rows_done < 60
+    assert f"{exc.rows_done} of 60 evaluations were finished" in str(exc)
+    assert sum(len(r["status"]) for _, r in exc.finished) == exc.rows_done
+    assert all(isinstance(r, dict) for _, r in exc.finished)

@@ -1,28 +1,29 @@
-"""Balancing by method, for any mechanism (DESIGN.md, "Balancing is organised by method").
+"""Balancing by method, for any mechanism.
 
 Each method is a module with a function ``balance(mechanism, design, samples) -> BalanceResult``
 over any :class:`mechbal.Mechanism` (serial, tree or closed-loop), built on the C++ regressors:
 
-=========  ==============================  ==================================================
-method     module                          what it makes zero (or least)
-=========  ==============================  ==================================================
-static     :mod:`mechbal.balance.static`   gravity torque over a workspace sample (counterweights)
-force      :mod:`mechbal.balance.force`    shaking force (centre of mass stationary) for all motions
-moment     :mod:`mechbal.balance.moment`   shaking moment (counter-rotating discs, gear ratios)
-springs    :mod:`mechbal.balance.springs`  gravity torque through springs (constant potential energy)
-rms        :mod:`mechbal.balance.rms`      RMS or peak actuator torque over a trajectory
-=========  ==============================  ==================================================
+| method | module | what it makes zero (or least) |
+|---|---|---|
+| static | `mechbal.balance.static` | gravity torque over a workspace sample (counterweights) |
+| force | `mechbal.balance.force` | shaking force (centre of mass stationary) for all motions |
+| moment | `mechbal.balance.moment` | shaking moment (counter-rotating discs, gear ratios) |
+| springs | `mechbal.balance.springs` | gravity torque through springs (constant potential energy) |
+| rms | `mechbal.balance.rms` | RMS or peak actuator torque over a trajectory |
 
 The design variables (which bodies or springs may be added or changed, where, with which bounds
 and mass budget) are :class:`~mechbal.balance.result.CounterweightSlot` /
 :class:`~mechbal.balance.result.SpringSlot` / :class:`~mechbal.balance.result.DiscSlot` /
 :class:`~mechbal.balance.result.InertiaSlot` objects (or the ``[balance]`` table of a case file);
 a result names what limited it (rank, an active bound, an impossibility).
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 
-from mechbal.balance.result import (BalanceResult, CounterweightSlot, DiscSlot, InertiaSlot,  # noqa: F401
-                                    SpringSlot)
+from mechbal.balance.result import BalanceResult, CounterweightSlot, DiscSlot, InertiaSlot, SpringSlot
+
+__all__ = ["METHODS", "BalanceResult", "CounterweightSlot", "DiscSlot", "InertiaSlot", "SpringSlot", "method"]
 
 #: method name -> module path; each module has ``balance(mechanism, design, samples, **options)``
 METHODS = {

@@ -30,7 +30,9 @@ least squares in the masses (Briot & Arakelian's counterweights at the points of
 the same position in each one's own link frame, as identical legs of a parallel mechanism do.
 Their columns are summed (x = E x_group), the bounds are the group's, and the mass budget counts
 each member. Without the tie such a system is often rank-deficient (legs driven by one actuator
-move no momentum along some combinations of their counterweights)."""
+move no momentum along some combinations of their counterweights).
+
+Layer: methods (docs/architecture.md)."""
 from __future__ import annotations
 
 import math

@@ -19,6 +19,8 @@ zero: ``mechbal.papers.paminsa.closed_form_counterweights``, which checks this m
 ``paminsa`` runner), the Heydari & Enferadi extra-linkage counterweights (eqs 29-31, the ``rpsp``
 runner), and the classical conditions of a four-bar (Berkof & Lowen 1969: counterweights on the
 crank and rocker), which the tests reproduce.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -32,6 +32,8 @@ five-bar, docs/discs_derivation.md section 5). Where what remains of a column is
 frame of a link (the base for joint 1 of the planar 3R: ``k1 theta1'`` about x), the result says
 which disc would cancel it: one on that link, geared to that coordinate, with ratio x inertia
 = -remainder.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

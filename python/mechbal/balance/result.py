@@ -1,4 +1,6 @@
-"""Design variables and results shared by every balancing method."""
+"""Design variables and results shared by every balancing method.
+
+Layer: methods (docs/architecture.md)."""
 from __future__ import annotations
 
 import math

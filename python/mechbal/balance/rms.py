@@ -30,6 +30,8 @@ the torques.
 
 Bounds that the optimum sits on are reported in ``limited_by`` (a fixed mass is a choice, not a
 limit); the result is ``exact`` only when no bound stops the optimum.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

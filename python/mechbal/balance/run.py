@@ -1,13 +1,10 @@
 """``mechbal balance CASE --method METHOD --out DIR``: balance a case's mechanism and write the run.
 
 CASE is a TOML case of kind ``mechanism`` / ``serial_chain`` (its ``[mechanism]``, ``[trajectory]``
-and ``[balance]`` tables), the built-in ``paminsa``, disc, ``rpsp`` and ``orthoglide`` cases (kinds
-``paminsa``, ``discs``, ``rpsp`` and ``orthoglide``: :mod:`mechbal.balance.cases`; the Orthoglide's
-``--method springs`` sizes its ``[[springs]]`` over its workspace grid as its runner does), the built-in ``arm2dof`` (its arm as a mechanism with links
-``shoulder`` and ``elbow``, x along each link; the counterweights of ``[counterweights]`` on the
-link extensions unless ``[balance]`` gives others; the minimum-energy cubic law of its
-``[trajectory]``), or a URDF file (with ``--design FILE.toml`` holding a ``[balance]`` table and
-optionally a ``[trajectory]``).
+and ``[balance]`` tables), a case of a kind that a paper registers an adapter for
+(:func:`register_case`, in ``mechbal/papers/<paper>/balance.py``: ``paminsa``, ``discs``, ``rpsp``,
+``orthoglide``, ``arm2dof``; found through :mod:`mechbal.registry`, never imported here), or a URDF
+file (with ``--design FILE.toml`` holding a ``[balance]`` table and optionally a ``[trajectory]``).
 
 DIR receives (all or nothing, :mod:`mechbal.output`): ``summary.json`` (the design, the
 residuals, the bounds and undetermined combinations, and before/after peak and RMS of the gravity
@@ -16,6 +13,8 @@ torque, the actuator torques, the shaking force and the shaking moment along the
 and ``bodies_balanced.npz`` (the schema of :mod:`mechbal.export`), ``balanced.toml`` (a case that
 ``mechbal run`` runs; springs as ``[[mechanism.springs]]``) and, for trees without springs,
 ``balanced.urdf`` (URDF cannot carry springs: summary.json says so instead).
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -23,7 +22,7 @@ import copy
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -62,6 +61,59 @@ class BalanceCase:
     notes: dict | None = None
 
 
+#: what builds the BalanceCase of a validated case, and (optionally) the case written back with the
+#: sized design instead of a ``kind = "mechanism"`` case: ``(cfg, raw, table, design_cfg) ->
+#: BalanceCase`` and ``(bc, result) -> dict | None``
+CaseBuilder = Callable[[Any, Optional[dict], Any, Any], BalanceCase]
+WrittenBack = Callable[[BalanceCase, BalanceResult], Optional[dict]]
+
+
+@dataclass(frozen=True)
+class CaseAdapter:
+    """The ``mechbal balance`` adapter of a case kind that is not general (a paper's)."""
+
+    build: CaseBuilder
+    written_back: WrittenBack | None = None
+
+
+_ADAPTERS: dict[str, CaseAdapter] = {}
+
+
+def register_case(kind: str, *, written_back: WrittenBack | None = None) -> Callable[[CaseBuilder], CaseBuilder]:
+    """Register ``build`` as the ``mechbal balance`` adapter of case kind ``kind`` (a paper's
+    ``balance.py`` does, on import; :mod:`mechbal.registry` imports it when a case is balanced)."""
+    def deco(build: CaseBuilder) -> CaseBuilder:
+        _ADAPTERS[kind] = CaseAdapter(build, written_back)
+        return build
+
+    return deco
+
+
+def case_adapter(kind: str) -> CaseAdapter | None:
+    """The registered adapter of ``kind``, or None."""
+    if kind not in _ADAPTERS:
+        from mechbal.registry import paper_modules
+
+        paper_modules("balance")
+    return _ADAPTERS.get(kind)
+
+
+def design_trajectory(mech, design_cfg, default: dict, guess):
+    """``(t, motion, trajectory_table, guess)`` of an adapter's case: the ``--design`` file's
+    ``[trajectory]`` when it has one (its ``initial_guess`` replacing ``guess``), else ``default``
+    (a ``[trajectory]``-like dict in the actuated joints)."""
+    if design_cfg is not None and design_cfg.trajectory is not None:
+        tr = design_cfg.trajectory
+        g = getattr(tr, "initial_guess", None)
+        guess = guess if g is None else np.array(g, float)
+        t, motion, tt = _trajectory_motion(mech, tr)
+    else:
+        t, motion, tt = _trajectory_motion(mech, default)
+    if guess is not None:
+        tt["initial_guess"] = [float(x) for x in guess]
+    return t, motion, tt, guess
+
+
 def slots_from_table(table, field: str = "balance.counterweights") -> list[CounterweightSlot]:
     """CounterweightSlots of ``[[balance.counterweights]]`` (validated entries)."""
     from mechbal.schema import inertia_matrix
@@ -93,7 +145,7 @@ def _trajectory_motion(mech, tt, law=None, field="trajectory"):
 
 def load_case(case: str, design: str | None = None) -> BalanceCase:
     """Read CASE (and ``--design``) into a :class:`BalanceCase`; ConfigError naming the field."""
-    from mechbal.cli import check_case_file
+    from mechbal.config import check_case_file
     from mechbal.config import load_case as load_toml_case
     from mechbal.mechanism import Mechanism
     from mechbal.schema import Balance, ChainTrajectory, Table, validate_case, validate_table
@@ -139,7 +191,7 @@ def case_from_config(cfg, raw: dict | None = None, design_cfg=None, *, source: s
     balance. ``design_cfg`` (a validated ``--design`` file) replaces the case's ``[balance]`` (and
     its ``[trajectory]`` the case's trajectory). ConfigError for a kind without a general model."""
     from mechbal.mechanism import Mechanism
-    from mechbal.schema import Arm2DofCase, SerialChainCase
+    from mechbal.schema import SerialChainCase
 
     table = design_cfg.balance if design_cfg is not None else getattr(cfg, "balance", None)
     name, title = cfg.case.name, cfg.case.title or cfg.case.name
@@ -152,26 +204,12 @@ def case_from_config(cfg, raw: dict | None = None, design_cfg=None, *, source: s
             tt["initial_guess"] = list(guess)
         return BalanceCase(name, title, mech, table, t, motion, tt,
                            None if guess is None else np.array(guess, float), raw, cfg.case.kind, [])
-    if isinstance(cfg, Arm2DofCase):
-        from mechbal.papers.arm2dof import arm2dof_mechanism
-
-        mech = arm2dof_mechanism(cfg.arm.model_dump(), name=name)
-        cw = cfg.counterweights
-        slots = [CounterweightSlot("counterweight1", "shoulder", cw.m_cw1, cw.m_cw1, direction=(-1.0, 0.0, 0.0)),
-                 CounterweightSlot("counterweight2", "elbow", cw.m_cw2, cw.m_cw2, direction=(-1.0, 0.0, 0.0))]
-        tr = cfg.trajectory
-        t, motion, tt = _trajectory_motion(mech, {"start": tr.start, "end": tr.end, "duration": tr.duration,
-                                                  "samples": tr.samples}, law="cubic")
-        return BalanceCase(name, title, mech, table, t, motion, tt, None, raw, "arm2dof", slots)
-    if cfg.case.kind in ("paminsa", "discs", "rpsp", "orthoglide"):
-        from mechbal.balance import cases as builtin
-
-        make = {"paminsa": builtin.paminsa_case, "rpsp": builtin.rpsp_case,
-                "orthoglide": builtin.orthoglide_case}.get(cfg.case.kind, builtin.discs_case)
-        return make(cfg, raw, table, design_cfg)
-    raise ConfigError("case.kind", f"mechbal balance reads cases of kind mechanism, serial_chain, arm2dof, "
-                                   f"paminsa, discs, rpsp or orthoglide, and URDF files ({cfg.case.kind!r}: its mechanism is not "
-                                   "on the general model yet)", cfg.case.kind)
+    adapter = case_adapter(cfg.case.kind)
+    if adapter is not None:
+        return adapter.build(cfg, raw, table, design_cfg)
+    known = ", ".join(["mechanism", "serial_chain", *sorted(_ADAPTERS)])
+    raise ConfigError("case.kind", f"mechbal balance reads cases of kind {known}, and URDF files "
+                                   f"({cfg.case.kind!r}: its mechanism is not on the general model yet)", cfg.case.kind)
 
 
 # ---- evaluation --------------------------------------------------------------------------------
@@ -291,12 +329,11 @@ def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
               + f".\nResidual {result.residual:.6g} {result.residual_units} (unbalanced {result.residual_before:.6g}).")
     case = {"name": f"{bc.name}-balanced", "kind": "mechanism", "title": f"{bc.title}, balanced ({method})"}
     tt = dict(bc.trajectory_table)
-    if bc.kind == "orthoglide" and bc.raw is not None:
-        from mechbal.balance.cases import orthoglide_written_back
-
-        data = orthoglide_written_back(bc, result)
-        if data is not None:   # the case itself, its [[springs]] with the sized rates
-            data["case"] = {**data["case"], **case, "kind": "orthoglide"}
+    adapter = _ADAPTERS.get(bc.kind)
+    if adapter is not None and adapter.written_back is not None and bc.raw is not None:
+        data = adapter.written_back(bc, result)
+        if data is not None:   # the case itself with the sized design (e.g. the Orthoglide's rates)
+            data["case"] = {**data["case"], **case, "kind": bc.kind}
             return toml_text(data, header)
     if bc.kind in ("mechanism", "serial_chain", "rpsp") and bc.raw is not None:
         # the case itself with the balancing elements added (rpsp: its counterweight bodies, which

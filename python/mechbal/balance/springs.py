@@ -49,6 +49,8 @@ off-the-shelf springs and a block-and-tackle ratio whose equivalent rate and pea
 theoretical ones, with the anchor correction the chosen rate implies (for a ZFL spring
 ``rate * anchor offset`` is what balances: eqs 15-19, Table 1 second row) and the total spring
 mass (Table 2).
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

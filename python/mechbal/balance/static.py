@@ -15,6 +15,8 @@ the loop solve (v = C v#).
 This generalises the static-balancing conditions of the papers' counterweights, e.g.
 Arakelian, Le Baron & Mottu 2011, eqs 21-22 / 30-31 (m_CW2 r_CW2 = m2 l_S2 and
 m_CW1 r_CW1 = m1 l_S1 + (m2 + m_CW2) l1 for the 2-DOF arm), which the tests reproduce.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

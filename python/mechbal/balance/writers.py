@@ -11,6 +11,8 @@
   it, as mechbal names links), its bodies merged into one ``<inertial>`` (exact for dynamics),
   joints ``revolute`` (``continuous`` without limits), ``prismatic``, ``fixed``, gears as
   ``<mimic>``. URDF has no gravity: the mechanism's is written in a comment.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -10,21 +10,32 @@ the files; ``mechbal run NAME --out DIR`` runs one.
 runner into a temporary folder next to ``DIR`` that replaces ``DIR`` only when the run is complete
 (:mod:`mechbal.output`): ``DIR`` holds a whole run or none. A runner writes only into the folder
 it is given and may call :func:`mechbal.progress.stage` at each stage of its work.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Callable
 
-from mechbal.config import CASES_DIR, ConfigError, load_case, read_toml
+from mechbal.config import ConfigError, builtin_cases, load_case, read_toml
+from mechbal.registry import paper_modules
 from mechbal.schema import validate_case
 
 Runner = Callable[[dict, Path], dict]
 _RUNNERS: dict[str, Runner] = {}
 _STAGES: dict[str, int] = {}
 
-#: the case ``mechbal demo`` runs
+#: the case ``mechbal demo`` runs (a paper's: when that paper is not installed, the first of
+#: :data:`FALLBACK_CASES` that is)
 DEFAULT_CASE = "paminsa"
+FALLBACK_CASES = ("four-bar", "arm2link")
+
+
+def default_case() -> str:
+    """The case ``mechbal demo`` runs: :data:`DEFAULT_CASE` if it is a built-in case here."""
+    names = builtin_cases()
+    return next((n for n in (DEFAULT_CASE, *FALLBACK_CASES) if n in names), DEFAULT_CASE)
 
 
 def register(kind: str, stages: int | None = None) -> Callable[[Runner], Runner]:
@@ -40,19 +51,21 @@ def register(kind: str, stages: int | None = None) -> Callable[[Runner], Runner]
 
 
 def _load_runners() -> None:
-    # Importing every module of this package registers its runners (a new case kind is a new
-    # module here plus its TOML file: nothing else to edit).
+    # Importing every module of this package, and every paper's ``runner`` module (found through
+    # mechbal.registry), registers the runners: a new case kind is a module plus its TOML file,
+    # nothing else to edit.
     import importlib
     import pkgutil
 
     for info in pkgutil.iter_modules(__path__):
         importlib.import_module(f"{__name__}.{info.name}")
+    paper_modules("runner")
 
 
 def available() -> list[tuple[str, str, str]]:
     """(name, kind, title) of every built-in case."""
     out = []
-    for p in sorted(CASES_DIR.glob("*.toml")):
+    for p in builtin_cases().values():
         header = read_toml(p).get("case", {})
         out.append((p.stem, header.get("kind", "?"), header.get("title", "")))
     return out

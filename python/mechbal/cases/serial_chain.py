@@ -1,7 +1,9 @@
 """Runner for ``kind = "mechanism"`` (alias ``kind = "serial_chain"``): any mechanism of the
 general model (:mod:`mechbal.spec`: chains, trees, extra bodies, gear couplings, loop closures)
 moving along a rest-to-rest trajectory of its actuated joints; shaking force and moment, base
-reaction with gravity, actuator torques and, for closed mechanisms, the loop solve's conditioning."""
+reaction with gravity, actuator torques and, for closed mechanisms, the loop solve's conditioning.
+
+Layer: methods (docs/architecture.md)."""
 from __future__ import annotations
 
 from pathlib import Path

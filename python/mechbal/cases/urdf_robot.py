@@ -8,6 +8,8 @@ Default trajectory: a quintic rest-to-rest motion over ``duration`` seconds (2 s
 upper limit by half the room left, at most 0.5 rad (revolute) or 0.1 m (prismatic); a joint with
 no room above moves towards its lower limit the same way; an unlimited (continuous) joint moves
 by 0.5 rad.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -1,73 +1,51 @@
-"""The papers' mechanisms as data on the general model (:class:`mechbal.Mechanism`).
+"""The papers: one package each, holding everything that exists to reproduce that paper.
 
-Each module builds, from the parameters a case runner reads, the mechanism the paper describes:
-joints with their parents and placements, every link's bodies (links, counterweights, discs), gear
-couplings for geared discs and, for the closed linkages, loop closures between named frames with
-the actuated joints named. The papers' closed forms (``Arm2DofDynamics``,
-``FiveBarDynamics``, ``PaminsaModel``) stay as fast paths and are tested against these general
-models (tests/python/test_papers.py, test_papers_loops.py). Each module also holds its paper's
-balancing closed forms (PAMINSA's counterweights, the disc conditions, the 2-DOF RMS cubic; the
-RPSP's eqs 29-31): the fast paths and regression tests of the general methods of
-:mod:`mechbal.balance`, with which the papers' runners size (and which they check against these).
+Each package ``mechbal.papers.<paper>`` holds the paper's mechanism as data on the general model
+(builders of :class:`mechbal.Mechanism`, TOML cases in its ``cases/`` folder), its closed forms (fast
+paths and regression checks of the general algorithms and methods), its case runner
+(``runner.py``) and its ``mechbal balance`` adapter (``balance.py``). General code finds a paper
+only through :mod:`mechbal.registry`, never by import, so deleting a paper's folder deletes the
+paper and nothing else (tests/python/test_layers.py checks it).
 
 * :mod:`mechbal.papers.arm2dof`: Arakelian, Le Baron & Mottu 2011, the 2-DOF arm with
-  counterweights.
+  counterweights, computed torque and the RMS-optimal counterweights.
 * :mod:`mechbal.papers.discs`: Coutinho & Hess Coelho, the planar 3R, spatial 3R and SCARA with
-  counter-rotating discs (gear couplings).
-* :mod:`mechbal.papers.five_bar`: the parallelogram 5R of the discs case (Coutinho & Hess Coelho).
+  counter-rotating discs (gear couplings), and the parallelogram 5R
+  (:mod:`mechbal.papers.discs.five_bar`).
 * :mod:`mechbal.papers.paminsa`: PAMINSA (Briot & Arakelian 2009): pantograph legs, guides,
-  columns, platform, counterweights, vertical counter-mass and wrist.
-* :mod:`mechbal.papers.rpsp`: Heydari & Enferadi, the 3(RPSP)-S robot: the closed-form inverse
-  kinematics (eqs 1-13) and sizing (eqs 29-31) that check the ``rpsp`` case's general model.
+  columns, platform, counterweights, vertical counter-mass and the reactionless wrist.
+* :mod:`mechbal.papers.rpsp`: Heydari & Enferadi, the 3(RPSP)-S robot: inverse kinematics
+  (eqs 1-13) and counterweights (eqs 29-31).
 * :mod:`mechbal.papers.orthoglide`: Martini et al. 2015, the Orthoglide's closed forms (eq 1,
-  eqs 2-19) that check the ``orthoglide`` case's general model.
+  eqs 2-19) and its spring balancing.
 
-The papers' closed forms and per-paper evaluators, re-exported from the C++ core (fast paths of
-the general model; SI units: m, kg, kg m^2, rad, s, N, N m):
+A paper's closed-form classes (``PaminsaModel``, ``Arm2DofDynamics``, ``FiveBarDynamics``, ...)
+are attributes of its package; ``mechbal.papers.<Name>`` finds them in whichever paper has them.
+The serial-chain evaluator of the first case runners (:class:`ChainModel`, :class:`JointSpec`,
+:func:`chain_kinematics`, :func:`shaking_wrench`) is here until the general model replaces its
+last users.
 
-* Arakelian, Le Baron & Mottu 2011: :class:`Arm2DofParameters`, :class:`Arm2DofCounterweights`,
-  :class:`Arm2DofDynamics` (a forward-dynamics plant and an inverse-dynamics back end),
-  :func:`pd_error_analytic` (eq 6).
-* Briot & Arakelian 2009 (PAMINSA): :class:`PaminsaParameters`, :class:`PaminsaCounterweights`,
-  :class:`PaminsaModel`, :func:`paminsa_kinematics`, :func:`paminsa_reactionless_run`,
-  :func:`wrist_momentum_matrix`, :func:`wrist_momentum_bias` (its controller is
-  :class:`mechbal.control.PaminsaController`).
-* Coutinho & Hess Coelho: :class:`FiveBarParameters`, :class:`FiveBarDynamics` (the serial arms
-  with discs are general mechanisms: :func:`disc_arm_mechanism`, evaluated by
-  :class:`mechbal.control.MechanismDynamics`).
-* The serial-chain evaluator the first case runners were written on (the general model,
-  :class:`mechbal.Mechanism`, supersedes it): :class:`ChainModel`, :class:`JointSpec`,
-  :func:`chain_kinematics` (every link's motion along a trajectory) and
-  :func:`shaking_wrench` (the shaking force [N] and moment about O [N m] of any set of bodies
-  from their masses, inertias and motion, eqs 1-4 of Briot & Arakelian 2009).
+Layer: papers (docs/architecture.md).
 """
-from mechbal import _core
-from mechbal.papers.arm2dof import arm2dof_mechanism
-from mechbal.papers.discs import disc_arm_mechanism, disc_design_mechanism
+from __future__ import annotations
 
-Arm2DofParameters = _core.Arm2DofParameters
-Arm2DofCounterweights = _core.Arm2DofCounterweights
-Arm2DofDynamics = _core.Arm2DofDynamics
-pd_error_analytic = _core.pd_error_analytic
-PaminsaParameters = _core.PaminsaParameters
-PaminsaCounterweights = _core.PaminsaCounterweights
-PaminsaModel = _core.PaminsaModel
-paminsa_kinematics = _core.paminsa_kinematics
-paminsa_reactionless_run = _core.paminsa_reactionless_run
-wrist_momentum_matrix = _core.wrist_momentum_matrix
-wrist_momentum_bias = _core.wrist_momentum_bias
-FiveBarParameters = _core.FiveBarParameters
-FiveBarDynamics = _core.FiveBarDynamics
+from typing import Any
+
+from mechbal import _core
+
 ChainModel = _core.ChainModel
 JointSpec = _core.JointSpec
 chain_kinematics = _core.chain_kinematics
 shaking_wrench = _core.shaking_wrench
 
-__all__ = [
-    "arm2dof_mechanism", "disc_arm_mechanism", "disc_design_mechanism",
-    "Arm2DofParameters", "Arm2DofCounterweights", "Arm2DofDynamics", "pd_error_analytic",
-    "PaminsaParameters", "PaminsaCounterweights", "PaminsaModel", "paminsa_kinematics",
-    "paminsa_reactionless_run", "wrist_momentum_matrix", "wrist_momentum_bias",
-    "FiveBarParameters", "FiveBarDynamics",
-    "ChainModel", "JointSpec", "chain_kinematics", "shaking_wrench",
-]
+__all__ = ["ChainModel", "JointSpec", "chain_kinematics", "shaking_wrench"]
+
+
+def __getattr__(name: str) -> Any:
+    # a paper's public name (mechbal.papers.PaminsaModel): found in whichever paper package has it
+    from mechbal.registry import papers
+
+    for module in papers().values():
+        if name in getattr(module, "__all__", ()):
+            return getattr(module, name)
+    raise AttributeError(f"module 'mechbal.papers' has no attribute {name!r}")

@@ -8,6 +8,8 @@ the round trip), frames, loops and the actuated joints. Numbers are written with
 round trip of the floats); rotations go through roll-pitch-yaw, so a placement read back differs
 from the original by rounding (~1e-16) only. tests/python/test_papers_loops.py checks that the
 shipped files equal what the generators produce.
+
+Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -19,6 +21,9 @@ import numpy as np
 from mechbal import _core
 
 __all__ = ["rpy_of", "case_toml"]
+
+#: the JSON Schema (python/mechbal/cases/mechbal.schema.json) seen from a paper's cases/ folder
+SCHEMA_FROM_PAPER_CASES = "../../../cases/mechbal.schema.json"
 
 _TYPES = {_core.JointType.revolute: "revolute", _core.JointType.prismatic: "prismatic",
           _core.JointType.fixed: "fixed"}
@@ -77,7 +82,7 @@ def case_toml(mech, *, name: str, title: str, header: str, trajectory: Mapping[s
     law, initial_guess); ``comments``: an end-of-line comment per joint, body, frame or loop name."""
     comments = dict(comments or {})
     d = mech.model.description
-    out: list[str] = ["#:schema ./mechbal.schema.json"]
+    out: list[str] = [f"#:schema {SCHEMA_FROM_PAPER_CASES}"]
     out += [("# " + line).rstrip() for line in header.strip("\n").splitlines()]
     out += ["[case]", f"name = {_str(name)}", 'kind = "mechanism"', f"title = {_str(title)}", ""]
     out += ["[mechanism]", f"gravity = {_vec(d.gravity)}"]

@@ -39,6 +39,8 @@ variables), returning a number or a dict of numbers (one column each): e.g.
 balancing method on each perturbed mechanism; a paper's sensitivity table (the Orthoglide's
 Table 6) is a ``kind = "sensitivity"`` sweep whose parameters are the mechanism's paths and the
 method's design variables, and whose metric is the method's result.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

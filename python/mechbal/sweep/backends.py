@@ -6,6 +6,8 @@ chunk order: the table does not depend on the backend.
 On a cluster the plan is scattered once to every worker (each builds its regressors once and caches
 them), each chunk is one task, and results are gathered as they complete; a worker that dies loses
 nothing: the scheduler reruns its tasks elsewhere (Dask's own resilience), so the table is complete.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 
@@ -15,7 +17,13 @@ from typing import Any
 from mechbal import progress as _progress
 from mechbal.sweep.evaluate import evaluate_chunk
 
-BACKENDS = ("serial", "processes", "dask")
+BACKENDS = ("auto", "serial", "processes", "dask")
+
+#: ``auto`` runs serially unless the rest of the sweep would take longer than this in one process
+#: [s]: the start-up of the ``processes`` backend (Dask's process pool, spawning interpreters that
+#: import mechbal and unpickle the plan) measured 0.6 to 2 s per run on the 2-core machines that
+#: run the tests, which made it 7 to 30 times slower than serial on every built-in sweep
+AUTO_SERIAL_SECONDS = 4.0
 
 
 def require_extra(module: str):
@@ -57,6 +65,8 @@ def run_chunks(plan, chunks: list[tuple[int, Any]], *, backend: str = "serial", 
         raise ValueError(f"backend: must be one of {', '.join(BACKENDS)}{did_you_mean(str(backend), list(BACKENDS))}")
     with (_bar(sum(len(v) for _, v in chunks)) if progress else _progress.counter("sweep", 0, show=False)) as shown:
         bar = _Tap(shown, callback, len(chunks))
+        if backend == "auto":
+            return _auto(plan, chunks, workers, bar)
         if backend == "serial":
             out = []
             for start, values in chunks:
@@ -66,6 +76,27 @@ def run_chunks(plan, chunks: list[tuple[int, Any]], *, backend: str = "serial", 
         if backend == "processes":
             return _processes(plan, chunks, workers, bar)
         return _distributed(plan, chunks, scheduler, bar)
+
+
+def _auto(plan, chunks, workers, bar) -> list[dict]:
+    """The first chunk in this process, timed; the rest too when they would take less than
+    :data:`AUTO_SERIAL_SECONDS` here, else on local processes (same results either way)."""
+    import time
+
+    if not chunks:
+        return []
+    t0 = time.perf_counter()
+    first = evaluate_chunk(plan, *chunks[0])
+    bar.chunk_done(first)
+    rest = chunks[1:]
+    per_row = (time.perf_counter() - t0) / max(1, len(chunks[0][1]))
+    if per_row * sum(len(v) for _, v in rest) <= AUTO_SERIAL_SECONDS or (workers or os.cpu_count() or 1) < 2:
+        out = [first]
+        for start, values in rest:
+            out.append(evaluate_chunk(plan, start, values))
+            bar.chunk_done(out[-1])
+        return out
+    return [first] + _processes(plan, rest, workers, bar)
 
 
 def _processes(plan, chunks, workers, bar) -> list[dict]:
@@ -100,14 +131,42 @@ def _distributed(plan, chunks, scheduler, bar) -> list[dict]:
                    for start, values in chunks]
         index = {f.key: i for i, f in enumerate(futures)}
         out: list[dict | None] = [None] * len(futures)
-        for future, result in distributed.as_completed(futures, with_results=True, loop=client.loop):
-            out[index[future.key]] = result
-            future.release()
-            bar.chunk_done(result)
+        try:
+            for future, result in distributed.as_completed(futures, with_results=True, loop=client.loop,
+                                                           raise_errors=False):
+                if future.status == "error" and isinstance(result, tuple):  # the chunk itself raised
+                    raise result[1].with_traceback(result[2])
+                if isinstance(result, BaseException) or not isinstance(result, dict):
+                    raise _incomplete(chunks, out, result)
+                out[index[future.key]] = result
+                future.release()
+                bar.chunk_done(result)
+        except (OSError, TimeoutError, distributed.client.FutureCancelledError) as exc:
+            raise _incomplete(chunks, out, exc) from None
         return out  # type: ignore[return-value]
     finally:
         if own:
             client.close()
 
 
-__all__ = ["BACKENDS", "require_extra", "run_chunks"]
+class SweepIncomplete(RuntimeError):
+    """The cluster failed before every chunk was evaluated (every worker lost, the scheduler
+    gone): ``finished`` holds the results of the chunks that were done, ``(start, result)`` in
+    chunk order, and ``rows_done`` / ``rows_total`` count their evaluations."""
+
+    def __init__(self, message: str, finished: list, rows_done: int, rows_total: int):
+        super().__init__(message)
+        self.finished, self.rows_done, self.rows_total = finished, rows_done, rows_total
+
+
+def _incomplete(chunks, out, cause) -> SweepIncomplete:
+    finished = [(start, r) for (start, _), r in zip(chunks, out) if r is not None]
+    done = sum(len(r["status"]) for _, r in finished)
+    total = sum(len(v) for _, v in chunks)
+    what = type(cause).__name__ if isinstance(cause, BaseException) else "no result"
+    return SweepIncomplete(f"the Dask cluster stopped before the sweep was done ({what}: every worker "
+                           f"lost or the scheduler gone): {done} of {total} evaluations were finished "
+                           f"and are kept (SweepIncomplete.finished)", finished, done, total)
+
+
+__all__ = ["AUTO_SERIAL_SECONDS", "BACKENDS", "SweepIncomplete", "require_extra", "run_chunks"]

@@ -1,15 +1,27 @@
 """Sweep files: a ``[sweep]`` table (strict schema: :class:`mechbal.schema.SweepFile`) over a case,
 and the run behind ``mechbal sweep CASE --spec FILE --out DIR``.
 
-Built-in sweep files live in ``python/mechbal/cases/sweeps/`` and are named by their stem
-(``mechbal sweep arm2link-balanced --spec tolerance``)."""
+Built-in sweep files live in ``python/mechbal/cases/sweeps/`` and in each paper's ``sweeps/``
+folder (:func:`mechbal.registry.sweep_dirs`), and are named by their stem
+(``mechbal sweep arm2link-balanced --spec arm2link-balanced-tolerance``).
+
+Layer: methods (docs/architecture.md)."""
 from __future__ import annotations
 
 from pathlib import Path
 
 from mechbal.errors import ConfigError
 
-SWEEPS_DIR = Path(__file__).resolve().parents[1] / "cases" / "sweeps"
+from mechbal.registry import GENERAL_SWEEPS_DIR as SWEEPS_DIR, sweep_dirs
+
+
+def builtin_sweeps() -> dict[str, Path]:
+    """Every built-in sweep file by name (the general ones and each paper's)."""
+    out: dict[str, Path] = {}
+    for d in sweep_dirs():
+        for p in sorted(d.glob("*.toml")):
+            out.setdefault(p.stem, p)
+    return dict(sorted(out.items()))
 
 
 def available() -> list[tuple[str, str, str]]:
@@ -17,7 +29,7 @@ def available() -> list[tuple[str, str, str]]:
     from mechbal.config import read_toml
 
     out = []
-    for p in sorted(SWEEPS_DIR.glob("*.toml")):
+    for p in builtin_sweeps().values():
         s = read_toml(p).get("sweep", {})
         out.append((p.stem, s.get("kind", "?"), s.get("title", "")))
     return out
@@ -28,8 +40,9 @@ def sweep_path(name_or_path: str | Path) -> Path:
     p = Path(name_or_path)
     if p.is_file():
         return p
-    if p.suffix == "" and (SWEEPS_DIR / f"{p.name}.toml").is_file() and p.name == str(name_or_path):
-        return SWEEPS_DIR / f"{p.name}.toml"
+    builtin = builtin_sweeps()
+    if p.suffix == "" and p.name == str(name_or_path) and p.name in builtin:
+        return builtin[p.name]
     if p.exists():
         raise ConfigError("--spec", "is not a file", str(name_or_path))
     from mechbal.schema import did_you_mean
@@ -42,7 +55,7 @@ def sweep_path(name_or_path: str | Path) -> Path:
 
 def read_sweep_file(path: str | Path):
     """The validated :class:`mechbal.schema.SweepFile` of a sweep file."""
-    from mechbal.cli import check_case_file
+    from mechbal.config import check_case_file
     from mechbal.config import read_toml
     from mechbal.schema import SweepFile, validate_table
 
@@ -71,7 +84,7 @@ def from_toml(spec_file: str | Path, case) -> "Sweep":  # noqa: F821
         raise ConfigError(field, message, has_value=False) from None
 
 
-def run_file(case, spec_file, out, *, backend: str = "serial", workers: int | None = None,
+def run_file(case, spec_file, out, *, backend: str = "auto", workers: int | None = None,
              scheduler=None, progress: bool = True):
     """Run a sweep file over a case into the folder ``out`` (a whole run or none: results.parquet
     or .csv, summary.json, plots); returns the :class:`mechbal.sweep.results.SweepResult`."""
@@ -90,4 +103,4 @@ def run_file(case, spec_file, out, *, backend: str = "serial", workers: int | No
     return result
 
 
-__all__ = ["SWEEPS_DIR", "available", "from_toml", "read_sweep_file", "run_file", "sweep_path"]
+__all__ = ["SWEEPS_DIR", "available", "builtin_sweeps", "from_toml", "read_sweep_file", "run_file", "sweep_path"]

@@ -1,6 +1,8 @@
 """Sweep definitions: :class:`Parameter` (a path and its distribution or grid) and :class:`Sweep`
 (a mechanism, its parameters, metrics, workspace sample and trajectory, and the kind of sweep),
-which generates every parameter set up front from its seed and runs them on a backend."""
+which generates every parameter set up front from its seed and runs them on a backend.
+
+Layer: methods (docs/architecture.md)."""
 from __future__ import annotations
 
 import itertools
@@ -369,9 +371,11 @@ class Sweep:
         rebuilt = any(not p.target.batched for p in self.parameters) or any(not m.builtin for m in self.metrics)
         return CHUNK_REBUILT if rebuilt else CHUNK_BATCHED
 
-    def run(self, backend: str = "serial", *, workers: int | None = None, scheduler=None,
+    def run(self, backend: str = "auto", *, workers: int | None = None, scheduler=None,
             progress: bool = True, callback=None):
-        """Evaluate every set: ``backend`` serial, processes (``workers`` local processes, default
+        """Evaluate every set: ``backend`` auto (serial unless the sweep would take longer than
+        :data:`mechbal.sweep.backends.AUTO_SERIAL_SECONDS` in one process, judged from its first
+        chunk; then processes), serial, processes (``workers`` local processes, default
         every core, through Dask's process scheduler) or dask (a distributed cluster: ``scheduler``
         an address ``tcp://host:port`` or a ``distributed.Client``); ``callback(done, total)``
         is called with the chunks done after each one (progress in a notebook). Returns a

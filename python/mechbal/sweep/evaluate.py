@@ -18,6 +18,8 @@ Two paths:
 For a closed mechanism the loops are solved on the nominal model (batched) or the rebuilt one, and
 the actuated forces are C^T tau, C the coupling matrix of v = C v# (read column by column from the
 loop solve of unit actuated velocities).
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -22,6 +22,8 @@ gives one column per key, ``<metric>.<key>``. It is evaluated on the mechanism r
 set's parameters, so it can be anything: a balancing method's ``BalanceResult.metrics``, a
 closed-form check, a cost. It must be picklable to run on processes or a cluster (a module-level
 function or a lambda; cloudpickle handles both).
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

@@ -29,6 +29,8 @@ parameters pi linearly or as a cheap closed form (pi = [m, m c, I_c + m (c.c 1 -
 every metric of the sweep is Y(q) pi with a regressor Y that does not depend on them: one regressor
 evaluation, then a matrix product over thousands of parameter sets. **Joint and gravity parameters
 are geometric**: the model is rebuilt for each set that changes one.
+
+Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 

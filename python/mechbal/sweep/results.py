@@ -1,6 +1,8 @@
 """Results of a sweep: the table (a pandas DataFrame, one row per evaluation), summary statistics,
 files (Parquet through pyarrow, or CSV) and plots (tornado chart of a sensitivity sweep,
-histograms of a Monte Carlo sweep)."""
+histograms of a Monte Carlo sweep).
+
+Layer: methods (docs/architecture.md)."""
 from __future__ import annotations
 
 import math

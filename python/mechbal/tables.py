@@ -1,0 +1,547 @@
+"""The strict tables of the case format that the mechanism description needs, as pydantic v2
+models, and the validation machinery of every table (core layer, below :mod:`mechbal.spec` and
+:mod:`mechbal.schema`).
+
+Every table forbids unknown keys (a misspelled key is an error that names it and the nearest known
+key), numbers are strict (no booleans, no strings, finite, bounded) and integers are integers.
+:func:`validate_table` turns the first problem into one :class:`~mechbal.errors.ConfigError` line
+naming the dotted field and the value. :mod:`mechbal.schema` builds the case kinds on these tables
+and re-exports them.
+
+Layer: Python core (docs/architecture.md).
+"""
+import difflib
+import json
+import math
+import sys
+import warnings
+from pathlib import Path
+from typing import Annotated, Any, Literal, Optional, Union, get_args, get_origin
+
+import numpy as np
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, PrivateAttr, TypeAdapter, ValidationError, \
+    model_validator
+from pydantic.json_schema import GenerateJsonSchema, WithJsonSchema
+from pydantic_core import PydanticCustomError
+
+from mechbal.errors import ConfigError, ConfigWarning, short_repr
+
+# ---- bounds -------------------------------------------------------------------------------------
+#: largest magnitude of any number in a case file (SI units: beyond it a value is absurd, and
+#: products of a few such values still cannot overflow)
+MAX_ABS = 1e12
+#: samples of a trajectory (arrays of samples x bodies x 3 x 3 are built and exported)
+MAX_SAMPLES = 1_000_000
+#: samples x bodies of the exported pose arrays (~1 GB of float64 rotations and positions)
+MAX_SAMPLE_BODIES = 4_000_000
+#: joints of a mechanism (a spherical joint counts three once expanded)
+MAX_JOINTS = 256
+MAX_BODIES = 1024
+MAX_FRAMES = 1024
+#: controller ticks of one simulated run (duration x rate)
+MAX_TICKS = 1_000_000
+#: random configurations of a mass-matrix survey
+MAX_CONFIGURATIONS = 100_000
+#: thresholds of the unit warnings
+WARN_MASS_KG = 1000.0
+WARN_REACH_M = 5.0
+WARN_LENGTH_M = 100.0
+WARN_ANGLE_RAD = 2.0 * math.pi
+
+# ---- value types --------------------------------------------------------------------------------
+_NUM = dict(strict=True, allow_inf_nan=False)
+Num = Annotated[float, Field(ge=-MAX_ABS, le=MAX_ABS, **_NUM)]
+NonNeg = Annotated[float, Field(ge=0, le=MAX_ABS, **_NUM)]
+Pos = Annotated[float, Field(gt=0, le=MAX_ABS, **_NUM)]
+Mass = Annotated[float, Field(ge=0, le=MAX_ABS, description="kg", **_NUM)]
+Length = Annotated[float, Field(ge=-MAX_ABS, le=MAX_ABS, description="m", **_NUM)]
+Angle = Annotated[float, Field(ge=-MAX_ABS, le=MAX_ABS, description="rad", **_NUM)]
+Duration = Annotated[float, Field(ge=1e-3, le=1e6, description="s", **_NUM)]
+#: a controller's tick rate: at most one second per tick
+Rate = Annotated[float, Field(ge=1, le=1e6, description="Hz", **_NUM)]
+Samples = Annotated[int, Field(ge=3, le=MAX_SAMPLES, strict=True)]
+Name = Annotated[str, Field(min_length=1, max_length=128, strict=True)]
+Title = Annotated[str, Field(max_length=1000, strict=True)]
+
+
+def _vec(n: int, item: Any = Num, description: str | None = None):
+    return Annotated[list[item], Field(min_length=n, max_length=n, description=description)]
+
+
+Vec2 = _vec(2)
+Vec3 = _vec(3)
+PosVec2 = _vec(2, Pos)
+PosVec3 = _vec(3, Pos)
+Xyz = _vec(3, Length, "m")
+Rpy = _vec(3, Angle, "rad: roll, pitch, yaw (fixed axes x, then y, then z)")
+JointValues = Annotated[list[Num], Field(min_length=1, max_length=MAX_JOINTS)]
+
+
+def _custom(message: str, sub: str = "", value: Any = None, has_value: bool = True):
+    """A validation error of ours: ``sub`` extends the location (``.axis``, ``[1][2]``); ``value``
+    replaces the input shown."""
+    return PydanticCustomError("mechbal", "{message}",
+                               {"message": message, "sub": sub, "value": value, "has_value": has_value})
+
+
+def _is_number(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def inertia_matrix(value: Any) -> np.ndarray:
+    """An inertia tensor about the centre of mass [kg m^2] from a 3x3 list, three principal
+    moments [Ixx, Iyy, Izz] or six values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]; it must be symmetric,
+    positive semi-definite and satisfy the triangle inequality of a physical body (the checks of
+    the C++ ``validate_rigid_body``). Raises a pydantic error (inside models) naming the entry."""
+    shape = "must be a 3x3 matrix, [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]"
+    if not isinstance(value, list):
+        raise _custom(shape, value=value)
+    rows = [x for x in value if isinstance(x, list)]
+    if rows and (len(value) != 3 or len(rows) != 3):
+        raise _custom(shape, value=value)
+    entries = ([(f"[{i}][{k}]", x) for i, r in enumerate(value) for k, x in enumerate(r)] if rows
+               else [(f"[{i}]", x) for i, x in enumerate(value)])
+    if rows and any(len(r) != 3 for r in value):
+        raise _custom(shape, value=value)
+    if not rows and len(value) not in (3, 6):
+        raise _custom(shape, value=value)
+    for sub, x in entries:
+        if not _is_number(x):
+            raise _custom("must be a number", sub, x)
+        if not math.isfinite(x):
+            raise _custom("must be finite", sub, x)
+        if abs(x) > MAX_ABS:
+            raise _custom(f"must be between -{_fmt(MAX_ABS)} and {_fmt(MAX_ABS)}", sub, x)
+    if rows:
+        inertia = np.array(value, dtype=float)
+    else:
+        v = np.array(value, dtype=float)
+        inertia = np.diag(v[:3])
+        if len(v) == 6:
+            inertia[0, 1] = inertia[1, 0] = v[3]
+            inertia[0, 2] = inertia[2, 0] = v[4]
+            inertia[1, 2] = inertia[2, 1] = v[5]
+    scale = max(1.0, float(np.max(np.abs(inertia))))
+    if np.max(np.abs(inertia - inertia.T)) > 1e-12 * scale:
+        raise _custom("must be symmetric", value=value)
+    p = np.linalg.eigvalsh(inertia)
+    tol = 1e-12 * scale
+    if p[0] < -tol:
+        raise _custom(f"must be positive semi-definite, smallest principal moment is {p[0]:.6g}",
+                      value=value)
+    if p[2] > p[0] + p[1] + tol:
+        raise _custom(f"violates the triangle inequality of a physical body: principal moments "
+                      f"{p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g}", value=value)
+    return inertia
+
+
+def _check_inertia(value: Any) -> Any:
+    inertia_matrix(value)
+    return value
+
+
+_INERTIA_JSON = {
+    "description": "kg m^2, about the centre of mass: [Ixx, Iyy, Izz], [Ixx, Iyy, Izz, Ixy, Ixz, "
+                   "Iyz] or a 3x3 matrix (symmetric, positive semi-definite, triangle inequality)",
+    "anyOf": [
+        {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3},
+        {"type": "array", "items": {"type": "number"}, "minItems": 6, "maxItems": 6},
+        {"type": "array", "minItems": 3, "maxItems": 3,
+         "items": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}},
+    ]}
+Inertia = Annotated[Any, AfterValidator(_check_inertia), WithJsonSchema(_INERTIA_JSON)]
+
+
+class Table(BaseModel):
+    """A TOML table: unknown keys are errors, values are never coerced."""
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+
+
+class CaseHeader(Table):
+    """``[case]``: what the file is."""
+    name: Name = Field(description="the case's name (summary.json 'case')")
+    kind: str = Field(description="which runner reads the file")
+    title: Title = ""
+
+
+# ---- the mechanism format (kinds serial_chain and mechanism) ----------------------------------
+
+class Origin(Table):
+    """A placement ``{xyz, rpy}`` (both optional): translation [m], then roll-pitch-yaw [rad]."""
+    xyz: Xyz = [0.0, 0.0, 0.0]
+    rpy: Rpy = [0.0, 0.0, 0.0]
+
+
+class DH(Table):
+    """Denavit-Hartenberg parameters (``mdh``: modified, Craig; ``dh``: standard)."""
+    a: Length
+    alpha: Angle
+    d: Length = 0.0
+    theta: Angle = 0.0
+
+
+class Limits(Table):
+    """Joint limits, all optional (absent: unbounded)."""
+    lower: Optional[Num] = Field(None, description="rad or m")
+    upper: Optional[Num] = Field(None, description="rad or m")
+    velocity: Optional[Pos] = Field(None, description="rad/s or m/s")
+    effort: Optional[Pos] = Field(None, description="N m or N")
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if self.lower is not None and self.upper is not None and self.lower > self.upper:
+            raise _custom(f"must be >= lower = {self.lower!r}", ".upper", self.upper)
+        return self
+
+
+class Mimic(Table):
+    """Gear coupling: q = ratio * q[joint] + offset."""
+    joint: Name
+    ratio: Num = 1.0
+    offset: Num = 0.0
+
+
+class LinkInertial(Table):
+    """The link's own body, in the link frame (the frame right after the joint's motion; for a
+    ``dh`` joint the standard DH frame of the link)."""
+    mass: Mass
+    com: Xyz = [0.0, 0.0, 0.0]
+    inertia: Inertia
+
+
+JointType = Literal["revolute", "prismatic", "fixed", "spherical"]
+
+
+class Joint(Table):
+    """``[[mechanism.joints]]``: a joint and the link it moves (they share the name)."""
+    name: Optional[Name] = Field(None, description="default joint<i> (1-based)")
+    type: JointType = "revolute"
+    parent: Optional[Name] = Field(
+        None, description="parent joint's name or 'base'; default: the previous joint in the list "
+                          "('base' for the first)")
+    origin: Optional[Origin] = None
+    mdh: Optional[DH] = None
+    dh: Optional[DH] = None
+    axis: Optional[Vec3] = Field(None, description="in the joint frame; default [0, 0, 1]")
+    limits: Optional[Limits] = None
+    mimic: Optional[Mimic] = None
+    link: Optional[LinkInertial] = None
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        given = [k for k in ("origin", "mdh", "dh") if getattr(self, k) is not None]
+        if len(given) > 1:
+            raise _custom("give only one of origin, mdh, dh", value=given)
+        if self.axis is not None:
+            if given and given[0] != "origin":
+                raise _custom("DH joints move along/about z; drop axis", ".axis", self.axis)
+            if self.type in ("fixed", "spherical"):
+                raise _custom(f"a {self.type} joint has no axis; drop it", ".axis", self.axis)
+            scale = max(abs(x) for x in self.axis)
+            if scale == 0.0 or np.linalg.norm(np.asarray(self.axis) / scale) * scale < 1e-12:
+                raise _custom("must be a non-zero vector", ".axis", self.axis)
+        for key in ("limits", "mimic"):
+            if getattr(self, key) is not None and self.type in ("fixed", "spherical"):
+                raise _custom(f"a {self.type} joint cannot have {key}", f".{key}",
+                              getattr(self, key).model_dump())
+        return self
+
+
+BodyKind = Literal["link", "counterweight", "motor", "disc", "payload", "other"]
+
+
+class Body(Table):
+    """``[[mechanism.bodies]]``: an extra rigid body on a link."""
+    name: Name
+    kind: BodyKind = "other"
+    link: Name = Field(description="name of the joint whose link carries it, or 'base'")
+    mass: Mass
+    com: Xyz = Field([0.0, 0.0, 0.0], description="m, in the link frame")
+    inertia: Inertia
+    rpy: Rpy = Field([0.0, 0.0, 0.0], description="rad, orientation of the inertia axes in the link frame")
+
+
+class Frame(Table):
+    """``[[mechanism.frames]]``: a named frame (tool, sensor) on a link."""
+    name: Name
+    link: Name = Field(description="name of the joint whose link carries it, or 'base'")
+    origin: Origin = Origin()
+
+
+class Loop(Table):
+    """``[[mechanism.loops]]``: a loop closure between two named frames."""
+    name: Name
+    type: Literal["point", "planar_point", "axis", "weld"] = Field(
+        "point", description="point (3 equations), planar_point (2, in the plane normal to frame_a's z), "
+                             "axis (5: points coincide, z axes parallel), weld (6)")
+    frame_a: Name = Field(description="a frame of [[mechanism.frames]]")
+    frame_b: Name = Field(description="a frame of [[mechanism.frames]], on another branch")
+
+
+SpringCount = Annotated[int, Field(ge=1, le=1000, strict=True, description="identical springs in parallel")]
+PulleyRatio = Annotated[float, Field(gt=0, le=1000, description="k: the anchor distance changes k times "
+                                                                "as much as each spring's length", **_NUM)]
+
+
+class MechanismSpring(Table):
+    """``[[mechanism.springs]]``: ``count`` identical linear springs of ``rate`` [N/m] each
+    between anchor A on link ``link_a`` and anchor B on ``link_b`` (anchors in the frames the
+    user described those links in, as a body's ``com``), carrying ``preload`` [N] each at the
+    anchor distance ``free_length`` [m], through a block and tackle of ratio ``pulley_ratio``:
+    tension at the anchors count preload / k + count rate / k^2 (d - free_length). Part of the
+    model: the inverse dynamics, static torque and simulation include it."""
+    name: Name
+    link_a: Name = Field(description="joint whose link carries anchor A, or 'base'")
+    anchor_a: Xyz = Field(description="m, in link_a's frame")
+    link_b: Name = Field(description="joint whose link carries anchor B, or 'base'")
+    anchor_b: Xyz = Field(description="m, in link_b's frame")
+    rate: NonNeg = Field(description="N/m, of each spring")
+    free_length: NonNeg = Field(0.0, description="m: anchor distance at which each spring carries only its preload")
+    preload: NonNeg = Field(0.0, description="N: initial tension of each spring")
+    count: SpringCount = 1
+    pulley_ratio: PulleyRatio = 1.0
+
+
+class Mechanism(Table):
+    """``[mechanism]``: a tree of joints with bodies, gears, frames, loop closures and springs."""
+    gravity: Vec3 = Field([0.0, 0.0, -9.81], description="m/s^2, in O")
+    base: Optional[Origin] = Field(None, description="placement of the root joints' base frame in O")
+    joints: Annotated[list[Joint], Field(min_length=1, max_length=MAX_JOINTS)]
+    bodies: Annotated[list[Body], Field(max_length=MAX_BODIES)] = []
+    frames: Annotated[list[Frame], Field(max_length=MAX_FRAMES)] = []
+    loops: Annotated[list[Loop], Field(max_length=MAX_FRAMES)] = []
+    actuated: Annotated[list[Name], Field(max_length=MAX_JOINTS,
+                                          description="actuated joints (required with loops)")] = []
+    springs: Annotated[list[MechanismSpring], Field(max_length=MAX_BODIES)] = []
+
+
+class ChainTrajectory(Table):
+    """``[trajectory]``: rest-to-rest motion of the actuated joints (every independent joint of an
+    open mechanism)."""
+    law: Literal["quintic", "cubic"] = "quintic"
+    start: JointValues = Field(description="one value per actuated joint (rad or m)")
+    end: JointValues = Field(description="one value per actuated joint (rad or m)")
+    duration: Duration
+    samples: Samples = 501
+    initial_guess: Optional[JointValues] = Field(
+        None, description="closed mechanisms: every joint coordinate near the assembly at start "
+                          "(picks the assembly mode of the loops), rad or m")
+
+
+
+# ---- error messages -----------------------------------------------------------------------------
+
+def _fmt(x: Any) -> str:
+    """A bound as people write it: 0, 1000000, 0.9, 1e+12."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return str(x)
+    if float(x).is_integer() and abs(x) < 1e7:
+        return str(int(x))
+    return f"{x:g}"
+
+
+def _path(loc: tuple, prefix: str = "") -> str:
+    out = prefix
+    for x in loc:
+        if isinstance(x, int):
+            out += f"[{x}]"
+        else:
+            x = str(x)
+            if not x.isprintable() or any(c in x for c in ".[]\"' "):
+                x = repr(x)  # a key with a newline or a dot stays one readable line
+            out += f".{x}" if out else x
+    return out
+
+
+def _unwrap(t: Any) -> Any:
+    while True:
+        origin = get_origin(t)
+        if origin is Annotated:
+            t = get_args(t)[0]
+        elif origin is Union or (sys.version_info >= (3, 10) and type(t).__name__ == "UnionType"):
+            args = [a for a in get_args(t) if a is not type(None)]
+            if len(args) != 1:
+                return t
+            t = args[0]
+        else:
+            return t
+
+
+def _type_at(root: Any, loc: tuple) -> Any:
+    """The annotation of the value at ``loc`` in model ``root`` (None if unknown)."""
+    t: Any = root
+    for x in loc:
+        t = _unwrap(t)
+        if isinstance(x, int):
+            if get_origin(t) is not list:
+                return None
+            t = get_args(t)[0]
+        elif isinstance(t, type) and issubclass(t, BaseModel) and x in t.model_fields:
+            field = t.model_fields[x]
+            t = field.annotation
+            if field.metadata:
+                t = Annotated[(t, *field.metadata)]
+        else:
+            return None
+    return _unwrap(t)
+
+
+def _lengths(root: Any, loc: tuple) -> tuple[Any, Any]:
+    """(min_length, max_length) declared for the list at ``loc``."""
+    parent = _type_at(root, loc[:-1])
+    if not (loc and isinstance(parent, type) and issubclass(parent, BaseModel)
+            and loc[-1] in parent.model_fields):
+        return None, None
+    lo = hi = None
+    field = parent.model_fields[loc[-1]]
+    metadata = list(field.metadata)
+    t = field.annotation
+    while True:  # Optional[Annotated[list, Field(...)]]
+        if get_origin(t) is Annotated:
+            metadata += list(get_args(t)[1:])
+            t = get_args(t)[0]
+        elif get_origin(t) is Union:
+            args = [a for a in get_args(t) if a is not type(None)]
+            if len(args) != 1:
+                break
+            t = args[0]
+        else:
+            break
+    for m in metadata:
+        lo = getattr(m, "min_length", None) if lo is None else lo
+        hi = getattr(m, "max_length", None) if hi is None else hi
+    return lo, hi
+
+
+def _allowed_keys(root: Any, loc: tuple) -> list[str]:
+    t = _type_at(root, loc)
+    if isinstance(t, type) and issubclass(t, BaseModel):
+        return list(t.model_fields)
+    return []
+
+
+def _choices(root: Any, loc: tuple) -> list[str]:
+    t = _type_at(root, loc)
+    if get_origin(t) is Literal:
+        return [str(a) for a in get_args(t)]
+    return []
+
+
+def did_you_mean(word: str, allowed: list[str]) -> str:
+    """`` (did you mean 'com'?)`` for the nearest allowed word, else the list of allowed words."""
+    lower = {a.lower(): a for a in allowed}
+    match = difflib.get_close_matches(word, allowed, n=1, cutoff=0.6) or \
+        ([lower[word.lower()]] if word.lower() in lower else []) or \
+        [lower[m] for m in difflib.get_close_matches(word.lower(), list(lower), n=1, cutoff=0.6)]
+    if match:
+        return f" (did you mean {match[0]!r}?)"
+    if allowed:
+        return f" (allowed: {', '.join(allowed)})"
+    return ""
+
+
+_TYPE_WORDS = {
+    "float_type": "must be a number", "float_parsing": "must be a number",
+    "int_type": "must be an integer", "int_parsing": "must be an integer",
+    "int_from_float": "must be an integer", "string_type": "must be a string",
+    "list_type": "must be a list", "dict_type": "must be a table", "model_type": "must be a table",
+    "model_attributes_type": "must be a table", "finite_number": "must be finite",
+    "bool_type": "must be true or false",
+}
+
+
+def _at(data: Any, loc: tuple) -> Any:
+    for x in loc:
+        try:
+            data = data[x]
+        except (KeyError, IndexError, TypeError):
+            return None
+    return data
+
+
+def _message(err: dict, root: Any, prefix: str, data: Any = None) -> tuple[str, str, bool, Any]:
+    """(field, message, has_value, value) of one pydantic error."""
+    loc, typ, ctx = tuple(err.get("loc", ())), err.get("type", ""), err.get("ctx") or {}
+    value = err.get("input")
+    if typ == "mechbal":
+        field = _path(loc, prefix) + ctx.get("sub", "")
+        v = ctx.get("value")
+        return field, ctx["message"], ctx.get("has_value", True), value if v is None else v
+    field = _path(loc, prefix)
+    if typ == "extra_forbidden":
+        key = str(loc[-1]) if loc else "?"
+        what = "unknown table" if isinstance(value, dict) else "unknown key"
+        allowed = _allowed_keys(root, loc[:-1])
+        table = _at(data, loc[:-1])
+        if isinstance(table, dict):  # the user meant a key that is not there yet
+            absent = [k for k in allowed if k not in table]
+            hint = did_you_mean(key, absent)
+            if "did you" in hint:
+                return field, what + hint, False, None
+        return field, what + did_you_mean(key, allowed), False, None
+    if typ == "missing":
+        return field, "is required", False, None
+    if typ == "literal_error":
+        choices = _choices(root, loc)
+        hint = did_you_mean(value, choices) if isinstance(value, str) and choices else ""
+        if hint.startswith(" (allowed"):
+            hint = ""
+        text = f"must be one of {', '.join(choices)}" if choices else "must be " + ctx.get("expected", "?")
+        return field, text + hint, True, value
+    bounds = {"greater_than_equal": (">=", "ge"), "greater_than": (">", "gt"),
+              "less_than_equal": ("<=", "le"), "less_than": ("<", "lt")}
+    if typ in bounds:
+        op, key = bounds[typ]
+        return field, f"must be {op} {_fmt(ctx.get(key))}", True, value
+    if typ in ("too_short", "too_long"):
+        lo, hi = _lengths(root, loc)
+        if lo is not None and lo == hi:
+            text = f"must have {lo} values"
+        elif typ == "too_short":
+            text = f"must have at least {lo} values"
+        else:
+            text = f"must have at most {hi} values"
+        return field, text, True, value
+    if typ in ("string_too_short",):
+        return field, "must not be empty", True, value
+    if typ in ("string_too_long",):
+        return field, f"must have at most {ctx.get('max_length')} characters", True, value
+    if typ in _TYPE_WORDS:
+        text = _TYPE_WORDS[typ]
+        if typ in ("float_type", "int_type") and _is_number(value) and not math.isfinite(float(value)):
+            text = "must be finite"
+        return field, text, True, value
+    return field, err.get("msg", "is invalid"), True, value
+
+
+def _errors_to_config_error(exc: ValidationError, root: Any, prefix: str = "", data: Any = None) -> ConfigError:
+    errors = exc.errors(include_url=False)
+    # an unknown key first: it usually explains the rest (a misspelled required key is also missing)
+    errors.sort(key=lambda e: e.get("type") != "extra_forbidden")
+    problems = []
+    for err in errors:
+        field, text, has_value, value = _message(err, root, prefix, data)
+        line = f"{field}: {text}" if field else text
+        if has_value:
+            line += f" (got {short_repr(value)})"
+        problems.append((field, line, text, has_value, value))
+    field, _, text, has_value, value = problems[0]
+    if len(problems) > 1:
+        rest = "; ".join(p[1] for p in problems[1:4])
+        more = f"; and {len(problems) - 4} more" if len(problems) > 4 else ""
+        if has_value:
+            text += f" (got {short_repr(value)})"
+            has_value = False
+        text += f"; also {rest}{more}"
+    return ConfigError(field, text, value, has_value=has_value,
+                       problems=[(p[0], p[1]) for p in problems])
+
+
+def validate_table(model: type, data: Any, prefix: str = "") -> Any:
+    """``model`` validated from ``data``; a ConfigError (fields under ``prefix``) if not."""
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        raise _errors_to_config_error(exc, model, prefix, data) from None
+    except RecursionError:
+        raise ConfigError(prefix or "case", "is nested too deeply", has_value=False) from None
