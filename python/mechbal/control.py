@@ -350,11 +350,15 @@ class ReactionlessController(_core.ReactionlessController):
         integrator: ``"euler"`` or ``"rk4"`` (needs the task motion at t + dt/2 and t + dt).
         rate_hz: tick rate [Hz].
         damping: damped least squares factor relative to the largest singular value.
-        q0, v0: actuated coordinates at the start [rad or m, rad/s or m/s] (default zeros, rest).
+        q0: actuated coordinates at the start [rad or m] (default zeros).
+        v0: their rates at the start [rad/s or m/s] (default rest); the target momentum is the
+            momentum there.
         q_guess: every coordinate near the assembly (closed loops).
-        kp, kd, torque_limit: gains of an optional computed-torque stage; then
+        kp: proportional gains [1/s^2] of an optional computed-torque stage; with ``kd``,
             :attr:`joint_controller` is a joint controller for :func:`mechbal.simulate.closed_loop`
             (which accepts this object directly).
+        kd: derivative gains [1/s] of the computed-torque stage.
+        torque_limit: |tau| limit per joint of the computed-torque stage [N m or N].
         **options: ``max_condition``, ``max_rate`` [rad/s], ``max_acceleration``,
             ``position_limits`` (bool), ``home_gain``, ``limit_gain``, ``home``, ``max_position``,
             ``max_speed``, ``max_task_acceleration`` (the task input range).
@@ -451,8 +455,13 @@ class ReactionlessTaskController(_core.ReactionlessTaskController):
         task_frame: a named frame of the mechanism.
         task_rows: the tracked twist components: ``"all"``, ``"linear"``, ``"angular"`` or
             ``"v_x"``, ..., ``"w_z"`` (a name or a list; O axes).
-        cancel, integrator, rate_hz, damping: as :class:`ReactionlessController`.
-        q0, v0: every coordinate at the start [rad or m] (default zeros, rest).
+        cancel: the momentum components minimised, as :class:`ReactionlessController`.
+        integrator: ``"euler"`` or ``"rk4"``.
+        rate_hz: tick rate [Hz].
+        damping: damped least squares factor relative to the largest singular value.
+        q0: every coordinate at the start [rad or m] (default zeros).
+        v0: every rate at the start [rad/s or m/s] (default rest).
+        **options: ``max_condition``, ``max_rate`` [rad/s].
     """
 
     def __init__(self, mechanism: Any, task_frame: str, task_rows: Any = "all", cancel: Any = "moment",
