@@ -62,8 +62,8 @@ def _cmd_run(args) -> int:
     check_case_file(args.case)
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer):  # the runner's tables, printed after its bar closes
-        summary = run_case(args.case, out, duration=getattr(args, "duration", None),
-                           samples=getattr(args, "samples", None))
+        summary = run_case(args.case, out, animate=getattr(args, "animate", False),
+                           duration=getattr(args, "duration", None), samples=getattr(args, "samples", None))
     if not args.quiet:
         sys.stdout.write(buffer.getvalue())
     notes = summary.get("non_finite_values") if isinstance(summary, dict) else None
@@ -177,6 +177,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="URDF files: duration of the default trajectory [s] (default: 2)")
     s.add_argument("--samples", type=int, metavar="N",
                    help="URDF files: number of instants of the default trajectory (default: 501)")
+    s.add_argument("--animate", action="store_true",
+                   help="also write DIR/animation_<variant>.gif: the mechanism moving, with the "
+                        "shaking force and moment drawn at its base")
     s.add_argument("-q", "--quiet", **quiet)
     s.set_defaults(func=_cmd_run)
     s = sub.add_parser("balance", help="balance a mechanism by a method (static, force, moment, springs, rms)",

@@ -71,10 +71,11 @@ def available() -> list[tuple[str, str, str]]:
     return out
 
 
-def run_case(name_or_path: str | Path, out: str | Path, **trajectory) -> dict:
+def run_case(name_or_path: str | Path, out: str | Path, *, animate: bool = False, **trajectory) -> dict:
     """Run a built-in case (by name), a TOML case file or a URDF file into the folder ``out``;
     returns the summary. ``trajectory``: ``duration`` and ``samples`` of a URDF file's default
-    trajectory (see :mod:`mechbal.cases.urdf_robot`).
+    trajectory (see :mod:`mechbal.cases.urdf_robot`). ``animate``: also write
+    ``animation_<variant>.gif`` beside every ``bodies_<variant>.npz`` (:mod:`mechbal.animation`).
 
     Raises :class:`mechbal.output.OutputError` (bad ``out``) and :class:`ConfigError` before any
     computation; whatever a runner raises leaves ``out`` as it was."""
@@ -106,7 +107,23 @@ def run_case(name_or_path: str | Path, out: str | Path, **trajectory) -> dict:
         name, kind = config.case.name, config.case.kind
     if kind not in _RUNNERS:
         raise ConfigError("case.kind", f"unknown kind (known: {', '.join(sorted(_RUNNERS))})", kind)
-    with staged_output(out) as tmp, progress.run_bar(name, _STAGES.get(kind)):
+    stages = _STAGES.get(kind)
+    with staged_output(out) as tmp, progress.run_bar(name, None if stages is None else stages + animate):
         summary = _RUNNERS[kind](config, tmp)
+        if animate:
+            progress.stage("animation")
+            _animate_run(Path(tmp), name)
         progress.finish()
     return summary
+
+
+def _animate_run(folder: Path, name: str) -> list[Path]:
+    from mechbal.animation import animate_bodies_file
+    from mechbal.export import read_bodies
+
+    out = []
+    for bodies in sorted(folder.glob("bodies_*.npz")):
+        variant = bodies.stem.removeprefix("bodies_")
+        out.append(animate_bodies_file(read_bodies(bodies), folder / f"animation_{variant}.gif",
+                                       title=f"{name} ({variant})"))
+    return out

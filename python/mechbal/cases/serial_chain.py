@@ -58,6 +58,16 @@ def run(config, out: Path) -> dict:
                          q_guess=None if guess is None else np.array(guess, float))
 
 
+def _drawing(mech: Mechanism, motion) -> dict:
+    """What a picture of the mechanism needs beside the bodies (:mod:`mechbal.animation`): every
+    link frame's origin and parent, and every named frame's origin with its link."""
+    links = list(mech.link_names)
+    by_name = {f.name: f.link for f in mech.model.description.frames}
+    frame_link = [links.index(by_name[n]) if by_name.get(n) in links else -1 for n in mech.frame_names]
+    return dict(link_position=motion.link_position, link_parent=np.array(mech.model.link_parents, int),
+                frame_position=motion.frame_placement[..., :3, 3], frame_link=np.array(frame_link, int))
+
+
 def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, title: str,
                   q_guess=None, summary_extra: dict | None = None) -> dict:
     """The run every mechanism gets (TOML case or URDF file): motion along ``traj`` at ``t``
@@ -83,7 +93,8 @@ def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, 
                  mass=np.array([b.mass for b in bodies], float),
                  inertia_body=np.array([b.inertia for b in bodies], float).reshape(-1, 3, 3),
                  com=motion.com, rotation=motion.rotation, shaking_force=F, shaking_moment=M,
-                 q=q, qd=v, qdd=a, torque=torque, base_reaction_force=R_F, base_reaction_moment=R_M)
+                 q=q, qd=v, qdd=a, torque=torque, base_reaction_force=R_F, base_reaction_moment=R_M,
+                 **_drawing(mech, motion))
     report.plot_wrench(out / "shaking_wrench.png", t, {"nominal": (F, M)}, title=title,
                        caption="Shaking force dP/dt and shaking moment dH_O/dt (about the base origin "
                                "O, inertial part only: no gravity) of all bodies along the trajectory.")
