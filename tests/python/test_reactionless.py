@@ -16,7 +16,7 @@ import pytest
 import mechbal
 from mechbal import control, simulate
 from mechbal.cases import run_case
-from mechbal.config import CASES_DIR, ConfigError
+from mechbal.config import CASES_DIR, ConfigError, case_path
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from mechbal.trajectory import RestToRest
 
@@ -145,7 +145,7 @@ def test_paminsa_exported_poses_conserve_angular_momentum(tmp_path):
     """PAMINSA as data (38 bodies, 9 loops) with its wrist balancing the moment: the shaking
     moment recomputed by finite differences from bodies_controlled.npz (RK4, 1 kHz) is at most
     1e-4 of the uncontrolled peak."""
-    case = _with_control(CASES_DIR / "paminsa-linkage.toml", tmp_path / "paminsa-rl.toml",
+    case = _with_control(case_path("paminsa-linkage"), tmp_path / "paminsa-rl.toml",
                          '[control]\nkind = "reactionless"\nbalancing_joints = ["wrist_phi", '
                          '"wrist_theta", "wrist_psi"]\ncancel = ["moment"]\nintegrator = "rk4"\n'
                          'rate_hz = 1000.0\n')
@@ -352,7 +352,7 @@ def test_operational_space_uses_redundancy_to_cancel_the_moment(tmp_path):
     assert np.all(r.status == 0)
     # the tool follows the circle: positions of the commanded poses against the integrated path
     p = mech.frame_placement(r.q, "tool")[:, :3, 3]
-    circle = p[0] + np.stack([0.1 * (np.cos(2 * r.t) - 1), 0.1 * np.sin(2 * r.t)], axis=1)
+    circle = p[0, :2] + np.stack([0.1 * (np.cos(2 * r.t) - 1), 0.1 * np.sin(2 * r.t)], axis=1)
     assert np.max(np.abs(p[:, :2] - circle)) < 1e-9
     # H_z of the commanded motion (recomputed by mechbal.Mechanism) stays at the start's (zero)
     H = mech.momentum(r.q, r.v).angular_momentum[:, 2]

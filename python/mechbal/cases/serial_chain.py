@@ -171,7 +171,7 @@ def _write_variant(mech: Mechanism, out: Path, variant: str, t, q, v, a):
                  mass=np.array([b.mass for b in bodies], float),
                  inertia_body=np.array([b.inertia for b in bodies], float).reshape(-1, 3, 3),
                  com=motion.com, rotation=motion.rotation, shaking_force=sw.shaking_force,
-                 shaking_moment=sw.shaking_moment, q=q, qd=v, qdd=a)
+                 shaking_moment=sw.shaking_moment, q=q, qd=v, qdd=a, **_drawing(mech, motion))
     return sw.shaking_force, sw.shaking_moment
 
 
