@@ -759,14 +759,16 @@ void bind_mechanism(py::module_& m) {
         batch_rows(mo, a, "a", N);
         const auto n = static_cast<Eigen::Index>(mo.dof());
         Array F = make_array({N, 3}), M = make_array({N, 3}), P = make_array({N, 3}), H = make_array({N, 3}),
-              RF = make_array({N, 3}), RM = make_array({N, 3});
+              RF = make_array({N, 3}), RM = make_array({N, 3}), SF = make_array({N, 3}),
+              SM = make_array({N, 3});
         auto status = run_batch(
             mo, N,
             [&](py::ssize_t k, MechanismData& d) {
               return base_reaction(mo, d, CVec(row(q, k), n), CVec(row(v, k), n), CVec(row(a, k), n));
             },
             [](const MechanismData& d) {
-              return finite_wrench(d) && d.base_reaction.force.allFinite() && d.base_reaction.moment.allFinite();
+              return finite_wrench(d) && d.base_reaction.force.allFinite() && d.base_reaction.moment.allFinite() &&
+                     d.support_reaction.force.allFinite() && d.support_reaction.moment.allFinite();
             },
             [&](py::ssize_t k, const MechanismData& d, bool ok) {
               put3(F, k, 0, d.shaking.force, ok);
@@ -775,6 +777,8 @@ void bind_mechanism(py::module_& m) {
               put3(H, k, 0, d.shaking.angular_momentum, ok);
               put3(RF, k, 0, d.base_reaction.force, ok);
               put3(RM, k, 0, d.base_reaction.moment, ok);
+              put3(SF, k, 0, d.support_reaction.force, ok);
+              put3(SM, k, 0, d.support_reaction.moment, ok);
             });
         py::dict out;
         out["shaking_force"] = F;
@@ -784,6 +788,8 @@ void bind_mechanism(py::module_& m) {
         if (with_gravity) {
           out["base_reaction_force"] = RF;
           out["base_reaction_moment"] = RM;
+          out["support_reaction_force"] = SF;
+          out["support_reaction_moment"] = SM;
         }
         out["status"] = status;
         return out;

@@ -60,6 +60,8 @@ def _cmd_run(args) -> int:
     out = Path(args.out)
     check_output_dir(out)           # before anything else: a bad --out fails in the first second
     check_case_file(args.case)
+    if getattr(args, "engine", "mechbal") == "mujoco":
+        return _run_mujoco(args, out)
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer):  # the runner's tables, printed after its bar closes
         summary = run_case(args.case, out, animate=getattr(args, "animate", False),
@@ -75,6 +77,22 @@ def _cmd_run(args) -> int:
               f"{out}/summary.json (listed under non_finite_values)", file=sys.stderr)
     if not args.quiet:
         print(f"wrote {out}/summary.json and the plots and bodies files beside it")
+    return 0
+
+
+def _run_mujoco(args, out: Path) -> int:
+    from mechbal.output import staged_output
+    from mechbal.verify import run_cosimulation
+
+    buffer = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(buffer), staged_output(out) as tmp:
+            run_cosimulation(args.case, tmp)
+    except ImportError as exc:  # the optional 'mujoco' extra is missing: the message names it
+        raise UserError(str(exc)) from None
+    if not args.quiet:
+        sys.stdout.write(buffer.getvalue())
+        print(f"wrote {out}/summary.json, base_reaction.png (MuJoCo beside mechbal) and the files beside them")
     return 0
 
 
@@ -138,6 +156,61 @@ def _cmd_sweep(args) -> int:
     return 0
 
 
+def _export_mechanism(case: str):
+    """(mechanism, assembled pose or None, q_guess) of a case for the exporters and MuJoCo: a
+    URDF file, or any case ``mechbal balance`` reads (its mechanism at the trajectory's start)."""
+    import numpy as np
+
+    from mechbal.mechanism import Mechanism
+
+    if str(case).lower().endswith(".urdf"):
+        check_case_file(case)
+        return Mechanism.from_urdf(case), None, None
+    from mechbal.balance.run import load_case
+
+    bc = load_case(case)
+    mech, qa = bc.mechanism, np.asarray(bc.motion[0][0], float)
+    q0 = np.asarray(mech.closed_motion(qa, q_guess=bc.q_guess).q, float) if mech.is_closed else qa
+    return mech, q0, bc.q_guess
+
+
+def _cmd_export(args) -> int:
+    from mechbal.export.common import ExportError
+
+    mech, q0, guess = _export_mechanism(args.case)
+    fmt = args.format or ("urdf" if str(args.out).lower().endswith(".urdf") else "mjcf")
+    try:
+        text = mech.to_urdf(name=mech.name) if fmt == "urdf" else mech.to_mjcf(q=q0, q_guess=guess)
+    except ExportError as exc:
+        raise UserError(str(exc)) from None
+    out = Path(args.out)
+    if out.is_dir():
+        raise UserError(f"--out: '{out}' is a folder: give a file name")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text)
+    if not args.quiet:
+        print(f"wrote {out} ({fmt.upper()}, {mech!r})")
+    return 0
+
+
+def _cmd_verify(args) -> int:
+    from mechbal.output import check_output_dir, staged_output
+    from mechbal.verify import run_verify
+
+    out = Path(args.out)
+    check_output_dir(out)
+    buffer = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(buffer), staged_output(out) as tmp:
+            run_verify(args.case, tmp, simulate=not args.no_simulation, method=args.method)
+    except ImportError as exc:  # the optional 'mujoco' extra is missing: the message names it
+        raise UserError(str(exc)) from None
+    if not args.quiet:
+        sys.stdout.write(buffer.getvalue())
+        print(f"wrote {out}/summary.json and the plots beside it")
+    return 0
+
+
 # ---- parser and main --------------------------------------------------------------------------
 
 class _Parser(argparse.ArgumentParser):
@@ -177,6 +250,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="URDF files: duration of the default trajectory [s] (default: 2)")
     s.add_argument("--samples", type=int, metavar="N",
                    help="URDF files: number of instants of the default trajectory (default: 501)")
+    s.add_argument("--engine", choices=("mechbal", "mujoco"), default="mechbal",
+                   help="mechbal: the case's own runner (default); mujoco: mechbal's computed-torque "
+                        "controller ticked at 1 kHz against MuJoCo integrating the case's MJCF export, "
+                        "MuJoCo's base reaction beside mechbal's (needs the 'mujoco' extra)")
     s.add_argument("--animate", action="store_true",
                    help="also write DIR/animation_<variant>.gif: the mechanism moving, with the "
                         "shaking force and moment drawn at its base")
@@ -199,6 +276,31 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
     s.add_argument("-q", "--quiet", **quiet)
     s.set_defaults(func=_cmd_balance)
+    s = sub.add_parser("export", help="write a case's mechanism as MJCF (MuJoCo) or URDF",
+                       description="Write the mechanism of a case (built-in name, TOML or URDF file) "
+                                   "as MJCF (any mechanism: loops, gears, springs; the assembled pose "
+                                   "of the trajectory's start as keyframe) or URDF (trees without "
+                                   "springs).")
+    s.add_argument("case", help="built-in case name or path to a TOML or URDF file")
+    s.add_argument("--format", choices=("mjcf", "urdf"), default=None,
+                   help="file format (default: urdf for an --out ending in .urdf, mjcf otherwise)")
+    s.add_argument("--out", required=True, metavar="FILE", help="the file to write")
+    s.add_argument("-q", "--quiet", **quiet)
+    s.set_defaults(func=_cmd_export)
+    s = sub.add_parser("verify", help="check a case's predictions (balanced and not) in MuJoCo",
+                       description="Export the case's mechanism and its balanced variant to MuJoCo and "
+                                   "compare mechbal's predicted shaking force, shaking moment and "
+                                   "gravity torque with MuJoCo's (inverse dynamics on the trajectory, "
+                                   "and a 1 kHz computed-torque simulation): DIR/summary.json, a "
+                                   "table and plots. Needs the 'mujoco' extra.")
+    s.add_argument("case", help="built-in case name or path to a TOML case file")
+    s.add_argument("--out", default="out/verify", metavar="DIR", help="output folder (default: out/verify)")
+    s.add_argument("--method", choices=("static", "force", "moment", "springs", "rms"), default=None,
+                   help="balancing method of the balanced variant (default: balance.method of the case)")
+    s.add_argument("--no-simulation", action="store_true",
+                   help="only the inverse dynamics on the trajectory (no forward simulation)")
+    s.add_argument("-q", "--quiet", **quiet)
+    s.set_defaults(func=_cmd_verify)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")
     s.add_argument("--out", default="out/demo", metavar="DIR", help="output folder (default: out/demo)")

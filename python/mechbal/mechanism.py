@@ -42,11 +42,17 @@ class ShakingWrench:
 
 @dataclass(frozen=True)
 class BaseReaction:
-    """Wrench the base exerts on the mechanism, gravity included: force [N], moment about O [N m]."""
+    """Wrench the base exerts on the moving mechanism, gravity included: force [N], moment about
+    O [N m]. The bodies that do not move (on the root link, or on links joined to it by fixed
+    joints only: a URDF's ``base_link``) are the base's own and do not count; ``support_force``
+    and ``support_moment`` are the same wrench with them (what the ground exerts on the base and
+    everything it carries)."""
 
     base_reaction_force: np.ndarray
     base_reaction_moment: np.ndarray
     status: np.ndarray
+    support_force: np.ndarray | None = None
+    support_moment: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -255,6 +261,31 @@ class Mechanism:
         return Mechanism(_core.MechanismModel(desc), name=name or self.name, source=self.source,
                          link_frames=self.link_frames)
 
+    # ---- export --------------------------------------------------------------------------------
+    def to_mjcf(self, path: str | Path | None = None, *, q=None, q_guess=None, name: str | None = None,
+                timestep: float = 1e-3) -> str:
+        """MuJoCo model (MJCF) of this mechanism: tree, gears, loops, springs, every body with its
+        own inertia, names kept (:mod:`mechbal.export.mjcf`); ``q``: the keyframe's pose (a closed
+        mechanism is assembled from ``q`` or ``q_guess``). Writes ``path`` when given; returns the
+        text. Raises :class:`mechbal.export.ExportError` (a ValueError) for what MJCF cannot hold."""
+        from mechbal.export.mjcf import mjcf_text
+
+        text = mjcf_text(self, name, q=q, q_guess=q_guess, timestep=timestep)
+        if path is not None:
+            Path(path).write_text(text)
+        return text
+
+    def to_urdf(self, path: str | Path | None = None, *, name: str | None = None) -> str:
+        """URDF of this mechanism (:mod:`mechbal.export.urdf`: link names, frames and every body's
+        inertia kept). Raises :class:`mechbal.export.ExportError` for loops or springs, which
+        URDF cannot describe. Writes ``path`` when given; returns the text."""
+        from mechbal.export.urdf import urdf_text
+
+        text = urdf_text(self, name)
+        if path is not None:
+            Path(path).write_text(text)
+        return text
+
     # ---- structure ---------------------------------------------------------------------------
     @property
     def dof(self) -> int:
@@ -460,12 +491,15 @@ class Mechanism:
         return ShakingWrench(F, M, P, H, st)
 
     def base_reaction(self, q, v, a) -> BaseReaction:
-        """Wrench the base exerts on the mechanism, gravity included: force = dP/dt - m g,
-        moment about O = dH_O/dt - (m c) x g."""
+        """Wrench the base exerts on the moving mechanism, gravity included: force = dP/dt - m g,
+        moment about O = dH_O/dt - (m c) x g, m and m c over the bodies that move (those on the
+        root link and on links fixed to it are the base's own: their weight is not carried by the
+        mechanism). ``support_force`` / ``support_moment``: the same over every body."""
         single, (q, v, a) = self._args(("q", "v", "a"), (q, v, a))
-        (F, M), st = self._finish(single, _core.mechanism_shaking_wrench(self.model, q, v, a, True),
-                                  ["base_reaction_force", "base_reaction_moment"])
-        return BaseReaction(F, M, st)
+        (F, M, SF, SM), st = self._finish(
+            single, _core.mechanism_shaking_wrench(self.model, q, v, a, True),
+            ["base_reaction_force", "base_reaction_moment", "support_reaction_force", "support_reaction_moment"])
+        return BaseReaction(F, M, st, SF, SM)
 
     def body_motion(self, q, v=None, a=None) -> BodyMotion:
         """Every body's pose, velocity and acceleration in O (v and a default to zero)."""

@@ -44,7 +44,9 @@ class ClosedLoopResult:
     * ``status`` (N,): per tick, the controller's and the plant's flags (0 = ok,
       :class:`mechbal.Status`);
     * ``saturated_ticks``: ticks on which the controller clipped the torque;
-    * ``steps_completed``: ``steps`` unless the plant failed (later rows repeat the last state).
+    * ``steps_completed``: ``steps`` unless the plant failed (later rows repeat the last state);
+    * ``mujoco``: with ``engine="mujoco"``, the co-simulation's record (MuJoCo's base reaction
+      beside mechbal's prediction), else None.
     """
 
     t: np.ndarray
@@ -56,6 +58,9 @@ class ClosedLoopResult:
     status: np.ndarray
     saturated_ticks: int
     steps_completed: int
+    #: ``engine="mujoco"``: the :class:`mechbal.export.mujoco_engine.CoSimulation` (MuJoCo's base
+    #: reaction at every tick beside mechbal's prediction, the loops' constraint violation)
+    mujoco: Any = None
 
     @property
     def tracking_error(self) -> np.ndarray:
@@ -88,7 +93,8 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
                 q0: npt.ArrayLike | None = None, qd0: npt.ArrayLike | None = None, *,
                 dt: float = 1e-3, duration: float | None = None,
                 sampling: str = "zero_order_hold",
-                q_guess: npt.ArrayLike | None = None) -> ClosedLoopResult:
+                q_guess: npt.ArrayLike | None = None, engine: str = "mechbal",
+                **engine_options: Any) -> ClosedLoopResult:
     """Simulate ``controller`` driving ``mechanism_or_plant`` along ``trajectory`` (one C++ call).
 
     Args:
@@ -110,6 +116,14 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
         sampling: ``"zero_order_hold"`` (a digital controller: the torque of tick k is held over
             the step) or ``"every_rk4_stage"`` (the continuous control law at each RK4 stage).
         q_guess: full coordinates near the assembly, for a closed-loop Mechanism.
+        engine: ``"mechbal"`` (the C++ RK4 above) or ``"mujoco"``: the controller ticked every
+            ``dt`` from Python against MuJoCo integrating the mechanism's MJCF export (a
+            :class:`mechbal.Mechanism` only; zero-order hold; needs ``mechbal[mujoco]``). The
+            result's ``mujoco`` holds MuJoCo's base reaction at every tick beside mechbal's
+            prediction.
+        **engine_options: with ``engine="mujoco"``, the options of
+            :func:`mechbal.export.mujoco_engine.co_simulate` (``substeps``, ``integrator``,
+            ``solref``, ``solimp``, ``minimum_mass``, ``constraint_weight``).
 
     Returns:
         :class:`ClosedLoopResult`. A plant failure (an unassemblable pose, a non-finite state)
@@ -117,6 +131,13 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
     """
     from mechbal.trajectory import RestToRest, as_trajectory
 
+    if engine == "mujoco":
+        return _closed_loop_mujoco(mechanism_or_plant, controller, trajectory, q0, qd0, dt=dt,
+                                   duration=duration, sampling=sampling, q_guess=q_guess, **engine_options)
+    if engine != "mechbal":
+        raise ValueError(f"engine must be 'mechbal' or 'mujoco', got {engine!r}")
+    if engine_options:
+        raise TypeError(f"unexpected options for the mechbal engine: {', '.join(engine_options)}")
     plant = _plant(mechanism_or_plant, q_guess)
     if hasattr(controller, "joint_controller"):  # a ReactionlessController with its CT stage
         if controller.joint_controller is None:
@@ -148,6 +169,28 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
                             status=np.asarray(log["tick_status"]),
                             saturated_ticks=int(log["saturated_ticks"]),
                             steps_completed=int(log["steps_completed"]))
+
+
+def _closed_loop_mujoco(mech: Any, controller: Any, trajectory: Any, q0, qd0, *, dt: float,
+                        duration: float | None, sampling: str, q_guess, **options: Any) -> ClosedLoopResult:
+    from mechbal.mechanism import Mechanism
+
+    if not isinstance(mech, Mechanism):
+        raise TypeError("engine='mujoco' simulates a mechbal.Mechanism (exported to MJCF), got "
+                        f"{type(mech).__name__}")
+    if sampling != "zero_order_hold":
+        raise ValueError("engine='mujoco' ticks the controller once per dt (sampling='zero_order_hold')")
+    if not isinstance(controller, _core.JointController):
+        raise TypeError("controller must be a joint controller (mechbal.control.ComputedTorque, "
+                        f"DecoupledJointController), got {type(controller).__name__}")
+    from mechbal.export.mujoco_engine import co_simulate  # the optional engine (mechbal[mujoco])
+
+    r = co_simulate(mech, controller, trajectory, q0, qd0, dt=dt, duration=duration, q_guess=q_guess,
+                    **options)
+    return ClosedLoopResult(t=r.t, q=r.q, qd=r.qd, q_des=r.q_des, qd_des=r.qd_des,
+                            joint_torque=r.joint_torque, status=r.status,
+                            saturated_ticks=r.saturated_ticks, steps_completed=r.steps_completed,
+                            mujoco=r)
 
 
 @dataclass

@@ -101,6 +101,62 @@ TEST(Mechanism, ShakingWrenchEqualsTheSumOverBodies) {
   }
 }
 
+TEST(Mechanism, BaseReactionCountsTheMovingBodiesOnly) {
+  // Bodies on the root and on links fixed to it are the base's own: the base reaction (on the
+  // moving mechanism) is the same with or without them; the support reaction adds their weight
+  // and its moment about O. Against the per-body base reaction of rigid_body.hpp over the moving
+  // bodies (an independent sum).
+  std::mt19937 rng(24);
+  for (int trial = 0; trial < 6; ++trial) {
+    MechanismDescription d;
+    d.joints.push_back(Joint{"mount", JointType::fixed, d.root_name, test::random_pose(rng)});
+    d.joints.push_back(Joint{"j1", JointType::revolute, "mount", test::random_pose(rng), Vec3::UnitZ()});
+    d.joints.push_back(Joint{"j2", JointType::prismatic, "j1", test::random_pose(rng), Vec3::UnitX()});
+    d.joints.push_back(Joint{"tool", JointType::fixed, "j2", test::random_pose(rng)});
+    for (const char* link : {"j1", "j2", "tool"}) {
+      const RigidBody rb = test::random_body(rng);
+      d.bodies.push_back(Body{std::string(link) + "_b", "link", link, rb.mass, test::random_vector(rng, 3, 0.2),
+                              rb.inertia_body});
+    }
+    const MechanismModel moving(d);
+    MechanismDescription with = d;
+    with.bodies.push_back(Body{"base_link", "link", d.root_name, 4.0, Vec3(0.1, -0.2, 0.3), Mat3::Identity()});
+    with.bodies.push_back(Body{"mount_b", "link", "mount", 2.5, Vec3(-0.3, 0.1, 0.2), Mat3::Identity()});
+    const MechanismModel model(with);
+    MechanismData d0(moving), d1(model);
+    const Eigen::VectorXd q = test::random_vector(rng, 2, 2.0), v = test::random_vector(rng, 2, 1.0),
+                          a = test::random_vector(rng, 2, 1.0);
+    ASSERT_EQ(base_reaction(moving, d0, q, v, a), Status::ok);
+    ASSERT_EQ(base_reaction(model, d1, q, v, a), Status::ok);
+    EXPECT_LT(rel(d1.base_reaction.force, d0.base_reaction.force), 1e-13);
+    EXPECT_LT(rel(d1.base_reaction.moment, d0.base_reaction.moment), 1e-13);
+    EXPECT_LT(rel(d0.support_reaction.force, d0.base_reaction.force), 1e-15);
+    const Vec3 g = model.gravity();
+    ASSERT_EQ(forward_kinematics(model, d1, q, v, a), Status::ok);
+    // the still bodies' weight: 4 kg at its com in O, 2.5 kg at the mount's com in O
+    const auto idx = [&](const char* n) { return static_cast<std::size_t>(model.body_index(n)); };
+    const Vec3 c_base = d1.body_states[idx("base_link")].com;
+    const Vec3 c_mount = d1.body_states[idx("mount_b")].com;
+    EXPECT_LT((c_base - Vec3(0.1, -0.2, 0.3)).norm(), 1e-15);
+    EXPECT_LT(rel(d1.support_reaction.force - d1.base_reaction.force, Vec3(-6.5 * g)), 1e-13);
+    EXPECT_LT(rel(d1.support_reaction.moment - d1.base_reaction.moment,
+                  Vec3(-c_base.cross(4.0 * g) - c_mount.cross(2.5 * g))), 1e-12);
+    // independent: rigid_body.hpp's base reaction over the three moving bodies
+    std::vector<RigidBody> inertias;
+    std::vector<BodyState> states;
+    for (const char* n : {"j1_b", "j2_b", "tool_b"}) {
+      inertias.push_back(d1.body_inertias[idx(n)]);
+      states.push_back(d1.body_states[idx(n)]);
+    }
+    ShakingWrench sw;
+    BaseReaction br;
+    ASSERT_EQ(shaking_wrench(inertias.data(), states.data(), 3, sw), Status::ok);
+    ASSERT_EQ(base_reaction(inertias.data(), states.data(), 3, g, sw, br), Status::ok);
+    EXPECT_LT(rel(d1.base_reaction.force, br.force), 1e-12);
+    EXPECT_LT(rel(d1.base_reaction.moment, br.moment), 1e-12);
+  }
+}
+
 TEST(Mechanism, VirtualPowerAndMomentumMatrix) {
   // tau . v = dT/dt + dV/dt with T = v^T M v / 2: checks the dynamics against the mass matrix along
   // a motion by finite differences of the energy; and A(q) v equals the momenta.

@@ -204,12 +204,18 @@ def test_root_inertial_is_a_body_on_the_base(tmp_path):
     assert np.allclose(base.inertia, R @ np.diag([0.3, 0.4, 0.5]) @ R.T, atol=1e-15)
     assert mech.total_mass == pytest.approx(7.5 + sum(ln.mass for ln in tree.links), rel=1e-15)
     compare_with_pinocchio(mech, pm, rng)
-    # the base's weight is in the base reaction, not in the shaking wrench
+    # the base's weight is in neither the shaking wrench nor the base reaction (the wrench the base
+    # exerts on the moving mechanism), only in the support reaction (everything, the base included)
     q, v, a = rng.normal(size=(3, mech.dof))
     without = mechbal.Mechanism.from_urdf_string(_urdf(tree))
     assert _rel(mech.shaking_wrench(q, v, a).shaking_force, without.shaking_wrench(q, v, a).shaking_force) < 1e-12
-    dF = mech.base_reaction(q, v, a).base_reaction_force - without.base_reaction(q, v, a).base_reaction_force
-    assert np.allclose(dF, -7.5 * mech.gravity, rtol=1e-12, atol=1e-12)
+    r, r0 = mech.base_reaction(q, v, a), without.base_reaction(q, v, a)
+    assert _rel(r.base_reaction_force, r0.base_reaction_force) < 1e-12
+    assert _rel(r.base_reaction_moment, r0.base_reaction_moment) < 1e-12
+    assert np.allclose(r.support_force - r0.support_force, -7.5 * mech.gravity, rtol=1e-12, atol=1e-12)
+    c = np.array([0.1, -0.2, 0.3])   # the base's centre of mass: its weight's moment about O
+    assert np.allclose(r.support_moment - r0.support_moment, np.cross(c, -7.5 * mech.gravity), rtol=1e-12,
+                       atol=1e-12)
 
 
 def test_every_urdf_link_is_a_frame(tmp_path):

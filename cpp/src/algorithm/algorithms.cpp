@@ -221,13 +221,30 @@ Status shaking_wrench(const MechanismModel& model, MechanismData& data, const Co
 Status base_reaction(const MechanismModel& model, MechanismData& data, const ConstVector& q,
                      const ConstVector& v, const ConstVector& a) noexcept {
   if (Status s = shaking_wrench(model, data, q, v, a); s != Status::ok) return s;
+  // the links that do not move (the root and the links fixed to it) are the base's: their weight
+  // is carried by the base itself, not through the moving mechanism's joints. Links are listed
+  // parents first, so one walk up each link's path decides (bounded by the tree's depth).
+  Vec3 mc_still = Vec3::Zero();
+  double m_still = 0.0;
+  for (int l = 0; l < model.num_links(); ++l) {
+    int k = l;
+    while (k > 0 && model.joint_type(k) == JointType::fixed) k = model.parent(k);
+    if (k != 0) continue;  // moves
+    const auto& c = model.link_constants(l);
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    mc_still += c.mass * W.world_position + W.world_rotation * c.first_moment;
+    m_still += c.mass;
+  }
   const Vec3 mc = mass_moment(model, data);
   const Vec3& g = model.gravity();
   data.mass = model.total_mass();
   data.center_of_mass = data.mass > 0.0 ? Vec3(mc / data.mass) : Vec3::Zero();
-  data.base_reaction.force = data.shaking.force - data.mass * g;
-  data.base_reaction.moment = data.shaking.moment - mc.cross(g);
-  return finite_result(data.base_reaction.force, data.base_reaction.moment);
+  data.base_reaction.force = data.shaking.force - (data.mass - m_still) * g;
+  data.base_reaction.moment = data.shaking.moment - (mc - mc_still).cross(g);
+  data.support_reaction.force = data.shaking.force - data.mass * g;
+  data.support_reaction.moment = data.shaking.moment - mc.cross(g);
+  return finite_result(data.base_reaction.force, data.base_reaction.moment, data.support_reaction.force,
+                       data.support_reaction.moment);
 }
 
 // ---- inverse dynamics ---------------------------------------------------------------------------

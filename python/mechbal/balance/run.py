@@ -11,8 +11,10 @@ residuals, the bounds and undetermined combinations, and before/after peak and R
 torque, the actuator torques, the shaking force and the shaking moment along the trajectory),
 ``gravity_torque.png``, ``joint_torques.png``, ``shaking_wrench.png``, ``bodies_unbalanced.npz``
 and ``bodies_balanced.npz`` (the schema of :mod:`mechbal.export`), ``balanced.toml`` (a case that
-``mechbal run`` runs; springs as ``[[mechanism.springs]]``) and, for trees without springs,
-``balanced.urdf`` (URDF cannot carry springs: summary.json says so instead).
+``mechbal run`` runs; springs as ``[[mechanism.springs]]``), ``balanced.xml`` (MJCF, for MuJoCo:
+:mod:`mechbal.export.mjcf`, the pose of the trajectory's start as keyframe) and, for trees without
+springs, ``balanced.urdf`` (URDF cannot carry loops or springs: summary.json's ``urdf`` says why
+instead).
 
 Layer: methods (docs/architecture.md).
 """
@@ -422,13 +424,20 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
     files = ["bodies_unbalanced.npz", "bodies_balanced.npz", "gravity_torque.png", "joint_torques.png",
              "shaking_wrench.png", "balanced.toml"]
     (out / "balanced.toml").write_text(_balanced_toml(bc, result, name))
-    urdf_note = None
-    if result.balanced.springs:   # URDF has no springs: no file that silently drops them
-        urdf_note = ("no balanced.urdf: the balanced mechanism has springs, which URDF cannot describe "
-                     "(balanced.toml carries them as [[mechanism.springs]])")
-    elif not result.balanced.is_closed:
-        from mechbal.balance.writers import urdf_text
+    from mechbal.export.common import ExportError
+    from mechbal.export.urdf import urdf_refusal, urdf_text
 
+    export_notes = {}
+    try:   # MJCF: any mechanism, assembled at the trajectory's start
+        (out / "balanced.xml").write_text(result.balanced.to_mjcf(q=after["q"][0], q_guess=bc.q_guess,
+                                                                  name=f"{bc.name}-balanced"))
+        files.append("balanced.xml")
+    except ExportError as exc:
+        export_notes["mjcf"] = f"no balanced.xml: {exc}"
+    why = urdf_refusal(result.balanced)   # no URDF that silently drops loops or springs
+    if why:
+        export_notes["urdf"] = f"no balanced.urdf: {why}; balanced.toml and balanced.xml carry them"
+    else:
         (out / "balanced.urdf").write_text(urdf_text(result.balanced, f"{bc.name}-balanced"))
         files.append("balanced.urdf")
     progress.stage("summary")
@@ -439,8 +448,7 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
                "before_after": _comparison(before, after),
                "total_mass_kg": {"unbalanced": bc.mechanism.total_mass, "balanced": result.balanced.total_mass},
                "files": files}
-    if urdf_note:
-        summary["urdf"] = urdf_note
+    summary.update(export_notes)
     if bc.notes:
         summary["case_notes"] = bc.notes
     write_summary(out / "summary.json", summary)

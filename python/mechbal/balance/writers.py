@@ -7,10 +7,8 @@
   every body with its centre of mass and full inertia in its link frame, frames, loops, springs).
   The root link is written ``base`` (a URDF's may be ``world``); a frame named ``base`` (a URDF
   link of that name) is written ``base_frame``, since ``base`` is the TOML format's fixed base.
-* :func:`urdf_text`: URDF of a mechanism without loops: one ``<link>`` per joint (named after
-  it, as mechbal names links), its bodies merged into one ``<inertial>`` (exact for dynamics),
-  joints ``revolute`` (``continuous`` without limits), ``prismatic``, ``fixed``, gears as
-  ``<mimic>``. URDF has no gravity: the mechanism's is written in a comment.
+* :func:`urdf_text`: URDF of a tree without springs, :func:`mechbal.export.urdf.urdf_text`
+  (imported here for the callers of this module).
 
 Layer: methods (docs/architecture.md).
 """
@@ -23,6 +21,8 @@ from typing import Any, Mapping
 import numpy as np
 
 from mechbal import _core
+from mechbal.export.common import merged_inertial, rpy_of  # noqa: F401  (shared with the exporters)
+from mechbal.export.urdf import urdf_text  # noqa: F401  (its home: mechbal.export.urdf)
 
 _BARE = set("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-")
 
@@ -84,15 +84,6 @@ def toml_text(data: Mapping[str, Any], header: str = "") -> str:
 
 # ---- Mechanism -> [mechanism] ----------------------------------------------------------------------
 
-def rpy_of(R: np.ndarray) -> list[float]:
-    """Roll, pitch, yaw with R = Rz(yaw) Ry(pitch) Rx(roll) (mechbal and URDF's convention)."""
-    R = np.asarray(R, float)
-    pitch = math.asin(max(-1.0, min(1.0, -R[2, 0])))
-    if abs(R[2, 0]) < 1.0 - 1e-12:
-        roll, yaw = math.atan2(R[2, 1], R[2, 2]), math.atan2(R[1, 0], R[0, 0])
-    else:  # gimbal lock: roll and yaw turn about the same axis
-        roll, yaw = 0.0, math.atan2(-R[0, 1], R[1, 1])
-    return [roll, pitch, yaw]
 
 
 def _inertia6(I: np.ndarray) -> list[float]:
@@ -157,88 +148,3 @@ def mechanism_table(mech) -> dict:
                         for lp in loops]
         out["actuated"] = list(d.actuated)
     return out
-
-
-# ---- URDF -----------------------------------------------------------------------------------------
-
-def _f(x: float) -> str:
-    return repr(float(x))
-
-
-def _v(x) -> str:
-    return " ".join(_f(v) for v in x)
-
-
-def merged_inertial(bodies) -> tuple[float, np.ndarray, np.ndarray]:
-    """(mass, centre of mass, inertia about it) of bodies on one link, in the link frame."""
-    m = sum(float(b.mass) for b in bodies)
-    if m <= 0.0:
-        return 0.0, np.zeros(3), np.zeros((3, 3))
-    c = sum(float(b.mass) * np.asarray(b.com, float) for b in bodies) / m
-    I = np.zeros((3, 3))
-    for b in bodies:
-        r = np.asarray(b.com, float) - c
-        I += np.asarray(b.inertia, float) + float(b.mass) * (r @ r * np.eye(3) - np.outer(r, r))
-    return m, c, 0.5 * (I + I.T)
-
-
-def urdf_text(mech, name: str | None = None) -> str:
-    """URDF of a mechanism without loops (ValueError for a closed one)."""
-    from xml.sax.saxutils import quoteattr
-
-    if mech.is_closed:
-        raise ValueError("URDF describes trees only: this mechanism has loop closures (write TOML)")
-    if mech.springs:
-        raise ValueError("URDF has no springs: this mechanism has springs, which a URDF would silently "
-                         "drop (write TOML)")
-    d = mech.model.description
-    g = np.asarray(d.gravity, float)
-    out = ['<?xml version="1.0"?>',
-           f"<!-- written by mechbal; gravity {_v(g)} m/s^2 in the base frame (URDF has no gravity) -->",
-           f"<robot name={quoteattr(name or mech.name)}>"]
-    by_link: dict[str, list] = {}
-    for b in d.bodies:
-        by_link.setdefault(b.link, []).append(b)
-
-    def link(n: str) -> None:
-        m, c, I = merged_inertial(by_link.get(n, []))
-        if m <= 0.0:
-            out.append(f"  <link name={quoteattr(n)}/>")
-            return
-        out.extend([f"  <link name={quoteattr(n)}>",
-                "    <inertial>",
-                f'      <origin xyz="{_v(c)}" rpy="0 0 0"/>',
-                f'      <mass value="{_f(m)}"/>',
-                f'      <inertia ixx="{_f(I[0, 0])}" ixy="{_f(I[0, 1])}" ixz="{_f(I[0, 2])}" '
-                f'iyy="{_f(I[1, 1])}" iyz="{_f(I[1, 2])}" izz="{_f(I[2, 2])}"/>',
-                "    </inertial>",
-                "  </link>"])
-
-    link(d.root_name)
-    for j in d.joints:
-        link(j.name)
-        T = np.asarray(j.placement)
-        typ = _TYPES[j.type]
-        bounded = math.isfinite(j.lower) and math.isfinite(j.upper)
-        if typ == "revolute" and not bounded:
-            typ = "continuous"
-        out.append(f"  <joint name={quoteattr(j.name)} type=\"{typ}\">")
-        out.append(f"    <parent link={quoteattr(j.parent)}/>")
-        out.append(f"    <child link={quoteattr(j.name)}/>")
-        out.append(f'    <origin xyz="{_v(T[:3, 3])}" rpy="{_v(rpy_of(T[:3, :3]))}"/>')
-        if typ != "fixed":
-            out.append(f'    <axis xyz="{_v(j.axis)}"/>')
-            attrs = []
-            if typ != "continuous":
-                lo = j.lower if math.isfinite(j.lower) else -1e9
-                hi = j.upper if math.isfinite(j.upper) else 1e9
-                attrs += [f'lower="{_f(lo)}"', f'upper="{_f(hi)}"']
-            attrs.append(f'effort="{_f(j.effort_limit if math.isfinite(j.effort_limit) else 0.0)}"')
-            attrs.append(f'velocity="{_f(j.velocity_limit if math.isfinite(j.velocity_limit) else 0.0)}"')
-            out.append(f"    <limit {' '.join(attrs)}/>")
-            if j.mimic_joint:
-                out.append(f"    <mimic joint={quoteattr(j.mimic_joint)} multiplier=\"{_f(j.mimic_ratio)}\" "
-                           f"offset=\"{_f(j.mimic_offset)}\"/>")
-        out.append("  </joint>")
-    out.append("</robot>")
-    return "\n".join(out) + "\n"

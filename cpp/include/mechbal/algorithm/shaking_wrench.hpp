@@ -2,7 +2,7 @@
 /// \file algorithm/shaking_wrench.hpp
 /// The shaking wrench of a mechanism: the rates of its momenta about O (Briot & Arakelian 2009,
 /// eqs 1-4), F = dP/dt and M_O = dH_O/dt, which the mechanism exerts on its base (with the sign
-/// convention of rigid_body.hpp), and the full base reaction with gravity.
+/// convention of rigid_body.hpp), and the base reaction with gravity.
 #include <Eigen/Core>
 
 #include "mechbal/model/data.hpp"
@@ -16,9 +16,13 @@ using ConstVector = Eigen::Ref<const Eigen::VectorXd>;
 /// data.shaking: momenta and their rates (force, moment about O) for the motion (q, v, a).
 Status shaking_wrench(const MechanismModel& model, MechanismData& data, const ConstVector& q,
                       const ConstVector& v, const ConstVector& a) noexcept;
-/// data.base_reaction: the wrench the base exerts on the mechanism, gravity included:
-/// force = dP/dt - m g, moment about O = dH_O/dt - (m c) x g. Also fills data.shaking,
-/// data.center_of_mass.
+/// data.base_reaction: the wrench the base exerts on the moving mechanism, gravity included:
+/// force = dP/dt - m g, moment about O = dH_O/dt - (m c) x g, where m and m c sum the bodies that
+/// move: the bodies on the root link and on links joined to it by fixed joints only (a URDF's
+/// `base_link` of 4 kg) are the base's own, their weight carried by the base, not by the
+/// mechanism's joints. data.support_reaction: the same with every body of the model (the wrench
+/// the ground exerts on the base with what it carries, the base's own bodies being the only
+/// ones fixed). Also fills data.shaking, data.mass and data.center_of_mass (all bodies).
 Status base_reaction(const MechanismModel& model, MechanismData& data, const ConstVector& q,
                      const ConstVector& v, const ConstVector& a) noexcept;
 

@@ -40,7 +40,13 @@ struct MechanismData {
   double mass = 0.0;                   ///< total mass [kg]
   Vec3 center_of_mass = Vec3::Zero();  ///< in O [m]
   ShakingWrench shaking;   ///< momenta about O and their rates (shaking force and moment)
-  BaseReaction base_reaction;  ///< wrench the base exerts on the mechanism (gravity included)
+  /// Wrench the base exerts on the moving mechanism, gravity included (moment about O): the
+  /// bodies on the root link and on links fixed to it are the base's own and do not count
+  /// (algorithm/shaking_wrench.hpp).
+  BaseReaction base_reaction;
+  /// Wrench the ground exerts on every body of the model, those fixed to the base included:
+  /// base_reaction plus the weight of the bodies that do not move.
+  BaseReaction support_reaction;
   Eigen::VectorXd joint_torque;    ///< inverse dynamics, springs included [N m or N], size dof
   Eigen::VectorXd gravity_torque;  ///< G(q)
   Eigen::VectorXd bias_torque;     ///< C(q, v) v + G(q) + K(q) (springs included)

@@ -1,4 +1,4 @@
-"""Data export shared by every case study.
+"""Run data shared by every case study: bodies files and summary.json.
 
 ``bodies_<variant>.npz`` holds, for N instants and B bodies:
 ``t`` (N,), ``names`` (B,), ``mass`` (B,), ``inertia_body`` (B,3,3) about each centre of mass in
