@@ -120,6 +120,14 @@ def main(argv=None):
         "computed_torque_over_decoupled": ratio(cases, "ct3_disc_arm", "decoupled_step3"),
         "computed_torque_over_decoupled_6": ratio(cases, "ct6_disc_arm", "decoupled_step6"),
     }
+    # the general reactionless controller (issue 21): the same controller over Pinocchio
+    # (computeCentroidalMap + its time variation) on the reaction-wheel arm (target >= 1), and
+    # the general PAMINSA tick (loops, controller, shaking wrench of 38 bodies) over the closed form
+    for integ in ("euler", "rk4"):
+        ratios[f"pinocchio_over_mechbal_reactionless_wheel_{integ}"] = ratio(
+            cases, f"reactionless_wheel_{integ}_pinocchio", f"reactionless_wheel_{integ}")
+        ratios[f"reactionless_paminsa_general_over_closed_form_{integ}"] = ratio(
+            cases, f"reactionless_paminsa_{integ}", f"paminsa_tick_{integ}")
     for dof in (6, 7):
         ratios[f"kdl_over_mechbal_id{dof}"] = ratio(cases, f"id{dof}_kdl_raw", f"id{dof}_mechbal")
         ratios[f"pinocchio_over_mechbal_id{dof}"] = ratio(cases, f"id{dof}_pinocchio",

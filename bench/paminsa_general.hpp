@@ -7,6 +7,8 @@
 // and the shaking wrench to 1e-9 relative along the bench trajectory) and aborts otherwise, so the
 // bench cannot time a model that drifted from the Python one.
 #include <Eigen/Geometry>
+#include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "mechbal/model/model.hpp"
@@ -110,6 +112,89 @@ inline MechanismDescription paminsa_description(const PaminsaModel& model) {
   d.bodies = std::move(bodies);
   d.actuated = {"leg1_guide", "leg3_guide", "leg1_slider", "wrist_phi", "wrist_theta", "wrist_psi"};
   return d;
+}
+
+struct ActuatedState {
+  Eigen::VectorXd q, v, a;
+};
+
+/// The actuated joints' motion for a platform and wrist motion (the closed form's inverse
+/// kinematics and its derivatives; mechbal.papers.paminsa.paminsa_actuated_motion): alpha_i is the
+/// angle of A_h,i - M_i, A_h,i = (k B_h,i - C_h,i)/(k - 1); z_B = z_A + (z_P - l_CJ - z_A)/k.
+inline ActuatedState actuated(const PaminsaModel& pm, const MechanismModel& model, const PlatformMotion& m,
+                       const WristMotion& w) {
+  const PaminsaParameters& p = pm.parameters();
+  const double k = p.k;
+  double q[3][3];  // alpha1, alpha3, z_B: value, rate, acceleration
+  for (int leg : {0, 2}) {
+    const Eigen::Vector2d Ah = (k * pm.slider_line()[leg] - (m.position + pm.platform_joint_offset()[leg]).head<2>()) / (k - 1.0);
+    const Eigen::Vector2d g = Ah - pm.guide_pivot()[leg], gd = -m.velocity.head<2>() / (k - 1.0),
+                          gdd = -m.acceleration.head<2>() / (k - 1.0);
+    const auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a(0) * b(1) - a(1) * b(0); };
+    const double r2 = g.squaredNorm(), ad = cross(g, gd) / r2;
+    double* out = q[leg == 0 ? 0 : 1];
+    out[0] = std::atan2(g(1), g(0));
+    out[1] = ad;
+    out[2] = (cross(g, gdd) - 2.0 * ad * g.dot(gd)) / r2;
+  }
+  q[2][0] = p.z_A + (m.position(2) - p.length_CJ - p.z_A) / k;
+  q[2][1] = m.velocity(2) / k;
+  q[2][2] = m.acceleration(2) / k;
+  ActuatedState s{Eigen::VectorXd(model.num_actuated()), Eigen::VectorXd(model.num_actuated()),
+                  Eigen::VectorXd(model.num_actuated())};
+  for (int i = 0; i < model.num_actuated(); ++i) {
+    const std::string& name = model.coordinate_name(model.actuated_coordinates()[static_cast<std::size_t>(i)]);
+    const int wrist = name == "wrist_phi" ? 0 : name == "wrist_theta" ? 1 : name == "wrist_psi" ? 2 : -1;
+    const int act = name == "leg1_guide" ? 0 : name == "leg3_guide" ? 1 : name == "leg1_slider" ? 2 : -1;
+    if (wrist >= 0) {
+      s.q(i) = w.angles(wrist);
+      s.v(i) = w.rates(wrist);
+      s.a(i) = w.accelerations(wrist);
+    } else if (act >= 0) {
+      s.q(i) = q[act][0];
+      s.v(i) = q[act][1];
+      s.a(i) = q[act][2];
+    } else {
+      throw std::invalid_argument("PAMINSA general model: unexpected actuated joint " + name);
+    }
+  }
+  return s;
+}
+
+/// Every coordinate at platform position P from the closed form's leg points (the assembly mode).
+inline Eigen::VectorXd initial_guess(const PaminsaModel& pm, const MechanismModel& model, const PlatformMotion& m,
+                              const WristMotion& w) {
+  PaminsaWorkspace ws;
+  if (paminsa_mechanism_kinematics(pm, m, ws) != Status::ok) throw std::invalid_argument("PAMINSA general model: platform pose unreachable");
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(model.dof());
+  const auto set = [&](const std::string& name, double value) {
+    for (int c = 0; c < model.dof(); ++c)
+      if (model.coordinate_name(c) == name) q(c) = value;
+  };
+  set("platform_x", m.position(0));
+  set("platform_y", m.position(1));
+  set("platform_z", m.position(2));
+  set("wrist_phi", w.angles(0));
+  set("wrist_theta", w.angles(1));
+  set("wrist_psi", w.angles(2));
+  for (int i = 0; i < 3; ++i) {
+    const auto& pts = ws.leg_points[static_cast<std::size_t>(i)];  // A, B, C, D, E, F
+    const Vec3 &A = pts[0], &B = pts[1], &C = pts[2], &D = pts[3], &E = pts[4], &F = pts[5];
+    const Eigen::Vector2d u = (A - B).head<2>().normalized();
+    const auto elevation = [&](const Vec3& d) { return std::atan2(d(2), d.head<2>().dot(u)); };
+    const double g_df = elevation(F - D), g_ec = elevation(C - E), g_ae = elevation(E - A);
+    const Eigen::Vector2d g = A.head<2>() - pm.guide_pivot()[static_cast<std::size_t>(i)];
+    const std::string L = "leg" + std::to_string(i + 1);
+    set(L + "_slider", B(2));
+    set(L + "_column", std::atan2(u(1), u(0)));
+    set(L + "_link2", g_df);
+    set(L + "_link1", g_ec - g_df);
+    set(L + "_link3", g_ae - g_ec);
+    set(L + "_link4", g_ec - g_df);
+    set(L + "_guide", std::atan2(g(1), g(0)));
+    set(L + "_stroke", g.norm());
+  }
+  return q;
 }
 
 }  // namespace mechbal::bench

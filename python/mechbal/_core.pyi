@@ -8,7 +8,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ChainModel', 'ComputedTorque', 'ControlConfig', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointSpec', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'RneChainDynamics', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_chain_model', 'chain_description', 'chain_kinematics', 'load_case_file', 'load_mechanism_file', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_toml', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
+__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ChainModel', 'ComputedTorque', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointSpec', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessCommand', 'ReactionlessController', 'ReactionlessJointController', 'ReactionlessTaskController', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'RneChainDynamics', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_chain_model', 'chain_description', 'chain_kinematics', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
 class Status:
     """
     Bit flags returned by real-time algorithms
@@ -687,43 +687,6 @@ class RneChainDynamics(MechanismDynamics):
     MechanismDynamics of a serial ChainModel (the chain as a general mechanism)
     """
     def __init__(self, model: ChainModel) -> None:
-        ...
-class ControlConfig:
-    """
-    The [control] table as the C++ reader checked it (read only)
-    """
-    @property
-    def balancing_joints(self) -> list[str]:
-        ...
-    @property
-    def cancel(self) -> list[str]:
-        ...
-    @property
-    def damping(self) -> float:
-        ...
-    @property
-    def integrator(self) -> str:
-        ...
-    @property
-    def k(self) -> list[float]:
-        ...
-    @property
-    def kd(self) -> list[float]:
-        ...
-    @property
-    def kind(self) -> str:
-        ...
-    @property
-    def kp(self) -> list[float]:
-        ...
-    @property
-    def rate_hz(self) -> float:
-        ...
-    @property
-    def task_frame(self) -> str:
-        ...
-    @property
-    def torque_limit(self) -> list[float]:
         ...
 class PaminsaCounterweights:
     """
@@ -1460,6 +1423,156 @@ class FiveBarDynamics:
     @property
     def reciprocal_condition(self) -> float:
         ...
+class ReactionlessTaskController:
+    """
+    Operational-space reactionless control: a redundant open mechanism follows a desired twist of a frame, v = J^+ x' + N z, with z minimising the selected momentum components in the null space
+    """
+    def __init__(self, model: MechanismModel, task_frame: str, task_rows: collections.abc.Sequence[str] = ['all'], cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, q0: typing.Any = None, v0: typing.Any = None) -> None:
+        ...
+    def run(self, twist: numpy.typing.ArrayLike) -> dict:
+        """
+        Ticks along the desired frame twist [v; w] (O axes) sampled every dt/2 ((2 steps + 1, 6)): q, v (steps + 1, dof), momentum, frame_twist (steps + 1, 6), status.
+        """
+    @property
+    def dof(self) -> int:
+        ...
+    @property
+    def dt(self) -> float:
+        ...
+    @property
+    def target(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[6, 1]"]:
+        ...
+class ReactionlessCommand:
+    """
+    One reactionless tick's command: actuated q, v, a (task as given, balancing computed), every coordinate q_full, v_full, a_full, the balancing joints' next positions, momentum [P; H_O], the predicted shaking_force [N] and shaking_moment [N m], condition, status
+    """
+    @property
+    def a(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def a_full(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def condition(self) -> float:
+        ...
+    @property
+    def momentum(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[6, 1]"]:
+        ...
+    @property
+    def next_balancing(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def q(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def q_full(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def shaking_force(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def shaking_moment(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    @property
+    def status(self) -> int:
+        ...
+    @property
+    def v(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def v_full(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+class ReactionlessController:
+    """
+    Reactionless control of any MechanismModel (C++ mechbal::ReactionlessController): balancing joints keep the selected momentum components at their target
+    """
+    def __init__(self, model: MechanismModel, balancing_joints: collections.abc.Sequence[str], q0: typing.Any = None, cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, position_limits: bool = True, home_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, limit_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, home: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_task_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, v0: typing.Any = None, q_guess: typing.Any = None) -> None:
+        """
+        q0: the actuated coordinates at the start (default zeros); v0: their rates (default rest)
+        """
+    def reset(self, q0: numpy.typing.ArrayLike, v0: typing.Any = None) -> int:
+        ...
+    def run(self, q_task: numpy.typing.ArrayLike, v_task: numpy.typing.ArrayLike, a_task: numpy.typing.ArrayLike) -> dict:
+        """
+        Ticks along the task motion sampled on the half-step grid t_j = j dt/2 ((2 steps + 1, n_task) each): the command at the steps + 1 ticks t_n = n dt (the last tick Euler).
+        """
+    def set_target(self, momentum: numpy.typing.ArrayLike, momentum_rate: numpy.typing.ArrayLike) -> int:
+        ...
+    def step(self, q_task: numpy.typing.ArrayLike, v_task: numpy.typing.ArrayLike, a_task: numpy.typing.ArrayLike, q_half: typing.Any = None, v_half: typing.Any = None, q_next: typing.Any = None, v_next: typing.Any = None) -> int:
+        """
+        One tick; without the half/next samples an Euler tick. Returns the status; the command is in `command`.
+        """
+    def step_into(self, now: numpy.typing.NDArray[numpy.float64], half: numpy.typing.NDArray[numpy.float64], next: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+        """
+        The fast tick: now (3, n_task) rows q, v, a of the task joints at t_n; half and next (2, n_task) rows q, v at t_n + dt/2 and t_n + dt; writes the actuated command into out (3, n_actuated) rows q, v, a; returns the status. C-contiguous float64 arrays only.
+        """
+    @property
+    def balancing_indices(self) -> list[int]:
+        ...
+    @property
+    def balancing_joints(self) -> list[str]:
+        ...
+    @property
+    def balancing_state(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def cancelled_rows(self) -> list[int]:
+        ...
+    @property
+    def command(self) -> ReactionlessCommand:
+        ...
+    @property
+    def dt(self) -> float:
+        ...
+    @property
+    def num_actuated(self) -> int:
+        ...
+    @property
+    def num_balancing(self) -> int:
+        ...
+    @property
+    def num_task(self) -> int:
+        ...
+    @property
+    def target(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[6, 1]"]:
+        ...
+    @property
+    def task_indices(self) -> list[int]:
+        ...
+    @property
+    def task_joints(self) -> list[str]:
+        ...
+class ReactionlessJointController(JointController):
+    """
+    The reactionless controller followed by computed torque over the model: a JointController over the actuated coordinates (the balancing joints' desired entries are ignored)
+    """
+    def __init__(self, model: MechanismModel, balancing_joints: collections.abc.Sequence[str], q0: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, position_limits: bool = True, home_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, limit_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, home: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_task_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, torque_limit: typing.Any = None, q_guess: typing.Any = None) -> None:
+        ...
+    def reset(self) -> None:
+        """
+        Forget the held command (zero torque).
+        """
+    def run(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> dict:
+        """
+        N consecutive ticks in one call: q, qd [rad or m, rad/s or m/s], q_des, qd_des, qdd_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
+        """
+    def step(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> tuple:
+        """
+        One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
+        """
+    def step_into(self, q: numpy.typing.NDArray[numpy.float64], qd: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], qd_des: numpy.typing.NDArray[numpy.float64], qdd_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+        """
+        The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
+        """
+    @property
+    def dof(self) -> int:
+        ...
+    @property
+    def last_command(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def reactionless(self) -> ReactionlessController:
+        ...
 def arm2dof_chain_model(arm: Arm2DofParameters, counterweights: Arm2DofCounterweights = ...) -> ChainModel:
     """
     The 2-DOF arm (counterweights merged into the links) as a ChainModel: x-z plane, joint axes along -y, gravity (0, 0, -g)
@@ -1471,14 +1584,6 @@ def chain_description(chain: ChainModel) -> MechanismDescription:
 def chain_kinematics(model: ChainModel, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
     """
     Every link's motion in the base frame for N joint states (q, qd, qdd each (N, dof)). Returns a dict of arrays (N, dof, 3) / (N, dof, 3, 3) / frames (N, dof, 4, 4), status_per_instant (N,) and their OR, status; a failed instant (non-finite input, or motion that overflows: out_of_range) gives identity poses and zero motion.
-    """
-def load_case_file(path: str) -> tuple[MechanismModel, ControlConfig, str]:
-    """
-    (model, control, name) of a case file read by the C++ reader (mechbal::load_case): the [mechanism] model, the [control] table checked against it (kind 'none' without one) and [case] name.
-    """
-def load_mechanism_file(path: str) -> MechanismModel:
-    """
-    The MechanismModel of the [mechanism] table of a case file or balanced.toml, read by the C++ reader (mechbal::load_mechanism). ValueError naming the dotted field and the value.
     """
 def mechanism_bias_torque(model: MechanismModel, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> dict:
     ...
@@ -1494,10 +1599,6 @@ def mechanism_closed_motion(model: MechanismModel, q_actuated: numpy.typing.Arra
     """
 def mechanism_frame_jacobian(model: MechanismModel, q: numpy.typing.ArrayLike, frame: str) -> dict:
     ...
-def mechanism_from_toml(text: str, source: str = 'string') -> MechanismModel:
-    """
-    As load_mechanism_file, from TOML text (the whole document).
-    """
 def mechanism_from_urdf(path: str) -> MechanismModel:
     """
     The MechanismModel of a URDF file (urdfdom): links with inertials as bodies, revolute / continuous / prismatic / fixed joints, mimic as gear couplings, limits, a frame per link. ValueError names the URDF element and the value.

@@ -158,7 +158,8 @@ def _cmd_demo(args) -> int:
 def _cmd_init(args) -> int:
     from mechbal import templates
 
-    sys.stdout.write(templates.LINKAGE if args.kind == "linkage" else templates.SERIAL)
+    text = {"linkage": templates.LINKAGE, "reactionless": templates.REACTIONLESS}
+    sys.stdout.write(text.get(args.kind, templates.SERIAL))
     return 0
 
 
@@ -373,9 +374,10 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("init", help="print a commented case template: mechbal init serial > my.toml",
                        description="Print a commented case file to standard output, to edit and "
                                    "run with 'mechbal run my.toml'.")
-    s.add_argument("kind", choices=("serial", "linkage"),
+    s.add_argument("kind", choices=("serial", "linkage", "reactionless"),
                    help="serial: a serial chain (joints, links, trajectory); linkage: a closed "
-                        "loop (four-bar with a counterweight)")
+                        "loop (four-bar with a counterweight); reactionless: an arm with a "
+                        "reaction wheel under the reactionless controller ([control] table)")
     s.set_defaults(func=_cmd_init)
     return p
 

@@ -12,6 +12,10 @@ calls.
   moment is zero (Briot & Arakelian 2009, eqs 23-26);
 * `PaminsaController`: the fully balanced PAMINSA tick: kinematics, D (eq 19), the reactionless
   wrist and the shaking wrench (Briot & Arakelian 2009).
+* `ReactionlessController`: reactionless control of any mechanism: balancing joints keep chosen
+  momentum components at their target, ``A_b v_b = h* - A_t v_t`` (the PAMINSA wrist is a special
+  case); with gains it also drives a computed-torque stage usable in
+  :func:`mechbal.simulate.closed_loop`.
 
 Three ways to tick a joint controller (``n`` joints; positions in rad or m, velocities in rad/s
 or m/s, accelerations in rad/s^2 or m/s^2, torques in N m or forces in N):
@@ -50,6 +54,8 @@ __all__ = [
     "WristIntegrator", "WristCommand", "PaminsaController", "JointController", "JointCommand",
     "ControlRun", "WristRun", "PaminsaRun", "InverseDynamics", "ForwardDynamics",
     "MechanismDynamics", "KdlChainDynamics", "Status", "status_text",
+    "ReactionlessController", "ReactionlessCommand", "ReactionlessRun", "ReactionlessJointController",
+    "ReactionlessTaskController", "TaskSpaceRun",
 ]
 
 Status = _core.Status
@@ -61,6 +67,7 @@ KdlChainDynamics = _core.KdlChainDynamics
 ReactionlessWristConfig = _core.ReactionlessWristConfig
 WristIntegrator = _core.WristIntegrator
 WristCommand = _core.WristCommand
+ReactionlessJointController = _core.ReactionlessJointController
 
 
 def status_text(status: int) -> str:
@@ -274,3 +281,199 @@ class PaminsaController(_core.PaminsaController):
         keys = PaminsaRun.__dataclass_fields__
         values = {k: np.asarray(r["status_per_instant" if k == "status" else k]) for k in keys}
         return PaminsaRun(**values)
+
+
+@dataclass(frozen=True)
+class ReactionlessCommand:
+    """One reactionless tick: the actuated command ``q`` [rad or m], ``v``, ``a`` (n_actuated,)
+    (task joints as given, balancing joints computed), every coordinate ``q_full``, ``v_full``,
+    ``a_full`` (dof,), the momentum ``momentum`` = [P; H_O] (6,) [kg m/s, kg m^2/s] of the
+    command, the predicted ``shaking_force`` [N] and ``shaking_moment`` [N m] about O (3,),
+    ``condition`` (cond of the balancing block) and ``status`` (int, 0 = ok)."""
+
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    q_full: np.ndarray
+    v_full: np.ndarray
+    a_full: np.ndarray
+    momentum: np.ndarray
+    shaking_force: np.ndarray
+    shaking_moment: np.ndarray
+    condition: float
+    status: int
+
+
+@dataclass(frozen=True)
+class ReactionlessRun:
+    """Ticks t_n = n dt of a reactionless run: ``t`` (N,) [s], the actuated command ``q``, ``v``,
+    ``a`` (N, n_actuated), every coordinate ``q_full``, ``v_full``, ``a_full`` (N, dof),
+    ``momentum`` (N, 6), predicted ``shaking_force`` [N] and ``shaking_moment`` [N m] (N, 3),
+    ``condition`` (N,), ``status`` (N,)."""
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    q_full: np.ndarray
+    v_full: np.ndarray
+    a_full: np.ndarray
+    momentum: np.ndarray
+    shaking_force: np.ndarray
+    shaking_moment: np.ndarray
+    condition: np.ndarray
+    status: np.ndarray
+
+
+def _cancel_list(cancel: Any) -> list[str]:
+    return [cancel] if isinstance(cancel, str) else [str(c) for c in cancel]
+
+
+class ReactionlessController(_core.ReactionlessController):
+    """Reactionless control of any mechanism (C++ ``mechbal::ReactionlessController``).
+
+    The actuated joints are split into task joints (motion given) and ``balancing_joints``
+    (motion computed each tick) so that the ``cancel``-ed components of the momentum about O,
+    h = [P; H_O] = A(q) v, keep their target (the momentum at the start): with loops v = C v#,
+    K = A C, and each tick solves ``S K_b v_b = S h* - S K_t v_t`` (exact, least squares or minimum
+    norm with a null-space objective), damped least squares near singularity
+    (``Status.singular``). The balancing accelerations ``S K_b a_b = S dh*/dt - S K_t a_t - S W(q,
+    v, c)`` are the feed-forward; the shaking wrench of the command is predicted. Derivation:
+    ``cpp/include/mechbal/control/reactionless.hpp``.
+
+    Args:
+        mechanism: a :class:`mechbal.Mechanism` (or a ``MechanismModel``).
+        balancing_joints: names of actuated joints.
+        cancel: ``"moment"`` (default), ``"force"``, ``"both"`` or single axes ``"moment_z"``,
+            ``"force_x"``, ... (a name or a list).
+        integrator: ``"euler"`` or ``"rk4"`` (needs the task motion at t + dt/2 and t + dt).
+        rate_hz: tick rate [Hz].
+        damping: damped least squares factor relative to the largest singular value.
+        q0: actuated coordinates at the start [rad or m] (default zeros).
+        v0: their rates at the start [rad/s or m/s] (default rest); the target momentum is the
+            momentum there.
+        q_guess: every coordinate near the assembly (closed loops).
+        kp: proportional gains [1/s^2] of an optional computed-torque stage; with ``kd``,
+            :attr:`joint_controller` is a joint controller for :func:`mechbal.simulate.closed_loop`
+            (which accepts this object directly).
+        kd: derivative gains [1/s] of the computed-torque stage.
+        torque_limit: |tau| limit per joint of the computed-torque stage [N m or N].
+        **options: ``max_condition``, ``max_rate`` [rad/s], ``max_acceleration``,
+            ``position_limits`` (bool), ``home_gain``, ``limit_gain``, ``home``, ``max_position``,
+            ``max_speed``, ``max_task_acceleration`` (the task input range).
+
+    Ticks: ``step(q_task, v_task, a_task[, q_half, v_half, q_next, v_next])`` ->
+    :class:`ReactionlessCommand`; ``step_into(now (3, nt), half (2, nt), next (2, nt), out (3,
+    na)) -> int`` (fast, float64 arrays); :meth:`run` over a task motion sampled every dt/2;
+    :meth:`follow` along a :mod:`mechbal.trajectory` of every actuated joint.
+    """
+
+    def __init__(self, mechanism: Any, balancing_joints: Any, cancel: Any = "moment",
+                 integrator: str = "euler", rate_hz: float = 1000.0, damping: float = 1e-2, *,
+                 q0: npt.ArrayLike | None = None, v0: npt.ArrayLike | None = None,
+                 q_guess: npt.ArrayLike | None = None, kp: npt.ArrayLike | None = None,
+                 kd: npt.ArrayLike | None = None, torque_limit: npt.ArrayLike | None = None,
+                 **options: Any):
+        model = getattr(mechanism, "model", mechanism)
+        if isinstance(balancing_joints, str):
+            balancing_joints = [balancing_joints]
+        na = len(model.actuated_coordinates)
+        q0 = np.zeros(na) if q0 is None else q0
+        kwargs = dict(balancing_joints=list(balancing_joints), cancel=_cancel_list(cancel),
+                      integrator=integrator, rate_hz=rate_hz, damping=damping, **options)
+        super().__init__(model, q0=q0, v0=v0, q_guess=q_guess, **kwargs)
+        self._model = model
+        self.joint_controller = None
+        if kp is not None or kd is not None:
+            if kp is None or kd is None:
+                raise ValueError("the computed-torque stage needs both kp and kd")
+            self.joint_controller = _core.ReactionlessJointController(
+                model, q0=q0, kp=kp, kd=kd, torque_limit=torque_limit, q_guess=q_guess, **kwargs)
+
+    def step(self, q_task: npt.ArrayLike, v_task: npt.ArrayLike,  # type: ignore[override]
+             a_task: npt.ArrayLike, q_half: npt.ArrayLike | None = None,
+             v_half: npt.ArrayLike | None = None, q_next: npt.ArrayLike | None = None,
+             v_next: npt.ArrayLike | None = None) -> ReactionlessCommand:
+        """One tick (Euler without the half/next samples): :class:`ReactionlessCommand`."""
+        status = super().step(q_task, v_task, a_task, q_half, v_half, q_next, v_next)
+        c = self.command
+        return ReactionlessCommand(
+            q=np.asarray(c.q), v=np.asarray(c.v), a=np.asarray(c.a), q_full=np.asarray(c.q_full),
+            v_full=np.asarray(c.v_full), a_full=np.asarray(c.a_full),
+            momentum=np.asarray(c.momentum), shaking_force=np.asarray(c.shaking_force),
+            shaking_moment=np.asarray(c.shaking_moment), condition=float(c.condition),
+            status=int(status))
+
+    def run(self, q_task: npt.ArrayLike, v_task: npt.ArrayLike,  # type: ignore[override]
+            a_task: npt.ArrayLike) -> ReactionlessRun:
+        """Ticks along the task motion sampled every dt/2 ((2 steps + 1, n_task) each, from
+        this controller's current state): :class:`ReactionlessRun` at the steps + 1 ticks."""
+        r = super().run(q_task, v_task, a_task)
+        N = np.asarray(r["q"]).shape[0]
+        return ReactionlessRun(t=np.arange(N) * self.dt,
+                               **{k: np.asarray(v) for k, v in r.items()})
+
+    def follow(self, trajectory: Any, duration: float | None = None) -> ReactionlessRun:
+        """Ticks along a trajectory of every actuated joint (a :mod:`mechbal.trajectory` object;
+        the balancing joints' entries are ignored) from t = 0 to ``duration`` (default its end)."""
+        from mechbal.trajectory import as_trajectory
+
+        traj = as_trajectory(trajectory)
+        if duration is None:
+            duration = float(getattr(traj, "end_time", traj.duration))
+        steps = int(round(duration / self.dt))
+        q, v, a = traj.evaluate(np.arange(2 * steps + 1) * (0.5 * self.dt))
+        task = list(self.task_indices)
+        return self.run(np.ascontiguousarray(np.atleast_2d(q)[:, task]),
+                        np.ascontiguousarray(np.atleast_2d(v)[:, task]),
+                        np.ascontiguousarray(np.atleast_2d(a)[:, task]))
+
+
+@dataclass(frozen=True)
+class TaskSpaceRun:
+    """Ticks t_n = n dt of an operational-space run: ``t`` (N,) [s], the command ``q``, ``v``
+    (N, dof), its ``momentum`` [P; H_O] (N, 6), the frame's commanded ``frame_twist`` [v; w]
+    (N, 6) and ``status`` (N,)."""
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    momentum: np.ndarray
+    frame_twist: np.ndarray
+    status: np.ndarray
+
+
+class ReactionlessTaskController(_core.ReactionlessTaskController):
+    """Operational-space reactionless control (the reaction null space): a redundant open
+    mechanism follows a desired twist of ``task_frame`` with ``v = J^+ x' + N z``, where ``z``
+    minimises the ``cancel``-ed momentum components (their departure from the momentum at the
+    start) within the task's null space (C++ ``mechbal::ReactionlessTaskController``).
+
+    Args:
+        mechanism: a :class:`mechbal.Mechanism` (open, every joint actuated).
+        task_frame: a named frame of the mechanism.
+        task_rows: the tracked twist components: ``"all"``, ``"linear"``, ``"angular"`` or
+            ``"v_x"``, ..., ``"w_z"`` (a name or a list; O axes).
+        cancel: the momentum components minimised, as :class:`ReactionlessController`.
+        integrator: ``"euler"`` or ``"rk4"``.
+        rate_hz: tick rate [Hz].
+        damping: damped least squares factor relative to the largest singular value.
+        q0: every coordinate at the start [rad or m] (default zeros).
+        v0: every rate at the start [rad/s or m/s] (default rest).
+        **options: ``max_condition``, ``max_rate`` [rad/s].
+    """
+
+    def __init__(self, mechanism: Any, task_frame: str, task_rows: Any = "all", cancel: Any = "moment",
+                 integrator: str = "euler", rate_hz: float = 1000.0, damping: float = 1e-2, *,
+                 q0: npt.ArrayLike | None = None, v0: npt.ArrayLike | None = None, **options: Any):
+        model = getattr(mechanism, "model", mechanism)
+        q0 = np.zeros(model.dof) if q0 is None else q0
+        super().__init__(model, task_frame, _cancel_list(task_rows), _cancel_list(cancel), integrator,
+                         rate_hz, damping, q0=q0, v0=v0, **options)
+
+    def run(self, twist: npt.ArrayLike) -> TaskSpaceRun:  # type: ignore[override]
+        """Ticks along the desired frame twist [v (m/s); w (rad/s)] (O axes) sampled every dt/2
+        ((2 steps + 1, 6)): :class:`TaskSpaceRun` at the steps + 1 ticks."""
+        r = super().run(twist)
+        N = np.asarray(r["q"]).shape[0]
+        return TaskSpaceRun(t=np.arange(N) * self.dt, **{k: np.asarray(v) for k, v in r.items()})

@@ -237,6 +237,43 @@ class _MechanismCase(Table):
         return self._spec
 
 
+#: the momentum components a reactionless controller can cancel ([control].cancel)
+MomentumComponentName = Literal["moment", "force", "both", "moment_x", "moment_y", "moment_z",
+                                "force_x", "force_y", "force_z"]
+
+
+class Control(Table):
+    """``[control]``: a real-time controller run along the case's trajectory. ``kind =
+    "reactionless"``: the balancing joints keep the cancelled momentum components at their
+    initial value (:class:`mechbal.control.ReactionlessController`); ``mechbal run`` compares the
+    motion with the balancing joints held (uncontrolled) and controlled."""
+    kind: Literal["reactionless", "computed_torque", "decoupled"] = Field(
+        description="which controller (mechbal run supports reactionless)")
+    balancing_joints: Annotated[list[Name], Field(min_length=1, max_length=MAX_JOINTS)] = Field(
+        description="actuated joints whose motion the controller computes")
+    cancel: Annotated[list[MomentumComponentName], Field(min_length=1, max_length=9)] = ["moment"]
+    integrator: Literal["euler", "rk4"] = "rk4"
+    rate_hz: Rate = 1000.0
+    damping: Annotated[float, Field(gt=0, lt=1, **_NUM)] = Field(
+        1e-2, description="damped least squares near singularity, relative to the largest "
+                          "singular value")
+    max_rate: Pos = Field(100.0, description="balancing joints' rate limit (rad/s or m/s)")
+    home_gain: NonNeg = Field(0.0, description="redundant balancing joints: pull towards the start pose (1/s)")
+    limit_gain: NonNeg = Field(0.0, description="redundant balancing joints: push away from the joint limits")
+    task_frame: Optional[Name] = Field(
+        None, description="operational-space mode: [trajectory] is then the frame's path "
+                          "(not yet supported by mechbal run)")
+
+    @model_validator(mode="after")
+    def _distinct(self):
+        seen = set()
+        for i, name in enumerate(self.balancing_joints):
+            if name in seen:
+                raise _custom("is listed twice", f".balancing_joints[{i}]", name)
+            seen.add(name)
+        return self
+
+
 class SerialChainCaseHeader(CaseHeader):
     kind: Literal["serial_chain", "mechanism"]
 
@@ -247,6 +284,7 @@ class SerialChainCase(_MechanismCase):
     mechanism: Mechanism
     trajectory: ChainTrajectory
     balance: Optional[Balance] = None
+    control: Optional[Control] = None
 
 
 # ---- sweep files (mechbal sweep CASE --spec FILE; mechbal.sweep) --------------------------------------

@@ -128,7 +128,8 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
             coordinates near the assembly) or any forward-dynamics plant (``MechanismDynamics``,
             ``Arm2DofDynamics``).
         controller: any joint controller (:class:`mechbal.control.ComputedTorque`, whose model
-            may differ from the plant, or :class:`mechbal.control.DecoupledJointController`).
+            may differ from the plant, :class:`mechbal.control.DecoupledJointController`, or a
+            :class:`mechbal.control.ReactionlessController` built with ``kp`` and ``kd``).
             Its state carries over from previous ticks; call ``reset()`` to start afresh.
         trajectory: any :mod:`mechbal.trajectory` object, evaluated at the simulation time
             t = 0 .. duration [s]. A rest-to-rest trajectory runs on the C++ path; any other is
@@ -163,6 +164,11 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
     if engine_options:
         raise TypeError(f"unexpected options for the mechbal engine: {', '.join(engine_options)}")
     plant = _plant(mechanism_or_plant, q_guess)
+    if hasattr(controller, "joint_controller"):  # a ReactionlessController with its CT stage
+        if controller.joint_controller is None:
+            raise TypeError("a ReactionlessController drives a plant through its computed-torque "
+                            "stage: construct it with kp and kd")
+        controller = controller.joint_controller
     if not isinstance(controller, _core.JointController):
         raise TypeError("controller must be a joint controller (mechbal.control.ComputedTorque, "
                         f"DecoupledJointController), got {type(controller).__name__}")

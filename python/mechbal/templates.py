@@ -157,3 +157,60 @@ initial_guess = [1.0, -0.6, 1.3]  # every joint (crank, coupler, rocker) near th
                                   # start [rad]: picks which of the linkage's assembly modes
                                   # (elbow up or down) is followed
 '''
+
+REACTIONLESS = '''\
+# A mechbal case with a reactionless controller: a planar two-link arm (shoulder and elbow about
+# the vertical z) carries a reaction wheel that the controller spins so that the angular momentum
+# about z stays at its initial value: the arm's motion exerts no shaking moment about z on its
+# base. Run it with
+#     mechbal run my.toml --out out/my
+# to get out/my/summary.json (peak shaking wrench with the wheel held still, "uncontrolled", and
+# under the controller, "controlled"), the plots and out/my/bodies_uncontrolled.npz,
+# out/my/bodies_controlled.npz (every body's pose at every controller tick).
+# Units are SI throughout: m, kg, kg m^2, rad, s. The base frame has z up.
+
+[case]
+name = "my_reactionless_arm"
+kind = "mechanism"            # any mechanism of the general model (trees, gears, closed loops)
+title = "Two-link arm with a reaction wheel"
+
+[mechanism]
+gravity = [0.0, 0.0, -9.81]
+
+[[mechanism.joints]]
+name = "shoulder"
+axis = [0.0, 0.0, 1.0]
+link = { mass = 2.0, com = [0.25, 0.0, 0.0], inertia = [0.002, 0.04, 0.04] }  # kg, m, kg m^2
+
+[[mechanism.joints]]
+name = "elbow"
+origin = { xyz = [0.5, 0.0, 0.0] }
+axis = [0.0, 0.0, 1.0]
+link = { mass = 1.5, com = [0.2, 0.0, 0.0], inertia = [0.001, 0.02, 0.02] }
+
+[[mechanism.joints]]
+name = "wheel"                # the balancing joint: an actuated disc on the forearm
+origin = { xyz = [0.3, 0.0, 0.0] }
+axis = [0.0, 0.0, 1.0]
+link = { mass = 2.0, com = [0.0, 0.0, 0.0], inertia = [0.05, 0.05, 0.1] }
+
+# Every actuated joint is listed; a balancing joint's start is its initial position, its end is
+# ignored (the controller computes its motion).
+[trajectory]
+law = "quintic"               # quintic | cubic
+start = [0.0, 0.0, 0.0]       # rad
+end = [1.0, -1.2, 0.0]
+duration = 2.0                # s
+samples = 2001
+
+[control]
+kind = "reactionless"
+balancing_joints = ["wheel"]  # actuated joints whose motion the controller computes
+cancel = ["moment_z"]         # any of "moment", "force", "both", "moment_x|y|z", "force_x|y|z"
+integrator = "rk4"            # or "euler"
+rate_hz = 1000                # controller rate [Hz]
+damping = 1e-3                # damped least squares near singularities (relative)
+# max_rate = 100.0            # balancing joints' rate limit [rad/s]
+# home_gain = 0.0             # with more balancing joints than cancelled components: pull
+# limit_gain = 0.0            #   towards the start pose / away from the joint limits [1/s]
+'''

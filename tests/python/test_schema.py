@@ -192,7 +192,7 @@ def test_the_issue_examples_are_refused():
         validate_case(bad)
     bad = copy.deepcopy(base)
     bad["counterweights"] = {"m_cw1": 1.0}
-    with pytest.raises(ConfigError, match=r"^counterweights: unknown table \(allowed: case, mechanism, trajectory, balance\)"):
+    with pytest.raises(ConfigError, match=r"^counterweights: unknown table \(allowed: case, mechanism, trajectory, balance, control\)"):
         validate_case(bad)
 
 

@@ -37,6 +37,7 @@
 #include "mechbal/control/joint_limits.hpp"
 #include "mechbal/papers/paminsa/reactionless_wrist.hpp"
 #include "mechbal/control/closed_loop.hpp"
+#include "mechbal/control/reactionless.hpp"
 #include "mechbal/control/config.hpp"
 #include "mechbal/control/factory.hpp"
 /// Reading mechbal's case format (TOML) and URDF

@@ -51,6 +51,8 @@ def run(config, out: Path) -> dict:
     if guess is not None and len(guess) != mech.dof:
         raise ConfigError("trajectory.initial_guess", f"must have {mech.dof} values (every joint with a "
                           f"coordinate: {', '.join(mech.joint_names)})", list(guess))
+    if case.control is not None:
+        return run_controlled(mech, case, out, q_guess=None if guess is None else np.array(guess, float))
     return run_mechanism(mech, traj, t, out, name=case.case.name, kind=case.case.kind,
                          title=case.case.title or case.case.name,
                          q_guess=None if guess is None else np.array(guess, float))
@@ -153,4 +155,117 @@ def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, 
         ["quantity", "x", "y", "z"]))
     print(report.table([["peak torque", *report.peak_abs(torque)], ["RMS torque", *rms]],
                        ["actuator torque [N m or N]", *names]))
+    return summary
+
+
+def _write_variant(mech: Mechanism, out: Path, variant: str, t, q, v, a):
+    """bodies_<variant>.npz of the motion (q, v, a) (every coordinate) with the wrench of those
+    poses; returns (F, M)."""
+    sw = mech.shaking_wrench(q, v, a)
+    motion = mech.body_motion(q, v, a)
+    if np.any(sw.status != 0) or np.any(motion.status != 0):
+        raise ConfigError("trajectory", f"the {variant} motion has non-finite results",
+                          has_value=False)
+    bodies = mech.bodies
+    write_bodies(out / f"bodies_{variant}.npz", t=t, names=mech.body_names,
+                 mass=np.array([b.mass for b in bodies], float),
+                 inertia_body=np.array([b.inertia for b in bodies], float).reshape(-1, 3, 3),
+                 com=motion.com, rotation=motion.rotation, shaking_force=sw.shaking_force,
+                 shaking_moment=sw.shaking_moment, q=q, qd=v, qdd=a, **_drawing(mech, motion))
+    return sw.shaking_force, sw.shaking_moment
+
+
+def run_controlled(mech: Mechanism, case, out: Path, q_guess=None) -> dict:
+    """A case with ``[control]`` (kind reactionless): the motion with the balancing joints held
+    at their start (``uncontrolled``) and under the reactionless controller (``controlled``), at
+    the controller's ticks; bodies_uncontrolled.npz, bodies_controlled.npz (each with the shaking
+    wrench of its stored poses), the plots and both variants' peaks in summary.json."""
+    from mechbal.schema import did_you_mean
+
+    ctl = case.control
+    name, title = case.case.name, case.case.title or case.case.name
+    if ctl.kind != "reactionless":
+        raise ConfigError("control.kind", "mechbal run simulates kind 'reactionless' (computed_torque "
+                          "and decoupled controllers: mechbal.simulate.closed_loop)", ctl.kind)
+    if ctl.task_frame is not None:
+        raise ConfigError("control.task_frame", "the operational-space mode is not available in "
+                          "mechbal run yet", ctl.task_frame)
+    names = mech.actuated_names
+    for i, b in enumerate(ctl.balancing_joints):
+        if b not in names:
+            raise ConfigError(f"control.balancing_joints[{i}]",
+                              f"is not an actuated joint{did_you_mean(b, names)}", b)
+    balancing = [names.index(b) for b in ctl.balancing_joints]
+    task = [i for i in range(len(names)) if i not in balancing]
+    end = list(case.trajectory.end)
+    if len(end) == len(names):
+        for i in balancing:  # a balancing joint's end is ignored: held at its start
+            end[i] = case.trajectory.start[i]
+    traj, _ = trajectory_from_config(case.trajectory.model_copy(update={"end": end}), len(names))
+    dt = 1.0 / ctl.rate_hz
+    steps = int(round(traj.duration / dt))
+    th = np.arange(2 * steps + 1) * (0.5 * dt)
+    t = th[::2]
+    qa, va, aa = traj.evaluate_batch(th)
+
+    progress.stage("uncontrolled motion (balancing joints held) and the reactionless controller")
+    qu, vu, au, _, _ = mechanism_motion(mech, traj, t, q_guess)
+    ctrl = control.ReactionlessController(
+        mech, ctl.balancing_joints, cancel=list(ctl.cancel), integrator=ctl.integrator,
+        rate_hz=ctl.rate_hz, damping=ctl.damping, max_rate=ctl.max_rate, home_gain=ctl.home_gain,
+        limit_gain=ctl.limit_gain, q0=qa[0], v0=va[0], q_guess=q_guess)
+    r = ctrl.run(np.ascontiguousarray(qa[:, task]), np.ascontiguousarray(va[:, task]),
+                 np.ascontiguousarray(aa[:, task]))
+    held = (r.status & np.uint32(int(control.Status.non_finite_input) | int(control.Status.out_of_range)
+                                      | int(control.Status.solver_error))) != 0
+    if np.any(held):
+        k = int(np.argmax(held))
+        raise ConfigError("control", f"the reactionless controller held its command at t = {t[k]:.4g} s "
+                          f"(status {control.status_text(int(r.status[k]))})", has_value=False)
+
+    progress.stage("bodies files and plots")
+    Fu, Mu = _write_variant(mech, out, "uncontrolled", t, qu, vu, au)
+    Fc, Mc = _write_variant(mech, out, "controlled", t, r.q_full, r.v_full, r.a_full)
+    report.plot_wrench(out / "shaking_wrench.png", t, {"uncontrolled": (Fu, Mu), "controlled": (Fc, Mc)},
+                       title=f"{title}: reactionless control",
+                       caption="Shaking force dP/dt and moment dH_O/dt about O with the balancing joints "
+                               f"({', '.join(ctl.balancing_joints)}) held still (uncontrolled) and "
+                               f"under the reactionless controller cancelling {', '.join(ctl.cancel)} "
+                               "(controlled).")
+    bnames = list(ctl.balancing_joints)
+    report.plot_series(out / "balancing_joints.png", t, {"position": r.q[:, balancing],
+                                                         "rate": r.v[:, balancing]},
+                       bnames, "rad or m, rad/s or m/s", title=f"{name}: balancing joints",
+                       caption="Commanded position and rate of each balancing joint.")
+
+    progress.stage("summary")
+    singular = (r.status & np.uint32(int(control.Status.singular))) != 0
+    saturated = (r.status & np.uint32(int(control.Status.saturated))) != 0
+    summary = {
+        "case": name,
+        "kind": case.case.kind,
+        "dof": mech.dof,
+        "actuated": names,
+        "closed": mech.is_closed,
+        "duration_s": float(traj.duration),
+        "samples": int(len(t)),
+        "law": traj.law.name,
+        "variants": ["uncontrolled", "controlled"],
+        "peak_shaking_force_N": {"uncontrolled": report.peak_abs(Fu), "controlled": report.peak_abs(Fc)},
+        "peak_shaking_moment_Nm": {"uncontrolled": report.peak_abs(Mu), "controlled": report.peak_abs(Mc)},
+        "control": {
+            "kind": ctl.kind, "balancing_joints": bnames, "cancel": list(ctl.cancel),
+            "integrator": ctl.integrator, "rate_hz": float(ctl.rate_hz), "damping": float(ctl.damping),
+            "ticks": int(len(t)), "singular_ticks": int(np.sum(singular)),
+            "saturated_ticks": int(np.sum(saturated)), "max_condition": float(np.max(r.condition)),
+            "peak_balancing_rate": report.peak_abs(r.v[:, balancing]),
+        },
+        "total_mass_kg": mech.total_mass,
+        "files": ["bodies_uncontrolled.npz", "bodies_controlled.npz", "shaking_wrench.png",
+                  "balancing_joints.png"],
+    }
+    write_summary(out / "summary.json", summary)
+    print(report.table(
+        [["uncontrolled", *report.peak_abs(Mu)], ["controlled", *report.peak_abs(Mc)]],
+        ["peak shaking moment about O [N m]", "x", "y", "z"]))
     return summary

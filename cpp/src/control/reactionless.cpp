@@ -1,0 +1,833 @@
+#include "mechbal/control/reactionless.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "mechbal/algorithm/jacobian.hpp"
+#include "mechbal/algorithm/momentum.hpp"
+#include "mechbal/algorithm/shaking_wrench.hpp"
+
+namespace mechbal {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& field, const std::string& what, double value) {
+  std::ostringstream msg;
+  msg << field << " " << what << ", got " << value;
+  throw std::invalid_argument(msg.str());
+}
+
+[[noreturn]] void fail(const std::string& message) { throw std::invalid_argument(message); }
+
+constexpr double huge = std::numeric_limits<double>::max();
+
+/// The flags of `s` that are also in `keep`.
+constexpr Status only(Status s, Status keep) noexcept {
+  return static_cast<Status>(static_cast<std::uint32_t>(s) & static_cast<std::uint32_t>(keep));
+}
+constexpr Status hard = Status::solver_error | Status::out_of_range | Status::non_finite_input;
+
+bool failed(Status s) noexcept {
+  return has(s, Status::solver_error) || has(s, Status::bad_size) || has(s, Status::non_finite_input) ||
+         has(s, Status::out_of_range);
+}
+
+}  // namespace
+
+std::uint32_t momentum_component(const std::string& name) noexcept {
+  if (name == "moment") return cancel_moment;
+  if (name == "force") return cancel_force;
+  if (name == "both") return cancel_both;
+  if (name == "force_x") return force_x;
+  if (name == "force_y") return force_y;
+  if (name == "force_z") return force_z;
+  if (name == "moment_x") return moment_x;
+  if (name == "moment_y") return moment_y;
+  if (name == "moment_z") return moment_z;
+  return 0u;
+}
+
+void validate_reactionless_config(const ReactionlessConfig& c) {
+  if (c.balancing_joints.empty()) fail("reactionless.balancing_joints must name at least one joint");
+  if (c.cancel == 0u || (c.cancel & ~cancel_both) != 0u)
+    fail("reactionless.cancel", "must select at least one of the six momentum components (bit mask 1..63)",
+         static_cast<double>(c.cancel));
+  if (c.integrator != ReactionlessIntegrator::euler && c.integrator != ReactionlessIntegrator::rk4)
+    fail("reactionless.integrator", "must be euler or rk4", static_cast<double>(c.integrator));
+  if (!(c.rate_hz >= 1.0 && c.rate_hz <= 1e6)) fail("reactionless.rate_hz", "must be in [1, 1e6] Hz", c.rate_hz);
+  if (!(c.damping > 0.0 && c.damping < 1.0)) fail("reactionless.damping", "must be in (0, 1)", c.damping);
+  if (!(std::isfinite(c.max_condition) && c.max_condition > 1.0))
+    fail("reactionless.max_condition", "must be finite and > 1", c.max_condition);
+  if (!(std::isfinite(c.max_rate) && c.max_rate > 0.0))
+    fail("reactionless.max_rate", "must be finite and > 0", c.max_rate);
+  if (!(std::isfinite(c.max_acceleration) && c.max_acceleration > 0.0))
+    fail("reactionless.max_acceleration", "must be finite and > 0", c.max_acceleration);
+  if (!(std::isfinite(c.home_gain) && c.home_gain >= 0.0))
+    fail("reactionless.home_gain", "must be finite and >= 0", c.home_gain);
+  if (!(std::isfinite(c.limit_gain) && c.limit_gain >= 0.0))
+    fail("reactionless.limit_gain", "must be finite and >= 0", c.limit_gain);
+  if (c.home.size() != 0 && !c.home.allFinite()) fail("reactionless.home must be finite");
+  if (!(std::isfinite(c.max_momentum) && c.max_momentum > 0.0))
+    fail("reactionless.max_momentum", "must be finite and > 0", c.max_momentum);
+  if (!(std::isfinite(c.max_moment) && c.max_moment > 0.0))
+    fail("reactionless.max_moment", "must be finite and > 0", c.max_moment);
+  validate_joint_input_range(c.task_range, "reactionless.task_range");
+}
+
+ReactionlessController::ReactionlessController(MechanismModel model, const ReactionlessConfig& config,
+                                               const Eigen::VectorXd& q0, const Eigen::VectorXd& v0,
+                                               const Eigen::VectorXd& q_guess)
+    : ReactionlessController(std::make_shared<const MechanismModel>(std::move(model)), config, q0, v0, q_guess) {}
+
+ReactionlessController::ReactionlessController(std::shared_ptr<const MechanismModel> model,
+                                               const ReactionlessConfig& config, const Eigen::VectorXd& q0,
+                                               const Eigen::VectorXd& v0, const Eigen::VectorXd& q_guess)
+    : model_(std::move(model)), config_(config), data_(*model_) {
+  build(q0, v0, q_guess);
+}
+
+void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::VectorXd& v0,
+                                   const Eigen::VectorXd& q_guess) {
+  validate_reactionless_config(config_);
+  const MechanismModel& m = *model_;
+  dt_ = 1.0 / config_.rate_hz;
+  n_ = m.dof();
+  na_ = m.num_actuated();
+  closed_ = m.is_closed();
+  if (!closed_ && m.num_passive() > 0)
+    fail("actuated: an open mechanism with passive joints ('" + m.coordinate_name(m.passive_coordinates()[0]) +
+         "') cannot be driven by the reactionless controller: actuate every joint");
+  const auto& actuated = m.actuated_coordinates();
+  std::vector<bool> is_balancing(static_cast<std::size_t>(na_), false);
+  for (std::size_t i = 0; i < config_.balancing_joints.size(); ++i) {
+    const std::string& name = config_.balancing_joints[i];
+    const std::string field = "reactionless.balancing_joints[" + std::to_string(i) + "]";
+    int coordinate = -1;
+    for (int c = 0; c < n_; ++c)
+      if (m.coordinate_name(c) == name) coordinate = c;
+    if (coordinate < 0) {
+      std::string known;
+      for (int a : actuated) known += (known.empty() ? "" : ", ") + m.coordinate_name(a);
+      fail(field + ": '" + name + "' is not a joint coordinate of the mechanism (actuated joints: " + known + ")");
+    }
+    const auto it = std::find(actuated.begin(), actuated.end(), coordinate);
+    if (it == actuated.end()) fail(field + ": '" + name + "' is a passive joint; balancing joints must be actuated");
+    const auto index = static_cast<std::size_t>(it - actuated.begin());
+    if (is_balancing[index]) fail(field + ": '" + name + "' is listed twice");
+    is_balancing[index] = true;
+  }
+  task_.clear();
+  balancing_.clear();
+  task_coord_.clear();
+  balancing_coord_.clear();
+  for (int i = 0; i < na_; ++i) {
+    const int c = actuated[static_cast<std::size_t>(i)];
+    if (is_balancing[static_cast<std::size_t>(i)]) {
+      balancing_.push_back(i);
+      balancing_coord_.push_back(c);
+    } else {
+      task_.push_back(i);
+      task_coord_.push_back(c);
+    }
+  }
+  nb_ = static_cast<int>(balancing_.size());
+  nt_ = static_cast<int>(task_.size());
+  rows_.clear();
+  for (int r = 0; r < 6; ++r)
+    if (config_.cancel & (1u << r)) rows_.push_back(r);
+  k_ = static_cast<int>(rows_.size());
+  wide_ = nb_ > k_;
+  square_ = nb_ == k_;
+
+  // a balancing coordinate on the path of a loop's frame moves the loops: C and c depend on it
+  balancing_in_loops_ = false;
+  for (int l = 0; l < m.num_loops(); ++l) {
+    for (int f : {m.loop_frame_a(l), m.loop_frame_b(l)}) {
+      for (int link = m.frame_link(f); link > 0; link = m.parent(link)) {
+        const int c = m.coordinate(link);
+        if (c >= 0 && std::find(balancing_coord_.begin(), balancing_coord_.end(), c) != balancing_coord_.end())
+          balancing_in_loops_ = true;
+      }
+    }
+  }
+
+  rate_limit_.resize(nb_);
+  lower_.resize(nb_);
+  upper_.resize(nb_);
+  for (int j = 0; j < nb_; ++j) {
+    const int c = balancing_coord_[static_cast<std::size_t>(j)];
+    rate_limit_(j) = std::min(config_.max_rate, m.velocity_limits()(c));
+    lower_(j) = m.lower_limits()(c);
+    upper_(j) = m.upper_limits()(c);
+  }
+  if (q0.size() != na_)
+    fail("q0 must have " + std::to_string(na_) + " values (the actuated coordinates), got " + std::to_string(q0.size()));
+  if (v0.size() != 0 && v0.size() != na_)
+    fail("v0 must have " + std::to_string(na_) + " values (the actuated coordinates), got " + std::to_string(v0.size()));
+  if (q_guess.size() != 0 && q_guess.size() != n_)
+    fail("q_guess must have " + std::to_string(n_) + " values (every coordinate), got " + std::to_string(q_guess.size()));
+  if (q_guess.size() != 0 && !q_guess.allFinite()) fail("q_guess must be finite");
+  if (config_.home.size() != 0 && config_.home.size() != nb_)
+    fail("reactionless.home must have " + std::to_string(nb_) + " values (one per balancing joint), got " +
+         std::to_string(config_.home.size()));
+  home_ = config_.home.size() != 0 ? config_.home : Eigen::VectorXd(Eigen::VectorXd::Zero(nb_));
+
+  // buffers
+  q_full_ = q_guess.size() != 0 ? q_guess : Eigen::VectorXd(Eigen::VectorXd::Zero(n_));
+  q_act_ = Eigen::VectorXd::Zero(na_);
+  v_act_ = Eigen::VectorXd::Zero(na_);
+  a_act_ = Eigen::VectorXd::Zero(na_);
+  v_full_ = Eigen::VectorXd::Zero(n_);
+  a_full_ = Eigen::VectorXd::Zero(n_);
+  K_ = Eigen::MatrixXd::Zero(6, na_);
+  Kb_ = Eigen::MatrixXd::Zero(k_, nb_);
+  kb_work_ = Eigen::VectorXd::Zero(k_);
+  for (Eigen::VectorXd* v : {&x_, &z_, &v_b_, &a_b_, &k1_, &k2_, &k3_, &k4_, &q_stage_, &r_nb_, &q_b_})
+    *v = Eigen::VectorXd::Zero(nb_);
+  r_ = SmallVector::Zero(k_);
+  y_ = SmallVector::Zero(std::min(k_, nb_) == nb_ && !wide_ ? nb_ : k_);
+  const int g = wide_ ? k_ : nb_;
+  if (g > 6) fail("reactionless: internal size error");
+  gram_ = Small::Identity(g, g);
+  eig_.compute(gram_, Eigen::EigenvaluesOnly);
+  llt_.compute(gram_);
+  if (square_) lu_.compute(Small(Small::Identity(k_, k_)));
+  command_.q = command_.v = command_.a = Eigen::VectorXd::Zero(na_);
+  command_.q_full = command_.v_full = command_.a_full = Eigen::VectorXd::Zero(n_);
+  command_.next_balancing = Eigen::VectorXd::Zero(nb_);
+
+  const Eigen::VectorXd v_start = v0.size() != 0 ? v0 : Eigen::VectorXd(Eigen::VectorXd::Zero(na_));
+  const Status s = reset(q0, v_start);
+  if (s != Status::ok && s != Status::singular) {
+    std::ostringstream msg;
+    msg << "q0: the start cannot be used (" << status_name(s) << ")";
+    if (has(s, Status::solver_error)) msg << ": the loops cannot be assembled there (give q_guess near the assembly)";
+    if (has(s, Status::out_of_range)) msg << ": beyond reactionless.task_range or max_momentum";
+    throw std::invalid_argument(msg.str());
+  }
+  if (config_.home.size() == 0) home_ = q_b_;
+}
+
+Status ReactionlessController::reset(const Eigen::Ref<const Eigen::VectorXd>& q0,
+                                     const Eigen::Ref<const Eigen::VectorXd>& v0) noexcept {
+  if (q0.size() != na_ || v0.size() != na_) return Status::bad_size;
+  if (!q0.allFinite() || !v0.allFinite()) return Status::non_finite_input;
+  if (na_ > 0 && (q0.cwiseAbs().maxCoeff() > config_.task_range.max_position ||
+                  v0.cwiseAbs().maxCoeff() > config_.task_range.max_speed))
+    return Status::out_of_range;
+  Status st = Status::ok;
+  q_act_ = q0;
+  v_act_ = v0;
+  a_act_.setZero();
+  if (closed_) {
+    Eigen::VectorXd& q = q_full_;
+    st = closed_motion(*model_, data_, q_act_, v_act_, a_act_, q, config_.loop_options);
+    if (failed(st)) return st;
+    momentum_matrix(*model_, data_, q_full_);
+    K_.noalias() = data_.momentum_matrix * data_.loop_projection;
+    v_full_ = data_.closed_velocity;
+  } else {
+    q_full_ = q_act_;
+    st = momentum_matrix(*model_, data_, q_full_);
+    if (failed(st)) return st;
+    K_ = data_.momentum_matrix;
+    v_full_ = v_act_;
+  }
+  Vec6 h;
+  h.noalias() = K_ * v_act_;
+  if (!h.allFinite()) return Status::out_of_range;
+  if (h.cwiseAbs().maxCoeff() > config_.max_momentum) return Status::out_of_range;
+  target_ = h;
+  target_rate_.setZero();
+  for (int j = 0; j < nb_; ++j) q_b_(j) = q0(balancing_[static_cast<std::size_t>(j)]);
+  command_.q = q0;
+  command_.v = v0;
+  command_.a.setZero();
+  command_.q_full = q_full_;
+  command_.v_full = v_full_;
+  command_.a_full.setZero();
+  command_.next_balancing = q_b_;
+  command_.momentum = h;
+  command_.shaking_force.setZero();
+  command_.shaking_moment.setZero();
+  command_.condition = 1.0;
+  command_.status = Status::ok;
+  return only(st, Status::singular);
+}
+
+Status ReactionlessController::set_target(const Vec6& momentum, const Vec6& momentum_rate) noexcept {
+  if (!momentum.allFinite() || !momentum_rate.allFinite()) return Status::non_finite_input;
+  if (momentum.cwiseAbs().maxCoeff() > config_.max_momentum ||
+      momentum_rate.cwiseAbs().maxCoeff() > config_.max_moment)
+    return Status::out_of_range;
+  target_ = momentum;
+  target_rate_ = momentum_rate;
+  return Status::ok;
+}
+
+Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q_t,
+                                        const Eigen::VectorXd& q_b) noexcept {
+  for (int i = 0; i < nt_; ++i) q_act_(task_[static_cast<std::size_t>(i)]) = q_t(i);
+  for (int j = 0; j < nb_; ++j) q_act_(balancing_[static_cast<std::size_t>(j)]) = q_b(j);
+  Status st = Status::ok;
+  if (closed_) {
+    // positions (warm-started from the last solve), C and c (c with the current velocity guess)
+    st = closed_motion(*model_, data_, q_act_, v_act_, a_act_, q_full_, config_.loop_options);
+    if (failed(st)) return st;
+    const Status sm = momentum_matrix(*model_, data_, q_full_);
+    if (sm != Status::ok) return st | sm;
+    K_.noalias() = data_.momentum_matrix * data_.loop_projection;
+  } else {
+    q_full_ = q_act_;
+    st = momentum_matrix(*model_, data_, q_full_);
+    if (st != Status::ok) return st;
+    K_ = data_.momentum_matrix;
+  }
+  for (int i = 0; i < k_; ++i)
+    for (int j = 0; j < nb_; ++j) Kb_(i, j) = K_(rows_[static_cast<std::size_t>(i)], balancing_[static_cast<std::size_t>(j)]);
+  return st;
+}
+
+Status ReactionlessController::rebalance(const Eigen::VectorXd& q_b) noexcept {
+  // same task pose as the last evaluate(): the loops' solution and C do not depend on the
+  // balancing coordinates (they move no loop frame), only A does
+  for (int j = 0; j < nb_; ++j) {
+    q_act_(balancing_[static_cast<std::size_t>(j)]) = q_b(j);
+    q_full_(balancing_coord_[static_cast<std::size_t>(j)]) = q_b(j);
+    // the loop solve's warm start follows (its tangent predictor needs q == closed_position)
+    data_.closed_position(balancing_coord_[static_cast<std::size_t>(j)]) = q_b(j);
+  }
+  const Status st = momentum_matrix(*model_, data_, q_full_);
+  if (st != Status::ok) return st;
+  K_.noalias() = data_.momentum_matrix * data_.loop_projection;
+  for (int i = 0; i < k_; ++i)
+    for (int j = 0; j < nb_; ++j) Kb_(i, j) = K_(rows_[static_cast<std::size_t>(i)], balancing_[static_cast<std::size_t>(j)]);
+  return Status::ok;
+}
+
+Status ReactionlessController::factorise(double& condition) noexcept {
+  if (wide_) {
+    gram_.noalias() = Kb_ * Kb_.transpose();
+  } else {
+    gram_.noalias() = Kb_.transpose() * Kb_;
+  }
+  if (!gram_.allFinite()) {
+    condition = huge;
+    damped_ = true;
+    gram_.setIdentity();
+    llt_.compute(gram_);
+    return Status::singular | Status::out_of_range;
+  }
+  eig_.compute(gram_, Eigen::EigenvaluesOnly);
+  const auto& lambda = eig_.eigenvalues();  // ascending
+  const double lmax = lambda(lambda.size() - 1), lmin = lambda(0);
+  if (!(lmax > 0.0)) {  // S K_b = 0: the balancing joints cannot act on the cancelled components
+    condition = huge;
+    damped_ = true;
+    gram_.diagonal().array() += 1.0;  // any positive damping: the solution is zero
+    llt_.compute(gram_);
+    return Status::singular;
+  }
+  condition = lmin > 0.0 ? std::sqrt(lmax / lmin) : huge;
+  if (condition <= config_.max_condition) {
+    damped_ = false;
+    if (square_) {
+      lu_.compute(Small(Kb_));
+    } else {
+      llt_.compute(gram_);
+    }
+    return Status::ok;
+  }
+  damped_ = true;
+  gram_.diagonal().array() += config_.damping * config_.damping * lmax;
+  llt_.compute(gram_);
+  return Status::singular;
+}
+
+void ReactionlessController::solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::VectorXd& x) noexcept {
+  for (int i = 0; i < k_; ++i) r_(i) = r(i);
+  if (wide_) {
+    y_ = llt_.solve(r_);
+    x.noalias() = Kb_.transpose() * y_;
+  } else if (square_ && !damped_) {
+    y_ = lu_.solve(r_);
+    x = y_;
+  } else {
+    SmallVector b(nb_);
+    b.noalias() = Kb_.transpose() * r_;
+    y_ = llt_.solve(b);
+    x = y_;
+  }
+}
+
+void ReactionlessController::project_null(const Eigen::VectorXd& z, Eigen::VectorXd& out) noexcept {
+  // (I - K_b^T (K_b K_b^T + lambda^2)^-1 K_b) z
+  SmallVector kz(k_);
+  kz.noalias() = Kb_ * z;
+  y_ = llt_.solve(kz);
+  out = z;
+  out.noalias() -= Kb_.transpose() * y_;
+}
+
+Status ReactionlessController::limit_rate(Eigen::VectorXd& v_b) const noexcept {
+  double peak = 0.0;
+  for (int j = 0; j < nb_; ++j) peak = std::max(peak, std::abs(v_b(j)) / rate_limit_(j));
+  if (peak > 1.0) {
+    v_b *= 1.0 / peak;  // direction kept
+    return Status::saturated;
+  }
+  return Status::ok;
+}
+
+Status ReactionlessController::rates(const Eigen::Ref<const Eigen::VectorXd>& v_t, const Vec6& h,
+                                     const Eigen::VectorXd& q_b, Eigen::VectorXd& v_b, double* condition) noexcept {
+  // r = S h* - S K_t v_t
+  for (int i = 0; i < k_; ++i) {
+    const int row = rows_[static_cast<std::size_t>(i)];
+    double s = h(row);
+    for (int j = 0; j < nt_; ++j) s -= K_(row, task_[static_cast<std::size_t>(j)]) * v_t(j);
+    kb_work_(i) = s;
+  }
+  double cond = 1.0;
+  Status st = factorise(cond);
+  if (condition) *condition = cond;
+  solve(kb_work_, v_b);
+  if (wide_ && (config_.home_gain > 0.0 || config_.limit_gain > 0.0)) {
+    for (int j = 0; j < nb_; ++j) {
+      double zj = -config_.home_gain * (q_b(j) - home_(j));
+      if (config_.limit_gain > 0.0 && std::isfinite(lower_(j)) && std::isfinite(upper_(j)) && upper_(j) > lower_(j)) {
+        const double mid = 0.5 * (lower_(j) + upper_(j)), half = 0.5 * (upper_(j) - lower_(j));
+        zj -= config_.limit_gain * (q_b(j) - mid) / (half * half);
+      }
+      z_(j) = zj;
+    }
+    project_null(z_, x_);
+    v_b += x_;
+  }
+  if (!v_b.allFinite()) {
+    v_b.setZero();
+    return st | Status::out_of_range;
+  }
+  return st | limit_rate(v_b);
+}
+
+Status ReactionlessController::hold(Status why) noexcept {
+  for (int j = 0; j < nb_; ++j) command_.q(balancing_[static_cast<std::size_t>(j)]) = q_b_(j);
+  command_.v.setZero();
+  command_.a.setZero();
+  command_.v_full.setZero();
+  command_.a_full.setZero();
+  command_.next_balancing = q_b_;
+  command_.momentum.setZero();
+  command_.shaking_force.setZero();
+  command_.shaking_moment.setZero();
+  command_.status = why;
+  return why;
+}
+
+bool ReactionlessController::task_in_range(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                           const Eigen::Ref<const Eigen::VectorXd>& v,
+                                           const Eigen::Ref<const Eigen::VectorXd>* a) const noexcept {
+  if (nt_ == 0) return true;
+  const JointInputRange& r = config_.task_range;
+  return q.cwiseAbs().maxCoeff() <= r.max_position && v.cwiseAbs().maxCoeff() <= r.max_speed &&
+         (a == nullptr || a->cwiseAbs().maxCoeff() <= r.max_acceleration);
+}
+
+Status ReactionlessController::step(const Eigen::Ref<const Eigen::VectorXd>& q_t,
+                                    const Eigen::Ref<const Eigen::VectorXd>& v_t,
+                                    const Eigen::Ref<const Eigen::VectorXd>& a_t,
+                                    const Eigen::Ref<const Eigen::VectorXd>& q_t_half,
+                                    const Eigen::Ref<const Eigen::VectorXd>& v_t_half,
+                                    const Eigen::Ref<const Eigen::VectorXd>& q_t_next,
+                                    const Eigen::Ref<const Eigen::VectorXd>& v_t_next) noexcept {
+  if (config_.integrator == ReactionlessIntegrator::rk4)
+    return tick(q_t, v_t, a_t, &q_t_half, &v_t_half, &q_t_next, &v_t_next);
+  return tick(q_t, v_t, a_t, nullptr, nullptr, nullptr, nullptr);
+}
+
+Status ReactionlessController::step_euler(const Eigen::Ref<const Eigen::VectorXd>& q_t,
+                                          const Eigen::Ref<const Eigen::VectorXd>& v_t,
+                                          const Eigen::Ref<const Eigen::VectorXd>& a_t) noexcept {
+  return tick(q_t, v_t, a_t, nullptr, nullptr, nullptr, nullptr);
+}
+
+Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t,
+                                    const Eigen::Ref<const Eigen::VectorXd>& v_t,
+                                    const Eigen::Ref<const Eigen::VectorXd>& a_t,
+                                    const Eigen::Ref<const Eigen::VectorXd>* q_half,
+                                    const Eigen::Ref<const Eigen::VectorXd>* v_half,
+                                    const Eigen::Ref<const Eigen::VectorXd>* q_next,
+                                    const Eigen::Ref<const Eigen::VectorXd>* v_next) noexcept {
+  const bool rk4 = q_half != nullptr;
+  if (q_t.size() != nt_ || v_t.size() != nt_ || a_t.size() != nt_) return Status::bad_size;
+  if (rk4 && (q_half->size() != nt_ || v_half->size() != nt_ || q_next->size() != nt_ || v_next->size() != nt_))
+    return Status::bad_size;
+  const bool finite = q_t.allFinite() && v_t.allFinite() && a_t.allFinite() &&
+                      (!rk4 || (q_half->allFinite() && v_half->allFinite() && q_next->allFinite() &&
+                                v_next->allFinite()));
+  if (!finite) return hold(Status::non_finite_input);
+  if (!task_in_range(q_t, v_t, &a_t) ||
+      (rk4 && (!task_in_range(*q_half, *v_half, nullptr) || !task_in_range(*q_next, *v_next, nullptr))))
+    return hold(Status::out_of_range);
+
+  // ---- t_n: pose, rates, velocities
+  Status st = evaluate(q_t, q_b_);
+  if (failed(st)) return hold(only(st, hard));
+  double cond = 1.0;
+  st |= rates(v_t, target_, q_b_, k1_, &cond);
+  if (has(st, Status::out_of_range)) return hold(Status::out_of_range);
+  const bool rate_saturated = has(st, Status::saturated);
+  for (int i = 0; i < nt_; ++i) {
+    v_act_(task_[static_cast<std::size_t>(i)]) = v_t(i);
+    a_act_(task_[static_cast<std::size_t>(i)]) = a_t(i);
+  }
+  for (int j = 0; j < nb_; ++j) {
+    v_act_(balancing_[static_cast<std::size_t>(j)]) = k1_(j);
+    a_act_(balancing_[static_cast<std::size_t>(j)]) = 0.0;
+  }
+  if (closed_) {
+    if (balancing_in_loops_) {
+      // C and c with the balancing rates (the position solve is converged: no iteration)
+      const Status s = closed_motion(*model_, data_, q_act_, v_act_, a_act_, q_full_, config_.loop_options);
+      if (failed(s)) return hold(only(s, hard));
+      st |= only(s, Status::singular);
+    }
+    // without balancing joints in the loops, c does not depend on their rates
+    v_full_.noalias() = data_.loop_projection * v_act_;
+    a_full_ = data_.loop_acceleration_bias;
+  } else {
+    v_full_ = v_act_;
+    a_full_.setZero();
+  }
+  // ---- feed-forward: S K_b a_b = S dh*/dt - S K_t a_t - S W(q, v, c)
+  if (const Status s = shaking_wrench(*model_, data_, q_full_, v_full_, a_full_); s != Status::ok)
+    return hold(Status::out_of_range);
+  Vec6 W;
+  W << data_.shaking.force, data_.shaking.moment;
+  for (int i = 0; i < k_; ++i) {
+    const int row = rows_[static_cast<std::size_t>(i)];
+    double s = target_rate_(row) - W(row);
+    for (int j = 0; j < nt_; ++j) s -= K_(row, task_[static_cast<std::size_t>(j)]) * a_t(j);
+    kb_work_(i) = s;
+  }
+  solve(kb_work_, a_b_);  // same operator as the rates at t_n
+  if (wide_ && (config_.home_gain > 0.0 || config_.limit_gain > 0.0)) {
+    // the derivative of the null-space objective z along the rates (the projector's own
+    // derivative is left out: a feed-forward term)
+    for (int j = 0; j < nb_; ++j) {
+      double zd = -config_.home_gain * k1_(j);
+      if (config_.limit_gain > 0.0 && std::isfinite(lower_(j)) && std::isfinite(upper_(j)) && upper_(j) > lower_(j)) {
+        const double half = 0.5 * (upper_(j) - lower_(j));
+        zd -= config_.limit_gain * k1_(j) / (half * half);
+      }
+      z_(j) = zd;
+    }
+    project_null(z_, x_);
+    a_b_ += x_;
+  }
+  if (!a_b_.allFinite()) return hold(Status::out_of_range);
+  if (rate_saturated) {
+    a_b_.setZero();  // the unsaturated formula no longer describes the commanded motion
+  } else {
+    const double peak = a_b_.cwiseAbs().maxCoeff();
+    if (peak > config_.max_acceleration) {
+      a_b_ *= config_.max_acceleration / peak;
+      st |= Status::saturated;
+    }
+  }
+  for (int j = 0; j < nb_; ++j) a_act_(balancing_[static_cast<std::size_t>(j)]) = a_b_(j);
+  if (closed_) a_full_.noalias() += data_.loop_projection * a_act_;
+  else a_full_ = a_act_;
+  Vec6 h, predicted;
+  h.noalias() = K_ * v_act_;
+  predicted.noalias() = K_ * a_act_;
+  predicted += W;
+  if (!h.allFinite() || !predicted.allFinite()) return hold(Status::out_of_range);
+
+  // the command at t_n (the stages below overwrite the model's data)
+  command_.q = q_act_;
+  command_.v = v_act_;
+  command_.a = a_act_;
+  command_.q_full = q_full_;
+  command_.v_full = v_full_;
+  command_.a_full = a_full_;
+  command_.momentum = h;
+  command_.shaking_force = predicted.head<3>();
+  command_.shaking_moment = predicted.tail<3>();
+  command_.condition = cond;
+
+  // ---- integration to t_n + dt
+  Eigen::VectorXd& next = command_.next_balancing;
+  if (rk4) {
+    Status ss = Status::ok;
+    q_stage_ = q_b_ + (0.5 * dt_) * k1_;
+    ss |= evaluate(*q_half, q_stage_);
+    if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k2_, nullptr);
+    q_stage_ = q_b_ + (0.5 * dt_) * k2_;
+    if (!failed(ss)) ss |= closed_ && !balancing_in_loops_ ? rebalance(q_stage_) : evaluate(*q_half, q_stage_);
+    if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k3_, nullptr);
+    q_stage_ = q_b_ + dt_ * k3_;
+    if (!failed(ss)) ss |= evaluate(*q_next, q_stage_);
+    if (!failed(ss)) ss |= rates(*v_next, target_ + dt_ * target_rate_, q_stage_, k4_, nullptr);
+    if (failed(ss)) {
+      return hold(only(ss, hard));
+    }
+    st |= ss;
+    next = q_b_ + (dt_ / 6.0) * (k1_ + 2.0 * k2_ + 2.0 * k3_ + k4_);
+  } else {
+    next = q_b_ + dt_ * k1_;
+  }
+  if (!next.allFinite()) return hold(Status::out_of_range);
+  if (config_.position_limits) {
+    bool outside = false;
+    for (int j = 0; j < nb_; ++j) outside = outside || next(j) < lower_(j) || next(j) > upper_(j);
+    if (outside) {
+      // hold the balancing joints where they are: the task goes on, the cancellation stops
+      const Status s = evaluate(q_t, q_b_);
+      if (failed(s)) return hold(only(s, hard));
+      for (int j = 0; j < nb_; ++j) {
+        v_act_(balancing_[static_cast<std::size_t>(j)]) = 0.0;
+        a_act_(balancing_[static_cast<std::size_t>(j)]) = 0.0;
+      }
+      if (closed_) {
+        const Status s2 = closed_motion(*model_, data_, q_act_, v_act_, a_act_, q_full_, config_.loop_options);
+        if (failed(s2)) return hold(only(s2, hard));
+        v_full_ = data_.closed_velocity;
+        a_full_ = data_.closed_acceleration;
+      } else {
+        v_full_ = v_act_;
+        a_full_ = a_act_;
+      }
+      if (shaking_wrench(*model_, data_, q_full_, v_full_, a_full_) != Status::ok) return hold(Status::out_of_range);
+      command_.q = q_act_;
+      command_.v = v_act_;
+      command_.a = a_act_;
+      command_.q_full = q_full_;
+      command_.v_full = v_full_;
+      command_.a_full = a_full_;
+      command_.momentum.noalias() = K_ * v_act_;
+      command_.shaking_force = data_.shaking.force;
+      command_.shaking_moment = data_.shaking.moment;
+      next = q_b_;
+      command_.status = st | Status::saturated;
+      return command_.status;
+    }
+  }
+  q_b_ = next;
+  command_.status = st;
+  return st;
+}
+
+ReactionlessJointController::ReactionlessJointController(std::shared_ptr<const MechanismModel> model,
+                                                         const ReactionlessConfig& config, const Eigen::VectorXd& q0,
+                                                         const Eigen::VectorXd& kp, const Eigen::VectorXd& kd,
+                                                         const Eigen::VectorXd& torque_limit,
+                                                         const JointInputRange& range, const Eigen::VectorXd& q_guess)
+    : dynamics_(model, q_guess),
+      reactionless_(model, config, q0, Eigen::VectorXd(), q_guess),
+      ct_(dynamics_, kp, kd, torque_limit, range) {
+  const int nt = reactionless_.num_task();
+  for (Eigen::VectorXd* v : {&q_t_, &v_t_, &a_t_, &q_h_, &v_h_, &q_n_, &v_n_}) *v = Eigen::VectorXd::Zero(nt);
+}
+
+Status ReactionlessJointController::step(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                         const Eigen::Ref<const Eigen::VectorXd>& qd,
+                                         const Eigen::Ref<const Eigen::VectorXd>& q_des,
+                                         const Eigen::Ref<const Eigen::VectorXd>& qd_des,
+                                         const Eigen::Ref<const Eigen::VectorXd>& qdd_des,
+                                         Eigen::Ref<Eigen::VectorXd> tau) noexcept {
+  const int na = dof();
+  if (q.size() != na || qd.size() != na || q_des.size() != na || qd_des.size() != na || qdd_des.size() != na ||
+      tau.size() != na)
+    return Status::bad_size;
+  const double h = 0.5 * reactionless_.dt(), H = reactionless_.dt();
+  for (int i = 0; i < reactionless_.num_task(); ++i) {
+    const int k = reactionless_.task_joints()[static_cast<std::size_t>(i)];
+    q_t_(i) = q_des(k);
+    v_t_(i) = qd_des(k);
+    a_t_(i) = qdd_des(k);
+    q_h_(i) = q_des(k) + h * qd_des(k) + 0.5 * h * h * qdd_des(k);
+    v_h_(i) = qd_des(k) + h * qdd_des(k);
+    q_n_(i) = q_des(k) + H * qd_des(k) + 0.5 * H * H * qdd_des(k);
+    v_n_(i) = qd_des(k) + H * qdd_des(k);
+  }
+  Status s = reactionless_.step(q_t_, v_t_, a_t_, q_h_, v_h_, q_n_, v_n_);
+  const ReactionlessCommand& c = reactionless_.command();
+  return s | ct_.step(q, qd, c.q, c.v, c.a, tau);
+}
+
+// ---- operational-space mode -----------------------------------------------------------------
+
+ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const MechanismModel> model,
+                                                       const TaskSpaceConfig& config, const Eigen::VectorXd& q0,
+                                                       const Eigen::VectorXd& v0)
+    : model_(std::move(model)), config_(config), data_(*model_) {
+  const MechanismModel& m = *model_;
+  if (m.is_closed() || m.num_passive() > 0)
+    fail("task_frame: the operational-space mode drives open mechanisms with every joint actuated");
+  frame_ = m.frame_index(config_.frame);
+  if (frame_ < 0) {
+    std::string known;
+    for (int f = 0; f < m.num_frames(); ++f) known += (known.empty() ? "" : ", ") + m.frame(f).name;
+    fail("task_frame: '" + config_.frame + "' is not a frame of the mechanism (frames: " + known + ")");
+  }
+  if (config_.task_rows == 0u || (config_.task_rows & ~cancel_both) != 0u)
+    fail("task_rows", "must select at least one of the six twist components (bit mask 1..63)",
+         static_cast<double>(config_.task_rows));
+  if (config_.cancel == 0u || (config_.cancel & ~cancel_both) != 0u)
+    fail("reactionless.cancel", "must select at least one of the six momentum components (bit mask 1..63)",
+         static_cast<double>(config_.cancel));
+  if (!(config_.rate_hz >= 1.0 && config_.rate_hz <= 1e6)) fail("reactionless.rate_hz", "must be in [1, 1e6] Hz", config_.rate_hz);
+  if (!(config_.damping > 0.0 && config_.damping < 1.0)) fail("reactionless.damping", "must be in (0, 1)", config_.damping);
+  if (!(std::isfinite(config_.max_condition) && config_.max_condition > 1.0))
+    fail("reactionless.max_condition", "must be finite and > 1", config_.max_condition);
+  if (!(std::isfinite(config_.max_rate) && config_.max_rate > 0.0))
+    fail("reactionless.max_rate", "must be finite and > 0", config_.max_rate);
+  if (!(std::isfinite(config_.max_twist) && config_.max_twist > 0.0))
+    fail("max_twist", "must be finite and > 0", config_.max_twist);
+  n_ = m.dof();
+  dt_ = 1.0 / config_.rate_hz;
+  for (int r = 0; r < 6; ++r) {
+    if (config_.task_rows & (1u << r)) task_rows_.push_back(r);
+    if (config_.cancel & (1u << r)) rows_.push_back(r);
+  }
+  if (q0.size() != n_ || !q0.allFinite())
+    fail("q0 must have " + std::to_string(n_) + " finite values (every coordinate), got " + std::to_string(q0.size()));
+  if (v0.size() != 0 && (v0.size() != n_ || !v0.allFinite()))
+    fail("v0 must have " + std::to_string(n_) + " finite values, got " + std::to_string(v0.size()));
+  const int nt = static_cast<int>(task_rows_.size()), k = static_cast<int>(rows_.size());
+  for (Eigen::VectorXd* v : {&q_, &q_cmd_, &v_cmd_, &k1_, &k2_, &k3_, &k4_, &q_stage_, &v0_, &z_, &w_})
+    *v = Eigen::VectorXd::Zero(n_);
+  rate_limit_ = m.velocity_limits().cwiseMin(config_.max_rate);
+  J_ = Eigen::MatrixXd::Zero(nt, n_);
+  Jt_ = Eigen::MatrixXd::Zero(n_, 6);
+  JpJ_ = Eigen::MatrixXd::Zero(n_, n_);
+  N_ = Eigen::MatrixXd::Zero(n_, n_);
+  M_ = Eigen::MatrixXd::Zero(k, n_);
+  rt_ = Eigen::VectorXd::Zero(nt);
+  rm_ = Eigen::VectorXd::Zero(k);
+  gram_ = Small::Identity(6, 6);
+  eig_.compute(gram_, Eigen::EigenvaluesOnly);
+  llt_.compute(gram_);
+  y_ = SmallVector::Zero(6);
+  q_ = q0;
+  q_cmd_ = q0;
+  const Eigen::VectorXd v_start = v0.size() ? v0 : Eigen::VectorXd(Eigen::VectorXd::Zero(n_));
+  if (mechbal::momentum(m, data_, q0, v_start) != Status::ok) fail("q0, v0: the momentum at the start is not finite");
+  target_ << data_.shaking.linear_momentum, data_.shaking.angular_momentum;
+}
+
+Status ReactionlessTaskController::min_norm(const Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::VectorXd>& r,
+                                            Eigen::VectorXd& x) noexcept {
+  const Eigen::Index rows = M.rows();
+  gram_.resize(rows, rows);
+  gram_.noalias() = M * M.transpose();
+  if (!gram_.allFinite()) {
+    x.setZero();
+    return Status::out_of_range;
+  }
+  eig_.compute(gram_, Eigen::EigenvaluesOnly);
+  const double lmax = eig_.eigenvalues()(rows - 1), lmin = eig_.eigenvalues()(0);
+  Status st = Status::ok;
+  if (!(lmax > 0.0)) {
+    x.setZero();
+    return Status::singular;
+  }
+  const double cond = lmin > 0.0 ? std::sqrt(lmax / lmin) : huge;
+  if (cond > config_.max_condition) {
+    gram_.diagonal().array() += config_.damping * config_.damping * lmax;
+    st = Status::singular;
+  }
+  llt_.compute(gram_);
+  SmallVector rr(rows);
+  for (Eigen::Index i = 0; i < rows; ++i) rr(i) = r(i);
+  y_ = llt_.solve(rr);
+  x.noalias() = M.transpose() * y_;
+  return st;
+}
+
+Status ReactionlessTaskController::rates(const Eigen::VectorXd& q, const Vec6& twist, Eigen::VectorXd& v) noexcept {
+  const MechanismModel& m = *model_;
+  if (frame_jacobian(m, data_, q, frame_) != Status::ok) return Status::out_of_range;
+  for (std::size_t i = 0; i < task_rows_.size(); ++i) {
+    J_.row(static_cast<Eigen::Index>(i)) = data_.frame_jacobian.row(task_rows_[i]);
+    rt_(static_cast<Eigen::Index>(i)) = twist(task_rows_[i]);
+  }
+  Status st = min_norm(J_, rt_, v0_);  // v0 = J^+ x'
+  // N = I - J^+ J, J^+ J = J^T (J J^T + lambda^2)^-1 J: columns of J^+ from the same factorisation
+  const Eigen::Index nt = J_.rows();
+  const Small G_inv = llt_.solve(Small(Small::Identity(nt, nt)));
+  Jt_.leftCols(nt).noalias() = J_.transpose() * G_inv;  // J^+ = J^T (J J^T + lambda^2)^-1
+  JpJ_.noalias() = Jt_.leftCols(nt) * J_;
+  N_ = -JpJ_;
+  N_.diagonal().array() += 1.0;
+  if (momentum_matrix(m, data_, q) != Status::ok) return Status::out_of_range;
+  for (std::size_t i = 0; i < rows_.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    M_.row(r).noalias() = data_.momentum_matrix.row(rows_[i]) * N_;
+    rm_(r) = target_(rows_[i]) - data_.momentum_matrix.row(rows_[i]).dot(v0_);
+  }
+  st |= min_norm(M_, rm_, z_);
+  v = v0_;
+  v.noalias() += N_ * z_;
+  if (!v.allFinite()) {
+    v.setZero();
+    return st | Status::out_of_range;
+  }
+  double peak = 0.0;
+  for (int j = 0; j < n_; ++j) peak = std::max(peak, std::abs(v(j)) / rate_limit_(j));
+  if (peak > 1.0) {
+    v *= 1.0 / peak;
+    st |= Status::saturated;
+  }
+  return st;
+}
+
+Status ReactionlessTaskController::step(const Vec6& twist, const Vec6& twist_half, const Vec6& twist_next) noexcept {
+  const bool rk4 = config_.integrator == ReactionlessIntegrator::rk4;
+  const auto hold = [this](Status why) {
+    q_cmd_ = q_;
+    v_cmd_.setZero();
+    h_.setZero();
+    twist_cmd_.setZero();
+    status_ = why;
+    return why;
+  };
+  if (!twist.allFinite() || (rk4 && (!twist_half.allFinite() || !twist_next.allFinite())))
+    return hold(Status::non_finite_input);
+  if (twist.cwiseAbs().maxCoeff() > config_.max_twist ||
+      (rk4 && (twist_half.cwiseAbs().maxCoeff() > config_.max_twist || twist_next.cwiseAbs().maxCoeff() > config_.max_twist)))
+    return hold(Status::out_of_range);
+  Status st = rates(q_, twist, k1_);
+  if (has(st, Status::out_of_range)) return hold(Status::out_of_range);
+  // the command at t_n: momentum and twist of the commanded rates (data_ is at q_)
+  h_.noalias() = data_.momentum_matrix * k1_;
+  twist_cmd_.noalias() = data_.frame_jacobian * k1_;
+  Eigen::VectorXd& next = q_stage_;
+  if (rk4) {
+    Status ss = Status::ok;
+    w_ = q_ + (0.5 * dt_) * k1_;
+    ss |= rates(w_, twist_half, k2_);
+    w_ = q_ + (0.5 * dt_) * k2_;
+    ss |= rates(w_, twist_half, k3_);
+    w_ = q_ + dt_ * k3_;
+    ss |= rates(w_, twist_next, k4_);
+    if (has(ss, Status::out_of_range)) return hold(Status::out_of_range);
+    st |= ss;
+    next = q_ + (dt_ / 6.0) * (k1_ + 2.0 * k2_ + 2.0 * k3_ + k4_);
+  } else {
+    next = q_ + dt_ * k1_;
+  }
+  if (!next.allFinite()) return hold(Status::out_of_range);
+  q_cmd_ = q_;
+  v_cmd_ = k1_;
+  q_ = next;
+  status_ = st;
+  return st;
+}
+
+}  // namespace mechbal
