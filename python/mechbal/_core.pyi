@@ -8,7 +8,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ChainModel', 'ComputedTorque', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointSpec', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessCommand', 'ReactionlessController', 'ReactionlessJointController', 'ReactionlessTaskController', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'RneChainDynamics', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_chain_model', 'chain_description', 'chain_kinematics', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
+__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ComputedTorque', 'ControlConfig', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MAX_URDF_BYTES', 'MAX_URDF_DEPTH', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessCommand', 'ReactionlessController', 'ReactionlessJointController', 'ReactionlessTaskController', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_description', 'load_case_file', 'load_mechanism_file', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_toml', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'read_urdf', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
 class Status:
     """
     Bit flags returned by real-time algorithms
@@ -167,7 +167,7 @@ class RestToRestTrajectory:
         ...
 class InverseDynamics:
     """
-    Joint-space inverse dynamics back end (base class of Arm2DofDynamics, KdlChainDynamics, RneChainDynamics)
+    Joint-space inverse dynamics back end (base class of Arm2DofDynamics, KdlChainDynamics, MechanismDynamics)
     """
     @property
     def dof(self) -> int:
@@ -231,91 +231,11 @@ class JointType:
     @property
     def value(self) -> int:
         ...
-class JointSpec:
-    """
-    One joint of a serial chain and the link it moves
-    """
-    def __init__(self, name: str, type: JointType, origin: numpy.typing.ArrayLike, axis: numpy.typing.ArrayLike, mass: typing.SupportsFloat | typing.SupportsIndex, com: numpy.typing.ArrayLike, inertia: numpy.typing.ArrayLike) -> None:
-        """
-        origin: 4x4 transform previous link frame -> joint frame at q=0; axis in the joint frame; com and inertia (about the centre of mass) in the link frame
-        """
-    @property
-    def axis(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
-        ...
-    @property
-    def com(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
-        ...
-    @property
-    def inertia(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
-        ...
-    @property
-    def mass(self) -> float:
-        ...
-    @property
-    def name(self) -> str:
-        ...
-    @property
-    def origin(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
-        ...
-    @property
-    def type(self) -> JointType:
-        ...
-class ChainModel:
-    """
-    Immutable, validated serial chain
-    """
-    def __init__(self, joints: collections.abc.Sequence[JointSpec], gravity: typing.Any = None, base: typing.Any = None) -> None:
-        """
-        gravity: (3,) [m/s^2], default (0, 0, -9.81); base: 4x4 transform, default identity
-        """
-    @property
-    def dof(self) -> int:
-        ...
-    @property
-    def gravity(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
-        ...
-    @property
-    def joints(self) -> list[JointSpec]:
-        ...
-    @property
-    def masses(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
-class KdlChainDynamics(InverseDynamics):
-    """
-    Joint-space dynamics of a ChainModel through Orocos KDL
-    """
-    @typing.overload
-    def __init__(self, model: ChainModel) -> None:
-        ...
-    @typing.overload
-    def __init__(self, model: MechanismModel) -> None:
-        """
-        From the general MechanismModel when it is a serial chain (bodies lumped per link); ValueError naming the link or joint otherwise
-        """
-    def coriolis(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        """
-        Coriolis and centrifugal torques C(q, qd) qd
-        """
-    def gravity(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        """
-        Gravity torques G(q)
-        """
-    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
-        """
-        Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, support_moment about the base origin, (N, 3)) by KDL's ChainIdSolver_RNE.
-        """
-    def mass_matrix(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
-        """
-        Mass matrix M(q) (dof, dof); ValueError for non-finite or overflowing q
-        """
-    @property
-    def dof(self) -> int:
-        ...
 class Joint:
     """
     One joint of a MechanismDescription; it moves the link of the same name (model.hpp for frames and conventions)
     """
-    def __init__(self, name: str, type: JointType = JointType.revolute, parent: str = 'base', placement: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] = ..., axis: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., lower: typing.SupportsFloat | typing.SupportsIndex = ..., upper: typing.SupportsFloat | typing.SupportsIndex = ..., velocity_limit: typing.SupportsFloat | typing.SupportsIndex = ..., effort_limit: typing.SupportsFloat | typing.SupportsIndex = ..., mimic_joint: str = '', mimic_ratio: typing.SupportsFloat | typing.SupportsIndex = 1.0, mimic_offset: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
+    def __init__(self, name: str, type: JointType = JointType.revolute, parent: str = 'base', placement: numpy.typing.ArrayLike = ..., axis: numpy.typing.ArrayLike = ..., lower: typing.SupportsFloat | typing.SupportsIndex = ..., upper: typing.SupportsFloat | typing.SupportsIndex = ..., velocity_limit: typing.SupportsFloat | typing.SupportsIndex = ..., effort_limit: typing.SupportsFloat | typing.SupportsIndex = ..., mimic_joint: str = '', mimic_ratio: typing.SupportsFloat | typing.SupportsIndex = 1.0, mimic_offset: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
         ...
     def __repr__(self) -> str:
         ...
@@ -359,7 +279,7 @@ class Body:
     """
     A named rigid body on a link: mass [kg], centre of mass [m] and inertia about it [kg m^2], both in the link frame
     """
-    def __init__(self, name: str, link: str, mass: typing.SupportsFloat | typing.SupportsIndex, com: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., inertia: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"] = ..., kind: str = 'link') -> None:
+    def __init__(self, name: str, link: str, mass: typing.SupportsFloat | typing.SupportsIndex, com: numpy.typing.ArrayLike = ..., inertia: numpy.typing.ArrayLike = ..., kind: str = 'link') -> None:
         ...
     def __repr__(self) -> str:
         ...
@@ -385,7 +305,7 @@ class Frame:
     """
     A named frame on a link (placement in the link frame)
     """
-    def __init__(self, name: str, link: str, placement: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] = ...) -> None:
+    def __init__(self, name: str, link: str, placement: numpy.typing.ArrayLike = ...) -> None:
         ...
     @property
     def link(self) -> str:
@@ -471,7 +391,7 @@ class Spring:
     """
     A linear spring between anchor A on link_a and anchor B on link_b (anchors in the link frames [m]): count identical springs of rate [N/m] each, carrying preload [N] at the anchor distance free_length [m], through a block and tackle of ratio pulley_ratio (model.hpp)
     """
-    def __init__(self, name: str, link_a: str, anchor_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], link_b: str, anchor_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], rate: typing.SupportsFloat | typing.SupportsIndex, free_length: typing.SupportsFloat | typing.SupportsIndex = 0.0, preload: typing.SupportsFloat | typing.SupportsIndex = 0.0, count: typing.SupportsInt | typing.SupportsIndex = 1, pulley_ratio: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> None:
+    def __init__(self, name: str, link_a: str, anchor_a: numpy.typing.ArrayLike, link_b: str, anchor_b: numpy.typing.ArrayLike, rate: typing.SupportsFloat | typing.SupportsIndex, free_length: typing.SupportsFloat | typing.SupportsIndex = 0.0, preload: typing.SupportsFloat | typing.SupportsIndex = 0.0, count: typing.SupportsInt | typing.SupportsIndex = 1, pulley_ratio: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> None:
         ...
     def __repr__(self) -> str:
         ...
@@ -512,7 +432,7 @@ class MechanismDescription:
     """
     Joints, bodies, frames, gravity and loop closures: what a MechanismModel is built from
     """
-    def __init__(self, joints: collections.abc.Sequence[Joint], bodies: collections.abc.Sequence[Body] = [], frames: collections.abc.Sequence[Frame] = [], gravity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., root_name: str = 'base', loops: collections.abc.Sequence[LoopConstraint] = [], actuated: collections.abc.Sequence[str] = [], springs: collections.abc.Sequence[Spring] = []) -> None:
+    def __init__(self, joints: collections.abc.Sequence[Joint], bodies: collections.abc.Sequence[Body] = [], frames: collections.abc.Sequence[Frame] = [], gravity: numpy.typing.ArrayLike = ..., root_name: str = 'base', loops: collections.abc.Sequence[LoopConstraint] = [], actuated: collections.abc.Sequence[str] = [], springs: collections.abc.Sequence[Spring] = []) -> None:
         ...
     @property
     def actuated(self) -> list[str]:
@@ -644,7 +564,7 @@ class MechanismDynamics(InverseDynamics, ForwardDynamics):
     """
     Joint-space dynamics of a MechanismModel (recursive Newton-Euler inverse dynamics with the base support wrench, composite rigid body mass matrix): the InverseDynamics back end of the general model, for ComputedTorque and the simulators
     """
-    def __init__(self, model: MechanismModel, q_guess: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"] = ...) -> None:
+    def __init__(self, model: MechanismModel, q_guess: numpy.typing.ArrayLike = ...) -> None:
         """
         Dynamics in the actuated coordinates (loops solved each call, warm-started from q_guess, the full coordinates near the assembly)
         """
@@ -682,11 +602,69 @@ class MechanismDynamics(InverseDynamics, ForwardDynamics):
     @property
     def solved_position(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
-class RneChainDynamics(MechanismDynamics):
+class KdlChainDynamics(InverseDynamics):
     """
-    MechanismDynamics of a serial ChainModel (the chain as a general mechanism)
+    Joint-space dynamics of a serial MechanismModel through Orocos KDL (the independent engine)
     """
-    def __init__(self, model: ChainModel) -> None:
+    def __init__(self, model: MechanismModel) -> None:
+        """
+        From the general MechanismModel when it is a serial chain (bodies lumped per link); ValueError naming the link or joint otherwise
+        """
+    def coriolis(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Coriolis and centrifugal torques C(q, qd) qd
+        """
+    def gravity(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Gravity torques G(q)
+        """
+    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+        """
+        Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, support_moment about the base origin, (N, 3)) by KDL's ChainIdSolver_RNE.
+        """
+    def mass_matrix(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Mass matrix M(q) (dof, dof); ValueError for non-finite or overflowing q
+        """
+    @property
+    def dof(self) -> int:
+        ...
+class ControlConfig:
+    """
+    The [control] table as the C++ reader checked it (read only)
+    """
+    @property
+    def balancing_joints(self) -> list[str]:
+        ...
+    @property
+    def cancel(self) -> list[str]:
+        ...
+    @property
+    def damping(self) -> float:
+        ...
+    @property
+    def integrator(self) -> str:
+        ...
+    @property
+    def k(self) -> list[float]:
+        ...
+    @property
+    def kd(self) -> list[float]:
+        ...
+    @property
+    def kind(self) -> str:
+        ...
+    @property
+    def kp(self) -> list[float]:
+        ...
+    @property
+    def rate_hz(self) -> float:
+        ...
+    @property
+    def task_frame(self) -> str:
+        ...
+    @property
+    def torque_limit(self) -> list[float]:
         ...
 class PaminsaCounterweights:
     """
@@ -1210,7 +1188,7 @@ class ComputedTorque(JointController):
     @typing.overload
     def __init__(self, model: InverseDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
         """
-        model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, RneChainDynamics). torque_limit: one value per joint (default and +inf: mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range of a tick (beyond it: the held command and Status.out_of_range)
+        model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, MechanismDynamics). torque_limit: one value per joint (default and +inf: mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range of a tick (beyond it: the held command and Status.out_of_range)
         """
     @typing.overload
     def __init__(self, model: FiveBarDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
@@ -1573,23 +1551,23 @@ class ReactionlessJointController(JointController):
     @property
     def reactionless(self) -> ReactionlessController:
         ...
-def arm2dof_chain_model(arm: Arm2DofParameters, counterweights: Arm2DofCounterweights = ...) -> ChainModel:
+def arm2dof_description(arm: Arm2DofParameters, counterweights: Arm2DofCounterweights = ...) -> MechanismDescription:
     """
-    The 2-DOF arm (counterweights merged into the links) as a ChainModel: x-z plane, joint axes along -y, gravity (0, 0, -g)
+    The 2-DOF arm (counterweights merged into the links) as a general MechanismDescription: x-z plane, joints 'shoulder' and 'elbow' with axes along -y, gravity (0, 0, -g)
     """
-def chain_description(chain: ChainModel) -> MechanismDescription:
+def load_case_file(path: str) -> tuple[MechanismModel, ControlConfig, str]:
     """
-    A serial ChainModel as a general MechanismDescription (base folded into the first joint)
+    (model, control, name) of a case file read by the C++ reader (mechbal::load_case): the [mechanism] model, the [control] table checked against it (kind 'none' without one) and [case] name.
     """
-def chain_kinematics(model: ChainModel, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+def load_mechanism_file(path: str) -> MechanismModel:
     """
-    Every link's motion in the base frame for N joint states (q, qd, qdd each (N, dof)). Returns a dict of arrays (N, dof, 3) / (N, dof, 3, 3) / frames (N, dof, 4, 4), status_per_instant (N,) and their OR, status; a failed instant (non-finite input, or motion that overflows: out_of_range) gives identity poses and zero motion.
+    The MechanismModel of the [mechanism] table of a case file or balanced.toml, read by the C++ reader (mechbal::load_mechanism). ValueError naming the dotted field and the value.
     """
 def mechanism_bias_torque(model: MechanismModel, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> dict:
     ...
 def mechanism_center_of_mass(model: MechanismModel, q: numpy.typing.ArrayLike) -> dict:
     ...
-def mechanism_closed_forward_dynamics(model: MechanismModel, q_actuated: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], v_actuated: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], tau_actuated: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], q_guess: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> dict:
+def mechanism_closed_forward_dynamics(model: MechanismModel, q_actuated: numpy.typing.ArrayLike, v_actuated: numpy.typing.ArrayLike, tau_actuated: numpy.typing.ArrayLike, q_guess: numpy.typing.ArrayLike) -> dict:
     ...
 def mechanism_closed_mass_matrix(model: MechanismModel, q_actuated: numpy.typing.ArrayLike, q_guess: numpy.typing.ArrayLike) -> dict:
     ...
@@ -1599,6 +1577,10 @@ def mechanism_closed_motion(model: MechanismModel, q_actuated: numpy.typing.Arra
     """
 def mechanism_frame_jacobian(model: MechanismModel, q: numpy.typing.ArrayLike, frame: str) -> dict:
     ...
+def mechanism_from_toml(text: str, source: str = 'string') -> MechanismModel:
+    """
+    As load_mechanism_file, from TOML text (the whole document).
+    """
 def mechanism_from_urdf(path: str) -> MechanismModel:
     """
     The MechanismModel of a URDF file (urdfdom): links with inertials as bodies, revolute / continuous / prismatic / fixed joints, mimic as gear couplings, limits, a frame per link. ValueError names the URDF element and the value.
@@ -1649,6 +1631,10 @@ def pd_error_analytic(e0: typing.SupportsFloat | typing.SupportsIndex, ed0: typi
     """
     Solution of e'' + kd e' + kp e = 0 (Arakelian et al. 2011, eq 6) at times t
     """
+def read_urdf(path: str, strict: bool = False, allow_massless: bool = False) -> tuple[MechanismModel, list[str]]:
+    """
+    (MechanismModel, warnings) of a URDF file: strict refuses the defects that the lenient reading repairs with one warning each (mechbal/io/urdf.hpp, UrdfOptions); a URDF with no <inertial> on any moving link is refused unless allow_massless.
+    """
 def shaking_wrench(mass: numpy.typing.ArrayLike, inertia_body: numpy.typing.ArrayLike, com: numpy.typing.ArrayLike, com_velocity: numpy.typing.ArrayLike, com_acceleration: numpy.typing.ArrayLike, rotation: numpy.typing.ArrayLike, angular_velocity: numpy.typing.ArrayLike, angular_acceleration: numpy.typing.ArrayLike) -> dict:
     """
     Shaking force and moment about O of B bodies over N instants (Briot & Arakelian 2009,
@@ -1688,5 +1674,7 @@ def wrist_momentum_matrix(J1: numpy.typing.ArrayLike, J2: numpy.typing.ArrayLike
     """
     N(q) of Briot & Arakelian 2009 eq 23 (corrected): wrist angular momentum = N qdot
     """
+MAX_URDF_BYTES: int = 67108864
+MAX_URDF_DEPTH: int = 64
 __version__: str = '0.1.0'
 simulate_computed_torque = simulate_closed_loop

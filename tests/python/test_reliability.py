@@ -451,9 +451,9 @@ def test_per_sample_functions_raise_on_non_finite_results(arm):
     d = _core.MechanismDynamics(arm.model)
     with pytest.raises(ValueError, match="overflow|out_of_range"):
         d.coriolis([0.1, 0.2], [1e300, 1e300])
-    rne = _core.RneChainDynamics(_core.arm2dof_chain_model(_core.Arm2DofParameters()))
+    kdl = _core.KdlChainDynamics(_core.MechanismModel(_core.arm2dof_description(_core.Arm2DofParameters())))
     with pytest.raises(ValueError, match="overflow|out_of_range"):
-        rne.coriolis([0.1, 0.2], [1e300, 1e300])
+        kdl.coriolis([0.1, 0.2], [1e300, 1e300])
     pm = _core.PaminsaModel(_core.PaminsaParameters())
     P, s = pm.forward_kinematics(0.1, 2.0, 1.8e308)
     assert s != S.ok
