@@ -16,15 +16,12 @@ Layer: methods (docs/architecture.md).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Callable
 
 from mechbal.config import ConfigError, builtin_cases, load_case, read_toml
 from mechbal.registry import paper_modules
 from mechbal.schema import validate_case
 
-Runner = Callable[[dict, Path], dict]
-_RUNNERS: dict[str, Runner] = {}
-_STAGES: dict[str, int] = {}
+from mechbal.cases.runners import _RUNNERS, _STAGES, Runner, register  # noqa: F401 (re-exported)
 
 #: the case ``mechbal demo`` runs (a paper's: when that paper is not installed, the first of
 #: :data:`FALLBACK_CASES` that is)
@@ -36,18 +33,6 @@ def default_case() -> str:
     """The case ``mechbal demo`` runs: :data:`DEFAULT_CASE` if it is a built-in case here."""
     names = builtin_cases()
     return next((n for n in (DEFAULT_CASE, *FALLBACK_CASES) if n in names), DEFAULT_CASE)
-
-
-def register(kind: str, stages: int | None = None) -> Callable[[Runner], Runner]:
-    """Register ``fn`` as the runner of ``kind``; ``stages``: how many times it calls
-    :func:`mechbal.progress.stage` (the length of its progress bar), if known."""
-    def deco(fn: Runner) -> Runner:
-        _RUNNERS[kind] = fn
-        if stages is not None:
-            _STAGES[kind] = stages
-        return fn
-
-    return deco
 
 
 def _load_runners() -> None:

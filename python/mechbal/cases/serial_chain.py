@@ -13,7 +13,7 @@ import numpy as np
 from mechbal import control
 import mechbal
 from mechbal import progress, report
-from mechbal.cases import register
+from mechbal.cases.runners import register
 from mechbal.config import ConfigError, trajectory_from_config
 from mechbal.export import write_bodies, write_summary
 from mechbal.mechanism import Mechanism

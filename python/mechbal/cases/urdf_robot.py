@@ -22,7 +22,7 @@ import numpy as np
 
 import mechbal
 from mechbal import trajectory
-from mechbal.cases import register
+from mechbal.cases.runners import register
 from mechbal.config import ConfigError, integer, number, require
 from mechbal.mechanism import Mechanism
 

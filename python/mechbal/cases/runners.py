@@ -1,0 +1,25 @@
+"""The registry of case runners: ``register(kind)`` and the runners by kind (below the case
+modules, which register into it, and :mod:`mechbal.cases`, which runs them: no import cycle).
+
+Layer: methods (docs/architecture.md).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+Runner = Callable[[dict, Path], dict]
+_RUNNERS: dict[str, Runner] = {}
+_STAGES: dict[str, int] = {}
+
+
+def register(kind: str, stages: int | None = None) -> Callable[[Runner], Runner]:
+    """Register ``fn`` as the runner of ``kind``; ``stages``: how many times it calls
+    :func:`mechbal.progress.stage` (the length of its progress bar), if known."""
+    def deco(fn: Runner) -> Runner:
+        _RUNNERS[kind] = fn
+        if stages is not None:
+            _STAGES[kind] = stages
+        return fn
+
+    return deco
