@@ -154,7 +154,7 @@ def pose_wrench(model, t, P, Pd, Pdd, wrist_angles):
     the *commanded* rates and feed-forward accelerations, zero to rounding at every tick; the
     stored angles are those rates integrated (Euler or RK4), whose motion does not have zero
     moment (Euler: 0.24 N m, 0.9 % of the unbalanced peak). A file must hold the wrench of the
-    poses it stores (DESIGN.md, Evidence), so this is what ``bodies_balanced*.npz`` calls
+    poses it stores (docs/architecture.md, Data flow: the output), so this is what ``bodies_balanced*.npz`` calls
     ``shaking_moment``; central differences of the stored poses agree with it to ~4e-5 N m (their
     own truncation error at 1 kHz)."""
     from scipy.interpolate import make_interp_spline
