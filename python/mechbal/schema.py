@@ -356,8 +356,8 @@ class Sweep(Table):
         None, description="monte_carlo: number of draws")
     seed: Annotated[int, Field(ge=0, le=2**63 - 1, strict=True)] = 0
     metrics: Annotated[list[Name], Field(min_length=1, max_length=64, description=(
-        "gravity_torque_peak | gravity_torque_rms | actuator_torque_peak | actuator_torque_rms | "
-        "shaking_force_peak | shaking_force_rms | shaking_moment_peak | shaking_moment_rms, "
+        "peak_gravity_torque | rms_gravity_torque | peak_joint_torque | rms_joint_torque | "
+        "peak_shaking_force | rms_shaking_force | peak_shaking_moment | rms_shaking_moment, "
         "torques optionally .<joint>"))]
     parameters: Annotated[list[SweepParameter], Field(min_length=1, max_length=256)]
     poses: SweepPoses = SweepPoses()

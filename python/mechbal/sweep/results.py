@@ -60,7 +60,7 @@ class SweepResult:
         units = {}
         for m in plan.metrics:
             if m.builtin:
-                units[m.name] = UNITS[m.quantity]
+                units[m.name] = UNITS[f"{m.statistic}_{m.quantity}"]
         settings = {"case": sweep.base.name, "evaluations": int(len(values)),
                     "chunk_size": sweep.default_chunk_size(),
                     "poses": None if sweep.poses is None else int(len(sweep.poses)),
