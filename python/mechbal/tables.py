@@ -88,23 +88,46 @@ def _is_number(x: Any) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
+#: the named form of an inertia in TOML, ``inertia = {ixx = .., iyy = .., izz = .., ixy = ..,
+#: ixz = .., iyz = ..}``, in the order of the six-value list form (products absent are 0)
+INERTIA_KEYS = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+
+
 def inertia_matrix(value: Any) -> np.ndarray:
-    """An inertia tensor about the centre of mass [kg m^2] from a 3x3 list, three principal
-    moments [Ixx, Iyy, Izz] or six values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]; it must be symmetric,
-    positive semi-definite and satisfy the triangle inequality of a physical body (the checks of
-    the C++ ``validate_rigid_body``). Raises a pydantic error (inside models) naming the entry."""
-    shape = "must be a 3x3 matrix, [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]"
-    if not isinstance(value, list):
+    """An inertia tensor about the centre of mass [kg m^2] from a table of named entries
+    ``{ixx, iyy, izz, ixy, ixz, iyz}`` (the three moments required, absent products 0, no other
+    key), six values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], three principal moments [Ixx, Iyy, Izz] or a
+    3x3 list; it must be symmetric, positive semi-definite and satisfy the triangle inequality of
+    a physical body (the checks of the C++ ``validate_rigid_body``). Raises a pydantic error
+    (inside models) naming the entry."""
+    shape = ("must be a table {ixx, iyy, izz, ixy, ixz, iyz}, a 3x3 matrix, [Ixx, Iyy, Izz] or "
+             "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]")
+    named = isinstance(value, dict)
+    if named:
+        for key in value:
+            if key not in INERTIA_KEYS:
+                absent = [k for k in INERTIA_KEYS if k not in value]
+                hint = did_you_mean(str(key), absent)
+                if "did you" not in hint:
+                    hint = did_you_mean(str(key), list(INERTIA_KEYS))
+                raise _custom("unknown key" + hint, f".{key}", has_value=False)
+        for key in INERTIA_KEYS[:3]:
+            if key not in value:
+                raise _custom("is required", f".{key}", has_value=False)
+        entries = [(f".{k}", value[k]) for k in INERTIA_KEYS if k in value]
+        rows = []
+    elif not isinstance(value, list):
         raise _custom(shape, value=value)
-    rows = [x for x in value if isinstance(x, list)]
-    if rows and (len(value) != 3 or len(rows) != 3):
-        raise _custom(shape, value=value)
-    entries = ([(f"[{i}][{k}]", x) for i, r in enumerate(value) for k, x in enumerate(r)] if rows
-               else [(f"[{i}]", x) for i, x in enumerate(value)])
-    if rows and any(len(r) != 3 for r in value):
-        raise _custom(shape, value=value)
-    if not rows and len(value) not in (3, 6):
-        raise _custom(shape, value=value)
+    else:
+        rows = [x for x in value if isinstance(x, list)]
+        if rows and (len(value) != 3 or len(rows) != 3):
+            raise _custom(shape, value=value)
+        entries = ([(f"[{i}][{k}]", x) for i, r in enumerate(value) for k, x in enumerate(r)] if rows
+                   else [(f"[{i}]", x) for i, x in enumerate(value)])
+        if rows and any(len(r) != 3 for r in value):
+            raise _custom(shape, value=value)
+        if not rows and len(value) not in (3, 6):
+            raise _custom(shape, value=value)
     for sub, x in entries:
         if not _is_number(x):
             raise _custom("must be a number", sub, x)
@@ -115,7 +138,7 @@ def inertia_matrix(value: Any) -> np.ndarray:
     if rows:
         inertia = np.array(value, dtype=float)
     else:
-        v = np.array(value, dtype=float)
+        v = np.array([value.get(k, 0.0) for k in INERTIA_KEYS] if named else value, dtype=float)
         inertia = np.diag(v[:3])
         if len(v) == 6:
             inertia[0, 1] = inertia[1, 0] = v[3]
@@ -141,9 +164,12 @@ def _check_inertia(value: Any) -> Any:
 
 
 _INERTIA_JSON = {
-    "description": "kg m^2, about the centre of mass: [Ixx, Iyy, Izz], [Ixx, Iyy, Izz, Ixy, Ixz, "
-                   "Iyz] or a 3x3 matrix (symmetric, positive semi-definite, triangle inequality)",
+    "description": "kg m^2, about the centre of mass: {ixx, iyy, izz, ixy, ixz, iyz} (products "
+                   "absent are 0), [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], [Ixx, Iyy, Izz] or a 3x3 matrix "
+                   "(symmetric, positive semi-definite, triangle inequality)",
     "anyOf": [
+        {"type": "object", "required": ["ixx", "iyy", "izz"], "additionalProperties": False,
+         "properties": {k: {"type": "number"} for k in INERTIA_KEYS}},
         {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3},
         {"type": "array", "items": {"type": "number"}, "minItems": 6, "maxItems": 6},
         {"type": "array", "minItems": 3, "maxItems": 3,

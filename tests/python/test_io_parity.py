@@ -168,17 +168,27 @@ def test_every_balanced_toml(balanced_files):
 
 # ---- random valid cases --------------------------------------------------------------------------
 
-def _inertia(rng) -> list:
+def _inertia(rng) -> list | dict:
     a, c = rng.uniform(1.0, 2.0, 2)  # largest <= the sum of the two others
     p = np.array([a, c, 0.5 * (a + c)]) * 0.05
     form = rng.integers(3)
+    # half the list forms are written in the named form, decided by a generator of their own so
+    # that the corpus drawn from rng stays what it was
+    pick = np.random.default_rng(int(a * 1e9))
+    named = form != 2 and pick.uniform() < 0.5
     if form == 0:
+        if named:  # principal axes: the products absent (0)
+            return {"ixx": float(p[0]), "iyy": float(p[1]), "izz": float(p[2])}
         return p.tolist()
     Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
     I = Q @ np.diag(p) @ Q.T
     I = 0.5 * (I + I.T)
     if form == 1:
-        return [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
+        six = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
+        if named:  # the named form, keys in any order
+            keys = ["ixx", "iyy", "izz", "ixy", "ixz", "iyz"]
+            return {keys[k]: float(six[k]) for k in pick.permutation(6)}
+        return six
     return I.tolist()
 
 
@@ -272,7 +282,11 @@ def test_the_random_corpus_covers_the_format():
             seen.update(["unnamed"] if "name" not in j else [])
             seen.update(k for k in ("origin", "mdh", "dh", "axis", "mimic", "limits", "parent") if k in j)
         seen.update(k for k in ("base", "bodies", "frames", "loops", "springs", "actuated") if k in m)
-    assert seen >= {"unnamed", "revolute", "prismatic", "fixed", "spherical", "origin", "mdh", "dh", "axis", "mimic",
+        inertias = [j["link"]["inertia"] for j in m["joints"] if "link" in j] + [b["inertia"] for b in m.get("bodies", [])]
+        seen.update("named inertia" if isinstance(x, dict) else f"inertia of {len(x)}" for x in inertias)
+        seen.update("named inertia without products" for x in inertias if isinstance(x, dict) and len(x) == 3)
+    assert seen >= {"named inertia", "named inertia without products", "inertia of 3", "inertia of 6",
+                    "unnamed", "revolute", "prismatic", "fixed", "spherical", "origin", "mdh", "dh", "axis", "mimic",
                     "limits", "parent", "base", "bodies", "frames", "loops", "springs", "actuated"}, seen
 
 
@@ -331,6 +345,16 @@ INVALID = {
     "inertia negative": _set(("joints", 0, "link", "inertia"), [-1.0, 1.0, 1.0]),
     "inertia triangle": _set(("joints", 0, "link", "inertia"), [1.0, 1.0, 3.0]),
     "inertia entry nan": _set(("joints", 0, "link", "inertia"), [1.0, NAN, 1.0]),
+    "inertia named unknown key": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": 1.0, "izz": 1.0, "ixq": 0.0}),
+    "inertia named upper case": _set(("joints", 0, "link", "inertia"), {"Ixx": 1.0, "iyy": 1.0, "izz": 1.0}),
+    "inertia named moment missing": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "izz": 1.0}),
+    "inertia named entry string": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": "1", "izz": 1.0}),
+    "inertia named entry bool": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": 1.0, "izz": 1.0, "ixy": True}),
+    "inertia named entry nan": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": NAN, "izz": 1.0}),
+    "inertia named entry list": _set(("joints", 0, "link", "inertia"), {"ixx": [1.0], "iyy": 1.0, "izz": 1.0}),
+    "inertia named triangle": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": 1.0, "izz": 3.0}),
+    "inertia named negative": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": 1.0, "izz": 1.0, "ixy": 2.0}),
+    "body inertia named unknown key": _append("bodies", {**BODY, "inertia": {"ixx": 0.0, "iyy": 0.0, "izz": 0.0, "iyx": 0.0}}),
     "com short": _set(("joints", 0, "link", "com"), [0.1, 0.0]),
     "com entry string": _set(("joints", 0, "link", "com"), [0.1, "x", 0.0]),
     "xyz absurd": _set(("joints", 1, "origin", "xyz"), [0.3, 0, 2e12]),

@@ -266,10 +266,38 @@ std::string fmt6(double x) {
   return os.str();
 }
 
-/// schema.inertia_matrix: 3x3, [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]; symmetric,
+/// The physical checks of an inertia (symmetric, positive semi-definite, triangle inequality).
+Mat3 checked_inertia(const Mat3& I, const std::string& f, const toml::node& n) {
+  const double scale = std::max(1.0, I.cwiseAbs().maxCoeff());
+  if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) fail(f, "must be symmetric", n);
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(I, Eigen::EigenvaluesOnly);
+  const Vec3 p = eig.eigenvalues();
+  const double tol = 1e-12 * scale;
+  if (p[0] < -tol) fail(f, "must be positive semi-definite, smallest principal moment is " + fmt6(p[0]), n);
+  if (p[2] > p[0] + p[1] + tol) {
+    fail(f, "violates the triangle inequality of a physical body: principal moments " + fmt6(p[0]) + ", " +
+                fmt6(p[1]) + ", " + fmt6(p[2]), n);
+  }
+  return I;
+}
+
+/// schema.inertia_matrix: a table {ixx, iyy, izz, ixy, ixz, iyz} (the moments required, absent
+/// products 0, no other key), 3x3, [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]; symmetric,
 /// positive semi-definite, triangle inequality.
 Mat3 inertia_matrix(const toml::node& n, const std::string& f) {
-  const char* shape = "must be a 3x3 matrix, [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]";
+  const char* shape = "must be a table {ixx, iyy, izz, ixy, ixz, iyz}, a 3x3 matrix, [Ixx, Iyy, Izz] or "
+                      "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]";
+  static const char* const kNamed[6] = {"ixx", "iyy", "izz", "ixy", "ixz", "iyz"};
+  if (auto t = n.as_table()) {
+    allow_keys(*t, f, {kNamed, kNamed + 6});
+    for (int k = 0; k < 3; ++k) required(*t, kNamed[k], f);
+    double v[6] = {0, 0, 0, 0, 0, 0};
+    for (int k = 0; k < 6; ++k)
+      if (const toml::node* x = get(*t, kNamed[k])) v[k] = number(*x, join(f, kNamed[k]));
+    Mat3 I;
+    I << v[0], v[3], v[4], v[3], v[1], v[5], v[4], v[5], v[2];
+    return checked_inertia(I, f, n);
+  }
   auto a = n.as_array();
   if (!a) fail(f, shape, n);
   std::size_t rows = 0;
@@ -315,17 +343,7 @@ Mat3 inertia_matrix(const toml::node& n, const std::string& f) {
       I(1, 2) = I(2, 1) = v[5];
     }
   }
-  const double scale = std::max(1.0, I.cwiseAbs().maxCoeff());
-  if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) fail(f, "must be symmetric", n);
-  Eigen::SelfAdjointEigenSolver<Mat3> eig(I, Eigen::EigenvaluesOnly);
-  const Vec3 p = eig.eigenvalues();
-  const double tol = 1e-12 * scale;
-  if (p[0] < -tol) fail(f, "must be positive semi-definite, smallest principal moment is " + fmt6(p[0]), n);
-  if (p[2] > p[0] + p[1] + tol) {
-    fail(f, "violates the triangle inequality of a physical body: principal moments " + fmt6(p[0]) + ", " +
-                fmt6(p[1]) + ", " + fmt6(p[2]), n);
-  }
-  return I;
+  return checked_inertia(I, f, n);
 }
 
 // ---- transforms (spec.py) ---------------------------------------------------------------------
