@@ -259,7 +259,7 @@ def _comparison(before: dict, after: dict) -> dict:
     for key, unit in (("static_torque", "N m or N"), ("torque", "N m or N"), ("shaking_force", "N"),
                       ("shaking_moment", "N m")):
         b, a = _stats(before[key]), _stats(after[key])
-        name = "actuator_torque" if key == "torque" else key
+        name = "joint_torque" if key == "torque" else key
         out[name] = {"unit": unit, "unbalanced": b, "balanced": a,
                      "peak_reduction_pct": common.reduction_pct(b["peak"], a["peak"]),
                      "rms_reduction_pct": common.reduction_pct(b["rms"], a["rms"])}
@@ -329,7 +329,7 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
 
 
 def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
-    from mechbal.balance.writers import mechanism_table, toml_text
+    from mechbal.balance.writers import inertia_table, mechanism_table, toml_text
 
     added = ([f"counterweights " + ", ".join(
         f"{k} {v['mass']:.6g} kg at {np.round(np.asarray(v['position'], float), 6).tolist()} m on {v['link']}"
@@ -368,7 +368,7 @@ def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
             com = R.T @ (np.asarray(b.com, float) - t)
             I = R.T @ np.asarray(b.inertia, float) @ R
             bodies.append({"name": b.name, "kind": "counterweight", "link": b.link, "mass": float(b.mass),
-                           "com": com.tolist(), "inertia": [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]})
+                           "com": com.tolist(), "inertia": inertia_table(I)})
         mech["bodies"] = bodies
         springs = list(mech.get("springs", []))
         own_springs = set(bc.mechanism.spring_names)
@@ -459,12 +459,12 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
                "balance": result.summary(),
                "trajectory": {k: v for k, v in bc.trajectory_table.items()},
                "before_after": _comparison(before, after),
-               "total_mass_kg": {"unbalanced": bc.mechanism.total_mass, "balanced": result.balanced.total_mass},
+               "total_mass": {"unbalanced": bc.mechanism.total_mass, "balanced": result.balanced.total_mass},
                "files": files}
     summary.update(export_notes)
     if bc.notes:
         summary["case_notes"] = bc.notes
-    write_summary(out / "summary.json", summary)
+    write_summary(out / "summary.json", summary, command="balance")
     rows = [[k, v["mass"], np.asarray(v["position"], float), ", ".join(v.get("active_bounds", [])) or "-"]
             for k, v in result.design.items() if "mass" in v]
     if rows:

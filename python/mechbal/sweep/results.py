@@ -146,7 +146,7 @@ class SweepResult:
         out.mkdir(parents=True, exist_ok=True)
         files = [self.write_table(out / f"results.{'csv' if fmt == 'csv' else 'parquet'}", fmt)]
         files += self.plot(out)
-        files.append(write_summary(out / "summary.json", self.summary()))
+        files.append(write_summary(out / "summary.json", self.summary(), command="sweep"))
         return files
 
     # ---- plots ------------------------------------------------------------------------------------

@@ -520,7 +520,7 @@ def sensitivity(kind: str, p: dict, parameters, errors, q, qd) -> list[dict]:
             rows.append(dict(parameter=name, error_pct=100.0 * e,
                              offdiag_ratio=m["offdiag_ratio"], coupling=m["coupling"],
                              diag_variation=m["diag_variation"], diag_shift_vs_k=m["diag_vs_k"],
-                             gravity_peak_over_unbalanced=m["peak_gravity_torque_Nm"] / gmax,
+                             gravity_peak_over_unbalanced=m["peak_gravity_torque"] / gmax,
                              velocity_peak_over_unbalanced=m["peak_velocity_terms"] / vmax))
     return rows
 
