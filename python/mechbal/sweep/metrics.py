@@ -1,6 +1,6 @@
 """Metrics of a sweep: the built-in ones (peak and RMS of gravity torque over a workspace sample, of
 actuator torque, shaking force and shaking moment over a trajectory) and any callable of a
-:class:`mechbal.Mechanism`.
+`mechbal.Mechanism`.
 
 A built-in metric is ``<statistic>_<quantity>`` or ``<statistic>_<quantity>.<joint>`` (the names
 of summary.json: ``peak_shaking_force``, ``rms_joint_torque``, ...):
