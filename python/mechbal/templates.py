@@ -30,7 +30,8 @@ gravity = [0.0, 0.0, -9.81]   # m/s^2 in the base frame
 #          or dh  = { a, alpha, d, theta }   standard Denavit-Hartenberg parameters
 #            (DH joints move about/along their z axis: no axis key)
 #   link = { mass, com, inertia }   the link after the joint: mass [kg], centre of mass [m] in the
-#          joint frame, inertia about the centre of mass [kg m^2] as [Ixx, Iyy, Izz],
+#          joint frame, inertia about the centre of mass [kg m^2] as
+#          { ixx, iyy, izz, ixy, ixz, iyz } (products absent: 0), [Ixx, Iyy, Izz],
 #          [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix
 
 [[mechanism.joints]]
@@ -45,7 +46,7 @@ name = "elbow"
 type = "revolute"
 origin = { xyz = [0.5, 0.0, 0.0] }   # 0.5 m along the first link
 axis = [0.0, -1.0, 0.0]
-link = { mass = 2.0, com = [0.2, 0.0, 0.0], inertia = [0.002, 0.03, 0.03] }
+link = { mass = 2.0, com = [0.2, 0.0, 0.0], inertia = { ixx = 0.002, iyy = 0.03, izz = 0.03 } }
 
 [trajectory]
 law = "quintic"               # quintic | cubic (minimum energy)
@@ -90,7 +91,8 @@ actuated = ["crank"]          # the motor-driven joints (one per degree of freed
 #   origin = { xyz = [...], rpy = [...] }  the joint frame in the parent link's frame
 #   axis    the joint axis in that frame
 #   link = { mass, com, inertia }  the link after the joint: mass [kg], centre of mass [m] in the
-#           joint frame, inertia about the centre of mass [kg m^2] as [Ixx, Iyy, Izz],
+#           joint frame, inertia about the centre of mass [kg m^2] as
+#           { ixx, iyy, izz, ixy, ixz, iyz } (products absent: 0), [Ixx, Iyy, Izz],
 #           [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix
 
 [[mechanism.joints]]

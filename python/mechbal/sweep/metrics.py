@@ -118,7 +118,7 @@ def resolve(metrics: Any, actuated: list[str], field: str = "metrics") -> list[M
                                  f"{', '.join(BUILTIN)}, optionally .<joint>; or give a callable)", what)
         statistic, quantity = base.split("_", 1)
         if joint:
-            if quantity not in ("gravity_torque", "actuator_torque"):
+            if quantity not in ("gravity_torque", "joint_torque"):
                 raise ConfigError(f, "only torques can be taken per joint", what)
             if joint not in actuated:
                 raise ConfigError(f, f"no actuated joint named {joint!r}{did_you_mean(joint, actuated)}", what)

@@ -487,7 +487,7 @@ def metrics(M, v, g, k=None) -> dict:
         diag_variation=float(np.max((diag.max(0) - diag.min(0)) / diag.mean(0))),
         diag_mean=diag.mean(0),
         peak_velocity_terms=float(np.max(np.abs(v))),
-        peak_gravity_torque_Nm=float(np.max(np.abs(g))))
+        peak_gravity_torque=float(np.max(np.abs(g))))
     if k is not None:
         out["diag_vs_k"] = float(np.max(np.abs(diag - np.asarray(k)) / np.asarray(k)))
     return out
