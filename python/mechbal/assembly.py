@@ -35,7 +35,7 @@ from mechbal.errors import ConfigError
 __all__ = ["FourBarLoop", "four_bar_loops", "loop_branches", "assemble", "Assembly", "BRANCHES"]
 
 BRANCHES = ("open", "crossed")
-#: candidate assemblies tried by :func:`assemble` (a grid of the passive joints, then random ones)
+#: candidate assemblies tried by `assemble` (a grid of the passive joints, then random ones)
 MAX_TRIES = 256
 #: |sin| between two axes below which they are parallel
 PARALLEL_TOL = 1e-9
@@ -64,7 +64,7 @@ def _chain(parents: list[int], link: int) -> list[int]:
 
 def four_bar_loops(mech) -> tuple[list[FourBarLoop], dict[str, str]]:
     """(the four-bar-like loops of ``mech``, {loop name: why it is not four-bar-like} for the
-    others). The parallel-axes check needs a pose: :func:`loop_branches` makes it."""
+    others). The parallel-axes check needs a pose: `loop_branches` makes it."""
     model = mech.model
     d = model.description
     links = list(model.link_names)

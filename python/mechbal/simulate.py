@@ -1,13 +1,13 @@
 """Simulation through the C++ core: a whole run per call, numpy in, numpy out.
 
-* :func:`closed_loop`: any joint controller (:mod:`mechbal.control`) driving any mechanism
-  (a :class:`mechbal.Mechanism`, closed loops included, or any forward-dynamics plant such as
-  ``Arm2DofDynamics``) along any trajectory (:mod:`mechbal.trajectory`), integrated by RK4 at the
+* `closed_loop`: any joint controller (`mechbal.control`) driving any mechanism
+  (a `mechbal.Mechanism`, closed loops included, or any forward-dynamics plant such as
+  ``Arm2DofDynamics``) along any trajectory (`mechbal.trajectory`), integrated by RK4 at the
   controller period.
-* :func:`passive`: no controller; the mechanism moves under gravity and its springs with zero
+* `passive`: no controller; the mechanism moves under gravity and its springs with zero
   joint effort from an initial state (RK4, the same C++ loop with
-  :class:`mechbal.control.PassiveController`), with its energy along the run.
-* open-loop evaluation along a trajectory: :class:`mechbal.Mechanism` (``shaking_wrench``,
+  `mechbal.control.PassiveController`), with its energy along the run.
+* open-loop evaluation along a trajectory: `mechbal.Mechanism` (``shaking_wrench``,
   ``base_reaction``, ``inverse_dynamics`` over ``(N, n)`` samples of a trajectory).
 
 Units: SI (s, rad or m, rad/s or m/s, N m or N).
@@ -44,7 +44,7 @@ class ClosedLoopResult:
     * ``q_des``, ``qd_des`` (N, n): the desired motion at the ticks;
     * ``joint_torque`` (N, n) [N m or N]: the command applied from t_k on;
     * ``status`` (N,): per tick, the controller's and the plant's flags (0 = ok,
-      :class:`mechbal.Status`);
+      `mechbal.Status`);
     * ``saturated_ticks``: ticks on which the controller clipped the torque;
     * ``steps_completed``: ``steps`` unless the plant failed (later rows repeat the last state);
     * ``mujoco``: with ``engine="mujoco"``, the co-simulation's record (MuJoCo's base reaction
@@ -60,7 +60,7 @@ class ClosedLoopResult:
     status: np.ndarray
     saturated_ticks: int
     steps_completed: int
-    #: ``engine="mujoco"``: the :class:`mechbal.export.mujoco_engine.CoSimulation` (MuJoCo's base
+    #: ``engine="mujoco"``: the `mechbal.export.mujoco_engine.CoSimulation` (MuJoCo's base
     #: reaction at every tick beside mechbal's prediction, the loops' constraint violation)
     mujoco: Any = None
 
@@ -97,7 +97,7 @@ MAX_STEPS = 10_000_000
 
 def _check_timing(dt: Any, duration: Any) -> tuple[float, float]:
     """(dt, duration) as floats, or ValueError / TypeError naming the argument: real numbers,
-    finite, dt > 0, duration >= dt, at most :data:`MAX_STEPS` steps."""
+    finite, dt > 0, duration >= dt, at most `MAX_STEPS` steps."""
     values = {}
     for name, x in (("dt", dt), ("duration", duration)):
         if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
@@ -126,15 +126,15 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
     """Simulate ``controller`` driving ``mechanism_or_plant`` along ``trajectory`` (one C++ call).
 
     Args:
-        mechanism_or_plant: a :class:`mechbal.Mechanism` (its forward dynamics in the actuated
+        mechanism_or_plant: a `mechbal.Mechanism` (its forward dynamics in the actuated
             coordinates; loops solved at every stage, warm-started from ``q_guess``, the full
             coordinates near the assembly) or any forward-dynamics plant (``MechanismDynamics``,
             ``Arm2DofDynamics``).
-        controller: any joint controller (:class:`mechbal.control.ComputedTorque`, whose model
-            may differ from the plant, :class:`mechbal.control.DecoupledJointController`, or a
-            :class:`mechbal.control.ReactionlessController` built with ``kp`` and ``kd``).
+        controller: any joint controller (`mechbal.control.ComputedTorque`, whose model
+            may differ from the plant, `mechbal.control.DecoupledJointController`, or a
+            `mechbal.control.ReactionlessController` built with ``kp`` and ``kd``).
             Its state carries over from previous ticks; call ``reset()`` to start afresh.
-        trajectory: any :mod:`mechbal.trajectory` object, evaluated at the simulation time
+        trajectory: any `mechbal.trajectory` object, evaluated at the simulation time
             t = 0 .. duration [s]. A rest-to-rest trajectory runs on the C++ path; any other is
             sampled every dt/2 first.
         q0: initial positions [rad or m]; default: the trajectory at t = 0.
@@ -146,15 +146,15 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
         q_guess: full coordinates near the assembly, for a closed-loop Mechanism.
         engine: ``"mechbal"`` (the C++ RK4 above) or ``"mujoco"``: the controller ticked every
             ``dt`` from Python against MuJoCo integrating the mechanism's MJCF export (a
-            :class:`mechbal.Mechanism` only; zero-order hold; needs ``mechbal[mujoco]``). The
+            `mechbal.Mechanism` only; zero-order hold; needs ``mechbal[mujoco]``). The
             result's ``mujoco`` holds MuJoCo's base reaction at every tick beside mechbal's
             prediction.
         **engine_options: with ``engine="mujoco"``, the options of
-            :func:`mechbal.export.mujoco_engine.co_simulate` (``substeps``, ``integrator``,
+            `mechbal.export.mujoco_engine.co_simulate` (``substeps``, ``integrator``,
             ``solref``, ``solimp``, ``minimum_mass``, ``constraint_weight``).
 
     Returns:
-        :class:`ClosedLoopResult`. A plant failure (an unassemblable pose, a non-finite state)
+        `ClosedLoopResult`. A plant failure (an unassemblable pose, a non-finite state)
         stops the integration and shows in ``status`` and ``steps_completed``; it does not raise.
     """
     from mechbal.trajectory import RestToRest, as_trajectory
@@ -222,7 +222,7 @@ def _closed_loop_mujoco(mech: Any, controller: Any, trajectory: Any, q0, qd0, *,
 
 @dataclass(frozen=True)
 class PassiveResult:
-    """A passive run (:func:`passive`), one row per step k = 0 .. steps (t_k = k dt):
+    """A passive run (`passive`), one row per step k = 0 .. steps (t_k = k dt):
 
     * ``t`` (N,) [s];
     * ``q``, ``v`` (N, na): the actuated coordinates and their rates (every coordinate of an open
@@ -231,7 +231,7 @@ class PassiveResult:
       and acceleration (forward dynamics at zero effort);
     * ``kinetic_energy``, ``potential_energy`` (N,) [J]: 1/2 v^T M v, and gravity (zero at O) plus
       springs; their sum ``energy`` is conserved by the exact motion (no effort, no friction);
-    * ``status`` (N,): per step (0 = ok); ``steps_completed`` as :class:`ClosedLoopResult`.
+    * ``status`` (N,): per step (0 = ok); ``steps_completed`` as `ClosedLoopResult`.
     """
 
     t: np.ndarray
@@ -263,11 +263,11 @@ class PassiveResult:
 
 def passive(mech: Any, q0: npt.ArrayLike, v0: npt.ArrayLike | None = None, *, dt: float = 1e-3,
             duration: float = 1.0, q_guess: npt.ArrayLike | None = None) -> PassiveResult:
-    """Passive simulation: no controller, zero joint effort; ``mech`` (a :class:`mechbal.Mechanism`,
+    """Passive simulation: no controller, zero joint effort; ``mech`` (a `mechbal.Mechanism`,
     closed loops included) moves under gravity and its springs from ``q0`` (actuated coordinates,
     every coordinate of an open mechanism) [rad or m] with rates ``v0`` (default at rest), RK4 with
-    step ``dt`` [s] for ``duration`` [s] (the closed loop of :func:`closed_loop` with
-    :class:`mechbal.control.PassiveController`). ``q_guess``: the full coordinates near the
+    step ``dt`` [s] for ``duration`` [s] (the closed loop of `closed_loop` with
+    `mechbal.control.PassiveController`). ``q_guess``: the full coordinates near the
     assembly of a closed mechanism (its branch). The result carries the energy along the run, the
     invariant of an unforced motion."""
     from mechbal.control import PassiveController

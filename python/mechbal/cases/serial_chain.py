@@ -1,5 +1,5 @@
 """Runner for ``kind = "mechanism"`` (alias ``kind = "serial_chain"``): any mechanism of the
-general model (:mod:`mechbal.spec`: chains, trees, extra bodies, gear couplings, loop closures)
+general model (`mechbal.spec`: chains, trees, extra bodies, gear couplings, loop closures)
 moving along a rest-to-rest trajectory of its actuated joints; shaking force and moment, base
 reaction with gravity, actuator torques and, for closed mechanisms, the loop solve's conditioning.
 
@@ -42,7 +42,7 @@ def mechanism_motion(mech: Mechanism, traj, t, q_guess=None):
 
 
 def start_assembly(mech: Mechanism, tr, traj):
-    """The assembly of a closed mechanism at the trajectory's start (:func:`mechbal.assembly.assemble`
+    """The assembly of a closed mechanism at the trajectory's start (`mechbal.assembly.assemble`
     with ``[trajectory] branch`` and ``initial_guess``), or None for an open one."""
     if not mech.is_closed:
         return None
@@ -80,7 +80,7 @@ def run(config, out: Path) -> dict:
 
 
 def _drawing(mech: Mechanism, motion) -> dict:
-    """What a picture of the mechanism needs beside the bodies (:mod:`mechbal.animation`): every
+    """What a picture of the mechanism needs beside the bodies (`mechbal.animation`): every
     link frame's origin and parent, and every named frame's origin with its link."""
     links = list(mech.link_names)
     by_name = {f.name: f.link for f in mech.model.description.frames}
@@ -307,7 +307,7 @@ def run_passive(mech: Mechanism, case, traj, out: Path, q_guess=None, assembly=N
     """A case with ``[control] kind = "passive"``: no controller; the mechanism starts from the
     trajectory's start with its initial rates (zero for the rest-to-rest laws, ``speed`` for
     constant_speed) and moves under gravity and its springs with zero effort for the trajectory's
-    duration, RK4 at ``rate_hz`` (:func:`mechbal.simulate.passive`). Writes bodies_passive.npz (the
+    duration, RK4 at ``rate_hz`` (`mechbal.simulate.passive`). Writes bodies_passive.npz (the
     shaking wrench of its stored poses), the wrench and energy plots, and summary.json with the
     energy balance (kinetic + gravity + springs, conserved by the exact motion)."""
     from mechbal import simulate
