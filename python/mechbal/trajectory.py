@@ -197,12 +197,13 @@ class ConstantSpeed:
         w = _vector("rpm", rpm) * (2.0 * np.pi / 60.0)
         if (duration is None) == (revolutions is None):
             raise ValueError("give duration or revolutions (exactly one)")
-        if revolutions is not None:
-            top = float(np.max(np.abs(w)))
-            if top == 0.0 or not revolutions > 0:
-                raise ValueError("revolutions needs a non-zero rpm and revolutions > 0")
-            duration = float(revolutions) * 2.0 * np.pi / top
-        return cls(start, w, float(duration))
+        if revolutions is None:
+            assert duration is not None   # exactly one of them (checked above)
+            return cls(start, w, float(duration))
+        top = float(np.max(np.abs(w)))
+        if top == 0.0 or not revolutions > 0:
+            raise ValueError("revolutions needs a non-zero rpm and revolutions > 0")
+        return cls(start, w, float(revolutions) * 2.0 * np.pi / top)
 
     @property
     def dof(self) -> int:

@@ -108,6 +108,9 @@ def design_trajectory(mech, design_cfg, default: dict, guess):
     (a ``[trajectory]``-like dict in the actuated joints)."""
     if design_cfg is not None and design_cfg.trajectory is not None:
         tr = design_cfg.trajectory
+        if getattr(tr, "branch", None) is not None:
+            raise ConfigError("trajectory.branch", "is read for kind = 'mechanism' cases; this case kind "
+                              "picks its assembly with a full initial_guess", tr.branch)
         g = getattr(tr, "initial_guess", None)
         guess = guess if g is None else np.array(g, float)
         t, motion, tt = _trajectory_motion(mech, tr)
@@ -175,6 +178,11 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
             raise ConfigError("--design", "a URDF has no [balance] table: give --design FILE.toml with "
                                           "[[balance.counterweights]] (and optionally a [trajectory])", has_value=False)
         rng = np.random.default_rng(design_cfg.balance.seed)
+        for key in ("initial_guess", "branch"):
+            value = getattr(design_cfg.trajectory, key, None)
+            if value is not None and not mech.is_closed:
+                raise ConfigError(f"trajectory.{key}", "is for closed mechanisms (with loops); this URDF has none",
+                                  value)
         if design_cfg.trajectory is not None:
             t, motion, tt = _trajectory_motion(mech, design_cfg.trajectory)
         else:
