@@ -409,6 +409,12 @@ INVALID = {
     "spring anchor missing": _append("springs", {k: v for k, v in SPRING.items() if k != "anchor_b"}),
     "spring link unknown": _append("springs", {**SPRING, "link_a": "zz"}),
     "spring duplicate": lambda m: m.update(springs=[SPRING, dict(SPRING)]),
+    # izz alone: only where the mechanism is planar (this one has a spherical joint), not with inertia
+    "izz not planar": _set(("joints", 0, "link"), {"mass": 1.0, "izz": 0.01}),
+    "izz and inertia": _set(("joints", 0, "link", "izz"), 0.01),
+    "izz negative": _set(("joints", 0, "link"), {"mass": 1.0, "izz": -0.01}),
+    "body izz with rpy": _append("bodies", {"name": "cw", "link": "a", "mass": 1.0, "izz": 0.01, "rpy": [0, 0, 1]}),
+    "body izz not planar": _append("bodies", {"name": "cw", "link": "a", "mass": 1.0, "izz": 0.01}),
 }
 
 
@@ -464,3 +470,56 @@ def test_load_case_file_reads_control(tmp_path):
     path.write_text(path.read_text().replace("kd = [20, 20, 20, 20, 20]", "kd = [20, 20]"))
     with pytest.raises(ValueError, match=r"^control\.kd: must have 5 values"):
         _core.load_case_file(str(path))
+
+
+# ---- izz alone and the [trajectory] through both readers ---------------------------------------------
+
+PLANAR = {"joints": [{"name": "crank", "axis": [0, -1, 0], "link": {"mass": 0.8, "com": [0.1, 0, 0], "izz": 0.003}},
+                     {"name": "coupler", "origin": {"xyz": [0.2, 0, 0]}, "axis": [0, -1, 0],
+                      "link": {"mass": 1.5, "com": [0.25, 0, 0], "izz": 0.032}},
+                     {"name": "rocker", "parent": "base", "origin": {"xyz": [0.45, 0, 0]}, "axis": [0, 1, 0],
+                      "link": {"mass": 1.1, "com": [0.2, 0, 0], "izz": 0.015}}],
+          "bodies": [{"name": "cw", "link": "crank", "mass": 0.6, "com": [-0.08, 0, 0], "izz": 0.0001}],
+          "frames": [{"name": "ct", "link": "coupler", "origin": {"xyz": [0.5, 0, 0]}},
+                     {"name": "rt", "link": "rocker", "origin": {"xyz": [0.4, 0, 0]}}],
+          "loops": [{"name": "pin", "frame_a": "ct", "frame_b": "rt"}], "actuated": ["crank"]}
+
+
+def test_planar_izz_case():
+    """A four-bar whose links give izz alone (one joint axis reversed: still parallel)."""
+    text = toml_text({"case": {"name": "planar", "kind": "mechanism"}, "mechanism": PLANAR})
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "p.toml"
+        path.write_text(text)
+        py = Mechanism.from_toml(path)
+    assert_same_model(py.model, _core.mechanism_from_toml(text), np.random.default_rng(5))
+    crank = py.model.description.bodies[0]
+    np.testing.assert_array_equal(np.asarray(crank.inertia), np.diag([0.0015, 0.003, 0.0015]))
+
+
+TRAJECTORIES = [
+    {"law": "constant_speed", "start": [0.5], "rpm": 120, "revolutions": 2, "samples": 11, "branch": "crossed"},
+    {"law": "constant_speed", "start": [0.5], "speed": [-3.0], "duration": 0.7, "initial_guess": [0.5]},
+    {"law": "cubic", "start": [0.5], "end": [1.0], "duration": 2, "initial_guess": [0.5, -0.6, 1.3]},
+]
+
+
+@pytest.mark.parametrize("k", range(len(TRAJECTORIES)))
+def test_both_readers_read_the_trajectory(tmp_path, k):
+    from mechbal.schema import validate_case
+
+    cfg = {"case": {"name": "planar", "kind": "mechanism"}, "mechanism": PLANAR, "trajectory": TRAJECTORIES[k]}
+    path = tmp_path / "t.toml"
+    path.write_text(toml_text(cfg))
+    tr = validate_case(cfg, warn=False).trajectory
+    c = _core.load_case_trajectory(str(path))
+    assert c.present and c.constant_speed == (tr.law == "constant_speed")
+    assert c.start == tr.start and c.samples == tr.samples and c.branch == (tr.branch or "")
+    assert c.initial_guess == (tr.initial_guess or [])
+    assert c.duration == pytest.approx(tr.motion_duration(), rel=1e-15)
+    if tr.law == "constant_speed":
+        assert c.speed == pytest.approx(tr.speeds(1), rel=1e-15) and c.end == []
+    else:
+        assert c.end == tr.end and c.law.name == tr.law

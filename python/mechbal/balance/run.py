@@ -61,6 +61,8 @@ class BalanceCase:
     default_slots: list
     default_design: dict | None = None
     notes: dict | None = None
+    #: closed mechanisms: the assembly at the start (`mechbal.assembly.Assembly.summary`)
+    assembly: dict | None = None
 
 
 #: what builds the BalanceCase of a validated case, and (optionally) the case written back with the
@@ -106,6 +108,9 @@ def design_trajectory(mech, design_cfg, default: dict, guess):
     (a ``[trajectory]``-like dict in the actuated joints)."""
     if design_cfg is not None and design_cfg.trajectory is not None:
         tr = design_cfg.trajectory
+        if getattr(tr, "branch", None) is not None:
+            raise ConfigError("trajectory.branch", "is read for kind = 'mechanism' cases; this case kind "
+                              "picks its assembly with a full initial_guess", tr.branch)
         g = getattr(tr, "initial_guess", None)
         guess = guess if g is None else np.array(g, float)
         t, motion, tt = _trajectory_motion(mech, tr)
@@ -173,6 +178,11 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
             raise ConfigError("--design", "a URDF has no [balance] table: give --design FILE.toml with "
                                           "[[balance.counterweights]] (and optionally a [trajectory])", has_value=False)
         rng = np.random.default_rng(design_cfg.balance.seed)
+        for key in ("initial_guess", "branch"):
+            value = getattr(design_cfg.trajectory, key, None)
+            if value is not None and not mech.is_closed:
+                raise ConfigError(f"trajectory.{key}", "is for closed mechanisms (with loops); this URDF has none",
+                                  value)
         if design_cfg.trajectory is not None:
             t, motion, tt = _trajectory_motion(mech, design_cfg.trajectory)
         else:
@@ -213,8 +223,14 @@ def case_from_config(cfg, raw: dict | None = None, design_cfg=None, *, source: s
         t, motion, tt = _trajectory_motion(mech, tr)
         if guess is not None:
             tt["initial_guess"] = list(guess)
-        return BalanceCase(name, title, mech, table, t, motion, tt,
-                           None if guess is None else np.array(guess, float), raw, cfg.case.kind, [])
+        q_guess, assembly = None if guess is None else np.array(guess, float), None
+        if mech.is_closed:   # the assembly at the start, on [trajectory] branch
+            from mechbal.assembly import assemble
+
+            asm = assemble(mech, motion[0][0], branch=getattr(tr, "branch", None), initial_guess=guess)
+            q_guess, assembly = asm.q, asm.summary()
+        return BalanceCase(name, title, mech, table, t, motion, tt, q_guess, raw, cfg.case.kind, [],
+                           assembly=assembly)
     adapter = case_adapter(cfg.case.kind)
     if adapter is not None:
         return adapter.build(cfg, raw, table, design_cfg)
@@ -318,8 +334,7 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
     lower = table.lower if table is not None else None
     upper = table.upper if table is not None else None
     if mech.is_closed and lower is None and upper is None:  # the trajectory's range assembles
-        lower = np.minimum(bc.trajectory_table["start"], bc.trajectory_table["end"])
-        upper = np.maximum(bc.trajectory_table["start"], bc.trajectory_table["end"])
+        lower, upper = np.min(bc.motion[0], axis=0), np.max(bc.motion[0], axis=0)
     width = len(mech.actuated_names) if mech.is_closed else mech.dof
     for key, v in (("lower", lower), ("upper", upper)):
         if v is not None and len(v) != width:
@@ -462,6 +477,8 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
                "total_mass": {"unbalanced": bc.mechanism.total_mass, "balanced": result.balanced.total_mass},
                "files": files}
     summary.update(export_notes)
+    if bc.assembly is not None:
+        summary["assembly"] = bc.assembly
     if bc.notes:
         summary["case_notes"] = bc.notes
     write_summary(out / "summary.json", summary, command="balance")
