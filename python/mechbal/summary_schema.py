@@ -183,7 +183,10 @@ RUN_MECHANISM: dict[str, Schema] = {
     "closed": boolean("True for a mechanism with loop closures."),
     "duration": number("s", "Duration of the trajectory."),
     "samples": integer("Instants along the trajectory."),
-    "law": string("Time law of the trajectory (quintic, cycloidal, ...)."),
+    "law": string("Time law of the trajectory (quintic, cycloidal, constant_speed, ...)."),
+    "speed": numbers("rad/s or m/s", "Speed of each actuated joint (law constant_speed)."),
+    "rpm": numbers("rev/min", "The same speeds in turns per minute (the case file's rpm key)."),
+    "revolutions": number(None, "Turns of the fastest joint over the run (law constant_speed)."),
     "variants": strings("The variants the per-variant values name."),
     **{k: METRICS[k] for k in ("peak_shaking_force", "peak_shaking_moment", "peak_joint_torque",
                                "rms_joint_torque", "peak_base_reaction_force",
@@ -195,6 +198,9 @@ RUN_MECHANISM: dict[str, Schema] = {
     "loops": detail("Loop solve along the trajectory: min_rcond, singular_instants, "
                     "max_closure_residual [m], max_newton_iterations."),
     "control": _CONTROL,
+    "passive": detail("[control] kind = passive: rate_hz, integrator, q0, v0, initial_energy [J], "
+                      "max_energy_drift [J], kinetic_energy_swing [J], relative_energy_drift, "
+                      "energy (definition), final_q, final_v."),
     "urdf": string("The URDF file (kind urdf)."),
     "joint_names": strings(), "body_names": strings(),
     "start": numbers("rad or m", "Start pose of the default motion (kind urdf)."),
@@ -245,6 +251,8 @@ BALANCE: dict[str, Schema] = {
     "total_mass": number_map("kg", "Total mass, unbalanced and balanced."),
     "urdf": string("Why no balanced.urdf was written (loops or springs), or its name."),
     "case_notes": detail("What the case's loader says (default motion, paper values)."),
+    "assembly": detail("Loop assembly: the branch (open or crossed), how it was chosen (branch, "
+                       "initial_guess or default) and the branch at the end."),
 }
 
 _VERIFY_QUANTITY = {"type": "object", "additionalProperties": False, "properties": {

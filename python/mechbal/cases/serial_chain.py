@@ -58,7 +58,7 @@ def motion_summary(tr, traj) -> dict:
     if getattr(tr, "law", None) != "constant_speed":
         return {}
     speed = np.asarray(traj.speed, float)
-    return {"speed_rad_s": speed, "speed_rpm": speed * 60.0 / (2.0 * np.pi),
+    return {"speed": speed, "rpm": speed * 60.0 / (2.0 * np.pi),
             "revolutions": float(np.max(np.abs(speed)) * traj.duration / (2.0 * np.pi))}
 
 
@@ -344,21 +344,21 @@ def run_passive(mech: Mechanism, case, traj, out: Path, q_guess=None, assembly=N
         "dof": mech.dof,
         "actuated": mech.actuated_names,
         "closed": mech.is_closed,
-        "duration_s": float(traj.duration),
+        "duration": float(traj.duration),
         "samples": int(len(t)),
         "law": law_name(traj),
         "variants": ["passive"],
-        "peak_shaking_force_N": {"passive": report.peak_abs(F)},
-        "peak_shaking_moment_Nm": {"passive": report.peak_abs(M)},
+        "peak_shaking_force": {"passive": report.peak_abs(F)},
+        "peak_shaking_moment": {"passive": report.peak_abs(M)},
         "passive": {
             "rate_hz": float(ctl.rate_hz), "integrator": "rk4", "q0": q0, "v0": v0,
-            "initial_energy_J": e0, "max_energy_drift_J": r.energy_drift,
-            "kinetic_energy_swing_J": swing,
+            "initial_energy": e0, "max_energy_drift": r.energy_drift,
+            "kinetic_energy_swing": swing,
             "relative_energy_drift": r.energy_drift / swing if swing > 0 else 0.0,
             "energy": "kinetic 1/2 v^T M v + gravity (zero at O) + springs; conserved by the exact motion",
             "final_q": r.q[-1], "final_v": r.v[-1],
         },
-        "total_mass_kg": mech.total_mass,
+        "total_mass": mech.total_mass,
         "files": ["bodies_passive.npz", "shaking_wrench.png", "energy.png"],
     }
     if assembly is not None:
