@@ -16,7 +16,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <limits>
 #include <memory>
 #include <vector>
 
@@ -25,12 +24,10 @@
 #include "bench_urdf.hpp"
 #include "mechbal/control/reactionless.hpp"
 
-
 namespace mechbal::bench {
 namespace {
 
 using namespace panda_reactionless;
-
 
 [[noreturn]] void fail(const char* what, double value) {
   std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
@@ -64,7 +61,6 @@ Tick mechbal_case(ReactionlessIntegrator integrator) {
     benchmark::ClobberMemory();
   };
 }
-
 
 }  // namespace
 }  // namespace mechbal::bench

@@ -479,9 +479,8 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
       (rk4 && (!task_in_range(*q_half, *v_half, nullptr) || !task_in_range(*q_next, *v_next, nullptr))))
     return hold(Status::out_of_range);
 
-  // ---- t_n: pose, rates, velocities. The task's rates first: c (a = C a# + c, quadratic in the
-  // velocities) is computed by evaluate() with them (the balancing joints' rates do not enter c
-  // unless they are in the loops, and then closed_motion runs again below with them)
+  // ---- t_n: pose, rates, velocities. The task velocities first: the loops' acceleration bias c
+  // that evaluate() leaves in data_ depends on them (not on balancing joints outside the loops)
   for (int i = 0; i < nt_; ++i) v_act_(task_[static_cast<std::size_t>(i)]) = v_t(i);
   const bool reuse = stage_cache_ && q_t == stage_q_ && v_t == stage_v_;  // exactly the last stage's
   stage_cache_ = false;
