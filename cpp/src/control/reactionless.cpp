@@ -9,6 +9,7 @@
 #include "mechbal/algorithm/jacobian.hpp"
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/detail/placed.hpp"
 
 namespace mechbal {
 
@@ -178,6 +179,8 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
   // buffers
   q_full_ = q_guess.size() != 0 ? q_guess : Eigen::VectorXd(Eigen::VectorXd::Zero(n_));
   q_act_ = Eigen::VectorXd::Zero(na_);
+  stage_q_ = Eigen::VectorXd::Zero(nt_);
+  stage_v_ = Eigen::VectorXd::Zero(nt_);
   v_act_ = Eigen::VectorXd::Zero(na_);
   a_act_ = Eigen::VectorXd::Zero(na_);
   v_full_ = Eigen::VectorXd::Zero(n_);
@@ -219,6 +222,7 @@ Status ReactionlessController::reset(const Eigen::Ref<const Eigen::VectorXd>& q0
                   v0.cwiseAbs().maxCoeff() > config_.task_range.max_speed))
     return Status::out_of_range;
   Status st = Status::ok;
+  stage_cache_ = false;
   q_act_ = q0;
   v_act_ = v0;
   a_act_.setZero();
@@ -277,7 +281,8 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
     // positions (warm-started from the last solve), C and c (c with the current velocity guess)
     st = closed_motion(*model_, data_, q_act_, v_act_, a_act_, q_full_, config_.loop_options);
     if (failed(st)) return st;
-    const Status sm = momentum_matrix(*model_, data_, q_full_);
+    // the solve left the links placed at its solution q_full_: no second placement
+    const Status sm = detail::momentum_matrix_placed(*model_, data_);
     if (sm != Status::ok) return st | sm;
     K_.noalias() = data_.momentum_matrix * data_.loop_projection;
   } else {
@@ -474,8 +479,12 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
       (rk4 && (!task_in_range(*q_half, *v_half, nullptr) || !task_in_range(*q_next, *v_next, nullptr))))
     return hold(Status::out_of_range);
 
-  // ---- t_n: pose, rates, velocities
-  Status st = evaluate(q_t, q_b_);
+  // ---- t_n: pose, rates, velocities. The task velocities first: the loops' acceleration bias c
+  // that evaluate() leaves in data_ depends on them (not on balancing joints outside the loops)
+  for (int i = 0; i < nt_; ++i) v_act_(task_[static_cast<std::size_t>(i)]) = v_t(i);
+  const bool reuse = stage_cache_ && q_t == stage_q_ && v_t == stage_v_;  // exactly the last stage's
+  stage_cache_ = false;
+  Status st = reuse ? stage_cache_status_ | rebalance(q_b_) : evaluate(q_t, q_b_);
   if (failed(st)) return hold(only(st, hard));
   double cond = 1.0;
   st |= rates(v_t, target_, q_b_, k1_, &cond);
@@ -504,7 +513,8 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
     a_full_.setZero();
   }
   // ---- feed-forward: S K_b a_b = S dh*/dt - S K_t a_t - S W(q, v, c)
-  if (const Status s = shaking_wrench(*model_, data_, q_full_, v_full_, a_full_); s != Status::ok)
+  // the links are placed at q_full_ (evaluate(), or closed_motion just above, at the same q)
+  if (const Status s = detail::shaking_wrench_placed(*model_, data_, q_full_, v_full_, a_full_); s != Status::ok)
     return hold(Status::out_of_range);
   Vec6 W;
   W << data_.shaking.force, data_.shaking.moment;
@@ -562,17 +572,26 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
 
   // ---- integration to t_n + dt
   Eigen::VectorXd& next = command_.next_balancing;
+  Status last_stage = Status::solver_error;  // RK4's evaluation at t_n + dt (for the next tick)
   if (rk4) {
     Status ss = Status::ok;
+    // each stage's loop projection with the task's rates of that instant (c, at t_n + dt, is then
+    // the next tick's: see stage_cache_)
+    const auto task_rates = [this](const Eigen::Ref<const Eigen::VectorXd>& v) {
+      for (int i = 0; i < nt_; ++i) v_act_(task_[static_cast<std::size_t>(i)]) = v(i);
+    };
     q_stage_ = q_b_ + (0.5 * dt_) * k1_;
+    task_rates(*v_half);
     ss |= evaluate(*q_half, q_stage_);
     if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k2_, nullptr);
     q_stage_ = q_b_ + (0.5 * dt_) * k2_;
     if (!failed(ss)) ss |= closed_ && !balancing_in_loops_ ? rebalance(q_stage_) : evaluate(*q_half, q_stage_);
     if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k3_, nullptr);
     q_stage_ = q_b_ + dt_ * k3_;
-    if (!failed(ss)) ss |= evaluate(*q_next, q_stage_);
+    task_rates(*v_next);
+    if (!failed(ss)) ss |= last_stage = evaluate(*q_next, q_stage_);
     if (!failed(ss)) ss |= rates(*v_next, target_ + dt_ * target_rate_, q_stage_, k4_, nullptr);
+    task_rates(v_t);
     if (failed(ss)) {
       return hold(only(ss, hard));
     }
@@ -619,6 +638,12 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
   }
   q_b_ = next;
   command_.status = st;
+  if (rk4 && closed_ && !balancing_in_loops_ && !failed(last_stage)) {
+    stage_cache_ = true;
+    stage_cache_status_ = last_stage;
+    stage_q_ = *q_next;
+    stage_v_ = *v_next;
+  }
   return st;
 }
 

@@ -222,6 +222,13 @@ class ReactionlessController {
   Eigen::VectorXd rate_limit_, lower_, upper_, home_;
   // state
   Eigen::VectorXd q_b_;
+  // RK4's last stage solved the loops at (q_t_next, v_t_next) with the momentum of the same loop
+  // solution: when the next tick starts at exactly those task positions and rates (a sampled
+  // trajectory), its t_n evaluation reuses them (the loop solve, C and c do not depend on the
+  // balancing joints when these move no loop frame): only A is recomputed (rebalance)
+  bool stage_cache_ = false;
+  Status stage_cache_status_ = Status::ok;
+  Eigen::VectorXd stage_q_, stage_v_;
   Vec6 target_ = Vec6::Zero(), target_rate_ = Vec6::Zero();
   ReactionlessCommand command_;
   // scratch (sized at construction)
