@@ -4,7 +4,7 @@ For the case's mechanism and its balanced variant (the case's ``[balance]`` meth
 design), along the case's trajectory:
 
 * **prescribed motion**: MuJoCo's inverse dynamics of the MJCF export on mechbal's (q, v, a)
-  (:meth:`mechbal.export.mujoco_engine.MujocoMechanism.inverse_dynamics`): the shaking force
+  (`mechbal.export.mujoco_engine.MujocoMechanism.inverse_dynamics`): the shaking force
   dP/dt and moment dH_O/dt (MuJoCo's base reaction on the moving bodies plus their weight), the
   actuator forces and the gravity (static) torque, projected on the actuated joints with mechbal's
   coupling matrix for a closed mechanism; the largest difference to mechbal's, relative to the
@@ -13,14 +13,14 @@ design), along the case's trajectory:
   prediction is judged against what balancing removed.
 * **simulated**: a 1 kHz computed-torque loop (mechbal's controller over mechbal's model, gains
   Kp = 400 / s^2, Kd = 40 / s) against MuJoCo integrating the export
-  (:func:`mechbal.export.mujoco_engine.co_simulate`): the peak shaking force and moment MuJoCo
+  (`mechbal.export.mujoco_engine.co_simulate`): the peak shaking force and moment MuJoCo
   realises, and the largest loop-closure violation of its soft constraints.
 
 DIR receives ``summary.json``, ``shaking_wrench.png`` (mechbal and MuJoCo, simulated) and the
 MJCF files ``unbalanced.xml``, ``balanced.xml``; the table is printed. Needs ``mechbal[mujoco]``.
 
 A case with a reactionless ``[control]`` table (the reaction-wheel arm, PAMINSA through the
-general controller: :func:`run_verify_reactionless`) is checked under its controller instead:
+general controller: `run_verify_reactionless`) is checked under its controller instead:
 uncontrolled (balancing joints held) and controlled, mechbal's predicted shaking wrench against
 MuJoCo's, by inverse dynamics on the same motion and co-simulated at 1 kHz.
 
@@ -40,7 +40,7 @@ KP, KD = 400.0, 40.0
 
 
 def case_trajectory(bc, n: int):
-    """The case's trajectory as a :mod:`mechbal.trajectory` object: its ``[trajectory]`` law, or
+    """The case's trajectory as a `mechbal.trajectory` object: its ``[trajectory]`` law, or
     the case's sampled motion (a paper's own law) through a cubic spline."""
     from mechbal.config import trajectory_from_config
     from mechbal.errors import ConfigError
@@ -328,7 +328,7 @@ def run_verify_reactionless(case, out: Path, *, simulate: bool = True, dt: float
     """``mechbal verify`` of a case with a reactionless ``[control]`` table (joint mode: balancing
     joints; not the operational-space mode). For each variant, **uncontrolled** (the balancing
     joints held at their start, tracked by computed torque) and **controlled** (the reactionless
-    controller with its computed-torque stage, :class:`mechbal.control.ReactionlessController`):
+    controller with its computed-torque stage, `mechbal.control.ReactionlessController`):
 
     * mechbal's predicted shaking force and moment (the motion's wrench; controlled: the wrench
       the controller predicts for its command, ticks with exact RK4 samples);

@@ -41,7 +41,8 @@ def _paminsa_closed_form(bodies: dict, case_file: Path, integrator: str):
     the platform motion of the case's trajectory, on the half-step grid of the controller."""
     from mechbal.config import trajectory_from_config
     from mechbal.papers import paminsa as paper
-    from mechbal.papers.paminsa.runner import parameters_from_config, wrist_config_from_config
+    from mechbal.papers.paminsa import parameters_from_config
+    from mechbal.papers.paminsa.runner import wrist_config_from_config
     from mechbal.schema import validate_case
 
     case = validate_case(tomllib.loads(case_file.read_text()), warn=False)

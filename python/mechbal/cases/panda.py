@@ -1,11 +1,11 @@
 """The built-in ``panda-reactionless`` case: the Franka Emika Panda from its URDF, its tool
 (``panda_hand_tcp``) following a straight path while the arm's redundancy keeps its angular
-momentum about O zero (the reaction null space, :class:`mechbal.control.ReactionlessTaskController`).
+momentum about O zero (the reaction null space, `mechbal.control.ReactionlessTaskController`).
 
 The URDF ships with mechbal (``mechbal/data/panda/panda.urdf``: kinematics and inertial parameters
 of franka_description's Panda as example-robot-data distributes it, meshes removed, fingers fixed;
 Apache-2.0, LICENSE and NOTICE beside it), so the case runs without the test extras. The case file
-``panda-reactionless.toml`` holds its ``[mechanism]`` table as :func:`panda_case_toml` writes it from
+``panda-reactionless.toml`` holds its ``[mechanism]`` table as `panda_case_toml` writes it from
 that URDF (tests/python/test_panda.py checks that the two are the same model and the URDF's
 dynamics against Pinocchio on example-robot-data's original file).
 

@@ -1,5 +1,5 @@
 """Runner for ``kind = "mechanism"`` (alias ``kind = "serial_chain"``): any mechanism of the
-general model (:mod:`mechbal.spec`: chains, trees, extra bodies, gear couplings, loop closures)
+general model (`mechbal.spec`: chains, trees, extra bodies, gear couplings, loop closures)
 moving along a rest-to-rest trajectory of its actuated joints; shaking force and moment, base
 reaction with gravity, actuator torques and, for closed mechanisms, the loop solve's conditioning.
 
@@ -59,7 +59,7 @@ def run(config, out: Path) -> dict:
 
 
 def _drawing(mech: Mechanism, motion) -> dict:
-    """What a picture of the mechanism needs beside the bodies (:mod:`mechbal.animation`): every
+    """What a picture of the mechanism needs beside the bodies (`mechbal.animation`): every
     link frame's origin and parent, and every named frame's origin with its link."""
     links = list(mech.link_names)
     by_name = {f.name: f.link for f in mech.model.description.frames}
@@ -308,8 +308,8 @@ def _motion_acceleration(t, v):
 
 def run_task_space(mech: Mechanism, case, out: Path) -> dict:
     """A case whose ``[control]`` names a ``task_frame`` (the operational-space mode,
-    :class:`mechbal.control.ReactionlessTaskController`): ``[trajectory]`` is the frame's path,
-    from its pose at ``start`` to its pose at ``end`` (joint positions; :func:`frame_path`), and
+    `mechbal.control.ReactionlessTaskController`): ``[trajectory]`` is the frame's path,
+    from its pose at ``start`` to its pose at ``end`` (joint positions; `frame_path`), and
     the arm starts at ``start``. The path is run twice at the controller's ticks: with the
     pseudo-inverse alone, v = J^+ x' (``uncontrolled``: no null-space term), and in the reaction
     null space, v = J^+ x' + N z (``controlled``); bodies_uncontrolled.npz and
