@@ -485,7 +485,7 @@ def run_verify_reactionless(case, out: Path, *, simulate: bool = True, dt: float
                            caption="Shaking force and moment about O: mechbal's prediction and MuJoCo's realised "
                                    f"wrench under the controller at {1 / dt:g} Hz, balancing joints held "
                                    "(uncontrolled) and reactionless (controlled).")
-    write_summary(out / "summary.json", summary)
+    write_summary(out / "summary.json", summary, command="verify")
     print(report.table(table, ["variant", "component", "mechbal peak", "MuJoCo peak (inverse)",
                                "MuJoCo peak (simulated)"]))
     return summary
