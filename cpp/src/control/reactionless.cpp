@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "mechbal/algorithm/jacobian.hpp"
+#include "mechbal/algorithm/kinematics.hpp"
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/detail/placed.hpp"
@@ -714,6 +715,8 @@ ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const Mec
     fail("reactionless.max_rate", "must be finite and > 0", config_.max_rate);
   if (!(std::isfinite(config_.max_twist) && config_.max_twist > 0.0))
     fail("max_twist", "must be finite and > 0", config_.max_twist);
+  if (!(std::isfinite(config_.max_twist_rate) && config_.max_twist_rate > 0.0))
+    fail("max_twist_rate", "must be finite and > 0", config_.max_twist_rate);
   n_ = m.dof();
   dt_ = 1.0 / config_.rate_hz;
   for (int r = 0; r < 6; ++r) {
@@ -725,7 +728,7 @@ ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const Mec
   if (v0.size() != 0 && (v0.size() != n_ || !v0.allFinite()))
     fail("v0 must have " + std::to_string(n_) + " finite values, got " + std::to_string(v0.size()));
   const int nt = static_cast<int>(task_rows_.size()), k = static_cast<int>(rows_.size());
-  for (Eigen::VectorXd* v : {&q_, &q_cmd_, &v_cmd_, &k1_, &k2_, &k3_, &k4_, &q_stage_, &v0_, &z_, &w_})
+  for (Eigen::VectorXd* v : {&q_, &q_cmd_, &v_cmd_, &a_cmd_, &zero_, &a0_, &k1_, &k2_, &k3_, &k4_, &q_stage_, &v0_, &z_, &w_})
     *v = Eigen::VectorXd::Zero(n_);
   rate_limit_ = m.velocity_limits().cwiseMin(config_.max_rate);
   J_ = Eigen::MatrixXd::Zero(nt, n_);
@@ -791,14 +794,16 @@ Status ReactionlessTaskController::rates(const Eigen::VectorXd& q, const Vec6& t
   N_ = -JpJ_;
   N_.diagonal().array() += 1.0;
   if (momentum_matrix(m, data_, q) != Status::ok) return Status::out_of_range;
-  for (std::size_t i = 0; i < rows_.size(); ++i) {
-    const auto r = static_cast<Eigen::Index>(i);
-    M_.row(r).noalias() = data_.momentum_matrix.row(rows_[i]) * N_;
-    rm_(r) = target_(rows_[i]) - data_.momentum_matrix.row(rows_[i]).dot(v0_);
-  }
-  st |= min_norm(M_, rm_, z_);
   v = v0_;
-  v.noalias() += N_ * z_;
+  if (config_.null_space) {
+    for (std::size_t i = 0; i < rows_.size(); ++i) {
+      const auto r = static_cast<Eigen::Index>(i);
+      M_.row(r).noalias() = data_.momentum_matrix.row(rows_[i]) * N_;
+      rm_(r) = target_(rows_[i]) - data_.momentum_matrix.row(rows_[i]).dot(v0_);
+    }
+    st |= min_norm(M_, rm_, z_);
+    v.noalias() += N_ * z_;
+  }
   if (!v.allFinite()) {
     v.setZero();
     return st | Status::out_of_range;
@@ -812,19 +817,72 @@ Status ReactionlessTaskController::rates(const Eigen::VectorXd& q, const Vec6& t
   return st;
 }
 
+Status ReactionlessTaskController::acceleration(const Eigen::VectorXd& v, const Vec6& twist_rate, bool saturated) noexcept {
+  const MechanismModel& m = *model_;
+  // J'v: the frame's acceleration with zero joint accelerations
+  if (forward_kinematics(m, data_, q_, v, zero_) != Status::ok) return Status::out_of_range;
+  const auto link = static_cast<std::size_t>(m.frame_link(frame_));
+  const Vec3 r = data_.frame_placements[static_cast<std::size_t>(frame_)].translation() - data_.link_position[link];
+  const Vec3& w = data_.link_angular_velocity[link];
+  const Vec3& alpha = data_.link_angular_acceleration[link];
+  Vec6 bias;
+  bias.head<3>() = data_.link_acceleration[link] + alpha.cross(r) + w.cross(w.cross(r));
+  bias.tail<3>() = alpha;
+  // W(q, v, 0) = (dA/dt) v: the shaking wrench of the rates alone
+  if (shaking_wrench(m, data_, q_, v, zero_) != Status::ok) return Status::out_of_range;
+  Vec6 W;
+  W << data_.shaking.force, data_.shaking.moment;
+  const Eigen::Index nt = J_.rows();
+  for (Eigen::Index i = 0; i < nt; ++i) {
+    const int row = task_rows_[static_cast<std::size_t>(i)];
+    rt_(i) = twist_rate(row) - bias(row);
+  }
+  a0_.noalias() = Jt_.leftCols(nt) * rt_;  // J^+ (x'' - J'v), J^+ of the rates at q_
+  a_cmd_ = a0_;
+  Status st = Status::ok;
+  if (saturated) {
+    a_cmd_.setZero();  // the scaled rates no longer follow the law: no feed-forward
+  } else if (config_.null_space) {
+    // S A N w = S dh*/dt - S W(q, v, 0) - S A a0 (a constant target: dh*/dt = 0); M_ = S A N at q_
+    for (std::size_t i = 0; i < rows_.size(); ++i)
+      rm_(static_cast<Eigen::Index>(i)) = -W(rows_[i]) - data_.momentum_matrix.row(rows_[i]).dot(a0_);
+    st |= min_norm(M_, rm_, z_);
+    a_cmd_.noalias() += N_ * z_;
+  }
+  if (!a_cmd_.allFinite()) return Status::out_of_range;
+  Vec6 predicted;
+  predicted.noalias() = data_.momentum_matrix * a_cmd_;
+  predicted += W;
+  if (!predicted.allFinite()) return Status::out_of_range;
+  force_ = predicted.head<3>();
+  moment_ = predicted.tail<3>();
+  return st;
+}
+
 Status ReactionlessTaskController::step(const Vec6& twist, const Vec6& twist_half, const Vec6& twist_next) noexcept {
+  Vec6 rate = (-3.0 * twist + 4.0 * twist_half - twist_next) / dt_;
+  if (!rate.allFinite()) rate.setZero();  // the tick below reports the non-finite input
+  return step(twist, rate, twist_half, twist_next);
+}
+
+Status ReactionlessTaskController::step(const Vec6& twist, const Vec6& twist_rate, const Vec6& twist_half,
+                                        const Vec6& twist_next) noexcept {
   const bool rk4 = config_.integrator == ReactionlessIntegrator::rk4;
   const auto hold = [this](Status why) {
     q_cmd_ = q_;
     v_cmd_.setZero();
+    a_cmd_.setZero();
     h_.setZero();
     twist_cmd_.setZero();
+    force_.setZero();
+    moment_.setZero();
     status_ = why;
     return why;
   };
-  if (!twist.allFinite() || (rk4 && (!twist_half.allFinite() || !twist_next.allFinite())))
+  if (!twist.allFinite() || !twist_rate.allFinite() ||
+      (rk4 && (!twist_half.allFinite() || !twist_next.allFinite())))
     return hold(Status::non_finite_input);
-  if (twist.cwiseAbs().maxCoeff() > config_.max_twist ||
+  if (twist.cwiseAbs().maxCoeff() > config_.max_twist || twist_rate.cwiseAbs().maxCoeff() > config_.max_twist_rate ||
       (rk4 && (twist_half.cwiseAbs().maxCoeff() > config_.max_twist || twist_next.cwiseAbs().maxCoeff() > config_.max_twist)))
     return hold(Status::out_of_range);
   Status st = rates(q_, twist, k1_);
@@ -832,6 +890,10 @@ Status ReactionlessTaskController::step(const Vec6& twist, const Vec6& twist_hal
   // the command at t_n: momentum and twist of the commanded rates (data_ is at q_)
   h_.noalias() = data_.momentum_matrix * k1_;
   twist_cmd_.noalias() = data_.frame_jacobian * k1_;
+  // the acceleration feed-forward at t_n (before the RK4 stages overwrite J^+, N and S A N)
+  const Status sa = acceleration(k1_, twist_rate, has(st, Status::saturated));
+  if (has(sa, Status::out_of_range)) return hold(Status::out_of_range);
+  st |= sa;
   Eigen::VectorXd& next = q_stage_;
   if (rk4) {
     Status ss = Status::ok;
