@@ -468,6 +468,8 @@ def both_controls(tmp_path: Path, data: dict):
     path.write_text(text)
     py = validate_case(read_toml(path), warn=False).control
     _, cpp, _ = _core.load_case_file(str(path))
+    _, from_text, _ = _core.case_from_toml(text)  # the same reader on the text
+    assert all(getattr(from_text, k) == getattr(cpp, k) for k in CONTROL_KEYS)
     return py, cpp
 
 
