@@ -10,6 +10,7 @@
 #include "mechbal/control/decoupled_control.hpp"
 #include "mechbal/control/mechanism_dynamics.hpp"
 #include "mechbal/control/reactionless.hpp"
+#include "mechbal/control/passive.hpp"
 
 namespace mechbal {
 
@@ -18,6 +19,7 @@ const char* control_kind_name(ControlKind kind) noexcept {
     case ControlKind::computed_torque: return "computed_torque";
     case ControlKind::decoupled: return "decoupled";
     case ControlKind::reactionless: return "reactionless";
+    case ControlKind::passive: return "passive";
     case ControlKind::none: break;
   }
   return "none";
@@ -221,6 +223,8 @@ std::unique_ptr<JointController> make_controller(const MechanismModel& model, co
                                                              vec(control.torque_limit), JointInputRange{}, q_guess);
       });
     }
+    case ControlKind::passive:
+      return std::make_unique<PassiveController>(n);
     case ControlKind::none: break;
   }
   throw std::invalid_argument("control: the case has no [control] table (kind none): nothing to build");

@@ -7,6 +7,7 @@
 ///      through the loop projection), gains kp, kd, torque_limit;
 ///    - decoupled: DecoupledJointController with k (the constant diagonal of the balanced mass
 ///      matrix; from the model at q = 0 when the config leaves it empty), kp, kd, torque_limit;
+///    - passive: PassiveController (zero effort: gravity and springs move the mechanism);
 ///    - reactionless: ReactionlessJointController, the reactionless controller followed by its
 ///      computed-torque stage (kp, kd required here, torque_limit), starting at the actuated
 ///      coordinates `q0` (the case's `[trajectory] start`: a balancing joint's start is its initial
