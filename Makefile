@@ -33,7 +33,8 @@ help:
 	@echo "make test   - install what is missing, then run the C++ tests (ctest) and pytest"
 	@echo "make test-sanitize - the C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 	@echo "make test-embedded - cross-build the minimal core + examples/embedded for aarch64, run it under"
-	@echo "             qemu-user on the PAMINSA case and compare with the native build (1e-12)"
+	@echo "             qemu-user on the PAMINSA case and the reaction-wheel arm and compare with the"
+	@echo "             native build (1e-12)"
 	@echo "make bench  - build and run the benchmarks"
 	@echo "make docs   - build the user guide and API reference into build/site (MkDocs, offline)"
 	@echo "make stubs  - regenerate python/mechbal/_core.pyi from the bindings (pybind11-stubgen)"
@@ -156,12 +157,15 @@ test-sanitize: $(SAN_BUILD)/build.ninja
 
 # ---- embedded: the minimal core (no KDL, no urdfdom: Eigen + toml++ only) and examples/embedded,
 # built natively and cross-built for aarch64 (Debian's g++-aarch64-linux-gnu), installed, then the
-# example runs the balanced PAMINSA under computed torque for EMBEDDED_TICKS ticks natively and
-# under qemu-user; the two tick traces must agree to 1e-12 of the scale of the 6 torques and of the
-# shaking wrench (force and moment together: the balanced design's shaking force is rounding noise).
+# example runs the balanced PAMINSA under computed torque and the reaction-wheel arm under its
+# reactionless controller (with a computed-torque stage) for EMBEDDED_TICKS ticks natively and
+# under qemu-user; each pair of tick traces must agree to 1e-12 of the scale of the torques and of
+# the shaking wrench (force and moment together: the balanced design's shaking force, and the wheel
+# arm's cancelled moment about z, are rounding noise).
 EMBEDDED_BUILD := build/embedded
 EMBEDDED_TICKS ?= 300
 EMBEDDED_CASE := python/mechbal/papers/paminsa/cases/paminsa-linkage.toml examples/embedded/paminsa-control.toml
+EMBEDDED_WHEEL_CASE := python/mechbal/cases/reaction-wheel-arm.toml examples/embedded/reaction-wheel-control.toml
 APT_EMBEDDED_PACKAGES := g++-aarch64-linux-gnu qemu-user
 define embedded_build
 	$(VENV)/bin/cmake -S . -B $(EMBEDDED_BUILD)/$(1)/core -G Ninja -DCMAKE_BUILD_TYPE=Release \
@@ -190,6 +194,12 @@ test-embedded: | $(VENV)/.stamp-venv
 	qemu-aarch64 -L /usr/aarch64-linux-gnu $(EMBEDDED_BUILD)/aarch64/example/mechbal_embedded $(EMBEDDED_CASE) \
 	  --ticks $(EMBEDDED_TICKS) --no-sleep --trace $(EMBEDDED_BUILD)/aarch64.trace
 	python3 tools/compare_traces.py $(EMBEDDED_BUILD)/native.trace $(EMBEDDED_BUILD)/aarch64.trace 1e-12 6,6
+	$(call say,"Running $(EMBEDDED_TICKS) ticks of the reaction-wheel arm (reactionless) natively and under qemu-aarch64")
+	$(EMBEDDED_BUILD)/native/example/mechbal_embedded $(EMBEDDED_WHEEL_CASE) --ticks $(EMBEDDED_TICKS) --no-sleep \
+	  --trace $(EMBEDDED_BUILD)/native-wheel.trace
+	qemu-aarch64 -L /usr/aarch64-linux-gnu $(EMBEDDED_BUILD)/aarch64/example/mechbal_embedded $(EMBEDDED_WHEEL_CASE) \
+	  --ticks $(EMBEDDED_TICKS) --no-sleep --trace $(EMBEDDED_BUILD)/aarch64-wheel.trace
+	python3 tools/compare_traces.py $(EMBEDDED_BUILD)/native-wheel.trace $(EMBEDDED_BUILD)/aarch64-wheel.trace 1e-12 3,6
 	@echo "    test-embedded took $$(( $$(date +%s) - $$(cat $(EMBEDDED_BUILD).start) )) s"
 
 # ---- benchmarks (never part of `make test`; own build dir so test and bench builds don't fight) --

@@ -50,6 +50,9 @@ void bind_io(py::module_& m) {
       .def_readonly("cancel", &ControlConfig::cancel)
       .def_readonly("integrator", &ControlConfig::integrator)
       .def_readonly("damping", &ControlConfig::damping)
+      .def_readonly("max_rate", &ControlConfig::max_rate)
+      .def_readonly("home_gain", &ControlConfig::home_gain)
+      .def_readonly("limit_gain", &ControlConfig::limit_gain)
       .def_readonly("task_frame", &ControlConfig::task_frame);
   m.def(
       "load_case_file",
@@ -63,6 +66,15 @@ void bind_io(py::module_& m) {
       "(model, control, name) of a case file read by the C++ reader (mechbal::load_case): the "
       "[mechanism] model, the [control] table checked against it (kind 'none' without one) and "
       "[case] name.");
+  m.def(
+      "case_from_toml",
+      [](const std::string& text, const std::string& source) {
+        return value_errors([&] {
+          LoadedCase c = case_from_string(text, source);
+          return py::make_tuple(std::move(c.model), c.control, c.name);
+        });
+      },
+      py::arg("text"), py::arg("source") = "string", "As load_case_file, from TOML text (the whole document).");
   py::class_<TrajectoryConfig>(m, "TrajectoryConfig", "The [trajectory] table as the C++ reader checked it (read only)")
       .def_readonly("present", &TrajectoryConfig::present)
       .def_readonly("law", &TrajectoryConfig::law)

@@ -14,6 +14,7 @@
 #include "array_checks.hpp"
 #include "bindings.hpp"
 #include "controller_step.hpp"
+#include "motion_tick.hpp"
 #include "mechbal/control/reactionless.hpp"
 
 namespace py = pybind11;
@@ -104,12 +105,9 @@ py::dict run(ReactionlessController& c, const Array& q, const Array& v, const Ar
   const std::string context = "the controller has " + std::to_string(nt) + " task joints";
   require_shape(q, "q_task", {-1, nt}, context.c_str());
   const auto rows = q.shape(0);
-  if (rows < 1 || rows % 2 == 0)
-    throw py::value_error("q_task must have 2 steps + 1 rows (the half-step grid t_j = j dt/2), got " +
-                          std::to_string(rows));
+  const py::ssize_t steps = half_step_ticks(rows, "q_task"), N = steps + 1;
   require_shape(v, "v_task", {rows, nt}, context.c_str());
   require_shape(a, "a_task", {rows, nt}, context.c_str());
-  const py::ssize_t steps = (rows - 1) / 2, N = steps + 1;
   const auto na = static_cast<py::ssize_t>(c.num_actuated()), n = static_cast<py::ssize_t>(c.model().dof());
   OutArray Q = make_array({N, na}), V = make_array({N, na}), A = make_array({N, na});
   OutArray QF = make_array({N, n}), VF = make_array({N, n}), AF = make_array({N, n});
@@ -215,16 +213,13 @@ void bind_task_controller(py::module_& m) {
           [](ReactionlessTaskController& c, const Array& twist, const py::object& twist_rate_obj) {
             require_shape(twist, "twist", {-1, 6});
             const auto rows = twist.shape(0);
-            if (rows < 1 || rows % 2 == 0)
-              throw py::value_error("twist must have 2 steps + 1 rows (the half-step grid t_j = j dt/2), got " +
-                                    std::to_string(rows));
             Array twist_rate;
             const bool with_rate = !twist_rate_obj.is_none();
             if (with_rate) {
               twist_rate = to_real_array(twist_rate_obj);
               require_shape(twist_rate, "twist_rate", {rows, 6});
             }
-            const py::ssize_t steps = (rows - 1) / 2, N = steps + 1, n = c.dof();
+            const py::ssize_t steps = half_step_ticks(rows, "twist"), N = steps + 1, n = c.dof();
             OutArray Q = make_array({N, n}), V = make_array({N, n}), A = make_array({N, n}), H = make_array({N, 6}),
                      X = make_array({N, 6}), F = make_array({N, 3}), M = make_array({N, 3});
             auto status = make_status_array(N);
@@ -365,14 +360,17 @@ void bind_reactionless(py::module_& m) {
             const double* p = detail::fast_matrix(now.h, "now", 3, nt);
             const double* h = detail::fast_matrix(half.h, "half", 2, nt);
             const double* x = detail::fast_matrix(next.h, "next", 2, nt);
-            double* o = detail::fast_matrix(out.h, "out", 3, na, true);
-            const Status s = c.step(CMap(p, nt), CMap(p + nt, nt), CMap(p + 2 * nt, nt), CMap(h, nt), CMap(h + nt, nt),
-                                    CMap(x, nt), CMap(x + nt, nt));
-            const ReactionlessCommand& cmd = c.command();
-            Eigen::Map<Eigen::VectorXd>(o, na) = cmd.q;
-            Eigen::Map<Eigen::VectorXd>(o + na, na) = cmd.v;
-            Eigen::Map<Eigen::VectorXd>(o + 2 * na, na) = cmd.a;
-            return static_cast<std::uint32_t>(s);
+            return motion_step_into(
+                out, na,
+                [&] {
+                  return c.step(CMap(p, nt), CMap(p + nt, nt), CMap(p + 2 * nt, nt), CMap(h, nt), CMap(h + nt, nt),
+                                CMap(x, nt), CMap(x + nt, nt));
+                },
+                [&](auto q, auto v, auto a) {
+                  q = c.command().q;
+                  v = c.command().v;
+                  a = c.command().a;
+                });
           },
           py::arg("now"), py::arg("half"), py::arg("next"), py::arg("out"),
           "The fast tick: now (3, n_task) rows q, v, a of the task joints at t_n; half and next (2, n_task) "

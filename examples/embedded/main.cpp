@@ -3,8 +3,13 @@
 // (make_controller) and runs it in a periodic loop at the table's rate: SCHED_FIFO and mlockall
 // where permitted, plain absolute-time sleeps otherwise. Each tick tracks the case's [trajectory]
 // (rest to rest in the actuated joints) and predicts the shaking wrench the motion puts on the base.
-// Prints the tick statistics and the peak shaking wrench; --trace writes every tick's torques and
-// wrench (for comparing builds, e.g. the aarch64 cross-build under qemu with the native one).
+// With kind = "reactionless" the balancing joints' motion is the controller's own (their [trajectory]
+// entries are ignored), the commanded motion is tracked by its computed-torque stage, and the
+// predicted wrench is that of the reactionless command: the cancelled components stay ~0. Prints the
+// tick statistics and the peak shaking wrench (for reactionless, also the peak of the cancelled
+// components against the same motion with the balancing joints held); --trace writes every tick's
+// torques and wrench (for comparing builds, e.g. the aarch64 cross-build under qemu with the native
+// one).
 //
 //   mechbal_embedded CASE.toml [CONTROL.toml] [--ticks N] [--no-sleep] [--trace FILE]
 //
@@ -90,8 +95,10 @@ int main(int argc, char** argv) {
     loaded = std::make_unique<LoadedCase>(load_case(opt.case_path));
     if (!opt.control_path.empty()) loaded->control = load_control(opt.control_path, loaded->model);
     const auto& guess = loaded->trajectory.initial_guess;  // the assembly mode of a closed mechanism
+    const auto& start = loaded->trajectory.start;  // a reactionless controller starts there
     controller = make_controller(loaded->model, loaded->control,
-                                 Eigen::Map<const Eigen::VectorXd>(guess.data(), static_cast<Eigen::Index>(guess.size())));
+                                 Eigen::Map<const Eigen::VectorXd>(guess.data(), static_cast<Eigen::Index>(guess.size())),
+                                 Eigen::Map<const Eigen::VectorXd>(start.data(), static_cast<Eigen::Index>(start.size())));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mechbal_embedded: %s\n", e.what());
     return 2;
@@ -111,6 +118,15 @@ int main(int argc, char** argv) {
     duration = c.trajectory.duration;
     law = c.trajectory.law;
   }
+  // kind reactionless: make_controller built a ReactionlessJointController (control/factory.hpp);
+  // the balancing joints are held at their start in the desired motion (the controller moves them)
+  const ReactionlessJointController* reactionless = nullptr;
+  std::vector<int> cancelled;
+  if (c.control.kind == ControlKind::reactionless) {
+    reactionless = static_cast<const ReactionlessJointController*>(controller.get());
+    for (int b : reactionless->reactionless().balancing_joints()) end[b] = start[b];
+    cancelled = reactionless->reactionless().cancelled_rows();
+  }
   const RestToRestTrajectory trajectory(start, end, duration, law);
   Eigen::VectorXd q_full = Eigen::VectorXd::Zero(n);  // the full coordinates (loops: warm start)
   if (!c.trajectory.initial_guess.empty()) q_full = Eigen::Map<const Eigen::VectorXd>(c.trajectory.initial_guess.data(), n);
@@ -123,6 +139,7 @@ int main(int argc, char** argv) {
   std::vector<double> trace;
   if (!opt.trace_path.empty()) trace.reserve(static_cast<std::size_t>(ticks) * static_cast<std::size_t>(na + 6));
   Vec3 peak_force = Vec3::Zero(), peak_moment = Vec3::Zero();
+  Vec6 peak_held = Vec6::Zero();  // reactionless: the shaking wrench with the balancing joints held
   long bad_ticks = 0, saturated = 0, singular = 0, misses = 0, first_bad = -1;
   Status first_bad_status = Status::ok;
 
@@ -147,15 +164,21 @@ int main(int argc, char** argv) {
     clock_gettime(CLOCK_MONOTONIC, &now);
     const double t = static_cast<double>(k) / rate;
     trajectory.evaluate(t, q_des, v_des, a_des);
-    // the "sensors": the desired motion with a small, deterministic tracking error
+    // the "sensors": the commanded motion (the desired one; reactionless: the last command, which
+    // moves the balancing joints) with a small, deterministic tracking error
     for (int i = 0; i < na; ++i) {
-      q[i] = q_des[i] + 1e-4 * std::sin(7.0 * t + i);
-      v[i] = v_des[i] + 1e-3 * std::cos(5.0 * t + i);
+      const bool commanded = reactionless != nullptr && k > 0;
+      q[i] = (commanded ? reactionless->reactionless().command().q[i] : q_des[i]) + 1e-4 * std::sin(7.0 * t + i);
+      v[i] = (commanded ? reactionless->reactionless().command().v[i] : v_des[i]) + 1e-3 * std::cos(5.0 * t + i);
     }
     const Status s = controller->step(q, v, q_des, v_des, a_des, tau);
     // the shaking wrench the commanded motion puts on the base
     Status w = Status::ok;
-    if (model.is_closed()) {
+    Vec3 F, M;
+    if (reactionless != nullptr) {  // the reactionless command's own prediction
+      F = reactionless->reactionless().command().shaking_force;
+      M = reactionless->reactionless().command().shaking_moment;
+    } else if (model.is_closed()) {
       w = closed_motion(model, data, q_des, v_des, a_des, q_full);
       if (!has(w, Status::solver_error)) {
         w |= shaking_wrench(model, data, data.closed_position, data.closed_velocity, data.closed_acceleration);
@@ -163,7 +186,13 @@ int main(int argc, char** argv) {
     } else {
       w = shaking_wrench(model, data, q_des, v_des, a_des);
     }
+    if (reactionless == nullptr) F = data.shaking.force, M = data.shaking.moment;
     clock_gettime(CLOCK_MONOTONIC, &done);
+    if (reactionless != nullptr) {  // for comparison (not timed): the desired motion, balancing joints held
+      w |= shaking_wrench(model, data, q_des, v_des, a_des);
+      peak_held.head<3>() = peak_held.head<3>().cwiseMax(data.shaking.force.cwiseAbs());
+      peak_held.tail<3>() = peak_held.tail<3>().cwiseMax(data.shaking.moment.cwiseAbs());
+    }
     const double compute = 1e6 * (seconds(done) - seconds(now));
     const double late = opt.sleep ? 1e6 * (seconds(now) - seconds(next)) : 0.0;
     compute_us[static_cast<std::size_t>(k)] = compute;
@@ -176,8 +205,6 @@ int main(int argc, char** argv) {
     }
     saturated += has(s, Status::saturated);
     singular += has(s, Status::singular) || has(w, Status::singular);
-    const Vec3& F = data.shaking.force;
-    const Vec3& M = data.shaking.moment;
     peak_force = peak_force.cwiseMax(F.cwiseAbs());
     peak_moment = peak_moment.cwiseMax(M.cwiseAbs());
     if (!opt.trace_path.empty()) {
@@ -200,6 +227,15 @@ int main(int argc, char** argv) {
               peak_force[2]);
   std::printf("predicted peak shaking moment |M_O| per axis [N m]: %.6g %.6g %.6g\n", peak_moment[0], peak_moment[1],
               peak_moment[2]);
+  if (reactionless != nullptr) {
+    // the cancelled components (rows of [dP/dt; dH_O/dt]) under the controller and held
+    static const char* row_names[6] = {"force_x", "force_y", "force_z", "moment_x", "moment_y", "moment_z"};
+    for (int r : cancelled) {
+      const double controlled = r < 3 ? peak_force[r] : peak_moment[r - 3];
+      std::printf("cancelled %s: peak %.3g (balancing joints held: %.6g), ratio %.3g\n", row_names[r], controlled,
+                  peak_held[r], peak_held[r] > 0.0 ? controlled / peak_held[r] : 0.0);
+    }
+  }
   std::printf("last torque:");
   for (int i = 0; i < na; ++i) std::printf(" %.6g", tau[i]);
   std::printf("\n");

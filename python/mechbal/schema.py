@@ -244,19 +244,29 @@ MomentumComponentName = Literal["moment", "force", "both", "moment_x", "moment_y
 
 #: the twist components an operational-space controller tracks ([control].task_rows)
 TwistComponentName = Literal["all", "linear", "angular", "v_x", "v_y", "v_z", "w_x", "w_y", "w_z"]
+#: [control] keys that belong to one kind only
+_CONTROL_ONLY = {"k": "decoupled", **{k: "reactionless" for k in (
+    "balancing_joints", "cancel", "integrator", "damping", "max_rate", "home_gain", "limit_gain",
+    "task_frame", "task_rows")}}
+#: per actuated joint, each > 0
+PerJoint = Annotated[list[Pos], Field(min_length=1, max_length=MAX_JOINTS)]
 
 
 class Control(Table):
     """``[control]``: a real-time controller run along the case's trajectory. ``kind =
     "reactionless"``: the balancing joints keep the cancelled momentum components at their
-    initial value (`mechbal.control.ReactionlessController`); ``mechbal run`` compares the
-    motion with the balancing joints held (uncontrolled) and controlled."""
+    initial value (`mechbal.control.ReactionlessController`), optionally followed by a
+    computed-torque stage (``kp``, ``kd``); ``mechbal run`` compares the motion with the balancing
+    joints held (uncontrolled) and controlled. ``computed_torque`` and ``decoupled``: joint
+    controllers with the gains ``kp``, ``kd`` (the C++ ``mechbal::make_controller`` builds each
+    kind from this table)."""
     kind: Literal["reactionless", "computed_torque", "decoupled", "passive"] = Field(
         description="which controller (mechbal run supports reactionless, and passive: no controller, "
                     "zero effort, the mechanism moves under gravity and springs from [trajectory]'s "
                     "start with its initial rates, over its duration)")
     balancing_joints: Optional[Annotated[list[Name], Field(min_length=1, max_length=MAX_JOINTS)]] = Field(
-        None, description="actuated joints whose motion the controller computes (required but for passive)")
+        None, description="reactionless (required without task_frame): actuated joints whose motion the "
+                          "controller computes")
     cancel: Annotated[list[MomentumComponentName], Field(min_length=1, max_length=9)] = ["moment"]
     integrator: Literal["euler", "rk4"] = "rk4"
     rate_hz: Rate = 1000.0
@@ -272,24 +282,66 @@ class Control(Table):
     task_rows: Optional[Annotated[list[TwistComponentName], Field(min_length=1, max_length=8)]] = Field(
         None, description="operational-space mode: the frame's tracked twist components "
                           "(default all: linear and angular)")
+    kp: Optional[PerJoint] = Field(
+        None, description="proportional gains (1/s^2), one per actuated joint: required for "
+                          "computed_torque and decoupled; reactionless: its computed-torque stage, with kd")
+    kd: Optional[PerJoint] = Field(None, description="derivative gains (1/s), one per actuated joint")
+    torque_limit: Optional[PerJoint] = Field(
+        None, description="|tau| limit per actuated joint (N m or N); default: the controller's own")
+    k: Optional[PerJoint] = Field(
+        None, description="decoupled: the constant diagonal of the balanced mass matrix (default: "
+                          "taken from the mechanism at q = 0)")
 
     @model_validator(mode="after")
-    def _distinct(self):
+    def _rules(self):
         if self.kind == "passive":   # no controller: only the tick rate of the log
             for key in sorted(self.model_fields_set - {"kind", "rate_hz"}):
                 raise _custom("is not for kind = 'passive' (no controller: only rate_hz)", f".{key}",
                               getattr(self, key))
             return self
-        if self.balancing_joints is None:
-            raise _custom(f"is required for kind = '{self.kind}'", ".balancing_joints", None, has_value=False)
         seen = set()
-        for i, name in enumerate(self.balancing_joints):
+        for i, name in enumerate(self.balancing_joints or []):
             if name in seen:
                 raise _custom("is listed twice", f".balancing_joints[{i}]", name)
             seen.add(name)
+        for key in type(self).model_fields:
+            only = _CONTROL_ONLY.get(key)
+            if only is not None and key in self.model_fields_set and self.kind != only:
+                raise _custom(f"is only for kind = {only!r}", f".{key}", getattr(self, key))
+        if self.kind == "reactionless" and self.balancing_joints is None and self.task_frame is None:
+            raise _custom("is required for kind = 'reactionless' (or task_frame: the operational-space "
+                          "mode)", ".balancing_joints", has_value=False)
+        if self.kind != "reactionless":
+            for key in ("kp", "kd"):
+                if getattr(self, key) is None:
+                    raise _custom(f"is required for kind = {self.kind!r}", f".{key}", has_value=False)
+        if self.kp is not None and self.kd is None:
+            raise _custom("is required with kp (the computed-torque stage)", ".kd", has_value=False)
+        if self.kd is not None and self.kp is None:
+            raise _custom("is required with kd (the computed-torque stage)", ".kp", has_value=False)
         if self.task_rows is not None and self.task_frame is None:
             raise _custom("is for the operational-space mode: give task_frame", ".task_rows", self.task_rows)
         return self
+
+
+def _control_cross_checks(control: Control, spec: Any, actuated: list[str]) -> None:
+    """``[control]`` against the mechanism (as the C++ reader's load_case): per-joint sizes, the
+    balancing joints among the actuated ones, the task frame among the frames."""
+    for key in ("kp", "kd", "torque_limit", "k"):
+        v = getattr(control, key)
+        if v is not None and len(v) != len(actuated):
+            raise ConfigError(f"control.{key}", f"must have {len(actuated)} values (one per actuated "
+                                                f"joint: {', '.join(actuated)})", v)
+    for i, b in enumerate(control.balancing_joints or []):
+        if b not in actuated:
+            raise ConfigError(f"control.balancing_joints[{i}]",
+                              f"is not an actuated joint{did_you_mean(b, actuated)}", b)
+    if control.task_frame is not None:
+        frames = [f.name for f in spec.frames]
+        if control.task_frame not in frames:
+            raise ConfigError("control.task_frame",
+                              f"is not a frame of the mechanism{did_you_mean(control.task_frame, frames)}",
+                              control.task_frame)
 
 
 class SerialChainCaseHeader(CaseHeader):
@@ -542,6 +594,8 @@ def _cross_checks(case: Any) -> None:
             raise ConfigError("trajectory.samples", f"must be <= {MAX_SAMPLE_BODIES // n_bodies} for "
                                                     f"{n_bodies} bodies (samples x bodies <= "
                                                     f"{MAX_SAMPLE_BODIES})", case.trajectory.samples)
+        if case.control is not None:
+            _control_cross_checks(case.control, spec, names)
 
 
 # ---- unit warnings -------------------------------------------------------------------------------

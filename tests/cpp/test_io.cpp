@@ -4,15 +4,21 @@
 // Parity with the Python reader is tested in tests/python/test_io_parity.py.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <utility>
 
 #include "alloc_counter.hpp"
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
+#include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/control/factory.hpp"
 #include "mechbal/io/case.hpp"
 #include "mechbal/control/mechanism_dynamics.hpp"
+#include "mechbal/control/reactionless.hpp"
 
 using namespace mechbal;
 
@@ -152,12 +158,62 @@ TEST(CaseReader, ControlTable) {
   EXPECT_EQ(r.control.integrator, "euler");
   EXPECT_NE(message_of(base + "[control]\nkind = \"reactionless\"\nbalancing_joints = [\"c\"]\n").find("control.balancing_joints[0]"),
             std::string::npos);
+  // every field of the reactionless table, and the defaults of the Python reader's schema.Control
+  EXPECT_EQ(r.control.damping, 1e-2);
+  EXPECT_EQ(r.control.max_rate, 100.0);
+  EXPECT_EQ(r.control.home_gain, 0.0);
+  EXPECT_TRUE(r.control.kp.empty() && r.control.task_frame.empty());
+  const LoadedCase full = case_from_string(
+      base + "[[mechanism.frames]]\nname = \"tip\"\nlink = \"b\"\n[control]\nkind = \"reactionless\"\n"
+             "balancing_joints = [\"a\"]\ncancel = [\"both\", \"moment_x\"]\nintegrator = \"rk4\"\nrate_hz = 500\n"
+             "damping = 0.25\nmax_rate = 7\nhome_gain = 0.5\nlimit_gain = 2\ntask_frame = \"tip\"\nkp = [1, 2]\n"
+             "kd = [3, 4]\ntorque_limit = [5, 6]\n");
+  EXPECT_EQ(full.control.cancel, (std::vector<std::string>{"both", "moment_x"}));
+  EXPECT_EQ(full.control.rate_hz, 500.0);
+  EXPECT_EQ(full.control.damping, 0.25);
+  EXPECT_EQ(full.control.max_rate, 7.0);
+  EXPECT_EQ(full.control.home_gain, 0.5);
+  EXPECT_EQ(full.control.limit_gain, 2.0);
+  EXPECT_EQ(full.control.task_frame, "tip");
+  EXPECT_EQ(full.control.kp, (std::vector<double>{1, 2}));
+  EXPECT_EQ(full.control.torque_limit, (std::vector<double>{5, 6}));
+  const std::string rl = base + "[control]\nkind = \"reactionless\"\nbalancing_joints = [\"b\"]\n";
+  const std::pair<std::string, std::string> refused[] = {
+      {"damping = 1", "control.damping: must be < 1 (got 1)"},
+      {"damping = 0", "control.damping: must be > 0 (got 0)"},
+      {"max_rate = -1.0", "control.max_rate: must be > 0 (got -1.0)"},
+      {"home_gain = nan", "control.home_gain: must be finite"},
+      {"limit_gain = \"1\"", "control.limit_gain: must be a number"},
+      {"cancel = []", "control.cancel: must have at least 1 values"},
+      {"cancel = [\"torque\"]", "control.cancel[0]: must be one of"},
+      {"integrator = \"rk45\"", "control.integrator: must be one of euler, rk4 (did you mean 'rk4'?)"},
+      {"task_frame = \"tool\"", "control.task_frame: is not a frame of the mechanism"},
+      {"kp = [1, 1]", "control.kd: is required with kp"},
+      {"kd = [1, 1]", "control.kp: is required with kd"},
+      {"kp = [1]\nkd = [1]", "control.kp: must have 2 values"},
+      {"k = [1, 1]", "control.k: is only for kind = 'decoupled'"},
+      {"rate = 1000", "control.rate: unknown key (did you mean 'rate_hz'?)"},
+  };
+  for (const auto& [line, expected] : refused) {
+    EXPECT_EQ(message_of(rl + line + "\n").rfind(expected, 0), 0u) << line << ": " << message_of(rl + line + "\n");
+  }
+  EXPECT_EQ(message_of(base + "[control]\nkind = \"reactionless\"\n").rfind("control.balancing_joints: is required", 0), 0u);
+  EXPECT_EQ(message_of(base + "[control]\nkind = \"reactionless\"\nbalancing_joints = [\"b\", \"b\"]\n")
+                .rfind("control.balancing_joints[1]: is listed twice", 0),
+            0u);
+  EXPECT_EQ(message_of(base + "[control]\nkind = \"computed_torque\"\nkp = [1, 1]\nkd = [1, 1]\ndamping = 0.1\n")
+                .rfind("control.damping: is only for kind = 'reactionless'", 0),
+            0u);
+  // make_controller builds a joint controller: the reactionless one needs its computed-torque stage
   try {
     make_controller(r.model, r.control);
-    ADD_FAILURE() << "reactionless built";
+    ADD_FAILURE() << "reactionless built without kp, kd";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("reactionless"), std::string::npos);
+    EXPECT_EQ(std::string(e.what()).rfind("control.kp: is required to build a joint controller", 0), 0u) << e.what();
   }
+  EXPECT_THROW(make_controller(full.model, full.control), std::invalid_argument);  // task_frame: make_task_controller
+  EXPECT_NE(make_reactionless_controller(r.model, r.control), nullptr);
+  EXPECT_THROW(make_task_controller(r.model, r.control), std::invalid_argument);
 }
 
 TEST(MakeController, ComputedTorqueIsTheInverseDynamicsOnTrack) {
@@ -225,6 +281,135 @@ TEST(MakeController, MadeControllersStepWithoutAllocating) {
   EXPECT_EQ(ok, 50);
   EXPECT_TRUE(tau.allFinite());
 }
+
+namespace {
+
+/// The reaction-wheel arm's case file with its [control] table, plus the computed-torque stage.
+LoadedCase wheel_arm_with_gains() {
+  std::string text;
+  {
+    std::ifstream in(cases_dir + "reaction-wheel-arm.toml");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  return case_from_string(text + "kp = [400.0, 400.0, 400.0]\nkd = [40.0, 40.0, 40.0]\n"
+                                 "torque_limit = [50.0, 50.0, 50.0]\n");
+}
+
+}  // namespace
+
+TEST(MakeController, ReactionlessTicksAsOneBuiltDirectly) {
+  const LoadedCase c = wheel_arm_with_gains();
+  ASSERT_EQ(c.control.kind, ControlKind::reactionless);
+  const Eigen::VectorXd q0 = Eigen::Map<const Eigen::VectorXd>(c.trajectory.start.data(), 3);
+  auto made = make_controller(c.model, c.control, Eigen::VectorXd(), q0);
+  ASSERT_EQ(made->dof(), 3);
+  // the same controller written out by hand
+  ReactionlessConfig config;
+  config.balancing_joints = {"wheel"};
+  config.cancel = moment_z;
+  config.integrator = ReactionlessIntegrator::rk4;
+  config.rate_hz = 1000.0;
+  config.damping = 1e-3;
+  const Eigen::VectorXd kp = Eigen::VectorXd::Constant(3, 400.0), kd = Eigen::VectorXd::Constant(3, 40.0);
+  ReactionlessJointController direct(std::make_shared<const MechanismModel>(c.model), config, q0, kp, kd,
+                                     Eigen::VectorXd::Constant(3, 50.0));
+  // and the motion command alone
+  auto made_motion = make_reactionless_controller(c.model, c.control, q0);
+  ReactionlessController direct_motion(c.model, config, q0);
+
+  Eigen::VectorXd end = Eigen::Map<const Eigen::VectorXd>(c.trajectory.end.data(), 3);
+  end[2] = q0[2];  // a balancing joint's end is ignored
+  const RestToRestTrajectory motion(q0, end, c.trajectory.duration, c.trajectory.law);
+  const int ticks = 2000;
+  Eigen::MatrixXd Q(3, ticks), V(3, ticks), A(3, ticks);
+  for (int k = 0; k < ticks; ++k) {
+    Eigen::VectorXd qk(3), vk(3), ak(3);
+    motion.evaluate(k * 1e-3, qk, vk, ak);
+    Q.col(k) = qk, V.col(k) = vk, A.col(k) = ak;
+  }
+  const Eigen::VectorXd q_meas_offset = Eigen::Vector3d(1e-4, -2e-4, 3e-4);
+  Eigen::VectorXd tau_made(3), tau_direct(3);
+  double worst_tau = 0.0, worst_motion = 0.0, peak_moment_z = 0.0, peak_moment_z_held = 0.0;
+  std::size_t allocations = 0;
+  int ok = 0;
+  MechanismData data(c.model);
+  const auto& made_command = static_cast<const ReactionlessJointController&>(*made).reactionless().command();
+  Eigen::VectorXd q = Q.col(0), v = V.col(0);
+  for (int k = 0; k < ticks; ++k) {
+    // the measured state: the last command tracked with a small error (the wheel moves as commanded)
+    if (k > 0) q = made_command.q + q_meas_offset, v = made_command.v;
+    Status s1, s2, s3, s4;
+    {
+      test::AllocationScope scope;
+      s1 = made->step(q, v, Q.col(k), V.col(k), A.col(k), tau_made);
+      s3 = made_motion->step_euler(Q.col(k).head(2), V.col(k).head(2), A.col(k).head(2));
+      allocations += scope.count();
+    }
+    s2 = direct.step(q, v, Q.col(k), V.col(k), A.col(k), tau_direct);
+    s4 = direct_motion.step_euler(Q.col(k).head(2), V.col(k).head(2), A.col(k).head(2));
+    EXPECT_EQ(s1, s2);
+    EXPECT_EQ(s3, s4);
+    ok += s1 == Status::ok && s3 == Status::ok;
+    worst_tau = std::max(worst_tau, (tau_made - tau_direct).cwiseAbs().maxCoeff());
+    const ReactionlessCommand& a = made_motion->command();
+    const ReactionlessCommand& b = direct_motion.command();
+    worst_motion = std::max({worst_motion, (a.q - b.q).cwiseAbs().maxCoeff(), (a.v - b.v).cwiseAbs().maxCoeff(),
+                             (a.a - b.a).cwiseAbs().maxCoeff(), (a.shaking_moment - b.shaking_moment).cwiseAbs().maxCoeff()});
+    // the reactionless command cancels the shaking moment about z; the arm with the wheel held does not
+    peak_moment_z = std::max(peak_moment_z, std::abs(made_command.shaking_moment.z()));
+    ASSERT_EQ(shaking_wrench(c.model, data, Q.col(k), V.col(k), A.col(k)), Status::ok);
+    peak_moment_z_held = std::max(peak_moment_z_held, std::abs(data.shaking.moment.z()));
+  }
+  std::printf("factory vs direct over %d ticks: |tau| %.3g, command %.3g; moment_z peak %.3g (held %.3g)\n", ticks,
+              worst_tau, worst_motion, peak_moment_z, peak_moment_z_held);
+  EXPECT_EQ(ok, ticks);
+  EXPECT_LE(worst_tau, 1e-12);
+  EXPECT_LE(worst_motion, 1e-12);
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_GT(peak_moment_z_held, 0.1);
+  EXPECT_LT(peak_moment_z, 1e-9 * peak_moment_z_held);
+}
+
+TEST(MakeController, TaskControllerTicksAsOneBuiltDirectly) {
+  // a redundant planar 3R arm following its tip in x, y, minimising the moment about z
+  const std::string text =
+      "[mechanism]\ngravity = [0.0, 0.0, -9.81]\n"
+      "[[mechanism.joints]]\nname = \"j1\"\nlink = {mass = 1.0, com = [0.2, 0, 0], inertia = [0.001, 0.01, 0.01]}\n"
+      "[[mechanism.joints]]\nname = \"j2\"\norigin = {xyz = [0.4, 0, 0]}\n"
+      "link = {mass = 0.8, com = [0.15, 0, 0], inertia = [0.001, 0.008, 0.008]}\n"
+      "[[mechanism.joints]]\nname = \"j3\"\norigin = {xyz = [0.3, 0, 0]}\n"
+      "link = {mass = 0.5, com = [0.1, 0, 0], inertia = [0.001, 0.004, 0.004]}\n"
+      "[[mechanism.frames]]\nname = \"tip\"\nlink = \"j3\"\norigin = {xyz = [0.2, 0, 0]}\n"
+      "[control]\nkind = \"reactionless\"\ncancel = [\"moment_z\"]\n"
+      "integrator = \"euler\"\ntask_frame = \"tip\"\n";
+  const LoadedCase c = case_from_string(text);
+  const Eigen::VectorXd q0 = Eigen::Vector3d(0.3, 0.8, -0.6);
+  auto made = make_task_controller(c.model, c.control, q0);
+  TaskSpaceConfig config;
+  config.frame = "tip";
+  config.cancel = moment_z;
+  config.integrator = ReactionlessIntegrator::euler;
+  ReactionlessTaskController direct(std::make_shared<const MechanismModel>(c.model), config, q0);
+  double worst = 0.0;
+  std::size_t allocations = 0;
+  for (int k = 0; k < 500; ++k) {
+    Vec6 twist = Vec6::Zero();
+    twist[0] = 0.05 * std::sin(2e-3 * k);
+    twist[1] = 0.04 * std::cos(3e-3 * k);
+    Status s;
+    {
+      test::AllocationScope scope;
+      s = made->step(twist, twist, twist);
+      allocations += scope.count();
+    }
+    EXPECT_EQ(s, direct.step(twist, twist, twist));
+    worst = std::max({worst, (made->q() - direct.q()).cwiseAbs().maxCoeff(),
+                      (made->v() - direct.v()).cwiseAbs().maxCoeff()});
+  }
+  EXPECT_LE(worst, 1e-12);
+  EXPECT_EQ(allocations, 0u);
 
 TEST(CaseReader, ConstantSpeedTrajectory) {
   const std::string base = arm("origin") + "[case]\nname = \"arm\"\nkind = \"mechanism\"\n";

@@ -472,6 +472,208 @@ def test_load_case_file_reads_control(tmp_path):
         _core.load_case_file(str(path))
 
 
+# ---- [control]: the same configuration, the same refusals (issue 27 with issue 21's table) ----------
+
+from mechbal.config import read_toml  # noqa: E402
+from mechbal.schema import validate_case  # noqa: E402
+
+CONTROL_KEYS = ("kind", "balancing_joints", "cancel", "integrator", "rate_hz", "damping", "max_rate",
+                "home_gain", "limit_gain", "task_frame", "kp", "kd", "torque_limit", "k")
+
+
+def wheel_arm() -> dict:
+    """The reaction-wheel arm with a tool frame on its forearm (for task_frame)."""
+    data = tomllib.loads((PKG / "cases" / "reaction-wheel-arm.toml").read_text())
+    data["mechanism"]["frames"] = [{"name": "tool", "link": "elbow", "origin": {"xyz": [0.4, 0.0, 0.0]}}]
+    return data
+
+
+def builtin_control_cases() -> list[Path]:
+    return [p for p in builtin_mechanism_cases() if isinstance(tomllib.loads(p.read_text()).get("control"), dict)]
+
+
+def both_controls(tmp_path: Path, data: dict):
+    text = toml_text(data).replace(f'"{NAN}"', "nan").replace(f'"{INF}"', "inf")
+    path = tmp_path / "control.toml"
+    path.write_text(text)
+    py = validate_case(read_toml(path), warn=False).control
+    _, cpp, _ = _core.load_case_file(str(path))
+    _, from_text, _ = _core.case_from_toml(text)  # the same reader on the text
+    assert all(getattr(from_text, k) == getattr(cpp, k) for k in CONTROL_KEYS)
+    return py, cpp
+
+
+def assert_same_control(py, cpp) -> None:
+    """Every field of the C++ ControlConfig equals the Python reader's (absent lists: empty)."""
+    for key in CONTROL_KEYS:
+        p, c = getattr(py, key), getattr(cpp, key)
+        if key == "task_frame":
+            p = p or ""
+        elif key in ("kp", "kd", "torque_limit", "k"):
+            p = [] if p is None else [float(x) for x in p]
+        elif isinstance(c, list):
+            p = [] if p is None else list(p)
+        elif isinstance(c, float):
+            p = float(p)
+        assert c == p, (key, p, c)
+    # the numbers bitwise (what the controller is built from)
+    for key in ("rate_hz", "damping", "max_rate", "home_gain", "limit_gain"):
+        assert np.float64(getattr(cpp, key)).tobytes() == np.float64(getattr(py, key)).tobytes(), key
+
+
+def test_the_builtin_control_corpus_is_found():
+    assert "reaction-wheel-arm.toml" in {p.name for p in builtin_control_cases()}
+
+
+@pytest.mark.parametrize("path", builtin_control_cases(), ids=lambda p: p.stem)
+def test_builtin_control(path, tmp_path):
+    py = validate_case(read_toml(path), warn=False).control
+    _, cpp, _ = _core.load_case_file(str(path))
+    assert_same_control(py, cpp)
+
+
+def random_control(seed: int) -> dict:
+    """A valid [control] of the wheel arm (3 actuated joints, frame 'tool'): each optional field
+    present or not, of every kind, integers where the format allows them."""
+    rng = np.random.default_rng(seed)
+    kind = ["reactionless", "computed_torque", "decoupled"][seed % 3]
+    pick = lambda p=0.5: rng.random() < p  # noqa: E731
+    num = lambda lo, hi: int(rng.integers(max(1, int(lo)), int(hi) + 1)) if pick(0.3) else float(rng.uniform(lo, hi))  # noqa: E731
+    per_joint = lambda: [num(0.5, 500.0) for _ in range(3)]  # noqa: E731
+    c: dict = {"kind": kind}
+    if pick():
+        c["rate_hz"] = num(1.0, 1e5)
+    if kind == "reactionless":
+        if pick(0.2):
+            c["task_frame"] = "tool"
+        if "task_frame" not in c or pick():
+            joints = ["shoulder", "elbow", "wheel"]
+            c["balancing_joints"] = [str(j) for j in rng.choice(joints, size=int(rng.integers(1, 4)), replace=False)]
+        if pick():
+            names = ["moment", "force", "both", "moment_x", "moment_y", "moment_z", "force_x", "force_y", "force_z"]
+            c["cancel"] = [str(n) for n in rng.choice(names, size=int(rng.integers(1, 10)))]
+        if pick():
+            c["integrator"] = str(rng.choice(["euler", "rk4"]))
+        if pick():
+            c["damping"] = float(rng.uniform(1e-6, 0.999))
+        for key in ("max_rate", "home_gain", "limit_gain"):
+            if pick():
+                c[key] = num(0.01, 1e3)
+        if pick(0.3):
+            c["kp"], c["kd"] = per_joint(), per_joint()
+    else:
+        c["kp"], c["kd"] = per_joint(), per_joint()
+        if kind == "decoupled" and pick():
+            c["k"] = per_joint()
+    if "kp" in c and pick():
+        c["torque_limit"] = per_joint()
+    return c
+
+
+@pytest.mark.parametrize("seed", range(60))
+def test_random_valid_control(tmp_path, seed):
+    data = wheel_arm()
+    data["control"] = random_control(seed)
+    assert_same_control(*both_controls(tmp_path, data))
+
+
+def _control(**changes):
+    """The wheel arm's [control] with keys set (None: removed)."""
+    def mutate(c: dict):
+        for k, v in changes.items():
+            if v is None:
+                c.pop(k, None)
+            else:
+                c[k] = v
+    return mutate
+
+
+REACTIONLESS_ONLY = dict(balancing_joints=None, cancel=None, integrator=None, damping=None)
+GAINS = dict(kp=[1.0, 2.0, 3.0], kd=[1.0, 1.0, 1.0])
+
+INVALID_CONTROL = {
+    "not a table": lambda c: "__replace__",
+    "kind missing": _control(kind=None),
+    "kind misspelled": _control(kind="reactionles"),
+    "kind a number": _control(kind=1),
+    "unknown key": _control(balancing=["wheel"]),
+    "unknown table": _control(limits={"max_rate": 1.0}),
+    "balancing missing": _control(balancing_joints=None),
+    "balancing empty": _control(balancing_joints=[]),
+    "balancing a string": _control(balancing_joints="wheel"),
+    "balancing entry a number": _control(balancing_joints=[1]),
+    "balancing entry empty": _control(balancing_joints=[""]),
+    "balancing entry long": _control(balancing_joints=["w" * 129]),
+    "balancing unknown": _control(balancing_joints=["wheal"]),
+    "balancing twice": _control(balancing_joints=["wheel", "wheel"]),
+    "balancing too many": _control(balancing_joints=[f"j{i}" for i in range(257)]),
+    "cancel empty": _control(cancel=[]),
+    "cancel a string": _control(cancel="moment"),
+    "cancel unknown": _control(cancel=["moment_w"]),
+    "cancel too long": _control(cancel=["moment"] * 10),
+    "integrator unknown": _control(integrator="rk5"),
+    "integrator a number": _control(integrator=4),
+    "rate zero": _control(rate_hz=0),
+    "rate huge": _control(rate_hz=2e6),
+    "rate nan": _control(rate_hz=NAN),
+    "rate inf": _control(rate_hz=INF),
+    "rate a string": _control(rate_hz="1000"),
+    "rate a boolean": _control(rate_hz=True),
+    "damping zero": _control(damping=0.0),
+    "damping one": _control(damping=1),
+    "damping negative": _control(damping=-0.1),
+    "damping nan": _control(damping=NAN),
+    "max_rate zero": _control(max_rate=0.0),
+    "max_rate absurd": _control(max_rate=1e13),
+    "home_gain negative": _control(home_gain=-1.0),
+    "limit_gain a string": _control(limit_gain="x"),
+    "task_frame unknown": _control(task_frame="tool0"),
+    "task_frame empty": _control(task_frame=""),
+    "task_frame a list": _control(task_frame=["tool"]),
+    "kp without kd": _control(kp=[1.0, 2.0, 3.0]),
+    "kd without kp": _control(kd=[1.0, 2.0, 3.0]),
+    "kp short": _control(kp=[1.0, 2.0], kd=[1.0, 1.0, 1.0]),
+    "kp entry zero": _control(kp=[1.0, 0.0, 3.0], kd=[1.0, 1.0, 1.0]),
+    "kp entry a boolean": _control(kp=[True, 1.0, 3.0], kd=[1.0, 1.0, 1.0]),
+    "kd entry nan": _control(kp=[1.0, 1.0, 3.0], kd=[1.0, NAN, 1.0]),
+    "torque_limit long": _control(**GAINS, torque_limit=[1.0, 1.0, 1.0, 1.0]),
+    "torque_limit negative": _control(**GAINS, torque_limit=[1.0, -1.0, 1.0]),
+    "k on reactionless": _control(k=[1.0, 1.0, 1.0]),
+    "balancing on computed_torque": _control(kind="computed_torque", **GAINS),
+    "damping on decoupled": _control(kind="decoupled", **GAINS, **{**REACTIONLESS_ONLY, "damping": 0.1}),
+    "computed_torque without kp": _control(kind="computed_torque", kd=[1.0, 1.0, 1.0], **REACTIONLESS_ONLY),
+    "decoupled without kd": _control(kind="decoupled", kp=[1.0, 1.0, 1.0], **REACTIONLESS_ONLY),
+    "decoupled k short": _control(kind="decoupled", **GAINS, k=[1.0], **REACTIONLESS_ONLY),
+}
+
+
+def invalid_control(mutate) -> dict:
+    data = wheel_arm()
+    if mutate(data["control"]) == "__replace__":
+        data["control"] = 5
+    return data
+
+
+def test_the_base_of_the_invalid_control_corpus_is_valid(tmp_path):
+    assert_same_control(*both_controls(tmp_path, invalid_control(lambda c: None)))
+
+
+@pytest.mark.parametrize("name", list(INVALID_CONTROL))
+def test_both_readers_refuse_the_control(tmp_path, name):
+    data = invalid_control(INVALID_CONTROL[name])
+    text = toml_text(data).replace(f'"{NAN}"', "nan").replace(f'"{INF}"', "inf")
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as py_exc:
+        validate_case(read_toml(path), warn=False)
+    with pytest.raises(ValueError) as cpp_exc:
+        _core.load_case_file(str(path))
+    py_field, cpp_message = py_exc.value.field, str(cpp_exc.value)
+    assert py_field.startswith("control"), py_exc.value
+    # the same field, and here the same whole message (the value shown as Python shows it)
+    assert cpp_message.startswith(py_field + ": "), f"Python: {py_exc.value}\nC++:    {cpp_message}"
+    assert cpp_message == str(py_exc.value)
+
 # ---- izz alone and the [trajectory] through both readers ---------------------------------------------
 
 PLANAR = {"joints": [{"name": "crank", "axis": [0, -1, 0], "link": {"mass": 0.8, "com": [0.1, 0, 0], "izz": 0.003}},

@@ -9,6 +9,7 @@
 #include "mechbal/control/computed_torque.hpp"
 #include "mechbal/control/decoupled_control.hpp"
 #include "mechbal/control/mechanism_dynamics.hpp"
+#include "mechbal/control/reactionless.hpp"
 #include "mechbal/control/passive.hpp"
 
 namespace mechbal {
@@ -76,10 +77,114 @@ std::vector<double> balanced_diagonal(const MechanismModel& model, const Eigen::
   return std::vector<double>(M.diagonal().data(), M.diagonal().data() + n);
 }
 
+[[noreturn]] void fail(const std::string& field, const std::string& message) {
+  throw std::invalid_argument("control." + field + ": " + message);
+}
+
+void require_kind(const ControlConfig& c, ControlKind kind, const char* what) {
+  if (c.kind != kind) {
+    fail("kind", std::string(what) + " needs kind = '" + control_kind_name(kind) + "' (got '" +
+                     control_kind_name(c.kind) + "')");
+  }
+}
+
+/// The reactionless controllers' own construction errors name "reactionless.<field>": say
+/// "control." where the field is the table's.
+template <typename T, typename Fn>
+T rename_errors(Fn fn) {
+  try {
+    return fn();
+  } catch (const std::invalid_argument& e) {
+    std::string what = e.what();
+    if (what.rfind("reactionless.", 0) == 0) what = "control." + what.substr(13);
+    throw std::invalid_argument(what);
+  }
+}
+
+std::uint32_t cancel_mask(const std::vector<std::string>& cancel) {
+  if (cancel.empty()) fail("cancel", "must name at least one momentum component");
+  std::uint32_t mask = 0;
+  for (std::size_t i = 0; i < cancel.size(); ++i) {
+    const std::uint32_t m = momentum_component(cancel[i]);
+    if (m == 0) {
+      fail("cancel[" + std::to_string(i) + "]", "'" + cancel[i] +
+                                                    "' is not a momentum component (moment, force, both, moment_x, "
+                                                    "moment_y, moment_z, force_x, force_y, force_z)");
+    }
+    mask |= m;
+  }
+  return mask;
+}
+
+ReactionlessIntegrator integrator_of(const std::string& name) {
+  if (name == "euler") return ReactionlessIntegrator::euler;
+  if (name == "rk4") return ReactionlessIntegrator::rk4;
+  fail("integrator", "must be one of euler, rk4 (got '" + name + "')");
+}
+
 }  // namespace
 
+ReactionlessConfig reactionless_config(const ControlConfig& control) {
+  require_kind(control, ControlKind::reactionless, "a reactionless controller");
+  ReactionlessConfig c;
+  c.balancing_joints = control.balancing_joints;
+  c.cancel = cancel_mask(control.cancel);
+  c.integrator = integrator_of(control.integrator);
+  c.rate_hz = control.rate_hz;
+  c.damping = control.damping;
+  c.max_rate = control.max_rate;
+  c.home_gain = control.home_gain;
+  c.limit_gain = control.limit_gain;
+  rename_errors<int>([&] {
+    validate_reactionless_config(c);
+    return 0;
+  });
+  return c;
+}
+
+TaskSpaceConfig task_space_config(const ControlConfig& control) {
+  require_kind(control, ControlKind::reactionless, "the operational-space mode");
+  if (control.task_frame.empty()) fail("task_frame", "is required for the operational-space mode");
+  TaskSpaceConfig c;
+  c.frame = control.task_frame;
+  c.cancel = cancel_mask(control.cancel);
+  c.integrator = integrator_of(control.integrator);
+  c.rate_hz = control.rate_hz;
+  c.damping = control.damping;
+  c.max_rate = control.max_rate;
+  return c;
+}
+
+std::unique_ptr<ReactionlessController> make_reactionless_controller(const MechanismModel& model,
+                                                                     const ControlConfig& control,
+                                                                     const Eigen::VectorXd& q0,
+                                                                     const Eigen::VectorXd& v0,
+                                                                     const Eigen::VectorXd& q_guess) {
+  const ReactionlessConfig config = reactionless_config(control);
+  if (!control.task_frame.empty()) {
+    fail("task_frame", "the operational-space mode follows the frame's path: make_task_controller builds it");
+  }
+  const Eigen::VectorXd start = q0.size() ? q0 : Eigen::VectorXd(Eigen::VectorXd::Zero(model.num_actuated()));
+  return rename_errors<std::unique_ptr<ReactionlessController>>([&] {
+    return std::make_unique<ReactionlessController>(std::make_shared<const MechanismModel>(model), config, start, v0,
+                                                    q_guess);
+  });
+}
+
+std::unique_ptr<ReactionlessTaskController> make_task_controller(const MechanismModel& model,
+                                                                 const ControlConfig& control,
+                                                                 const Eigen::VectorXd& q0,
+                                                                 const Eigen::VectorXd& v0) {
+  const TaskSpaceConfig config = task_space_config(control);
+  const Eigen::VectorXd start = q0.size() ? q0 : Eigen::VectorXd(Eigen::VectorXd::Zero(model.dof()));
+  return rename_errors<std::unique_ptr<ReactionlessTaskController>>([&] {
+    return std::make_unique<ReactionlessTaskController>(std::make_shared<const MechanismModel>(model), config, start,
+                                                        v0);
+  });
+}
+
 std::unique_ptr<JointController> make_controller(const MechanismModel& model, const ControlConfig& control,
-                                                 const Eigen::VectorXd& q_guess) {
+                                                 const Eigen::VectorXd& q_guess, const Eigen::VectorXd& q0) {
   const int n = model.num_actuated();
   switch (control.kind) {
     case ControlKind::computed_torque: {
@@ -97,10 +202,27 @@ std::unique_ptr<JointController> make_controller(const MechanismModel& model, co
       return std::make_unique<DecoupledJointController>(vec(k), vec(control.kp), vec(control.kd),
                                                         vec(control.torque_limit));
     }
-    case ControlKind::reactionless:
-      throw std::invalid_argument(
-          "control.kind: 'reactionless' is read and checked, but this build has no reactionless controller "
-          "yet (use computed_torque or decoupled)");
+    case ControlKind::reactionless: {
+      const ReactionlessConfig config = reactionless_config(control);
+      if (!control.task_frame.empty()) {
+        fail("task_frame", "the operational-space mode follows a frame's path, not joint targets: "
+                           "make_task_controller builds it");
+      }
+      if (control.kp.empty() || control.kd.empty()) {
+        fail(control.kp.empty() ? "kp" : "kd",
+             "is required to build a joint controller (the reactionless controller's computed-torque stage); "
+             "make_reactionless_controller builds the motion command alone");
+      }
+      check_size(control.kp, n, "kp", false);
+      check_size(control.kd, n, "kd", false);
+      check_size(control.torque_limit, n, "torque_limit", true);
+      const Eigen::VectorXd start = q0.size() ? q0 : Eigen::VectorXd(Eigen::VectorXd::Zero(n));
+      return rename_errors<std::unique_ptr<JointController>>([&]() -> std::unique_ptr<JointController> {
+        return std::make_unique<ReactionlessJointController>(std::make_shared<const MechanismModel>(model), config,
+                                                             start, vec(control.kp), vec(control.kd),
+                                                             vec(control.torque_limit), JointInputRange{}, q_guess);
+      });
+    }
     case ControlKind::passive:
       return std::make_unique<PassiveController>(n);
     case ControlKind::none: break;

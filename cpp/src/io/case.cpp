@@ -6,7 +6,9 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cctype>
 #include <charconv>
+#include <filesystem>
 #include <fstream>
 #include <cmath>
 #include <limits>
@@ -37,15 +39,33 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // ---- messages ---------------------------------------------------------------------------------
 
-/// Python's repr of a float: the shortest round trip, "1.0" for integral values.
+/// Python's repr of a float: the shortest round trip, fixed for exponents -4..15 ("1.0",
+/// "2000000.0", "0.0001"), else scientific ("1e+16", "1.5e-05").
 std::string float_repr(double x) {
   if (std::isnan(x)) return "nan";
   if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
   char buf[64];
-  auto r = std::to_chars(buf, buf + sizeof buf, x);
-  std::string s(buf, r.ptr);
-  if (s.find_first_of(".en") == std::string::npos) s += ".0";
-  return s;
+  auto r = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::scientific);
+  const std::string sci(buf, r.ptr);  // [-]d[.ddd]e(+|-)XX
+  const std::size_t e = sci.find('e');
+  const int exponent = std::stoi(sci.substr(e + 1));
+  if (exponent < -4 || exponent >= 16) return sci;
+  const bool negative = sci[0] == '-';
+  std::string digits;
+  for (std::size_t k = negative ? 1 : 0; k < e; ++k)
+    if (sci[k] != '.') digits += sci[k];
+  std::string out;
+  if (exponent < 0) {
+    out = "0." + std::string(static_cast<std::size_t>(-exponent - 1), '0') + digits;
+  } else {
+    const auto point = static_cast<std::size_t>(exponent + 1);
+    if (digits.size() <= point) {
+      out = digits + std::string(point - digits.size(), '0') + ".0";
+    } else {
+      out = digits.substr(0, point) + "." + digits.substr(point);
+    }
+  }
+  return negative ? "-" + out : out;
 }
 
 /// schema._fmt: bounds as the Python reader prints them (1e+12, 0, 1000).
@@ -56,7 +76,48 @@ std::string bound_repr(double x) {
   return os.str();
 }
 
-std::string quote(const std::string& s) { return "'" + s + "'"; }
+/// Python's repr of a str: single quotes (double when the text holds a single quote and no
+/// double one), backslashes, the quote and control characters escaped; one line always.
+std::string quote(const std::string& s) {
+  const char q = s.find('\'') != std::string::npos && s.find('"') == std::string::npos ? '"' : '\'';
+  std::string out(1, q);
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (ch == '\\' || ch == q) {
+      out += '\\';
+      out += ch;
+    } else if (ch == '\n') {
+      out += "\\n";
+    } else if (ch == '\r') {
+      out += "\\r";
+    } else if (ch == '\t') {
+      out += "\\t";
+    } else if (c < 0x20 || c == 0x7f) {
+      static const char hex[] = "0123456789abcdef";
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    } else {
+      out += ch;
+    }
+  }
+  return out + q;
+}
+
+/// A parser's message on one line: control characters escaped.
+std::string one_line(std::string_view text) {
+  std::string out;
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c < 0x20 || c == 0x7f) {
+      static const char hex[] = "0123456789abcdef";
+      out += ch == '\n' ? std::string("\\n") : std::string("\\x") + hex[c >> 4] + hex[c & 15];
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
 
 void repr_into(const toml::node& n, std::string& out, int depth) {
   if (out.size() > 200 || depth > 8) {
@@ -136,15 +197,40 @@ std::string lower(std::string s) {
   return s;
 }
 
-/// schema.did_you_mean: " (did you mean 'x'?)" for the nearest allowed word, else the list.
-std::string did_you_mean(const std::string& word, const std::vector<std::string>& allowed) {
+/// difflib.get_close_matches(word, candidates, n=1, cutoff=0.6): the best ratio, ties to the
+/// largest word (heapq.nlargest over (ratio, word)); nullptr when none reaches the cutoff.
+const std::string* closest(const std::string& word, const std::vector<std::string>& candidates) {
   const std::string* best = nullptr;
-  double best_ratio = 0.6;
-  for (const auto& a : allowed) {
-    const double r = std::max(similarity(word, a), similarity(lower(word), lower(a)));
-    if (r >= best_ratio && (best == nullptr || r > best_ratio)) best = &a, best_ratio = r;
+  double best_ratio = 0.0;
+  for (const auto& a : candidates) {
+    const double r = similarity(word, a);
+    if (r < 0.6) continue;
+    if (best == nullptr || r > best_ratio || (r == best_ratio && a > *best)) best = &a, best_ratio = r;
   }
-  if (best) return " (did you mean " + quote(*best) + "?)";
+  return best;
+}
+
+/// schema.did_you_mean: " (did you mean 'x'?)" for the nearest allowed word (as written, then
+/// ignoring case), else the list.
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& allowed) {
+  const std::string* match = closest(word, allowed);
+  if (!match) {
+    // {a.lower(): a}: the last word of each lowercase spelling, in order of first appearance
+    std::vector<std::string> lowers;
+    std::map<std::string, const std::string*> by_lower;
+    for (const auto& a : allowed) {
+      const std::string l = lower(a);
+      if (!by_lower.count(l)) lowers.push_back(l);
+      by_lower[l] = &a;
+    }
+    const std::string lw = lower(word);
+    if (by_lower.count(lw)) {
+      match = by_lower[lw];
+    } else if (const std::string* m = closest(lw, lowers)) {
+      match = by_lower[*m];
+    }
+  }
+  if (match) return " (did you mean " + quote(*match) + "?)";
   if (allowed.empty()) return "";
   std::string out = " (allowed: ";
   for (std::size_t k = 0; k < allowed.size(); ++k) out += (k ? ", " : "") + allowed[k];
@@ -988,23 +1074,108 @@ MechanismDescription build_description(const MechanismIn& m, const std::string& 
 
 // ---- documents ------------------------------------------------------------------------------
 
-toml::table parse(const std::string& text, const std::string& source) {
-  try {
-    return toml::parse(text, source);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream os;
-    os << "is not valid TOML: " << e.description() << " (line " << e.source().begin.line << ", column "
-       << e.source().begin.column << ")";
-    fail(source, os.str());
+// config.MAX_CASE_BYTES, config.MAX_CASE_DEPTH
+constexpr std::uintmax_t kMaxCaseBytes = 4u * 1024u * 1024u;
+constexpr int kMaxCaseDepth = 32;
+
+[[noreturn]] void too_deep(const std::string& source) {
+  fail(source, "nests arrays or tables more than " + std::to_string(kMaxCaseDepth) +
+                   " deep, too deeply to be a case file");
+}
+
+/// Refuses, before parsing, a dotted key or table header of more than kMaxCaseDepth segments
+/// (`a.b.c. ... = 1`): each segment is a table level, and toml++ walks a deep tree recursively (a
+/// stack overflow for ~1e5 levels). Outside strings and comments, a run of key characters and
+/// dots holds more than one dot only in a dotted key (a float or a date has one).
+void check_dotted_depth(const std::string& text, const std::string& source) {
+  int dots = 0;
+  const std::size_t n = text.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = text[i];
+    if (c == '#') {
+      while (i < n && text[i] != '\n') ++i;
+      dots = 0;
+    } else if (c == '"' || c == '\'') {
+      const bool triple = i + 2 < n && text[i + 1] == c && text[i + 2] == c;
+      i += triple ? 3 : 1;
+      for (; i < n; ++i) {
+        if (c == '"' && text[i] == '\\') {
+          ++i;
+        } else if (text[i] == c && (!triple || (i + 2 < n && text[i + 1] == c && text[i + 2] == c))) {
+          if (triple) i += 2;
+          break;
+        } else if (!triple && text[i] == '\n') {
+          break;  // an unterminated string: the parser says so
+        }
+      }
+    } else if (c == '.') {
+      if (++dots > kMaxCaseDepth) too_deep(source);
+    } else if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '+' || c == ' ' ||
+                 c == '\t')) {
+      dots = 0;
+    }
   }
 }
 
+/// config._nesting_depth: the deepest nesting of tables and arrays (the document is depth 1),
+/// without recursion.
+int nesting_depth(const toml::table& doc) {
+  int deepest = 0;
+  std::vector<std::pair<const toml::node*, int>> stack{{&doc, 1}};
+  while (!stack.empty()) {
+    const auto [node, d] = stack.back();
+    stack.pop_back();
+    deepest = std::max(deepest, d);
+    if (d > kMaxCaseDepth + 1) continue;
+    if (const toml::table* t = node->as_table()) {
+      for (auto&& [k, v] : *t)
+        if (v.is_table() || v.is_array()) stack.emplace_back(&v, d + 1);
+    } else if (const toml::array* a = node->as_array()) {
+      for (auto&& v : *a)
+        if (v.is_table() || v.is_array()) stack.emplace_back(&v, d + 1);
+    }
+  }
+  return deepest;
+}
+
+toml::table parse(const std::string& text, const std::string& source) {
+  check_dotted_depth(text, source);
+  toml::table doc;
+  try {
+    doc = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    if (e.description().find("TOML_MAX_NESTED_VALUES") != std::string_view::npos) too_deep(source);
+    std::ostringstream os;
+    os << "is not valid TOML: " << one_line(e.description()) << " (line " << e.source().begin.line << ", column "
+       << e.source().begin.column << ")";
+    fail(source, os.str());
+  }
+  if (nesting_depth(doc) > kMaxCaseDepth) too_deep(source);
+  return doc;
+}
+
+/// config.read_regular_file: a regular file of at most kMaxCaseBytes, else ConfigError("case").
 std::string read_file(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) fail("case", "file not found", quote(path));
+  if (std::filesystem::is_directory(status)) fail("case", "is a folder, not a file", quote(path));
+  if (!std::filesystem::is_regular_file(status)) fail("case", "is not a regular file (a device, pipe or socket)", quote(path));
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) fail("case", "cannot be read: " + ec.message(), quote(path));
+  if (size > kMaxCaseBytes) {
+    fail("case", "is " + std::to_string(size) + " bytes, more than such a file can be (" +
+                     std::to_string(kMaxCaseBytes) + " bytes)", quote(path));
+  }
   std::ifstream in(path, std::ios::binary);
-  if (!in) fail("case", "file not found", quote(path));
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
+  if (!in) fail("case", "cannot be read", quote(path));
+  std::string text;
+  text.resize(static_cast<std::size_t>(size));
+  in.read(text.data(), static_cast<std::streamsize>(size));
+  if (static_cast<std::uintmax_t>(in.gcount()) != size || in.peek() != std::char_traits<char>::eof()) {
+    fail("case", "changed while being read", quote(path));
+  }
+  return text;
 }
 
 MechanismDescription description_of(const toml::table& doc) {
@@ -1039,90 +1210,107 @@ std::vector<std::string> names_list(const toml::node& n, const std::string& f, s
   return out;
 }
 
+/// schema.Control: the same keys, bounds and defaults; the checks across tables (sizes, joint and
+/// frame names) as schema._cross_checks, in the same order, so both readers name the same field.
 ControlConfig read_control(const toml::node& n, const MechanismModel& model) {
   const std::string f = "control";
   const auto& t = table_of(n, f);
-  const std::vector<std::string> common{"kind", "rate_hz", "kp", "kd", "torque_limit"};
   const std::vector<std::string> decoupled{"k"};
-  const std::vector<std::string> reactionless{"balancing_joints", "cancel", "integrator", "damping", "task_frame"};
-  std::vector<std::string> all = common;
-  all.insert(all.end(), decoupled.begin(), decoupled.end());
-  all.insert(all.end(), reactionless.begin(), reactionless.end());
+  const std::vector<std::string> reactionless{"balancing_joints", "cancel", "integrator", "damping",
+                                              "max_rate", "home_gain", "limit_gain", "task_frame"};
+  const std::vector<std::string> all{"kind", "balancing_joints", "cancel", "integrator", "rate_hz", "damping", "max_rate",
+                               "home_gain", "limit_gain", "task_frame", "kp", "kd", "torque_limit", "k"};
   allow_keys(t, f, all);
   ControlConfig c;
+  // the table's own fields (types, ranges), in the Python model's order
   const std::string kind =
-      choice(required(t, "kind", f), join(f, "kind"), {"computed_torque", "decoupled", "reactionless", "passive"});
+      choice(required(t, "kind", f), join(f, "kind"), {"reactionless", "computed_torque", "decoupled", "passive"});
   c.kind = kind == "computed_torque" ? ControlKind::computed_torque
            : kind == "decoupled"     ? ControlKind::decoupled
            : kind == "passive"       ? ControlKind::passive
                                      : ControlKind::reactionless;
-  for (auto&& [k, v] : t) {
-    const std::string key(k.str());
+  if (auto x = get(t, "balancing_joints")) c.balancing_joints = names_list(*x, join(f, "balancing_joints"), kMaxJoints);
+  if (auto x = get(t, "cancel")) {
+    const std::string fc = join(f, "cancel");
+    const toml::array& a = array_of(*x, fc, 1, 9);
+    c.cancel.clear();
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      c.cancel.push_back(choice(*a.get(k), item(fc, k), {"moment", "force", "both", "moment_x", "moment_y",
+                                                         "moment_z", "force_x", "force_y", "force_z"}));
+    }
+  }
+  if (auto x = get(t, "integrator")) c.integrator = choice(*x, join(f, "integrator"), {"euler", "rk4"});
+  if (auto x = get(t, "rate_hz")) c.rate_hz = number(*x, join(f, "rate_hz"), 1.0, 1e6);
+  if (auto x = get(t, "damping")) {
+    c.damping = number(*x, join(f, "damping"), 0.0, kMaxAbs, Lo::gt);
+    if (!(c.damping < 1.0)) fail(join(f, "damping"), "must be < 1", *x);
+  }
+  if (auto x = get(t, "max_rate")) c.max_rate = number(*x, join(f, "max_rate"), 0.0, kMaxAbs, Lo::gt);
+  if (auto x = get(t, "home_gain")) c.home_gain = number(*x, join(f, "home_gain"), 0.0);
+  if (auto x = get(t, "limit_gain")) c.limit_gain = number(*x, join(f, "limit_gain"), 0.0);
+  if (auto x = get(t, "task_frame")) c.task_frame = name(*x, join(f, "task_frame"));
+  std::vector<std::vector<double>*> per_joint{&c.kp, &c.kd, &c.torque_limit, &c.k};
+  const char* per_joint_keys[] = {"kp", "kd", "torque_limit", "k"};
+  for (std::size_t i = 0; i < per_joint.size(); ++i) {
+    if (auto x = get(t, per_joint_keys[i])) *per_joint[i] = numbers(*x, join(f, per_joint_keys[i]), kMaxJoints, 0.0, Lo::gt);
+  }
+  // the table's own rules across its fields (schema.Control._rules)
+  if (c.kind == ControlKind::passive) {  // no controller: only the tick rate of the log
+    for (auto&& [k, v] : t) {            // toml++ keeps the keys sorted, as Python's sorted()
+      const std::string key(k.str());
+      if (key != "kind" && key != "rate_hz") fail(join(f, key), "is not for kind = 'passive' (no controller: only rate_hz)", v);
+    }
+    return c;
+  }
+  const std::string fb = join(f, "balancing_joints");
+  for (std::size_t k = 0; k < c.balancing_joints.size(); ++k) {
+    const auto begin = c.balancing_joints.begin();
+    if (std::find(begin, begin + static_cast<long>(k), c.balancing_joints[k]) != begin + static_cast<long>(k)) {
+      fail(item(fb, k), "is listed twice", quote(c.balancing_joints[k]));
+    }
+  }
+  for (const std::string& key : all) {  // in the Python model's field order
+    const toml::node* v = t.get(key);
+    if (!v) continue;
     const bool is_decoupled = std::find(decoupled.begin(), decoupled.end(), key) != decoupled.end();
     const bool is_reactionless = std::find(reactionless.begin(), reactionless.end(), key) != reactionless.end();
     if ((is_decoupled && c.kind != ControlKind::decoupled) || (is_reactionless && c.kind != ControlKind::reactionless)) {
-      fail(join(f, key), std::string("is only for kind = '") + (is_decoupled ? "decoupled" : "reactionless") + "'", v);
-    }
-    // a passive run has no controller: no gains, no torque limit (only kind and rate_hz)
-    if (c.kind == ControlKind::passive && key != "kind" && key != "rate_hz" && !is_decoupled && !is_reactionless) {
-      fail(join(f, key), "is not for kind = 'passive' (no controller: only rate_hz)", v);
+      fail(join(f, key), std::string("is only for kind = '") + (is_decoupled ? "decoupled" : "reactionless") + "'", *v);
     }
   }
-  if (auto x = get(t, "rate_hz")) c.rate_hz = number(*x, join(f, "rate_hz"), 1.0, 1e6);
-  const std::size_t na = static_cast<std::size_t>(model.num_actuated());
-  std::string actuated;
-  for (int i : model.actuated_coordinates()) actuated += (actuated.empty() ? "" : ", ") + model.coordinate_name(i);
-  auto per_joint = [&](const char* key, bool needed) {
-    const toml::node* x = get(t, key);
-    if (!x) {
-      if (needed) fail(join(f, key), "is required for kind = '" + kind + "'");
-      return std::vector<double>();
+  if (c.kind == ControlKind::reactionless && !get(t, "balancing_joints") && !get(t, "task_frame")) {
+    fail(fb, "is required for kind = 'reactionless' (or task_frame: the operational-space mode)");
+  }
+  if (c.kind != ControlKind::reactionless) {
+    for (const char* key : {"kp", "kd"}) {
+      if (!get(t, key)) fail(join(f, key), "is required for kind = '" + kind + "'");
     }
-    std::vector<double> v = numbers(*x, join(f, key), kMaxJoints, 0.0, Lo::gt);
-    if (v.size() != na) {
-      fail(join(f, key), "must have " + std::to_string(na) + " values (one per actuated joint: " + actuated + ")", *x);
+  }
+  if (get(t, "kp") && !get(t, "kd")) fail(join(f, "kd"), "is required with kp (the computed-torque stage)");
+  if (get(t, "kd") && !get(t, "kp")) fail(join(f, "kp"), "is required with kd (the computed-torque stage)");
+  // against the mechanism (schema._cross_checks)
+  std::vector<std::string> actuated;
+  for (int i : model.actuated_coordinates()) actuated.push_back(model.coordinate_name(i));
+  std::string actuated_list;
+  for (const auto& a : actuated) actuated_list += (actuated_list.empty() ? "" : ", ") + a;
+  for (std::size_t i = 0; i < per_joint.size(); ++i) {
+    if (!per_joint[i]->empty() && per_joint[i]->size() != actuated.size()) {
+      fail(join(f, per_joint_keys[i]),
+           "must have " + std::to_string(actuated.size()) + " values (one per actuated joint: " + actuated_list + ")",
+           *get(t, per_joint_keys[i]));
     }
-    return v;
-  };
-  const bool gains_needed = c.kind != ControlKind::reactionless && c.kind != ControlKind::passive;
-  c.kp = per_joint("kp", gains_needed);
-  c.kd = per_joint("kd", gains_needed);
-  if (c.kp.empty() != c.kd.empty()) fail(join(f, c.kp.empty() ? "kp" : "kd"), "is required with " + std::string(c.kp.empty() ? "kd" : "kp"));
-  c.torque_limit = per_joint("torque_limit", false);
-  c.k = per_joint("k", false);
-  if (c.kind == ControlKind::reactionless) {
-    const std::string fb = join(f, "balancing_joints");
-    c.balancing_joints = names_list(required(t, "balancing_joints", f), fb, kMaxJoints);
-    const auto& coords = model.coordinate_names();
-    for (std::size_t k = 0; k < c.balancing_joints.size(); ++k) {
-      const auto& nm = c.balancing_joints[k];
-      if (std::find(coords.begin(), coords.end(), nm) == coords.end()) {
-        fail(item(fb, k), "not a joint with its own coordinate" + did_you_mean(nm, coords), quote(nm));
-      }
-      if (std::find(c.balancing_joints.begin(), c.balancing_joints.begin() + static_cast<long>(k), nm) !=
-          c.balancing_joints.begin() + static_cast<long>(k)) {
-        fail(item(fb, k), "names a joint twice", quote(nm));
-      }
+  }
+  for (std::size_t k = 0; k < c.balancing_joints.size(); ++k) {
+    const auto& nm = c.balancing_joints[k];
+    if (std::find(actuated.begin(), actuated.end(), nm) == actuated.end()) {
+      fail(item(fb, k), "is not an actuated joint" + did_you_mean(nm, actuated), quote(nm));
     }
-    if (auto x = get(t, "cancel")) {
-      const std::string fc = join(f, "cancel");
-      const toml::array& a = array_of(*x, fc, 1, 6);
-      c.cancel.clear();
-      for (std::size_t k = 0; k < a.size(); ++k) {
-        c.cancel.push_back(choice(*a.get(k), item(fc, k), {"moment", "force", "moment_x", "moment_y", "moment_z",
-                                                           "force_x", "force_y", "force_z"}));
-      }
-    }
-    if (auto x = get(t, "integrator")) c.integrator = choice(*x, join(f, "integrator"), {"rk4", "euler"});
-    if (auto x = get(t, "damping")) c.damping = number(*x, join(f, "damping"), 0.0);
-    if (auto x = get(t, "task_frame")) {
-      c.task_frame = name(*x, join(f, "task_frame"));
-      if (model.frame_index(c.task_frame) < 0) {
-        std::vector<std::string> frames;
-        for (int k = 0; k < model.num_frames(); ++k) frames.push_back(model.frame(k).name);
-        fail(join(f, "task_frame"), "no such frame" + did_you_mean(c.task_frame, frames), *x);
-      }
-    }
+  }
+  if (!c.task_frame.empty() && model.frame_index(c.task_frame) < 0) {
+    std::vector<std::string> frames;
+    for (int k = 0; k < model.num_frames(); ++k) frames.push_back(model.frame(k).name);
+    fail(join(f, "task_frame"), "is not a frame of the mechanism" + did_you_mean(c.task_frame, frames),
+         *get(t, "task_frame"));
   }
   return c;
 }

@@ -22,8 +22,9 @@ const char* control_kind_name(ControlKind kind) noexcept;
 struct ControlConfig {
   ControlKind kind = ControlKind::none;
   double rate_hz = 1000.0;  ///< the controller's tick rate [Hz]
-  /// Diagonal gains of the outer loop (computed_torque, decoupled; optional computed-torque stage
-  /// of reactionless), one value > 0 per actuated coordinate.
+  /// Diagonal gains of the outer loop, one value > 0 per actuated coordinate: required for
+  /// computed_torque and decoupled; for reactionless the optional computed-torque stage (both or
+  /// neither).
   std::vector<double> kp, kd;
   /// Command limits (one value > 0 per actuated coordinate); empty: default_torque_limit.
   std::vector<double> torque_limit;
@@ -31,13 +32,18 @@ struct ControlConfig {
   /// (the diagonal of M# at q = 0, which must then be diagonal).
   std::vector<double> k;
 
-  // ---- reactionless (issue 21's controller) ----
-  std::vector<std::string> balancing_joints;  ///< joints whose motion cancels the momentum
-  /// Cancelled momentum components: "moment", "force", "moment_x|y|z", "force_x|y|z".
+  // ---- reactionless (issue 21's controller); only with kind = "reactionless" ----
+  /// Joints whose motion cancels the momentum: actuated coordinates (required).
+  std::vector<std::string> balancing_joints;
+  /// Cancelled momentum components: "moment", "force", "both", "moment_x|y|z", "force_x|y|z".
   std::vector<std::string> cancel{"moment"};
   std::string integrator = "rk4";  ///< "rk4" or "euler"
-  double damping = 1e-3;           ///< damped least squares near singularities
-  std::string task_frame;          ///< operational-space mode: the frame following [trajectory]
+  double damping = 1e-2;           ///< damped least squares near singularity, in (0, 1)
+  double max_rate = 100.0;         ///< balancing joints' rate limit [rad/s or m/s], > 0
+  double home_gain = 0.0;          ///< redundant balancing joints: pull towards the start pose [1/s]
+  double limit_gain = 0.0;         ///< redundant balancing joints: push away from the joint limits
+  /// Operational-space mode: the frame whose path [trajectory] gives (empty: joint-space mode).
+  std::string task_frame;
 };
 
 }  // namespace mechbal

@@ -7,6 +7,7 @@
 
 #include "array_checks.hpp"
 #include "controller_step.hpp"
+#include "motion_tick.hpp"
 #include "bindings.hpp"
 #include "mechbal/papers/paminsa/paminsa.hpp"
 #include "mechbal/papers/paminsa/reactionless_wrist.hpp"
@@ -16,6 +17,14 @@ namespace py = pybind11;
 namespace mechbal::pyb {
 
 namespace {
+
+/// A wrist command into the rows of a fast tick's `out` (motion_tick.hpp).
+template <typename Row>
+void write_wrist(const WristCommand& c, Row q, Row v, Row a) {
+  q = c.angles;
+  v = c.rates;
+  a = c.accelerations;
+}
 
 constexpr py::ssize_t kBodies = static_cast<py::ssize_t>(PaminsaBodyIndex::count);
 
@@ -204,13 +213,8 @@ void bind_paminsa(py::module_& m) {
             const double* dd = detail::fast_array(Dd.h, "D_dot", 3);
             const double* dh = detail::fast_array(Dh.h, "D_half", 3);
             const double* dn = detail::fast_array(Dn.h, "D_next", 3);
-            double* o = detail::fast_matrix(out.h, "out", 3, 3, true);
-            const Status s = w.step(CV(d), CV(dd), CV(dh), CV(dn));
-            const WristCommand& c = w.command();
-            Eigen::Map<Vec3>{o} = c.angles;
-            Eigen::Map<Vec3>(o + 3) = c.rates;
-            Eigen::Map<Vec3>(o + 6) = c.accelerations;
-            return static_cast<std::uint32_t>(s);
+            return motion_step_into(out, 3, [&] { return w.step(CV(d), CV(dd), CV(dh), CV(dn)); },
+                                    [&](auto q, auto v, auto a) { write_wrist(w.command(), q, v, a); });
           },
           py::arg("D"), py::arg("D_dot"), py::arg("D_half"), py::arg("D_next"), py::arg("out"),
           "The fast tick: D [kg m^2/s], D_dot [N m], D_half, D_next as float64 arrays of 3; writes "
@@ -394,13 +398,8 @@ void bind_paminsa(py::module_& m) {
             const double* n = detail::fast_matrix(now.h, "now", 3, 3);
             const double* h = detail::fast_matrix(half.h, "half", 3, 3);
             const double* x = detail::fast_matrix(next.h, "next", 3, 3);
-            double* o = detail::fast_matrix(out.h, "out", 3, 3, true);
-            const Status s = c.tick(motion(n), motion(h), motion(x));
-            const WristCommand& w = c.wrist().command();
-            Eigen::Map<Vec3>{o} = w.angles;
-            Eigen::Map<Vec3>(o + 3) = w.rates;
-            Eigen::Map<Vec3>(o + 6) = w.accelerations;
-            return static_cast<std::uint32_t>(s);
+            return motion_step_into(out, 3, [&] { return c.tick(motion(n), motion(h), motion(x)); },
+                                    [&](auto q, auto v, auto a) { write_wrist(c.wrist().command(), q, v, a); });
           },
           py::arg("now"), py::arg("half"), py::arg("next"), py::arg("out"),
           "The fast tick: the platform motion at t_n, t_n + dt/2, t_n + dt, each a (3, 3) float64 "
@@ -445,12 +444,9 @@ void bind_paminsa(py::module_& m) {
           const Vec3 q0 = fixed_vector<3>(q0_arg, "initial_wrist_angles");
           require_shape(P, "P_half", {-1, 3});
           const auto J = P.shape(0);
-          if (J < 3 || J % 2 == 0)
-            throw py::value_error("P_half must have 2 * steps + 1 rows (steps >= 1), got " +
-                                  std::to_string(J));
+          const auto steps = half_step_ticks(J, "P_half", 1);
           require_shape(Pd, "Pd_half", {J, 3});
           require_shape(Pdd, "Pdd_half", {J, 3});
-          const auto steps = (J - 1) / 2;
           BatchArrays out(steps + 1);
           const Status s = paminsa_reactionless_run(mo, c, q0, static_cast<std::size_t>(steps),
                                                     P.data(), Pd.data(), Pdd.data(), out.view());
