@@ -167,8 +167,7 @@ Tick paminsa_wrench_case() {
     PaminsaWorkspace ws;
     ShakingWrench w;
     if (paminsa_kinematics(s->model, platform_at(t), wrist_at(t), ws) != Status::ok ||
-        shaking_wrench(s->model.bodies().data(), ws.states.data(), PaminsaBodyIndex::count, w) !=
-            Status::ok)
+        paminsa_shaking_wrench(s->model, ws, w) != Status::ok)
       fail("PAMINSA bench trajectory is not reachable", t);
     return w;
   };
@@ -181,8 +180,7 @@ Tick paminsa_wrench_case() {
     const std::size_t k = static_cast<std::size_t>(s->k);
     s->k = (s->k + 1) & (kTicks - 1);
     s->status = paminsa_kinematics(s->model, s->platform[k], s->wrist[k], s->ws);
-    s->status |= shaking_wrench(s->model.bodies().data(), s->ws.states.data(),
-                                PaminsaBodyIndex::count, s->out);
+    s->status |= paminsa_shaking_wrench(s->model, s->ws, s->out);
     benchmark::DoNotOptimize(s->status);
     benchmark::DoNotOptimize(&s->out);
     benchmark::ClobberMemory();

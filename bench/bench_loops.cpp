@@ -61,7 +61,7 @@ Tick paminsa_general_case() {
   auto s = std::make_shared<PaminsaGeneralCase>();
   for (int n = 0; n < kTicks; ++n) s->in.push_back(actuated(s->closed, s->model, platform_at(n * kDt), wrist_at(n * kDt)));
   // check at setup, at 64 consecutive ticks: the general path's momenta and shaking wrench equal
-  // the closed form's (paminsa_kinematics + shaking_wrench of the 38 bodies) to 1e-9
+  // the closed form's (paminsa_kinematics + paminsa_shaking_wrench of the 38 bodies) to 1e-9
   s->q = initial_guess(s->closed, s->model, platform_at(0.0), wrist_at(0.0));
   PaminsaWorkspace ws;
   for (int n = 0; n < 64; ++n) {
@@ -73,7 +73,7 @@ Tick paminsa_general_case() {
       fail("PAMINSA general model: shaking_wrench failed", n);
     ShakingWrench w;
     if (paminsa_kinematics(s->closed, platform_at(n * kDt), wrist_at(n * kDt), ws) != Status::ok ||
-        shaking_wrench(s->closed.bodies().data(), ws.states.data(), PaminsaBodyIndex::count, w) != Status::ok)
+        paminsa_shaking_wrench(s->closed, ws, w) != Status::ok)
       fail("PAMINSA closed form failed on the bench trajectory", n);
     const ShakingWrench& g = s->data.shaking;
     const double rel = std::max({(g.force - w.force).norm() / std::max(1.0, w.force.norm()),

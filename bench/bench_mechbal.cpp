@@ -1,4 +1,4 @@
-// mechbal's own real-time paths: shaking wrench of a body set, chain kinematics (the model's
+// mechbal's own real-time paths: the shaking wrench of a chain (general path), chain kinematics (the model's
 // forward kinematics: every body's motion), recursive Newton-Euler inverse dynamics, the
 // computed-torque tick (the real ComputedTorque controller over MechanismDynamics and over the
 // closed-form Arm2DofDynamics) and the CRBA mass matrix.
@@ -9,8 +9,8 @@
 #include "bench_ct.hpp"
 #include "bench_registry.hpp"
 #include "mechbal/papers/arm2dof/arm2dof.hpp"
-#include "mechbal/model/rigid_body.hpp"
 #include "mechbal/algorithm/kinematics.hpp"
+#include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/control/mechanism_dynamics.hpp"
 #include "mechbal/model/data.hpp"
 #include "test_support.hpp"
@@ -18,30 +18,23 @@
 namespace mechbal::bench {
 namespace {
 
-struct BodySet {
-  std::vector<RigidBody> bodies;
-  std::vector<BodyState> states;
-  ShakingWrench out;
+// The general shaking wrench (algorithm/shaking_wrench.hpp: forward kinematics, then the momenta
+// about O and their rates) of a chain of `count` links, one body each.
+struct ChainWrench {
+  explicit ChainWrench(int dof) : model(bench_chain(dof)), data(model), x(bench_states(dof)) {}
+  MechanismModel model;
+  MechanismData data;
+  JointStates x;
+  int k = 0;
 };
 
 Tick shaking_wrench_case(int count) {
-  auto s = std::make_shared<BodySet>();
-  std::mt19937 rng(static_cast<unsigned>(count));
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (int i = 0; i < count; ++i) {
-    s->bodies.push_back(test::random_body(rng));
-    BodyState st;
-    st.com = Vec3(u(rng), u(rng), u(rng));
-    st.com_velocity = Vec3(u(rng), u(rng), u(rng));
-    st.com_acceleration = Vec3(u(rng), u(rng), u(rng));
-    st.rotation = Eigen::Quaterniond::UnitRandom().toRotationMatrix();
-    st.angular_velocity = Vec3(u(rng), u(rng), u(rng));
-    st.angular_acceleration = Vec3(u(rng), u(rng), u(rng));
-    s->states.push_back(st);
-  }
+  auto s = std::make_shared<ChainWrench>(count);
   return [s] {
-    shaking_wrench(s->bodies.data(), s->states.data(), s->states.size(), s->out);
-    benchmark::DoNotOptimize(s->out);
+    const int k = s->k = (s->k + 1) & (JointStates::count - 1);
+    shaking_wrench(s->model, s->data, s->x.q[k], s->x.qd[k], s->x.qdd[k]);
+    benchmark::DoNotOptimize(&s->data.shaking);
+    benchmark::ClobberMemory();
   };
 }
 

@@ -1,7 +1,8 @@
 """Python-side timings of mechbal (issue 6).
 
 1. Per-call cost of a single-instant call through the bindings (arrays of one instant in, a dict of
-   arrays out): MechanismDynamics.inverse_dynamics (6 joints), shaking_wrench (10 bodies). The
+   arrays out): MechanismDynamics.inverse_dynamics (6 joints), Mechanism.shaking_wrench (a chain of
+   10 links, kinematics included). The
    binding overhead is this minus the C++ tick time of mechbal-bench (the merge script subtracts).
    Also one controller tick through the bindings: ComputedTorque.step (6-joint RNE back end, and
    the 2-DOF closed form), ReactionlessWrist.step (Euler, RK4), DecoupledJointController.step (3 joints).
@@ -9,10 +10,12 @@
    out), float64 arrays read and the torque written in place (no copy, no allocation, no tuple),
    for the same three joint controllers (ct6_step_into, ct2_step_into, decoupled3_step_into) and
    the reactionless wrist (wrist_euler_step_into, wrist_rk4_step_into: the command into a (3, 3)).
-2. Batch throughput (instants per second) of mechbal.shaking_wrench over a 1e5-instant trajectory
-   of 10 bodies against a pure-numpy implementation of the same formula (Briot & Arakelian 2009,
-   eqs 1-4): F = sum m a_G; M_O = sum (m OG x a_G + I alpha + w x I w), I = R I_body R^T. The two
-   are checked to agree (1e-9 relative) before anything is timed.
+2. Batch throughput (instants per second) of the general Mechanism.shaking_wrench over a
+   1e5-instant trajectory of a chain of 10 links (forward kinematics and the momentum rates in one
+   C++ call) against a pure-numpy implementation of the same formula (Briot & Arakelian 2009,
+   eqs 1-4) given the bodies' motion, which numpy is not timed for (it comes from
+   Mechanism.body_motion): F = sum m a_G; M_O = sum (m OG x a_G + I alpha + w x I w),
+   I = R I_body R^T. The two are checked to agree (1e-9 relative) before anything is timed.
 4. Sizing (issue 11): static balancing by counterweights (mechbal.balance.static: batched C++
    gravity regressor of the probe bodies, least squares, bounds) of a random spatial 7-joint arm
    with a counterweight slot on each of links 2-7, over 10 000 random poses (target < 1 s on one
@@ -61,31 +64,6 @@ def numpy_shaking_wrench(mass, inertia_body, com, acc, rotation, w, alpha):
     moment = (np.einsum("b,nbi->ni", mass, np.cross(com, acc))
               + Ial.sum(axis=1) + np.cross(w, Iw).sum(axis=1))
     return force, moment
-
-
-def random_bodies(rng, n_instants, n_bodies):
-    mass = rng.uniform(0.1, 2.0, n_bodies)
-    inertia = np.empty((n_bodies, 3, 3))
-    for b in range(n_bodies):
-        Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-        a, c = rng.uniform(0.1, 2.0, 2)
-        p = np.array([a, c, abs(a - c) + 0.5 * (a + c - abs(a - c))]) * 0.05
-        inertia[b] = Q @ np.diag(p) @ Q.T
-        inertia[b] = 0.5 * (inertia[b] + inertia[b].T)
-    # random rotations from random quaternions
-    qt = rng.normal(size=(n_instants, n_bodies, 4))
-    qt /= np.linalg.norm(qt, axis=-1, keepdims=True)
-    x, y, z, s = np.moveaxis(qt, -1, 0)
-    R = np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - s * z), 2 * (x * z + s * y)], -1),
-        np.stack([2 * (x * y + s * z), 1 - 2 * (x * x + z * z), 2 * (y * z - s * x)], -1),
-        np.stack([2 * (x * z - s * y), 2 * (y * z + s * x), 1 - 2 * (x * x + y * y)], -1),
-    ], -2)
-    shape = (n_instants, n_bodies, 3)
-    return dict(mass=mass, inertia_body=inertia, com=rng.uniform(-1, 1, shape),
-                com_velocity=rng.uniform(-1, 1, shape), com_acceleration=rng.uniform(-3, 3, shape),
-                rotation=np.ascontiguousarray(R), angular_velocity=rng.uniform(-2, 2, shape),
-                angular_acceleration=rng.uniform(-5, 5, shape))
 
 
 def best_time(fn, repeat, number=1):
@@ -247,8 +225,9 @@ def main(argv=None):
     q, qd, qdd = (rng.uniform(-1, 1, (1, 6)) for _ in range(3))
     med, p99 = median_per_call_ns(lambda: rne.inverse_dynamics(q, qd, qdd), calls)
     results["per_call"]["id6_mechbal"] = {"median_ns": med, "p99_ns": p99}
-    one = random_bodies(rng, 1, 10)
-    med, p99 = median_per_call_ns(lambda: mechbal.shaking_wrench(**one), calls)
+    chain10 = mechbal.Mechanism(chain_from_specs(random_chain_specs(rng, "R" * 10)))
+    q10, v10, a10 = (rng.uniform(-1, 1, 10) for _ in range(3))
+    med, p99 = median_per_call_ns(lambda: chain10.shaking_wrench(q10, v10, a10), calls)
     results["per_call"]["shaking_wrench_10"] = {"median_ns": med, "p99_ns": p99}
 
     # controller ticks through the bindings (1-D numpy arrays in, (tau, status) / status out)
@@ -291,18 +270,24 @@ def main(argv=None):
         results["per_call"][f"{name}_step_into"] = {"median_ns": med, "p99_ns": p99}
 
     # ---- 2. batch throughput against numpy ------------------------------------------------------
-    data = random_bodies(rng, args.instants, args.bodies)
-    mb = mechbal.shaking_wrench(**data)
+    chain = mechbal.Mechanism(chain_from_specs(random_chain_specs(rng, "R" * args.bodies)))
+    qn, vn, an = (np.ascontiguousarray(rng.uniform(-1.5, 1.5, (args.instants, args.bodies))) for _ in range(3))
+    m = chain.body_motion(qn, vn, an)
+    bodies = chain.model.bodies
+    data = dict(mass=np.array([b.mass for b in bodies]), inertia_body=np.array([b.inertia for b in bodies]),
+                com=m.com, com_acceleration=m.com_acceleration, rotation=np.ascontiguousarray(m.rotation),
+                angular_velocity=m.angular_velocity, angular_acceleration=m.angular_acceleration)
+    mb = chain.shaking_wrench(qn, vn, an)
     F_np, M_np = numpy_shaking_wrench(data["mass"], data["inertia_body"], data["com"],
                                       data["com_acceleration"], data["rotation"],
                                       data["angular_velocity"], data["angular_acceleration"])
-    err_F = np.linalg.norm(mb["force"] - F_np) / np.linalg.norm(F_np)
-    err_M = np.linalg.norm(mb["moment"] - M_np) / np.linalg.norm(M_np)
+    err_F = np.linalg.norm(mb.shaking_force - F_np) / np.linalg.norm(F_np)
+    err_M = np.linalg.norm(mb.shaking_moment - M_np) / np.linalg.norm(M_np)
     if not (err_F < 1e-9 and err_M < 1e-9):
         raise SystemExit(f"mechbal and numpy shaking wrench disagree: force {err_F:g}, "
                          f"moment {err_M:g} (relative)")
     repeat = 3 if args.quick else 7
-    t_mb = best_time(lambda: mechbal.shaking_wrench(**data), repeat)
+    t_mb = best_time(lambda: chain.shaking_wrench(qn, vn, an), repeat)
     t_np = best_time(lambda: numpy_shaking_wrench(
         data["mass"], data["inertia_body"], data["com"], data["com_acceleration"],
         data["rotation"], data["angular_velocity"], data["angular_acceleration"]), repeat)

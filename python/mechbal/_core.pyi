@@ -8,7 +8,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ComputedTorque', 'ControlConfig', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MAX_URDF_BYTES', 'MAX_URDF_DEPTH', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'PassiveController', 'ReactionlessCommand', 'ReactionlessController', 'ReactionlessJointController', 'ReactionlessTaskController', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'Spring', 'Status', 'TimeLaw', 'TrajectoryConfig', 'WristCommand', 'WristIntegrator', 'arm2dof_description', 'case_from_toml', 'load_case_file', 'load_case_trajectory', 'load_mechanism_file', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_toml', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'read_urdf', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
+__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ComputedTorque', 'ControlConfig', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MAX_URDF_BYTES', 'MAX_URDF_DEPTH', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'PassiveController', 'ReactionlessCommand', 'ReactionlessController', 'ReactionlessJointController', 'ReactionlessTaskController', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'Spring', 'Status', 'TimeLaw', 'TrajectoryConfig', 'WristCommand', 'WristIntegrator', 'arm2dof_description', 'load_case_file', 'load_case_trajectory', 'load_mechanism_file', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_toml', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'read_urdf', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
 class Status:
     """
     Bit flags returned by real-time algorithms
@@ -643,9 +643,6 @@ class ControlConfig:
     def damping(self) -> float:
         ...
     @property
-    def home_gain(self) -> float:
-        ...
-    @property
     def integrator(self) -> str:
         ...
     @property
@@ -659,12 +656,6 @@ class ControlConfig:
         ...
     @property
     def kp(self) -> list[float]:
-        ...
-    @property
-    def limit_gain(self) -> float:
-        ...
-    @property
-    def max_rate(self) -> float:
         ...
     @property
     def rate_hz(self) -> float:
@@ -1628,10 +1619,6 @@ def arm2dof_description(arm: Arm2DofParameters, counterweights: Arm2DofCounterwe
     """
     The 2-DOF arm (counterweights merged into the links) as a general MechanismDescription: x-z plane, joints 'shoulder' and 'elbow' with axes along -y, gravity (0, 0, -g)
     """
-def case_from_toml(text: str, source: str = 'string') -> tuple[MechanismModel, ControlConfig, str]:
-    """
-    As load_case_file, from TOML text (the whole document).
-    """
 def load_case_file(path: str) -> tuple[MechanismModel, ControlConfig, str]:
     """
     (model, control, name) of a case file read by the C++ reader (mechbal::load_case): the [mechanism] model, the [control] table checked against it (kind 'none' without one) and [case] name.
@@ -1715,17 +1702,6 @@ def pd_error_analytic(e0: typing.SupportsFloat | typing.SupportsIndex, ed0: typi
 def read_urdf(path: str, strict: bool = False, allow_massless: bool = False) -> tuple[MechanismModel, list[str]]:
     """
     (MechanismModel, warnings) of a URDF file: strict refuses the defects that the lenient reading repairs with one warning each (mechbal/io/urdf.hpp, UrdfOptions); a URDF with no <inertial> on any moving link is refused unless allow_massless.
-    """
-def shaking_wrench(mass: numpy.typing.ArrayLike, inertia_body: numpy.typing.ArrayLike, com: numpy.typing.ArrayLike, com_velocity: numpy.typing.ArrayLike, com_acceleration: numpy.typing.ArrayLike, rotation: numpy.typing.ArrayLike, angular_velocity: numpy.typing.ArrayLike, angular_acceleration: numpy.typing.ArrayLike) -> dict:
-    """
-    Shaking force and moment about O of B bodies over N instants (Briot & Arakelian 2009,
-    eqs 1-4), in one C++ call.
-    
-    mass (B,), inertia_body (B,3,3) about each centre of mass in the body frame; com, com_velocity,
-    com_acceleration, angular_velocity, angular_acceleration (N,B,3) and rotation (N,B,3,3) body->base,
-    all in the base frame. Returns a dict of (N,3) arrays: force (dP/dt), moment (dH_O/dt),
-    linear_momentum, angular_momentum; status_per_instant (N,) and their OR, status. Instants with
-    non-finite input (non_finite_input) or an overflowing wrench (out_of_range) give zeros.
     """
 def simulate_closed_loop(plant: ForwardDynamics, controller: JointController, desired: RestToRestTrajectory, q0: numpy.typing.ArrayLike, qd0: numpy.typing.ArrayLike, dt: typing.SupportsFloat | typing.SupportsIndex = 0.001, duration: typing.SupportsFloat | typing.SupportsIndex = 1.0, sampling: str = 'zero_order_hold') -> dict:
     """

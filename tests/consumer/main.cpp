@@ -54,15 +54,23 @@ void computed_torque_over(mechbal::InverseDynamics& model, const char* name) {
 int main() {
   std::printf("mechbal %s\n", MECHBAL_VERSION);
 
-  // rigid bodies: one body falling freely has shaking force m a
-  mechbal::RigidBody body;
-  body.mass = 2.0;
-  body.inertia_body = mechbal::Mat3::Identity() * 0.1;
-  mechbal::BodyState state;
-  state.com_acceleration = mechbal::Vec3(0.0, 0.0, -9.81);
-  mechbal::ShakingWrench w;
-  const mechbal::Status s = mechbal::shaking_wrench(&body, &state, 1, w);
-  check(s == mechbal::Status::ok && std::abs(w.force.z() + 19.62) < 1e-12, "shaking_wrench");
+  // shaking wrench: one body on a vertical slider accelerating at -9.81 m/s^2 has F = m a
+  {
+    mechbal::MechanismDescription d;
+    mechbal::Joint slider;
+    slider.name = "slider";
+    slider.type = mechbal::JointType::prismatic;
+    slider.parent = d.root_name;
+    slider.axis = mechbal::Vec3::UnitZ();
+    d.joints.push_back(slider);
+    d.bodies.push_back(mechbal::Body{"body", "link", "slider", 2.0, mechbal::Vec3::Zero(),
+                                     mechbal::Mat3::Identity() * 0.1});
+    const mechbal::MechanismModel model(d);
+    mechbal::MechanismData data(model);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(1), a = Eigen::VectorXd::Constant(1, -9.81);
+    const mechbal::Status s = mechbal::shaking_wrench(model, data, zero, zero, a);
+    check(s == mechbal::Status::ok && std::abs(data.shaking.force.z() + 19.62) < 1e-12, "shaking_wrench");
+  }
 
   // ComputedTorque over every back end of the same arm
   const mechbal::MechanismModel arm = two_link_arm();

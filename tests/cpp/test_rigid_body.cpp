@@ -1,5 +1,7 @@
-// Shaking wrench (Briot & Arakelian 2009, eqs 1-4) against central finite differences of the
-// momenta on random, analytically known multi-body motions.
+// The tests' reference sum over a set of bodies (test::body_set_wrench: Briot & Arakelian 2009,
+// eqs 1-4), the independent check of the general algorithm/shaking_wrench and of PAMINSA's closed
+// forms, against central finite differences of its momenta on random, analytically known
+// multi-body motions; and the validation of a rigid body's mass properties.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -61,7 +63,7 @@ Motion random_motion(std::mt19937& rng) {
 
 }  // namespace
 
-TEST(ShakingWrench, MatchesFiniteDifferencesOfMomentum) {
+TEST(BodySetWrench, MatchesFiniteDifferencesOfMomentum) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 20; ++trial) {
     const int count = 1 + trial % 7;
@@ -74,9 +76,7 @@ TEST(ShakingWrench, MatchesFiniteDifferencesOfMomentum) {
     auto wrench_at = [&](double t) {
       std::vector<BodyState> s;
       for (const auto& m : motions) s.push_back(m.at(t));
-      ShakingWrench w;
-      EXPECT_EQ(shaking_wrench(bodies.data(), s.data(), s.size(), w), Status::ok);
-      return w;
+      return test::body_set_wrench(bodies.data(), s.data(), s.size());
     };
     const double t = 0.37 * trial, h = 1e-5;
     const ShakingWrench w = wrench_at(t), wp = wrench_at(t + h), wm = wrench_at(t - h);
@@ -86,75 +86,6 @@ TEST(ShakingWrench, MatchesFiniteDifferencesOfMomentum) {
     const double scale_m = std::max(1.0, w.moment.norm());
     EXPECT_LT((dP - w.force).norm() / scale_f, 1e-8) << "trial " << trial;
     EXPECT_LT((dH - w.moment).norm() / scale_m, 1e-8) << "trial " << trial;
-  }
-}
-
-TEST(ShakingWrench, StaticBodyUnderGravityNeedsItsWeight) {
-  RigidBody b;
-  b.mass = 3.0;
-  b.inertia_body = Mat3::Identity() * 0.2;
-  BodyState s;
-  s.com = Vec3(0.5, 0.0, 1.0);
-  ShakingWrench w;
-  ASSERT_EQ(shaking_wrench(&b, &s, 1, w), Status::ok);
-  EXPECT_EQ(w.force.norm(), 0.0);
-  BaseReaction r;
-  ASSERT_EQ(base_reaction(&b, &s, 1, Vec3(0, 0, -9.81), w, r), Status::ok);
-  EXPECT_NEAR(r.force.z(), 3.0 * 9.81, 1e-12);
-  // moment about O of the support = - (c x m g) = -(0.5 x,1 z) x (0,0,-29.43): about y
-  EXPECT_NEAR(r.moment.y(), -0.5 * 3.0 * 9.81, 1e-12);
-}
-
-TEST(ShakingWrench, NonFiniteInputGivesStatusAndZeroOutput) {
-  RigidBody b;
-  b.mass = 1.0;
-  b.inertia_body = Mat3::Identity();
-  BodyState s;
-  s.com_acceleration = Vec3(1.0, std::numeric_limits<double>::quiet_NaN(), 0.0);
-  ShakingWrench w;
-  EXPECT_EQ(shaking_wrench(&b, &s, 1, w), Status::non_finite_input);
-  EXPECT_TRUE(w.force.allFinite());
-  EXPECT_EQ(w.force.norm(), 0.0);
-}
-
-TEST(ShakingWrench, BatchEqualsSingleInstant) {
-  std::mt19937 rng(11);
-  const std::size_t B = 5, N = 13;
-  std::vector<RigidBody> bodies;
-  std::vector<Motion> motions;
-  for (std::size_t j = 0; j < B; ++j) {
-    bodies.push_back(test::random_body(rng));
-    motions.push_back(random_motion(rng));
-  }
-  std::vector<double> c(N * B * 3), v(N * B * 3), a(N * B * 3), w(N * B * 3), al(N * B * 3),
-      R(N * B * 9), F(N * 3), M(N * 3), P(N * 3), H(N * 3);
-  for (std::size_t k = 0; k < N; ++k) {
-    for (std::size_t j = 0; j < B; ++j) {
-      const BodyState s = motions[j].at(0.1 * k);
-      const std::size_t i3 = (k * B + j) * 3, i9 = (k * B + j) * 9;
-      for (int r = 0; r < 3; ++r) {
-        c[i3 + r] = s.com(r);
-        v[i3 + r] = s.com_velocity(r);
-        a[i3 + r] = s.com_acceleration(r);
-        w[i3 + r] = s.angular_velocity(r);
-        al[i3 + r] = s.angular_acceleration(r);
-        for (int q = 0; q < 3; ++q) R[i9 + 3 * r + q] = s.rotation(r, q);  // row-major
-      }
-    }
-  }
-  BodyTrajectoryView view{N, B, c.data(), v.data(), a.data(), R.data(), w.data(), al.data()};
-  ASSERT_EQ(shaking_wrench_batch(bodies.data(), view, F.data(), M.data(), P.data(), H.data()),
-            Status::ok);
-  for (std::size_t k = 0; k < N; ++k) {
-    std::vector<BodyState> s;
-    for (const auto& m : motions) s.push_back(m.at(0.1 * k));
-    ShakingWrench one;
-    shaking_wrench(bodies.data(), s.data(), B, one);
-    for (int r = 0; r < 3; ++r) {
-      EXPECT_NEAR(F[3 * k + r], one.force(r), 1e-12 * (1 + one.force.norm()));
-      EXPECT_NEAR(M[3 * k + r], one.moment(r), 1e-12 * (1 + one.moment.norm()));
-      EXPECT_NEAR(H[3 * k + r], one.angular_momentum(r), 1e-12 * (1 + one.angular_momentum.norm()));
-    }
   }
 }
 

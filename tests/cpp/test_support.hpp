@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <random>
 
+#include "mechbal/model/data.hpp"
 #include "mechbal/model/model.hpp"
 #include "mechbal/model/rigid_body.hpp"
+#include <cstddef>
 #include <string>
 
 namespace mechbal::test {
@@ -20,6 +22,27 @@ inline RigidBody random_body(std::mt19937& rng) {
   const Mat3 Q = Eigen::Quaterniond::UnitRandom().toRotationMatrix();
   b.inertia_body = Q * p.asDiagonal() * Q.transpose() * 0.05;
   return b;
+}
+
+/// Momenta about O and their rates of `count` bodies given their states, summed body by body
+/// with each inertia formed in the base frame, I = R J R^T (Briot & Arakelian 2009, eqs 1-4):
+/// P = sum m v, H_O = sum (m c x v + I w), F = sum m a, M_O = sum (m c x a + I alpha + w x I w).
+/// The tests' independent reference for the general algorithm/shaking_wrench and for PAMINSA's
+/// closed forms; test_rigid_body.cpp checks it against finite differences of its momenta.
+inline ShakingWrench body_set_wrench(const RigidBody* bodies, const BodyState* states,
+                                     std::size_t count) {
+  ShakingWrench w;
+  for (std::size_t j = 0; j < count; ++j) {
+    const RigidBody& b = bodies[j];
+    const BodyState& s = states[j];
+    const Mat3 I = s.rotation * b.inertia_body * s.rotation.transpose();
+    w.linear_momentum += b.mass * s.com_velocity;
+    w.angular_momentum += b.mass * s.com.cross(s.com_velocity) + I * s.angular_velocity;
+    w.force += b.mass * s.com_acceleration;
+    w.moment += b.mass * s.com.cross(s.com_acceleration) + I * s.angular_acceleration +
+                s.angular_velocity.cross(I * s.angular_velocity);
+  }
+  return w;
 }
 
 inline Eigen::Isometry3d random_pose(std::mt19937& rng, double scale = 0.4) {

@@ -13,6 +13,7 @@ from mechbal.cases import DEFAULT_CASE, run_case
 from mechbal.config import ConfigError, load_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from mechbal.papers import paminsa as paper
+from body_set import body_set_wrench
 
 INNER = slice(2, -2)  # np.gradient's one-sided ends are less accurate
 
@@ -175,7 +176,7 @@ def test_paper_reported_masses_do_not_force_balance(paminsa_run):
 
 # ---------------------------------------------------------------------------- model
 def test_wrist_matrix_against_body_by_body_angular_momentum(params):
-    """H_wrist = N(q) qdot, with H from mechbal.shaking_wrench on the wrist bodies alone."""
+    """H_wrist = N(q) qdot, with H summed body by body (body_set.py) over the wrist bodies alone."""
     model = _core.PaminsaModel(params)
     rng = np.random.default_rng(3)
     n = 5
@@ -187,20 +188,23 @@ def test_wrist_matrix_against_body_by_body_angular_momentum(params):
     names = model.body_names[35:38]
     assert names == ["wrist1", "wrist2", "wrist3"]
     J = [np.diag(v) for v in params.wrist_inertia]
-    sw = mechbal.shaking_wrench(np.zeros(3), np.asarray(model.inertia_body)[w], k["com"][:, w],
-                                k["com_velocity"][:, w], k["com_acceleration"][:, w],
-                                k["rotation"][:, w], k["angular_velocity"][:, w],
-                                k["angular_acceleration"][:, w])
+    sw = body_set_wrench(np.zeros(3), np.asarray(model.inertia_body)[w], k["com"][:, w],
+                         k["com_velocity"][:, w], k["com_acceleration"][:, w],
+                         k["rotation"][:, w], k["angular_velocity"][:, w],
+                         k["angular_acceleration"][:, w])
     for i in range(n):
         N = _core.wrist_momentum_matrix(*J, q[i])
         np.testing.assert_allclose(N @ qd[i], sw["angular_momentum"][i], atol=1e-12)
         bias = _core.wrist_momentum_bias(*J, q[i], qd[i])
         np.testing.assert_allclose(N @ qdd[i] + bias, sw["moment"][i], atol=1e-11)
     # D + H_wrist = total angular momentum (eq 19)
-    full = mechbal.shaking_wrench(np.asarray(model.masses), np.asarray(model.inertia_body), k["com"],
-                                  k["com_velocity"], k["com_acceleration"], k["rotation"],
-                                  k["angular_velocity"], k["angular_acceleration"])
+    full = body_set_wrench(np.asarray(model.masses), np.asarray(model.inertia_body), k["com"],
+                           k["com_velocity"], k["com_acceleration"], k["rotation"],
+                           k["angular_velocity"], k["angular_acceleration"])
     np.testing.assert_allclose(k["D"] + sw["angular_momentum"], full["angular_momentum"], atol=1e-12)
+    # PAMINSA's own sum over its 38 bodies (paminsa_kinematics' shaking force and moment)
+    np.testing.assert_allclose(k["shaking_force"], full["force"], rtol=0, atol=1e-12 * np.abs(full["force"]).max())
+    np.testing.assert_allclose(k["shaking_moment"], full["moment"], rtol=0, atol=1e-12 * np.abs(full["moment"]).max())
 
 
 def test_kinematics_batch_matches_finite_differences(params):

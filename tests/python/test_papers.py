@@ -18,6 +18,7 @@ from mechbal.config import load_case
 from mechbal.papers import arm2dof_mechanism, disc_arm_mechanism, disc_design_mechanism
 from mechbal.papers import discs as dz
 from mechbal.papers import arm2dof as paper_arm2dof
+from body_set import body_set_wrench
 
 RTOL = 1e-12
 
@@ -128,6 +129,47 @@ def disc_case(kind):
     return config, p, motion
 
 
+def _arm_with_spinning_discs(kind, d, q, qd, qdd):
+    """Every body of a serial disc design along (q, qd, qdd): the links from the arm alone
+    (`mechbal.papers.discs.arm_mechanism`, no discs), each disc written out by hand: it spins at
+    ratio * q[joint] about its axis through its carrier's frame origin (rotation R_c Rot(axis,
+    ratio q_j), omega = omega_c + ratio q_j' a, alpha = alpha_c + ratio q_j'' a + omega_c x ratio
+    q_j' a), mass 0 (lumped into the carrier) and its own central inertia."""
+    joints, links, discs = dz.serial_structure(kind, d)
+    m = dz.arm_mechanism(joints, links).body_motion(q, qd, qdd)
+    assert np.all(np.asarray(m.status) == 0)
+    kin = dict(com=m.com, com_velocity=m.com_velocity, com_acceleration=m.com_acceleration,
+               rotation=m.rotation, angular_velocity=m.angular_velocity,
+               angular_acceleration=m.angular_acceleration)
+    names = [f"link{i + 1}" for i in range(len(links))]
+    mass = [b.mass for b in links]
+    inertia = [np.asarray(b.inertia, float) for b in links]
+    out = {k: [kin[k][:, i] for i in range(len(links))] for k in kin}
+    for k, ds in enumerate(discs):
+        c = ds.carrier
+        Rc, o = m.link_rotation[:, c + 1], m.link_position[:, c + 1]  # link c is the model's link c + 1
+        axis = np.asarray(ds.axis, float) / np.linalg.norm(ds.axis)
+        a = Rc @ axis
+        ang = ds.ratio * q[:, ds.joint]
+        K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        Rrel = np.eye(3) + np.sin(ang)[:, None, None] * K + (1 - np.cos(ang))[:, None, None] * (K @ K)
+        wc, alc = kin["angular_velocity"][:, c], kin["angular_acceleration"][:, c]
+        spin = ds.ratio * qd[:, ds.joint, None] * a
+        r = o - kin["com"][:, c]  # carrier CoM -> disc centre
+        names.append(f"disc{k + 4}")
+        mass.append(0.0)
+        inertia.append(np.diag(ds.inertia))
+        out["com"].append(o)
+        out["com_velocity"].append(kin["com_velocity"][:, c] + np.cross(wc, r))
+        out["com_acceleration"].append(kin["com_acceleration"][:, c] + np.cross(alc, r)
+                                       + np.cross(wc, np.cross(wc, r)))
+        out["rotation"].append(Rc @ Rrel)
+        out["angular_velocity"].append(wc + spin)
+        out["angular_acceleration"].append(alc + ds.ratio * qdd[:, ds.joint, None] * a + np.cross(wc, spin))
+    return dict(names=names, mass=np.array(mass), inertia_body=np.array(inertia),
+                **{k: np.stack(v, 1) for k, v in out.items()})
+
+
 @pytest.mark.parametrize("balanced", [False, True], ids=["unbalanced", "balanced"])
 @pytest.mark.parametrize("kind", list(DISC_CASES))
 def test_disc_arm_general_model_equals_the_coupled_model(kind, balanced):
@@ -153,22 +195,32 @@ def test_disc_arm_general_model_equals_the_coupled_model(kind, balanced):
         assert rel(V_g[i], two_stage.velocity, floor=peak) < RTOL
         assert rel(tau[i], two_stage.mass @ qdd[k][i] + two_stage.velocity + two_stage.gravity, floor=peak) < RTOL
 
-    # every body's motion and the shaking wrench against the runner's bodies (bodies_*.npz)
-    bodies = _disc_bodies(kind, d, q, qd, qdd)
+    # every body's motion and the shaking wrench against the arm alone with each disc spun by hand
+    # (its gear coupling written out), the wrench summed body by body in numpy
+    bodies = _arm_with_spinning_discs(kind, d, q, qd, qdd)
     assert mech.body_names == bodies["names"]
     motion = mech.body_motion(q, qd, qdd)
     for key in ("rotation", "angular_velocity", "angular_acceleration"):
         assert rel(getattr(motion, key), bodies[key]) < RTOL, key
     for key in ("com", "com_velocity", "com_acceleration"):  # discs: massless, axle placed elsewhere
         assert rel(getattr(motion, key)[:, :3], bodies[key][:, :3]) < RTOL, key
-    ref_w = _core.shaking_wrench(bodies["mass"], bodies["inertia_body"], bodies["com"],
-                                 bodies["com_velocity"], bodies["com_acceleration"], bodies["rotation"],
-                                 bodies["angular_velocity"], bodies["angular_acceleration"])
+    ref_w = body_set_wrench(bodies["mass"], bodies["inertia_body"], bodies["com"],
+                            bodies["com_velocity"], bodies["com_acceleration"], bodies["rotation"],
+                            bodies["angular_velocity"], bodies["angular_acceleration"])
     w = mech.shaking_wrench(q, qd, qdd)
     # (the balanced planar arms have no shaking force: its scale is sum m |a| of the bodies)
     force_scale = np.sum(bodies["mass"] * np.max(np.linalg.norm(bodies["com_acceleration"], axis=2), axis=0))
     assert rel(w.shaking_force, ref_w["force"], floor=force_scale) < RTOL
     assert rel(w.shaking_moment, ref_w["moment"]) < RTOL
+    # the runner's bodies_*.npz: these bodies, and the wrench of their motion
+    written = _disc_bodies(kind, d, q, qd, qdd)
+    assert written["names"] == bodies["names"]
+    assert np.array_equal(written["mass"], bodies["mass"]) and np.array_equal(written["inertia_body"],
+                                                                              bodies["inertia_body"])
+    for key in ("rotation", "angular_velocity", "angular_acceleration"):
+        assert rel(written[key], bodies[key]) < RTOL, key
+    assert rel(written["shaking_force"], ref_w["force"], floor=force_scale) < RTOL
+    assert rel(written["shaking_moment"], ref_w["moment"]) < RTOL
 
 
 @pytest.mark.parametrize("kind", list(DISC_CASES))

@@ -1,11 +1,13 @@
 """The existing closed loops as data (issue 10): the five-bar of the discs case and PAMINSA on the
 general model (mechbal.papers.discs.five_bar, mechbal.papers.paminsa: trees + loop closures, solved by
-the general loop solve) against their closed forms (FiveBarDynamics and the discs runner's
-five-bar motion; PaminsaModel / paminsa_kinematics), to 1e-10 relative along the cases'
-trajectories; and the shipped TOML files are exactly what the generators produce."""
+the general loop solve) against their closed forms (FiveBarDynamics and the five-bar's bodies in
+closed form; PaminsaModel / paminsa_kinematics), their momenta summed body by body in numpy
+(body_set.py), to 1e-10 relative along the cases' trajectories; and the shipped TOML files are
+exactly what the generators produce."""
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -14,6 +16,7 @@ import pytest
 
 from mechbal import Mechanism, _core
 from mechbal.config import load_case
+from body_set import body_set_wrench
 
 TOL = 1e-10
 _ROTATIONAL = ("rotation", "angular_velocity", "angular_acceleration")
@@ -27,10 +30,11 @@ def _rel(a, b, scale: float = 0.0) -> float:
 
 
 def _momenta(b: dict) -> dict:
-    """Linear and angular momentum (about O), shaking force and moment of a closed form's bodies."""
-    w = _core.shaking_wrench(b["mass"], b["inertia_body"], b["com"], b["com_velocity"], b["com_acceleration"],
-                             b["rotation"], b["angular_velocity"], b["angular_acceleration"])
-    assert w["status"] == _core.Status.ok
+    """Linear and angular momentum (about O), shaking force and moment of a closed form's bodies:
+    the tests' numpy sum over the bodies (body_set.py), independent of the general model."""
+    w = body_set_wrench(b["mass"], b["inertia_body"], b["com"], b["com_velocity"], b["com_acceleration"],
+                        b["rotation"], b["angular_velocity"], b["angular_acceleration"])
+    assert all(np.isfinite(x).all() for x in w.values())
     return {"linear_momentum": w["linear_momentum"], "angular_momentum": w["angular_momentum"],
             "shaking_force": w["force"], "shaking_moment": w["moment"]}
 
@@ -52,6 +56,64 @@ def _compare_bodies(mech: Mechanism, motion, closed: dict, names, inertia) -> di
 # ------------------------------------------------------------------------------------------------
 # five-bar
 # ------------------------------------------------------------------------------------------------
+def _five_bar_closed_form_bodies(d: dict, q, qd, qdd) -> dict:
+    """The five-bar's bodies along (q, qd, qdd) of (theta1, theta2) in closed form: the passive
+    angles, rates and accelerations of FiveBarDynamics.motion (p = C p#, p' = C p#'' + cbar) and
+    each link's centre of mass on its line, B + L e(t) with its derivatives (proximal/distal links
+    about x, the end-effector point mass at FiveBarDynamics' tip)."""
+    from mechbal.papers import discs as dz
+
+    N = len(q)
+    m = dz.fivebar_dynamics(d).motion(q, qd, qdd)
+    assert m["status"] == _core.Status.ok
+    th, w, al = m["angles"], m["rates"], m["accelerations"]
+    names, mass, inertia = [], [], []
+    com, vel, acc, rot, omg, alp = ([] for _ in range(6))
+    e = lambda t: np.stack([np.zeros_like(t), np.cos(t), np.sin(t)], -1)  # noqa: E731
+    nv = lambda t: np.stack([np.zeros_like(t), -np.sin(t), np.cos(t)], -1)  # noqa: E731
+
+    def Rx(t):
+        R = np.zeros((len(t), 3, 3))
+        R[:, 0, 0] = 1.0
+        R[:, 1, 1] = R[:, 2, 2] = np.cos(t)
+        R[:, 2, 1], R[:, 1, 2] = np.sin(t), -np.sin(t)
+        return R
+
+    def point(base, L, t, td, tdd):  # base + L e(t) and its derivatives
+        return (base[0] + L * e(t), base[1] + L * td[:, None] * nv(t),
+                base[2] + L * (tdd[:, None] * nv(t) - td[:, None] ** 2 * e(t)))
+
+    ax = np.array([1.0, 0.0, 0.0])
+    for i, leg in ((1, 0), (2, 1)):
+        A = (np.tile([0.0, d["d"] if i == 2 else 0.0, 0.0], (N, 1)), np.zeros((N, 3)), np.zeros((N, 3)))
+        t1, t1d, t1dd = th[:, 2 * leg], w[:, 2 * leg], al[:, 2 * leg]
+        phi = t1 + th[:, 2 * leg + 1]
+        phid, phidd = t1d + w[:, 2 * leg + 1], t1dd + al[:, 2 * leg + 1]
+        B = point(A, d[f"a{i}"], t1, t1d, t1dd)
+        for name, base, L, t, td, tdd, key, mk in (
+                (f"proximal{i}", A, d[f"cp{i}"], t1, t1d, t1dd, f"p{i}", f"mp{i}"),
+                (f"distal{i}", B, d[f"cd{i}"], phi, phid, phidd, f"d{i}", f"md{i}")):
+            G = point(base, L, t, td, tdd)
+            names.append(name)
+            mass.append(d[mk])
+            inertia.append(np.diag(d[f"inertia_{key}"]))
+            com.append(G[0]), vel.append(G[1]), acc.append(G[2]), rot.append(Rx(t))
+            omg.append(td[:, None] * ax), alp.append(tdd[:, None] * ax)
+    names.append("end_effector")
+    mass.append(d["mP"])
+    inertia.append(np.zeros((3, 3)))
+    z = np.zeros((N, 1))
+    com.append(np.hstack([z, m["end_effector"]]))
+    vel.append(np.hstack([z, m["end_effector_velocity"]]))
+    acc.append(np.hstack([z, m["end_effector_acceleration"]]))
+    rot.append(np.tile(np.eye(3), (N, 1, 1)))
+    omg.append(np.zeros((N, 3))), alp.append(np.zeros((N, 3)))
+    stack = lambda xs: np.stack(xs, 1)  # noqa: E731
+    return dict(names=names, mass=np.array(mass), inertia_body=np.array(inertia), com=stack(com),
+                com_velocity=stack(vel), com_acceleration=stack(acc), rotation=stack(rot),
+                angular_velocity=stack(omg), angular_acceleration=stack(alp))
+
+
 def _five_bar_run(balanced: bool):
     from mechbal.papers.discs.runner import _disc_bodies, _torques, parameters_from_config
     from mechbal.papers.discs.five_bar import five_bar_design_mechanism, five_bar_initial_guess
@@ -66,16 +128,18 @@ def _five_bar_run(balanced: bool):
     q, qd, qdd = _core.RestToRestTrajectory(np.array(tr["start"], float), np.array(tr["end"], float),
                                             tr["duration"], _core.TimeLaw.quintic).evaluate_batch(t)
     solved = mech.closed_motion(q, qd, qdd, q_guess=five_bar_initial_guess(mech, d, q[0]), with_forces=True)
-    closed = _disc_bodies("fivebar", d, q, qd, qdd)
+    closed = _five_bar_closed_form_bodies(d, q, qd, qdd)
     return dict(mech=mech, d=d, q=q, qd=qd, qdd=qdd, solved=solved, closed=closed,
-                torque=_torques("fivebar", d, q, qd, qdd))
+                runner=_disc_bodies("fivebar", d, q, qd, qdd), torque=_torques("fivebar", d, q, qd, qdd))
 
 
 @pytest.mark.parametrize("balanced", [False, True], ids=["unbalanced", "balanced"])
 def test_five_bar_general_model_equals_the_closed_form(balanced):
     """Every body's motion, the momenta, the shaking force and moment and the actuated torques of
-    the general five-bar (loop solve + projection) equal FiveBarDynamics and the discs runner's
-    five-bar bodies to 1e-10 relative along the case's trajectory."""
+    the general five-bar (loop solve + projection) equal the closed form (FiveBarDynamics and the
+    five-bar's bodies in closed form, summed by numpy) to 1e-10 relative along the case's
+    trajectory; so do the bodies and the shaking wrench the discs runner writes
+    (bodies_*.npz, from the general model)."""
     r = _five_bar_run(balanced)
     mech, m, closed = r["mech"], r["solved"], r["closed"]
     assert np.all(m.status == 0) and m.residual.max() < 1e-12
@@ -90,6 +154,15 @@ def test_five_bar_general_model_equals_the_closed_form(balanced):
         diffs[key] = _rel(getattr(sw, key), reference[key], scale[key])
     # actuated torques: C^T tau of the tree = FiveBarDynamics' M' qdd + v' + g'
     diffs["actuated_torque"] = _rel(m.actuated_force, r["torque"])
+    # what the discs runner writes: the same bodies, and the wrench of those bodies' motion
+    runner = r["runner"]
+    assert runner["names"] == closed["names"]
+    diffs.update({f"runner_{k}": v for k, v in _compare_bodies(
+        mech, SimpleNamespace(**{k: runner[k] for k in _MOTION}), closed, closed["names"],
+        closed["inertia_body"]).items()})
+    diffs["runner_shaking_force"] = _rel(runner["shaking_force"], reference["shaking_force"], scale["shaking_force"])
+    diffs["runner_shaking_moment"] = _rel(runner["shaking_moment"], reference["shaking_moment"],
+                                          scale["shaking_moment"])
     # reduced mass matrix and gravity: C^T M C, C^T G = FiveBarDynamics.evaluate's M', g'
     from mechbal.papers import discs as dz
 

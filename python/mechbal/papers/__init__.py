@@ -21,8 +21,9 @@ paper and nothing else (tests/python/test_layers.py checks it).
 
 A paper's closed-form classes (``PaminsaModel``, ``Arm2DofDynamics``, ``FiveBarDynamics``, ...)
 are attributes of its package; ``mechbal.papers.<Name>`` finds them in whichever paper has them.
-`shaking_wrench` (the shaking wrench of a set of bodies given their motion, batched) is
-here for the runners that write the bodies of a closed-form motion (the discs' five-bar).
+`shaking_wrench` (the shaking wrench of a set of bodies given their motion) is deprecated and
+warns: the shaking wrench is `mechbal.Mechanism.shaking_wrench` on the general model, and the
+poses of a bodies file are checked by `mechbal.export.shaking_wrench_by_finite_differences`.
 
 Layer: papers (docs/architecture.md).
 """
@@ -30,9 +31,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from mechbal import _core
-
-shaking_wrench = _core.shaking_wrench
+from mechbal.papers._body_set import shaking_wrench  # deprecated, one release
 
 __all__ = ["shaking_wrench"]
 

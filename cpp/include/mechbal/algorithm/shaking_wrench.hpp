@@ -1,8 +1,9 @@
 #pragma once
 /// \file algorithm/shaking_wrench.hpp
 /// The shaking wrench of a mechanism: the rates of its momenta about O (Briot & Arakelian 2009,
-/// eqs 1-4), F = dP/dt and M_O = dH_O/dt, which the mechanism exerts on its base (with the sign
-/// convention of rigid_body.hpp), and the base reaction with gravity.
+/// eqs 1-4), F = dP/dt and M_O = dH_O/dt (the mechanism pushes on its base with -F, -M_O), and
+/// the base reaction with gravity. The only shaking wrench of the general layer; a paper's closed
+/// form is a fast path tested against it.
 #include <Eigen/Core>
 
 #include "mechbal/model/data.hpp"

@@ -18,6 +18,25 @@
 
 namespace mechbal {
 
+/// Momenta about the base origin O and their rates: what algorithm/shaking_wrench.hpp computes
+/// for a mechanism (MechanismData::shaking). Briot & Arakelian 2009, eqs 1-4: the shaking force is
+/// F = dP/dt = sum_j m_j a_Gj and the shaking moment about O is M_O = dH_O/dt =
+/// sum_j (m_j OG_j x a_Gj + I_j dw_j/dt + w_j x I_j w_j), with I_j the inertia in the base frame.
+struct ShakingWrench {
+  Vec3 linear_momentum = Vec3::Zero();   ///< P = sum m v_G            [kg m/s]
+  Vec3 angular_momentum = Vec3::Zero();  ///< H_O = sum (m OG x v_G + I w) [kg m^2/s]
+  Vec3 force = Vec3::Zero();             ///< shaking force F = dP/dt (eq 1)          [N]
+  Vec3 moment = Vec3::Zero();            ///< shaking moment M_O = dH_O/dt (eqs 2-4) [N m]
+};
+
+/// A wrench on the mechanism from its base or the ground, gravity included (moment about O):
+/// MechanismData::base_reaction and support_reaction (algorithm/shaking_wrench.hpp). The
+/// mechanism pushes on its base with the opposite wrench.
+struct BaseReaction {
+  Vec3 force = Vec3::Zero();
+  Vec3 moment = Vec3::Zero();
+};
+
 struct MechanismData {
   explicit MechanismData(const MechanismModel& model);
 

@@ -571,8 +571,8 @@ namespace {
 ///   d(I w)/dt = (a_u' - a_n bd) u + (a_n' + a_u bd) n + a_e' e_z,
 /// the column (link 6, body X = e_z, w = bd e_z) has I w = Jx bd e_z, and the guide (link 5) and
 /// CP3 turn about the vertical through M_i: sum m (M + l g) x (l ad g_perp) = (sum m l) ad M x g_perp
-/// + (sum m l^2) ad e_z, plus Jz ad e_z. Exact (same quantities as shaking_wrench over the bodies'
-/// states; tests/cpp/test_paminsa.cpp checks it to 1e-12 on random models and motions).
+/// + (sum m l^2) ad e_z, plus Jz ad e_z. Exact (same quantities as the sum over the bodies'
+/// states, sum_bodies; tests/cpp/test_paminsa.cpp checks it to 1e-12 on random models and motions).
 /// The inertias are the model's principal ones (link_inertia, diagonal by construction).
 inline Vec3 in_base(const Plane& pl, double cu, double cn, double cz) noexcept {
   return Vec3(cu * pl.u(0) + cn * pl.n(0), cu * pl.u(1) + cn * pl.n(1), cz);
@@ -714,15 +714,60 @@ Status paminsa_mechanism_angular_momentum(const PaminsaModel& model, const Platf
   return Status::ok;
 }
 
+namespace {
+
+/// PAMINSA's own sum over its bodies' states (Briot & Arakelian 2009, eqs 1-4): bodies
+/// [first, first + count) of the model and the workspace. P = sum m v, H_O = sum (m c x v + I w),
+/// F = sum m a, M_O = sum (m c x a + I alpha + w x I w), I = R J R^T applied as R (J (R^T x)).
+/// Non-finite states: Status::non_finite_input; finite states whose sums overflow:
+/// Status::out_of_range; either leaves `out` zero. The fast path of the general
+/// algorithm/shaking_wrench.hpp (tests/python/test_papers_loops.py checks them equal).
+Status sum_bodies(const PaminsaModel& model, const PaminsaWorkspace& ws, std::size_t first,
+                  std::size_t count, ShakingWrench& out) noexcept {
+  out = ShakingWrench{};
+  for (std::size_t j = first; j < first + count; ++j) {
+    const RigidBody& b = model.bodies()[j];
+    const BodyState& s = ws.states[j];
+    if (!(s.com.allFinite() && s.com_velocity.allFinite() && s.com_acceleration.allFinite() &&
+          s.rotation.allFinite() && s.angular_velocity.allFinite() &&
+          s.angular_acceleration.allFinite())) {
+      out = ShakingWrench{};
+      return Status::non_finite_input;
+    }
+    out.linear_momentum.noalias() += b.mass * s.com_velocity;
+    out.angular_momentum.noalias() += b.mass * s.com.cross(s.com_velocity);
+    out.force.noalias() += b.mass * s.com_acceleration;
+    out.moment.noalias() += b.mass * s.com.cross(s.com_acceleration);
+    if (b.inertia_body.isZero(0.0)) continue;  // point mass (exactly): no rotational terms
+    const Mat3& R = s.rotation;
+    const Vec3 Iw = R * (b.inertia_body * (R.transpose() * s.angular_velocity));
+    const Vec3 Ialpha = R * (b.inertia_body * (R.transpose() * s.angular_acceleration));
+    out.angular_momentum.noalias() += Iw;
+    out.moment.noalias() += Ialpha + s.angular_velocity.cross(Iw);
+  }
+  if (!(out.linear_momentum.allFinite() && out.angular_momentum.allFinite() &&
+        out.force.allFinite() && out.moment.allFinite())) {
+    out = ShakingWrench{};
+    return Status::out_of_range;
+  }
+  return Status::ok;
+}
+
+}  // namespace
+
 Status paminsa_mechanism_momentum(const PaminsaModel& model, const PaminsaWorkspace& ws, Vec3& D,
                                   Vec3& D_dot) noexcept {
   ShakingWrench sw;
-  const Status s =
-      shaking_wrench(model.bodies().data(), ws.states.data(), Idx::mechanism_count, sw);
+  const Status s = sum_bodies(model, ws, 0, Idx::mechanism_count, sw);
   if (s != Status::ok) return s;
   D = sw.angular_momentum;
   D_dot = sw.moment;
   return Status::ok;
+}
+
+Status paminsa_shaking_wrench(const PaminsaModel& model, const PaminsaWorkspace& ws,
+                              ShakingWrench& out) noexcept {
+  return sum_bodies(model, ws, 0, Idx::count, out);
 }
 
 // ------------------------------------------------------------------------------ controller
@@ -807,8 +852,7 @@ Status PaminsaController::tick(const PlatformMotion& now, const PlatformMotion& 
   }
   // all 38 bodies = the mechanism's sums + the three wrist links' (not re-summed from scratch)
   ShakingWrench wrist;
-  shaking_wrench(model_.bodies().data() + Idx::wrist(0), ws_.states.data() + Idx::wrist(0), 3,
-                 wrist);
+  sum_bodies(model_, ws_, Idx::wrist(0), 3, wrist);
   wrench_.linear_momentum = mechanism.linear_momentum + wrist.linear_momentum;
   wrench_.angular_momentum = mechanism.angular_momentum + wrist.angular_momentum;
   wrench_.force = mechanism.force + wrist.force;
@@ -867,7 +911,7 @@ Status paminsa_kinematics_batch(const PaminsaModel& model, std::size_t instants,
     // the inputs are finite here (paminsa_kinematics checked them): a non-finite body state or
     // wrench is an overflow of finite input
     if (s == Status::ok) {
-      s = shaking_wrench(model.bodies().data(), ws.states.data(), Idx::count, sw);
+      s = paminsa_shaking_wrench(model, ws, sw);
       if (s == Status::non_finite_input) s = Status::out_of_range;
     }
     if (s == Status::ok) {

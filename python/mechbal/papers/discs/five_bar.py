@@ -21,9 +21,10 @@ y-z plane, every joint axis along x, z up, gravity (0, 0, -g). Leg i is a 2R arm
 The five-bar has no counter-rotating discs: its balancing is leg-wise static balancing (the
 balanced centres of mass of ``mechbal.papers.discs.balance_fivebar``).
 
-The closed form (``FiveBarDynamics``: positions, the coupling projection, M', v', g') and the
-five-bar motion of ``mechbal.papers.discs.runner`` equal this general model to 1e-10 along the case's
-trajectory (tests/python/test_papers_loops.py); ``python/mechbal/papers/discs/cases/five-bar-linkage.toml`` is
+The closed form (``FiveBarDynamics``: positions, the coupling projection, M', v', g', the passive
+motion) equals this general model to 1e-10 along the case's trajectory
+(tests/python/test_papers_loops.py); the ``discs`` runner writes the five-bar's bodies files and
+shaking wrench from this model, its loop solved along the trajectory; ``python/mechbal/papers/discs/cases/five-bar-linkage.toml`` is
 `five_bar_case_toml` of the shipped ``five-bar`` case (balanced), run by ``mechbal run``.
 
 Layer: papers (docs/architecture.md).

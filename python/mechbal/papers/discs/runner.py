@@ -20,7 +20,6 @@ from pathlib import Path
 import numpy as np
 
 from mechbal import control
-from mechbal import papers
 from mechbal import trajectory
 from mechbal import progress, report
 from mechbal.cases import register
@@ -28,6 +27,7 @@ from mechbal.config import ConfigError
 from mechbal.schema import validate_case
 from mechbal.export import write_bodies, write_summary
 from mechbal.papers import discs as dz
+from mechbal.papers.discs.five_bar import five_bar_design_mechanism, five_bar_initial_guess
 from mechbal.papers.discs import _SPEC, parameters_from_config  # noqa: F401 (re-exported)
 
 #: which corrections concern which mechanism
@@ -137,123 +137,46 @@ def _controller_check(kind, bal, k, cfg, q_des, qd_des, qdd_des, n):
 
 
 def _disc_bodies(kind, d, q, qd, qdd):
-    """Every body of a design along (q, qd, qdd) (N, n): names, mass (B,), inertia_body (B,3,3)
-    and the motion arrays (N, B, ...) of mechbal.shaking_wrench.
+    """Every body of a design along the actuated motion (q, qd, qdd) (N, n), on the general model:
+    names, mass (B,), inertia_body (B,3,3), the bodies' motion (N, B, ...: com, com_velocity,
+    com_acceleration, rotation, angular_velocity, angular_acceleration) and the shaking wrench of
+    that motion (shaking_force, shaking_moment (N, 3), `mechbal.Mechanism.shaking_wrench`).
 
-    Serial arms: the links from the general model's body motion (the arm alone,
-    `mechbal.papers.discs.arm_mechanism`); each disc spins at ratio * q[joint]
-    about its axis through the carrier's frame origin (rotation R_c Rot(axis, ratio q_j),
-    omega = omega_c + ratio q_j' a, alpha = alpha_c + ratio q_j'' a + omega_c x ratio q_j' a).
-    As in the model, a disc's mass is lumped into its carrier link (the link masses of the case
-    include the discs), so a disc body has mass 0 and its own central inertia.
-    Five-bar: proximal/distal links and the end-effector point mass, with the passive angles,
-    rates and accelerations from the C++ FiveBarDynamics.motion (p = C p#, p' = C p#'' + cbar)."""
-    N = len(q)
+    Serial arms: `mechbal.papers.discs.disc_mechanism` (each disc a joint geared to its driving
+    joint, on its axle; as in the case files, a disc's mass is lumped into its carrier link, so a
+    disc body has mass 0 and its own central inertia). Five-bar:
+    `mechbal.papers.discs.five_bar.five_bar_design_mechanism`, its loop solved along the actuated
+    motion from the closed form's assembly (`five_bar_initial_guess`); the closed form
+    FiveBarDynamics equals it to 1e-10 (tests/python/test_papers_loops.py)."""
     if kind == "fivebar":
-        m = dz.fivebar_dynamics(d).motion(q, qd, qdd)
-        if m["status"] != control.Status.ok:
-            raise RuntimeError(f"five-bar trajectory hits a singular pose ({m['status']})")
-        th, w, al = m["angles"], m["rates"], m["accelerations"]
-        names, mass, inertia = [], [], []
-        com, vel, acc, rot, omg, alp = ([] for _ in range(6))
-        e = lambda t: np.stack([np.zeros_like(t), np.cos(t), np.sin(t)], -1)  # noqa: E731
-        nv = lambda t: np.stack([np.zeros_like(t), -np.sin(t), np.cos(t)], -1)  # noqa: E731
-
-        def Rx(t):
-            R = np.zeros((len(t), 3, 3))
-            R[:, 0, 0] = 1.0
-            R[:, 1, 1] = R[:, 2, 2] = np.cos(t)
-            R[:, 2, 1], R[:, 1, 2] = np.sin(t), -np.sin(t)
-            return R
-
-        def point(base, L, t, td, tdd):  # base + L e(t) and its derivatives
-            return (base[0] + L * e(t), base[1] + L * td[:, None] * nv(t),
-                    base[2] + L * (tdd[:, None] * nv(t) - td[:, None] ** 2 * e(t)))
-
-        ax = np.array([1.0, 0.0, 0.0])
-        for i, leg in ((1, 0), (2, 1)):
-            A = (np.tile([0.0, d["d"] if i == 2 else 0.0, 0.0], (N, 1)), np.zeros((N, 3)),
-                 np.zeros((N, 3)))
-            t1, t1d, t1dd = th[:, 2 * leg], w[:, 2 * leg], al[:, 2 * leg]
-            phi = t1 + th[:, 2 * leg + 1]
-            phid, phidd = t1d + w[:, 2 * leg + 1], t1dd + al[:, 2 * leg + 1]
-            B = point(A, d[f"a{i}"], t1, t1d, t1dd)
-            for name, base, L, t, td, tdd, key, mk in (
-                    (f"proximal{i}", A, d[f"cp{i}"], t1, t1d, t1dd, f"p{i}", f"mp{i}"),
-                    (f"distal{i}", B, d[f"cd{i}"], phi, phid, phidd, f"d{i}", f"md{i}")):
-                G = point(base, L, t, td, tdd)
-                names.append(name)
-                mass.append(d[mk])
-                inertia.append(np.diag(d[f"inertia_{key}"]))
-                com.append(G[0]), vel.append(G[1]), acc.append(G[2]), rot.append(Rx(t))
-                omg.append(td[:, None] * ax), alp.append(tdd[:, None] * ax)
-        names.append("end_effector")
-        mass.append(d["mP"])
-        inertia.append(np.zeros((3, 3)))
-        z = np.zeros((N, 1))
-        com.append(np.hstack([z, m["end_effector"]]))
-        vel.append(np.hstack([z, m["end_effector_velocity"]]))
-        acc.append(np.hstack([z, m["end_effector_acceleration"]]))
-        rot.append(np.tile(np.eye(3), (N, 1, 1)))
-        omg.append(np.zeros((N, 3))), alp.append(np.zeros((N, 3)))
-        stack = lambda xs: np.stack(xs, 1)  # noqa: E731
-        return dict(names=names, mass=np.array(mass), inertia_body=np.array(inertia),
-                    com=stack(com), com_velocity=stack(vel), com_acceleration=stack(acc),
-                    rotation=stack(rot), angular_velocity=stack(omg),
-                    angular_acceleration=stack(alp))
-
-    joints, links, discs = dz.serial_structure(kind, d)
-    m = dz.arm_mechanism(joints, links).body_motion(q, qd, qdd)
-    if np.any(np.asarray(m.status) != 0):
-        raise RuntimeError(f"arm kinematics failed: {np.asarray(m.status).max()}")
-    # link c's frame is the model's link c + 1 (link 0 is the base)
-    kin = dict(com=m.com, com_velocity=m.com_velocity, com_acceleration=m.com_acceleration,
-               rotation=m.rotation, angular_velocity=m.angular_velocity,
-               angular_acceleration=m.angular_acceleration)
-    names = [f"link{i + 1}" for i in range(len(links))]
-    mass = [b.mass for b in links]
-    inertia = [np.asarray(b.inertia, float) for b in links]
-    out = {k: [kin[k][:, i] for i in range(len(links))]
-           for k in ("com", "com_velocity", "com_acceleration", "rotation", "angular_velocity",
-                     "angular_acceleration")}
-    for k, ds in enumerate(discs):
-        c = ds.carrier
-        Rc, o = m.link_rotation[:, c + 1], m.link_position[:, c + 1]
-        axis = np.asarray(ds.axis, float) / np.linalg.norm(ds.axis)
-        a = Rc @ axis
-        ang = ds.ratio * q[:, ds.joint]
-        K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-        Rrel = (np.eye(3) + np.sin(ang)[:, None, None] * K
-                + (1 - np.cos(ang))[:, None, None] * (K @ K))
-        wc, alc = kin["angular_velocity"][:, c], kin["angular_acceleration"][:, c]
-        spin = ds.ratio * qd[:, ds.joint, None] * a
-        r = o - kin["com"][:, c]  # carrier CoM -> disc centre
-        names.append(f"disc{k + 4}")
-        mass.append(0.0)
-        inertia.append(np.diag(ds.inertia))
-        out["com"].append(o)
-        out["com_velocity"].append(kin["com_velocity"][:, c] + np.cross(wc, r))
-        out["com_acceleration"].append(kin["com_acceleration"][:, c] + np.cross(alc, r)
-                                       + np.cross(wc, np.cross(wc, r)))
-        out["rotation"].append(Rc @ Rrel)
-        out["angular_velocity"].append(wc + spin)
-        out["angular_acceleration"].append(alc + ds.ratio * qdd[:, ds.joint, None] * a
-                                           + np.cross(wc, spin))
-    return dict(names=names, mass=np.array(mass), inertia_body=np.array(inertia),
-                **{k: np.stack(v, 1) for k, v in out.items()})
+        mech = five_bar_design_mechanism(d)
+        solved = mech.closed_motion(q, qd, qdd, q_guess=five_bar_initial_guess(mech, d, q[0]))
+        if np.any(np.asarray(solved.status) != 0):
+            raise RuntimeError("five-bar trajectory: the loop solve fails or hits a singular pose "
+                               f"({control.Status(int(np.bitwise_or.reduce(solved.status)))})")
+        q, qd, qdd = solved.q, solved.v, solved.a
+    else:
+        mech = dz.disc_mechanism(kind, d)
+    motion = mech.body_motion(q, qd, qdd)
+    wrench = mech.shaking_wrench(q, qd, qdd)
+    if np.any(np.asarray(motion.status) != 0) or np.any(np.asarray(wrench.status) != 0):
+        raise RuntimeError(f"{kind} kinematics failed: {np.max(motion.status)}, {np.max(wrench.status)}")
+    bodies = mech.model.bodies
+    return dict(names=mech.body_names, mass=np.array([b.mass for b in bodies]),
+                inertia_body=np.array([np.asarray(b.inertia, float) for b in bodies]),
+                **{k: np.asarray(getattr(motion, k)) for k in (
+                    "com", "com_velocity", "com_acceleration", "rotation", "angular_velocity",
+                    "angular_acceleration")},
+                shaking_force=np.asarray(wrench.shaking_force), shaking_moment=np.asarray(wrench.shaking_moment))
 
 
 def _write_bodies(path, t, b, q, qd, qdd):
-    """bodies_<variant>.npz (mechbal.export schema) with mechbal.shaking_wrench of the bodies."""
-    w = papers.shaking_wrench(b["mass"], b["inertia_body"], b["com"], b["com_velocity"],
-                             b["com_acceleration"], b["rotation"], b["angular_velocity"],
-                             b["angular_acceleration"])
-    if w["status"] != control.Status.ok:
-        raise RuntimeError(f"shaking wrench failed: {w['status']}")
+    """bodies_<variant>.npz (mechbal.export schema): the bodies' poses and the shaking wrench of
+    that motion (`_disc_bodies`)."""
     write_bodies(path, t=t, names=b["names"], mass=b["mass"], inertia_body=b["inertia_body"],
-                 com=b["com"], rotation=b["rotation"], shaking_force=w["force"],
-                 shaking_moment=w["moment"], q=q, qd=qd, qdd=qdd)
-    return w["force"], w["moment"]
+                 com=b["com"], rotation=b["rotation"], shaking_force=b["shaking_force"],
+                 shaking_moment=b["shaking_moment"], q=q, qd=qd, qdd=qdd)
+    return b["shaking_force"], b["shaking_moment"]
 
 
 @register("discs", stages=5)

@@ -24,8 +24,9 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "mechbal/papers/paminsa/reactionless_wrist.hpp"
+#include "mechbal/model/data.hpp"
 #include "mechbal/model/rigid_body.hpp"
+#include "mechbal/papers/paminsa/reactionless_wrist.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal {
@@ -167,10 +168,18 @@ Status paminsa_kinematics(const PaminsaModel& model, const PlatformMotion& platf
 Status paminsa_mechanism_momentum(const PaminsaModel& model, const PaminsaWorkspace& ws, Vec3& D,
                                   Vec3& D_dot) noexcept;
 
+/// Momenta about O and their rates (shaking force and moment, Briot & Arakelian 2009, eqs 1-4) of
+/// all 38 bodies of a workspace filled by paminsa_kinematics: the sum over the bodies' states,
+/// PAMINSA's own fast path (the general path is algorithm/shaking_wrench.hpp over
+/// papers/paminsa/cases/paminsa-linkage.toml, tested equal). Non-finite states give
+/// Status::non_finite_input, an overflowing sum Status::out_of_range; either leaves `out` zero.
+Status paminsa_shaking_wrench(const PaminsaModel& model, const PaminsaWorkspace& ws,
+                              ShakingWrench& out) noexcept;
+
 /// The 35 mechanism bodies' momenta and their rates (linear momentum, D of eq 19, shaking force,
 /// dD/dt) in closed form from the platform motion, without forming the bodies' states (each leg is
-/// a planar linkage in a vertical plane turning about z; derivation in paminsa.cpp). Equals
-/// shaking_wrench over the states of paminsa_mechanism_kinematics (to rounding). Same statuses as
+/// a planar linkage in a vertical plane turning about z; derivation in paminsa.cpp). Equals the
+/// sum over the 35 bodies' states of paminsa_mechanism_kinematics (to rounding). Same statuses as
 /// paminsa_mechanism_kinematics; `out` is untouched unless Status::ok.
 Status paminsa_mechanism_wrench(const PaminsaModel& model, const PlatformMotion& platform,
                                 ShakingWrench& out) noexcept;
