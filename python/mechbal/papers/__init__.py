@@ -28,13 +28,54 @@ Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+import numpy.typing as npt
 
 from mechbal import _core
+from mechbal._deprecation import DeprecatedAttributes
+from mechbal.mechanism import ShakingWrench
 
-shaking_wrench = _core.shaking_wrench
+__all__ = ["shaking_wrench", "BodiesShakingWrench"]
 
-__all__ = ["shaking_wrench"]
+
+@dataclass(frozen=True)
+class BodiesShakingWrench(DeprecatedAttributes, ShakingWrench):
+    """The `mechbal.ShakingWrench` of a set of bodies (`shaking_wrench`): ``shaking_force`` [N],
+    ``shaking_moment`` about O [N m], ``linear_momentum`` [kg m/s], ``angular_momentum`` about O
+    [kg m^2/s], each (N, 3), and ``status`` (N,). The dict of earlier releases (``["force"]``,
+    ``["moment"]``, ``["status"]`` the OR of the instants' flags, ``["status_per_instant"]``)
+    is read for one release with a DeprecationWarning."""
+
+    _dict_keys: ClassVar[dict[str, str]] = {
+        "force": "shaking_force", "moment": "shaking_moment", "linear_momentum": "linear_momentum",
+        "angular_momentum": "angular_momentum", "status": "status",
+        "status_per_instant": "status"}
+
+    def _dict_value(self, key: str, attribute: str) -> Any:
+        if key == "status":
+            return int(np.bitwise_or.reduce(np.atleast_1d(self.status)))
+        return getattr(self, attribute)
+
+
+def shaking_wrench(mass: npt.ArrayLike, inertia_body: npt.ArrayLike, com: npt.ArrayLike,
+                   com_velocity: npt.ArrayLike, com_acceleration: npt.ArrayLike,
+                   rotation: npt.ArrayLike, angular_velocity: npt.ArrayLike,
+                   angular_acceleration: npt.ArrayLike) -> BodiesShakingWrench:
+    """Shaking force and moment about O of B bodies over N instants (Briot & Arakelian 2009,
+    eqs 1-4) from their motion: ``mass`` (B,) [kg], ``inertia_body`` (B, 3, 3) [kg m^2] about
+    each centre of mass in body axes, ``com`` [m], ``com_velocity`` [m/s], ``com_acceleration``
+    [m/s^2] (N, B, 3), ``rotation`` (N, B, 3, 3) body to O, ``angular_velocity`` [rad/s] and
+    ``angular_acceleration`` [rad/s^2] (N, B, 3) in O: a `BodiesShakingWrench` (N, 3) each."""
+    r = _core.shaking_wrench(mass, inertia_body, com, com_velocity, com_acceleration, rotation,
+                             angular_velocity, angular_acceleration)
+    return BodiesShakingWrench(shaking_force=np.asarray(r["force"]),
+                               shaking_moment=np.asarray(r["moment"]),
+                               linear_momentum=np.asarray(r["linear_momentum"]),
+                               angular_momentum=np.asarray(r["angular_momentum"]),
+                               status=np.asarray(r["status_per_instant"]))
 
 
 def __getattr__(name: str) -> Any:

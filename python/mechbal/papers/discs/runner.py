@@ -303,12 +303,12 @@ def _write_bodies(path, t, b, q, qd, qdd):
     w = papers.shaking_wrench(b["mass"], b["inertia_body"], b["com"], b["com_velocity"],
                              b["com_acceleration"], b["rotation"], b["angular_velocity"],
                              b["angular_acceleration"])
-    if w["status"] != control.Status.ok:
-        raise RuntimeError(f"shaking wrench failed: {w['status']}")
+    if np.any(w.status != 0):
+        raise RuntimeError(f"shaking wrench failed: {control.status_text(int(np.bitwise_or.reduce(w.status)))}")
     write_bodies(path, t=t, names=b["names"], mass=b["mass"], inertia_body=b["inertia_body"],
-                 com=b["com"], rotation=b["rotation"], shaking_force=w["force"],
-                 shaking_moment=w["moment"], q=q, qd=qd, qdd=qdd)
-    return w["force"], w["moment"]
+                 com=b["com"], rotation=b["rotation"], shaking_force=w.shaking_force,
+                 shaking_moment=w.shaking_moment, q=q, qd=qd, qdd=qdd)
+    return w.shaking_force, w.shaking_moment
 
 
 @register("discs", stages=5)
