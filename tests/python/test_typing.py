@@ -56,7 +56,7 @@ def test_mypy_accepts_the_public_modules_and_the_examples():
     assert r.returncode == 0, r.stdout[-6000:] + r.stderr[-2000:]
 
 
-USER_SCRIPT = ROOT / "tests" / "python" / "typing" / "user_script.py"
+USER_SCRIPT = ROOT / "tests" / "python" / "typed_usage" / "user_script.py"
 
 
 def test_mypy_strict_accepts_the_examples_and_a_user_script():

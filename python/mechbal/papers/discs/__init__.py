@@ -27,13 +27,13 @@ link's mass and centre of mass, so the disc body carries only its central inerti
 diag(J_x, J_y, J_z) (disc frame, x = spin axis) and mass 0: where its axle sits then changes no
 force, torque or momentum, only the disc's reported pose. The unbalanced designs have no discs.
 
-The planar 5R five-bar is a closed loop: :mod:`mechbal.papers.discs.five_bar` (its per-tick fast path
+The planar 5R five-bar is a closed loop: `mechbal.papers.discs.five_bar` (its per-tick fast path
 is ``mechbal.FiveBarDynamics``).
 
 **The paper's closed forms** (derivation and every correction: docs/discs_derivation.md): the
 fast path of the disc cases and the regression test of the general shaking-moment method
-(:mod:`mechbal.balance.moment`), with which the ``discs`` runner sizes the discs' gear ratios and
-the inertia conditions and which it checks against :data:`BALANCE`.
+(`mechbal.balance.moment`), with which the ``discs`` runner sizes the discs' gear ratios and
+the inertia conditions and which it checks against `BALANCE`.
 
 Procedure (the paper's order matters): static balancing first (centre-of-mass positions l_g that
 cancel gravity, eqs 8, 18, 29) makes the arm's mass matrix constant (planar) or free of
@@ -99,8 +99,8 @@ def _principal(d: Mapping[str, Any], i: int) -> np.ndarray:
 
 
 def disc_design_mechanism(kind: str, design: Mapping[str, Any], *, name: str | None = None) -> Mechanism:
-    """A design of :func:`design` (balanced, unbalanced or perturbed as built) as
-    a :class:`mechbal.Mechanism` (module docstring for frames and disc couplings).
+    """A design of `design` (balanced, unbalanced or perturbed as built) as
+    a `mechbal.Mechanism` (module docstring for frames and disc couplings).
 
     Joints ``joint1..3`` (the coordinates, in order) and, with ``design['discs']``, the geared
     ``disc4..7`` joints; bodies ``link1..3`` and ``disc4..7`` in that order (the order of the
@@ -147,7 +147,7 @@ def disc_design_mechanism(kind: str, design: Mapping[str, Any], *, name: str | N
 
 def disc_arm_mechanism(case_config: Mapping[str, Any] | str | Path, balanced: bool = True) -> Mechanism:
     """The arm of a disc case (``discs-3r``, ``discs-spatial``, ``scara``: a case name, path or
-    the loaded TOML dict) as a :class:`mechbal.Mechanism`, built from the runner's parameters
+    the loaded TOML dict) as a `mechbal.Mechanism`, built from the runner's parameters
     (``mechbal.papers.discs.runner.parameters_from_config``).
 
     ``balanced=True``: static balancing (eqs 8, 18, 29 generalised), the discs with the gear
@@ -361,7 +361,7 @@ def arm_mechanism(joints, links) -> Mechanism:
 
 def disc_mechanism(kind: str, d: dict):
     """A serial design on the general model: mechbal.Mechanism with each disc a gear-coupled
-    joint (:func:`disc_design_mechanism`). What :func:`evaluate` and the runner use."""
+    joint (`disc_design_mechanism`). What `evaluate` and the runner use."""
     return disc_design_mechanism(kind, d)
 
 
@@ -461,7 +461,7 @@ def sample_states(kind: str, n: int, rng: np.random.Generator):
 @renamed_kwargs(qd="v")
 def evaluate(kind: str, d: dict, q: np.ndarray, v: np.ndarray):
     """(M (N, n, n), v (N, n), g (N, n)) of design d at N states, in C++: the general model for
-    the serial arms (:func:`disc_mechanism`: CRBA mass matrix, v = bias - gravity torque),
+    the serial arms (`disc_mechanism`: CRBA mass matrix, v = bias - gravity torque),
     FiveBarDynamics for the 5R (a closed loop; ``fivebar_model`` is its Python reference). A
     singular five-bar state raises ValueError."""
     qd = v

@@ -24,7 +24,7 @@ balanced centres of mass of ``mechbal.papers.discs.balance_fivebar``).
 The closed form (``FiveBarDynamics``: positions, the coupling projection, M', v', g') and the
 five-bar motion of ``mechbal.papers.discs.runner`` equal this general model to 1e-10 along the case's
 trajectory (tests/python/test_papers_loops.py); ``python/mechbal/papers/discs/cases/five-bar-linkage.toml`` is
-:func:`five_bar_case_toml` of the shipped ``five-bar`` case (balanced), run by ``mechbal run``.
+`five_bar_case_toml` of the shipped ``five-bar`` case (balanced), run by ``mechbal run``.
 
 Layer: papers (docs/architecture.md).
 """
@@ -58,7 +58,7 @@ def five_bar_design_mechanism(d: Mapping[str, Any], *, name: str = "five-bar",
                               gravity: float = 9.81) -> Mechanism:
     """A five-bar design (``mechbal.papers.discs.design("fivebar", p, balanced)``: lengths a_i, b_i,
     d, masses mp_i, md_i, mP, centres of mass cp_i, cd_i, inertias ``inertia_p1`` ...) as a closed
-    :class:`mechbal.Mechanism` (module docstring)."""
+    `mechbal.Mechanism` (module docstring)."""
     R = _core.JointType.revolute
     joints, bodies = [], []
     for i in (1, 2):

@@ -104,11 +104,11 @@ _SIZED = {"planar3r": {"beta": ("disc5", "ratio"), "gamma": ("disc7", "ratio")},
 
 
 def general_discs(case, kind: str, closed: dict):
-    """The discs by the general shaking-moment method (:mod:`mechbal.balance.moment`) on the
+    """The discs by the general shaking-moment method (`mechbal.balance.moment`) on the
     statically balanced arm with the case's ``[balance]`` (``mechbal balance CASE --method
     moment``), next to the closed forms ``closed`` (``mechbal.papers.discs.BALANCE[kind]``).
     Returns (general values, closed-form values, largest relative difference, BalanceResult);
-    ConfigError when they differ beyond :data:`DISC_AGREEMENT_RTOL`.
+    ConfigError when they differ beyond `DISC_AGREEMENT_RTOL`.
 
     Serial arms: the chosen gear ratios (beta, gamma: eqs 14, 25, 35) and inertias (Jy2, Jy3:
     corrected eq 25) and the constant diagonal of the mass matrix (k_i: eqs 16, 27, 37). Five-bar
@@ -196,7 +196,7 @@ def _disc_bodies(kind, d, q, qd, qdd):
     and the motion arrays (N, B, ...) of mechbal.shaking_wrench.
 
     Serial arms: the links from the general model's body motion (the arm alone,
-    :func:`mechbal.papers.discs.arm_mechanism`); each disc spins at ratio * q[joint]
+    `mechbal.papers.discs.arm_mechanism`); each disc spins at ratio * q[joint]
     about its axis through the carrier's frame origin (rotation R_c Rot(axis, ratio q_j),
     omega = omega_c + ratio q_j' a, alpha = alpha_c + ratio q_j'' a + omega_c x ratio q_j' a).
     As in the model, a disc's mass is lumped into its carrier link (the link masses of the case

@@ -142,7 +142,7 @@ def _T(xyz=(0.0, 0.0, 0.0), R=None) -> np.ndarray:
 # Counterweights for complete shaking-force balancing (Briot & Arakelian 2009, eqs 6-16): the
 # paper's fast path and the regression test of the general method.
 #
-# 1. :func:`closed_form_counterweights` -- the paper's closed forms, re-derived for the
+# 1. `closed_form_counterweights` -- the paper's closed forms, re-derived for the
 #    reconstructed leg. Writing every leg point as an affine combination of A, C and E
 #    (D = E + (C-E)/k, F = A + (C-E)/k, B = ((k-1)A + C)/k) and using G_A = G_C,h/(1-k),
 #    G_B = G_C,z/k, the momentum of leg i is
@@ -164,10 +164,10 @@ def _T(xyz=(0.0, 0.0, 0.0), R=None) -> np.ndarray:
 #      (1.6915); 4.49 is not reproduced by eq 14 under any misprint we tried. The reported masses
 #      leave ~17 N of shaking force (63 % of the unbalanced peak) -- see the case summary.
 #
-# 2. The general method, :mod:`mechbal.balance.force` (least squares of the linear momentum of
+# 2. The general method, `mechbal.balance.force` (least squares of the linear momentum of
 #    the general model over sampled closed motions), with the slots of ``cases/paminsa.toml``'s
 #    ``[balance]`` table: the ``paminsa`` runner sizes with it and reports the closed form beside it
-#    (:func:`counterweights_from_design` reads its design back into a :class:`CounterweightSet`).
+#    (`counterweights_from_design` reads its design back into a `CounterweightSet`).
 #    With the legs tied (identical legs) every mass is determined; untied, legs 1 and 2 (one
 #    actuator) leave combinations of their masses undetermined, as the paper's cycle alone does
 #    (no x motion).
@@ -260,7 +260,7 @@ def reported_counterweights(params, vertical: float) -> CounterweightSet:
 
 
 def counterweights_from_design(design: dict, source: str) -> CounterweightSet:
-    """A :class:`CounterweightSet` from the design of a balancing method (``BalanceResult.design``)
+    """A `CounterweightSet` from the design of a balancing method (``BalanceResult.design``)
     whose slots carry the paper's names (``leg<i>.CP1_atA``, ``leg<i>.CP2_atF``,
     ``leg<i>.CP3_atL``, ``vertical_counter_mass``: ``cases/paminsa.toml``'s ``[balance]``).
     KeyError naming the missing slot otherwise."""
@@ -281,10 +281,10 @@ def _balanced(params):
 
 
 def paminsa_mechanism(params, balanced: bool = True, *, name: str | None = None) -> Mechanism:
-    """PAMINSA as a closed :class:`mechbal.Mechanism` (module docstring) from
+    """PAMINSA as a closed `mechbal.Mechanism` (module docstring) from
     ``mechbal.PaminsaParameters`` (``mechbal.papers.paminsa.runner.parameters_from_config``).
     ``balanced=True``: the closed-form counterweights (eqs 11, 14-16 corrected:
-    :func:`closed_form_counterweights`) replace the parameters' own;
+    `closed_form_counterweights`) replace the parameters' own;
     ``balanced=False``: the parameters' counterweights as given (none in the case file)."""
     p = _balanced(params) if balanced else params
     lay = paminsa_layout(p)
@@ -363,7 +363,7 @@ def _elevation(d: np.ndarray, u: np.ndarray) -> float:
 
 
 def paminsa_initial_guess(mech: Mechanism, params, P, wrist_angles=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """Every coordinate of :func:`paminsa_mechanism` at platform position P, from the closed form's
+    """Every coordinate of `paminsa_mechanism` at platform position P, from the closed form's
     leg points (``PaminsaModel.leg_points``: the assembly of A6, elbow outward and up)."""
     model = _core.PaminsaModel(params)
     pts, status = model.leg_points(np.asarray(P, float))
@@ -387,7 +387,7 @@ def paminsa_initial_guess(mech: Mechanism, params, P, wrist_angles=(0.0, 0.0, 0.
 
 def paminsa_actuated_motion(mech: Mechanism, params, P, Pd, Pdd, wrist=None, wrist_rates=None,
                             wrist_accelerations=None):
-    """(q#, v#, a#) (N, 6) of the actuated joints of :func:`paminsa_mechanism` for a platform
+    """(q#, v#, a#) (N, 6) of the actuated joints of `paminsa_mechanism` for a platform
     motion P, Pd, Pdd (N, 3) and a wrist motion (N, 3; default still at zero): the closed-form
     inverse kinematics (``PaminsaModel.inverse_kinematics``) and its derivatives. alpha_i is the
     angle of A_h,i - M_i with A_h,i = (k B_h,i - C_h,i)/(k - 1); z_B = z_A + (z_P - l_CJ - z_A)/k."""

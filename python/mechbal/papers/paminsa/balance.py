@@ -1,5 +1,5 @@
 """``mechbal balance`` on a ``paminsa`` case (Briot & Arakelian 2009): the mechanism of
-:func:`mechbal.papers.paminsa.paminsa_mechanism` built from the case's ``[geometry]``, ``[masses]``,
+`mechbal.papers.paminsa.paminsa_mechanism` built from the case's ``[geometry]``, ``[masses]``,
 ``[inertias]``, unbalanced and without the zero-mass placeholder counterweights (so the ``[balance]``
 slots may carry the paper's names ``leg1.CP1_atA`` ...); the trajectory rest-to-rest in the actuated
 joints between the actuator positions of the case's start and end platform positions, wrist still

@@ -3,7 +3,7 @@ fully balanced (counterweights + vertical counter-mass + reactionless wrist), ov
 
 Writes bodies_{unbalanced,force_balanced,balanced}.npz (+ bodies_balanced_{euler,rk4}.npz, whose
 shaking_force/shaking_moment are the wrench of the stored poses and shaking_*_commanded the
-controller's ideal one: see :func:`pose_wrench`),
+controller's ideal one: see `pose_wrench`),
 shaking_wrench.png (the paper's Fig. 4), wrist_angles.png (Fig. 5), wrist_condition.png and
 summary.json, and prints a table.
 
@@ -85,10 +85,10 @@ COUNTERWEIGHT_AGREEMENT_KG = 1e-6
 
 
 def general_counterweights(config):
-    """PAMINSA's counterweights by the general shaking-force method (:mod:`mechbal.balance.force`)
-    on the case's mechanism (:func:`mechbal.papers.paminsa.paminsa_mechanism`, unbalanced) with the
+    """PAMINSA's counterweights by the general shaking-force method (`mechbal.balance.force`)
+    on the case's mechanism (`mechbal.papers.paminsa.paminsa_mechanism`, unbalanced) with the
     slots of its ``[balance]`` table, as ``mechbal balance paminsa --method force`` runs it.
-    Returns (:class:`mechbal.papers.paminsa.CounterweightSet`, the method's BalanceResult)."""
+    Returns (`mechbal.papers.paminsa.CounterweightSet`, the method's BalanceResult)."""
     from mechbal.balance.run import case_from_config, run_method
 
     case = validate_case(config, warn=False)
