@@ -150,11 +150,11 @@ class RestToRestTrajectory:
         ...
     def evaluate(self, t: typing.SupportsFloat | typing.SupportsIndex) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
         """
-        (q, qd, qdd) at time t
+        (q, v, a) at time t
         """
     def evaluate_batch(self, times: numpy.typing.ArrayLike) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
         """
-        (q, qd, qdd), each (N, size), at the N given times
+        (q, v, a), each (N, size), at the N given times
         """
     @property
     def duration(self) -> float:
@@ -568,15 +568,15 @@ class MechanismDynamics(InverseDynamics, ForwardDynamics):
         """
         Dynamics in the actuated coordinates (loops solved each call, warm-started from q_guess, the full coordinates near the assembly)
         """
-    def bias(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    def bias(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
-        Bias torques C(q, qd) qd + G(q) + K(q) (springs included)
+        Bias torques C(q, v) v + G(q) + K(q) (springs included)
         """
-    def coriolis(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    def coriolis(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
-        Coriolis and centrifugal torques C(q, qd) qd
+        Coriolis and centrifugal torques C(q, v) v
         """
-    def forward_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    def forward_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Accelerations a = M^-1 (tau - b) (actuated coordinates)
         """
@@ -584,9 +584,9 @@ class MechanismDynamics(InverseDynamics, ForwardDynamics):
         """
         Gravity torques G(q) (gravity alone; with springs see static_torque)
         """
-    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+    def inverse_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
         """
-        Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, support_moment about the base origin, (N, 3)); q, qd, qdd each (N, dof). Instants with non-finite input give zeros and set their flag in `status`.
+        Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, support_moment about the base origin, (N, 3)); q, v, a each (N, dof). Instants with non-finite input give zeros and set their flag in `status`.
         """
     def mass_matrix(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         """
@@ -610,15 +610,15 @@ class KdlChainDynamics(InverseDynamics):
         """
         From the general MechanismModel when it is a serial chain (bodies lumped per link); ValueError naming the link or joint otherwise
         """
-    def coriolis(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    def coriolis(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
-        Coriolis and centrifugal torques C(q, qd) qd
+        Coriolis and centrifugal torques C(q, v) v
         """
     def gravity(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Gravity torques G(q)
         """
-    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+    def inverse_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
         """
         Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, support_moment about the base origin, (N, 3)) by KDL's ChainIdSolver_RNE.
         """
@@ -1151,23 +1151,23 @@ class Arm2DofDynamics(InverseDynamics, ForwardDynamics):
     """
     def __init__(self, arm: Arm2DofParameters, counterweights: Arm2DofCounterweights = ...) -> None:
         ...
-    def coriolis_matrix(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 2]"]:
+    def coriolis_matrix(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 2]"]:
         """
-        C(q, qd) (2, 2), Christoffel form
+        C(q, v) (2, 2), Christoffel form
         """
-    def forward_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike) -> dict:
+    def forward_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike) -> dict:
         """
-        Accelerations (N, 2): {'qdd', 'status'}
+        Accelerations (N, 2): {'a', 'status'}
         """
     def gravity(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 1]"]:
         """
         Q(q) (2,), eqs 21-22
         """
-    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+    def inverse_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
         """
         Joint torques (N, 2): {'tau', 'status'}
         """
-    def kinetic_energy(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> float:
+    def kinetic_energy(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> float:
         ...
     def mass_matrix(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 2]"]:
         """
@@ -1197,17 +1197,35 @@ class ComputedTorque(JointController):
         """
         Forget the held command (zero torque).
         """
-    def run(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> dict:
+    @typing.overload
+    def run(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> dict:
         """
-        N consecutive ticks in one call: q, qd [rad or m, rad/s or m/s], q_des, qd_des, qdd_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
+        N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
         """
-    def step(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> tuple:
+    @typing.overload
+    def run(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """
         One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
         """
-    def step_into(self, q: numpy.typing.NDArray[numpy.float64], qd: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], qd_des: numpy.typing.NDArray[numpy.float64], qdd_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+    @typing.overload
+    def step(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step_into(self, q: numpy.typing.NDArray[numpy.float64], v: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], v_des: numpy.typing.NDArray[numpy.float64], a_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
         """
         The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
+        """
+    @typing.overload
+    def step_into(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
         """
     @property
     def dof(self) -> int:
@@ -1220,7 +1238,7 @@ class ComputedTorque(JointController):
         ...
 class DecoupledJointController(JointController):
     """
-    tau_i = k_i (qdd_d + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho eqs 15, 26, 36)
+    tau_i = k_i (a_des + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho eqs 15, 26, 36)
     """
     def __init__(self, k: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
         """
@@ -1230,17 +1248,35 @@ class DecoupledJointController(JointController):
         """
         Forget the held command (zero torque).
         """
-    def run(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> dict:
+    @typing.overload
+    def run(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> dict:
         """
-        N consecutive ticks in one call: q, qd [rad or m, rad/s or m/s], q_des, qd_des, qdd_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
+        N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
         """
-    def step(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> tuple:
+    @typing.overload
+    def run(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """
         One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
         """
-    def step_into(self, q: numpy.typing.NDArray[numpy.float64], qd: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], qd_des: numpy.typing.NDArray[numpy.float64], qdd_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+    @typing.overload
+    def step(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step_into(self, q: numpy.typing.NDArray[numpy.float64], v: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], v_des: numpy.typing.NDArray[numpy.float64], a_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
         """
         The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
+        """
+    @typing.overload
+    def step_into(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
         """
     @property
     def dof(self) -> int:
@@ -1380,15 +1416,15 @@ class FiveBarDynamics:
     """
     def __init__(self, parameters: FiveBarParameters, singular_tolerance: typing.SupportsFloat | typing.SupportsIndex = 1e-06) -> None:
         ...
-    def evaluate(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> dict:
+    def evaluate(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> dict:
         """
         For N states (q, qd each (N, 2)): {'mass' (N, 2, 2), 'velocity', 'gravity' (N, 2), 'ok' (N,), 'reciprocal_condition' (N,), 'status_per_instant' (N,), 'status' (OR)}; failed states give zeros
         """
-    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+    def inverse_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
         """
         Joint torques (N, 2): {'tau', 'status_per_instant' (N,), 'status' (OR)}
         """
-    def motion(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+    def motion(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
         """
         Joint angles/rates/accelerations (N, 4) in the order (theta1, theta12, theta2, theta22) and the end effector (y, z) position/velocity/acceleration (N, 2); status_per_instant (N,) and their OR, status; failed instants give zeros
         """
@@ -1530,17 +1566,35 @@ class ReactionlessJointController(JointController):
         """
         Forget the held command (zero torque).
         """
-    def run(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> dict:
+    @typing.overload
+    def run(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> dict:
         """
-        N consecutive ticks in one call: q, qd [rad or m, rad/s or m/s], q_des, qd_des, qdd_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
+        N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
         """
-    def step(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> tuple:
+    @typing.overload
+    def run(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """
         One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
         """
-    def step_into(self, q: numpy.typing.NDArray[numpy.float64], qd: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], qd_des: numpy.typing.NDArray[numpy.float64], qdd_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+    @typing.overload
+    def step(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step_into(self, q: numpy.typing.NDArray[numpy.float64], v: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], v_des: numpy.typing.NDArray[numpy.float64], a_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
         """
         The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
+        """
+    @typing.overload
+    def step_into(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
         """
     @property
     def dof(self) -> int:
@@ -1619,7 +1673,7 @@ def mechanism_static_torque(model: MechanismModel, q: numpy.typing.ArrayLike) ->
     """
 def mechanism_torque_regressor(model: MechanismModel, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
     ...
-def paminsa_kinematics(model: PaminsaModel, P: numpy.typing.ArrayLike, Pd: numpy.typing.ArrayLike, Pdd: numpy.typing.ArrayLike, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+def paminsa_kinematics(model: PaminsaModel, P: numpy.typing.ArrayLike, Pd: numpy.typing.ArrayLike, Pdd: numpy.typing.ArrayLike, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
     """
     Every body's motion (N, 38, ...), the shaking wrench about O and D, dD/dt (eq 19) for platform motion and prescribed wrist motion, each (N, 3).
     """
@@ -1646,11 +1700,11 @@ def shaking_wrench(mass: numpy.typing.ArrayLike, inertia_body: numpy.typing.Arra
     linear_momentum, angular_momentum; status_per_instant (N,) and their OR, status. Instants with
     non-finite input (non_finite_input) or an overflowing wrench (out_of_range) give zeros.
     """
-def simulate_closed_loop(plant: ForwardDynamics, controller: JointController, desired: RestToRestTrajectory, q0: numpy.typing.ArrayLike, qd0: numpy.typing.ArrayLike, dt: typing.SupportsFloat | typing.SupportsIndex = 0.001, duration: typing.SupportsFloat | typing.SupportsIndex = 1.0, sampling: str = 'zero_order_hold') -> dict:
+def simulate_closed_loop(plant: ForwardDynamics, controller: JointController, desired: RestToRestTrajectory, q0: numpy.typing.ArrayLike, v0: numpy.typing.ArrayLike, dt: typing.SupportsFloat | typing.SupportsIndex = 0.001, duration: typing.SupportsFloat | typing.SupportsIndex = 1.0, sampling: str = 'zero_order_hold') -> dict:
     """
-    RK4 closed loop of `plant` (any ForwardDynamics: Arm2DofDynamics, MechanismDynamics of any mechanism) under `controller` (any JointController) tracking `desired`; returns a dict of arrays t (N+1,), q, qd, q_des, qd_des, tau (N+1, dof), status, saturated_ticks, steps_completed.
+    RK4 closed loop of `plant` (any ForwardDynamics: Arm2DofDynamics, MechanismDynamics of any mechanism) under `controller` (any JointController) tracking `desired`; returns a dict of arrays t (N+1,), q, v, q_des, v_des, tau (N+1, dof), status, saturated_ticks, steps_completed.
     """
-def simulate_closed_loop_sampled(plant: ForwardDynamics, controller: JointController, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike, q0: numpy.typing.ArrayLike, qd0: numpy.typing.ArrayLike, dt: typing.SupportsFloat | typing.SupportsIndex = 0.001, duration: typing.SupportsFloat | typing.SupportsIndex = 1.0, sampling: str = 'zero_order_hold') -> dict:
+def simulate_closed_loop_sampled(plant: ForwardDynamics, controller: JointController, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike, q0: numpy.typing.ArrayLike, v0: numpy.typing.ArrayLike, dt: typing.SupportsFloat | typing.SupportsIndex = 0.001, duration: typing.SupportsFloat | typing.SupportsIndex = 1.0, sampling: str = 'zero_order_hold') -> dict:
     """
     simulate_closed_loop tracking a sampled desired motion: q_des, qd_des, qdd_des each (2 steps + 1, dof), sampled every dt/2 from t = 0 (steps = round(duration / dt)).
     """

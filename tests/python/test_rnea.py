@@ -56,7 +56,7 @@ def test_rnea_matches_pinocchio(types, seed):
 def test_rnea_bad_input_names_the_argument():
     rng = np.random.default_rng(3)
     rne = mechbal.MechanismDynamics(chain_from_specs(random_chain_specs(rng, "RRR")))
-    with pytest.raises(ValueError, match="qd"):
+    with pytest.raises(ValueError, match=r"v must have shape \(3,\) or \(N, 3\), got \(2, 4\)"):
         rne.inverse_dynamics(np.zeros((2, 3)), np.zeros((2, 4)), np.zeros((2, 3)))
     with pytest.raises(ValueError, match=r"q must have shape \(3,\).*got \(2,\)"):
         rne.mass_matrix(np.zeros(2))

@@ -44,7 +44,7 @@ def test_controller_step_and_run_accept_qd_names_with_a_warning(arm):
         run = ct.run(Q, qd=Q * 0, q_des=Q, qd_des=Q * 0, qdd_des=Q * 0)
     _same(run.joint_torque, ct.run(Q, Q * 0, Q, Q * 0, Q * 0).joint_torque)
     with pytest.raises(TypeError, match="both 'qd'"):
-        ct.step(q, v, q_des=q, v_des=v, a_des=v, qd=v)
+        ct.step(q, v=v, q_des=q, v_des=v, a_des=v, qd=v)
 
 
 def test_step_into_accepts_qd_names_with_a_warning(arm):
