@@ -16,7 +16,7 @@ from mechbal.balance.run import BalanceCase, design_trajectory, register_case
 from mechbal.papers import discs as dz
 from mechbal.papers.discs import disc_design_mechanism
 from mechbal.papers.discs.five_bar import five_bar_design_mechanism, five_bar_initial_guess
-from mechbal.papers.discs.runner import parameters_from_config
+from mechbal.papers.discs import parameters_from_config
 
 
 @register_case("discs")

@@ -101,8 +101,8 @@ def five_bar_mechanism(case_config: Mapping[str, Any] | str | Path = "five-bar",
                        balanced: bool = True) -> Mechanism:
     """The five-bar of a ``discs`` case with ``case.mechanism = "fivebar"`` (a case name, path or
     loaded TOML dict), balanced (leg-wise static balancing) or the case's ``[unbalanced]``
-    baseline, from the runner's parameters (``mechbal.papers.discs.runner.parameters_from_config``)."""
-    from mechbal.papers.discs.runner import parameters_from_config
+    baseline, from the runner's parameters (``mechbal.papers.discs.parameters_from_config``)."""
+    from mechbal.papers.discs import parameters_from_config
     from mechbal.papers import discs as dz
 
     config = _case(case_config)
@@ -117,7 +117,7 @@ def five_bar_case_toml(case_config: Mapping[str, Any] | str | Path = "five-bar",
     """The ``kind = "mechanism"`` case file of a five-bar case's mechanism with the case's
     trajectory (rest-to-rest in (theta1, theta2)) and the closed form's assembly as the initial
     guess: what ``python/mechbal/papers/discs/cases/five-bar-linkage.toml`` holds for the shipped case."""
-    from mechbal.papers.discs.runner import parameters_from_config
+    from mechbal.papers.discs import parameters_from_config
     from mechbal.papers._toml import case_toml
     from mechbal.papers import discs as dz
 

@@ -26,70 +26,15 @@ from mechbal import papers
 from mechbal import trajectory
 from mechbal import progress, report
 from mechbal.cases import register
-from mechbal.config import ConfigError, inertia
-from mechbal.schema import inertia_matrix, validate_case
+from mechbal.config import ConfigError
+from mechbal.schema import validate_case
 from mechbal.export import write_bodies, write_summary
 from mechbal.papers import discs as dz
+from mechbal.papers.discs import _SPEC, parameters_from_config  # noqa: F401 (re-exported)
 
-_SPEC = {
-    "planar3r": dict(params=("l1", "l2", "m1", "m2", "m3"),
-                     bodies=("link1", "link2", "link3", "disc4", "disc5", "disc6", "disc7"),
-                     unbalanced=("lg1", "lg2", "lg3"), n=3),
-    "spatial3r": dict(params=("l1", "l2", "m1", "m2", "m3"),
-                      bodies=("link1", "link2", "link3", "disc4", "disc5"),
-                      unbalanced=("lg2", "lg3"), n=3),
-    "scara": dict(params=("l1", "l2", "m1", "m2", "m3"),
-                  bodies=("link1", "link2", "link3", "disc4", "disc5"),
-                  unbalanced=("lg1", "lg2"), n=3),
-    "fivebar": dict(params=("a1", "a2", "b1", "b2", "d", "mp1", "mp2", "md1", "md2", "mP",
-                            "mP1_share"),
-                    bodies=("proximal1", "proximal2", "distal1", "distal2"),
-                    unbalanced=("cp1", "cp2", "cd1", "cd2"), n=2),
-}
-_FIVEBAR_KEYS = {"proximal1": "p1", "proximal2": "p2", "distal1": "d1", "distal2": "d2"}
 #: which corrections concern which mechanism
 _CORRECTIONS = {"planar3r": (), "spatial3r": ("C1", "C2", "C3", "C4", "C5", "C6", "C7", "C8"),
                 "scara": ("C9", "C10"), "fivebar": ("C11",)}
-
-
-def _principal(I: np.ndarray, field: str) -> np.ndarray:
-    if np.max(np.abs(I - np.diag(np.diag(I)))) > 0.0:
-        raise ConfigError(field, "must be principal (give [Jx, Jy, Jz] in the link frame)",
-                          I.tolist())
-    return np.diag(I).copy()
-
-
-def parameters_from_config(kind: str, config) -> dict:
-    """Flat parameter dict (the names of docs/discs_derivation.md) from a case (validated, or a
-    dict validated here); errors name the field."""
-    case = validate_case(config, warn=False)
-    if case.case.mechanism != kind:
-        raise ConfigError("case.mechanism", f"must be {kind!r} here", case.case.mechanism)
-    spec = _SPEC[kind]
-    pt, it, ut = case.parameters, case.inertia, case.unbalanced
-    p = {k: getattr(pt, k) for k in spec["params"]}
-    for b in spec["bodies"]:
-        J = _principal(inertia_matrix(getattr(it, b)), f"inertia.{b}")
-        if kind == "fivebar":
-            key = _FIVEBAR_KEYS[b]
-            p[f"J{key}"] = J[0]
-            p[f"inertia_{key}"] = J
-        else:
-            i = b[-1]
-            p[f"Jx{i}"], p[f"Jy{i}"], p[f"Jz{i}"] = J
-    for k in spec["unbalanced"]:
-        p[f"{k}_unbal"] = getattr(ut, k)
-    for b in ("link1", "link2", "link3"):
-        if kind != "fivebar" and getattr(ut, b) is not None:
-            J = _principal(inertia_matrix(getattr(ut, b)), f"unbalanced.{b}")
-            i = b[-1]
-            p[f"Jx{i}_unbal"], p[f"Jy{i}_unbal"], p[f"Jz{i}_unbal"] = J
-    if kind == "spatial3r":  # the inertia conditions of eq 25 must give a physical body
-        ic = dz.balance_spatial3r(p)["inertia_conditions"]
-        for i in (2, 3):
-            J = [p[f"Jx{i}"], ic[f"Jy{i}"], p[f"Jz{i}"]]
-            inertia(J, f"inertia.link{i} with the eq 25 condition Jy{i} = {ic[f'Jy{i}']:.6g}")
-    return p
 
 
 #: how far the general method's gear ratios, inertias and decoupled inertias k_i may be from the

@@ -63,6 +63,7 @@ import numpy as np
 
 from mechbal import _core
 from mechbal.mechanism import Mechanism
+from mechbal.schema import validate_case
 
 # the closed forms of the C++ core (cpp/src/papers/paminsa/): fast paths of the general model
 PaminsaParameters = _core.PaminsaParameters
@@ -73,7 +74,7 @@ paminsa_reactionless_run = _core.paminsa_reactionless_run
 wrist_momentum_matrix = _core.wrist_momentum_matrix
 wrist_momentum_bias = _core.wrist_momentum_bias
 
-__all__ = ["PaminsaParameters", "PaminsaCounterweights", "PaminsaModel", "paminsa_kinematics", "paminsa_reactionless_run", "wrist_momentum_matrix", "wrist_momentum_bias",
+__all__ = ["PaminsaParameters", "parameters_from_config", "PaminsaCounterweights", "PaminsaModel", "paminsa_kinematics", "paminsa_reactionless_run", "wrist_momentum_matrix", "wrist_momentum_bias",
            "paminsa_mechanism", "paminsa_layout", "paminsa_initial_guess", "paminsa_actuated_motion",
            "paminsa_case_toml", "ACTUATED", "body_names", "CounterweightSet", "closed_form_counterweights",
            "printed_counterweights", "reported_counterweights", "counterweights_from_design",
@@ -282,7 +283,7 @@ def _balanced(params):
 
 def paminsa_mechanism(params, balanced: bool = True, *, name: str | None = None) -> Mechanism:
     """PAMINSA as a closed `mechbal.Mechanism` (module docstring) from
-    ``mechbal.PaminsaParameters`` (``mechbal.papers.paminsa.runner.parameters_from_config``).
+    ``mechbal.PaminsaParameters`` (`parameters_from_config`).
     ``balanced=True``: the closed-form counterweights (eqs 11, 14-16 corrected:
     `closed_form_counterweights`) replace the parameters' own;
     ``balanced=False``: the parameters' counterweights as given (none in the case file)."""
@@ -422,7 +423,6 @@ def paminsa_case_toml(config="paminsa", balanced: bool = True, samples: int = 50
     shipped case. Its trajectory is rest-to-rest in the actuated joints between the actuator
     positions of the case's start and end platform positions (the case itself moves P on a straight
     line: the same end points, not the same path), wrist still at the case's initial angles."""
-    from mechbal.papers.paminsa.runner import parameters_from_config
     from mechbal.config import load_case
     from mechbal.papers._toml import case_toml
 
@@ -457,6 +457,34 @@ paper's start and end platform positions (the paminsa case moves P on a straight
     comments["trajectory.start"] = "actuated joints in the model's order: " + ", ".join(mech.actuated_names)
     return case_toml(mech, name="paminsa-linkage", title=f"PAMINSA ({variant}) on the general model",
                      header=header, trajectory=traj, comments=comments)
+
+# ---- a case's parameters (the runner, the balance adapter and the case-file generator) ----
+_GEOMETRY_SCALARS = ("k", "a", "b", "c", "d", "e", "f", "length_BG", "length_AE", "length_DF",
+                     "length_CE", "length_AF", "length_CJ", "length_MS5", "length_MO", "nominal_rho",
+                     "z_A", "elbow", "vertical_mass_z0", "cp3_ratio")
+
+
+def parameters_from_config(config):
+    """mechbal.PaminsaParameters (without counterweights) from the [geometry], [masses],
+    [inertias] tables of a case (validated, or a dict validated here); ConfigError names the
+    field. The C++ model validates the rest (ValueError naming the field)."""
+    case = validate_case(config, warn=False)
+    p = PaminsaParameters()
+    g = case.geometry
+    for key in _GEOMETRY_SCALARS:
+        setattr(p, key, getattr(g, key))
+    p.nominal_platform = np.array(g.nominal_platform, float)
+    if isinstance(g.vertical_mass_xy, str):  # "centroid"
+        p.vertical_mass_at_centroid = True
+    else:
+        p.vertical_mass_at_centroid = False
+        p.vertical_mass_xy = np.array(g.vertical_mass_xy, float)
+    p.platform_mass = case.masses.platform
+    p.link_mass = [float(x) for x in case.masses.links]
+    p.link_inertia = [np.array(v, float) for v in case.inertias.links]
+    p.wrist_inertia = [np.array(v, float) for v in case.inertias.wrist]
+    return p
+
 
 # importing the schema registers this paper's case kind (mechbal.registry imports this package)
 from mechbal.papers.paminsa import schema as _schema  # noqa: E402,F401

@@ -17,7 +17,7 @@ import numpy as np
 
 from mechbal.balance.run import BalanceCase, design_trajectory, register_case
 from mechbal.papers.paminsa import paminsa_actuated_motion, paminsa_initial_guess, paminsa_mechanism
-from mechbal.papers.paminsa.runner import parameters_from_config
+from mechbal.papers.paminsa import parameters_from_config
 
 
 @register_case("paminsa")

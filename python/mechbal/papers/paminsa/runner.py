@@ -27,35 +27,7 @@ from mechbal.config import ConfigError
 from mechbal.schema import validate_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences, write_bodies, write_summary
 from mechbal.papers import paminsa as paper
-
-_GEOMETRY_SCALARS = ("k", "a", "b", "c", "d", "e", "f", "length_BG", "length_AE", "length_DF",
-                     "length_CE", "length_AF", "length_CJ", "length_MS5", "length_MO", "nominal_rho",
-                     "z_A", "elbow", "vertical_mass_z0", "cp3_ratio")
-
-
-def parameters_from_config(config):
-    """mechbal.PaminsaParameters (without counterweights) from the [geometry], [masses],
-    [inertias] tables of a case (validated, or a dict validated here); ConfigError names the
-    field. The C++ model validates the rest (ValueError naming the field)."""
-    from mechbal.papers.paminsa import PaminsaParameters
-
-    case = validate_case(config, warn=False)
-    p = PaminsaParameters()
-    g = case.geometry
-    for key in _GEOMETRY_SCALARS:
-        setattr(p, key, getattr(g, key))
-    p.nominal_platform = np.array(g.nominal_platform, float)
-    if isinstance(g.vertical_mass_xy, str):  # "centroid"
-        p.vertical_mass_at_centroid = True
-    else:
-        p.vertical_mass_at_centroid = False
-        p.vertical_mass_xy = np.array(g.vertical_mass_xy, float)
-    p.platform_mass = case.masses.platform
-    p.link_mass = [float(x) for x in case.masses.links]
-    p.link_inertia = [np.array(v, float) for v in case.inertias.links]
-    p.wrist_inertia = [np.array(v, float) for v in case.inertias.wrist]
-    return p
-
+from mechbal.papers.paminsa import parameters_from_config  # noqa: F401 (re-exported)
 
 def wrist_config_from_config(config, integrator: str | None = None):
     from mechbal.control import ReactionlessWristConfig, WristIntegrator
