@@ -26,16 +26,13 @@ Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, NamedTuple, Protocol, Union, runtime_checkable
+from typing import Any, NamedTuple, Protocol, Union, runtime_checkable
 
 import numpy as np
 import numpy.typing as npt
 
 from mechbal import _core
 from mechbal._deprecation import warn_renamed
-
-if TYPE_CHECKING:
-    from mechbal.mechanism import Mechanism
 
 __all__ = ["Trajectory", "Motion", "RestToRest", "quintic", "minimum_energy_cubic", "ViaPoints",
            "Sampled", "TimeLaw", "RestToRestTrajectory", "as_trajectory", "quintic_within_limits"]
@@ -372,7 +369,7 @@ def _limit_list(x: np.ndarray) -> list[float | None]:
     return [float(v) if np.isfinite(v) else None for v in x]
 
 
-def quintic_within_limits(mech: Mechanism, start: ArrayLike, end: ArrayLike, duration: float, *,
+def quintic_within_limits(mech: Any, start: ArrayLike, end: ArrayLike, duration: float, *,
                           samples: int = 101, max_doublings: int = 10) -> tuple[float, dict[str, Any]]:
     """``(duration, report)`` of a quintic rest-to-rest move of an open mechanism from ``start``
     to ``end`` that respects the joints' limits where the model has them (URDF <limit>):

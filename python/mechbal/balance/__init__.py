@@ -26,13 +26,13 @@ from typing import TYPE_CHECKING, Any, Protocol, cast
 
 from mechbal.balance.result import (
     BalanceResult, CounterweightDesign, CounterweightSlot, DiscDesign, DiscSlot, InertiaDesign,
-    InertiaSlot, SlotDesign, SpringDesign, SpringSlot)
+    InertiaSlot, SlotDesign, SpringDesign, SpringSlot)  # noqa: F401 (SlotDesign: the union)
 
 if TYPE_CHECKING:
     from mechbal.balance import force, moment, rms, springs, static
 
 __all__ = ["METHODS", "BalanceResult", "CounterweightSlot", "DiscSlot", "InertiaSlot", "SpringSlot",
-           "CounterweightDesign", "SpringDesign", "DiscDesign", "InertiaDesign", "SlotDesign",
+           "CounterweightDesign", "SpringDesign", "DiscDesign", "InertiaDesign",
            "BalancingMethod", "method", "static", "force", "moment", "springs", "rms"]
 
 #: method name -> module path; each module has ``balance(mechanism, design, samples, **options)``
