@@ -81,7 +81,7 @@ class DeprecatedAttributes:
             raise KeyError(key)
         new = keys[key]
         warnings.warn(f"{type(self).__name__}: result[{key!r}] is deprecated (the result is no "
-                      f"longer a dict), use result.{new.split('(')[0]}", DeprecationWarning,
+                      f"longer a dict), use result.{new}", DeprecationWarning,
                       stacklevel=2)
         return self._dict_value(key, new)
 

@@ -132,7 +132,9 @@ def _states(where: str, dof: int, **arrays: npt.ArrayLike) -> tuple[bool, list[F
             raise ValueError(f"{where}: {name} must have shape ({dof},) or (N, {dof}), got "
                              f"{a.shape}")
         is_single = a.ndim == 1
-        a2 = np.ascontiguousarray(np.atleast_2d(a), dtype=np.float64)
+        a2 = a.reshape(1, -1) if is_single else a
+        if a2.dtype.char != "d" or not a2.flags.c_contiguous:  # not float64 C-contiguous
+            a2 = np.ascontiguousarray(a2, dtype=np.float64)
         if single is None:
             single, first = is_single, name
         elif is_single != single or a2.shape[0] != out[0].shape[0]:
