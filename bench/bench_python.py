@@ -6,7 +6,7 @@
    binding overhead is this minus the C++ tick time of mechbal-bench (the merge script subtracts).
    Also one controller tick through the bindings: ComputedTorque.step (6-joint RNE back end, and
    the 2-DOF closed form), ReactionlessWrist.step (Euler, RK4), DecoupledJointController.step (3 joints).
-   The fast tick of issue 15 (target <= 1.5 us median): step_into(q, qd, q_des, qd_des, qdd_des,
+   The fast tick of issue 15 (target <= 1.5 us median): step_into(q, v, q_des, v_des, a_des,
    out), float64 arrays read and the torque written in place (no copy, no allocation, no tuple),
    for the same three joint controllers (ct6_step_into, ct2_step_into, decoupled3_step_into) and
    the reactionless wrist (wrist_euler_step_into, wrist_rk4_step_into: the command into a (3, 3)).
@@ -222,8 +222,8 @@ def main(argv=None):
     # ---- 1. single-instant calls through the bindings ----------------------------------------
     model = chain_from_specs(random_chain_specs(rng, "RRRRRR"))
     rne = mechbal.control.MechanismDynamics(model)
-    q, qd, qdd = (rng.uniform(-1, 1, (1, 6)) for _ in range(3))
-    med, p99 = median_per_call_ns(lambda: rne.inverse_dynamics(q, qd, qdd), calls)
+    q, v, a = (rng.uniform(-1, 1, (1, 6)) for _ in range(3))
+    med, p99 = median_per_call_ns(lambda: rne.inverse_dynamics(q, v, a), calls)
     results["per_call"]["id6_mechbal"] = {"median_ns": med, "p99_ns": p99}
     chain10 = mechbal.Mechanism(chain_from_specs(random_chain_specs(rng, "R" * 10)))
     q10, v10, a10 = (rng.uniform(-1, 1, 10) for _ in range(3))
@@ -233,8 +233,8 @@ def main(argv=None):
     # controller ticks through the bindings (1-D numpy arrays in, (tau, status) / status out)
     n = 6
     ct = mechbal.ComputedTorque(rne, np.full(n, 100.0), np.full(n, 20.0))
-    q, qd, q_d, qd_d, qdd_d = (rng.uniform(-1, 1, n) for _ in range(5))
-    med, p99 = median_per_call_ns(lambda: ct.step(q, qd, q_d, qd_d, qdd_d), calls)
+    q, v, q_d, v_d, a_d = (rng.uniform(-1, 1, n) for _ in range(5))
+    med, p99 = median_per_call_ns(lambda: ct.step(q, v, q_d, v_d, a_d), calls)
     results["per_call"]["ct6_mechbal"] = {"median_ns": med, "p99_ns": p99}
     arm = mechbal.Arm2DofDynamics(mechbal.Arm2DofParameters())
     ct2 = mechbal.ComputedTorque(arm, np.full(2, 100.0), np.full(2, 20.0))
@@ -242,7 +242,7 @@ def main(argv=None):
     med, p99 = median_per_call_ns(lambda: ct2.step(q2, qd2, q2_d, qd2_d, qdd2_d), calls)
     results["per_call"]["ct2_closed_form"] = {"median_ns": med, "p99_ns": p99}
     out6, out2 = np.zeros(n), np.zeros(2)
-    med, p99 = median_per_call_ns(lambda: ct.step_into(q, qd, q_d, qd_d, qdd_d, out6), calls)
+    med, p99 = median_per_call_ns(lambda: ct.step_into(q, v, q_d, v_d, a_d, out6), calls)
     results["per_call"]["ct6_step_into"] = {"median_ns": med, "p99_ns": p99}
     med, p99 = median_per_call_ns(lambda: ct2.step_into(q2, qd2, q2_d, qd2_d, qdd2_d, out2), calls)
     results["per_call"]["ct2_step_into"] = {"median_ns": med, "p99_ns": p99}

@@ -19,8 +19,8 @@ pybind11::dict batch_inverse_dynamics(Dynamics& d, const Array& q, const Array& 
   const auto n = static_cast<pybind11::ssize_t>(d.dof());
   require_shape(q, "q", {-1, n});
   const auto N = q.shape(0);
-  require_shape(qd, "qd", {N, n});
-  require_shape(qdd, "qdd", {N, n});
+  require_shape(qd, "v", {N, n});
+  require_shape(qdd, "a", {N, n});
   OutArray tau = make_array({N, n}), F = make_array({N, 3}), M = make_array({N, 3});
   auto per_instant = make_status_array(N);
   using CVec = Eigen::Map<const Eigen::VectorXd>;

@@ -23,7 +23,7 @@ namespace {
 void bind_discs(py::module_& m) {
   py::class_<DecoupledJointController, JointController> dc(
       m, "DecoupledJointController",
-      "tau_i = k_i (qdd_d + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho "
+      "tau_i = k_i (a_des + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho "
       "eqs 15, 26, 36)");
   dc.def(py::init([](const Array& k, const Array& kp, const Array& kd,
                        const py::object& torque_limit, double max_position, double max_speed,

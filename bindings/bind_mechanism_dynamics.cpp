@@ -40,13 +40,13 @@ void bind_mechanism_dynamics(py::module_& m) {
       .def(
           "forward_dynamics",
           [](MechanismDynamics& d, const Array& q, const Array& qd, const Array& tau) {
-            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "qd"),
+            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "v"),
                                   tau_ = one_state(d, tau, "tau");
             Eigen::VectorXd a = Eigen::VectorXd::Zero(d.dof());
             raise_unless_ok(d.forward_dynamics(q_, qd_, tau_, a), "MechanismDynamics.forward_dynamics");
             return a;
           },
-          py::arg("q"), py::arg("qd"), py::arg("tau"), "Accelerations a = M^-1 (tau - b) (actuated coordinates)")
+          py::arg("q"), py::arg("v"), py::arg("tau"), "Accelerations a = M^-1 (tau - b) (actuated coordinates)")
       .def_property_readonly("solved_position",
                              [](const MechanismDynamics& d) { return Eigen::VectorXd(d.solved_position()); })
       .def_property_readonly("dof", &MechanismDynamics::dof)
@@ -55,9 +55,9 @@ void bind_mechanism_dynamics(py::module_& m) {
           [](MechanismDynamics& d, const Array& q, const Array& qd, const Array& qdd) {
             return batch_inverse_dynamics(d, q, qd, qdd);
           },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          py::arg("q"), py::arg("v"), py::arg("a"),
           "Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, "
-          "support_moment about the base origin, (N, 3)); q, qd, qdd each (N, dof). Instants with "
+          "support_moment about the base origin, (N, 3)); q, v, a each (N, dof). Instants with "
           "non-finite input give zeros and set their flag in `status`.")
       .def(
           "mass_matrix",
@@ -89,21 +89,21 @@ void bind_mechanism_dynamics(py::module_& m) {
       .def(
           "bias",
           [](MechanismDynamics& d, const Array& q, const Array& qd) {
-            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "qd");
+            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "v");
             Eigen::VectorXd b = Eigen::VectorXd::Zero(d.dof());
             raise_unless_ok(d.bias(q_, qd_, b), "MechanismDynamics.bias");
             return b;
           },
-          py::arg("q"), py::arg("qd"), "Bias torques C(q, qd) qd + G(q) + K(q) (springs included)")
+          py::arg("q"), py::arg("v"), "Bias torques C(q, v) v + G(q) + K(q) (springs included)")
       .def(
           "coriolis",
           [](MechanismDynamics& d, const Array& q, const Array& qd) {
-            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "qd");
+            const Eigen::VectorXd q_ = one_state(d, q, "q"), qd_ = one_state(d, qd, "v");
             Eigen::VectorXd c = Eigen::VectorXd::Zero(d.dof());
             raise_unless_ok(d.coriolis(q_, qd_, c), "MechanismDynamics.coriolis");
             return c;
           },
-          py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques C(q, qd) qd");
+          py::arg("q"), py::arg("v"), "Coriolis and centrifugal torques C(q, v) v");
 
   py::class_<KdlChainDynamics, InverseDynamics>(
       m, "KdlChainDynamics",
@@ -124,7 +124,7 @@ void bind_mechanism_dynamics(py::module_& m) {
           [](KdlChainDynamics& d, const Array& q, const Array& qd, const Array& qdd) {
             return batch_inverse_dynamics(d, q, qd, qdd);
           },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          py::arg("q"), py::arg("v"), py::arg("a"),
           "Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, "
           "support_moment about the base origin, (N, 3)) by KDL's ChainIdSolver_RNE.")
       .def(
@@ -140,12 +140,12 @@ void bind_mechanism_dynamics(py::module_& m) {
           "coriolis",
           [](KdlChainDynamics& d, const Array& q, const Array& qd) {
             const Eigen::VectorXd q_ = vector_arg(q, "q", d.dof(), false, "one value per joint");
-            const Eigen::VectorXd qd_ = vector_arg(qd, "qd", d.dof(), false, "one value per joint");
+            const Eigen::VectorXd qd_ = vector_arg(qd, "v", d.dof(), false, "one value per joint");
             Eigen::VectorXd c = Eigen::VectorXd::Zero(d.dof());
             raise_unless_ok(d.coriolis(q_, qd_, c), "KdlChainDynamics.coriolis");
             return c;
           },
-          py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques C(q, qd) qd")
+          py::arg("q"), py::arg("v"), "Coriolis and centrifugal torques C(q, v) v")
       .def(
           "gravity",
           [](KdlChainDynamics& d, const Array& q) {

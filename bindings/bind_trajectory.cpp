@@ -37,7 +37,7 @@ or minimum-energy cubic law (Arakelian et al. 2011, eqs 10-13).)doc")
              t.evaluate(time, q, qd, qdd);
              return py::make_tuple(q, qd, qdd);
            },
-           py::arg("t"), "(q, qd, qdd) at time t")
+           py::arg("t"), "(q, v, a) at time t")
       .def("evaluate_batch",
            [](const RestToRestTrajectory& t, const Array& times) {
              require_shape(times, "times", {-1});
@@ -49,7 +49,7 @@ or minimum-energy cubic law (Arakelian et al. 2011, eqs 10-13).)doc")
                               qdd.mutable_data());
              return py::make_tuple(q, qd, qdd);
            },
-           py::arg("times"), "(q, qd, qdd), each (N, size), at the N given times");
+           py::arg("times"), "(q, v, a), each (N, size), at the N given times");
 }
 
 }  // namespace

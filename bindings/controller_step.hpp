@@ -47,10 +47,10 @@ pybind11::tuple controller_step(Controller& c, const Array& q, const Array& qd, 
   const auto n = static_cast<pybind11::ssize_t>(c.dof());
   const std::string context = "the controller has " + std::to_string(n) + " joints";
   const Eigen::VectorXd q_ = vector_arg(q, "q", n, false, context.c_str());
-  const Eigen::VectorXd qd_ = vector_arg(qd, "qd", n, false, context.c_str());
+  const Eigen::VectorXd qd_ = vector_arg(qd, "v", n, false, context.c_str());
   const Eigen::VectorXd q_des_ = vector_arg(q_des, "q_des", n, false, context.c_str());
-  const Eigen::VectorXd qd_des_ = vector_arg(qd_des, "qd_des", n, false, context.c_str());
-  const Eigen::VectorXd qdd_des_ = vector_arg(qdd_des, "qdd_des", n, false, context.c_str());
+  const Eigen::VectorXd qd_des_ = vector_arg(qd_des, "v_des", n, false, context.c_str());
+  const Eigen::VectorXd qdd_des_ = vector_arg(qdd_des, "a_des", n, false, context.c_str());
   Eigen::VectorXd tau = c.last_command();
   const Status s = c.step(q_, qd_, q_des_, qd_des_, qdd_des_, tau);
   return pybind11::make_tuple(tau, s);
@@ -136,10 +136,10 @@ std::uint32_t controller_step_into(Controller& c, FastArg q, FastArg qd, FastArg
   const auto n = static_cast<pybind11::ssize_t>(c.dof());
   using CMap = Eigen::Map<const Eigen::VectorXd>;
   const double* q_ = detail::fast_array(q.h, "q", n);
-  const double* qd_ = detail::fast_array(qd.h, "qd", n);
+  const double* qd_ = detail::fast_array(qd.h, "v", n);
   const double* q_des_ = detail::fast_array(q_des.h, "q_des", n);
-  const double* qd_des_ = detail::fast_array(qd_des.h, "qd_des", n);
-  const double* qdd_des_ = detail::fast_array(qdd_des.h, "qdd_des", n);
+  const double* qd_des_ = detail::fast_array(qd_des.h, "v_des", n);
+  const double* qdd_des_ = detail::fast_array(qdd_des.h, "a_des", n);
   Eigen::Map<Eigen::VectorXd> tau(detail::fast_array(out.h, "out", n, true), n);
   return static_cast<std::uint32_t>(c.step(CMap(q_, n), CMap(qd_, n), CMap(q_des_, n),
                                            CMap(qd_des_, n), CMap(qdd_des_, n), tau));
@@ -154,10 +154,10 @@ pybind11::dict controller_run(Controller& c, const Array& q, const Array& qd, co
   const std::string context = "the controller has " + std::to_string(n) + " joints";
   require_shape(q, "q", {-1, n}, context.c_str());
   const auto N = q.shape(0);
-  require_shape(qd, "qd", {N, n}, context.c_str());
+  require_shape(qd, "v", {N, n}, context.c_str());
   require_shape(q_des, "q_des", {N, n}, context.c_str());
-  require_shape(qd_des, "qd_des", {N, n}, context.c_str());
-  require_shape(qdd_des, "qdd_des", {N, n}, context.c_str());
+  require_shape(qd_des, "v_des", {N, n}, context.c_str());
+  require_shape(qdd_des, "a_des", {N, n}, context.c_str());
   OutArray tau = make_array({N, n});
   auto status = make_status_array(N);
   using CMap = Eigen::Map<const Eigen::VectorXd>;
@@ -176,25 +176,68 @@ pybind11::dict controller_run(Controller& c, const Array& q, const Array& qd, co
   return d;
 }
 
+/// The keyword names of earlier releases (qd, qd_des, qdd_des), accepted for one release: a
+/// second overload of step / step_into / run that renames them (a DeprecationWarning each) and
+/// calls the method again. Positional calls never reach it (the first overload takes them).
+inline pybind11::object call_with_renamed_kwargs(const pybind11::object& self, const char* method,
+                                                 const pybind11::args& args,
+                                                 const pybind11::kwargs& kwargs) {
+  static const char* const renames[][2] = {{"qd", "v"}, {"qd_des", "v_des"}, {"qdd_des", "a_des"}};
+  pybind11::dict kw;
+  bool renamed = false;
+  for (const auto& item : kwargs) {
+    std::string key = pybind11::str(item.first);
+    for (const auto& r : renames) {
+      if (key == r[0]) {
+        const std::string message = std::string(method) + ": '" + r[0] + "' is deprecated, use '" +
+                                    r[1] + "' (the old name goes in the next release)";
+        if (PyErr_WarnEx(PyExc_DeprecationWarning, message.c_str(), 1) < 0)
+          throw pybind11::error_already_set();
+        if (kwargs.contains(r[1]))
+          throw pybind11::type_error(std::string(method) + ": got both '" + r[0] +
+                                     "' (deprecated) and '" + r[1] + "'");
+        key = r[1];
+        renamed = true;
+        break;
+      }
+    }
+    kw[pybind11::str(key)] = item.second;
+  }
+  if (!renamed)
+    throw pybind11::type_error(std::string(method) +
+                               "(): incompatible arguments; the signature is (q, v, q_des, v_des, "
+                               "a_des" + (std::string(method) == "step_into" ? ", out)" : ")"));
+  return self.attr(method)(*args, **kw);
+}
+
 /// step, step_into, run and reset of a joint controller class (the same methods on every one).
 template <typename Controller, typename PyClass>
 void bind_joint_controller_ticks(PyClass& cls) {
   namespace py = pybind11;
-  cls.def("step", &controller_step<Controller>, py::arg("q"), py::arg("qd"), py::arg("q_des"),
-          py::arg("qd_des"), py::arg("qdd_des"),
+  static constexpr const char* deprecated_doc =
+      "Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release";
+  cls.def("step", &controller_step<Controller>, py::arg("q"), py::arg("v"), py::arg("q_des"),
+          py::arg("v_des"), py::arg("a_des"),
           "One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or "
           "out-of-range input returns the held command and a non-ok status.")
-      .def("step_into", &controller_step_into<Controller>, py::arg("q"), py::arg("qd"),
-           py::arg("q_des"), py::arg("qd_des"), py::arg("qdd_des"), py::arg("out"),
+      .def("step_into", &controller_step_into<Controller>, py::arg("q"), py::arg("v"),
+           py::arg("q_des"), py::arg("v_des"), py::arg("a_des"), py::arg("out"),
            "The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n "
            "values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every "
            "argument must be a C-contiguous float64 numpy array of n values; nothing is copied or "
            "allocated.")
-      .def("run", &controller_run<Controller>, py::arg("q"), py::arg("qd"), py::arg("q_des"),
-           py::arg("qd_des"), py::arg("qdd_des"),
-           "N consecutive ticks in one call: q, qd [rad or m, rad/s or m/s], q_des, qd_des, "
-           "qdd_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}")
+      .def("run", &controller_run<Controller>, py::arg("q"), py::arg("v"), py::arg("q_des"),
+           py::arg("v_des"), py::arg("a_des"),
+           "N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, "
+           "a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}")
       .def("reset", &Controller::reset, "Forget the held command (zero torque).");
+  for (const char* method : {"step", "step_into", "run"})
+    cls.def(
+        method,
+        [method](const py::object& self, const py::args& args, const py::kwargs& kwargs) {
+          return call_with_renamed_kwargs(self, method, args, kwargs);
+        },
+        deprecated_doc);
 }
 
 /// The input range of a joint controller from the Python keyword arguments.

@@ -21,7 +21,7 @@ slots = [CounterweightSlot("shoulder_counterweight", link="upper_arm", mass_max=
          CounterweightSlot("elbow_counterweight", link="forearm", mass_max=5.0, max_radius=0.10)]
 result = static.balance(arm, slots, samples=200)
 for name, cw in result.design.items():
-    print(f"{name}: {cw['mass']:.4f} kg at {np.round(cw['position'], 4)} m in {cw['frame']}")
+    print(f"{name}: {cw.mass:.4f} kg at {np.round(cw.position, 4)} m in {cw.frame}")
 print(f"RMS gravity torque over the sample: {result.residual_before:.3f} N m before, "
       f"{result.residual:.1e} N m after (exact: {result.exact})")
 
@@ -37,6 +37,6 @@ assert result.exact and after < 1e-9 * before
 # everything on the shoulder axis. Link masses 2.0 / 1.0 kg at 0.2 / 0.15 m, upper arm 0.4 m.
 m_elbow = 1.0 * 0.15 / 0.10
 m_shoulder = (2.0 * 0.2 + (1.0 + m_elbow) * 0.4) / 0.15
-assert abs(result.design["elbow_counterweight"]["mass"] - m_elbow) < 1e-9
-assert abs(result.design["shoulder_counterweight"]["mass"] - m_shoulder) < 1e-9
+assert abs(result.design["elbow_counterweight"].mass - m_elbow) < 1e-9
+assert abs(result.design["shoulder_counterweight"].mass - m_shoulder) < 1e-9
 print(f"closed form: {m_shoulder:.4f} kg and {m_elbow:.4f} kg: agree")

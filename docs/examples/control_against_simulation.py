@@ -42,19 +42,19 @@ assert run.ok and np.abs(run.tracking_error).max() < 1e-3
 plant = control.MechanismDynamics(robot.model)
 controller.reset()
 dt, steps = 1e-3, 1000
-q, qd = np.array([0.05, -0.05]), np.zeros(2)
+q, v = np.array([0.05, -0.05]), np.zeros(2)
 tau = np.zeros(robot.dof)  # preallocated output of step_into
-q_des, qd_des, qdd_des = motion.evaluate(np.arange(steps) * dt)
+q_des, v_des, a_des = motion.evaluate(np.arange(steps) * dt)
 statuses = np.zeros(steps, dtype=np.uint32)
 for k in range(steps):
-    statuses[k] = controller.step_into(q, qd, q_des[k], qd_des[k], qdd_des[k], tau)
-    qdd = plant.forward_dynamics(q, qd, tau)   # the plant: M(q) qdd = tau - C qd - G
-    qd = qd + dt * qdd                          # semi-implicit Euler
-    q = q + dt * qd
+    statuses[k] = controller.step_into(q, v, q_des[k], v_des[k], a_des[k], tau)
+    a = plant.forward_dynamics(q, v, tau)       # the plant: M(q) a = tau - C v - G
+    v = v + dt * a                              # semi-implicit Euler
+    q = q + dt * v
 print(f"ticked from Python: final error {np.abs(q - motion.evaluate(steps * dt)[0]).max():.2e} rad, "
       f"non-ok ticks: {np.count_nonzero(statuses)}")
 assert not statuses.any() and np.abs(q - motion.evaluate(1.0)[0]).max() < 1e-2
 
 # Batch: the controller over a whole recorded (N, n) log in one call.
-batch = controller.run(run.q, run.qd, run.q_des, run.qd_des, np.zeros_like(run.q))
+batch = controller.run(run.q, run.v, run.q_des, run.v_des, np.zeros_like(run.q))
 print("batch of", batch.joint_torque.shape[0], "ticks: statuses", set(batch.status.tolist()))

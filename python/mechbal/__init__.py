@@ -10,8 +10,10 @@ The public API (SI units throughout: m, kg, kg m^2, rad, s, N, N m; base frame z
 * `mechbal.control`: the real-time controllers (computed torque, decoupled joint control,
   reactionless wrist, PAMINSA), tick by tick and in batch;
 * `mechbal.trajectory`: desired motions (quintic, minimum-energy cubic, via points, a user's
-  samples) with one `evaluate(t) -> (q, qd, qdd)`;
+  samples) with one `evaluate(t) -> Motion(q, v, a)`;
 * `mechbal.simulate`: closed loop of any controller on any mechanism;
+* `mechbal.sweep`: sensitivity and tolerance sweeps over a case's parameters;
+* `mechbal.export`: URDF and MJCF files of a mechanism, bodies files, the MuJoCo engine;
 * `mechbal.papers`: what exists only to reproduce a paper (closed forms, per-paper models);
 * `mechbal.cases`: the built-in case studies and `run_case(name, out_dir)`.
 
@@ -23,7 +25,7 @@ of `Status` bit flags (0 = ok). The C++ core is ``mechbal._core`` (typed in
 from __future__ import annotations
 
 import importlib
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from mechbal._core import Status, __version__
 from mechbal._core import (  # the description objects of Mechanism.from_description
@@ -34,12 +36,19 @@ from mechbal.mechanism import (
     BaseReaction, BatchArray, BodyMotion, ClosedMotion, Mechanism, Momentum, ShakingWrench)
 from mechbal import assembly, balance, control, papers, simulate, trajectory
 
+if TYPE_CHECKING:  # loaded on first use (module __getattr__ below): `import mechbal` stays quick
+    from mechbal import cases, export, sweep
+
 __all__ = [
     "Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion", "BatchArray",
     "Joint", "JointType", "Body", "Frame", "LoopConstraint", "LoopType", "MechanismDescription", "Spring",
     "MechanismModel", "Status", "ConfigError", "ConfigWarning", "PlausibilityWarning",
-    "load_case", "balance", "control", "trajectory", "simulate", "assembly", "papers", "cases", "__version__",
+    "load_case", "balance", "control", "trajectory", "simulate", "assembly", "papers", "cases", "sweep",
+    "export", "__version__",
 ]
+
+#: public subpackages loaded on first use (their imports cost more than `import mechbal` itself)
+_LAZY = {"cases", "sweep", "export"}
 
 # Names that lived here before the public modules existed (kept so that existing scripts run);
 # each has its home in a public module, listed in _MOVED.
@@ -56,8 +65,8 @@ _LEGACY_CORE = {"RestToRestTrajectory", "validate_rigid_body"}
 
 
 def __getattr__(name: str) -> Any:
-    if name == "cases":
-        return importlib.import_module("mechbal.cases")
+    if name in _LAZY:
+        return importlib.import_module(f"mechbal.{name}")
     if name in _MOVED:
         return getattr(importlib.import_module(f"mechbal.{_MOVED[name]}"), name)
     if name in _LEGACY_CORE:

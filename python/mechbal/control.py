@@ -4,9 +4,9 @@ The classes here are the C++ controllers themselves (Python subclasses that add 
 a tick from Python runs the same ``noexcept``, allocation-free ``step()`` an embedded 1 kHz loop
 calls.
 
-* `ComputedTorque`: `tau = M(q) (qdd_des + Kp e + Kd e') + C(q, qd) qd + G(q)` over any
+* `ComputedTorque`: `tau = M(q) (a_des + Kp e + Kd e') + C(q, v) v + G(q)` over any
   dynamics back end (Arakelian, Le Baron & Mottu 2011, eqs 2-6);
-* `DecoupledJointController`: `tau_i = k_i (qdd_des + Kp e + Kd e')` for a dynamically balanced
+* `DecoupledJointController`: `tau_i = k_i (a_des + Kp e + Kd e')` for a dynamically balanced
   arm whose mass matrix is diagonal and constant (Coutinho & Hess Coelho, eqs 15, 26, 36);
 * `PassiveController`: no controller, zero effort every tick (a passive simulation: gravity and
   springs move the mechanism; `mechbal.simulate.passive`);
@@ -22,13 +22,16 @@ calls.
 Three ways to tick a joint controller (``n`` joints; positions in rad or m, velocities in rad/s
 or m/s, accelerations in rad/s^2 or m/s^2, torques in N m or forces in N):
 
-* ``step(q, qd, q_des, qd_des, qdd_des) -> JointCommand(joint_torque, status)``: any real
+* ``step(q, v, q_des, v_des, a_des) -> JointCommand(joint_torque, status)``: any real
   array-like input;
-* ``step_into(q, qd, q_des, qd_des, qdd_des, out) -> int``: the fast tick (about a microsecond;
+* ``step_into(q, v, q_des, v_des, a_des, out) -> int``: the fast tick (about a microsecond;
   ``bench/bench_python.py``): C-contiguous float64 arrays only, the torque written into the
   preallocated ``out``, the status returned;
-* ``run(q, qd, q_des, qd_des, qdd_des) -> ControlRun``: N consecutive ticks over (N, n) arrays
+* ``run(q, v, q_des, v_des, a_des) -> ControlRun``: N consecutive ticks over (N, n) arrays
   in one C++ call.
+
+The keyword names of earlier releases (``qd``, ``qd_des``, ``qdd_des``) still work for one
+release and raise a `DeprecationWarning`.
 
 Statuses are bit flags of `mechbal.Status` (0 = ok), one per tick (``status`` arrays in
 batch results, as in every batch result of mechbal). Non-finite or out-of-range input never
@@ -37,25 +40,27 @@ raises in a tick: it returns the held (last safe) command and a non-ok status.
 The dynamics back ends a `ComputedTorque` computes over are here too:
 `MechanismDynamics` (the general model, any mechanism, closed loops included),
 `KdlChainDynamics` (Orocos KDL on a serial MechanismModel, the independent engine), and the
-papers' closed forms in `mechbal.papers`.
+papers' closed forms in `mechbal.papers`. Their ``inverse_dynamics(q, v, a)`` returns an
+`InverseDynamicsResult` (``joint_torque``, ``support_force``, ``support_moment``, ``status``).
 
 Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
 from mechbal import _core
+from mechbal._deprecation import DeprecatedAttributes, renamed_kwargs
 
 __all__ = [
     "ComputedTorque", "DecoupledJointController", "PassiveController", "ReactionlessWrist", "ReactionlessWristConfig",
     "WristIntegrator", "WristCommand", "PaminsaController", "JointController", "JointCommand",
     "ControlRun", "WristRun", "PaminsaRun", "InverseDynamics", "ForwardDynamics",
-    "MechanismDynamics", "KdlChainDynamics", "Status", "status_text",
+    "MechanismDynamics", "KdlChainDynamics", "InverseDynamicsResult", "Status", "status_text",
     "ReactionlessController", "ReactionlessCommand", "ReactionlessRun", "ReactionlessJointController",
     "ReactionlessTaskController", "TaskSpaceRun",
 ]
@@ -64,8 +69,6 @@ Status = _core.Status
 JointController = _core.JointController
 InverseDynamics = _core.InverseDynamics
 ForwardDynamics = _core.ForwardDynamics
-MechanismDynamics = _core.MechanismDynamics
-KdlChainDynamics = _core.KdlChainDynamics
 ReactionlessWristConfig = _core.ReactionlessWristConfig
 WristIntegrator = _core.WristIntegrator
 WristCommand = _core.WristCommand
@@ -75,6 +78,153 @@ ReactionlessJointController = _core.ReactionlessJointController
 def status_text(status: int) -> str:
     """The names of the flags set in a status (``"ok"`` for 0), e.g. ``"saturated"``."""
     return str(_core.status_name(int(status)))
+
+
+FloatArray = npt.NDArray[np.float64]
+StatusArray = npt.NDArray[np.uint32]
+
+
+@dataclass(frozen=True)
+class InverseDynamicsResult(DeprecatedAttributes):
+    """Inverse dynamics of a dynamics back end (`MechanismDynamics`, `KdlChainDynamics`):
+    ``joint_torque`` (N, dof) [N m or N], the wrench the base exerts on the chain
+    ``support_force`` [N] and ``support_moment`` about the base origin [N m] (N, 3), and
+    ``status`` (N,) per instant (instants with non-finite input give zeros and their flag). A
+    single sample (1-D q, v, a) gives (dof,), (3,), (3,) and a 0-d ``status``.
+
+    The dict of earlier releases is read for one release with a DeprecationWarning:
+    ``result["tau"]``, ``["support_force"]``, ``["support_moment"]``, ``["status"]`` (the OR of
+    every instant's flags) and ``["status_per_instant"]``."""
+
+    joint_torque: FloatArray
+    support_force: FloatArray
+    support_moment: FloatArray
+    status: StatusArray
+
+    _renamed: ClassVar[dict[str, str]] = {"tau": "joint_torque"}
+    _dict_keys: ClassVar[dict[str, str]] = {
+        "tau": "joint_torque", "support_force": "support_force",
+        "support_moment": "support_moment", "status": "status", "status_per_instant": "status"}
+
+    def _dict_value(self, key: str, attribute: str) -> Any:
+        if key == "status":
+            return int(np.bitwise_or.reduce(np.atleast_1d(self.status)))
+        if key == "status_per_instant":
+            return np.atleast_1d(self.status)
+        return getattr(self, attribute)
+
+    @property
+    def ok(self) -> bool:
+        """True when every instant's status is 0 (ok)."""
+        return bool(np.all(self.status == 0))
+
+
+def _states(where: str, dof: int, **arrays: npt.ArrayLike) -> tuple[bool, list[FloatArray]]:
+    """(single, [(N, dof) float64 C-contiguous arrays]) from (dof,) or (N, dof) array-likes; a
+    ValueError / TypeError naming the argument otherwise."""
+    out: list[FloatArray] = []
+    single: bool | None = None
+    first = ""
+    for name, value in arrays.items():
+        a = np.asarray(value)
+        if a.dtype.kind not in "iuf":
+            raise TypeError(f"{where}: {name} must be real numbers (int or float), got dtype "
+                            f"{a.dtype}")
+        if a.ndim not in (1, 2) or a.shape[-1] != dof:
+            raise ValueError(f"{where}: {name} must have shape ({dof},) or (N, {dof}), got "
+                             f"{a.shape}")
+        is_single = a.ndim == 1
+        a2 = a.reshape(1, -1) if is_single else a
+        if a2.dtype.char != "d" or not a2.flags.c_contiguous:  # not float64 C-contiguous
+            a2 = np.ascontiguousarray(a2, dtype=np.float64)
+        if single is None:
+            single, first = is_single, name
+        elif is_single != single or a2.shape[0] != out[0].shape[0]:
+            raise ValueError(f"{where}: {name} has shape {a.shape}, which does not match {first} "
+                             f"{np.shape(arrays[first])}")
+        out.append(a2)
+    return bool(single), out
+
+
+def _inverse_dynamics(backend: Any, base: Any, q: npt.ArrayLike, v: npt.ArrayLike,
+                      a: npt.ArrayLike) -> InverseDynamicsResult:
+    where = f"{type(backend).__name__}.inverse_dynamics"
+    single, (q2, v2, a2) = _states(where, int(backend.dof), q=q, v=v, a=a)
+    r = base.inverse_dynamics(backend, q2, v2, a2)
+    tau = np.asarray(r["tau"])
+    force = np.asarray(r["support_force"])
+    moment = np.asarray(r["support_moment"])
+    status = np.asarray(r["status_per_instant"], dtype=np.uint32)
+    if single:
+        if status[0] != 0:
+            raise ValueError(f"{where}: input rejected ({status_text(int(status[0]))}); q, v, a "
+                             "must be finite and give finite results")
+        return InverseDynamicsResult(tau[0], force[0], moment[0], status[0, ...])
+    return InverseDynamicsResult(tau, force, moment, status)
+
+
+class MechanismDynamics(_core.MechanismDynamics):
+    """Joint-space dynamics of a ``MechanismModel`` in its actuated coordinates (recursive
+    Newton-Euler inverse dynamics with the base support wrench, composite rigid body mass matrix,
+    loops solved each call, warm-started from ``q_guess``): the dynamics back end of the general
+    model for `ComputedTorque` and the simulators.
+
+    Args:
+        model: the ``MechanismModel`` (``Mechanism.model``).
+        q_guess: every coordinate near the assembly [rad or m] (closed loops; default: none).
+
+    ``inverse_dynamics(q, v, a)`` -> `InverseDynamicsResult`; ``forward_dynamics(q, v, tau)``,
+    ``bias(q, v)``, ``coriolis(q, v)``, ``mass_matrix(q)``, ``gravity(q)``,
+    ``static_torque(q)`` -> arrays (one sample).
+    """
+
+    @renamed_kwargs(qd="v", qdd="a")
+    def inverse_dynamics(self, q: npt.ArrayLike, v: npt.ArrayLike,  # type: ignore[override]
+                         a: npt.ArrayLike) -> InverseDynamicsResult:
+        """Joint torques and the base support wrench at one sample ((dof,) each) or N samples
+        ((N, dof) each): `InverseDynamicsResult`."""
+        return _inverse_dynamics(self, _core.MechanismDynamics, q, v, a)
+
+    @renamed_kwargs(qd="v")
+    def forward_dynamics(self, q: npt.ArrayLike, v: npt.ArrayLike,  # type: ignore[override]
+                         tau: npt.ArrayLike) -> FloatArray:
+        """Accelerations a = M^-1 (tau - b) (dof,) [rad/s^2 or m/s^2] at one sample."""
+        return np.asarray(super().forward_dynamics(q, v, tau))
+
+    @renamed_kwargs(qd="v")
+    def bias(self, q: npt.ArrayLike, v: npt.ArrayLike) -> FloatArray:  # type: ignore[override]
+        """Bias torques C(q, v) v + G(q) + K(q) (springs included) (dof,) [N m or N]."""
+        return np.asarray(super().bias(q, v))
+
+    @renamed_kwargs(qd="v")
+    def coriolis(self, q: npt.ArrayLike, v: npt.ArrayLike) -> FloatArray:  # type: ignore[override]
+        """Coriolis and centrifugal torques C(q, v) v (dof,) [N m or N]."""
+        return np.asarray(super().coriolis(q, v))
+
+
+class KdlChainDynamics(_core.KdlChainDynamics):
+    """Joint-space dynamics of a serial ``MechanismModel`` through Orocos KDL (the independent
+    engine; bodies lumped per link); ValueError naming the link or joint when the model is not a
+    serial chain.
+
+    Args:
+        model: the ``MechanismModel`` (``Mechanism.model``).
+
+    ``inverse_dynamics(q, v, a)`` -> `InverseDynamicsResult` (KDL's ``ChainIdSolver_RNE``);
+    ``coriolis(q, v)``, ``mass_matrix(q)``, ``gravity(q)`` -> arrays (one sample).
+    """
+
+    @renamed_kwargs(qd="v", qdd="a")
+    def inverse_dynamics(self, q: npt.ArrayLike, v: npt.ArrayLike,  # type: ignore[override]
+                         a: npt.ArrayLike) -> InverseDynamicsResult:
+        """Joint torques and the base support wrench at one sample ((dof,) each) or N samples
+        ((N, dof) each): `InverseDynamicsResult`."""
+        return _inverse_dynamics(self, _core.KdlChainDynamics, q, v, a)
+
+    @renamed_kwargs(qd="v")
+    def coriolis(self, q: npt.ArrayLike, v: npt.ArrayLike) -> FloatArray:  # type: ignore[override]
+        """Coriolis and centrifugal torques C(q, v) v (dof,) [N m or N]."""
+        return np.asarray(super().coriolis(q, v))
 
 
 class JointCommand(NamedTuple):
@@ -132,7 +282,7 @@ class PaminsaRun:
     status: np.ndarray
 
 
-def _control_run(result: dict) -> ControlRun:
+def _control_run(result: dict[str, Any]) -> ControlRun:
     return ControlRun(joint_torque=np.asarray(result["joint_torque"]),
                       status=np.asarray(result["status"]))
 
@@ -142,7 +292,7 @@ def _dynamics(model: Any, q_guess: npt.ArrayLike | None) -> Any:
 
     if isinstance(model, Mechanism):
         guess = np.zeros(model.dof) if q_guess is None else np.asarray(q_guess, dtype=float)
-        return _core.MechanismDynamics(model.model, guess)
+        return MechanismDynamics(model.model, guess)
     if q_guess is not None:
         raise ValueError("q_guess is for a Mechanism model (closed loops); a dynamics back end "
                          "was given")
@@ -151,7 +301,7 @@ def _dynamics(model: Any, q_guess: npt.ArrayLike | None) -> Any:
 
 class ComputedTorque(_core.ComputedTorque):
     """Computed-torque control (Arakelian, Le Baron & Mottu 2011, eqs 2-6):
-    ``tau = M(q) (qdd_des + Kp (q_des - q) + Kd (qd_des - qd)) + C(q, qd) qd + G(q)``, clipped
+    ``tau = M(q) (a_des + Kp (q_des - q) + Kd (v_des - v)) + C(q, v) v + G(q)``, clipped
     to ``torque_limit``; with an exact model the error obeys ``e'' + Kd e' + Kp e = 0`` (eq 6).
 
     Args:
@@ -163,7 +313,7 @@ class ComputedTorque(_core.ComputedTorque):
         kd: derivative gains [1/s], one per joint.
         torque_limit: |tau| limit per joint [N m or N] (default and +inf: 1e4).
         **input_range: ``max_position``, ``max_speed``, ``max_acceleration``: the input range of a
-            tick (|q| [rad or m], |qd|, |qdd_des|); beyond it the tick holds the last command
+            tick (|q| [rad or m], |v|, |a_des|); beyond it the tick holds the last command
             with ``Status.out_of_range``.
         q_guess: with a closed-loop Mechanism, every joint coordinate near the assembly [rad or
             m] (picks the assembly mode the loop solve follows; default zeros).
@@ -177,21 +327,23 @@ class ComputedTorque(_core.ComputedTorque):
                  **input_range: float):
         super().__init__(_dynamics(model, q_guess), kp, kd, torque_limit, **input_range)
 
-    def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-             qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:
+    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
+    def step(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+             v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> JointCommand:
         """One tick: `JointCommand` (joint_torque (n,) [N m or N], status)."""
-        tau, status = super().step(q, qd, q_des, qd_des, qdd_des)
+        tau, status = super().step(q, v, q_des, v_des, a_des)
         return JointCommand(np.asarray(tau), int(status))
 
-    def run(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-            qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> ControlRun:
+    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
+    def run(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+            v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> ControlRun:
         """N consecutive ticks over (N, n) arrays in one C++ call: `ControlRun`."""
-        return _control_run(super().run(q, qd, q_des, qd_des, qdd_des))
+        return _control_run(super().run(q, v, q_des, v_des, a_des))
 
 
 class DecoupledJointController(_core.DecoupledJointController):
     """Decoupled joint control of a dynamically balanced arm (Coutinho & Hess Coelho, eqs 15,
-    26, 36): ``tau_i = k_i (qdd_des_i + Kp_i e_i + Kd_i e'_i)``, exact when counter-rotating
+    26, 36): ``tau_i = k_i (a_des_i + Kp_i e_i + Kd_i e'_i)``, exact when counter-rotating
     discs make the mass matrix diagonal and constant and gravity is balanced.
 
     Args:
@@ -204,16 +356,18 @@ class DecoupledJointController(_core.DecoupledJointController):
     tick as for `ComputedTorque`.
     """
 
-    def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-             qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:
+    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
+    def step(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+             v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> JointCommand:
         """One tick: `JointCommand` (joint_torque (n,) [N m or N], status)."""
-        tau, status = super().step(q, qd, q_des, qd_des, qdd_des)
+        tau, status = super().step(q, v, q_des, v_des, a_des)
         return JointCommand(np.asarray(tau), int(status))
 
-    def run(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-            qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> ControlRun:
+    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
+    def run(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+            v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> ControlRun:
         """N consecutive ticks over (N, n) arrays in one C++ call: `ControlRun`."""
-        return _control_run(super().run(q, qd, q_des, qd_des, qdd_des))
+        return _control_run(super().run(q, v, q_des, v_des, a_des))
 
 
 class PassiveController(_core.PassiveController):
@@ -226,16 +380,18 @@ class PassiveController(_core.PassiveController):
         dof: number of actuated coordinates (>= 1).
     """
 
-    def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-             qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:
+    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
+    def step(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+             v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> JointCommand:
         """One tick: `JointCommand` (zero joint_torque (n,), status)."""
-        tau, status = super().step(q, qd, q_des, qd_des, qdd_des)
+        tau, status = super().step(q, v, q_des, v_des, a_des)
         return JointCommand(np.asarray(tau), int(status))
 
-    def run(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-            qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> ControlRun:
+    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
+    def run(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+            v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> ControlRun:
         """N consecutive ticks over (N, n) arrays in one C++ call: `ControlRun`."""
-        return _control_run(super().run(q, qd, q_des, qd_des, qdd_des))
+        return _control_run(super().run(q, v, q_des, v_des, a_des))
 
 
 class ReactionlessWrist(_core.ReactionlessWrist):

@@ -24,11 +24,15 @@ import contextlib as _contextlib
 import contextvars as _contextvars
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from mechbal import _core
+
+#: what the public methods return: float64 arrays
+FloatArray = npt.NDArray[np.float64]
 
 __all__ = ["Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion",
            "BatchArray", "UrdfRepairWarning", "urdf_reading", "INERTIAL_PARAMETER_NAMES"]
@@ -317,7 +321,7 @@ class Mechanism:
             raise ConfigError("mechanism", str(exc), has_value=False) from None
         return cls(model, name=name, source=source, link_frames=getattr(spec, "link_frames", None))
 
-    def user_frame(self, link: str) -> np.ndarray:
+    def user_frame(self, link: str) -> FloatArray:
         """(4, 4) placement, in the link frame of ``link`` (the frame right after its joint's
         motion), of the frame the user described that link in: the standard-DH frame of a ``dh``
         joint of a TOML file, ``mechanism.base`` for ``base``, the identity otherwise (URDF link
@@ -357,7 +361,8 @@ class Mechanism:
                          link_frames=self.link_frames)
 
     # ---- export --------------------------------------------------------------------------------
-    def to_mjcf(self, path: str | Path | None = None, *, q=None, q_guess=None, name: str | None = None,
+    def to_mjcf(self, path: str | Path | None = None, *, q: npt.ArrayLike | None = None,
+                q_guess: npt.ArrayLike | None = None, name: str | None = None,
                 timestep: float = 1e-3) -> str:
         """MuJoCo model (MJCF) of this mechanism: tree, gears, loops, springs, every body with its
         own inertia, names kept (`mechbal.export.mjcf`); ``q``: the keyframe's pose (a closed
@@ -413,17 +418,17 @@ class Mechanism:
         return float(self.model.total_mass)
 
     @property
-    def gravity(self) -> np.ndarray:
+    def gravity(self) -> FloatArray:
         """Gravity acceleration in O [m/s^2] (3,)."""
         return np.array(self.model.gravity)
 
     @property
-    def bodies(self):
+    def bodies(self) -> list[_core.Body]:
         """The bodies (``mechbal.Body``: name, link, mass [kg], com [m], inertia [kg m^2])."""
         return list(self.model.bodies)
 
     @property
-    def springs(self):
+    def springs(self) -> list[_core.Spring]:
         """The springs (``mechbal.Spring``: name, link_a, anchor_a, link_b, anchor_b [m, link
         frames], rate [N/m], free_length [m], preload [N], count, pulley_ratio), in model order."""
         return list(self.model.springs)
@@ -493,7 +498,7 @@ class Mechanism:
         return [BatchArray(result[k], status) for k in keys], status
 
     # ---- algorithms --------------------------------------------------------------------------
-    def inverse_dynamics(self, q, v, a) -> np.ndarray:
+    def inverse_dynamics(self, q: npt.ArrayLike, v: npt.ArrayLike, a: npt.ArrayLike) -> FloatArray:
         """Joint forces tau = M(q) a + C(q, v) v + G(q) + K(q) [N m or N] (K: the springs' joint
         forces, `spring_torque`), gear couplings projected.
         A batch returns a `BatchArray` (N, dof) whose ``status`` (N,) flags the rejected
@@ -503,20 +508,20 @@ class Mechanism:
                                  ["joint_torque"])
         return tau
 
-    def mass_matrix(self, q) -> np.ndarray:
+    def mass_matrix(self, q: npt.ArrayLike) -> FloatArray:
         """Joint-space mass matrix M(q) (dof, dof) [kg m^2, kg]; a batch gives (N, dof, dof)."""
         single, (q,) = self._args(("q",), (q,))
         (M,), _ = self._finish(single, _core.mechanism_mass_matrix(self.model, q), ["mass_matrix"])
         return M
 
-    def gravity_torque(self, q) -> np.ndarray:
+    def gravity_torque(self, q: npt.ArrayLike) -> FloatArray:
         """Gravity torques G(q): the joint forces that hold the weights still [N m or N]; with
         springs, `static_torque` is what holds the mechanism still."""
         single, (q,) = self._args(("q",), (q,))
         (g,), _ = self._finish(single, _core.mechanism_gravity_torque(self.model, q), ["gravity_torque"])
         return g
 
-    def static_torque(self, q) -> np.ndarray:
+    def static_torque(self, q: npt.ArrayLike) -> FloatArray:
         """G(q) + K(q): the joint forces that hold the mechanism still, gravity and springs [N m
         or N] (`gravity_torque` without springs). Zero over the workspace exactly when the
         springs balance the mechanism statically."""
@@ -529,56 +534,56 @@ class Mechanism:
         (x,), _ = self._finish(single, _core.mechanism_springs(self.model, q), [key])
         return x
 
-    def spring_torque(self, q) -> np.ndarray:
+    def spring_torque(self, q: npt.ArrayLike) -> FloatArray:
         """K(q) = dV_springs/dq: the joint forces that hold the springs still [N m or N] (the
         convention of `gravity_torque`; ``cpp/include/mechbal/algorithm/springs.hpp``)."""
         return self._springs(q, "spring_torque")
 
-    def spring_lengths(self, q) -> np.ndarray:
+    def spring_lengths(self, q: npt.ArrayLike) -> FloatArray:
         """Anchor distance d of each spring [m]: (S,) or (N, S), columns as `spring_names`."""
         return self._springs(q, "spring_length")
 
-    def spring_tension(self, q) -> np.ndarray:
+    def spring_tension(self, q: npt.ArrayLike) -> FloatArray:
         """Tension at each spring's anchors, count preload / k + K_eq (d - free_length) [N]."""
         return self._springs(q, "spring_tension")
 
-    def spring_energy(self, q):
+    def spring_energy(self, q: npt.ArrayLike) -> float | FloatArray:
         """Elastic energy of all springs [J] (zero when each is at its free length): a float, or (N,)."""
         e = self._springs(q, "spring_energy")
         return float(e) if np.ndim(e) == 0 else e
 
-    def potential_energy(self, q):
+    def potential_energy(self, q: npt.ArrayLike) -> float | FloatArray:
         """Gravity (-sum m g . c, zero at O) plus springs' energy [J]: constant over the workspace
         exactly when the mechanism is statically balanced. A float, or (N,)."""
         e = self._springs(q, "potential_energy")
         return float(e) if np.ndim(e) == 0 else e
 
-    def bias_torque(self, q, v) -> np.ndarray:
+    def bias_torque(self, q: npt.ArrayLike, v: npt.ArrayLike) -> FloatArray:
         """C(q, v) v + G(q) + K(q) [N m or N] (springs included: the inverse dynamics at a = 0)."""
         single, (q, v) = self._args(("q", "v"), (q, v))
         (b,), _ = self._finish(single, _core.mechanism_bias_torque(self.model, q, v), ["bias_torque"])
         return b
 
-    def center_of_mass(self, q) -> np.ndarray:
+    def center_of_mass(self, q: npt.ArrayLike) -> FloatArray:
         """Centre of mass of all bodies in O [m]: (3,) or (N, 3)."""
         single, (q,) = self._args(("q",), (q,))
         (c,), _ = self._finish(single, _core.mechanism_center_of_mass(self.model, q), ["center_of_mass"])
         return c
 
-    def momentum(self, q, v) -> Momentum:
+    def momentum(self, q: npt.ArrayLike, v: npt.ArrayLike) -> Momentum:
         """Linear momentum and angular momentum about O."""
         single, (q, v) = self._args(("q", "v"), (q, v))
         (P, H), st = self._finish(single, _core.mechanism_momentum(self.model, q, v),
                                   ["linear_momentum", "angular_momentum"])
         return Momentum(P, H, st)
 
-    def momentum_matrix(self, q) -> np.ndarray:
+    def momentum_matrix(self, q: npt.ArrayLike) -> FloatArray:
         """A(q) with [P; H_O] = A(q) v: (6, dof), linear rows first."""
         single, (q,) = self._args(("q",), (q,))
         (A,), _ = self._finish(single, _core.mechanism_momentum_matrix(self.model, q), ["momentum_matrix"])
         return A
 
-    def shaking_wrench(self, q, v, a) -> ShakingWrench:
+    def shaking_wrench(self, q: npt.ArrayLike, v: npt.ArrayLike, a: npt.ArrayLike) -> ShakingWrench:
         """Shaking force F = dP/dt [N] and shaking moment M_O = dH_O/dt [N m] about O, with the
         momenta, for the motion (q, v, a) (Briot & Arakelian 2009, eqs 1-4)."""
         single, (q, v, a) = self._args(("q", "v", "a"), (q, v, a))
@@ -587,7 +592,7 @@ class Mechanism:
             ["shaking_force", "shaking_moment", "linear_momentum", "angular_momentum"])
         return ShakingWrench(F, M, P, H, st)
 
-    def base_reaction(self, q, v, a) -> BaseReaction:
+    def base_reaction(self, q: npt.ArrayLike, v: npt.ArrayLike, a: npt.ArrayLike) -> BaseReaction:
         """Wrench the base exerts on the moving mechanism, gravity included: force = dP/dt - m g,
         moment about O = dH_O/dt - (m c) x g, m and m c over the bodies that move (those on the
         root link and on links fixed to it are the base's own: their weight is not carried by the
@@ -598,7 +603,8 @@ class Mechanism:
             ["base_reaction_force", "base_reaction_moment", "support_reaction_force", "support_reaction_moment"])
         return BaseReaction(F, M, st, SF, SM)
 
-    def body_motion(self, q, v=None, a=None) -> BodyMotion:
+    def body_motion(self, q: npt.ArrayLike, v: npt.ArrayLike | None = None,
+                    a: npt.ArrayLike | None = None) -> BodyMotion:
         """Every body's pose, velocity and acceleration in O (v and a default to zero)."""
         q_arr = _real_array(q, "q")
         v = np.zeros_like(q_arr) if v is None else v
@@ -609,28 +615,28 @@ class Mechanism:
         values, st = self._finish(single, _core.mechanism_kinematics(self.model, q, v, a), keys)
         return BodyMotion(**{k: np.asarray(x) for k, x in zip(keys, values)}, status=st)
 
-    def body_poses(self, q) -> tuple[np.ndarray, np.ndarray]:
+    def body_poses(self, q: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
         """(com, rotation) of every body: (B, 3) and (B, 3, 3), or with a leading N axis."""
         m = self.body_motion(q)
         if np.ndim(m.status) == 0:
             return m.com, m.rotation
         return BatchArray(m.com, m.status), BatchArray(m.rotation, m.status)
 
-    def frame_placement(self, q, frame: str) -> np.ndarray:
+    def frame_placement(self, q: npt.ArrayLike, frame: str) -> FloatArray:
         """4x4 placement of a named frame in O."""
         i = self._frame(frame)
         m = self.body_motion(q)
         T = m.frame_placement[..., i, :, :]
         return T if np.ndim(m.status) == 0 else BatchArray(T, m.status)
 
-    def frame_jacobian(self, q, frame: str) -> np.ndarray:
+    def frame_jacobian(self, q: npt.ArrayLike, frame: str) -> FloatArray:
         """[v; w] = J(q) qdot of a named frame's origin, O's axes: (6, dof)."""
         self._frame(frame)
         single, (q,) = self._args(("q",), (q,))
         (J,), _ = self._finish(single, _core.mechanism_frame_jacobian(self.model, q, frame), ["jacobian"])
         return J
 
-    def torque_regressor(self, q, v, a) -> np.ndarray:
+    def torque_regressor(self, q: npt.ArrayLike, v: npt.ArrayLike, a: npt.ArrayLike) -> FloatArray:
         """Y(q, v, a) with tau = Y pi, pi the stacked 10 inertial parameters of every body
         ([m, m c, Ixx, Ixy, Iyy, Ixz, Iyz, Izz], c and I about the link origin, link frame; column
         k is ``inertial_parameter_names[k]``)."""
@@ -638,13 +644,13 @@ class Mechanism:
         (Y,), _ = self._finish(single, _core.mechanism_torque_regressor(self.model, q, v, a), ["regressor"])
         return Y
 
-    def gravity_regressor(self, q) -> np.ndarray:
+    def gravity_regressor(self, q: npt.ArrayLike) -> FloatArray:
         """Y(q) with G(q) = Y pi."""
         single, (q,) = self._args(("q",), (q,))
         (Y,), _ = self._finish(single, _core.mechanism_gravity_regressor(self.model, q), ["regressor"])
         return Y
 
-    def momentum_regressor(self, q, v) -> np.ndarray:
+    def momentum_regressor(self, q: npt.ArrayLike, v: npt.ArrayLike) -> FloatArray:
         """Y(q, v) with [P; H_O] = Y pi (6, 10 B)."""
         single, (q, v) = self._args(("q", "v"), (q, v))
         (Y,), _ = self._finish(single, _core.mechanism_momentum_regressor(self.model, q, v), ["regressor"])
@@ -657,7 +663,7 @@ class Mechanism:
         (``m, mcx, mcy, mcz, ixx, ixy, iyy, ixz, iyz, izz``)."""
         return [f"{b.name}.{p}" for b in self.model.bodies for p in INERTIAL_PARAMETER_NAMES]
 
-    def inertial_parameters(self) -> np.ndarray:
+    def inertial_parameters(self) -> FloatArray:
         """pi: the stacked 10 inertial parameters of every body, in the regressors' convention
         (``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` per body, inertia about the link
         origin in the link frame; `inertial_parameter_names` names each entry)."""
@@ -669,7 +675,8 @@ class Mechanism:
         return np.array(out, dtype=float).reshape(-1)
 
     # ---- closed loops --------------------------------------------------------------------------
-    def closed_motion(self, q_actuated, v_actuated=None, a_actuated=None, *, q_guess=None,
+    def closed_motion(self, q_actuated: npt.ArrayLike, v_actuated: npt.ArrayLike | None = None,
+                      a_actuated: npt.ArrayLike | None = None, *, q_guess: npt.ArrayLike | None = None,
                       max_iterations: int = 50, tolerance: float = 1e-13, singular_rcond: float = 1e-7,
                       with_forces: bool = False) -> "ClosedMotion":
         """Solve the loop closures along a motion of the actuated joints (1-D: one instant; 2-D:
@@ -705,7 +712,8 @@ class Mechanism:
                             iterations=out["iterations"], status=out["status"],
                             actuated_force=out.get("actuated_force"), projection=out.get("projection"))
 
-    def actuated_forces(self, q_actuated, v_actuated, a_actuated, **kw) -> np.ndarray:
+    def actuated_forces(self, q_actuated: npt.ArrayLike, v_actuated: npt.ArrayLike,
+                        a_actuated: npt.ArrayLike, **kw: Any) -> FloatArray:
         """Actuated forces tau# = C^T tau(q, v, a) of the closed mechanism [N m or N]; for one
         instant raises ValueError when the loops cannot be solved there."""
         m = self.closed_motion(q_actuated, v_actuated, a_actuated, with_forces=True, **kw)
@@ -716,7 +724,8 @@ class Mechanism:
             return m.actuated_force
         return BatchArray(m.actuated_force, m.status)
 
-    def reduced_mass_matrix(self, q_actuated, *, q_guess=None) -> tuple[np.ndarray, np.ndarray]:
+    def reduced_mass_matrix(self, q_actuated: npt.ArrayLike, *,
+                            q_guess: npt.ArrayLike | None = None) -> tuple[FloatArray, FloatArray]:
         """(C^T M C, C^T G): mass matrix and gravity forces in the actuated coordinates. One
         instant raises ValueError where the loops cannot be solved; a batch gives
         `BatchArray` results whose ``status`` flags the failed instants (NaN rows)."""

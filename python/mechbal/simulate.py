@@ -17,12 +17,14 @@ Layer: Python core (docs/architecture.md).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import numpy.typing as npt
 
 from mechbal import _core
+from mechbal._deprecation import DeprecatedAttributes, renamed_kwargs
+from mechbal.control import MechanismDynamics
 
 #: the C++ RK4 closed loop (any ForwardDynamics plant, any JointController): dict of arrays
 simulate_closed_loop = _core.simulate_closed_loop
@@ -32,16 +34,16 @@ __all__ = ["closed_loop", "ClosedLoopResult", "passive", "PassiveResult", "Forwa
            "simulate_closed_loop", "simulate_computed_torque"]
 
 ForwardDynamics = _core.ForwardDynamics
-MechanismDynamics = _core.MechanismDynamics
+FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
-class ClosedLoopResult:
+class ClosedLoopResult(DeprecatedAttributes):
     """One closed-loop run, one row per controller tick k = 0 .. steps (t_k = k dt):
 
     * ``t`` (N,) [s];
-    * ``q``, ``qd`` (N, n): the plant's state [rad or m, rad/s or m/s];
-    * ``q_des``, ``qd_des`` (N, n): the desired motion at the ticks;
+    * ``q``, ``v`` (N, n): the plant's state [rad or m, rad/s or m/s];
+    * ``q_des``, ``v_des`` (N, n): the desired motion at the ticks;
     * ``joint_torque`` (N, n) [N m or N]: the command applied from t_k on;
     * ``status`` (N,): per tick, the controller's and the plant's flags (0 = ok,
       `mechbal.Status`);
@@ -49,23 +51,28 @@ class ClosedLoopResult:
     * ``steps_completed``: ``steps`` unless the plant failed (later rows repeat the last state);
     * ``mujoco``: with ``engine="mujoco"``, the co-simulation's record (MuJoCo's base reaction
       beside mechbal's prediction), else None.
+
+    ``qd`` and ``qd_des``, the names of earlier releases, still read ``v`` and ``v_des`` for one
+    release (with a DeprecationWarning).
     """
 
-    t: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    q_des: np.ndarray
-    qd_des: np.ndarray
-    joint_torque: np.ndarray
-    status: np.ndarray
+    t: FloatArray
+    q: FloatArray
+    v: FloatArray
+    q_des: FloatArray
+    v_des: FloatArray
+    joint_torque: FloatArray
+    status: npt.NDArray[np.uint32]
     saturated_ticks: int
     steps_completed: int
     #: ``engine="mujoco"``: the `mechbal.export.mujoco_engine.CoSimulation` (MuJoCo's base
     #: reaction at every tick beside mechbal's prediction, the loops' constraint violation)
     mujoco: Any = None
 
+    _renamed: ClassVar[dict[str, str]] = {"qd": "v", "qd_des": "v_des"}
+
     @property
-    def tracking_error(self) -> np.ndarray:
+    def tracking_error(self) -> FloatArray:
         """``q_des - q`` (N, n) [rad or m]."""
         return self.q_des - self.q
 
@@ -81,7 +88,7 @@ def _plant(mechanism_or_plant: Any, q_guess: npt.ArrayLike | None) -> Any:
     if isinstance(mechanism_or_plant, Mechanism):
         model = mechanism_or_plant.model
         guess = np.zeros(model.dof) if q_guess is None else np.asarray(q_guess, dtype=float)
-        return _core.MechanismDynamics(model, guess)
+        return MechanismDynamics(model, guess)
     if isinstance(mechanism_or_plant, _core.MechanismModel):
         return _plant(__import__("mechbal").Mechanism(mechanism_or_plant), q_guess)
     if not isinstance(mechanism_or_plant, _core.ForwardDynamics):
@@ -117,8 +124,9 @@ def _check_timing(dt: Any, duration: Any) -> tuple[float, float]:
     return dt, duration
 
 
+@renamed_kwargs(qd0="v0")
 def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
-                q0: npt.ArrayLike | None = None, qd0: npt.ArrayLike | None = None, *,
+                q0: npt.ArrayLike | None = None, v0: npt.ArrayLike | None = None, *,
                 dt: float = 1e-3, duration: float | None = None,
                 sampling: str = "zero_order_hold",
                 q_guess: npt.ArrayLike | None = None, engine: str = "mechbal",
@@ -138,7 +146,8 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
             t = 0 .. duration [s]. A rest-to-rest trajectory runs on the C++ path; any other is
             sampled every dt/2 first.
         q0: initial positions [rad or m]; default: the trajectory at t = 0.
-        qd0: initial velocities [rad/s or m/s]; default: the trajectory at t = 0.
+        v0: initial velocities [rad/s or m/s]; default: the trajectory at t = 0 (``qd0``, the
+            name of earlier releases, works for one release and warns).
         dt: controller period = RK4 step [s].
         duration: simulated time [s]; default the trajectory's ``end_time`` (or ``duration``).
         sampling: ``"zero_order_hold"`` (a digital controller: the torque of tick k is held over
@@ -165,7 +174,7 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
                             "stage: construct it with kp and kd")
         controller = controller.joint_controller
     if engine == "mujoco":
-        return _closed_loop_mujoco(mechanism_or_plant, controller, trajectory, q0, qd0, dt=dt,
+        return _closed_loop_mujoco(mechanism_or_plant, controller, trajectory, q0, v0, dt=dt,
                                    duration=duration, sampling=sampling, q_guess=q_guess, **engine_options)
     if engine != "mechbal":
         raise ValueError(f"engine must be 'mechbal' or 'mujoco', got {engine!r}")
@@ -179,27 +188,29 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
     if duration is None:  # until the motion ends (a trajectory may start after t = 0)
         duration = float(getattr(traj, "end_time", traj.duration))
     dt, duration = _check_timing(dt, duration)
-    q_start, qd_start, _ = traj.evaluate(0.0)
+    q_start, v_start, _ = traj.evaluate(0.0)
     q0 = q_start if q0 is None else q0
-    qd0 = qd_start if qd0 is None else qd0
+    v0 = v_start if v0 is None else v0
     if isinstance(traj, RestToRest):
-        log = _core.simulate_closed_loop(plant, controller, traj.core, q0, qd0, dt, duration,
+        log = _core.simulate_closed_loop(plant, controller, traj.core, q0, v0, dt, duration,
                                          sampling)
     else:
         steps = int(round(duration / dt))
-        q_des, qd_des, qdd_des = traj.evaluate(np.arange(2 * steps + 1) * (0.5 * dt))
-        log = _core.simulate_closed_loop_sampled(plant, controller, q_des, qd_des, qdd_des, q0,
-                                                 qd0, dt, duration, sampling)
+        q_des, v_des, a_des = traj.evaluate(np.arange(2 * steps + 1) * (0.5 * dt))
+        log = _core.simulate_closed_loop_sampled(plant, controller, q_des, v_des, a_des, q0,
+                                                 v0, dt, duration, sampling)
     return ClosedLoopResult(t=np.asarray(log["t"]), q=np.asarray(log["q"]),
-                            qd=np.asarray(log["qd"]), q_des=np.asarray(log["q_des"]),
-                            qd_des=np.asarray(log["qd_des"]), joint_torque=np.asarray(log["tau"]),
+                            v=np.asarray(log["v"]), q_des=np.asarray(log["q_des"]),
+                            v_des=np.asarray(log["v_des"]), joint_torque=np.asarray(log["tau"]),
                             status=np.asarray(log["tick_status"]),
                             saturated_ticks=int(log["saturated_ticks"]),
                             steps_completed=int(log["steps_completed"]))
 
 
-def _closed_loop_mujoco(mech: Any, controller: Any, trajectory: Any, q0, qd0, *, dt: float,
-                        duration: float | None, sampling: str, q_guess, **options: Any) -> ClosedLoopResult:
+def _closed_loop_mujoco(mech: Any, controller: Any, trajectory: Any, q0: npt.ArrayLike | None,
+                        v0: npt.ArrayLike | None, *, dt: float, duration: float | None,
+                        sampling: str, q_guess: npt.ArrayLike | None,
+                        **options: Any) -> ClosedLoopResult:
     from mechbal.mechanism import Mechanism
 
     if not isinstance(mech, Mechanism):
@@ -212,9 +223,9 @@ def _closed_loop_mujoco(mech: Any, controller: Any, trajectory: Any, q0, qd0, *,
                         f"DecoupledJointController), got {type(controller).__name__}")
     from mechbal.export.mujoco_engine import co_simulate  # the optional engine (mechbal[mujoco])
 
-    r = co_simulate(mech, controller, trajectory, q0, qd0, dt=dt, duration=duration, q_guess=q_guess,
+    r = co_simulate(mech, controller, trajectory, q0, v0, dt=dt, duration=duration, q_guess=q_guess,
                     **options)
-    return ClosedLoopResult(t=r.t, q=r.q, qd=r.qd, q_des=r.q_des, qd_des=r.qd_des,
+    return ClosedLoopResult(t=r.t, q=r.q, v=r.v, q_des=r.q_des, v_des=r.v_des,
                             joint_torque=r.joint_torque, status=r.status,
                             saturated_ticks=r.saturated_ticks, steps_completed=r.steps_completed,
                             mujoco=r)

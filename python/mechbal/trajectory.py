@@ -1,10 +1,13 @@
-"""Desired motions: one interface, ``evaluate(t) -> (q, qd, qdd)``, for every kind of trajectory.
+"""Desired motions: one interface, ``evaluate(t) -> Motion(q, v, a)``, for every kind of trajectory.
 
 Every trajectory here has ``dof`` (number of coordinates), ``duration`` [s] (the motion runs over
 ``[0, duration]``; `Sampled` over the span of its samples) and ``evaluate(t)``:
 
-* ``t`` a number: ``(q, qd, qdd)`` each of shape ``(dof,)``;
+* ``t`` a number: a `Motion` ``(q, v, a)``, each of shape ``(dof,)``;
 * ``t`` an array of N times: each of shape ``(N, dof)`` (one call, no Python loop).
+
+`Motion` is a named tuple: ``q, v, a = traj.evaluate(t)`` and ``traj.evaluate(t).v`` both work
+(``.qd`` and ``.qdd``, the names of earlier releases, still work for one release and warn).
 
 Positions are in rad (revolute) or m (prismatic), velocities in rad/s or m/s, accelerations in
 rad/s^2 or m/s^2, times in s. Before its start and after its end a trajectory holds its first or
@@ -25,22 +28,45 @@ Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
-from typing import Protocol, Union, runtime_checkable
+from typing import Any, NamedTuple, Protocol, Union, runtime_checkable
 
 import numpy as np
 import numpy.typing as npt
 
 from mechbal import _core
+from mechbal._deprecation import warn_renamed
 
-__all__ = ["Trajectory", "RestToRest", "quintic", "minimum_energy_cubic", "ConstantSpeed", "ViaPoints", "Sampled",
-           "TimeLaw", "RestToRestTrajectory"]
+__all__ = ["Trajectory", "Motion", "RestToRest", "quintic", "minimum_energy_cubic", "ConstantSpeed", "ViaPoints",
+           "Sampled", "TimeLaw", "RestToRestTrajectory", "as_trajectory", "quintic_within_limits"]
 
 TimeLaw = _core.TimeLaw
 #: the C++ rest-to-rest law (quintic or minimum-energy cubic) that RestToRest wraps
 RestToRestTrajectory = _core.RestToRestTrajectory
 ArrayLike = npt.ArrayLike
 Times = Union[float, npt.ArrayLike]
-Motion = tuple[np.ndarray, np.ndarray, np.ndarray]
+FloatArray = npt.NDArray[np.float64]
+
+
+class Motion(NamedTuple):
+    """A desired motion at one time or N times: positions ``q`` [rad or m], velocities ``v``
+    [rad/s or m/s] and accelerations ``a`` [rad/s^2 or m/s^2], each ``(dof,)`` or ``(N, dof)``.
+    A tuple, so ``q, v, a = trajectory.evaluate(t)`` works."""
+
+    q: FloatArray
+    v: FloatArray
+    a: FloatArray
+
+    @property
+    def qd(self) -> FloatArray:
+        """Deprecated name of `v`."""
+        warn_renamed("qd", "v", "Motion")
+        return self.v
+
+    @property
+    def qdd(self) -> FloatArray:
+        """Deprecated name of `a`."""
+        warn_renamed("qdd", "a", "Motion")
+        return self.a
 
 
 @runtime_checkable
@@ -56,7 +82,8 @@ class Trajectory(Protocol):
         """Time span of the motion [s]."""
 
     def evaluate(self, t: Times) -> Motion:
-        """``(q, qd, qdd)`` at time(s) ``t`` [s]."""
+        """`Motion` ``(q, v, a)`` at time(s) ``t`` [s]."""
+        ...
 
 
 def _times(t: Times) -> tuple[bool, np.ndarray]:
@@ -81,15 +108,15 @@ def _vector(name: str, value: ArrayLike) -> np.ndarray:
     return a
 
 
-def _finite_motion(what: str, single: bool, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> Motion:
+def _finite_motion(what: str, single: bool, q: FloatArray, v: FloatArray, a: FloatArray) -> Motion:
     """The motion, or ValueError when finite input overflowed into a non-finite value."""
-    for name, x in (("q", q), ("qd", qd), ("qdd", qdd)):
+    for name, x in (("q", q), ("v", v), ("a", a)):
         if not np.all(np.isfinite(x)):
             raise ValueError(f"{what}.evaluate: {name} is not finite (the points, velocities or "
                              "times overflow: values too large or times too close)")
     if single:
-        return q[0], qd[0], qdd[0]
-    return q, qd, qdd
+        return Motion(q[0], v[0], a[0])
+    return Motion(q, v, a)
 
 
 class RestToRest:
@@ -138,12 +165,13 @@ class RestToRest:
         return str(self.core.law.name)
 
     def evaluate(self, t: Times) -> Motion:
-        """``(q, qd, qdd)`` at ``t`` [s]: ``(dof,)`` each for a number, ``(N, dof)`` for N times."""
+        """`Motion` ``(q, v, a)`` at ``t`` [s]: ``(dof,)`` each for a number, ``(N, dof)`` for N
+        times."""
         single, ts = _times(t)
-        q, qd, qdd = self.core.evaluate_batch(ts)
+        q, v, a = self.core.evaluate_batch(ts)
         if single:
-            return q[0], qd[0], qdd[0]
-        return q, qd, qdd
+            return Motion(q[0], v[0], a[0])
+        return Motion(q, v, a)
 
     def __repr__(self) -> str:
         return f"<RestToRest {self.law}, {self.dof} coordinates, {self.duration:g} s>"
@@ -322,7 +350,7 @@ class ViaPoints(_OverTimes):
         return int(self._points.shape[1])
 
     def evaluate(self, t: Times) -> Motion:
-        """``(q, qd, qdd)`` at absolute times ``t`` [s]; held at rest outside ``times``."""
+        """`Motion` ``(q, v, a)`` at absolute times ``t`` [s]; held at rest outside ``times``."""
         single, ts = _times(t)
         i = np.clip(np.searchsorted(self._t, ts, side="right") - 1, 0, len(self._h) - 1)
         h = self._h[i][:, None]
@@ -330,17 +358,17 @@ class ViaPoints(_OverTimes):
             u = np.clip((ts - self._t[i]) / self._h[i], 0.0, 1.0)[:, None]
             c = self._c[:, i, :]  # (6, N, dof)
             q = c[0] + u * (c[1] + u * (c[2] + u * (c[3] + u * (c[4] + u * c[5]))))
-            qd = (c[1] + u * (2 * c[2] + u * (3 * c[3] + u * (4 * c[4] + u * 5 * c[5])))) / h
-            qdd = (2 * c[2] + u * (6 * c[3] + u * (12 * c[4] + u * 20 * c[5]))) / h**2
+            v = (c[1] + u * (2 * c[2] + u * (3 * c[3] + u * (4 * c[4] + u * 5 * c[5])))) / h
+            a = (2 * c[2] + u * (6 * c[3] + u * (12 * c[4] + u * 20 * c[5]))) / h**2
         outside = ((ts < self._t[0]) | (ts > self._t[-1]))[:, None]
-        qd = np.where(outside, 0.0, qd)
-        qdd = np.where(outside, 0.0, qdd)
-        return _finite_motion("ViaPoints", single, q, qd, qdd)
+        v = np.where(outside, 0.0, v)
+        a = np.where(outside, 0.0, a)
+        return _finite_motion("ViaPoints", single, q, v, a)
 
 
 class Sampled(_OverTimes):
     """A user's sampled motion (measured or planned elsewhere), interpolated by a cubic spline
-    (``scipy.interpolate.CubicSpline``) per coordinate: q(t) the spline, qd and qdd its first
+    (``scipy.interpolate.CubicSpline``) per coordinate: q(t) the spline, v and a its first
     and second derivatives.
 
     Args:
@@ -389,15 +417,16 @@ class Sampled(_OverTimes):
         return int(self._dof)
 
     def evaluate(self, t: Times) -> Motion:
-        """``(q, qd, qdd)`` at absolute times ``t`` [s]; held at rest outside the samples."""
+        """`Motion` ``(q, v, a)`` at absolute times ``t`` [s]; held at rest outside the
+        samples."""
         single, ts = _times(t)
         tc = np.clip(ts, self._t[0], self._t[-1])
         outside = ((ts < self._t[0]) | (ts > self._t[-1]))[:, None]
         with np.errstate(all="ignore"):  # an overflow is reported below, not as a RuntimeWarning
             q = self._spline(tc)
-            qd = np.where(outside, 0.0, self._d1(tc))
-            qdd = np.where(outside, 0.0, self._d2(tc))
-        return _finite_motion("Sampled", single, q, qd, qdd)
+            v = np.where(outside, 0.0, self._d1(tc))
+            a = np.where(outside, 0.0, self._d2(tc))
+        return _finite_motion("Sampled", single, q, v, a)
 
 
 def as_trajectory(obj: object) -> Trajectory:
@@ -419,12 +448,12 @@ QUINTIC_PEAK_VELOCITY = 15.0 / 8.0
 QUINTIC_PEAK_ACCELERATION = 10.0 / np.sqrt(3.0)
 
 
-def _limit_list(x: np.ndarray) -> list:
+def _limit_list(x: np.ndarray) -> list[float | None]:
     return [float(v) if np.isfinite(v) else None for v in x]
 
 
-def quintic_within_limits(mech, start: ArrayLike, end: ArrayLike, duration: float, *,
-                          samples: int = 101, max_doublings: int = 10) -> tuple[float, dict]:
+def quintic_within_limits(mech: Any, start: ArrayLike, end: ArrayLike, duration: float, *,
+                          samples: int = 101, max_doublings: int = 10) -> tuple[float, dict[str, Any]]:
     """``(duration, report)`` of a quintic rest-to-rest move of an open mechanism from ``start``
     to ``end`` that respects the joints' limits where the model has them (URDF <limit>):
 

@@ -240,7 +240,7 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3) -> dict:
     q0 = (np.asarray(mech.closed_motion(bc.motion[0][0], q_guess=bc.q_guess).q) if mech.is_closed
           else np.asarray(bc.motion[0][0], float))
     (out / "mechanism.xml").write_text(mjcf_text(mech, q=q0, q_guess=bc.q_guess))
-    np.savez_compressed(out / "cosimulation.npz", t=cs.t, q=cs.q, qd=cs.qd, q_des=cs.q_des, qd_des=cs.qd_des,
+    np.savez_compressed(out / "cosimulation.npz", t=cs.t, q=cs.q, qd=cs.v, q_des=cs.q_des, qd_des=cs.v_des,
                         joint_torque=cs.joint_torque, status=cs.status,
                         base_reaction_force=cs.base_reaction_force, base_reaction_moment=cs.base_reaction_moment,
                         predicted_base_reaction_force=cs.predicted_base_reaction_force,

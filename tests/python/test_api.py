@@ -130,11 +130,11 @@ def test_step_step_into_and_run_agree():
 def test_step_into_bad_input_is_a_named_error_or_a_status():
     c = arm_controller()
     z, out = np.zeros(2), np.zeros(2)
-    with pytest.raises(TypeError, match="qd_des"):
+    with pytest.raises(TypeError, match="v_des"):
         c.step_into(z, z, z, [0.0, 0.0], z, out)
     with pytest.raises(TypeError, match="q_des"):
         c.step_into(z, z, z.astype(np.float32), z, z, out)
-    with pytest.raises(TypeError, match="qd"):
+    with pytest.raises(TypeError, match="step_into: v must"):
         c.step_into(z, np.zeros(4)[::2], z, z, z, out)  # not contiguous
     with pytest.raises(ValueError, match=r"out must have shape \(2,\)"):
         c.step_into(z, z, z, z, z, np.zeros(3))

@@ -215,7 +215,7 @@ def test_rms_method_with_mass_budget_on_a_3_joint_chain():
     best_fixed = rms.balance(mech, fixed, (q, qd, qdd), coupling="total", starts=4)
     best_budget = rms.balance(mech, free, (q, qd, qdd), coupling="total", mass_budget=2.0, starts=4)
     J = lambda res: float(np.sum(np.asarray(res.metrics["rms_torque_after"]) ** 2))  # noqa: E731
-    masses = [best_budget.design[f"cw{i}"]["mass"] for i in range(3)]
+    masses = [best_budget.design[f"cw{i}"].mass for i in range(3)]
     assert sum(masses) <= 2.0 + 1e-6 and min(masses) >= -1e-9
     for _ in range(50):  # no random feasible design beats the optimum
         r = rng.uniform(-0.5, 0.5, 3)

@@ -54,7 +54,7 @@ def test_static_fixed_masses_give_the_papers_static_radii(arm):
     eqs 21-22 and 30-31), and gravity torque ~0 over 1000 other random poses."""
     res = static.balance(arm, [Slot("cw1", "shoulder", 7.4, 7.4, direction=MINUS_X),
                                Slot("cw2", "elbow", 2.0, 2.0, direction=MINUS_X)], 200)
-    r1, r2 = res.design["cw1"]["signed_distance"], res.design["cw2"]["signed_distance"]
+    r1, r2 = res.design["cw1"].signed_distance, res.design["cw2"].signed_distance
     assert r2 == pytest.approx(2.0 * 0.1 / 2.0, abs=1e-12)
     assert r1 == pytest.approx((2.5 * 0.1 + (2.0 + 2.0) * 0.4) / 7.4, abs=1e-12)
     assert res.exact and res.limited_by == [] and res.rank == res.unknowns == 2
@@ -62,7 +62,7 @@ def test_static_fixed_masses_give_the_papers_static_radii(arm):
     G = res.balanced.gravity_torque(random_poses(arm, 1000, 7))
     assert np.max(np.abs(G)) < 1e-9
     # positions are given back in the user's frame and the design round-trips
-    assert np.allclose(res.design["cw1"]["position"], [-r1, 0, 0], atol=1e-14)
+    assert np.allclose(res.design["cw1"].position, [-r1, 0, 0], atol=1e-14)
 
 
 def test_static_lightest_design_and_undetermined_combinations(arm):
@@ -70,9 +70,9 @@ def test_static_lightest_design_and_undetermined_combinations(arm):
     radius (m = |h| / R); what gravity cannot see is listed as undetermined."""
     res = static.balance(arm, [Slot("cw1", "shoulder", max_radius=0.2), Slot("cw2", "elbow", max_radius=0.1)], 300)
     assert res.exact
-    assert res.design["cw2"]["mass"] == pytest.approx(2.0 * 0.1 / 0.1, rel=1e-8)
-    assert res.design["cw1"]["mass"] == pytest.approx((2.5 * 0.1 + (2.0 + 2.0) * 0.4) / 0.2, rel=1e-8)
-    assert res.design["cw1"]["active_bounds"] == ["max_radius"]
+    assert res.design["cw2"].mass == pytest.approx(2.0 * 0.1 / 0.1, rel=1e-8)
+    assert res.design["cw1"].mass == pytest.approx((2.5 * 0.1 + (2.0 + 2.0) * 0.4) / 0.2, rel=1e-8)
+    assert res.design["cw1"].active_bounds == ["max_radius"]
     assert res.active_bounds == ["cw1.max_radius", "cw2.max_radius"]
     # a mass at the shoulder axis, y mass moments (along the axes), and 1 kg at the elbow vs
     # l1 = 0.4 kg m of link 1's mass moment along x
@@ -91,7 +91,7 @@ def test_static_bound_is_reported_never_success(arm):
                                Slot("cw2", "elbow", 0.0, 5.0, max_radius=0.1, direction=MINUS_X)], q)
     assert not res.exact
     assert "bound: cw1.mass_max" in res.limited_by and "bound: cw1.max_radius" in res.limited_by
-    assert res.design["cw1"]["mass"] == pytest.approx(3.0, rel=1e-9)
+    assert res.design["cw1"].mass == pytest.approx(3.0, rel=1e-9)
     G = res.balanced.gravity_torque(q)
     assert res.residual == pytest.approx(float(np.sqrt(np.mean(G ** 2))), rel=1e-12)
     assert 0 < res.residual < res.residual_before
@@ -122,7 +122,7 @@ def test_static_closed_four_bar_equals_force_balance(four_bar):
     f = force.balance(four_bar, slots, 120, q_guess=FOUR_BAR_GUESS)
     assert s.exact and f.exact
     for k in ("cw_crank", "cw_rocker"):
-        assert s.design[k]["mass"] == pytest.approx(f.design[k]["mass"], rel=1e-8)
+        assert s.design[k].mass == pytest.approx(f.design[k].mass, rel=1e-8)
     _, G = s.balanced.reduced_mass_matrix(np.linspace(0, 6, 40)[:, None], q_guess=FOUR_BAR_GUESS)
     assert np.max(np.abs(G)) < 1e-9
 
@@ -159,9 +159,9 @@ def test_positions_are_in_the_users_dh_frame():
              Slot("cw2", "j2", 0.0, 50.0, max_radius=0.1, center=(-0.25, 0.0, 0.0))]
     res = static.balance(mech, slots, 200)
     assert res.exact
-    assert np.allclose(res.design["cw2"]["position"], [-0.35, 0.0, 0.0], atol=1e-7)
-    assert res.design["cw2"]["mass"] == pytest.approx(1.0 * 0.15 / 0.1, rel=1e-7)
-    bodies = [dict(name=k, kind="counterweight", link=v["link"], mass=v["mass"], com=list(v["position"]),
+    assert np.allclose(res.design["cw2"].position, [-0.35, 0.0, 0.0], atol=1e-7)
+    assert res.design["cw2"].mass == pytest.approx(1.0 * 0.15 / 0.1, rel=1e-7)
+    bodies = [dict(name=k, kind="counterweight", link=v.link, mass=v.mass, com=list(v.position),
                    inertia=[0.0, 0.0, 0.0]) for k, v in res.design.items()]
     again = Mechanism.from_spec(mechanism_spec({**table, "bodies": bodies}))
     assert np.max(np.abs(again.gravity_torque(random_poses(again, 500, 2)))) < 1e-9
@@ -182,10 +182,10 @@ def test_force_four_bar_closed_form(four_bar, tmp_path):
     h_crank = -m2 * a * (1 - z2 / b) - crank_own
     h_rocker = -m2 * z2 * c / b - rocker_own
     assert res.exact and res.rank == 4 and res.unknowns == 8
-    assert res.design["cw_crank"]["mass"] == pytest.approx(abs(h_crank) / 0.1, rel=1e-9)
-    assert res.design["cw_rocker"]["mass"] == pytest.approx(abs(h_rocker) / 0.1, rel=1e-9)
-    assert np.allclose(res.design["cw_crank"]["position"], [-0.1, 0, 0], atol=1e-9)
-    assert np.allclose(res.design["cw_rocker"]["position"], [-0.1, 0, 0], atol=1e-9)
+    assert res.design["cw_crank"].mass == pytest.approx(abs(h_crank) / 0.1, rel=1e-9)
+    assert res.design["cw_rocker"].mass == pytest.approx(abs(h_rocker) / 0.1, rel=1e-9)
+    assert np.allclose(res.design["cw_crank"].position, [-0.1, 0, 0], atol=1e-9)
+    assert np.allclose(res.design["cw_rocker"].position, [-0.1, 0, 0], atol=1e-9)
     # a random smooth crank motion (sum of sines), solved by the loops
     t = np.linspace(0.0, 2.0, 4001)
     rng = np.random.default_rng(4)
@@ -219,8 +219,8 @@ def test_force_serial_arm_needs_masses_at_each_joint(arm):
     res = force.balance(arm, [Slot("cw1", "shoulder", 7.4, 7.4, direction=MINUS_X),
                               Slot("cw2", "elbow", 2.0, 2.0, direction=MINUS_X)], 100)
     assert res.exact
-    assert res.design["cw1"]["signed_distance"] == pytest.approx(0.25, abs=1e-12)
-    assert res.design["cw2"]["signed_distance"] == pytest.approx(0.1, abs=1e-12)
+    assert res.design["cw1"].signed_distance == pytest.approx(0.25, abs=1e-12)
+    assert res.design["cw2"].signed_distance == pytest.approx(0.1, abs=1e-12)
 
 
 def test_force_paminsa_counterweights_from_the_momentum_regressor():
@@ -281,11 +281,11 @@ def test_rms_reproduces_the_2dof_radii_and_its_closed_form(arm):
     fast = rms.balance(arm, design, motion)
     slow = rms.balance(arm, design, motion, fast_path=False, starts=2)
     closed = paper.rms_optimal_radii(_core.Arm2DofParameters(**ARM, g=9.81), 7.4, 2.0, *motion)
-    r = [fast.design[k]["signed_distance"] for k in ("cw1", "cw2")]
+    r = [fast.design[k].signed_distance for k in ("cw1", "cw2")]
     assert r == pytest.approx([0.2509, 0.1913], abs=5e-5)
     assert r == pytest.approx([closed.r_cw1, closed.r_cw2], abs=1e-10)
-    assert [slow.design[k]["signed_distance"] for k in ("cw1", "cw2")] == pytest.approx(r, abs=1e-6)
-    assert "Cardano" in fast.design["cw1"]["method"] and fast.exact
+    assert [slow.design[k].signed_distance for k in ("cw1", "cw2")] == pytest.approx(r, abs=1e-6)
+    assert "Cardano" in fast.design["cw1"].method and fast.exact
     # the reported torques are the balanced mechanism's
     tau = fast.balanced.inverse_dynamics(*motion)
     assert fast.metrics["rms_torque_after"] == pytest.approx(np.sqrt(np.mean(tau ** 2, axis=0)), rel=1e-12)
@@ -295,7 +295,7 @@ def test_rms_bounds_and_peak(arm):
     motion = arm2dof_motion(301)
     res = rms.balance(arm, [Slot("cw1", "shoulder", 7.4, 7.4, max_radius=0.2, direction=MINUS_X),
                             Slot("cw2", "elbow", 2.0, 2.0, direction=MINUS_X)], motion)
-    assert res.design["cw1"]["signed_distance"] == pytest.approx(0.2, abs=1e-12)
+    assert res.design["cw1"].signed_distance == pytest.approx(0.2, abs=1e-12)
     assert res.limited_by == ["bound: cw1.max_radius"] and not res.exact
     peak = rms.balance(arm, [Slot("cw1", "shoulder", 7.4, 7.4, direction=MINUS_X),
                              Slot("cw2", "elbow", 2.0, 2.0, direction=MINUS_X)], motion, objective="peak", starts=2)

@@ -137,12 +137,12 @@ def test_fixed_position_is_exact_and_equals_max_radius_zero():
     slots = [Slot("cw1", "arm1", position=(-0.2, 0.0, 0.0)), Slot("cw2", "arm2", position=(-0.25, 0.0, 0.0))]
     r = static.balance(mech, slots, 50)
     assert r.exact and r.unknowns == 2 and r.rank == 2
-    assert r.design["cw1"]["mass"] == pytest.approx(2.0 * 0.3 / 0.2, rel=1e-12)
-    assert r.design["cw2"]["mass"] == pytest.approx(2.0 * 0.3 / 0.25, rel=1e-12)
-    assert r.design["cw1"]["position"].tolist() == [-0.2, 0.0, 0.0]
+    assert r.design["cw1"].mass == pytest.approx(2.0 * 0.3 / 0.2, rel=1e-12)
+    assert r.design["cw2"].mass == pytest.approx(2.0 * 0.3 / 0.25, rel=1e-12)
+    assert r.design["cw1"].position.tolist() == [-0.2, 0.0, 0.0]
     r0 = static.balance(mech, [Slot("cw1", "arm1", center=(-0.2, 0, 0), max_radius=0.0),
                                Slot("cw2", "arm2", center=(-0.25, 0, 0), max_radius=0.0)], 50)
-    assert r0.unknowns == 2 and r0.design["cw1"]["mass"] == pytest.approx(3.0, rel=1e-12)
+    assert r0.unknowns == 2 and r0.design["cw1"].mass == pytest.approx(3.0, rel=1e-12)
 
 
 def test_tied_slots_share_mass_and_position_in_static_force_and_rms():
@@ -152,10 +152,10 @@ def test_tied_slots_share_mass_and_position_in_static_force_and_rms():
     assert r.exact and r.tied == {"cw1": ["cw1", "cw2"]}
     assert r.unknowns == 4   # one group: its mass and its 3 mass moments
     for k in ("cw1", "cw2"):
-        assert r.design[k]["mass"] == pytest.approx(3.0, rel=1e-9)       # lightest: at the full radius
-        assert np.allclose(r.design[k]["position"], [-0.2, 0, 0], atol=1e-9)
+        assert r.design[k].mass == pytest.approx(3.0, rel=1e-9)       # lightest: at the full radius
+        assert np.allclose(r.design[k].position, [-0.2, 0, 0], atol=1e-9)
     rf = force.balance(mech, tied, 50)
-    assert rf.exact and rf.design["cw2"]["mass"] == pytest.approx(rf.design["cw1"]["mass"], rel=1e-12)
+    assert rf.exact and rf.design["cw2"].mass == pytest.approx(rf.design["cw1"].mass, rel=1e-12)
     # rms (total coupling): one set of variables for the group
     t = np.linspace(0, 1, 201)
     q = np.stack([np.sin(3 * t), 0.5 * np.cos(2 * t)], 1)
@@ -164,7 +164,7 @@ def test_tied_slots_share_mass_and_position_in_static_force_and_rms():
     rr = rms.balance(mech, [Slot("cw1", "arm1", 1.0, 1.0, direction=(-1, 0, 0), max_radius=1.0),
                             Slot("cw2", "arm2", tie="cw1")], (q, v, a), coupling="total")
     assert rr.unknowns == 1 and rr.tied == {"cw1": ["cw1", "cw2"]}
-    assert rr.design["cw2"]["signed_distance"] == pytest.approx(rr.design["cw1"]["signed_distance"], abs=1e-15)
+    assert rr.design["cw2"].signed_distance == pytest.approx(rr.design["cw1"].signed_distance, abs=1e-15)
     with pytest.raises(ValueError, match=r"design\[1\].tie: .*per_joint"):
         rms.balance(mech, [Slot("cw1", "arm1", 1.0, 1.0, direction=(-1, 0, 0), max_radius=1.0),
                            Slot("cw2", "arm2", tie="cw1")], (q, v, a), coupling="per_joint")

@@ -121,19 +121,19 @@ def test_lightest_design_against_an_independent_lower_bound(seed):
     r = static.balance(mech, slots, q, mass_budget=budget)
     A, b = columns(mech, slots, q)
     lb = lower_bound(A, b, slots, budget)
-    mass = sum(d["mass"] for d in r.design.values())
+    mass = sum(d.mass for d in r.design.values())
     # our design is within every bound (checked here, not by the method)
     for s in slots:
         d = r.design[s.name]
-        assert -1e-9 <= d["mass"] <= s.mass_max * (1 + 1e-9)
-        assert d["radius"] <= s.max_radius * (1 + 1e-7) + 1e-12 or d["mass"] < 1e-9
+        assert -1e-9 <= d.mass <= s.mass_max * (1 + 1e-9)
+        assert d.radius <= s.max_radius * (1 + 1e-7) + 1e-12 or d.mass < 1e-9
     if budget is not None:
         assert mass <= budget * (1 + 1e-9)
     if lb is None:            # no least-squares solution within the bounds: a constrained one
         assert not r.exact and any(x.startswith("bound:") for x in r.limited_by)
         return
     # it reaches the least squares, and it is the lightest: within 0.2 % of a lower bound
-    x = np.concatenate([[d["mass"], *(d["mass"] * np.asarray(d["position"]))] for d in
+    x = np.concatenate([[d.mass, *(d.mass * np.asarray(d.position))] for d in
                         (r.design[s.name] for s in slots)])
     ls = np.linalg.lstsq(A, -b, rcond=None)[0]
     assert np.sqrt(np.mean((A @ x + b) ** 2)) <= np.sqrt(np.mean((A @ ls + b) ** 2)) + 1e-7 * np.sqrt(np.mean(b ** 2))
@@ -204,7 +204,7 @@ def test_four_joint_arm_where_a_local_search_stopped_at_four_times_the_mass():
     q = np.random.default_rng(11).uniform(-np.pi, np.pi, (30, mech.dof))
     r = static.balance(mech, slots, q, mass_budget=budget)
     assert r.exact, r.limited_by
-    mass = sum(d["mass"] for d in r.design.values())
+    mass = sum(d.mass for d in r.design.values())
     A, b = columns(mech, slots, q)
     lb = lower_bound(A, b, slots, budget)
     assert lb - 1e-7 <= mass <= lb * (1 + 2e-3)

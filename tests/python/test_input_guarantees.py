@@ -55,19 +55,19 @@ def five_bar():
 def test_complex_string_bool_object_and_ragged_arrays_are_refused_naming_the_argument(chain, wrist_J):
     ct = _core.ComputedTorque(_core.Arm2DofDynamics(_core.Arm2DofParameters()), [100, 100], [20, 20])
     z = np.zeros(2)
-    with pytest.raises(TypeError, match=r"qd must be an array of real numbers.*complex"):
+    with pytest.raises(TypeError, match=r"v must be an array of real numbers.*complex"):
         ct.step(z, np.array([1 + 1j, 0]), z, z, z)
     with pytest.raises(TypeError, match=r"q_des must be .*strings"):
         ct.step(z, z, ["1.0", "2.0"], z, z)
     with pytest.raises(TypeError, match=r"q must be .*booleans"):
         ct.step(np.array([True, False]), z, z, z, z)
-    with pytest.raises(TypeError, match=r"qdd_des must be .*objects"):
+    with pytest.raises(TypeError, match=r"a_des must be .*objects"):
         ct.step(z, z, z, z, np.array([object(), object()]))
-    with pytest.raises(TypeError, match=r"qd_des must be .*not an array of numbers"):
+    with pytest.raises(TypeError, match=r"v_des must be .*not an array of numbers"):
         ct.step(z, z, z, [[1.0], [1.0, 2.0]], z)
     rne = _core.MechanismDynamics(chain)
     n = chain.dof
-    with pytest.raises(TypeError, match=r"qdd must be .*complex"):
+    with pytest.raises(TypeError, match=r"a must be .*complex"):
         rne.inverse_dynamics(np.zeros((1, n)), np.zeros((1, n)), np.zeros((1, n), complex))
     w = _core.ReactionlessWrist(*wrist_J, _core.ReactionlessWristConfig(), [1.5, 1.5, 1.5], [0, 0, 0])
     with pytest.raises(TypeError, match=r"D_dot must be .*strings"):
@@ -83,15 +83,15 @@ def test_complex_string_bool_object_and_ragged_arrays_are_refused_naming_the_arg
 def test_size_errors_name_the_argument_the_expected_and_the_received_shape(chain, wrist_J):
     dc = _core.DecoupledJointController([1.0, 2.0, 0.5], [100.0] * 3, [20.0] * 3)
     z = np.zeros(3)
-    with pytest.raises(ValueError, match=r"qd must have shape \(3,\) \(the controller has 3 joints\), got \(4,\)"):
+    with pytest.raises(ValueError, match=r"v must have shape \(3,\) \(the controller has 3 joints\), got \(4,\)"):
         dc.step(z, np.zeros(4), z, z, z)
     w = _core.ReactionlessWrist(*wrist_J, _core.ReactionlessWristConfig(), [1.5, 1.5, 1.5], [0, 0, 0])
     with pytest.raises(ValueError, match=r"D_half must have shape \(3,\), got \(3, 1\)"):
         w.step(z, z, np.zeros((3, 1)), z)
     kdl = _core.KdlChainDynamics(chain)
-    with pytest.raises(ValueError, match=r"qd must have shape \(4,\) \(one value per joint\), got \(2,\)"):
+    with pytest.raises(ValueError, match=r"v must have shape \(4,\) \(one value per joint\), got \(2,\)"):
         kdl.coriolis(np.zeros(4), np.zeros(2))
-    with pytest.raises(ValueError, match=r"qdd must have shape \(5, 4\), got \(5, 3\)"):
+    with pytest.raises(ValueError, match=r"a must have shape \(5, 4\), got \(5, 3\)"):
         kdl.inverse_dynamics(np.zeros((5, 4)), np.zeros((5, 4)), np.zeros((5, 3)))
 
 

@@ -77,8 +77,8 @@ def test_planar3r_reproduces_eq14_and_the_base_disc_completes_moment_balance():
     m, p, d = disc_arm("planar3r")
     cf = dz.balance_planar3r(p)
     r = moment.balance(m, paper_discs("planar3r", p, d), _samples("planar3r", 200, 1))
-    assert r.design["disc5"]["ratio"] == pytest.approx(cf["beta"], rel=1e-10)
-    assert r.design["disc7"]["ratio"] == pytest.approx(cf["gamma"], rel=1e-10)
+    assert r.design["disc5"].ratio == pytest.approx(cf["beta"], rel=1e-10)
+    assert r.design["disc7"].ratio == pytest.approx(cf["gamma"], rel=1e-10)
     cols = r.metrics["columns"]
     assert cols["joint2"]["cancelled"] and cols["joint3"]["cancelled"]
     # joint 1 turns the whole arm: what remains is k1 theta1' about x (eq 16), and the method
@@ -95,7 +95,7 @@ def test_planar3r_reproduces_eq14_and_the_base_disc_completes_moment_balance():
     slots = paper_discs("planar3r", p, d) + [DiscSlot("disc0", "base", "joint1", inertia=0.05)]
     r2 = moment.balance(m, slots, _samples("planar3r", 200, 1))
     assert r2.exact, r2.limited_by
-    assert r2.design["disc0"]["ratio"] == pytest.approx(-cf["k"][0] / 0.05, rel=1e-10)
+    assert r2.design["disc0"].ratio == pytest.approx(-cf["k"][0] / 0.05, rel=1e-10)
     rng = np.random.default_rng(7)
     q = _samples("planar3r", 1000, 8)
     assert _peak_H(r2.balanced, q, rng) < 1e-9
@@ -111,8 +111,8 @@ def test_planar3r_disc_inertias_for_given_ratios():
     slots[1] = DiscSlot("disc5", "joint1", "joint2", position=(0, d["l1"], 0), ratio=cf["beta"])
     slots[3] = DiscSlot("disc7", "joint2", "joint3", position=(0, d["l2"], 0), ratio=cf["gamma"])
     r = moment.balance(m, slots, _samples("planar3r", 200, 2))
-    assert r.design["disc5"]["inertia"] == pytest.approx(p["Jx5"], rel=1e-10)
-    assert r.design["disc7"]["inertia"] == pytest.approx(p["Jx7"], rel=1e-10)
+    assert r.design["disc5"].inertia == pytest.approx(p["Jx5"], rel=1e-10)
+    assert r.design["disc7"].inertia == pytest.approx(p["Jx7"], rel=1e-10)
 
 
 def test_spatial3r_reproduces_corrected_eq25_and_full_balance_with_two_more_discs():
@@ -122,11 +122,11 @@ def test_spatial3r_reproduces_corrected_eq25_and_full_balance_with_two_more_disc
                                               InertiaSlot("link3_shape", "link3", ("Iyy",))]
     q = _samples("spatial3r", 200, 3)
     r = moment.balance(m, slots, q)
-    assert r.design["disc5"]["ratio"] == pytest.approx(cf["beta"], rel=1e-10)
-    assert r.design["link2_cross_bar"]["Iyy"] == pytest.approx(cf["inertia_conditions"]["Jy2"], rel=1e-10)
-    assert r.design["link3_shape"]["Iyy"] == pytest.approx(cf["inertia_conditions"]["Jy3"], rel=1e-10)
+    assert r.design["disc5"].ratio == pytest.approx(cf["beta"], rel=1e-10)
+    assert r.design["link2_cross_bar"].components["Iyy"] == pytest.approx(cf["inertia_conditions"]["Jy2"], rel=1e-10)
+    assert r.design["link3_shape"].components["Iyy"] == pytest.approx(cf["inertia_conditions"]["Jy3"], rel=1e-10)
     # the printed eq 25 (J_y2 = J_z2, J_y3 = J_z3 + mu) is not what the method finds (C2)
-    assert abs(r.design["link2_cross_bar"]["Iyy"] - p["Jz2"]) > 0.1
+    assert abs(r.design["link2_cross_bar"].components["Iyy"] - p["Jz2"]) > 0.1
     mm = r.metrics["mass_matrix"]
     assert mm["offdiag_ratio"] < 1e-12 and mm["diag_variation"] < 1e-12
     assert np.allclose(mm["diag_mean"], cf["k"], rtol=1e-10)
@@ -146,7 +146,7 @@ def test_scara_reproduces_eq35_generalised_and_says_why_the_rest_is_impossible()
     m, p, d = disc_arm("scara")
     cf = dz.balance_scara(p)
     r = moment.balance(m, paper_discs("scara", p, d), _samples("scara", 200, 4))
-    assert r.design["disc5"]["ratio"] == pytest.approx(cf["beta"], rel=1e-10)
+    assert r.design["disc5"].ratio == pytest.approx(cf["beta"], rel=1e-10)
     assert np.allclose(r.metrics["mass_matrix"]["diag_mean"], cf["k"], rtol=1e-10)
     cols = r.metrics["columns"]
     assert cols["joint3"].get("force_balanced") is False        # F_x = m3 d3'' (docs §6b)
@@ -187,8 +187,8 @@ def test_parallelogram_five_bar_base_discs_reproduce_the_decoupled_inertias():
     slots = [DiscSlot("disc1", "base", "p1", inertia=0.05), DiscSlot("disc2", "base", "p2", inertia=0.05)]
     r = moment.balance(m, slots, samples, q_guess=guess)
     assert r.exact, r.limited_by
-    assert r.design["disc1"]["geared_inertia"] == pytest.approx(-cf["k"][0], rel=1e-9)
-    assert r.design["disc2"]["geared_inertia"] == pytest.approx(-cf["k"][1], rel=1e-9)
+    assert r.design["disc1"].geared_inertia == pytest.approx(-cf["k"][0], rel=1e-9)
+    assert r.design["disc2"].geared_inertia == pytest.approx(-cf["k"][1], rel=1e-9)
     motion = r.balanced.closed_motion(samples, np.random.default_rng(3).uniform(-1, 1, samples.shape), q_guess=guess)
     H = r.balanced.momentum(motion.q, motion.v).angular_momentum
     assert np.max(np.abs(H)) < 1e-9

@@ -157,9 +157,9 @@ def test_published_spring_numbers_through_the_model(machine, case, grid):
     assert result.balanced.spring_names == [s.name for s in case.springs]
     published = {case.roles.distal_spring: (2.510052, 2321.798099958), case.roles.proximal_spring: (11.130576923, 4471.771447237)}
     for name, (rate, peak) in published.items():
-        assert result.design[name]["rate"] / 1e3 == pytest.approx(rate, rel=1e-9)
+        assert result.design[name].rate / 1e3 == pytest.approx(rate, rel=1e-9)
         d, where = og.peak_distance(machine, name, grid, case.workspace.center, case.workspace.edge)
-        sprung = machine.with_springs(machine.springs({n: v["rate"] for n, v in result.design.items()}))
+        sprung = machine.with_springs(machine.springs({n: v.rate for n, v in result.design.items()}))
         m, *_ = machine.solve(np.asarray(where)[None], with_coupling=False)
         tension = sprung.spring_tension(m.q)[0, sprung.spring_names.index(name)]
         assert tension == pytest.approx(peak, rel=1e-6)

@@ -41,17 +41,17 @@ def test_kdl_matches_pinocchio(types, seed):
     q, qd, qdd = (rng.uniform(-2, 2, (N, n)), rng.uniform(-1.5, 1.5, (N, n)),
                   rng.uniform(-3, 3, (N, n)))
     out = kdl.inverse_dynamics(q, qd, qdd)
-    assert out["status"] == mechbal.Status.ok
+    assert out.ok
     for k in range(N):
         tau_pin = pin.rnea(pm, pd, q[k], qd[k], qdd[k])
-        rel = np.linalg.norm(out["tau"][k] - tau_pin) / max(1.0, np.linalg.norm(tau_pin))
-        assert rel < 1e-9, (k, out["tau"][k], tau_pin)
+        rel = np.linalg.norm(out.joint_torque[k] - tau_pin) / max(1.0, np.linalg.norm(tau_pin))
+        assert rel < 1e-9, (k, out.joint_torque[k], tau_pin)
         # wrench the base exerts on joint 1's subtree, in the world frame about the origin
         # (rnea does not update oMi: place the joints first)
         pin.forwardKinematics(pm, pd, q[k])
         f_world = pd.oMi[1].act(pd.f[1])
         F_ref = np.concatenate([f_world.linear, f_world.angular])
-        F_mb = np.concatenate([out["support_force"][k], out["support_moment"][k]])
+        F_mb = np.concatenate([out.support_force[k], out.support_moment[k]])
         assert np.linalg.norm(F_mb - F_ref) / max(1.0, np.linalg.norm(F_ref)) < 1e-9
         M_pin = pin.crba(pm, pd, q[k])
         M_pin = np.triu(M_pin) + np.triu(M_pin, 1).T

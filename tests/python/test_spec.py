@@ -185,7 +185,7 @@ def test_merged_bodies_give_the_same_dynamics_as_one_body():
     merged["joints"][0]["link"] = {"mass": m, "com": c.tolist(), "inertia": I.tolist()}
     q = np.array([[0.3, -0.5], [1.0, 0.2]])
     qd, qdd = np.ones_like(q), -np.ones_like(q)
-    tau = [mechbal.KdlChainDynamics(chain_from_config(x).model).inverse_dynamics(q, qd, qdd)["tau"]
+    tau = [mechbal.KdlChainDynamics(chain_from_config(x).model).inverse_dynamics(q, qd, qdd).joint_torque
            for x in (extra, merged)]
     np.testing.assert_allclose(tau[0], tau[1], rtol=1e-12, atol=1e-12)
 

@@ -488,7 +488,7 @@ def test_a_balancing_method_is_a_metric():
 
     def counterweights(mech):
         r = method("static").balance(mech, slots, samples=30)
-        return {"cw1": r.design["cw1"]["mass"], "cw2": r.design["cw2"]["mass"], "residual": r.residual}
+        return {"cw1": r.design["cw1"].mass, "cw2": r.design["cw2"].mass, "residual": r.residual}
 
     sweep = Sweep("arm2link", [Parameter("bodies.shoulder.mass", tolerance=0.05),
                                Parameter("bodies.elbow.mass", tolerance=0.05)],

@@ -21,9 +21,19 @@ Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 
-from mechbal.balance.result import BalanceResult, CounterweightSlot, DiscSlot, InertiaSlot, SpringSlot
+import importlib
+from typing import TYPE_CHECKING, Any, Protocol, cast
 
-__all__ = ["METHODS", "BalanceResult", "CounterweightSlot", "DiscSlot", "InertiaSlot", "SpringSlot", "method"]
+from mechbal.balance.result import (
+    BalanceResult, CounterweightDesign, CounterweightSlot, DiscDesign, DiscSlot, InertiaDesign,
+    InertiaSlot, SlotDesign, SpringDesign, SpringSlot)  # noqa: F401 (SlotDesign: the union)
+
+if TYPE_CHECKING:
+    from mechbal.balance import force, moment, rms, springs, static
+
+__all__ = ["METHODS", "BalanceResult", "CounterweightSlot", "DiscSlot", "InertiaSlot", "SpringSlot",
+           "CounterweightDesign", "SpringDesign", "DiscDesign", "InertiaDesign",
+           "BalancingMethod", "method", "static", "force", "moment", "springs", "rms"]
 
 #: method name -> module path; each module has ``balance(mechanism, design, samples, **options)``
 METHODS = {
@@ -35,13 +45,25 @@ METHODS = {
 }
 
 
-def method(name: str):
-    """The module of a balancing method by name (ValueError with the known names otherwise)."""
-    import importlib
+class BalancingMethod(Protocol):
+    """What `method` returns: a method's module, with its ``balance`` function."""
 
+    def balance(self, mechanism: Any, design: Any, samples: Any, /, *args: Any,
+                **options: Any) -> BalanceResult[Any]: ...
+
+
+def method(name: str) -> BalancingMethod:
+    """The module of a balancing method by name (ValueError with the known names otherwise)."""
     if name not in METHODS:
         from mechbal.schema import did_you_mean
 
         raise ValueError(f"method: unknown balancing method '{name}'{did_you_mean(name, list(METHODS))} "
                          f"(known: {', '.join(METHODS)})")
-    return importlib.import_module(METHODS[name])
+    return cast(BalancingMethod, importlib.import_module(METHODS[name]))
+
+
+def __getattr__(name: str) -> Any:
+    # the method modules load on first use (``mechbal.balance.static`` after ``import mechbal``)
+    if name in METHODS:
+        return importlib.import_module(METHODS[name])
+    raise AttributeError(f"module 'mechbal.balance' has no attribute {name!r}")

@@ -42,7 +42,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from mechbal import _core
-from mechbal.balance.result import BalanceResult, CounterweightSlot
+from mechbal.balance.result import BalanceResult, CounterweightDesign, CounterweightSlot
 
 #: a least-squares residual below this fraction of the unbalanced one counts as exact
 EXACT_RTOL = 1e-9
@@ -383,8 +383,9 @@ class LinearSolution:
     #: None when no least-squares solution meets the bounds
     lower_bound: float | None = None
 
-    def result(self, method: str, slots: Sequence[Slot], design: dict, residual: float, units: str,
-               metrics: dict, balanced) -> BalanceResult:
+    def result(self, method: str, slots: Sequence[Slot], design: dict[str, CounterweightDesign],
+               residual: float, units: str, metrics: dict[str, Any],
+               balanced: Any) -> BalanceResult[CounterweightDesign]:
         """The `BalanceResult` of a method that solved this linear problem (static, force):
         its rank, bounds, undetermined combinations and tied groups."""
         return BalanceResult(method=method, design=design, residual=residual,
@@ -810,11 +811,13 @@ def describe_unconstrained(design: dict) -> str:
                      f"(minimum-norm mass {d['mass']:.4g} kg)" for n, d in design.items())
 
 
-def design_from_solution(x: np.ndarray, slots: Sequence[Slot], active: Sequence[str]) -> tuple[dict, list]:
+def design_from_solution(x: np.ndarray, slots: Sequence[Slot],
+                         active: Sequence[str]) -> tuple[dict[str, CounterweightDesign], list[Any]]:
     """(design dict per slot, [(slot, mass, position_user)]) from (m, h_user) per slot: position
     h/m (on the slot's line when it has a direction; the given one when it is fixed); a vanishing
     mass sits at the centre. Tied slots say which slot they are tied to (``tied_to``)."""
-    design, placed = {}, []
+    design: dict[str, CounterweightDesign] = {}
+    placed: list[Any] = []
     for k, s in enumerate(slots):
         m, h = float(x[4 * k]), np.array(x[4 * k + 1:4 * k + 4])
         if s.fixed_position:
@@ -830,23 +833,20 @@ def design_from_solution(x: np.ndarray, slots: Sequence[Slot], active: Sequence[
     return design, placed
 
 
-def _slot_design(s: Slot, m: float, p: np.ndarray, active: Sequence[str]) -> dict:
+def _slot_design(s: Slot, m: float, p: np.ndarray, active: Sequence[str],
+                 method: str | None = None) -> CounterweightDesign:
     given = s.given or s.link
     frame = (f"frame '{given}' (on link '{s.link}')" if given != s.link else
              f"the frame link '{s.link}' is described in" + ("" if np.allclose(s.T, np.eye(4)) else " (its DH frame)"))
-    out = {"link": s.link, "mass": m, "position": p, "radius": float(np.linalg.norm(p - s.center)),
-           "mass_moment": m * p, "frame": frame,
-           "bounds": {"mass_min": s.mass_min, "mass_max": _or_none(s.mass_max),
-                      "max_radius": _or_none(s.max_radius), "center": s.center, "direction": s.direction},
-           "active_bounds": [a[len(key) + 1:] for key in [s.tie or s.name] for a in active
-                             if a.startswith(key + ".")]}
-    if s.direction is not None:
-        out["signed_distance"] = float(s.direction @ (p - s.center))
-    if s.fixed_position:
-        out["fixed_position"] = True
-    if s.tie is not None:
-        out["tied_to"] = s.tie
-    return out
+    return CounterweightDesign(
+        link=s.link, mass=m, position=p, radius=float(np.linalg.norm(p - s.center)),
+        mass_moment=m * p, frame=frame,
+        bounds={"mass_min": s.mass_min, "mass_max": _or_none(s.mass_max),
+                "max_radius": _or_none(s.max_radius), "center": s.center, "direction": s.direction},
+        active_bounds=[a[len(key) + 1:] for key in [s.tie or s.name] for a in active
+                       if a.startswith(key + ".")],
+        signed_distance=(float(s.direction @ (p - s.center)) if s.direction is not None else None),
+        fixed_position=bool(s.fixed_position), tied_to=s.tie, method=method)
 
 
 def _or_none(x: float):

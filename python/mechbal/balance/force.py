@@ -27,9 +27,11 @@ from __future__ import annotations
 from typing import Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from mechbal.balance import common
-from mechbal.balance.result import BalanceResult, CounterweightSlot
+from mechbal.balance.result import BalanceResult, CounterweightDesign, CounterweightSlot
+from mechbal.mechanism import Mechanism
 
 
 def motion_sample(mech, samples, *, seed: int = 0, lower=None, upper=None, q_guess=None):
@@ -60,8 +62,10 @@ def motion_sample(mech, samples, *, seed: int = 0, lower=None, upper=None, q_gue
     return cs.q, cs.v, cs.dropped
 
 
-def balance(mechanism, design: Sequence[CounterweightSlot], samples=200, *, mass_budget: float | None = None,
-            seed: int = 0, lower=None, upper=None, q_guess=None) -> BalanceResult:
+def balance(mechanism: Mechanism, design: Sequence[CounterweightSlot] | CounterweightSlot,
+            samples: int | npt.ArrayLike = 200, *, mass_budget: float | None = None, seed: int = 0,
+            lower: npt.ArrayLike | None = None, upper: npt.ArrayLike | None = None,
+            q_guess: npt.ArrayLike | None = None) -> BalanceResult[CounterweightDesign]:
     """Counterweights that make the linear momentum zero (least squares) over sampled motions:
     complete shaking-force balance where the residual is zero.
 

@@ -42,9 +42,10 @@ import math
 from typing import Any, Mapping, Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from mechbal import _core
-from mechbal.balance.result import BalanceResult, DiscSlot, InertiaSlot
+from mechbal.balance.result import BalanceResult, DiscDesign, DiscSlot, InertiaDesign, InertiaSlot
 from mechbal.mechanism import Mechanism
 
 __all__ = ["balance", "with_discs", "angular_momentum_columns", "design_from_table"]
@@ -242,8 +243,11 @@ def _as_design(design):
     return discs, inertias
 
 
-def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: float = 1e-9,
-            check_motions: int = 1000, seed: int = 0, **options) -> BalanceResult:
+def balance(mechanism: Mechanism,
+            design: Sequence[DiscSlot | InertiaSlot] | DiscSlot | InertiaSlot | Mapping[str, Any],
+            samples: npt.ArrayLike, *, q_guess: npt.ArrayLike | None = None,
+            tolerance: float = 1e-9, check_motions: int = 1000, seed: int = 0,
+            **options: Any) -> BalanceResult[DiscDesign | InertiaDesign]:
     """Disc inertias, gear ratios and free body inertias that cancel the angular momentum
     (hence the shaking moment) for all motions over the workspace ``samples`` (configurations
     (N, dof); actuated positions (N, na) for a closed mechanism).
@@ -251,9 +255,9 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     ``design``: `DiscSlot` and
     `InertiaSlot` objects (or ``{"discs": [...], "inertias": [...]}``).
 
-    Returns a `BalanceResult`: ``design[disc] = {"inertia", "transverse_inertia",
-    "ratio", "geared_inertia" (ratio x inertia), "carrier", "joint", "axis"}``,
-    ``design[inertia slot] = {component: value}``; ``residual`` the peak |H_O| [kg m^2/s] of the
+    Returns a `BalanceResult`: ``design[disc]`` a `DiscDesign` (``inertia``,
+    ``transverse_inertia``, ``ratio``, ``geared_inertia`` = ratio x inertia, ``carrier``,
+    ``joint``, ``axis``), ``design[inertia slot]`` an `InertiaDesign` (``components``); ``residual`` the peak |H_O| [kg m^2/s] of the
     balanced mechanism over ``check_motions`` random velocities (U(-1, 1) rad/s or m/s) at the
     samples, ``residual_before`` the same for the mechanism as given; ``metrics["columns"]`` per
     independent rate and axis whether it is cancelled, and why not; ``metrics["mass_matrix"]``
@@ -410,7 +414,7 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
 
     # the sized design
     values = {nx: float(v) for nx, v in zip(names_x, x)}
-    design_out: dict[str, dict[str, Any]] = {}
+    design_out: dict[str, DiscDesign | InertiaDesign] = {}
     limited: list[str] = []
     sized_discs = []
     for s in discs:
@@ -426,19 +430,20 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
                 ratio = h / Ja
         sized = dataclasses.replace(s, inertia=float(Ja), ratio=float(ratio))
         sized_discs.append(sized)
-        design_out[s.name] = {"inertia": float(Ja), "transverse_inertia": _transverse(sized, float(Ja)),
-                              "ratio": float(ratio), "geared_inertia": float(ratio * Ja), "carrier": s.carrier,
-                              "joint": s.joint, "axis": list(map(float, s.axis)),
-                              "position": list(map(float, s.position))}
+        design_out[s.name] = DiscDesign(
+            inertia=float(Ja), transverse_inertia=_transverse(sized, float(Ja)), ratio=float(ratio),
+            geared_inertia=float(ratio * Ja), carrier=s.carrier, joint=s.joint,
+            axis=list(map(float, s.axis)), position=list(map(float, s.position)))
         if s.ratio is None and not (s.ratio_min <= ratio <= s.ratio_max):
             limited.append(f"bound: {s.name}.ratio {ratio:.6g} outside [{s.ratio_min}, {s.ratio_max}]")
     new_inertias: dict[str, dict[str, float]] = {}
     for s in islots:
-        design_out[s.name] = {"body": s.body}
+        chosen: dict[str, float] = {}
         for c in s.components:
             v = values[(s.name, c)]
-            design_out[s.name][c] = v
+            chosen[c] = v
             new_inertias.setdefault(s.body, {})[c] = v
+        design_out[s.name] = InertiaDesign(body=s.body, components=chosen)
     balanced = with_discs(mechanism, sized_discs, new_inertias, name=f"{mechanism.name} (moment-balanced)")
 
     # per column: cancelled, or why not

@@ -4,10 +4,17 @@ Layer: methods (docs/architecture.md)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import Any
+import warnings
+from dataclasses import dataclass, field, fields
+from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar, Union
 
 import numpy as np
+import numpy.typing as npt
+
+from mechbal._deprecation import DeprecatedAttributes
+
+if TYPE_CHECKING:
+    from mechbal.mechanism import Mechanism
 
 
 @dataclass(frozen=True)
@@ -105,11 +112,148 @@ class InertiaSlot:
     minimum: float = 0.0
 
 
+class _DesignEntry(DeprecatedAttributes):
+    """What a method chose for one slot. Read the fields (``design["cw1"].mass``); the dict of
+    earlier releases (``design["cw1"]["mass"]``, ``"mass" in design["cw1"]``,
+    ``design["cw1"].get("method")``) still works for one release with a DeprecationWarning.
+    `to_dict` is the plain form written to summary.json."""
+
+    #: fields left out of the plain form when None (or False)
+    _optional: ClassVar[tuple[str, ...]] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """The plain form (summary.json): every field, optional ones only when set."""
+        out: dict[str, Any] = {}
+        for f in fields(self):  # type: ignore[arg-type]
+            value = getattr(self, f.name)
+            if f.name in self._optional and (value is None or value is False):
+                continue
+            out[f.name] = value
+        return out
+
+    def __getitem__(self, key: str) -> Any:
+        d = self.to_dict()
+        if key not in d:
+            raise KeyError(key)
+        warnings.warn(f"{type(self).__name__}: design[...][{key!r}] is deprecated (the design is "
+                      f"no longer a dict), use .{key}", DeprecationWarning, stacklevel=2)
+        return d[key]
+
+    def get(self, key: str, default: Any = None) -> Any:
+        """Deprecated dict access (``.get(key, default)``)."""
+        d = self.to_dict()
+        if key not in d:
+            return default
+        warnings.warn(f"{type(self).__name__}: design[...].get({key!r}) is deprecated, use "
+                      f".{key}", DeprecationWarning, stacklevel=2)
+        return d[key]
+
+    def keys(self) -> list[str]:
+        """Deprecated dict access: the keys of the plain form."""
+        return list(self.to_dict())
+
+    def __contains__(self, key: object) -> bool:
+        return key in self.to_dict()
+
+
+@dataclass(frozen=True)
+class CounterweightDesign(_DesignEntry):
+    """A sized counterweight (methods ``static``, ``force``, ``rms``): ``mass`` [kg] at
+    ``position`` [m] in the frame the slot was described in (``frame``, on ``link``), its
+    ``radius`` from the slot's centre [m] and ``mass_moment`` = mass x position [kg m]; the slot's
+    ``bounds`` and the ones it sits on (``active_bounds``); ``signed_distance`` [m] along the
+    slot's ``direction`` (when it has one); ``fixed_position`` when only the mass was chosen;
+    ``tied_to`` the slot it shares mass and position with; ``method`` how the ``rms`` method
+    found it."""
+
+    link: str
+    mass: float
+    position: npt.NDArray[np.float64]
+    radius: float
+    mass_moment: npt.NDArray[np.float64]
+    frame: str
+    bounds: dict[str, Any]
+    active_bounds: list[str]
+    signed_distance: float | None = None
+    fixed_position: bool = False
+    tied_to: str | None = None
+    method: str | None = None
+
+    _optional: ClassVar[tuple[str, ...]] = ("signed_distance", "fixed_position", "tied_to", "method")
+
+
+@dataclass(frozen=True)
+class SpringDesign(_DesignEntry):
+    """A sized spring (method ``springs``): ``rate`` [N/m] of each of ``count`` springs
+    (``rate_N_per_mm`` the same in N/mm), behind a block and tackle of ``pulley_ratio``, so
+    ``equivalent_rate`` [N/m] at the anchors; ``free_length`` [m], ``preload`` [N]; the anchors
+    ``anchor_a`` on ``link_a`` and ``anchor_b`` on ``link_b`` [m]; over the samples the
+    ``peak_tension`` / ``min_tension`` at the anchors [N], ``peak_length`` / ``min_length`` of
+    the anchor distance [m], ``min_stretch`` beyond the free length [m] and
+    ``peak_force_per_spring`` [N]."""
+
+    rate: float
+    rate_N_per_mm: float
+    equivalent_rate: float
+    count: int
+    pulley_ratio: float
+    free_length: float
+    preload: float
+    link_a: str
+    anchor_a: list[float]
+    link_b: str
+    anchor_b: list[float]
+    peak_tension: float
+    min_tension: float
+    peak_length: float
+    min_length: float
+    min_stretch: float
+    peak_force_per_spring: float
+
+
+@dataclass(frozen=True)
+class DiscDesign(_DesignEntry):
+    """A sized counter-rotating disc (method ``moment``): axial ``inertia`` [kg m^2] and
+    ``transverse_inertia``, gear ``ratio`` to ``joint``'s rate, ``geared_inertia`` = ratio x
+    inertia, on link ``carrier`` at ``position`` [m] along ``axis`` (carrier frame)."""
+
+    inertia: float
+    transverse_inertia: float
+    ratio: float
+    geared_inertia: float
+    carrier: str
+    joint: str
+    axis: list[float]
+    position: list[float]
+
+
+@dataclass(frozen=True)
+class InertiaDesign(_DesignEntry):
+    """Chosen central principal inertias of an existing ``body`` (method ``moment``):
+    ``components`` maps ``"Ixx"``, ``"Iyy"``, ``"Izz"`` to their values [kg m^2]."""
+
+    body: str
+    components: dict[str, float]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The plain form: ``{"body": ..., "Iyy": ...}``."""
+        return {"body": self.body, **self.components}
+
+
+#: what a method chose for one slot
+SlotDesign = Union[CounterweightDesign, SpringDesign, DiscDesign, InertiaDesign]
+#: the design type of a method's result: ``BalanceResult[CounterweightDesign]`` (static, force,
+#: rms), ``BalanceResult[SpringDesign]`` (springs), ``BalanceResult[DiscDesign | InertiaDesign]``
+#: (moment)
+D = TypeVar("D", bound=_DesignEntry)
+
+
 @dataclass
-class BalanceResult:
+class BalanceResult(Generic[D]):
     """What a balancing method returns.
 
-    ``design``: the chosen values, per slot name (``{"mass": kg, "position": [m, m, m], ...}``);
+    ``design``: what the method chose, per slot name: a `CounterweightDesign`, `SpringDesign`,
+    `DiscDesign` or `InertiaDesign` (``result.design["cw1"].mass``);
     ``residual``: the remaining norm of what the method drives to zero (units in
     ``residual_units``), ``residual_before`` the same quantity unbalanced; ``rank`` and
     ``unknowns`` of the linear problem where there is one; ``limited_by``: human-readable reasons
@@ -125,7 +269,7 @@ class BalanceResult:
     mass and position (``{slot tied to: [every slot of the group]}``)."""
 
     method: str
-    design: dict[str, dict[str, Any]]
+    design: dict[str, D]
     residual: float
     residual_before: float
     residual_units: str
@@ -133,8 +277,9 @@ class BalanceResult:
     unknowns: int | None = None
     limited_by: list[str] = field(default_factory=list)
     metrics: dict[str, Any] = field(default_factory=dict)
-    balanced: Any = None
-    elements: list = field(default_factory=list)
+    #: the balanced mechanism (keyword only, required)
+    balanced: Mechanism = field(kw_only=True)
+    elements: list[Any] = field(default_factory=list)
     active_bounds: list[str] = field(default_factory=list)
     undetermined: list[str] = field(default_factory=list)
     tied: dict[str, list[str]] = field(default_factory=dict)
@@ -144,11 +289,15 @@ class BalanceResult:
 
     @property
     def exact(self) -> bool:
+        """True when nothing limited the balance (``limited_by`` is empty)."""
         return not self.limited_by
+
 
     def summary(self) -> dict[str, Any]:
         """Plain JSON-able dict (for summary.json)."""
-        def plain(x):
+        def plain(x: Any) -> Any:
+            if isinstance(x, _DesignEntry):
+                return plain(x.to_dict())
             if isinstance(x, dict):
                 return {k: plain(v) for k, v in x.items()}
             if isinstance(x, (list, tuple)):

@@ -39,12 +39,14 @@ import math
 from typing import Callable, Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from mechbal import _core
 from mechbal.balance import common
-from mechbal.balance.result import BalanceResult, CounterweightSlot
+from mechbal.balance.result import BalanceResult, CounterweightDesign, CounterweightSlot
 
 _IDX = [(0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)]  # Ixx, Ixy, Iyy, Ixz, Iyz, Izz
+from mechbal.mechanism import Mechanism
 
 
 # ---- the quartic in a radius and its stationarity cubic (Arakelian et al. 2011, eqs 39-59, general form)
@@ -377,9 +379,11 @@ def _cardano(model: _TorqueModel, var: _Variables, j: int):
     return np.array([candidates[int(np.argmin(values))]])
 
 
-def balance(mechanism, design: Sequence[CounterweightSlot], samples, *, objective: str = "rms",
-            coupling: str | None = None, weights=None, mass_budget: float | None = None,
-            starts: int = 5, seed: int = 0, q_guess=None, fast_path: bool = True) -> BalanceResult:
+def balance(mechanism: Mechanism, design: Sequence[CounterweightSlot] | CounterweightSlot,
+            samples: tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike], *, objective: str = "rms",
+            coupling: str | None = None, weights: npt.ArrayLike | None = None,
+            mass_budget: float | None = None, starts: int = 5, seed: int = 0,
+            q_guess: npt.ArrayLike | None = None, fast_path: bool = True) -> BalanceResult[CounterweightDesign]:
     """Counterweights minimising the RMS (``objective="rms"``) or peak (``"peak"``) actuator
     torques along a sampled trajectory ``samples = (q, v, a)`` (closed: of the actuated joints).
 
@@ -453,10 +457,9 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples, *, objectiv
             active += var.active(y)
             tau_fixed = model(y, grad=False)[0]
     placed = [(s, float(values[s.name][0]), np.asarray(values[s.name][1], float)) for s in slots]
-    design_out = {}
+    design_out: dict[str, CounterweightDesign] = {}
     for s, m, p in placed:
-        design_out[s.name] = common._slot_design(s, m, p, active)
-        design_out[s.name]["method"] = methods[s.name]
+        design_out[s.name] = common._slot_design(s, m, p, active, method=methods[s.name])
     balanced = common.balanced_mechanism(mech, placed)
     tau_after = balanced.inverse_dynamics(q, v, a)
     if C is not None:

@@ -30,7 +30,8 @@ import numpy as np
 
 from mechbal import _core, progress, report
 from mechbal.balance import METHODS, common, method as method_module
-from mechbal.balance.result import BalanceResult, CounterweightSlot
+from mechbal.balance.result import (
+    BalanceResult, CounterweightDesign, CounterweightSlot, DiscDesign, SpringDesign)
 from mechbal.errors import ConfigError
 from mechbal.export import write_bodies, write_summary
 
@@ -346,15 +347,16 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
 def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
     from mechbal.balance.writers import inertia_table, mechanism_table, toml_text
 
+    cws = {k: v for k, v in result.design.items() if isinstance(v, CounterweightDesign)}
+    springs = {k: v for k, v in result.design.items() if isinstance(v, SpringDesign)}
+    discs = {k: v for k, v in result.design.items() if isinstance(v, DiscDesign)}
     added = ([f"counterweights " + ", ".join(
-        f"{k} {v['mass']:.6g} kg at {np.round(np.asarray(v['position'], float), 6).tolist()} m on {v['link']}"
-        for k, v in result.design.items() if "mass" in v)] if any("mass" in v for v in result.design.values()) else [])
-    added += ([f"springs " + ", ".join(f"{k} {v['rate']:.6g} N/m x {v['count']} ({v['link_a']} - {v['link_b']})"
-                                       for k, v in result.design.items() if "rate" in v and "link_a" in v)]
-              if any("link_a" in v for v in result.design.values()) else [])
-    added += ([f"discs " + ", ".join(f"{k} ({v['inertia']:.6g} kg m^2, ratio {v['ratio']:.6g} to {v['joint']}) on {v['carrier']}"
-                                     for k, v in result.design.items() if "ratio" in v)]
-              if any("ratio" in v for v in result.design.values()) else [])
+        f"{k} {v.mass:.6g} kg at {np.round(np.asarray(v.position, float), 6).tolist()} m on {v.link}"
+        for k, v in cws.items())] if cws else [])
+    added += ([f"springs " + ", ".join(f"{k} {v.rate:.6g} N/m x {v.count} ({v.link_a} - {v.link_b})"
+                                       for k, v in springs.items())] if springs else [])
+    added += ([f"discs " + ", ".join(f"{k} ({v.inertia:.6g} kg m^2, ratio {v.ratio:.6g} to {v.joint}) on {v.carrier}"
+                                     for k, v in discs.items())] if discs else [])
     header = (f"{bc.name} balanced by `mechbal balance --method {method}`: " + "; ".join(added or ["nothing added"])
               + f".\nResidual {result.residual:.6g} {result.residual_units} (unbalanced {result.residual_before:.6g}).")
     case = {"name": f"{bc.name}-balanced", "kind": "mechanism", "title": f"{bc.title}, balanced ({method})"}
@@ -482,15 +484,16 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
     if bc.notes:
         summary["case_notes"] = bc.notes
     write_summary(out / "summary.json", summary, command="balance")
-    rows = [[k, v["mass"], np.asarray(v["position"], float), ", ".join(v.get("active_bounds", [])) or "-"]
-            for k, v in result.design.items() if "mass" in v]
+    rows = [[k, v.mass, np.asarray(v.position, float), ", ".join(v.active_bounds) or "-"]
+            for k, v in result.design.items() if isinstance(v, CounterweightDesign)]
     if rows:
         print(report.table(rows, ["counterweight", "mass [kg]", "position [m] (link frame)", "active bounds"]))
-    rows = [[k, v["rate"], v["count"], v["pulley_ratio"], v["peak_tension"]]
-            for k, v in result.design.items() if "link_a" in v and "rate" in v]
+    rows = [[k, v.rate, v.count, v.pulley_ratio, v.peak_tension]
+            for k, v in result.design.items() if isinstance(v, SpringDesign)]
     if rows:
         print(report.table(rows, ["spring", "rate [N/m]", "count", "pulley ratio", "peak tension [N]"]))
-    discs = [[k, v["carrier"], v["joint"], v["ratio"], v["inertia"]] for k, v in result.design.items() if "ratio" in v]
+    discs = [[k, v.carrier, v.joint, v.ratio, v.inertia] for k, v in result.design.items()
+             if isinstance(v, DiscDesign)]
     if discs:
         print(report.table(discs, ["disc", "carrier", "geared to", "ratio", "inertia [kg m^2]"]))
     cmp = summary["before_after"]

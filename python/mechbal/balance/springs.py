@@ -64,9 +64,10 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping, Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from mechbal import _core
-from mechbal.balance.result import BalanceResult, SpringSlot
+from mechbal.balance.result import BalanceResult, SpringDesign, SpringSlot
 from mechbal.mechanism import Mechanism
 
 __all__ = ["spring_torque", "potential_energy", "spring_energy", "spring_tension", "spring_lengths",
@@ -290,8 +291,10 @@ def _bounds_of(slot: SpringSlot, side: str):
     return lo, hi
 
 
-def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: float = 1e-9,
-            max_nfev: int = 200, catalogue=None, closure_tolerance: float = 1e-13, **options) -> BalanceResult:
+def balance(mechanism: Mechanism, design: Sequence[SpringSlot] | SpringSlot | Mapping[str, Any],
+            samples: npt.ArrayLike, *, q_guess: npt.ArrayLike | None = None,
+            tolerance: float = 1e-9, max_nfev: int = 200, catalogue: Any = None,
+            closure_tolerance: float = 1e-13, **options: Any) -> BalanceResult[SpringDesign]:
     """Size springs so that gravity torque + spring torque = 0 over a workspace sample.
 
     ``design``: `SpringSlot` objects (or ``{"springs": [...]}``).
@@ -303,7 +306,7 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     the actuated coordinates; ``closure_tolerance`` [m] of that loop solve (stiff springs need a
     tighter one: a closure error e leaves about K e on the actuators).
 
-    Returns a `BalanceResult`: ``design[name]`` with ``rate`` [N/m] (each spring),
+    Returns a `BalanceResult`: ``design[name]`` a `SpringDesign` with ``rate`` [N/m] (each spring),
     ``equivalent_rate`` [N/m] at the anchors, the anchors, ``peak_tension`` [N],
     ``min_stretch`` [m]; ``residual`` the peak static joint force left (gravity + springs) [N m
     or N], ``residual_before`` the peak gravity torque; ``rank``/``unknowns`` of the linear rate
@@ -452,21 +455,20 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     columns = [balanced.spring_names.index(s.name) for s in sized]
     lengths = np.atleast_2d(balanced.spring_lengths(q))[:, columns]
     tensions = np.atleast_2d(balanced.spring_tension(q))[:, columns]
-    design_out: dict[str, dict[str, Any]] = {}
+    design_out: dict[str, SpringDesign] = {}
     limited: list[str] = []
     for i, s in enumerate(sized):
         d, T = lengths[:, i], tensions[:, i]
         x_s = d - s.free_length
-        design_out[s.name] = {
-            "rate": s.rate, "rate_N_per_mm": s.rate / 1000.0, "equivalent_rate": equivalent_rate(s),
-            "count": _count(s), "pulley_ratio": s.pulley_ratio, "free_length": s.free_length,
-            "preload": float(getattr(s, "preload", 0.0)),
-            "link_a": s.link_a, "anchor_a": list(s.anchor_a), "link_b": s.link_b, "anchor_b": list(s.anchor_b),
-            "peak_tension": float(np.max(T)), "min_tension": float(np.min(T)),
-            "peak_length": float(np.max(d)), "min_length": float(np.min(d)),
-            "min_stretch": float(np.min(x_s)),
-            "peak_force_per_spring": float(np.max(T)) * s.pulley_ratio / _count(s),
-        }
+        design_out[s.name] = SpringDesign(
+            rate=s.rate, rate_N_per_mm=s.rate / 1000.0, equivalent_rate=equivalent_rate(s),
+            count=_count(s), pulley_ratio=s.pulley_ratio, free_length=s.free_length,
+            preload=float(getattr(s, "preload", 0.0)),
+            link_a=s.link_a, anchor_a=list(s.anchor_a), link_b=s.link_b, anchor_b=list(s.anchor_b),
+            peak_tension=float(np.max(T)), min_tension=float(np.min(T)),
+            peak_length=float(np.max(d)), min_length=float(np.min(d)),
+            min_stretch=float(np.min(x_s)),
+            peak_force_per_spring=float(np.max(T)) * s.pulley_ratio / _count(s))
         if np.min(x_s) < -1e-12 and equivalent_rate(s) > 0:
             limited.append(f"slack: {s.name} is shorter than its free length at some samples "
                            f"(min stretch {np.min(x_s):.4g} m): the spring model does not hold there")
@@ -538,7 +540,7 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
         for name, cands in clusters.items():
             if not cands:
                 notes.append(f"catalogue: no cluster implements {name} (rate "
-                             f"{design_out[name]['equivalent_rate']:.4g} N/m, peak {design_out[name]['peak_tension']:.4g} N)")
+                             f"{design_out[name].equivalent_rate:.4g} N/m, peak {design_out[name].peak_tension:.4g} N)")
     return result
 
 
@@ -824,7 +826,7 @@ def select_for_result(mechanism: Mechanism, result: BalanceResult, samples, cata
         def peak_with_cluster(K, s=s, peak_at=peak_at):
             return peak_at(K)
 
-        out[s.name] = select_springs(K0, float(result.design[s.name]["peak_tension"]), catalogue,
+        out[s.name] = select_springs(K0, float(getattr(result.design[s.name], "peak_tension")), catalogue,
                                      anchor_offset=offset, peak_force_at=peak_with_cluster, **select_options)
     return out
 

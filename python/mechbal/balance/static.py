@@ -23,9 +23,11 @@ from __future__ import annotations
 from typing import Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from mechbal.balance import common
-from mechbal.balance.result import BalanceResult, CounterweightSlot
+from mechbal.balance.result import BalanceResult, CounterweightDesign, CounterweightSlot
+from mechbal.mechanism import Mechanism
 
 
 def workspace_sample(mech, samples, *, seed: int = 0, lower=None, upper=None, q_guess=None):
@@ -59,8 +61,10 @@ def gravity_rows(mech, q, C=None) -> np.ndarray:
     return G if C is None else np.einsum("nij,ni->nj", C, G)
 
 
-def balance(mechanism, design: Sequence[CounterweightSlot], samples=1000, *, mass_budget: float | None = None,
-            seed: int = 0, lower=None, upper=None, q_guess=None) -> BalanceResult:
+def balance(mechanism: Mechanism, design: Sequence[CounterweightSlot] | CounterweightSlot,
+            samples: int | npt.ArrayLike = 1000, *, mass_budget: float | None = None, seed: int = 0,
+            lower: npt.ArrayLike | None = None, upper: npt.ArrayLike | None = None,
+            q_guess: npt.ArrayLike | None = None) -> BalanceResult[CounterweightDesign]:
     """Counterweights that make the gravity torque zero (least squares) over a workspace sample.
 
     ``design``: the counterweight slots (`CounterweightSlot`: link, mass range, distance

@@ -25,11 +25,12 @@ about O: force = dP/dt - m g, moment = dH_O/dt - (m c) x g over the bodies that 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from mechbal import _core
+from mechbal._deprecation import DeprecatedAttributes, renamed_kwargs
 from mechbal.export.mjcf import MINIMUM, _build, minimum_bodies
 
 __all__ = ["MujocoMechanism", "MujocoInverse", "require_mujoco"]
@@ -241,9 +242,9 @@ CONSTRAINT_WEIGHT = 1e-4
 
 
 @dataclass(frozen=True)
-class CoSimulation:
+class CoSimulation(DeprecatedAttributes):
     """A 1 kHz co-simulation (`co_simulate`): the controller's log, one row per tick
-    k = 0 .. steps (``t``, ``q``, ``qd``, ``q_des``, ``qd_des``, ``joint_torque``, ``status``, in
+    k = 0 .. steps (``t``, ``q``, ``v``, ``q_des``, ``v_des``, ``joint_torque``, ``status``, in
     the controller's coordinates: the actuated joints of a closed mechanism), MuJoCo's base
     reaction at each tick (``base_reaction_force`` / ``_moment``: the moving bodies' momentum rate
     minus their weight, `MujocoMechanism.momentum_rate`) beside mechbal's prediction along
@@ -252,9 +253,9 @@ class CoSimulation:
     loop-closure violation ``constraint_violation`` (N,) [m or rad] of MuJoCo's soft constraints."""
     t: np.ndarray
     q: np.ndarray
-    qd: np.ndarray
+    v: np.ndarray
     q_des: np.ndarray
-    qd_des: np.ndarray
+    v_des: np.ndarray
     joint_torque: np.ndarray
     status: np.ndarray
     saturated_ticks: int
@@ -268,6 +269,8 @@ class CoSimulation:
     mass_moment: np.ndarray
     predicted_mass_moment: np.ndarray
     constraint_violation: np.ndarray
+
+    _renamed: ClassVar[dict[str, str]] = {"qd": "v", "qd_des": "v_des"}
 
     @property
     def shaking_force(self) -> np.ndarray:
@@ -292,7 +295,8 @@ class CoSimulation:
         return self.q_des - self.q
 
 
-def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 1e-3,
+@renamed_kwargs(qd0="v0")
+def co_simulate(mech, controller, trajectory, q0=None, v0=None, *, dt: float = 1e-3,
                 duration: float | None = None, q_guess=None, substeps: int = 1,
                 integrator: str = "RK4", solref: tuple[float, float] | None = None,
                 solimp: tuple[float, ...] | None = None, minimum_mass: float | None = None,
@@ -308,7 +312,7 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
     (default `MINIMUM_FRACTION` of the total mass: MuJoCo's solver fails on a link of 1e-13
     kg; mechbal's prediction is of the mechanism with them, ``MujocoMechanism.exported``);
     ``constraint_weight``: factor on MuJoCo's inverse weights (`CONSTRAINT_WEIGHT`: a
-    constraint under load gives (1 - d) / d x weight x force in acceleration). The state starts on the trajectory at t = 0 (or ``q0``, ``qd0``)."""
+    constraint under load gives (1 - d) / d x weight x force in acceleration). The state starts on the trajectory at t = 0 (or ``q0``, ``v0``)."""
     from mechbal.trajectory import as_trajectory
 
     traj = as_trajectory(trajectory)
@@ -320,17 +324,17 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
         raise ValueError(f"substeps must be >= 1, got {substeps}")
     steps = int(round(duration / dt))
     t = np.arange(steps + 1) * dt
-    q_des, qd_des, qdd_des = (np.atleast_2d(np.asarray(x, float)) for x in traj.evaluate(t))
+    q_des, v_des, a_des = (np.atleast_2d(np.asarray(x, float)) for x in traj.evaluate(t))
     if q_des.shape[0] != t.size:
-        q_des, qd_des, qdd_des = (x.reshape(t.size, -1) for x in (q_des, qd_des, qdd_des))
+        q_des, v_des, a_des = (x.reshape(t.size, -1) for x in (q_des, v_des, a_des))
     closed = mech.is_closed
     act = [mech.joint_names.index(n) for n in mech.actuated_names] if closed else list(range(mech.dof))
     # mechbal's prediction along the desired motion (full coordinates)
     if closed:
-        motion = mech.closed_motion(q_des, qd_des, qdd_des, q_guess=q_guess)
+        motion = mech.closed_motion(q_des, v_des, a_des, q_guess=q_guess)
         Q, V, A = motion.q, motion.v, motion.a
     else:
-        Q, V, A = q_des, qd_des, qdd_des
+        Q, V, A = q_des, v_des, a_des
     if minimum_mass is None:
         minimum_mass = max(MINIMUM_FRACTION * mech.total_mass, MINIMUM)
     sim = MujocoMechanism(mech, q=Q[0], q_guess=q_guess, timestep=dt / int(substeps), minimum_mass=minimum_mass,
@@ -345,9 +349,9 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
         imp = np.asarray(solimp, float)
         m.eq_solimp[:, :imp.size] = imp
     q_start, v_start = Q[0], V[0]
-    if q0 is not None or qd0 is not None:   # a given start (controller coordinates)
+    if q0 is not None or v0 is not None:   # a given start (controller coordinates)
         qa0 = q_des[0] if q0 is None else np.asarray(q0, float)
-        va0 = qd_des[0] if qd0 is None else np.asarray(qd0, float)
+        va0 = v_des[0] if v0 is None else np.asarray(v0, float)
         if closed:
             start = mech.closed_motion(qa0, va0, q_guess=Q[0])
             q_start, v_start = np.asarray(start.q), np.asarray(start.v)
@@ -358,7 +362,7 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
     g = np.asarray(mech.gravity, float)
     moving = sim.moving_bodies
     n = len(act)
-    log = {k: np.zeros((steps + 1, n)) for k in ("q", "qd", "tau")}
+    log = {k: np.zeros((steps + 1, n)) for k in ("q", "v", "tau")}
     status = np.zeros(steps + 1, dtype=np.uint32)
     F = np.zeros((steps + 1, 3))
     M = np.zeros((steps + 1, 3))
@@ -371,7 +375,7 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
     for k in range(steps + 1):
         qk, vk = sim.coordinates()
         qa, va = qk[act], vk[act]
-        cmd = controller.step(qa, va, q_des[k], qd_des[k], qdd_des[k])
+        cmd = controller.step(qa, va, q_des[k], v_des[k], a_des[k])
         # a wrapped controller returns a JointCommand, a bare core one (tau, status)
         tau_k, status_k = (cmd.joint_torque, cmd.status) if hasattr(cmd, "joint_torque") else cmd
         tau = np.asarray(tau_k, float)
@@ -383,7 +387,7 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
         F[k], M[k] = sim.momentum_rate()
         mc[k] = sum(m.body_mass[b] * d.xipos[b] for b in moving) if moving else np.zeros(3)
         viol[k] = float(np.max(np.abs(d.efc_pos[:d.ne]))) if d.ne else 0.0
-        log["q"][k], log["qd"][k], log["tau"][k] = qa, va, tau
+        log["q"][k], log["v"][k], log["tau"][k] = qa, va, tau
         if k == steps:
             break
         for _ in range(int(substeps)):
@@ -396,7 +400,7 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
     still_bodies = _still_bodies(model)
     masses = np.array([0.0 if b.name in still_bodies else float(b.mass) for b in model.bodies])
     mc_pred = np.einsum("b,nbi->ni", masses, bm.com)
-    return CoSimulation(t=t, q=log["q"], qd=log["qd"], q_des=q_des, qd_des=qd_des, joint_torque=log["tau"],
+    return CoSimulation(t=t, q=log["q"], v=log["v"], q_des=q_des, v_des=v_des, joint_torque=log["tau"],
                         status=status, saturated_ticks=saturated, steps_completed=completed,
                         base_reaction_force=F, base_reaction_moment=M,
                         predicted_base_reaction_force=np.asarray(br.base_reaction_force),

@@ -44,12 +44,18 @@ Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 from mechbal.sweep.core import KINDS, Parameter, Sweep, load_base  # noqa: F401
 from mechbal.sweep.metrics import BUILTIN as BUILTIN_METRICS  # noqa: F401
 from mechbal.sweep.parameters import PATH_FORMS  # noqa: F401
 
+if TYPE_CHECKING:  # loaded on first use (pandas and the file formats are optional)
+    from mechbal.sweep.config import SWEEPS_DIR, from_toml, run_file, sweep_path  # noqa: F401
+    from mechbal.sweep.results import SweepResult  # noqa: F401
 
-def __getattr__(name):
+
+def __getattr__(name: str) -> Any:
     if name == "SweepResult":
         from mechbal.sweep.results import SweepResult
         return SweepResult

@@ -10,13 +10,17 @@ import math
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from mechbal.errors import ConfigError
 from mechbal.sweep.metrics import STATIC, MetricSpec, resolve
 from mechbal.sweep.parameters import Target, nominal_value, parse_path
+
+if TYPE_CHECKING:
+    from mechbal.sweep.results import SweepResult
 
 KINDS = ("monte_carlo", "sensitivity", "grid")
 #: largest number of evaluations of one sweep (rows of the table)
@@ -236,11 +240,15 @@ class Sweep:
     (``trajectory_samples`` instants). ``chunk_size``: evaluations per task (default 4096 when
     every set is batched, 64 otherwise)."""
 
-    def __init__(self, case, parameters: Sequence, metrics, *, kind: str = "monte_carlo",
-                 evaluations: int | None = None, seed: int = 0, poses=None, pose_count: int = 100,
-                 pose_source: str | None = None, pose_lower=None, pose_upper=None, trajectory=None,
-                 trajectory_samples: int | None = None, q_guess=None, chunk_size: int | None = None,
-                 name: str = "sweep", title: str = ""):
+    def __init__(self, case: Any, parameters: Sequence[Parameter | Mapping[str, Any]],
+                 metrics: str | Sequence[str] | Mapping[str, Callable[..., Any]] | Sequence[Any], *,
+                 kind: str = "monte_carlo", evaluations: int | None = None, seed: int = 0,
+                 poses: npt.ArrayLike | None = None, pose_count: int = 100,
+                 pose_source: str | None = None, pose_lower: npt.ArrayLike | None = None,
+                 pose_upper: npt.ArrayLike | None = None,
+                 trajectory: tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike] | None = None,
+                 trajectory_samples: int | None = None, q_guess: npt.ArrayLike | None = None,
+                 chunk_size: int | None = None, name: str = "sweep", title: str = "") -> None:
         self.base = case if isinstance(case, Base) else load_base(case, trajectory_samples)
         self.name, self.title = name, title
         if kind not in KINDS:
@@ -371,8 +379,9 @@ class Sweep:
         rebuilt = any(not p.target.batched for p in self.parameters) or any(not m.builtin for m in self.metrics)
         return CHUNK_REBUILT if rebuilt else CHUNK_BATCHED
 
-    def run(self, backend: str = "auto", *, workers: int | None = None, scheduler=None,
-            progress: bool = True, callback=None):
+    def run(self, backend: str = "auto", *, workers: int | None = None, scheduler: Any = None,
+            progress: bool = True,
+            callback: Callable[[int, int], object] | None = None) -> SweepResult:
         """Evaluate every set: ``backend`` auto (serial unless the sweep would take longer than
         `mechbal.sweep.backends.AUTO_SERIAL_SECONDS` in one process, judged from its first
         chunk; then processes), serial, processes (``workers`` local processes, default

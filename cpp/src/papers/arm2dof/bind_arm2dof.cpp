@@ -80,9 +80,9 @@ py::dict log_to_dict(const ClosedLoopLog& log) {
   py::dict d;
   d["t"] = log.t;
   d["q"] = log.q;
-  d["qd"] = log.qd;
+  d["v"] = log.qd;
   d["q_des"] = log.q_des;
-  d["qd_des"] = log.qd_des;
+  d["v_des"] = log.qd_des;
   d["tau"] = log.tau;
   d["status"] = log.status;
   d["tick_status"] = log.tick_status;
@@ -148,21 +148,21 @@ void bind_arm2dof(py::module_& m) {
       .def(
           "inverse_dynamics",
           [](Arm2DofDynamics& d, const Array& q, const Array& qd, const Array& qdd) {
-            return batch3(q, "q", qd, "qd", qdd, "qdd", "tau",
+            return batch3(q, "q", qd, "v", qdd, "a", "tau",
                           [&](const auto& a, const auto& b, const auto& c, auto& o) {
                             return d.inverse_dynamics(a, b, c, o);
                           });
           },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"), "Joint torques (N, 2): {'tau', 'status'}")
+          py::arg("q"), py::arg("v"), py::arg("a"), "Joint torques (N, 2): {'tau', 'status'}")
       .def(
           "forward_dynamics",
           [](Arm2DofDynamics& d, const Array& q, const Array& qd, const Array& tau) {
-            return batch3(q, "q", qd, "qd", tau, "tau", "qdd",
+            return batch3(q, "q", qd, "v", tau, "tau", "a",
                           [&](const auto& a, const auto& b, const auto& c, auto& o) {
                             return d.forward_dynamics(a, b, c, o);
                           });
           },
-          py::arg("q"), py::arg("qd"), py::arg("tau"), "Accelerations (N, 2): {'qdd', 'status'}")
+          py::arg("q"), py::arg("v"), py::arg("tau"), "Accelerations (N, 2): {'a', 'status'}")
       // no status in these signatures: NaN input or an overflowing result is a ValueError
       .def("mass_matrix",
            [](const Arm2DofDynamics& d, const Array& q) {
@@ -172,10 +172,10 @@ void bind_arm2dof(py::module_& m) {
       .def("coriolis_matrix",
            [](const Arm2DofDynamics& d, const Array& q, const Array& qd) {
              return finite_result(d.coriolis_matrix(fixed_vector<2>(q, "q", true),
-                                                    fixed_vector<2>(qd, "qd", true)),
+                                                    fixed_vector<2>(qd, "v", true)),
                                   "coriolis_matrix");
            },
-           py::arg("q"), py::arg("qd"), "C(q, qd) (2, 2), Christoffel form")
+           py::arg("q"), py::arg("v"), "C(q, v) (2, 2), Christoffel form")
       .def("gravity",
            [](const Arm2DofDynamics& d, const Array& q) {
              return finite_result(d.gravity(fixed_vector<2>(q, "q", true)), "gravity");
@@ -184,10 +184,10 @@ void bind_arm2dof(py::module_& m) {
       .def("kinetic_energy",
            [](const Arm2DofDynamics& d, const Array& q, const Array& qd) {
              return finite_result(d.kinetic_energy(fixed_vector<2>(q, "q", true),
-                                                   fixed_vector<2>(qd, "qd", true)),
+                                                   fixed_vector<2>(qd, "v", true)),
                                   "kinetic_energy");
            },
-           py::arg("q"), py::arg("qd"))
+           py::arg("q"), py::arg("v"))
       .def("potential_energy",
            [](const Arm2DofDynamics& d, const Array& q) {
              return finite_result(d.potential_energy(fixed_vector<2>(q, "q", true)),
@@ -215,7 +215,7 @@ void bind_arm2dof(py::module_& m) {
       [](ForwardDynamics& plant, JointController& controller, const RestToRestTrajectory& desired,
          const Array& q0_arg, const Array& qd0_arg, double dt, double duration,
          const std::string& sampling) {
-        const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "qd0", -1);
+        const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "v0", -1);
         const ClosedLoopOptions opt = closed_loop_options(dt, duration, sampling);
         ClosedLoopLog log;
         {
@@ -224,11 +224,11 @@ void bind_arm2dof(py::module_& m) {
         }
         return log_to_dict(log);
       },
-      py::arg("plant"), py::arg("controller"), py::arg("desired"), py::arg("q0"), py::arg("qd0"),
+      py::arg("plant"), py::arg("controller"), py::arg("desired"), py::arg("q0"), py::arg("v0"),
       py::arg("dt") = 1e-3, py::arg("duration") = 1.0, py::arg("sampling") = "zero_order_hold",
       "RK4 closed loop of `plant` (any ForwardDynamics: Arm2DofDynamics, MechanismDynamics of any "
       "mechanism) under `controller` (any JointController) tracking `desired`; returns a dict of arrays "
-      "t (N+1,), q, qd, q_des, qd_des, tau (N+1, dof), status, saturated_ticks, steps_completed.");
+      "t (N+1,), q, v, q_des, v_des, tau (N+1, dof), status, saturated_ticks, steps_completed.");
   m.attr("simulate_computed_torque") = m.attr("simulate_closed_loop");
   m.def(
       "simulate_closed_loop_sampled",
@@ -238,14 +238,14 @@ void bind_arm2dof(py::module_& m) {
         const auto n = static_cast<py::ssize_t>(plant.dof());
         require_shape(q_des, "q_des", {-1, n}, "one row every dt/2, one value per joint");
         const auto J = q_des.shape(0);
-        require_shape(qd_des, "qd_des", {J, n});
-        require_shape(qdd_des, "qdd_des", {J, n});
+        require_shape(qd_des, "v_des", {J, n});
+        require_shape(qdd_des, "a_des", {J, n});
         using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
         SampledMotion desired;
         desired.q = Eigen::Map<const RowMajor>(q_des.data(), J, n);
         desired.qd = Eigen::Map<const RowMajor>(qd_des.data(), J, n);
         desired.qdd = Eigen::Map<const RowMajor>(qdd_des.data(), J, n);
-        const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "qd0", -1);
+        const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "v0", -1);
         const ClosedLoopOptions opt = closed_loop_options(dt, duration, sampling);
         ClosedLoopLog log;
         {
@@ -254,8 +254,8 @@ void bind_arm2dof(py::module_& m) {
         }
         return log_to_dict(log);
       },
-      py::arg("plant"), py::arg("controller"), py::arg("q_des"), py::arg("qd_des"),
-      py::arg("qdd_des"), py::arg("q0"), py::arg("qd0"), py::arg("dt") = 1e-3,
+      py::arg("plant"), py::arg("controller"), py::arg("q_des"), py::arg("v_des"),
+      py::arg("a_des"), py::arg("q0"), py::arg("v0"), py::arg("dt") = 1e-3,
       py::arg("duration") = 1.0, py::arg("sampling") = "zero_order_hold",
       "simulate_closed_loop tracking a sampled desired motion: q_des, qd_des, qdd_des each "
       "(2 steps + 1, dof), sampled every dt/2 from t = 0 (steps = round(duration / dt)).");

@@ -69,7 +69,7 @@ void bind_five_bar(py::module_& m) {
           [](FiveBarDynamics& f, const Array& q, const Array& qd) {
             require_shape(q, "q", {-1, 2});
             const auto N = q.shape(0);
-            require_shape(qd, "qd", {N, 2});
+            require_shape(qd, "v", {N, 2});
             OutArray M = make_array({N, 2, 2}), v = make_array({N, 2}), g = make_array({N, 2}),
                      rc = make_array({N});
             py::array_t<bool> ok(N);
@@ -99,7 +99,7 @@ void bind_five_bar(py::module_& m) {
             out["status_per_instant"] = per_instant;
             return out;
           },
-          py::arg("q"), py::arg("qd"),
+          py::arg("q"), py::arg("v"),
           "For N states (q, qd each (N, 2)): {'mass' (N, 2, 2), 'velocity', 'gravity' (N, 2), "
           "'ok' (N,), 'reciprocal_condition' (N,), 'status_per_instant' (N,), 'status' (OR)}; "
           "failed states give zeros")
@@ -108,8 +108,8 @@ void bind_five_bar(py::module_& m) {
           [](FiveBarDynamics& f, const Array& q, const Array& qd, const Array& qdd) {
             require_shape(q, "q", {-1, 2});
             const auto N = q.shape(0);
-            require_shape(qd, "qd", {N, 2});
-            require_shape(qdd, "qdd", {N, 2});
+            require_shape(qd, "v", {N, 2});
+            require_shape(qdd, "a", {N, 2});
             OutArray tau = make_array({N, 2});
             auto per_instant = make_status_array(N);
             Status status = Status::ok;
@@ -128,15 +128,15 @@ void bind_five_bar(py::module_& m) {
             out["status_per_instant"] = per_instant;
             return out;
           },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          py::arg("q"), py::arg("v"), py::arg("a"),
           "Joint torques (N, 2): {'tau', 'status_per_instant' (N,), 'status' (OR)}")
       .def(
           "motion",
           [](FiveBarDynamics& f, const Array& q, const Array& qd, const Array& qdd) {
             require_shape(q, "q", {-1, 2});
             const auto N = q.shape(0);
-            require_shape(qd, "qd", {N, 2});
-            require_shape(qdd, "qdd", {N, 2});
+            require_shape(qd, "v", {N, 2});
+            require_shape(qdd, "a", {N, 2});
             OutArray ang = make_array({N, 4}), rate = make_array({N, 4}), acc = make_array({N, 4}),
                      P = make_array({N, 2}), vP = make_array({N, 2}), aP = make_array({N, 2});
             auto per_instant = make_status_array(N);
@@ -169,7 +169,7 @@ void bind_five_bar(py::module_& m) {
             out["status_per_instant"] = per_instant;
             return out;
           },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          py::arg("q"), py::arg("v"), py::arg("a"),
           "Joint angles/rates/accelerations (N, 4) in the order (theta1, theta12, theta2, "
           "theta22) and the end effector (y, z) position/velocity/acceleration (N, 2); "
           "status_per_instant (N,) and their OR, status; failed instants give zeros");

@@ -425,8 +425,8 @@ void bind_paminsa(py::module_& m) {
           require_shape(Pd, "Pd", {N, 3});
           require_shape(Pdd, "Pdd", {N, 3});
           require_shape(q, "q", {N, 3});
-          require_shape(qd, "qd", {N, 3});
-          require_shape(qdd, "qdd", {N, 3});
+          require_shape(qd, "v", {N, 3});
+          require_shape(qdd, "a", {N, 3});
           BatchArrays out(N);
           const Status s = paminsa_kinematics_batch(mo, static_cast<std::size_t>(N), P.data(),
                                                     Pd.data(), Pdd.data(), q.data(), qd.data(),
@@ -434,7 +434,7 @@ void bind_paminsa(py::module_& m) {
           return out.to_dict(s);
         },
         py::arg("model"), py::arg("P"), py::arg("Pd"), py::arg("Pdd"), py::arg("q"),
-        py::arg("qd"), py::arg("qdd"),
+        py::arg("v"), py::arg("a"),
         "Every body's motion (N, 38, ...), the shaking wrench about O and D, dD/dt (eq 19) for "
         "platform motion and prescribed wrist motion, each (N, 3).");
 

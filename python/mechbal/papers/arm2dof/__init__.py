@@ -28,21 +28,97 @@ Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 import numpy as np
+import numpy.typing as npt
 
 from mechbal.balance.rms import cubic_real_roots, squared_sum, stationarity_cubic
 
 from mechbal import _core
-from mechbal.mechanism import Mechanism
+from mechbal._deprecation import renamed_kwargs
+from mechbal.mechanism import BatchArray, Mechanism
 
 # the closed forms of the C++ core (cpp/src/papers/arm2dof/): fast paths of the general model
 Arm2DofParameters = _core.Arm2DofParameters
 Arm2DofCounterweights = _core.Arm2DofCounterweights
-Arm2DofDynamics = _core.Arm2DofDynamics
 pd_error_analytic = _core.pd_error_analytic
+
+
+class _LegacyKeys(BatchArray):
+    """A batch result that also answers the dict keys of earlier releases (``["tau"]`` or
+    ``["qdd"]``: the array itself; ``["status"]``: the OR of the statuses) for one release, with
+    a DeprecationWarning."""
+
+    _key: str = ""
+
+    def __getitem__(self, key: Any) -> Any:
+        if isinstance(key, str):
+            if key == self._key:
+                warnings.warn(f"result[{key!r}] is deprecated: the result is the array itself "
+                              "(its per-instant status in .status)", DeprecationWarning, stacklevel=2)
+                return np.asarray(self)
+            if key == "status":
+                warnings.warn("result['status'] is deprecated: use result.status (per instant)",
+                              DeprecationWarning, stacklevel=2)
+                return int(np.bitwise_or.reduce(np.atleast_1d(self.status)))
+            raise KeyError(key)
+        return super().__getitem__(key)
+
+
+class _TorqueBatch(_LegacyKeys):
+    _key = "tau"
+
+
+class _AccelerationBatch(_LegacyKeys):
+    _key = "qdd"
+
+
+def _closed_form_batch(where: str, call: Any, cls: type[_LegacyKeys], out_key: str,
+                       **arrays: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    single = np.ndim(next(iter(arrays.values()))) == 1
+    rows = [np.atleast_2d(np.asarray(x, dtype=float)) for x in arrays.values()]
+    r = call(*rows)
+    values, status = np.asarray(r[out_key]), np.asarray(r["status_per_instant"]
+                                                        if "status_per_instant" in r else r["status"])
+    status = np.broadcast_to(status, values.shape[:1]).astype(np.uint32)
+    if single:
+        if status[0] != 0:
+            raise ValueError(f"{where}: input rejected (status {int(status[0])}); the arguments "
+                             "must be finite and give finite results")
+        return values[0]
+    return cls(values, status)
+
+
+class Arm2DofDynamics(_core.Arm2DofDynamics):
+    """Closed-form dynamics of the 2-DOF arm (Arakelian, Le Baron & Mottu 2011, eqs 14-31,
+    corrected): the fast path of the general model, a dynamics back end of
+    `mechbal.control.ComputedTorque` and a plant of `mechbal.simulate.closed_loop`.
+
+    Args:
+        arm: ``Arm2DofParameters``.
+        counterweights: ``Arm2DofCounterweights`` (default: none).
+
+    ``inverse_dynamics(q, v, a)`` and ``forward_dynamics(q, v, tau)`` take one sample ((2,) each:
+    a (2,) result, ValueError on rejected input) or N samples ((N, 2) each: an (N, 2) array whose
+    ``status`` (N,) flags the rejected instants), as `mechbal.Mechanism` does.
+    """
+
+    @renamed_kwargs(qd="v", qdd="a")
+    def inverse_dynamics(self, q: npt.ArrayLike, v: npt.ArrayLike,  # type: ignore[override]
+                         a: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Joint torques tau [N m], (2,) or (N, 2)."""
+        return _closed_form_batch("Arm2DofDynamics.inverse_dynamics", super().inverse_dynamics,
+                                  _TorqueBatch, "tau", q=q, v=v, a=a)
+
+    @renamed_kwargs(qd="v")
+    def forward_dynamics(self, q: npt.ArrayLike, v: npt.ArrayLike,  # type: ignore[override]
+                         tau: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Joint accelerations a [rad/s^2], (2,) or (N, 2)."""
+        return _closed_form_batch("Arm2DofDynamics.forward_dynamics", super().forward_dynamics,
+                                  _AccelerationBatch, "a", q=q, v=v, tau=tau)
 
 __all__ = ["Arm2DofParameters", "Arm2DofCounterweights", "Arm2DofDynamics", "pd_error_analytic",
            "arm2dof_mechanism", "arm_torques", "static_balancing_radii", "cw_coefficients",
@@ -136,10 +212,11 @@ def arm2dof_mechanism(arm, counterweights=None, *, name: str = "arm2dof") -> Mec
 # 0.1913 m, confirmed by a direct numerical minimisation of the full inverse dynamics (see
 # `rms_optimal_radii_numerical`, `mechbal.balance.rms` and ``mechbal run arm2dof``).
 
-def arm_torques(arm, counterweights, q, qd, qdd) -> np.ndarray:
+@renamed_kwargs(qd="v", qdd="a")
+def arm_torques(arm, counterweights, q, v, a) -> np.ndarray:
     """Joint torques (N, 2) of the 2-DOF arm (closed form, eqs 14-31 corrected) along samples."""
     cw = counterweights if counterweights is not None else _core.Arm2DofCounterweights()
-    out = _core.Arm2DofDynamics(arm, cw).inverse_dynamics(q, qd, qdd)
+    out = _core.Arm2DofDynamics(arm, cw).inverse_dynamics(q, v, a)
     if out["status"] != _core.Status.ok:
         raise ValueError(f"inverse dynamics failed along the trajectory: {out['status']}")
     return out["tau"]
@@ -155,7 +232,8 @@ def static_balancing_radii(arm, m_cw1: float, m_cw2: float) -> tuple[float, floa
     return r1, r2
 
 
-def cw_coefficients(arm, m_cw1: float, m_cw2: float, r_cw2: float, q, qd, qdd):
+@renamed_kwargs(qd="v", qdd="a")
+def cw_coefficients(arm, m_cw1: float, m_cw2: float, r_cw2: float, q, v, a):
     """Per-sample coefficients of tau1_CW = c11 r1^2 + c12 r1 + c13(r2) (eq 32) and
     tau2_CW = c21 r2^2 + c22 r2 (eq 36):
 
@@ -166,8 +244,8 @@ def cw_coefficients(arm, m_cw1: float, m_cw2: float, r_cw2: float, q, qd, qdd):
     c21 = m_CW2 (q1'' + q2'')                                                 (eq 37)
     c22 = -m_CW2 [l1 q1'' cos q2 + l1 q1'^2 sin q2 + g cos(q1+q2)]             (eq 38, sign fixed)
     """
-    q, qd, qdd = (np.asarray(x, float) for x in (q, qd, qdd))
-    q1, q2, d1, d2, a1, a2 = q[:, 0], q[:, 1], qd[:, 0], qd[:, 1], qdd[:, 0], qdd[:, 1]
+    q, v, a = (np.asarray(x, float) for x in (q, v, a))
+    q1, q2, d1, d2, a1, a2 = q[:, 0], q[:, 1], v[:, 0], v[:, 1], a[:, 0], a[:, 1]
     l1, g, r2 = arm.l1, arm.g, r_cw2
     c2, s2, c12 = np.cos(q2), np.sin(q2), np.cos(q1 + q2)
     c11 = m_cw1 * a1
@@ -194,22 +272,23 @@ class RadiiResult:
     delta_tau2: list[float] = field(default_factory=list)
 
 
-def rms_optimal_radii(arm, m_cw1: float, m_cw2: float, q, qd, qdd) -> RadiiResult:
+@renamed_kwargs(qd="v", qdd="a")
+def rms_optimal_radii(arm, m_cw1: float, m_cw2: float, q, v, a) -> RadiiResult:
     """Counterweight radii that minimise the RMS torque of each joint along the sampled motion
-    (q, qd, qdd each (N, 2)), for any 2R arm, trajectory and counterweight masses (eqs 39-59).
+    (q, v, a each (N, 2)), for any 2R arm, trajectory and counterweight masses (eqs 39-59).
 
     tau2 depends on r2 only (CW1 rides on link 1), tau1 on r1 and r2: r2 is found first from the
     joint-2 cubic, then r1 from the joint-1 cubic with c13(r2) (corrected ordering of eqs 43-45).
     Every real root of each cubic is tried and the one with the least Delta tau kept.
     """
-    q, qd, qdd = (np.asarray(x, float) for x in (q, qd, qdd))
-    tau0 = arm_torques(arm, None, q, qd, qdd)
-    _, _, _, c21, c22 = cw_coefficients(arm, m_cw1, m_cw2, 0.0, q, qd, qdd)
+    q, v, a = (np.asarray(x, float) for x in (q, v, a))
+    tau0 = arm_torques(arm, None, q, v, a)
+    _, _, _, c21, c22 = cw_coefficients(arm, m_cw1, m_cw2, 0.0, q, v, a)
     cubic2 = stationarity_cubic(c21, c22, tau0[:, 1])
     roots2 = cubic_real_roots(*cubic2)
     dt2 = [squared_sum(c21, c22, tau0[:, 1], r) for r in roots2]
     r2 = roots2[int(np.argmin(dt2))]
-    c11, c12, c13, _, _ = cw_coefficients(arm, m_cw1, m_cw2, r2, q, qd, qdd)
+    c11, c12, c13, _, _ = cw_coefficients(arm, m_cw1, m_cw2, r2, q, v, a)
     d1 = tau0[:, 0] + c13
     cubic1 = stationarity_cubic(c11, c12, d1)
     roots1 = cubic_real_roots(*cubic1)
@@ -218,7 +297,8 @@ def rms_optimal_radii(arm, m_cw1: float, m_cw2: float, q, qd, qdd) -> RadiiResul
     return RadiiResult(r1, r2, cubic1, cubic2, roots1, roots2, dt1, dt2)
 
 
-def rms_optimal_radii_numerical(arm, m_cw1: float, m_cw2: float, q, qd, qdd,
+@renamed_kwargs(qd="v", qdd="a")
+def rms_optimal_radii_numerical(arm, m_cw1: float, m_cw2: float, q, v, a,
                                 bracket: tuple[float, float] = (-2.0, 2.0)) -> tuple[float, float]:
     """Independent check of `rms_optimal_radii`: scipy minimises the mean squared torque of
     the full closed-form inverse dynamics (no coefficient formulas), joint 2 over r2 first, then
@@ -227,7 +307,7 @@ def rms_optimal_radii_numerical(arm, m_cw1: float, m_cw2: float, q, qd, qdd,
 
     def ms(joint, r1, r2):
         cw = _core.Arm2DofCounterweights(m_cw1, m_cw2, r1, r2)
-        return float(np.mean(arm_torques(arm, cw, q, qd, qdd)[:, joint] ** 2))
+        return float(np.mean(arm_torques(arm, cw, q, v, a)[:, joint] ** 2))
 
     def argmin(f):
         grid = np.linspace(bracket[0], bracket[1], 201)

@@ -18,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
+from mechbal.balance.result import CounterweightDesign
+
 from mechbal import control
 from mechbal.papers import arm2dof as papers
 from mechbal import simulate
@@ -56,10 +58,10 @@ def general_radii(case):
     r = []
     for name, link in (("counterweight1", "shoulder"), ("counterweight2", "elbow")):
         d = result.design.get(name)
-        if d is None or d["link"] != link or d["bounds"]["direction"] is None:
+        if not isinstance(d, CounterweightDesign) or d.link != link or d.bounds["direction"] is None:
             raise ConfigError("balance.counterweights", f"the arm2dof runner needs the slot '{name}' on '{link}' "
                               "with a direction (the paper's counterweight on the link extension)", has_value=False)
-        r.append(float(np.dot(d["position"], [-1.0, 0.0, 0.0])))
+        r.append(float(np.dot(d.position, [-1.0, 0.0, 0.0])))
     return r, result
 
 
@@ -170,7 +172,7 @@ def run(config, out: Path) -> dict:
     r_general, sized = general_radii(case)
     res = closed_forms.rms_optimal_radii(arm, m_cw1, m_cw2, *motion["B"])
     r_difference = float(np.max(np.abs(np.subtract(r_general, [res.r_cw1, res.r_cw2]))))
-    masses = [sized.design[n]["mass"] for n in ("counterweight1", "counterweight2")]
+    masses = [sized.design[n].mass for n in ("counterweight1", "counterweight2")]
     if r_difference > RADIUS_AGREEMENT_M or not np.allclose(masses, [m_cw1, m_cw2], rtol=1e-12):
         raise ConfigError("balance", f"the general RMS method's counterweights ({masses[0]:.6g} kg at "
                           f"{r_general[0]:.6g} m, {masses[1]:.6g} kg at {r_general[1]:.6g} m) differ from the "
@@ -288,7 +290,7 @@ def run(config, out: Path) -> dict:
                  "max_abs_difference": r_difference, "tolerance": RADIUS_AGREEMENT_M, "unit": "m",
                  "method": {"name": "rms", "coupling": sized.metrics["coupling"],
                             "objective": sized.metrics["objective"], "exact": sized.exact,
-                            "how": [sized.design[n].get("method") for n in ("counterweight1", "counterweight2")],
+                            "how": [getattr(sized.design[n], "method", None) for n in ("counterweight1", "counterweight2")],
                             "rms_joint_torque_after": sized.metrics["rms_torque_after"]},
                  "closed_form_source": "Arakelian et al. 2011, eqs 39-59 corrected (Cardano)"},
         "r_cw_numerical": list(r_num),

@@ -68,6 +68,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from mechbal import _core
+from mechbal._deprecation import renamed_kwargs
 from mechbal.papers.discs import coupling as cp
 from mechbal.config import ConfigError, inertia
 from mechbal.mechanism import Mechanism
@@ -388,10 +389,12 @@ def fivebar_positions(d: dict, th1: float, th2: float):
     return B1, B2, P
 
 
-def fivebar_model(d: dict, q, qd) -> cp.CoupledModel:
+@renamed_kwargs(qd="v")
+def fivebar_model(d: dict, q, v) -> cp.CoupledModel:
     """M', v', g' of the 5R in (theta11, theta21) by the coupling method: subsystems leg 1
     (theta11, theta12), leg 2 (theta21, theta22), point mass P (v_Py, v_Pz); constraints
     v_P - J_tip,i qd_leg,i = 0 (4 rows), so A° (4x4) is not the identity."""
+    qd = v
     th1, th2 = q
     B1, B2, P = fivebar_positions(d, th1, th2)
     phi1 = np.arctan2(*(P - B1)[[2, 1]])
@@ -407,13 +410,13 @@ def fivebar_model(d: dict, q, qd) -> cp.CoupledModel:
     def tip_jacobian(k):
         joints, _, base, b = legs[k]
         kin = cp.chain_kinematics(joints, qs[k], np.zeros(2), base)
-        tip = kin[1]["p"] + kin[1]["R"] @ np.array([0.0, b, 0.0])
+        tip = kin[1].p + kin[1].R @ np.array([0.0, b, 0.0])
         return cp.point_jacobian(kin, 1, tip)[0][1:]
 
     def leg(k, qdl):
         joints, links, base, b = legs[k]
         model, kin = cp.arm_model(joints, links, qs[k], qdl, base)
-        tip = kin[1]["p"] + kin[1]["R"] @ np.array([0.0, b, 0.0])
+        tip = kin[1].p + kin[1].R @ np.array([0.0, b, 0.0])
         sub = cp.Subsystem(model.mass, model.velocity, model.gravity)
         return sub, cp.point_bias(kin, 1, tip)[1:]
 
@@ -456,11 +459,13 @@ def sample_states(kind: str, n: int, rng: np.random.Generator):
     return q, rng.uniform(-2, 2, (n, 3))
 
 
-def evaluate(kind: str, d: dict, q: np.ndarray, qd: np.ndarray):
+@renamed_kwargs(qd="v")
+def evaluate(kind: str, d: dict, q: np.ndarray, v: np.ndarray):
     """(M (N, n, n), v (N, n), g (N, n)) of design d at N states, in C++: the general model for
     the serial arms (`disc_mechanism`: CRBA mass matrix, v = bias - gravity torque),
     FiveBarDynamics for the 5R (a closed loop; ``fivebar_model`` is its Python reference). A
     singular five-bar state raises ValueError."""
+    qd = v
     q, qd = np.asarray(q, float), np.asarray(qd, float)
     if kind == "fivebar":
         r = fivebar_dynamics(d).evaluate(q, qd)
@@ -507,9 +512,11 @@ def perturbed_design(kind: str, p: dict, parameter: str, error: float) -> dict:
     return d
 
 
-def sensitivity(kind: str, p: dict, parameters, errors, q, qd) -> list[dict]:
+@renamed_kwargs(qd="v")
+def sensitivity(kind: str, p: dict, parameters, errors, q, v) -> list[dict]:
     """How far the balanced mass matrix leaves diagonal/constant (and gravity/velocity terms
     leave zero) when one quantity is off by each relative error."""
+    qd = v
     M0, v0, g0 = evaluate(kind, design(kind, p, False), q, qd)
     vmax, gmax = np.max(np.abs(v0)), np.max(np.abs(g0))
     k = np.asarray(BALANCE[kind](p)["k"])

@@ -31,9 +31,11 @@ Layer: papers (the discs paper's own method; docs/architecture.md).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Sequence
+from typing import Callable, ClassVar, Sequence
 
 import numpy as np
+
+from mechbal._deprecation import DeprecatedAttributes
 
 GRAVITY = np.array([0.0, 0.0, -9.81])
 
@@ -172,8 +174,31 @@ class Disc:
     inertia: np.ndarray
 
 
-def chain_kinematics(joints, q, qd, base=np.zeros(3)):
-    """Poses, rates and bias (qdd = 0) accelerations of every link frame (origin on its joint)."""
+@dataclass(frozen=True)
+class LinkKinematics(DeprecatedAttributes):
+    """One link frame of `chain_kinematics` (O axes): rotation ``R`` (3, 3) link to O, origin
+    ``p`` [m] (on its joint), joint axis ``z`` and joint origin ``o`` [m], angular velocity ``w``
+    [rad/s] and bias angular acceleration ``al`` [rad/s^2], origin velocity ``v`` [m/s] and bias
+    acceleration ``a`` [m/s^2], joint ``type`` ("R" or "P"). ``kin["R"]``, the dict of earlier
+    releases, works for one release with a DeprecationWarning."""
+
+    R: np.ndarray
+    p: np.ndarray
+    z: np.ndarray
+    o: np.ndarray
+    w: np.ndarray
+    al: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    type: str
+
+    _dict_keys: ClassVar[dict[str, str]] = {k: k for k in ("R", "p", "z", "o", "w", "al", "v", "a", "type")}
+
+
+def chain_kinematics(joints, q, v, base=np.zeros(3)) -> list[LinkKinematics]:
+    """Poses, rates and bias (a = 0) accelerations of every link frame (origin on its joint), for
+    positions ``q`` and velocities ``v`` of the joints."""
+    qd = v
     R, p = np.eye(3), np.asarray(base, float).copy()
     w, al, v, a = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
     out = []
@@ -195,7 +220,7 @@ def chain_kinematics(joints, q, qd, base=np.zeros(3)):
             a_n = a_n + _cross(al, z * q[i]) + _cross(w, _cross(w, z * q[i])) \
                 + 2.0 * _cross(w, z * qd[i])
             w_n, al_n = w.copy(), al.copy()
-        out.append(dict(R=R_n, p=p_n, z=z, o=o, w=w_n, al=al_n, v=v_n, a=a_n, type=jt.type))
+        out.append(LinkKinematics(R=R_n, p=p_n, z=z, o=o, w=w_n, al=al_n, v=v_n, a=a_n, type=jt.type))
         R, p, w, al, v, a = R_n, p_n, w_n, al_n, v_n, a_n
     return out
 
@@ -204,25 +229,25 @@ def point_jacobian(kin, i, r):
     n = len(kin)
     Jv, Jw = np.zeros((3, n)), np.zeros((3, n))
     for j in range(i + 1):
-        if kin[j]["type"] == "R":
-            Jw[:, j] = kin[j]["z"]
-            Jv[:, j] = _cross(kin[j]["z"], r - kin[j]["o"])
+        if kin[j].type == "R":
+            Jw[:, j] = kin[j].z
+            Jv[:, j] = _cross(kin[j].z, r - kin[j].o)
         else:
-            Jv[:, j] = kin[j]["z"]
+            Jv[:, j] = kin[j].z
     return Jv, Jw
 
 
 def point_bias(kin, i, r):
     k = kin[i]
-    rho = r - k["p"]
-    return k["a"] + _cross(k["al"], rho) + _cross(k["w"], _cross(k["w"], rho))
+    rho = r - k.p
+    return k.a + _cross(k.al, rho) + _cross(k.w, _cross(k.w, rho))
 
 
 def link_subsystem(link: Link, kin_i, gravity=GRAVITY) -> Subsystem:
     """Newton-Euler model of a rigid link in (v_G, omega), base frame."""
-    R = kin_i["R"]
+    R = kin_i.R
     Iw = R @ link.inertia @ R.T
-    w = kin_i["w"]
+    w = kin_i.w
     return Subsystem(block_diag([link.mass * np.eye(3), Iw]),
                      np.concatenate([np.zeros(3), _cross(w, Iw @ w)]),
                      np.concatenate([-link.mass * np.asarray(gravity), np.zeros(3)]))
@@ -236,11 +261,11 @@ def arm_model(joints, links, q, qd, base=np.zeros(3), gravity=GRAVITY):
     subs = [Subsystem(np.zeros((n, n)), np.zeros(n), np.zeros(n))]
     rows, bias = [], []
     for i, b in enumerate(links):
-        rG = kin[i]["p"] + kin[i]["R"] @ b.com
+        rG = kin[i].p + kin[i].R @ b.com
         Jv, Jw = point_jacobian(kin, i, rG)
         subs.append(link_subsystem(b, kin[i], gravity))
         rows.append(np.vstack([Jv, Jw]))
-        bias.append(np.concatenate([point_bias(kin, i, rG), kin[i]["al"]]))
+        bias.append(np.concatenate([point_bias(kin, i, rG), kin[i].al]))
     N = len(links)
     A = np.zeros((6 * N, n + 6 * N))
     for k in range(N):
@@ -254,14 +279,14 @@ def disc_subsystem(disc: Disc, kin, q, qd):
     omega_d - J_d qd = 0 (A° = 1, A# = -J_d), bias J_d' qd (eqs 10-11, 20-21, 31-32)."""
     c = kin[disc.carrier]
     axis = np.asarray(disc.axis, float) / np.linalg.norm(disc.axis)
-    Rd = c["R"] @ rotation(axis, disc.ratio * q[disc.joint])
-    a_w = c["R"] @ axis
+    Rd = c.R @ rotation(axis, disc.ratio * q[disc.joint])
+    a_w = c.R @ axis
     n = len(kin)
-    _, Jw_c = point_jacobian(kin, disc.carrier, c["p"])
+    _, Jw_c = point_jacobian(kin, disc.carrier, c.p)
     E = np.zeros((3, n))
     E[:, disc.joint] = disc.ratio * a_w
     Jd = Rd.T @ (Jw_c + E)
-    bias = Rd.T @ (c["al"] + _cross(c["w"], disc.ratio * a_w * qd[disc.joint]))
+    bias = Rd.T @ (c.al + _cross(c.w, disc.ratio * a_w * qd[disc.joint]))
     wB = Jd @ qd
     Jm = np.diag(disc.inertia)
     return Subsystem(Jm, _cross(wB, Jm @ wB), np.zeros(3)), Jd, bias

@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from mechbal.balance.result import DiscDesign
+
 from mechbal import control
 from mechbal import trajectory
 from mechbal import progress, report
@@ -68,16 +70,17 @@ def general_discs(case, kind: str, closed: dict):
     result = run_method(case_from_config(case), "moment")
     general, reference = {}, {}
     for name, (slot, key) in _SIZED[kind].items():
-        if slot not in result.design or key not in result.design[slot]:
+        plain = result.design[slot].to_dict() if slot in result.design else {}
+        if key not in plain:
             raise ConfigError("balance", f"the discs runner compares {name} with the closed form: it needs the "
                               f"slot '{slot}' choosing '{key}' (see the built-in case {case.case.name!r})",
                               has_value=False)
-        general[name] = float(result.design[slot][key])
+        general[name] = float(plain[key])
         reference[name] = float(closed["inertia_conditions"][name] if name.startswith("Jy") else closed[name])
     if kind == "fivebar":
         cols = result.metrics["columns"]
         left = [c["peak_remaining"] for c in cols.values() if not c["cancelled"]]
-        discs = sum(float(v["inertia"]) for v in result.design.values() if "inertia" in v and "ratio" in v)
+        discs = sum(float(v.inertia) for v in result.design.values() if isinstance(v, DiscDesign))
         if len(left) != 1:
             raise ConfigError("balance.discs", "the five-bar check expects the leg discs of the built-in table "
                               f"(one actuated rate's angular momentum left; got {len(left)})", has_value=False)
@@ -269,8 +272,9 @@ def run(config, out: Path) -> dict:
         "discs": {"general_method": general, "closed_form": reference, "max_rel_difference": difference,
                   "tolerance_rel": DISC_AGREEMENT_RTOL,
                   "method": {"name": "moment", "exact": sized.exact, "limited_by": sized.limited_by,
-                             "design": {k: {kk: v[kk] for kk in ("carrier", "joint", "ratio", "inertia", "Iyy")
-                                            if kk in v} for k, v in sized.design.items()}},
+                             "design": {k: {kk: x for kk, x in v.to_dict().items()
+                                            if kk in ("carrier", "joint", "ratio", "inertia", "Iyy")}
+                                        for k, v in sized.design.items()}},
                   "sized_by_the_general_method": sorted(k for k in general if k in ("beta", "gamma", "Jy2", "Jy3")),
                   "closed_form_source": "Coutinho & Hess Coelho eqs 14, 16, 25, 27, 35, 37 corrected "
                                         "(mechbal.papers.discs.BALANCE)"},

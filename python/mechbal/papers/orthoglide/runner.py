@@ -181,7 +181,7 @@ class Orthoglide:
     def size_rates(self, p) -> tuple[dict[str, float], float, int]:
         """`size` as (rates [N/m], residual [N] max over samples and axes, rank)."""
         r = self.size(p)
-        return {n: float(d["rate"]) for n, d in r.design.items()}, float(r.residual), int(r.rank or 0)
+        return {n: float(getattr(d, "rate")) for n, d in r.design.items()}, float(r.residual), int(r.rank or 0)
 
     def dynamics(self, path: paper.PlatformPath, springs: Sequence[SpringSlot]) -> dict:
         """Motor forces along a path (the model's inverse dynamics with the springs, projected

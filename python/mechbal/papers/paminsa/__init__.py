@@ -269,7 +269,7 @@ def counterweights_from_design(design: dict, source: str) -> CounterweightSet:
         if name not in design:
             raise KeyError(f"the design has no slot '{name}' (the paper's counterweights are "
                            "leg<i>.CP1_atA, leg<i>.CP2_atF, leg<i>.CP3_atL and vertical_counter_mass)")
-        return float(design[name]["mass"])
+        return float(design[name].mass)
 
     return CounterweightSet([mass(f"leg{i}.CP1_atA") for i in (1, 2, 3)],
                             [mass(f"leg{i}.CP2_atF") for i in (1, 2, 3)],

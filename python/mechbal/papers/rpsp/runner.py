@@ -212,7 +212,7 @@ def size_counterweights(mech: Mechanism, spec, names: list[str], platform, dplat
 
     slots, bare = counterweight_slots(mech, spec, names)
     result = force.balance(bare, slots, (platform, dplatform), q_guess=q_guess)
-    return {n: float(result.design[n]["mass"]) for n in names}, result
+    return {n: float(result.design[n].mass) for n in names}, result
 
 
 def _bodies_file(path, mech, t, motion, F, M, **extra):
