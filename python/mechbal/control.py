@@ -130,6 +130,10 @@ class PaminsaRun:
     status: np.ndarray
 
 
+#: JointCommand from the binding's (tau, int status) tuple without a Python-level __new__
+_joint_command = tuple.__new__
+
+
 def _control_run(result: dict) -> ControlRun:
     return ControlRun(joint_torque=np.asarray(result["joint_torque"]),
                       status=np.asarray(result["status"]))
@@ -178,8 +182,7 @@ class ComputedTorque(_core.ComputedTorque):
     def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
              qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:
         """One tick: :class:`JointCommand` (joint_torque (n,) [N m or N], status)."""
-        tau, status = super().step(q, qd, q_des, qd_des, qdd_des)
-        return JointCommand(np.asarray(tau), int(status))
+        return _joint_command(JointCommand, self._tick(q, qd, q_des, qd_des, qdd_des))
 
     def run(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
             qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> ControlRun:
@@ -205,8 +208,7 @@ class DecoupledJointController(_core.DecoupledJointController):
     def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
              qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:
         """One tick: :class:`JointCommand` (joint_torque (n,) [N m or N], status)."""
-        tau, status = super().step(q, qd, q_des, qd_des, qdd_des)
-        return JointCommand(np.asarray(tau), int(status))
+        return _joint_command(JointCommand, self._tick(q, qd, q_des, qd_des, qdd_des))
 
     def run(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
             qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> ControlRun:
