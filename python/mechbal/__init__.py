@@ -17,7 +17,7 @@ The public API (SI units throughout: m, kg, kg m^2, rad, s, N, N m; base frame z
 
 Results are dataclasses with named fields (``shaking_force``, ``shaking_moment``,
 ``base_reaction_force``, ``joint_torque``, ...) and, for batches, a per-instant ``status`` array
-of :class:`Status` bit flags (0 = ok). The C++ core is ``mechbal._core`` (typed in
+of `Status` bit flags (0 = ok). The C++ core is ``mechbal._core`` (typed in
 ``_core.pyi``); use the modules above rather than reaching into it.
 """
 from __future__ import annotations

@@ -9,7 +9,7 @@ a closed linkage meet there), when the bodies file carries ``link_position``, ``
 (area proportional to mass), and at the base origin O the shaking force F = dP/dt (red) and the
 shaking moment M_O = dH_O/dt (blue, its component normal to the view as a signed arc) are drawn to
 their own scale: the longest arrow of the run is a third of the mechanism's reach. A wrench below
-:data:`mechbal.report.ROUNDOFF_FLOOR` is drawn as nothing and labelled "0 (below 1e-12)".
+`mechbal.report.ROUNDOFF_FLOOR` is drawn as nothing and labelled "0 (below 1e-12)".
 
 Layer: Python core (docs/architecture.md).
 """
@@ -144,7 +144,7 @@ def animate(path: str | Path, t: np.ndarray, com: np.ndarray, mass: np.ndarray,
 
 def animate_bodies_file(bodies: Mapping[str, np.ndarray], path: str | Path, *, title: str = "",
                         max_frames: int = 120, fps: int = 20) -> Path:
-    """:func:`animate` from a bodies file's arrays (:func:`mechbal.export.read_bodies`)."""
+    """`animate` from a bodies file's arrays (`mechbal.export.read_bodies`)."""
     return animate(path, bodies["t"], bodies["com"], bodies["mass"], bodies["shaking_force"],
                    bodies["shaking_moment"], link_position=bodies.get("link_position"),
                    link_parent=bodies.get("link_parent"), frame_position=bodies.get("frame_position"),

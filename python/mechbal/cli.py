@@ -2,7 +2,7 @@
 
 Exit codes (the table is in README.md, "Exit codes"): 0 success; 2 a user's mistake (bad case
 file or value, bad output folder, bad arguments, a value outside the plausible ranges of
-:mod:`mechbal.plausibility` without ``--force``), reported as one line ``mechbal: error: ...``
+`mechbal.plausibility` without ``--force``), reported as one line ``mechbal: error: ...``
 naming the field or path; 3 an internal error (a bug in mechbal), reported as one line with a
 request to report it (set ``MECHBAL_DEBUG=1`` for the traceback); 4 another run into the same
 ``--out`` finished at the same moment (this run's results were discarded, the other run's folder

@@ -1,8 +1,8 @@
 """Configuration: TOML files -> validated models.
 
-The schema of every case file is in :mod:`mechbal.schema` (pydantic models, strict: unknown keys
-are errors); :func:`mechbal.schema.validate_case` checks a whole file before anything runs. Every
-error is a :class:`ConfigError` naming the offending field by its dotted path (for example
+The schema of every case file is in `mechbal.schema` (pydantic models, strict: unknown keys
+are errors); `mechbal.schema.validate_case` checks a whole file before anything runs. Every
+error is a `ConfigError` naming the offending field by its dotted path (for example
 ``mechanism.joints[1].link.mass``) and the value found, and nothing is half-built: models are only
 constructed once every field has been read and checked. The helpers here (``number``, ``vector``,
 ...) remain for code that checks values outside case files.
@@ -90,7 +90,7 @@ def inertia(value: Any, field: str) -> np.ndarray:
     """An inertia tensor about the centre of mass [kg m^2]: a 3x3 list, three principal moments
     [Ixx, Iyy, Izz], or six values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]. Must be symmetric positive
     semi-definite and satisfy the triangle inequality of a physical body
-    (:func:`mechbal.schema.inertia_matrix`)."""
+    (`mechbal.schema.inertia_matrix`)."""
     from pydantic_core import PydanticCustomError
 
     from mechbal.schema import inertia_matrix
@@ -125,7 +125,7 @@ MAX_CASE_DEPTH = 32
 
 def read_regular_file(path: str | Path, field: str = "case", max_bytes: int = MAX_CASE_BYTES) -> bytes:
     """The bytes of ``path`` if it is a regular file of at most ``max_bytes``; otherwise a
-    :class:`ConfigError` naming ``field`` and the path, at once: a folder, a device (``/dev/zero``
+    `ConfigError` naming ``field`` and the path, at once: a folder, a device (``/dev/zero``
     would be read forever), a FIFO (would block), a socket, a missing or unreadable file. The file
     is opened without blocking and checked on the open descriptor (no race with a rename)."""
     import stat
@@ -179,8 +179,8 @@ def _nesting_depth(node: Any) -> int:
 
 
 def parse_toml(raw: bytes, source: str) -> dict:
-    """A TOML document (bytes of ``source``) as a dict, or a one-line :class:`ConfigError`: not
-    UTF-8 (names the line), invalid TOML, nested deeper than :data:`MAX_CASE_DEPTH`."""
+    """A TOML document (bytes of ``source``) as a dict, or a one-line `ConfigError`: not
+    UTF-8 (names the line), invalid TOML, nested deeper than `MAX_CASE_DEPTH`."""
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -200,15 +200,15 @@ def parse_toml(raw: bytes, source: str) -> dict:
 
 
 def read_toml(path: str | Path) -> dict:
-    """A TOML case file as a dict: a regular file of at most :data:`MAX_CASE_BYTES`, UTF-8, valid
-    TOML nested at most :data:`MAX_CASE_DEPTH` deep; anything else is a :class:`ConfigError`."""
+    """A TOML case file as a dict: a regular file of at most `MAX_CASE_BYTES`, UTF-8, valid
+    TOML nested at most `MAX_CASE_DEPTH` deep; anything else is a `ConfigError`."""
     path = Path(path)
     return parse_toml(read_regular_file(path, "case"), str(path))
 
 
 def builtin_cases() -> dict[str, Path]:
     """Every built-in case file by name: the general cases and each paper's (the registry's
-    folders, :mod:`mechbal.registry`)."""
+    folders, `mechbal.registry`)."""
     out: dict[str, Path] = {}
     for d in case_dirs():
         for p in sorted(d.glob("*.toml")):
@@ -232,7 +232,7 @@ def case_path(name_or_path: str | Path) -> Path:
 def check_case_file(name_or_path: str) -> Path:
     """Path of the case after the checks that the TOML reader does not do: a regular file, not a
     folder, of reasonable size, UTF-8 text, valid TOML of reasonable nesting (raises
-    :class:`ConfigError` naming the path)."""
+    `ConfigError` naming the path)."""
     from mechbal import _core
 
     path = case_path(name_or_path)  # ConfigError for an unknown built-in name or a missing file
@@ -253,8 +253,8 @@ def load_case(name_or_path: str | Path) -> dict:
 
 
 def trajectory_from_config(table: Any, dof: int, field: str = "trajectory"):
-    """A :class:`mechbal.RestToRestTrajectory` and the sample times from a ``[trajectory]`` table
-    (a dict or a validated :class:`mechbal.schema.ChainTrajectory`) with ``law`` (quintic |
+    """A `mechbal.RestToRestTrajectory` and the sample times from a ``[trajectory]`` table
+    (a dict or a validated `mechbal.schema.ChainTrajectory`) with ``law`` (quintic |
     cubic), ``start``, ``end`` (``dof`` values), ``duration`` [s] and ``samples`` (number of
     instants, 3 .. 1e6)."""
     from mechbal._core import RestToRestTrajectory, TimeLaw

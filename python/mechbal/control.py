@@ -15,7 +15,7 @@ calls.
 * `ReactionlessController`: reactionless control of any mechanism: balancing joints keep chosen
   momentum components at their target, ``A_b v_b = h* - A_t v_t`` (the PAMINSA wrist is a special
   case); with gains it also drives a computed-torque stage usable in
-  :func:`mechbal.simulate.closed_loop`.
+  `mechbal.simulate.closed_loop`.
 
 Three ways to tick a joint controller (``n`` joints; positions in rad or m, velocities in rad/s
 or m/s, accelerations in rad/s^2 or m/s^2, torques in N m or forces in N):
@@ -32,7 +32,7 @@ Statuses are bit flags of `mechbal.Status` (0 = ok), one per tick (``status`` ar
 batch results, as in every batch result of mechbal). Non-finite or out-of-range input never
 raises in a tick: it returns the held (last safe) command and a non-ok status.
 
-The dynamics back ends a :class:`ComputedTorque` computes over are here too:
+The dynamics back ends a `ComputedTorque` computes over are here too:
 `MechanismDynamics` (the general model, any mechanism, closed loops included),
 `KdlChainDynamics` (Orocos KDL on a serial MechanismModel, the independent engine), and the
 papers' closed forms in `mechbal.papers`.
@@ -157,10 +157,10 @@ class ComputedTorque(_core.ComputedTorque):
     to ``torque_limit``; with an exact model the error obeys ``e'' + Kd e' + Kp e = 0`` (eq 6).
 
     Args:
-        model: a :class:`mechbal.Mechanism` (its :class:`MechanismDynamics` is built and kept) or
-            any dynamics back end: :class:`MechanismDynamics`,
-            :class:`KdlChainDynamics`, ``Arm2DofDynamics``,
-            ``FiveBarDynamics`` (:mod:`mechbal.papers`). The model may differ from the plant.
+        model: a `mechbal.Mechanism` (its `MechanismDynamics` is built and kept) or
+            any dynamics back end: `MechanismDynamics`,
+            `KdlChainDynamics`, ``Arm2DofDynamics``,
+            ``FiveBarDynamics`` (`mechbal.papers`). The model may differ from the plant.
         kp: proportional gains [1/s^2], one per joint.
         kd: derivative gains [1/s], one per joint.
         torque_limit: |tau| limit per joint [N m or N] (default and +inf: 1e4).
@@ -170,7 +170,7 @@ class ComputedTorque(_core.ComputedTorque):
         q_guess: with a closed-loop Mechanism, every joint coordinate near the assembly [rad or
             m] (picks the assembly mode the loop solve follows; default zeros).
 
-    Ticks: ``step`` / ``step_into`` / ``run`` (see :mod:`mechbal.control`); ``reset()`` forgets
+    Ticks: ``step`` / ``step_into`` / ``run`` (see `mechbal.control`); ``reset()`` forgets
     the held command.
     """
 
@@ -181,12 +181,12 @@ class ComputedTorque(_core.ComputedTorque):
 
     def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
              qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:
-        """One tick: :class:`JointCommand` (joint_torque (n,) [N m or N], status)."""
+        """One tick: `JointCommand` (joint_torque (n,) [N m or N], status)."""
         return _joint_command(JointCommand, self._tick(q, qd, q_des, qd_des, qdd_des))
 
     def run(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
             qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> ControlRun:
-        """N consecutive ticks over (N, n) arrays in one C++ call: :class:`ControlRun`."""
+        """N consecutive ticks over (N, n) arrays in one C++ call: `ControlRun`."""
         return _control_run(super().run(q, qd, q_des, qd_des, qdd_des))
 
 
@@ -199,20 +199,20 @@ class DecoupledJointController(_core.DecoupledJointController):
         k: the constant diagonal of the mass matrix [kg m^2 or kg], one per joint.
         kp: proportional gains [1/s^2].
         kd: derivative gains [1/s].
-        torque_limit: as :class:`ComputedTorque`.
+        torque_limit: as `ComputedTorque`.
 
     The keywords ``max_position``, ``max_speed`` and ``max_acceleration`` bound the input of a
-    tick as for :class:`ComputedTorque`.
+    tick as for `ComputedTorque`.
     """
 
     def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
              qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:
-        """One tick: :class:`JointCommand` (joint_torque (n,) [N m or N], status)."""
+        """One tick: `JointCommand` (joint_torque (n,) [N m or N], status)."""
         return _joint_command(JointCommand, self._tick(q, qd, q_des, qd_des, qdd_des))
 
     def run(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
             qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> ControlRun:
-        """N consecutive ticks over (N, n) arrays in one C++ call: :class:`ControlRun`."""
+        """N consecutive ticks over (N, n) arrays in one C++ call: `ControlRun`."""
         return _control_run(super().run(q, qd, q_des, qd_des, qdd_des))
 
 
@@ -225,21 +225,21 @@ class ReactionlessWrist(_core.ReactionlessWrist):
         J1: inertia matrix of the first wrist link about its centre [kg m^2] (3, 3), link frame.
         J2: the same for the second wrist link.
         J3: the same for the third wrist link.
-        config: :class:`ReactionlessWristConfig` (rate [Hz], integrator, limits, damping).
+        config: `ReactionlessWristConfig` (rate [Hz], integrator, limits, damping).
         initial_angles: wrist angles at the start [rad] (3,).
         target_momentum: H_target [kg m^2/s] (3,), usually D at the rest the motion starts from.
 
     A tick ``step(D, D_dot, D_half, D_next) -> int`` takes D [kg m^2/s] and dD/dt [N m] of the
     rest of the mechanism at t_n (RK4 also D at t_n + dt/2 and t_n + dt) and leaves the
-    :class:`WristCommand` in ``command`` (angles, rates, accelerations, condition_number,
+    `WristCommand` in ``command`` (angles, rates, accelerations, condition_number,
     status); ``step_into(D, D_dot, D_half, D_next, out) -> int`` is the fast tick (float64
     arrays; the command written into ``out`` (3, 3), rows angles [rad], rates [rad/s],
-    accelerations [rad/s^2]); :meth:`run` ticks N times in one call.
+    accelerations [rad/s^2]); `run` ticks N times in one call.
     """
 
     def run(self, D: npt.ArrayLike, D_dot: npt.ArrayLike, D_half: npt.ArrayLike,  # type: ignore[override]
             D_next: npt.ArrayLike) -> WristRun:
-        """N consecutive ticks, each argument (N, 3): :class:`WristRun`."""
+        """N consecutive ticks, each argument (N, 3): `WristRun`."""
         r = super().run(D, D_dot, D_half, D_next)
         return WristRun(**{k: np.asarray(v) for k, v in r.items()})
 
@@ -250,8 +250,8 @@ class PaminsaController(_core.PaminsaController):
     cancels the shaking moment, and the shaking wrench of all 38 bodies is computed.
 
     Args:
-        model: ``PaminsaModel`` (:mod:`mechbal.papers`), with its counterweights.
-        config: :class:`ReactionlessWristConfig` (the tick rate is ``config.rate_hz``).
+        model: ``PaminsaModel`` (`mechbal.papers`), with its counterweights.
+        config: `ReactionlessWristConfig` (the tick rate is ``config.rate_hz``).
         initial_wrist_angles: [rad] (3,).
         max_speed: |platform velocity| per component a tick accepts [m/s] (default 10).
         max_acceleration: |platform acceleration| per component [m/s^2] (default 1e3).
@@ -262,7 +262,7 @@ class PaminsaController(_core.PaminsaController):
     ``shaking_force`` [N], ``shaking_moment`` [N m], ``D``, ``D_dot`` and ``wrist_command``.
     Fast tick: ``step_into(now, half, next, out) -> int`` with (3, 3) float64 arrays whose rows
     are position, velocity, acceleration, the wrist command written into ``out`` (3, 3): rows
-    angles, rates, accelerations. Batch: :meth:`run`.
+    angles, rates, accelerations. Batch: `run`.
     """
 
     def __init__(self, model: Any, config: Any, initial_wrist_angles: npt.ArrayLike,
@@ -344,7 +344,7 @@ class ReactionlessController(_core.ReactionlessController):
     ``cpp/include/mechbal/control/reactionless.hpp``.
 
     Args:
-        mechanism: a :class:`mechbal.Mechanism` (or a ``MechanismModel``).
+        mechanism: a `mechbal.Mechanism` (or a ``MechanismModel``).
         balancing_joints: names of actuated joints.
         cancel: ``"moment"`` (default), ``"force"``, ``"both"`` or single axes ``"moment_z"``,
             ``"force_x"``, ... (a name or a list).
@@ -356,7 +356,7 @@ class ReactionlessController(_core.ReactionlessController):
             momentum there.
         q_guess: every coordinate near the assembly (closed loops).
         kp: proportional gains [1/s^2] of an optional computed-torque stage; with ``kd``,
-            :attr:`joint_controller` is a joint controller for :func:`mechbal.simulate.closed_loop`
+            `joint_controller` is a joint controller for `mechbal.simulate.closed_loop`
             (which accepts this object directly).
         kd: derivative gains [1/s] of the computed-torque stage.
         torque_limit: |tau| limit per joint of the computed-torque stage [N m or N].
@@ -365,9 +365,9 @@ class ReactionlessController(_core.ReactionlessController):
             ``max_speed``, ``max_task_acceleration`` (the task input range).
 
     Ticks: ``step(q_task, v_task, a_task[, q_half, v_half, q_next, v_next])`` ->
-    :class:`ReactionlessCommand`; ``step_into(now (3, nt), half (2, nt), next (2, nt), out (3,
-    na)) -> int`` (fast, float64 arrays); :meth:`run` over a task motion sampled every dt/2;
-    :meth:`follow` along a :mod:`mechbal.trajectory` of every actuated joint.
+    `ReactionlessCommand`; ``step_into(now (3, nt), half (2, nt), next (2, nt), out (3,
+    na)) -> int`` (fast, float64 arrays); `run` over a task motion sampled every dt/2;
+    `follow` along a `mechbal.trajectory` of every actuated joint.
     """
 
     def __init__(self, mechanism: Any, balancing_joints: Any, cancel: Any = "moment",
@@ -396,7 +396,7 @@ class ReactionlessController(_core.ReactionlessController):
              a_task: npt.ArrayLike, q_half: npt.ArrayLike | None = None,
              v_half: npt.ArrayLike | None = None, q_next: npt.ArrayLike | None = None,
              v_next: npt.ArrayLike | None = None) -> ReactionlessCommand:
-        """One tick (Euler without the half/next samples): :class:`ReactionlessCommand`."""
+        """One tick (Euler without the half/next samples): `ReactionlessCommand`."""
         status = super().step(q_task, v_task, a_task, q_half, v_half, q_next, v_next)
         c = self.command
         return ReactionlessCommand(
@@ -409,14 +409,14 @@ class ReactionlessController(_core.ReactionlessController):
     def run(self, q_task: npt.ArrayLike, v_task: npt.ArrayLike,  # type: ignore[override]
             a_task: npt.ArrayLike) -> ReactionlessRun:
         """Ticks along the task motion sampled every dt/2 ((2 steps + 1, n_task) each, from
-        this controller's current state): :class:`ReactionlessRun` at the steps + 1 ticks."""
+        this controller's current state): `ReactionlessRun` at the steps + 1 ticks."""
         r = super().run(q_task, v_task, a_task)
         N = np.asarray(r["q"]).shape[0]
         return ReactionlessRun(t=np.arange(N) * self.dt,
                                **{k: np.asarray(v) for k, v in r.items()})
 
     def follow(self, trajectory: Any, duration: float | None = None) -> ReactionlessRun:
-        """Ticks along a trajectory of every actuated joint (a :mod:`mechbal.trajectory` object;
+        """Ticks along a trajectory of every actuated joint (a `mechbal.trajectory` object;
         the balancing joints' entries are ignored) from t = 0 to ``duration`` (default its end)."""
         from mechbal.trajectory import as_trajectory
 
@@ -452,11 +452,11 @@ class ReactionlessTaskController(_core.ReactionlessTaskController):
     start) within the task's null space (C++ ``mechbal::ReactionlessTaskController``).
 
     Args:
-        mechanism: a :class:`mechbal.Mechanism` (open, every joint actuated).
+        mechanism: a `mechbal.Mechanism` (open, every joint actuated).
         task_frame: a named frame of the mechanism.
         task_rows: the tracked twist components: ``"all"``, ``"linear"``, ``"angular"`` or
             ``"v_x"``, ..., ``"w_z"`` (a name or a list; O axes).
-        cancel: the momentum components minimised, as :class:`ReactionlessController`.
+        cancel: the momentum components minimised, as `ReactionlessController`.
         integrator: ``"euler"`` or ``"rk4"``.
         rate_hz: tick rate [Hz].
         damping: damped least squares factor relative to the largest singular value.
@@ -475,7 +475,7 @@ class ReactionlessTaskController(_core.ReactionlessTaskController):
 
     def run(self, twist: npt.ArrayLike) -> TaskSpaceRun:  # type: ignore[override]
         """Ticks along the desired frame twist [v (m/s); w (rad/s)] (O axes) sampled every dt/2
-        ((2 steps + 1, 6)): :class:`TaskSpaceRun` at the steps + 1 ticks."""
+        ((2 steps + 1, 6)): `TaskSpaceRun` at the steps + 1 ticks."""
         r = super().run(twist)
         N = np.asarray(r["q"]).shape[0]
         return TaskSpaceRun(t=np.arange(N) * self.dt, **{k: np.asarray(v) for k, v in r.items()})

@@ -44,5 +44,5 @@ def short_repr(value: Any, limit: int = 80) -> str:
 
 class PlausibilityWarning(ConfigWarning):
     """A value is finite and valid but outside the physically plausible range of
-    :mod:`mechbal.plausibility` (a joint travel beyond 1e3 rad or m, a gravity beyond 1e3 m/s^2, a
+    `mechbal.plausibility` (a joint travel beyond 1e3 rad or m, a gravity beyond 1e3 m/s^2, a
     mass beyond 1e6 kg). The Python API warns; the command line refuses it unless ``--force``."""

@@ -1,19 +1,20 @@
-"""The general mechanism model from Python: :class:`Mechanism`.
+"""The general mechanism model from Python: `Mechanism`.
 
-A :class:`Mechanism` wraps the C++ ``MechanismModel`` (a tree of revolute, prismatic and fixed
+A `Mechanism` wraps the C++ ``MechanismModel`` (a tree of revolute, prismatic and fixed
 joints, any number of named bodies on each link, gear couplings, named frames and gravity; see
 ``cpp/include/mechbal/model/model.hpp`` for the frame conventions) and exposes every algorithm over it.
 
 Every method takes either one sample (1-D arrays of ``dof`` values) or a batch ((N, dof) arrays),
 evaluated in one C++ call. A single sample given as 1-D float64 numpy arrays goes straight to the
 C++ algorithm (no conversion, no Python-level checking: about Pinocchio's cost per call,
-``bench/bench_python.py``); any other input takes the general path, which converts and checks it. One sample returns plain arrays and raises :class:`ValueError` when the
+``bench/bench_python.py``); any other input takes the general path, which converts and checks it.
+One sample returns plain arrays and raises `ValueError` when the
 input is rejected (wrong size, non-finite, overflow); a batch returns arrays with a leading N axis
-and a per-instant status (0 = ok; see :class:`mechbal.Status`): the result dataclasses have a
-``status`` field, and the plain-array results are :class:`BatchArray` with a ``status``
+and a per-instant status (0 = ok; see `mechbal.Status`): the result dataclasses have a
+``status`` field, and the plain-array results are `BatchArray` with a ``status``
 attribute. A rejected instant is flagged in its status and its values are NaN (rotations and
 placements: the identity), never zeros that would pass for a result. Arrays of real numbers
-only: complex, string, boolean and object arrays are a :class:`TypeError`.
+only: complex, string, boolean and object arrays are a `TypeError`.
 
 Units: SI throughout (m, kg, kg m^2, rad, N, N m); world quantities in the base frame O; moments
 and angular momenta about O's origin.
@@ -39,7 +40,7 @@ __all__ = ["Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion
 
 class BatchArray(np.ndarray):
     """A batch result (N, ...) with its per-instant ``status`` (N,) (uint32 bit flags of
-    :class:`mechbal.Status`, 0 = ok); rows whose status is not 0 hold NaN. ``ok`` is the boolean
+    `mechbal.Status`, 0 = ok); rows whose status is not 0 hold NaN. ``ok`` is the boolean
     mask of the good rows. Slicing or arithmetic gives plain results: read ``status`` first."""
 
     status: np.ndarray
@@ -78,7 +79,7 @@ _URDF_READING = _contextvars.ContextVar("urdf_reading", default={"strict": False
 
 @_contextlib.contextmanager
 def urdf_reading(*, strict: bool = False, allow_massless: bool = False):
-    """Defaults of :meth:`Mechanism.from_urdf` within the block (the CLI's ``--strict`` and
+    """Defaults of `Mechanism.from_urdf` within the block (the CLI's ``--strict`` and
     ``--allow-massless`` reach every URDF a command reads this way)."""
     token = _URDF_READING.set({"strict": bool(strict), "allow_massless": bool(allow_massless)})
     try:
@@ -182,7 +183,7 @@ def _status_text(code: int) -> str:
 class Mechanism:
     """A mechanism: the general model plus every algorithm over it (see the module docstring).
 
-    Build one with :meth:`from_urdf`, :meth:`from_toml` or :meth:`from_description`.
+    Build one with `from_urdf`, `from_toml` or `from_description`.
     """
 
     def __init__(self, model: "_core.MechanismModel", *, name: str = "mechanism",
@@ -193,7 +194,7 @@ class Mechanism:
         self.name = name
         self.source = source
         #: link -> (4, 4) placement in the link frame of the frame the user described the link in
-        #: (see :meth:`user_frame`); absent links: the identity
+        #: (see `user_frame`); absent links: the identity
         self.link_frames = {str(k): np.array(v, dtype=float) for k, v in (link_frames or {}).items()}
         from mechbal import plausibility
 
@@ -232,8 +233,8 @@ class Mechanism:
                          loops: Sequence["_core.LoopConstraint"] = (),
                          actuated: Sequence[str] = (),
                          springs: Sequence["_core.Spring"] = ()) -> "Mechanism":
-        """From C++ description objects (:class:`mechbal.Joint`, :class:`mechbal.Body`,
-        :class:`mechbal.Frame`, :class:`mechbal.LoopConstraint`, :class:`mechbal.Spring`) and the
+        """From C++ description objects (`mechbal.Joint`, `mechbal.Body`,
+        `mechbal.Frame`, `mechbal.LoopConstraint`, `mechbal.Spring`) and the
         names of the actuated joints (required with loops). Raises ValueError naming the field on
         bad input."""
         desc = _core.MechanismDescription(list(joints), list(bodies), list(frames),
@@ -251,15 +252,15 @@ class Mechanism:
         URDF link is a named frame (see ``cpp/include/mechbal/io/urdf.hpp`` for the mapping).
 
         By default the reading is lenient: it loads what Pinocchio loads, repairing harmless
-        defects with one :class:`UrdfRepairWarning` each, naming the URDF element and the repair
+        defects with one `UrdfRepairWarning` each, naming the URDF element and the repair
         (a ``<mimic>`` on a fixed joint, or of a joint that does not exist, ignored; a body's
         non-physical inertia replaced by the nearest physical one, the warning saying whether the
         body is negligible -- mass at most 1e-4 of the URDF's total -- or the dynamics change; a
         negligible non-physical placeholder on the fixed root dropped). ``strict=True`` refuses them. A URDF with no
         ``<inertial>`` on any moving link is refused unless ``allow_massless=True`` (kinematics
-        only). None: the defaults of :func:`urdf_reading` (False unless set, e.g. by the CLI's
+        only). None: the defaults of `urdf_reading` (False unless set, e.g. by the CLI's
         ``--strict`` / ``--allow-massless``).
-        Raises :class:`mechbal.config.ConfigError` (a ValueError) naming the URDF element."""
+        Raises `mechbal.config.ConfigError` (a ValueError) naming the URDF element."""
         import warnings
 
         from mechbal.config import ConfigError, read_regular_file
@@ -286,7 +287,7 @@ class Mechanism:
 
     @classmethod
     def from_urdf_string(cls, xml: str, name: str = "urdf") -> "Mechanism":
-        """As :meth:`from_urdf`, from a URDF document held in a string."""
+        """As `from_urdf`, from a URDF document held in a string."""
         from mechbal.config import ConfigError
 
         try:
@@ -311,7 +312,7 @@ class Mechanism:
 
     @classmethod
     def from_spec(cls, spec, name: str = "mechanism", source: str | None = None) -> "Mechanism":
-        """From a :class:`mechbal.spec.MechanismSpec` (what the TOML reader produces)."""
+        """From a `mechbal.spec.MechanismSpec` (what the TOML reader produces)."""
         from mechbal.config import ConfigError
 
         types = {"revolute": _core.JointType.revolute, "prismatic": _core.JointType.prismatic,
@@ -357,7 +358,7 @@ class Mechanism:
 
     def with_bodies(self, bodies: Sequence["_core.Body"], *, replace: bool = False,
                     name: str | None = None) -> "Mechanism":
-        """A copy with ``bodies`` (:class:`mechbal.Body`, com and inertia in the link frames)
+        """A copy with ``bodies`` (`mechbal.Body`, com and inertia in the link frames)
         added to its own (``replace``: instead of its own): same joints, frames, loops, gravity
         and user frames. Raises ValueError naming the problem (duplicate name, unknown link)."""
         d = self.model.description
@@ -370,7 +371,7 @@ class Mechanism:
 
     def with_springs(self, springs: Sequence["_core.Spring"], *, replace: bool = False,
                      name: str | None = None) -> "Mechanism":
-        """A copy with ``springs`` (:class:`mechbal.Spring`, anchors in the link frames) added to
+        """A copy with ``springs`` (`mechbal.Spring`, anchors in the link frames) added to
         its own (``replace``: instead of its own): same joints, bodies, frames, loops, gravity
         and user frames. Raises ValueError naming the problem (duplicate name, unknown link,
         negative rate...)."""
@@ -386,9 +387,9 @@ class Mechanism:
     def to_mjcf(self, path: str | Path | None = None, *, q=None, q_guess=None, name: str | None = None,
                 timestep: float = 1e-3) -> str:
         """MuJoCo model (MJCF) of this mechanism: tree, gears, loops, springs, every body with its
-        own inertia, names kept (:mod:`mechbal.export.mjcf`); ``q``: the keyframe's pose (a closed
+        own inertia, names kept (`mechbal.export.mjcf`); ``q``: the keyframe's pose (a closed
         mechanism is assembled from ``q`` or ``q_guess``). Writes ``path`` when given; returns the
-        text. Raises :class:`mechbal.export.ExportError` (a ValueError) for what MJCF cannot hold."""
+        text. Raises `mechbal.export.ExportError` (a ValueError) for what MJCF cannot hold."""
         from mechbal.export.mjcf import mjcf_text
 
         text = mjcf_text(self, name, q=q, q_guess=q_guess, timestep=timestep)
@@ -397,8 +398,8 @@ class Mechanism:
         return text
 
     def to_urdf(self, path: str | Path | None = None, *, name: str | None = None) -> str:
-        """URDF of this mechanism (:mod:`mechbal.export.urdf`: link names, frames and every body's
-        inertia kept). Raises :class:`mechbal.export.ExportError` for loops or springs, which
+        """URDF of this mechanism (`mechbal.export.urdf`: link names, frames and every body's
+        inertia kept). Raises `mechbal.export.ExportError` for loops or springs, which
         URDF cannot describe. Writes ``path`` when given; returns the text."""
         from mechbal.export.urdf import urdf_text
 
@@ -456,7 +457,7 @@ class Mechanism:
 
     @property
     def spring_names(self) -> list[str]:
-        """Names of the springs, in model order (the columns of :meth:`spring_lengths`)."""
+        """Names of the springs, in model order (the columns of `spring_lengths`)."""
         return list(self.model.spring_names)
 
     @property
@@ -521,8 +522,8 @@ class Mechanism:
     # ---- algorithms --------------------------------------------------------------------------
     def inverse_dynamics(self, q, v, a) -> np.ndarray:
         """Joint forces tau = M(q) a + C(q, v) v + G(q) + K(q) [N m or N] (K: the springs' joint
-        forces, :meth:`spring_torque`), gear couplings projected.
-        A batch returns a :class:`BatchArray` (N, dof) whose ``status`` (N,) flags the rejected
+        forces, `spring_torque`), gear couplings projected.
+        A batch returns a `BatchArray` (N, dof) whose ``status`` (N,) flags the rejected
         instants (their rows are NaN)."""
         tau = self._single.inverse_dynamics(q, v, a)
         if tau is not None:
@@ -543,7 +544,7 @@ class Mechanism:
 
     def gravity_torque(self, q) -> np.ndarray:
         """Gravity torques G(q): the joint forces that hold the weights still [N m or N]; with
-        springs, :meth:`static_torque` is what holds the mechanism still."""
+        springs, `static_torque` is what holds the mechanism still."""
         g = self._single.gravity_torque(q)
         if g is not None:
             return g
@@ -553,7 +554,7 @@ class Mechanism:
 
     def static_torque(self, q) -> np.ndarray:
         """G(q) + K(q): the joint forces that hold the mechanism still, gravity and springs [N m
-        or N] (:meth:`gravity_torque` without springs). Zero over the workspace exactly when the
+        or N] (`gravity_torque` without springs). Zero over the workspace exactly when the
         springs balance the mechanism statically."""
         single, (q,) = self._args(("q",), (q,))
         (g,), _ = self._finish(single, _core.mechanism_static_torque(self.model, q), ["static_torque"])
@@ -566,11 +567,11 @@ class Mechanism:
 
     def spring_torque(self, q) -> np.ndarray:
         """K(q) = dV_springs/dq: the joint forces that hold the springs still [N m or N] (the
-        convention of :meth:`gravity_torque`; ``cpp/include/mechbal/algorithm/springs.hpp``)."""
+        convention of `gravity_torque`; ``cpp/include/mechbal/algorithm/springs.hpp``)."""
         return self._springs(q, "spring_torque")
 
     def spring_lengths(self, q) -> np.ndarray:
-        """Anchor distance d of each spring [m]: (S,) or (N, S), columns as :attr:`spring_names`."""
+        """Anchor distance d of each spring [m]: (S,) or (N, S), columns as `spring_names`."""
         return self._springs(q, "spring_length")
 
     def spring_tension(self, q) -> np.ndarray:
@@ -756,7 +757,7 @@ class Mechanism:
     def reduced_mass_matrix(self, q_actuated, *, q_guess=None) -> tuple[np.ndarray, np.ndarray]:
         """(C^T M C, C^T G): mass matrix and gravity forces in the actuated coordinates. One
         instant raises ValueError where the loops cannot be solved; a batch gives
-        :class:`BatchArray` results whose ``status`` flags the failed instants (NaN rows)."""
+        `BatchArray` results whose ``status`` flags the failed instants (NaN rows)."""
         qa = np.atleast_2d(_real_array(q_actuated, "q_actuated"))
         guess = np.zeros(self.dof) if q_guess is None else _real_array(q_guess, "q_guess")
         r = _core.mechanism_closed_mass_matrix(self.model, np.ascontiguousarray(qa), guess)

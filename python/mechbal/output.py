@@ -10,7 +10,7 @@ beside the new ones). The output path is checked before any computation:
   never replaces a folder of other files (``--out ~`` is refused, not emptied);
 - the folder that will hold ``DIR`` must be writable (checked by creating the temporary folder).
 
-Every refusal is an :class:`OutputError` whose message names the path and the reason.
+Every refusal is an `OutputError` whose message names the path and the reason.
 
 Recovery after a run that died (SIGKILL, a crash, a timeout): the temporary folders carry the
 writing process's id (``.DIR.partial-<pid>-XXXX``, ``.DIR.old-<pid>-XXXX``). The next run into
@@ -18,7 +18,7 @@ writing process's id (``.DIR.partial-<pid>-XXXX``, ``.DIR.old-<pid>-XXXX``). The
 without a process id, are left alone). A run killed between its two renames leaves the old run in
 ``.DIR.old-<pid>-*`` and no ``DIR``: the next run puts it back first (then replaces it as usual).
 A run that finds, at the final move, that another run has just put its own ``DIR`` in place
-(two runs into one ``--out`` at once) raises :class:`OutputRaceError` (the CLI's exit code 4):
+(two runs into one ``--out`` at once) raises `OutputRaceError` (the CLI's exit code 4):
 the other run's folder is kept whole, this run's results are discarded.
 Layer: Python core (docs/architecture.md).
 """
@@ -59,7 +59,7 @@ def _reason(exc: OSError) -> str:
 
 
 def check_output_dir(out: str | Path) -> Path:
-    """Absolute ``DIR`` after every check that needs no write (raises :class:`OutputError`)."""
+    """Absolute ``DIR`` after every check that needs no write (raises `OutputError`)."""
     given = out
     out = Path(os.path.abspath(os.path.expanduser(str(out))))
     if out.exists() or out.is_symlink():

@@ -1,12 +1,12 @@
 """Physically plausible ranges of inputs that are finite and valid but almost surely a mistake.
 
-Outside them the Python API warns (:class:`mechbal.errors.PlausibilityWarning`, once per value)
+Outside them the Python API warns (`mechbal.errors.PlausibilityWarning`, once per value)
 and the command line refuses the case (exit code 2) unless ``--force``:
 
-- a joint travel (a trajectory's ``end - start``, a joint's limit) beyond :data:`MAX_TRAVEL`
+- a joint travel (a trajectory's ``end - start``, a joint's limit) beyond `MAX_TRAVEL`
   (1e3 rad, about 160 turns, or 1e3 m);
-- a gravity of norm beyond :data:`MAX_GRAVITY` (1e3 m/s^2, about 100 g);
-- a mass beyond :data:`MAX_MASS` (1e6 kg, a thousand tonnes).
+- a gravity of norm beyond `MAX_GRAVITY` (1e3 m/s^2, about 100 g);
+- a mass beyond `MAX_MASS` (1e6 kg, a thousand tonnes).
 
 Layer: Python core (docs/architecture.md).
 """
@@ -37,7 +37,7 @@ def _vector(x: Any) -> list[float] | None:
 
 
 def mechanism_problems(mechanism) -> list[tuple[str, str]]:
-    """(field, message) for each value of a :class:`mechbal.Mechanism` outside the ranges."""
+    """(field, message) for each value of a `mechbal.Mechanism` outside the ranges."""
     out = []
     g = [float(v) for v in mechanism.gravity]
     if math.hypot(*g) > MAX_GRAVITY:
@@ -95,7 +95,7 @@ def case_problems(config: Any) -> list[tuple[str, str]]:
 
 
 def warn(problems: list[tuple[str, str]], stacklevel: int = 3) -> None:
-    """One :class:`PlausibilityWarning` per problem (the CLI turns them into errors)."""
+    """One `PlausibilityWarning` per problem (the CLI turns them into errors)."""
     for field, message in problems:
         warnings.warn(f"{field}: {message} (outside the plausible range; see mechbal.plausibility)",
                       PlausibilityWarning, stacklevel=stacklevel)

@@ -5,9 +5,9 @@ True)``) and ``MECHBAL_PROGRESS`` is not ``0``; it shows up only after half a se
 prints nothing (``MECHBAL_PROGRESS_DELAY`` seconds). ``MECHBAL_PROGRESS=1`` forces bars on (for a
 terminal that does not say it is one).
 
-- :func:`run_bar` / :func:`stage`: one bar per case run, advanced by the runner at each stage
+- `run_bar` / `stage`: one bar per case run, advanced by the runner at each stage
   ("sizing counterweights", "simulating", "plots", ...);
-- :func:`track`: wraps a loop whose length is known (sweeps, per-tick Python loops).
+- `track`: wraps a loop whose length is known (sweeps, per-tick Python loops).
 
 Layer: Python core (docs/architecture.md).
 """

@@ -8,10 +8,10 @@ removes it, nothing else to edit) and imports each once, on first use. A paper p
 * ``cases/*.toml``: its built-in case files (found by name like those of ``mechbal/cases/``);
 * ``sweeps/*.toml``: its built-in sweep files;
 * ``__init__.py``: its mechanism builders and closed forms; importing it registers the schema of
-  its case kinds (:func:`mechbal.schema.register_case_model`);
-* ``runner.py``: the runner of its case kinds (:func:`mechbal.cases.register`), imported when a
+  its case kinds (`mechbal.schema.register_case_model`);
+* ``runner.py``: the runner of its case kinds (`mechbal.cases.register`), imported when a
   case is run;
-* ``balance.py``: its ``mechbal balance`` adapters (:func:`mechbal.balance.run.register_case`),
+* ``balance.py``: its ``mechbal balance`` adapters (`mechbal.balance.run.register_case`),
   imported when a case is balanced.
 
 Layer: Python core (docs/architecture.md).

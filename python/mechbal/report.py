@@ -1,6 +1,6 @@
 """Reports: plots (matplotlib, Agg) and terminal tables.
 
-Plots follow three rules. A panel whose every series stays below :data:`ROUNDOFF_FLOOR` (SI units:
+Plots follow three rules. A panel whose every series stays below `ROUNDOFF_FLOOR` (SI units:
 N, N m, rad, ...) is round-off, not a signal: it is drawn as a flat zero marked "0 (below 1e-12)"
 instead of being autoscaled to look like one. A wrench plot shows only the components that carry a
 signal, and its caption names those left out. A legend is drawn only when it tells series apart
@@ -36,7 +36,7 @@ ROUNDOFF_FLOOR = 1e-12
 
 
 def _is_roundoff(*arrays: np.ndarray) -> bool:
-    """Every finite value of every array is below :data:`ROUNDOFF_FLOOR` in magnitude."""
+    """Every finite value of every array is below `ROUNDOFF_FLOOR` in magnitude."""
     for a in arrays:
         a = np.asarray(a, float)
         finite = a[np.isfinite(a)]
@@ -97,7 +97,7 @@ def plot_wrench(path: str | Path, t: np.ndarray,
                 moment: str = "shaking moment") -> Path:
     """Force x, y, z [N] and moment x, y, z [N m], one line per variant (successive variants
     dashed, dotted, ... over the previous ones), one panel per component that carries a signal in
-    some variant; the components that are round-off (below :data:`ROUNDOFF_FLOOR`) in every
+    some variant; the components that are round-off (below `ROUNDOFF_FLOOR`) in every
     variant are named in the caption instead of drawn (a planar case: force z, moment x, y)."""
     plt = _pyplot()
     comps = [(f"{force} {axis}", "force [N]", 0, k) for k, axis in enumerate("xyz")] + \
@@ -137,7 +137,7 @@ def plot_wrench(path: str | Path, t: np.ndarray,
 def plot_series(path: str | Path, t: np.ndarray, series: Mapping[str, np.ndarray],
                 labels: Sequence[str], ylabel: str | Sequence[str], title: str = "",
                 caption: str = "") -> Path:
-    """One panel per column (e.g. per joint) in a grid (:func:`grid_shape`), one line per named
+    """One panel per column (e.g. per joint) in a grid (`grid_shape`), one line per named
     series; ``ylabel`` with its unit, one for all panels or one per panel."""
     plt = _pyplot()
     n = len(labels)

@@ -3,13 +3,13 @@
 One model per case kind (``[case] kind = ...``), one nested model per table. Every table forbids
 unknown keys (a misspelled key is an error that names it and the nearest known key), numbers are
 strict (no booleans, no strings, finite, bounded) and integers are integers. Sizes that drive
-memory or time (samples, joints, ticks) have upper bounds. :func:`validate_case` turns the first
-problem into one :class:`~mechbal.errors.ConfigError` line naming the dotted field and the value,
+memory or time (samples, joints, ticks) have upper bounds. `validate_case` turns the first
+problem into one `ConfigError` line naming the dotted field and the value,
 then runs the checks that need more than one table (trajectory size against the mechanism's
 degrees of freedom, cross references of the general mechanism format) and warns
-(:class:`~mechbal.errors.ConfigWarning`) about likely unit mistakes.
+(`ConfigWarning`) about likely unit mistakes.
 
-:func:`json_schema` publishes the same models as JSON Schema for editors;
+`json_schema` publishes the same models as JSON Schema for editors;
 ``python/mechbal/cases/mechbal.schema.json`` is its output for every kind
 (``python -m mechbal.schema > python/mechbal/cases/mechbal.schema.json`` regenerates it; a test
 keeps it current).
@@ -224,12 +224,12 @@ class Balance(Table):
 
 
 class _MechanismCase(Table):
-    """A case with a ``[mechanism]`` table: its :class:`mechbal.spec.MechanismSpec`, built once."""
+    """A case with a ``[mechanism]`` table: its `mechbal.spec.MechanismSpec`, built once."""
     _spec: Any = PrivateAttr(None)
 
     @property
     def spec(self):
-        """The :class:`mechbal.spec.MechanismSpec` of ``[mechanism]``."""
+        """The `mechbal.spec.MechanismSpec` of ``[mechanism]``."""
         if self._spec is None:
             from mechbal.spec import mechanism_spec
 
@@ -245,7 +245,7 @@ MomentumComponentName = Literal["moment", "force", "both", "moment_x", "moment_y
 class Control(Table):
     """``[control]``: a real-time controller run along the case's trajectory. ``kind =
     "reactionless"``: the balancing joints keep the cancelled momentum components at their
-    initial value (:class:`mechbal.control.ReactionlessController`); ``mechbal run`` compares the
+    initial value (`mechbal.control.ReactionlessController`); ``mechbal run`` compares the
     motion with the balancing joints held (uncontrolled) and controlled."""
     kind: Literal["reactionless", "computed_torque", "decoupled"] = Field(
         description="which controller (mechbal run supports reactionless)")
@@ -384,7 +384,7 @@ class SweepFile(Table):
 
 #: case kind -> model (or, for kinds that several mechanisms share, ``[case] mechanism`` -> model), its
 #: checks across tables and its unit warnings; the general kinds here, a paper's when its package is
-#: imported (:func:`register_case_model`, found through :mod:`mechbal.registry`)
+#: imported (`register_case_model`, found through `mechbal.registry`)
 @dataclass(frozen=True)
 class CaseKind:
     model: Any
@@ -481,7 +481,7 @@ def _model_for(config: Any) -> type:
 def validate_case(config: Any, *, warn: bool = True):
     """The validated model of a whole case file (a dict from TOML), or a ConfigError naming the
     first problem: unknown or misspelled keys and tables anywhere, types, ranges, sizes, and the
-    checks across tables. Likely unit mistakes are warned about (:class:`ConfigWarning`).
+    checks across tables. Likely unit mistakes are warned about (`ConfigWarning`).
     Idempotent: a validated model is returned as is."""
     if isinstance(config, BaseModel):
         return config

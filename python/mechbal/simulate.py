@@ -1,10 +1,10 @@
 """Simulation through the C++ core: a whole run per call, numpy in, numpy out.
 
-* :func:`closed_loop`: any joint controller (:mod:`mechbal.control`) driving any mechanism
-  (a :class:`mechbal.Mechanism`, closed loops included, or any forward-dynamics plant such as
-  ``Arm2DofDynamics``) along any trajectory (:mod:`mechbal.trajectory`), integrated by RK4 at the
+* `closed_loop`: any joint controller (`mechbal.control`) driving any mechanism
+  (a `mechbal.Mechanism`, closed loops included, or any forward-dynamics plant such as
+  ``Arm2DofDynamics``) along any trajectory (`mechbal.trajectory`), integrated by RK4 at the
   controller period.
-* open-loop evaluation along a trajectory: :class:`mechbal.Mechanism` (``shaking_wrench``,
+* open-loop evaluation along a trajectory: `mechbal.Mechanism` (``shaking_wrench``,
   ``base_reaction``, ``inverse_dynamics`` over ``(N, n)`` samples of a trajectory).
 
 Units: SI (s, rad or m, rad/s or m/s, N m or N).
@@ -41,7 +41,7 @@ class ClosedLoopResult:
     * ``q_des``, ``qd_des`` (N, n): the desired motion at the ticks;
     * ``joint_torque`` (N, n) [N m or N]: the command applied from t_k on;
     * ``status`` (N,): per tick, the controller's and the plant's flags (0 = ok,
-      :class:`mechbal.Status`);
+      `mechbal.Status`);
     * ``saturated_ticks``: ticks on which the controller clipped the torque;
     * ``steps_completed``: ``steps`` unless the plant failed (later rows repeat the last state);
     * ``mujoco``: with ``engine="mujoco"``, the co-simulation's record (MuJoCo's base reaction
@@ -57,7 +57,7 @@ class ClosedLoopResult:
     status: np.ndarray
     saturated_ticks: int
     steps_completed: int
-    #: ``engine="mujoco"``: the :class:`mechbal.export.mujoco_engine.CoSimulation` (MuJoCo's base
+    #: ``engine="mujoco"``: the `mechbal.export.mujoco_engine.CoSimulation` (MuJoCo's base
     #: reaction at every tick beside mechbal's prediction, the loops' constraint violation)
     mujoco: Any = None
 
@@ -94,7 +94,7 @@ MAX_STEPS = 10_000_000
 
 def _check_timing(dt: Any, duration: Any) -> tuple[float, float]:
     """(dt, duration) as floats, or ValueError / TypeError naming the argument: real numbers,
-    finite, dt > 0, duration >= dt, at most :data:`MAX_STEPS` steps."""
+    finite, dt > 0, duration >= dt, at most `MAX_STEPS` steps."""
     values = {}
     for name, x in (("dt", dt), ("duration", duration)):
         if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
@@ -123,15 +123,15 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
     """Simulate ``controller`` driving ``mechanism_or_plant`` along ``trajectory`` (one C++ call).
 
     Args:
-        mechanism_or_plant: a :class:`mechbal.Mechanism` (its forward dynamics in the actuated
+        mechanism_or_plant: a `mechbal.Mechanism` (its forward dynamics in the actuated
             coordinates; loops solved at every stage, warm-started from ``q_guess``, the full
             coordinates near the assembly) or any forward-dynamics plant (``MechanismDynamics``,
             ``Arm2DofDynamics``).
-        controller: any joint controller (:class:`mechbal.control.ComputedTorque`, whose model
-            may differ from the plant, :class:`mechbal.control.DecoupledJointController`, or a
-            :class:`mechbal.control.ReactionlessController` built with ``kp`` and ``kd``).
+        controller: any joint controller (`mechbal.control.ComputedTorque`, whose model
+            may differ from the plant, `mechbal.control.DecoupledJointController`, or a
+            `mechbal.control.ReactionlessController` built with ``kp`` and ``kd``).
             Its state carries over from previous ticks; call ``reset()`` to start afresh.
-        trajectory: any :mod:`mechbal.trajectory` object, evaluated at the simulation time
+        trajectory: any `mechbal.trajectory` object, evaluated at the simulation time
             t = 0 .. duration [s]. A rest-to-rest trajectory runs on the C++ path; any other is
             sampled every dt/2 first.
         q0: initial positions [rad or m]; default: the trajectory at t = 0.
@@ -143,15 +143,15 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
         q_guess: full coordinates near the assembly, for a closed-loop Mechanism.
         engine: ``"mechbal"`` (the C++ RK4 above) or ``"mujoco"``: the controller ticked every
             ``dt`` from Python against MuJoCo integrating the mechanism's MJCF export (a
-            :class:`mechbal.Mechanism` only; zero-order hold; needs ``mechbal[mujoco]``). The
+            `mechbal.Mechanism` only; zero-order hold; needs ``mechbal[mujoco]``). The
             result's ``mujoco`` holds MuJoCo's base reaction at every tick beside mechbal's
             prediction.
         **engine_options: with ``engine="mujoco"``, the options of
-            :func:`mechbal.export.mujoco_engine.co_simulate` (``substeps``, ``integrator``,
+            `mechbal.export.mujoco_engine.co_simulate` (``substeps``, ``integrator``,
             ``solref``, ``solimp``, ``minimum_mass``, ``constraint_weight``).
 
     Returns:
-        :class:`ClosedLoopResult`. A plant failure (an unassemblable pose, a non-finite state)
+        `ClosedLoopResult`. A plant failure (an unassemblable pose, a non-finite state)
         stops the integration and shows in ``status`` and ``steps_completed``; it does not raise.
     """
     from mechbal.trajectory import RestToRest, as_trajectory

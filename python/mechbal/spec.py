@@ -1,4 +1,4 @@
-"""A mechanism as plain data: :class:`MechanismSpec`, built from a validated ``[mechanism]`` table.
+"""A mechanism as plain data: `MechanismSpec`, built from a validated ``[mechanism]`` table.
 
 This is what the general C++ ``MechanismModel`` is built from. Everything the TOML format lets a
 user say in several ways is settled here:
@@ -17,7 +17,7 @@ user say in several ways is settled here:
   body on ``base`` is in O (``mechanism.base`` applied).
 * **Springs.** ``[[mechanism.springs]]`` anchors are given like a body's ``com``: in the frame
   the user described the link in (DH frame, ``mechanism.base`` for ``base``), moved here into the
-  link frame (:class:`SpringSpec`).
+  link frame (`SpringSpec`).
 * **Spherical joints** become three revolute joints about z, y and x of the joint frame, named
   ``<name>_z``, ``<name>_y``, ``<name>_x``; the link ``<name>`` (its body, children, bodies and
   frames that name it) is the last one's, the two intermediate links are massless.
@@ -198,8 +198,8 @@ def _move_body(T: np.ndarray, com: np.ndarray, inertia: np.ndarray) -> tuple[np.
 
 
 def mechanism_spec(mechanism: Any, field: str = "mechanism") -> MechanismSpec:
-    """The :class:`MechanismSpec` of a ``[mechanism]`` table (a dict, validated here, or a
-    validated :class:`mechbal.tables.Mechanism`); ConfigError naming the field otherwise."""
+    """The `MechanismSpec` of a ``[mechanism]`` table (a dict, validated here, or a
+    validated `mechbal.tables.Mechanism`); ConfigError naming the field otherwise."""
     from mechbal.tables import Mechanism, inertia_matrix, validate_table
 
     m = mechanism if isinstance(mechanism, Mechanism) else validate_table(Mechanism, mechanism, field)

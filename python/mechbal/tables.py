@@ -1,11 +1,11 @@
 """The strict tables of the case format that the mechanism description needs, as pydantic v2
-models, and the validation machinery of every table (core layer, below :mod:`mechbal.spec` and
-:mod:`mechbal.schema`).
+models, and the validation machinery of every table (core layer, below `mechbal.spec` and
+`mechbal.schema`).
 
 Every table forbids unknown keys (a misspelled key is an error that names it and the nearest known
 key), numbers are strict (no booleans, no strings, finite, bounded) and integers are integers.
-:func:`validate_table` turns the first problem into one :class:`~mechbal.errors.ConfigError` line
-naming the dotted field and the value. :mod:`mechbal.schema` builds the case kinds on these tables
+`validate_table` turns the first problem into one `ConfigError` line
+naming the dotted field and the value. `mechbal.schema` builds the case kinds on these tables
 and re-exports them.
 
 Layer: Python core (docs/architecture.md).

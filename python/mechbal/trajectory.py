@@ -1,7 +1,7 @@
 """Desired motions: one interface, ``evaluate(t) -> (q, qd, qdd)``, for every kind of trajectory.
 
 Every trajectory here has ``dof`` (number of coordinates), ``duration`` [s] (the motion runs over
-``[0, duration]``; :class:`Sampled` over the span of its samples) and ``evaluate(t)``:
+``[0, duration]``; `Sampled` over the span of its samples) and ``evaluate(t)``:
 
 * ``t`` a number: ``(q, qd, qdd)`` each of shape ``(dof,)``;
 * ``t`` an array of N times: each of shape ``(N, dof)`` (one call, no Python loop).
@@ -112,7 +112,7 @@ class RestToRest:
             time_law: _core.TimeLaw = getattr(_core.TimeLaw, law)
         else:
             time_law = law
-        #: the C++ trajectory (what :func:`mechbal.simulate.closed_loop` runs on)
+        #: the C++ trajectory (what `mechbal.simulate.closed_loop` runs on)
         self.core = _core.RestToRestTrajectory(start, end, duration, time_law)
 
     @property
@@ -318,7 +318,7 @@ class Sampled(_OverTimes):
 
 
 def as_trajectory(obj: object) -> Trajectory:
-    """A :class:`Trajectory` from a trajectory object or a C++ ``RestToRestTrajectory``."""
+    """A `Trajectory` from a trajectory object or a C++ ``RestToRestTrajectory``."""
     if isinstance(obj, _core.RestToRestTrajectory):
         r = RestToRest.__new__(RestToRest)
         r.core = obj

@@ -4,7 +4,7 @@ For the case's mechanism and its balanced variant (the case's ``[balance]`` meth
 design), along the case's trajectory:
 
 * **prescribed motion**: MuJoCo's inverse dynamics of the MJCF export on mechbal's (q, v, a)
-  (:meth:`mechbal.export.mujoco_engine.MujocoMechanism.inverse_dynamics`): the shaking force
+  (`mechbal.export.mujoco_engine.MujocoMechanism.inverse_dynamics`): the shaking force
   dP/dt and moment dH_O/dt (MuJoCo's base reaction on the moving bodies plus their weight), the
   actuator forces and the gravity (static) torque, projected on the actuated joints with mechbal's
   coupling matrix for a closed mechanism; the largest difference to mechbal's, relative to the
@@ -13,7 +13,7 @@ design), along the case's trajectory:
   prediction is judged against what balancing removed.
 * **simulated**: a 1 kHz computed-torque loop (mechbal's controller over mechbal's model, gains
   Kp = 400 / s^2, Kd = 40 / s) against MuJoCo integrating the export
-  (:func:`mechbal.export.mujoco_engine.co_simulate`): the peak shaking force and moment MuJoCo
+  (`mechbal.export.mujoco_engine.co_simulate`): the peak shaking force and moment MuJoCo
   realises, and the largest loop-closure violation of its soft constraints.
 
 DIR receives ``summary.json``, ``shaking_wrench.png`` (mechbal and MuJoCo, simulated) and the
@@ -35,7 +35,7 @@ KP, KD = 400.0, 40.0
 
 
 def case_trajectory(bc, n: int):
-    """The case's trajectory as a :mod:`mechbal.trajectory` object: its ``[trajectory]`` law, or
+    """The case's trajectory as a `mechbal.trajectory` object: its ``[trajectory]`` law, or
     the case's sampled motion (a paper's own law) through a cubic spline."""
     from mechbal.config import trajectory_from_config
     from mechbal.errors import ConfigError

@@ -27,7 +27,7 @@ def random_chain_specs(rng: np.random.Generator, types: str):
 
 
 def chain_from_specs(specs, gravity=(0.0, 0.0, -9.81), base=None):
-    """The serial chain of ``specs`` as a general :class:`mechbal.MechanismModel`: joint i's parent
+    """The serial chain of ``specs`` as a general `mechbal.MechanismModel`: joint i's parent
     is joint i - 1, one body per link (named after its joint), ``base`` (4x4) folded into the
     first joint's placement."""
     joints, bodies, parent = [], [], "base"

@@ -354,3 +354,17 @@ def test_closed_loop_on_a_closed_linkage_from_toml():
     # exact model, control law at every RK4 stage: the error follows eq 6
     expected = papers.pd_error_analytic(-0.02, 0.0, 100.0, 20.0, r.t)
     np.testing.assert_allclose(r.tracking_error[:, 0], expected, atol=1e-8)
+
+
+def test_docstrings_are_markdown_not_rest():
+    """The API pages render docstrings as Markdown (Google style): a reST role such as
+    :class:`x` shows up literally, so none may come back."""
+    import re
+    from pathlib import Path
+
+    role = re.compile(r":(?:py:)?(?:class|mod|func|meth|attr|data|exc|obj|ref):`")
+    package = Path(__file__).resolve().parents[2] / "python" / "mechbal"
+    files = sorted([*package.rglob("*.py"), *package.rglob("*.pyi")])
+    found = [f"{p.relative_to(package)}:{i}" for p in files
+             for i, line in enumerate(p.read_text().splitlines(), 1) if role.search(line)]
+    assert not found, f"reST roles in docstrings (write `name` instead): {found[:10]}"

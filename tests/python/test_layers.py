@@ -87,6 +87,66 @@ def test_import_linter_contracts_hold():
     assert "0 broken" in r.stdout
 
 
+_CYCLES_SCRIPT = r"""
+import json, sys
+import grimp
+graph = grimp.build_graph("mechbal", cache_dir=None)
+index, low, stack, comps = {}, {}, [], []
+sys.setrecursionlimit(10000)
+def visit(v):  # Tarjan's strongly connected components
+    index[v] = low[v] = len(index)
+    stack.append(v)
+    for w in graph.find_modules_directly_imported_by(v) - {"mechbal"}:
+        if w not in index:
+            visit(w)
+            low[v] = min(low[v], low[w])
+        elif w in stack:
+            low[v] = min(low[v], index[w])
+    if low[v] == index[v]:
+        comp = []
+        while True:
+            w = stack.pop()
+            comp.append(w)
+            if w == v:
+                break
+        if len(comp) > 1:
+            comps.append(sorted(comp))
+for m in sorted(graph.modules):
+    if m not in index:
+        visit(m)
+print(json.dumps(comps))
+"""
+
+
+def _import_cycles(package_dir: Path) -> list[list[str]]:
+    """Import cycles (strongly connected components of more than one module, function-level
+    imports included) of the package `mechbal` found in `package_dir`, without the edges to the
+    root package itself: `from mechbal import _core` is recorded as importing `mechbal`, whose
+    __init__ imports the public modules, which would join everything into one false circle."""
+    pytest.importorskip("grimp")
+    import json
+    import os
+
+    r = subprocess.run([sys.executable, "-c", _CYCLES_SCRIPT], capture_output=True, text=True, timeout=300,
+                       cwd=package_dir, env={**os.environ, "PYTHONPATH": str(package_dir)})
+    assert r.returncode == 0, r.stderr[-3000:]
+    return json.loads(r.stdout)
+
+
+def test_no_import_cycles_anywhere_in_the_package():
+    # stronger than the sibling contract: a paper's __init__ importing its own runner (which
+    # imports the paper back) is a cycle too
+    assert _import_cycles(ROOT / "python") == [], "import cycles"
+
+
+def test_the_cycle_check_finds_a_parent_child_cycle(tmp_path):
+    shutil.copytree(ROOT / "python" / "mechbal", tmp_path / "mechbal",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.so"))
+    with (tmp_path / "mechbal" / "papers" / "paminsa" / "__init__.py").open("a") as f:
+        f.write("\n\ndef _planted():\n    from mechbal.papers.paminsa.runner import run  # noqa\n")
+    assert ["mechbal.papers.paminsa", "mechbal.papers.paminsa.runner"] in _import_cycles(tmp_path)
+
+
 def test_the_contracts_catch_an_upward_import(tmp_path):
     # the same contracts on a copy of the package in which one core module imports a paper:
     # import-linter must report the layer broken (the check above can fail)

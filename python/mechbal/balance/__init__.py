@@ -1,7 +1,7 @@
 """Balancing by method, for any mechanism.
 
 Each method is a module with a function ``balance(mechanism, design, samples) -> BalanceResult``
-over any :class:`mechbal.Mechanism` (serial, tree or closed-loop), built on the C++ regressors:
+over any `mechbal.Mechanism` (serial, tree or closed-loop), built on the C++ regressors:
 
 | method | module | what it makes zero (or least) |
 |---|---|---|
@@ -12,9 +12,9 @@ over any :class:`mechbal.Mechanism` (serial, tree or closed-loop), built on the 
 | rms | `mechbal.balance.rms` | RMS or peak actuator torque over a trajectory |
 
 The design variables (which bodies or springs may be added or changed, where, with which bounds
-and mass budget) are :class:`~mechbal.balance.result.CounterweightSlot` /
-:class:`~mechbal.balance.result.SpringSlot` / :class:`~mechbal.balance.result.DiscSlot` /
-:class:`~mechbal.balance.result.InertiaSlot` objects (or the ``[balance]`` table of a case file);
+and mass budget) are `CounterweightSlot` /
+`SpringSlot` / `DiscSlot` /
+`InertiaSlot` objects (or the ``[balance]`` table of a case file);
 a result names what limited it (rank, an active bound, an impossibility).
 
 Layer: methods (docs/architecture.md).

@@ -19,7 +19,7 @@ allow and the bounds only chose among equals; if there is none, the constrained 
 (convex: the bounds are linear or second-order cones in (m, h)) is solved instead, and the active
 bounds are reported as what limited the balance.
 
-Positions are in the frame the user described each link in (:meth:`Mechanism.user_frame`):
+Positions are in the frame the user described each link in (`Mechanism.user_frame`):
 the variables are (m, h_user) with ``h_link = R h_user + m t`` for the user frame (R, t).
 
 **Fixed positions.** A slot whose position is given (``position``, or ``max_radius = 0``) has one
@@ -56,7 +56,7 @@ ACTIVE_RTOL = 1e-7
 
 @dataclass
 class Slot:
-    """A :class:`CounterweightSlot` checked against a mechanism: ``T`` (4, 4) is the user frame
+    """A `CounterweightSlot` checked against a mechanism: ``T`` (4, 4) is the user frame
     of ``link`` in the link frame (the link's own, or that of the named frame the slot gave as
     its ``link``, e.g. a URDF link); ``center``, ``direction`` (unit or None) and ``inertia`` are
     in the user frame, as given."""
@@ -361,7 +361,7 @@ def closed_samples(mech, q_actuated, v_actuated=None, q_guess=None) -> ClosedSam
 
 @dataclass
 class LinearSolution:
-    """What :func:`solve_mass_moments` found. ``x`` (4K,): (m, h_user) per slot; ``residual`` and
+    """What `solve_mass_moments` found. ``x`` (4K,): (m, h_user) per slot; ``residual`` and
     ``residual_before``: RMS of A x + b and of b over the rows; ``least_squares_residual``: RMS of
     the unconstrained optimum; ``rank`` of A; ``undetermined``: the combinations of unknowns that
     change nothing (a basis of the null space of A); ``active_bounds``; ``limited_by``."""
@@ -385,7 +385,7 @@ class LinearSolution:
 
     def result(self, method: str, slots: Sequence[Slot], design: dict, residual: float, units: str,
                metrics: dict, balanced) -> BalanceResult:
-        """The :class:`BalanceResult` of a method that solved this linear problem (static, force):
+        """The `BalanceResult` of a method that solved this linear problem (static, force):
         its rank, bounds, undetermined combinations and tied groups."""
         return BalanceResult(method=method, design=design, residual=residual,
                              residual_before=self.residual_before, residual_units=units,
@@ -728,7 +728,7 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
 
     # stage 2a: the lightest least-squares solution within the bounds: a convex program (linear
     # objective, linear bounds, second-order cones), solved by HiGHS on polyhedral outer
-    # approximations of the cones (:func:`lightest_within_bounds`)
+    # approximations of the cones (`lightest_within_bounds`)
     d = Z.shape[1]
     y = y0
     lower_bound = None

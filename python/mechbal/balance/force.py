@@ -9,7 +9,7 @@ mass moments: ``P(q, v) = Y_P(q, v) pi`` (the linear rows of the momentum regres
 (P = 0 for every motion means the total centre of mass does not move, so F = 0 whatever the
 accelerations). This is solved as a linear least squares with its rank, residual and
 undetermined combinations, then masses and positions under the bounds
-(:mod:`mechbal.balance.common`). Closed mechanisms: (q, v) come from the loop solve of sampled
+(`mechbal.balance.common`). Closed mechanisms: (q, v) come from the loop solve of sampled
 actuated states (``Mechanism.closed_motion``: v = C v#), so only the motions the loops allow are
 required to be balanced.
 
@@ -34,7 +34,7 @@ from mechbal.balance.result import BalanceResult, CounterweightSlot
 
 def motion_sample(mech, samples, *, seed: int = 0, lower=None, upper=None, q_guess=None):
     """(q, v, dropped): ``samples`` an int (random positions in the box of
-    :func:`common.sample_box`, velocities standard normal, for the actuated joints of a closed
+    `common.sample_box`, velocities standard normal, for the actuated joints of a closed
     mechanism) or a tuple (q, v) of (N, dof) arrays (closed: (q#, v#), (N, na))."""
     closed = mech.is_closed
     width = len(mech.actuated_names) if closed else mech.dof
@@ -65,8 +65,8 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples=200, *, mass
     """Counterweights that make the linear momentum zero (least squares) over sampled motions:
     complete shaking-force balance where the residual is zero.
 
-    ``design``: counterweight slots (:class:`CounterweightSlot`); ``samples``: a number of random
-    (q, v), or a tuple of arrays (:func:`motion_sample`); ``mass_budget``: bound on the total
+    ``design``: counterweight slots (`CounterweightSlot`); ``samples``: a number of random
+    (q, v), or a tuple of arrays (`motion_sample`); ``mass_budget``: bound on the total
     counterweight mass. ``residual``: the RMS linear momentum of the balanced mechanism over the
     samples [kg m/s], recomputed from the balanced model."""
     mech = mechanism

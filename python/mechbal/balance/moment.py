@@ -10,16 +10,16 @@ and the columns are those of the actuated rates. The condition needs the mechani
 force-balanced first (method ``force``): where the linear momentum of a unit rate is not zero,
 its moment depends on the reference point and no disc can cancel it.
 
-**Discs** (:class:`~mechbal.balance.result.DiscSlot`). A disc rides on an axle fixed to a
+**Discs** (`DiscSlot`). A disc rides on an axle fixed to a
 carrier link and turns relative to it by ``ratio * q_j'`` (a gear train to coordinate j: a gear
 coupling on the general model). Its mass is part of the carrier's (as in the paper), so it adds
 only its inertia: axial ``J_a`` about the axle, transverse ``J_t`` (thin disc: J_a / 2). Its
 angular momentum is ``R I R^T w_carrier + ratio J_a q_j' a`` -- linear in the unknowns
 ``(J_a, J_t)`` and ``h = ratio * J_a`` jointly, so the condition is a linear least-squares problem
 in the disc inertias, the "geared inertias" h (hence the ratios) and any central inertia of an
-existing body left free (:class:`~mechbal.balance.result.InertiaSlot`: the spatial arm's
+existing body left free (`InertiaSlot`: the spatial arm's
 corrected conditions J_y2 = J_z2 + m3 l2^2 (1 + m3/m2), J_y3 = J_z3 are of this kind). The rows
-come from the angular rows of the momentum regressor (:meth:`mechbal.Mechanism.momentum_regressor`)
+come from the angular rows of the momentum regressor (`mechbal.Mechanism.momentum_regressor`)
 of the mechanism with the discs rigid on their carriers and geared at ratio 1.
 
 **When full balance is impossible.** The columns (coordinate k, axis x/y/z) that the slots can
@@ -156,10 +156,10 @@ DEFAULT_SAMPLES = 200
 
 
 def design_from_table(table, mechanism: Mechanism):
-    """(design, samples, options) of a validated ``[balance]`` table for :func:`balance` (what
-    ``mechbal balance --method moment`` runs): the :class:`DiscSlot` of ``[[balance.discs]]`` and
-    :class:`InertiaSlot` of ``[[balance.inertias]]``, checked against the mechanism
-    (:class:`~mechbal.errors.ConfigError` naming ``balance.discs[i].carrier`` ...); ``samples``:
+    """(design, samples, options) of a validated ``[balance]`` table for `balance` (what
+    ``mechbal balance --method moment`` runs): the `DiscSlot` of ``[[balance.discs]]`` and
+    `InertiaSlot` of ``[[balance.inertias]]``, checked against the mechanism
+    (`ConfigError` naming ``balance.discs[i].carrier`` ...); ``samples``:
     ``balance.samples`` (default 200) uniform random poses in the box ``balance.lower`` ..
     ``balance.upper`` (default the joint limits, else +-pi / +-0.5 m: ``common.sample_box``), of
     the actuated joints of a closed mechanism (whose box must be given: where its loops
@@ -248,10 +248,10 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     (hence the shaking moment) for all motions over the workspace ``samples`` (configurations
     (N, dof); actuated positions (N, na) for a closed mechanism).
 
-    ``design``: :class:`~mechbal.balance.result.DiscSlot` and
-    :class:`~mechbal.balance.result.InertiaSlot` objects (or ``{"discs": [...], "inertias": [...]}``).
+    ``design``: `DiscSlot` and
+    `InertiaSlot` objects (or ``{"discs": [...], "inertias": [...]}``).
 
-    Returns a :class:`BalanceResult`: ``design[disc] = {"inertia", "transverse_inertia",
+    Returns a `BalanceResult`: ``design[disc] = {"inertia", "transverse_inertia",
     "ratio", "geared_inertia" (ratio x inertia), "carrier", "joint", "axis"}``,
     ``design[inertia slot] = {component: value}``; ``residual`` the peak |H_O| [kg m^2/s] of the
     balanced mechanism over ``check_motions`` random velocities (U(-1, 1) rad/s or m/s) at the

@@ -116,8 +116,8 @@ class BalanceResult:
     the result is not exact (``"rank 4 < 6 unknowns: ..."``, ``"bound: cw1.mass_max"``,
     ``"impossible: ..."``), empty when the balance is exact; ``metrics``: before/after peak and
     RMS values (gravity torque, actuator torque, shaking force and moment) where computed;
-    ``balanced``: the balanced :class:`mechbal.Mechanism`; ``elements``: balancing elements that
-    are not bodies of the mechanism (the sized :class:`SpringSlot` objects of the spring method);
+    ``balanced``: the balanced `mechbal.Mechanism`; ``elements``: balancing elements that
+    are not bodies of the mechanism (the sized `SpringSlot` objects of the spring method);
     ``active_bounds``: every bound the design sits on (``"cw1.max_radius"``, ``"mass_budget"``),
     whether or not it limited the balance (when it did, it is also in ``limited_by``);
     ``undetermined``: combinations of the unknowns that the condition does not determine (the

@@ -21,8 +21,8 @@ the torques.
   already fixed: a counterweight does not change the torque of a joint that is not its ancestor,
   so this is the corrected ordering of eqs 43-45 for any tree. A joint served by one slot of fixed
   mass on a line, minimising RMS, is the paper's quartic: its stationarity cubic (eqs 41-49) is
-  solved in closed form (Viete / Cardano, eqs 50-59: :func:`cubic_real_roots`; the paper's own
-  coefficients, eqs 33-38, are :func:`mechbal.papers.arm2dof.rms_optimal_radii`)
+  solved in closed form (Viete / Cardano, eqs 50-59: `cubic_real_roots`; the paper's own
+  coefficients, eqs 33-38, are `mechbal.papers.arm2dof.rms_optimal_radii`)
   and every real root inside the bounds and both bounds are compared (the fast path, checked
   against the numerical path in the tests).
 * ``"total"``: every slot together minimises ``sum_j w_j mean(tau_j^2)`` (or the largest

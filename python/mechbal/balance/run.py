@@ -2,17 +2,17 @@
 
 CASE is a TOML case of kind ``mechanism`` / ``serial_chain`` (its ``[mechanism]``, ``[trajectory]``
 and ``[balance]`` tables), a case of a kind that a paper registers an adapter for
-(:func:`register_case`, in ``mechbal/papers/<paper>/balance.py``: ``paminsa``, ``discs``, ``rpsp``,
-``orthoglide``, ``arm2dof``; found through :mod:`mechbal.registry`, never imported here), or a URDF
+(`register_case`, in ``mechbal/papers/<paper>/balance.py``: ``paminsa``, ``discs``, ``rpsp``,
+``orthoglide``, ``arm2dof``; found through `mechbal.registry`, never imported here), or a URDF
 file (with ``--design FILE.toml`` holding a ``[balance]`` table and optionally a ``[trajectory]``).
 
-DIR receives (all or nothing, :mod:`mechbal.output`): ``summary.json`` (the design, the
+DIR receives (all or nothing, `mechbal.output`): ``summary.json`` (the design, the
 residuals, the bounds and undetermined combinations, and before/after peak and RMS of the gravity
 torque, the actuator torques, the shaking force and the shaking moment along the trajectory),
 ``gravity_torque.png``, ``joint_torques.png``, ``shaking_wrench.png``, ``bodies_unbalanced.npz``
-and ``bodies_balanced.npz`` (the schema of :mod:`mechbal.export`), ``balanced.toml`` (a case that
+and ``bodies_balanced.npz`` (the schema of `mechbal.export`), ``balanced.toml`` (a case that
 ``mechbal run`` runs; springs as ``[[mechanism.springs]]``), ``balanced.xml`` (MJCF, for MuJoCo:
-:mod:`mechbal.export.mjcf`, the pose of the trajectory's start as keyframe) and, for trees without
+`mechbal.export.mjcf`, the pose of the trajectory's start as keyframe) and, for trees without
 springs, ``balanced.urdf`` (URDF cannot carry loops or springs: summary.json's ``urdf`` says why
 instead).
 
@@ -44,7 +44,7 @@ class BalanceCase:
     """What a balance run needs: the mechanism, the validated ``[balance]`` table (or None),
     the trajectory (actuated joints: q, v, a (N, na) and t), its description for the TOML
     written back, the assembly guess of a closed mechanism, and the source; ``default_design``:
-    per method of :data:`mechbal.balance.METHODS` outside the counterweight methods, the
+    per method of `mechbal.balance.METHODS` outside the counterweight methods, the
     (design, samples, options) it runs without a ``[balance]`` table (the case's own design
     variables); ``notes``: what summary.json says about the case (``case_notes``)."""
 
@@ -83,7 +83,7 @@ _ADAPTERS: dict[str, CaseAdapter] = {}
 
 def register_case(kind: str, *, written_back: WrittenBack | None = None) -> Callable[[CaseBuilder], CaseBuilder]:
     """Register ``build`` as the ``mechbal balance`` adapter of case kind ``kind`` (a paper's
-    ``balance.py`` does, on import; :mod:`mechbal.registry` imports it when a case is balanced)."""
+    ``balance.py`` does, on import; `mechbal.registry` imports it when a case is balanced)."""
     def deco(build: CaseBuilder) -> CaseBuilder:
         _ADAPTERS[kind] = CaseAdapter(build, written_back)
         return build
@@ -146,7 +146,7 @@ def _trajectory_motion(mech, tt, law=None, field="trajectory"):
 
 
 def load_case(case: str, design: str | None = None) -> BalanceCase:
-    """Read CASE (and ``--design``) into a :class:`BalanceCase`; ConfigError naming the field."""
+    """Read CASE (and ``--design``) into a `BalanceCase`; ConfigError naming the field."""
     from mechbal.config import check_case_file
     from mechbal.config import load_case as load_toml_case
     from mechbal.mechanism import Mechanism
@@ -197,7 +197,7 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
 
 
 def case_from_config(cfg, raw: dict | None = None, design_cfg=None, *, source: str | None = None) -> BalanceCase:
-    """The :class:`BalanceCase` of a validated case (``mechbal.schema.validate_case``; ``raw`` its
+    """The `BalanceCase` of a validated case (``mechbal.schema.validate_case``; ``raw`` its
     TOML table, for the case written back): what ``mechbal balance`` and the papers' runners
     balance. ``design_cfg`` (a validated ``--design`` file) replaces the case's ``[balance]`` (and
     its ``[trajectory]`` the case's trajectory). ConfigError for a kind without a general model."""

@@ -6,7 +6,7 @@ constant over the workspace; then the static joint forces vanish:
 eqs 11-14; Herder 2001). This module generalises the paper's distal and proximal devices (eqs 5-6,
 9-10, 15-19) to springs between any two anchor points of any two links.
 
-**Spring model** (one :class:`~mechbal.balance.result.SpringSlot`). ``count`` identical springs in
+**Spring model** (one `SpringSlot`). ``count`` identical springs in
 parallel, each of rate ``rate`` [N/m] and initial tension ``preload`` [N], act between anchor A on
 ``link_a`` and anchor B on ``link_b`` through a block and tackle of ratio ``k = pulley_ratio``: the
 anchor distance d changes k times as much as the springs' length. By virtual work (cable tension T
@@ -25,18 +25,18 @@ The model holds while every spring is stretched (d >= L0); the result flags samp
 
 **Generalised forces.** With u = (r_B - r_A)/d and J_A, J_B the linear rows of the Jacobians of
 the anchor points, the joint forces that hold the springs still (the convention of
-:meth:`mechbal.Mechanism.gravity_torque`) are
+`mechbal.Mechanism.gravity_torque`) are
 
     spring_torque = dV/dq = T (J_B - J_A)^T u = J_A^T f - J_B^T f,   f = -T u
 
 (f the force the spring exerts on B). The springs are elements of the mechanism model
 (``mechbal.Spring``, ``cpp/include/mechbal/algorithm/springs.hpp``): lengths, tensions, energy and
-these joint forces are computed there, and the balanced mechanism returned by :func:`balance`
+these joint forces are computed there, and the balanced mechanism returned by `balance`
 carries its springs, so its inverse dynamics, static torque and simulation include them. A slot
-becomes a model spring through :func:`model_spring` (an anchor given in a named frame, e.g. a DH
+becomes a model spring through `model_spring` (an anchor given in a named frame, e.g. a DH
 frame, moved into its link's frame).
 
-**Sizing** (:func:`balance`). For fixed anchors, free lengths and preloads, T and V are affine in
+**Sizing** (`balance`). For fixed anchors, free lengths and preloads, T and V are affine in
 the rates, so "gravity torque + spring torque = 0 at every sample" is a linear least-squares
 problem in the equivalent rates (bounds: 0 <= rate <= rate_max; rank and residual reported).
 Anchors left free within bounds (``anchor_a_bounds``, ``anchor_b_bounds``) are found by nonlinear
@@ -44,7 +44,7 @@ least squares (scipy ``least_squares``) around that linear solve (variable proje
 mechanisms are balanced in their actuated coordinates (C^T (G + tau_s) = 0 on the loop-solved
 configurations).
 
-**Catalogue selection** (:func:`select_springs`, :func:`load_catalogue`): clusters of identical
+**Catalogue selection** (`select_springs`, `load_catalogue`): clusters of identical
 off-the-shelf springs and a block-and-tackle ratio whose equivalent rate and peak force meet the
 theoretical ones, with the anchor correction the chosen rate implies (for a ZFL spring
 ``rate * anchor offset`` is what balances: eqs 15-19, Table 1 second row) and the total spring
@@ -128,7 +128,7 @@ def _reference(mechanism: Mechanism, slot: SpringSlot, side: str) -> tuple[str, 
 
 
 def model_spring(mechanism: Mechanism, slot: SpringSlot, *, anchors=None, probe: bool = False) -> "_core.Spring":
-    """The :class:`mechbal.Spring` of a slot on ``mechanism`` (anchors moved into the link frames
+    """The `mechbal.Spring` of a slot on ``mechanism`` (anchors moved into the link frames
     when the slot names a frame). ``anchors``: (anchor_a, anchor_b) overriding the slot's;
     ``probe``: a unit-tension spring (tension 1 N at any length, no rate) whose energy is the
     anchor distance d and whose joint force is dd/dq -- what the least squares are built from."""
@@ -235,7 +235,7 @@ def spring_torque(mechanism: Mechanism, springs: Sequence[SpringSlot], q) -> np.
     """Joint forces that hold the springs still, dV_springs/dq = J_A^T f - J_B^T f [N m or N]
     (f the force each spring exerts on its anchor B), in the coordinates of ``mechanism``
     (for a closed mechanism the full tree coordinates: project with C^T). Same convention as
-    :meth:`mechbal.Mechanism.gravity_torque`: the static motor torque is their sum.
+    `mechbal.Mechanism.gravity_torque`: the static motor torque is their sum.
     (dof,) for one configuration, (N, dof) for a batch."""
     springs, q2, single = _prepare(mechanism, springs, q)
     tau = _evaluated(mechanism, springs).spring_torque(q2)
@@ -294,7 +294,7 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
             max_nfev: int = 200, catalogue=None, closure_tolerance: float = 1e-13, **options) -> BalanceResult:
     """Size springs so that gravity torque + spring torque = 0 over a workspace sample.
 
-    ``design``: :class:`~mechbal.balance.result.SpringSlot` objects (or ``{"springs": [...]}``).
+    ``design``: `SpringSlot` objects (or ``{"springs": [...]}``).
     A slot with ``rate=None`` has its rate chosen (0 <= rate <= ``rate_max``); a slot with
     ``anchor_a_bounds`` / ``anchor_b_bounds`` has those anchor coordinates chosen within the
     bounds (coordinates with equal lower and upper bounds stay fixed).
@@ -303,7 +303,7 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     the actuated coordinates; ``closure_tolerance`` [m] of that loop solve (stiff springs need a
     tighter one: a closure error e leaves about K e on the actuators).
 
-    Returns a :class:`BalanceResult`: ``design[name]`` with ``rate`` [N/m] (each spring),
+    Returns a `BalanceResult`: ``design[name]`` with ``rate`` [N/m] (each spring),
     ``equivalent_rate`` [N/m] at the anchors, the anchors, ``peak_tension`` [N],
     ``min_stretch`` [m]; ``residual`` the peak static joint force left (gravity + springs) [N m
     or N], ``residual_before`` the peak gravity torque; ``rank``/``unknowns`` of the linear rate
@@ -313,8 +313,8 @@ def balance(mechanism: Mechanism, design, samples, *, q_guess=None, tolerance: f
     ``balanced`` the mechanism with the sized springs as elements of its model (what the static
     torque after, the tensions and the energy are evaluated on). The springs cancel the static
     torque of ``mechanism`` as it is (gravity, and the springs it may already have).
-    With ``catalogue`` (a path, a list of :class:`CatalogueSpring`, or "shipped"),
-    ``metrics["catalogue"]`` holds the ranked clusters of :func:`select_for_result` per spring.
+    With ``catalogue`` (a path, a list of `CatalogueSpring`, or "shipped"),
+    ``metrics["catalogue"]`` holds the ranked clusters of `select_for_result` per spring.
     """
     from scipy.optimize import least_squares, lsq_linear
 
@@ -549,9 +549,9 @@ DEFAULT_SAMPLES = 1000
 
 
 def design_from_table(table, mechanism: Mechanism):
-    """(design, samples, options) of a validated ``[balance]`` table for :func:`balance` (what
+    """(design, samples, options) of a validated ``[balance]`` table for `balance` (what
     ``mechbal balance --method springs`` runs): the ``[[balance.springs]]`` slots with their
-    anchors moved from the frames the user described the links in (:meth:`Mechanism.user_frame`)
+    anchors moved from the frames the user described the links in (`Mechanism.user_frame`)
     into the link frames; ``balance.samples`` (default 1000) random poses in
     ``balance.lower``..``balance.upper`` (default the joint limits, else +-pi / +-0.5 m) drawn
     with ``balance.seed`` -- for a closed mechanism its actuated coordinates, in a nearest-neighbour
@@ -796,12 +796,12 @@ def select_springs(rate: float, peak_force: float, catalogue: Sequence[Catalogue
 
 def select_for_result(mechanism: Mechanism, result: BalanceResult, samples, catalogue=None, *,
                       offsets: Mapping[str, tuple[str, int]] | None = None, **select_options) -> dict[str, list[SpringCluster]]:
-    """Catalogue clusters for every spring of a :func:`balance` result, with the peak force
+    """Catalogue clusters for every spring of a `balance` result, with the peak force
     recomputed on ``samples`` (open mechanisms: configurations) for each candidate's rate and
     corrected anchor. ``offsets[name] = ("a" or "b", coordinate)`` names the anchor coordinate
     that is the spring's balancing offset (a ZFL spring balances with ``rate * offset``
     constant): it is moved to keep that product; without it the anchors stay and only the rate
-    changes (then the balance is approximate: check with :func:`spring_torque`)."""
+    changes (then the balance is approximate: check with `spring_torque`)."""
     offsets = dict(offsets or {})
     q = np.atleast_2d(np.asarray(samples, float))
     out = {}

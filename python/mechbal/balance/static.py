@@ -8,7 +8,7 @@ links L_k:
 
 is a linear least-squares problem in the mass moments (m_k, m_k p_k), solved exactly (rank,
 residual, minimum-norm solution, undetermined combinations), then the masses and positions are
-chosen under the slots' bounds and the mass budget (:mod:`mechbal.balance.common`). For a closed
+chosen under the slots' bounds and the mass budget (`mechbal.balance.common`). For a closed
 mechanism the condition is on the actuated joints, C(q)^T G(q) = 0, with C the coupling matrix of
 the loop solve (v = C v#).
 
@@ -30,7 +30,7 @@ from mechbal.balance.result import BalanceResult, CounterweightSlot
 
 def workspace_sample(mech, samples, *, seed: int = 0, lower=None, upper=None, q_guess=None):
     """(q, C) of the sample: ``samples`` an int (that many uniform random configurations in the
-    box :func:`common.sample_box`: joint limits, else +-pi / +-0.5 m) or an (N, dof) array of
+    box `common.sample_box`: joint limits, else +-pi / +-0.5 m) or an (N, dof) array of
     configurations (of the actuated joints, (N, na), for a closed mechanism). C is None for an
     open mechanism, the coupling matrices (N, dof, na) for a closed one (unassemblable samples
     are dropped). Returns (q, C, q_actuated, dropped)."""
@@ -63,10 +63,10 @@ def balance(mechanism, design: Sequence[CounterweightSlot], samples=1000, *, mas
             seed: int = 0, lower=None, upper=None, q_guess=None) -> BalanceResult:
     """Counterweights that make the gravity torque zero (least squares) over a workspace sample.
 
-    ``design``: the counterweight slots (:class:`CounterweightSlot`: link, mass range, distance
+    ``design``: the counterweight slots (`CounterweightSlot`: link, mass range, distance
     ``max_radius`` from ``center``, optional line ``direction``; positions in the frame the user
     described the link in). ``samples``: a number of random configurations or an array of them
-    (:func:`workspace_sample`; ``lower``/``upper`` bound the random box, ``q_guess`` picks the
+    (`workspace_sample`; ``lower``/``upper`` bound the random box, ``q_guess`` picks the
     assembly mode of a closed mechanism). ``mass_budget``: bound on the total counterweight mass.
 
     Among the least-squares solutions that meet the bounds, the lightest is returned; when no

@@ -1,13 +1,13 @@
 """Write a (balanced) mechanism back as a case file: TOML (any mechanism) and URDF (trees).
 
-* :func:`toml_text`: a small TOML writer for case data (tables, arrays of tables, inline tables
+* `toml_text`: a small TOML writer for case data (tables, arrays of tables, inline tables
   inside them, numbers written to round-trip exactly, strings, booleans, arrays).
-* :func:`mechanism_table`: the ``[mechanism]`` table of a :class:`mechbal.Mechanism` from its
+* `mechanism_table`: the ``[mechanism]`` table of a `mechbal.Mechanism` from its
   model (joints as ``origin = {xyz, rpy}`` + ``axis`` in the parent link's frame, limits, gears,
   every body with its centre of mass and full inertia in its link frame, frames, loops, springs).
   The root link is written ``base`` (a URDF's may be ``world``); a frame named ``base`` (a URDF
   link of that name) is written ``base_frame``, since ``base`` is the TOML format's fixed base.
-* :func:`urdf_text`: URDF of a tree without springs, :func:`mechbal.export.urdf.urdf_text`
+* `urdf_text`: URDF of a tree without springs, `mechbal.export.urdf.urdf_text`
   (imported here for the callers of this module).
 
 Layer: methods (docs/architecture.md).
@@ -74,7 +74,7 @@ def _table(lines: list[str], path: list[str], table: Mapping[str, Any], array: b
 
 
 def toml_text(data: Mapping[str, Any], header: str = "") -> str:
-    """TOML text of ``data`` (what :func:`tomllib.loads` reads back equal); ``header``: comment
+    """TOML text of ``data`` (what `tomllib.loads` reads back equal); ``header``: comment
     lines put first."""
     lines = [f"# {h}" if h else "#" for h in header.splitlines()] if header else []
     _table(lines, [], data)

@@ -1,15 +1,15 @@
 """Built-in case studies: one TOML file each in this folder, run by the runner of its ``kind``.
 
 A runner is ``run(config, out: Path) -> dict`` (the summary) registered with
-:func:`register`; ``config`` is the case validated by :func:`mechbal.schema.validate_case` (a
+`register`; ``config`` is the case validated by `mechbal.schema.validate_case` (a
 runner also accepts the raw dict of a TOML file and validates it itself). ``mechbal cases`` lists
 the files; ``mechbal run NAME --out DIR`` runs one.
 
 
-:func:`run_case` checks the output path and reads the case before any computation, then runs the
+`run_case` checks the output path and reads the case before any computation, then runs the
 runner into a temporary folder next to ``DIR`` that replaces ``DIR`` only when the run is complete
-(:mod:`mechbal.output`): ``DIR`` holds a whole run or none. A runner writes only into the folder
-it is given and may call :func:`mechbal.progress.stage` at each stage of its work.
+(`mechbal.output`): ``DIR`` holds a whole run or none. A runner writes only into the folder
+it is given and may call `mechbal.progress.stage` at each stage of its work.
 
 Layer: methods (docs/architecture.md).
 """
@@ -24,13 +24,13 @@ from mechbal.schema import validate_case
 from mechbal.cases.runners import _RUNNERS, _STAGES, Runner, register  # noqa: F401 (re-exported)
 
 #: the case ``mechbal demo`` runs (a paper's: when that paper is not installed, the first of
-#: :data:`FALLBACK_CASES` that is)
+#: `FALLBACK_CASES` that is)
 DEFAULT_CASE = "paminsa"
 FALLBACK_CASES = ("four-bar", "arm2link")
 
 
 def default_case() -> str:
-    """The case ``mechbal demo`` runs: :data:`DEFAULT_CASE` if it is a built-in case here."""
+    """The case ``mechbal demo`` runs: `DEFAULT_CASE` if it is a built-in case here."""
     names = builtin_cases()
     return next((n for n in (DEFAULT_CASE, *FALLBACK_CASES) if n in names), DEFAULT_CASE)
 
@@ -59,10 +59,10 @@ def available() -> list[tuple[str, str, str]]:
 def run_case(name_or_path: str | Path, out: str | Path, *, animate: bool = False, **trajectory) -> dict:
     """Run a built-in case (by name), a TOML case file or a URDF file into the folder ``out``;
     returns the summary. ``trajectory``: ``duration`` and ``samples`` of a URDF file's default
-    trajectory (see :mod:`mechbal.cases.urdf_robot`). ``animate``: also write
-    ``animation_<variant>.gif`` beside every ``bodies_<variant>.npz`` (:mod:`mechbal.animation`).
+    trajectory (see `mechbal.cases.urdf_robot`). ``animate``: also write
+    ``animation_<variant>.gif`` beside every ``bodies_<variant>.npz`` (`mechbal.animation`).
 
-    Raises :class:`mechbal.output.OutputError` (bad ``out``) and :class:`ConfigError` before any
+    Raises `mechbal.output.OutputError` (bad ``out``) and `ConfigError` before any
     computation; whatever a runner raises leaves ``out`` as it was."""
     from mechbal import progress
     from mechbal.output import check_output_dir, staged_output

@@ -1,5 +1,5 @@
 """The registry of case runners: ``register(kind)`` and the runners by kind (below the case
-modules, which register into it, and :mod:`mechbal.cases`, which runs them: no import cycle).
+modules, which register into it, and `mechbal.cases`, which runs them: no import cycle).
 
 Layer: methods (docs/architecture.md).
 """
@@ -15,7 +15,7 @@ _STAGES: dict[str, int] = {}
 
 def register(kind: str, stages: int | None = None) -> Callable[[Runner], Runner]:
     """Register ``fn`` as the runner of ``kind``; ``stages``: how many times it calls
-    :func:`mechbal.progress.stage` (the length of its progress bar), if known."""
+    `mechbal.progress.stage` (the length of its progress bar), if known."""
     def deco(fn: Runner) -> Runner:
         _RUNNERS[kind] = fn
         if stages is not None:

@@ -1,5 +1,5 @@
 """Runner for ``kind = "mechanism"`` (alias ``kind = "serial_chain"``): any mechanism of the
-general model (:mod:`mechbal.spec`: chains, trees, extra bodies, gear couplings, loop closures)
+general model (`mechbal.spec`: chains, trees, extra bodies, gear couplings, loop closures)
 moving along a rest-to-rest trajectory of its actuated joints; shaking force and moment, base
 reaction with gravity, actuator torques and, for closed mechanisms, the loop solve's conditioning.
 
@@ -59,7 +59,7 @@ def run(config, out: Path) -> dict:
 
 
 def _drawing(mech: Mechanism, motion) -> dict:
-    """What a picture of the mechanism needs beside the bodies (:mod:`mechbal.animation`): every
+    """What a picture of the mechanism needs beside the bodies (`mechbal.animation`): every
     link frame's origin and parent, and every named frame's origin with its link."""
     links = list(mech.link_names)
     by_name = {f.name: f.link for f in mech.model.description.frames}

@@ -1,5 +1,5 @@
 """Runner for a URDF file (``mechbal run robot.urdf --out DIR``): the robot read by the C++ URDF
-reader as a general :class:`mechbal.Mechanism`, moved along a default rest-to-rest trajectory;
+reader as a general `mechbal.Mechanism`, moved along a default rest-to-rest trajectory;
 shaking force and moment about O, base reaction and joint torques (inverse dynamics), written as
 every case writes them (summary.json, PNG plots, bodies_nominal.npz).
 
@@ -9,7 +9,7 @@ upper limit by half the room left, at most 0.5 rad (revolute) or 0.1 m (prismati
 no room above moves towards its lower limit the same way; an unlimited (continuous) joint moves
 by 0.5 rad. The duration is lengthened where the URDF's velocity limits (15/8 |step| / limit, the
 quintic's peak) or effort limits (doubled while the inverse-dynamics torque exceeds one) need it:
-:func:`mechbal.trajectory.quintic_within_limits`; summary.json's ``default_motion`` echoes the
+`mechbal.trajectory.quintic_within_limits`; summary.json's ``default_motion`` echoes the
 limits, the peaks reached and whether they are respected.
 
 Layer: methods (docs/architecture.md).

@@ -1,13 +1,13 @@
 """Files that carry mechbal's results and models to other tools.
 
-* :mod:`mechbal.export.bodies`: ``bodies_<variant>.npz`` (every body's motion and mechbal's
+* `mechbal.export.bodies`: ``bodies_<variant>.npz`` (every body's motion and mechbal's
   shaking wrench, enough to recompute it) and the strict-JSON ``summary.json`` of every run;
   re-exported here (``from mechbal.export import write_bodies, write_summary, ...``).
-* :mod:`mechbal.export.mjcf`: a MuJoCo model (MJCF) of any mechanism: tree, gears, loops,
-  springs, every body with its own inertia (:meth:`mechbal.Mechanism.to_mjcf`).
-* :mod:`mechbal.export.urdf`: URDF of a mechanism URDF can describe (a tree without springs),
-  link names, frames and every body's inertia kept (:meth:`mechbal.Mechanism.to_urdf`).
-* :mod:`mechbal.export.mujoco`: the exported model in MuJoCo (optional extra ``mechbal[mujoco]``):
+* `mechbal.export.mjcf`: a MuJoCo model (MJCF) of any mechanism: tree, gears, loops,
+  springs, every body with its own inertia (`mechbal.Mechanism.to_mjcf`).
+* `mechbal.export.urdf`: URDF of a mechanism URDF can describe (a tree without springs),
+  link names, frames and every body's inertia kept (`mechbal.Mechanism.to_urdf`).
+* `mechbal.export.mujoco`: the exported model in MuJoCo (optional extra ``mechbal[mujoco]``):
   inverse dynamics and base reaction on mechbal's motion, forward simulation.
 
 Layer: core (docs/architecture.md): files of the core's objects, below ``Mechanism.to_mjcf`` and
@@ -26,14 +26,14 @@ __all__ = ["BODY_FIELDS", "write_bodies", "read_bodies", "momenta_by_finite_diff
 
 
 def mjcf_text(mech, name=None, **kw) -> str:
-    """MJCF of ``mech`` (:func:`mechbal.export.mjcf.mjcf_text`)."""
+    """MJCF of ``mech`` (`mechbal.export.mjcf.mjcf_text`)."""
     from mechbal.export.mjcf import mjcf_text as f
 
     return f(mech, name, **kw)
 
 
 def urdf_text(mech, name=None) -> str:
-    """URDF of ``mech`` (:func:`mechbal.export.urdf.urdf_text`)."""
+    """URDF of ``mech`` (`mechbal.export.urdf.urdf_text`)."""
     from mechbal.export.urdf import urdf_text as f
 
     return f(mech, name)

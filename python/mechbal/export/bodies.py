@@ -5,9 +5,9 @@
 the body frame, ``com`` (N,B,3) and ``rotation`` (N,B,3,3) (body -> base) in the base frame, and
 mechbal's own ``shaking_force`` (N,3) and ``shaking_moment`` (N,3) about the base origin O.
 From these arrays alone the shaking wrench can be recomputed by finite differences
-(:func:`shaking_wrench_by_finite_differences`).
+(`shaking_wrench_by_finite_differences`).
 
-``summary.json`` is strict JSON (:func:`write_summary`): non-finite numbers are written as null and
+``summary.json`` is strict JSON (`write_summary`): non-finite numbers are written as null and
 listed under ``non_finite_values``.
 
 Layer: methods (docs/architecture.md).

@@ -1,9 +1,9 @@
 """What the URDF and MJCF writers share: names of links, orientations, merged inertias, the
 tree's joint values from a mechanism's coordinates.
 
-Link names. In a :class:`mechbal.Mechanism` a link is named after the joint that moves it (the
+Link names. In a `mechbal.Mechanism` a link is named after the joint that moves it (the
 root after ``root_name``); a URDF read by mechbal also has every URDF link as a frame of identity
-placement on its link. :func:`link_labels` gives each link the name of such a frame when there is
+placement on its link. `link_labels` gives each link the name of such a frame when there is
 one (so ``upper_arm_link`` stays ``upper_arm_link``, not ``shoulder_lift_joint``; a link with a
 frame of its own name keeps it: a URDF's root ``world``), the link's own name otherwise; names
 are unique. Only a mechanism whose root is a frame of identity placement of the same name (what

@@ -1,8 +1,8 @@
-"""MJCF (MuJoCo's model format) of any mechanism: :func:`mjcf_text`.
+"""MJCF (MuJoCo's model format) of any mechanism: `mjcf_text`.
 
-What is written, for a :class:`mechbal.Mechanism`:
+What is written, for a `mechbal.Mechanism`:
 
-* **Tree.** One ``<body>`` per link, named as :func:`mechbal.export.common.link_labels` says (a
+* **Tree.** One ``<body>`` per link, named as `mechbal.export.common.link_labels` says (a
   URDF's link names kept), placed by its joint's placement at q = 0 (so MuJoCo's ``qpos`` is
   mechbal's joint value, ``qpos0`` = 0); the joint as a ``hinge`` / ``slide`` of the same name and
   axis at the body origin (a fixed joint: none, the body is welded to its parent); position limits
@@ -21,7 +21,7 @@ What is written, for a :class:`mechbal.Mechanism`:
   ``planar_point`` loop (the origin of B on the z axis of A) a ``connect`` between A's site and
   the point of B's link at A's origin in the assembled pose: exact when the loop moves in the
   plane normal to z_A, which is what the closure describes (MuJoCo has no point-on-line equality).
-* **Constraint softness.** Loops and gears get ``solimp`` :data:`SOLIMP` (nearly hard; MuJoCo's
+* **Constraint softness.** Loops and gears get ``solimp`` `SOLIMP` (nearly hard; MuJoCo's
   constraints are soft, which shows as a residual shaking force of a balanced linkage).
 * **Springs.** A spatial ``<tendon>`` between two sites at the anchors, ``stiffness`` = the
   equivalent rate count rate / pulley_ratio^2, ``springlength`` = free_length - preload tension /
@@ -32,8 +32,8 @@ What is written, for a :class:`mechbal.Mechanism`:
   after it; its torque limit as ``forcerange`` when the joint has one.
 * **MuJoCo's minimum.** MuJoCo refuses a moving body (with the bodies welded to it) of no mass or
   of a zero principal moment of inertia (a point-mass link, a massless rotor's own link); such a
-  link gets a body ``<link>_minimum`` of :data:`MINIMUM` kg and kg m^2 at its origin (listed in
-  :attr:`MjcfNames.minimum`).
+  link gets a body ``<link>_minimum`` of `MINIMUM` kg and kg m^2 at its origin (listed in
+  `MjcfNames.minimum`).
 * **Pose.** A keyframe ``assembled`` with the joint values of the assembled pose (the loops
   closed; mechbal's q = 0 for a tree unless a pose is given).
 * **Geometry** (to look at; no contacts, no mass): capsules from each link's origin to its child
@@ -87,7 +87,7 @@ class MjcfNames:
     (moving joints, mechbal = MuJoCo names), ``moving_roots``: the bodies whose parent does not
     move (the base reaction is what the world exerts through them), ``still``: the static
     bodies (the links joined to the root by fixed joints and their bodies), ``minimum``: the
-    bodies of :data:`MINIMUM` mass added so that MuJoCo accepts a link."""
+    bodies of `MINIMUM` mass added so that MuJoCo accepts a link."""
     links: dict[str, str] = field(default_factory=dict)
     bodies: dict[str, str] = field(default_factory=dict)
     sites: dict[str, str] = field(default_factory=dict)
@@ -145,13 +145,13 @@ def _spring_constants(sp) -> tuple[float, float]:
 
 
 def mjcf_names(mech) -> MjcfNames:
-    """The MuJoCo names :func:`mjcf_text` gives ``mech``'s parts."""
+    """The MuJoCo names `mjcf_text` gives ``mech``'s parts."""
     return _build(mech, None, None, 1e-3, names_only=True)[1]
 
 
 def minimum_bodies(mech, minimum_mass: float = MINIMUM) -> list:
     """The bodies (``mechbal.Body``) the export adds so that MuJoCo accepts every moving link
-    (:attr:`MjcfNames.minimum`): ``minimum_mass`` kg at each such link's origin, principal
+    (`MjcfNames.minimum`): ``minimum_mass`` kg at each such link's origin, principal
     moments ``minimum_mass`` x (0.1 m)^2 (``MINIMUM`` kg m^2 at the default). ``mech.with_bodies``
     of them is the mechanism MuJoCo integrates."""
     names = mjcf_names(mech)
@@ -163,8 +163,8 @@ def minimum_bodies(mech, minimum_mass: float = MINIMUM) -> list:
 def mjcf_text(mech, name: str | None = None, *, q=None, q_guess=None, timestep: float = 1e-3,
               minimum_mass: float = MINIMUM) -> str:
     """MJCF of ``mech`` (module docstring). ``q``: the pose of the keyframe (dof,); a closed
-    mechanism is assembled from ``q`` or ``q_guess`` (:func:`mechbal.export.common.assembled_pose`).
-    ``minimum_mass``: of the body added to a link MuJoCo would refuse (:func:`minimum_bodies`).
+    mechanism is assembled from ``q`` or ``q_guess`` (`mechbal.export.common.assembled_pose`).
+    ``minimum_mass``: of the body added to a link MuJoCo would refuse (`minimum_bodies`).
     ExportError (a ValueError, one line) when a part has no MuJoCo equivalent."""
     return _build(mech, q, q_guess, timestep, name=name, minimum_mass=minimum_mass)[0]
 

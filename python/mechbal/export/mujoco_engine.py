@@ -2,25 +2,25 @@
 
 Needs the optional extra ``mechbal[mujoco]`` (imported when used; a clear ImportError otherwise).
 
-:class:`MujocoMechanism` loads ``mech.to_mjcf()`` and gives, in mechbal's coordinates:
+`MujocoMechanism` loads ``mech.to_mjcf()`` and gives, in mechbal's coordinates:
 
-* :meth:`~MujocoMechanism.inverse_dynamics`: MuJoCo's inverse dynamics (``mj_inverse``) on
+* `inverse_dynamics`: MuJoCo's inverse dynamics (``mj_inverse``) on
   mechbal's full (q, v, a) with the constraints (loops, gears, limits) switched off, i.e. the
   tree's joint forces, projected on mechbal's coordinates through the gear couplings (virtual
   power; for a closed mechanism the actuated forces are ``C^T`` of them, C mechbal's coupling
   matrix); the base reaction from MuJoCo's ``cfrc_int`` of the moving roots (the bodies whose
   parent does not move), after ``mj_rnePostConstraint``, moved to O; ``support_*``: the same over
   every child of the world (the links fixed to the base included: their weight is the base's own).
-* :meth:`~MujocoMechanism.momentum_rate`: the base reaction of MuJoCo's current motion as the
+* `momentum_rate`: the base reaction of MuJoCo's current motion as the
   rate of momentum of the moving bodies from MuJoCo's ``cacc`` and ``cinert`` (every body,
   constraint forces included whatever their bookkeeping), gravity included: what a simulation
   records.
-* :meth:`~MujocoMechanism.set_state`, :meth:`~MujocoMechanism.coordinates`: mechbal's q, v <->
+* `set_state`, `coordinates`: mechbal's q, v <->
   MuJoCo's qpos, qvel.
 
 Base reaction: the wrench the base exerts on the moving mechanism, gravity included, moment
 about O: force = dP/dt - m g, moment = dH_O/dt - (m c) x g over the bodies that move (mechbal's
-:meth:`mechbal.Mechanism.base_reaction`).
+`mechbal.Mechanism.base_reaction`).
 """
 from __future__ import annotations
 
@@ -77,7 +77,7 @@ def _cross_force(v: np.ndarray, f: np.ndarray) -> np.ndarray:
 class MujocoMechanism:
     """``mech`` exported to MJCF and loaded in MuJoCo (module docstring). ``q`` / ``q_guess``:
     the assembled pose of the keyframe (closed mechanisms); ``timestep`` [s]; ``minimum_mass``:
-    of the bodies added to the links MuJoCo would refuse (:func:`mechbal.export.mjcf.minimum_bodies`;
+    of the bodies added to the links MuJoCo would refuse (`mechbal.export.mjcf.minimum_bodies`;
     ``exported`` is ``mech`` with them: the mechanism MuJoCo integrates); ``constraint_weight``:
     factor on MuJoCo's inverse weights of bodies, dofs and tendons, which set how much its soft
     constraints give under load (1: MuJoCo's own)."""
@@ -125,7 +125,7 @@ class MujocoMechanism:
     def _weigh_light_bodies(self) -> list[str]:
         """MuJoCo makes a constraint the softer the lighter the bodies it joins (its impedance
         scales with their inverse weights ``body_invweight0``): a massless link of mechbal's (a
-        kinematic guide, with :data:`~mechbal.export.mjcf.MINIMUM` mass in MJCF) makes its loop
+        kinematic guide, with `MINIMUM` mass in MJCF) makes its loop
         1e13 times softer than the others, and a closed mechanism driven through it drifts off its
         closure. Such bodies (inverse weight over 1e3 times the median of the bodies with mass)
         get the median: the constraints' softness changes, not the dynamics. Returns their names."""
@@ -230,7 +230,7 @@ class MujocoMechanism:
 
 
 def load(mech, **kw: Any) -> MujocoMechanism:
-    """:class:`MujocoMechanism` of ``mech``."""
+    """`MujocoMechanism` of ``mech``."""
     return MujocoMechanism(mech, **kw)
 
 
@@ -242,11 +242,11 @@ CONSTRAINT_WEIGHT = 1e-4
 
 @dataclass(frozen=True)
 class CoSimulation:
-    """A 1 kHz co-simulation (:func:`co_simulate`): the controller's log, one row per tick
+    """A 1 kHz co-simulation (`co_simulate`): the controller's log, one row per tick
     k = 0 .. steps (``t``, ``q``, ``qd``, ``q_des``, ``qd_des``, ``joint_torque``, ``status``, in
     the controller's coordinates: the actuated joints of a closed mechanism), MuJoCo's base
     reaction at each tick (``base_reaction_force`` / ``_moment``: the moving bodies' momentum rate
-    minus their weight, :meth:`MujocoMechanism.momentum_rate`) beside mechbal's prediction along
+    minus their weight, `MujocoMechanism.momentum_rate`) beside mechbal's prediction along
     the desired motion (``predicted_base_reaction_force`` / ``_moment``), the moving mass ``mass``
     and first moment ``mass_moment`` (N, 3) that turn them into shaking wrenches, and the largest
     loop-closure violation ``constraint_violation`` (N,) [m or rad] of MuJoCo's soft constraints."""
@@ -305,9 +305,9 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
     (0.02, 1) when None); ``solimp``: their impedance (d0, d_width, width[, mid, power]), MuJoCo's
     default (0.9, 0.95, 0.001) when None: the closer d to 1, the harder the constraint (MuJoCo
     caps d at 0.9999). ``minimum_mass`` [kg]: of the bodies added to massless moving links
-    (default :data:`MINIMUM_FRACTION` of the total mass: MuJoCo's solver fails on a link of 1e-13
+    (default `MINIMUM_FRACTION` of the total mass: MuJoCo's solver fails on a link of 1e-13
     kg; mechbal's prediction is of the mechanism with them, ``MujocoMechanism.exported``);
-    ``constraint_weight``: factor on MuJoCo's inverse weights (:data:`CONSTRAINT_WEIGHT`: a
+    ``constraint_weight``: factor on MuJoCo's inverse weights (`CONSTRAINT_WEIGHT`: a
     constraint under load gives (1 - d) / d x weight x force in acceleration). The state starts on the trajectory at t = 0 (or ``q0``, ``qd0``)."""
     from mechbal.trajectory import as_trajectory
 

@@ -1,6 +1,6 @@
 """URDF of a mechanism URDF can describe: a tree without springs.
 
-* One ``<link>`` per mechbal link, named as :func:`mechbal.export.common.link_labels` says (a
+* One ``<link>`` per mechbal link, named as `mechbal.export.common.link_labels` says (a
   URDF read by mechbal keeps its link names, its root included), its bodies merged into one
   ``<inertial>`` (exact for the dynamics; a body of zero mass keeps its rotational inertia, as a
   disc's rotor does).
@@ -14,7 +14,7 @@
   by a fixed joint ``<frame>_fixed`` (URDF's way of naming a frame: ``tool0``, ``ee_link``).
 * URDF has no gravity: the mechanism's is written in a comment.
 
-A closed mechanism or one with springs raises :class:`~mechbal.export.common.ExportError` (one
+A closed mechanism or one with springs raises `ExportError` (one
 line), since a URDF would silently drop the loops or the springs; write MJCF or TOML instead.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Write a :class:`mechbal.Mechanism` as a ``kind = "mechanism"`` case file (the TOML format of
+"""Write a `mechbal.Mechanism` as a ``kind = "mechanism"`` case file (the TOML format of
 docs/case_format.md): how the papers' generated mechanisms become shipped data.
 
 Every joint is written with its parent, ``origin = {xyz, rpy}``, ``axis`` and ``mimic`` (the

@@ -5,7 +5,7 @@ Declare the parameters (a path into the mechanism such as ``bodies.counterweight
 ``joints.elbow.placement.xyz[0]``, ``bodies.link2.com[1]``, or a design variable
 ``design.<name>``), their laws (nominal -+ %, -+ an absolute delta, uniform bounds, normal, a list),
 the metrics (peak and RMS of gravity torque over a workspace sample, of actuator torque, shaking
-force and shaking moment over a trajectory, and any callable of a :class:`mechbal.Mechanism`), and
+force and shaking moment over a trajectory, and any callable of a `mechbal.Mechanism`), and
 run::
 
     from mechbal.sweep import Parameter, Sweep

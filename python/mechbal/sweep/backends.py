@@ -1,6 +1,6 @@
 """Where the chunks of a sweep run: in this process, on local processes (Dask's process scheduler),
 or on a Dask distributed cluster. Every backend runs the same pure function
-(:func:`mechbal.sweep.evaluate.evaluate_chunk`) on the same chunks, and results are put back in
+(`mechbal.sweep.evaluate.evaluate_chunk`) on the same chunks, and results are put back in
 chunk order: the table does not depend on the backend.
 
 On a cluster the plan is scattered once to every worker (each builds its regressors once and caches
@@ -80,7 +80,7 @@ def run_chunks(plan, chunks: list[tuple[int, Any]], *, backend: str = "serial", 
 
 def _auto(plan, chunks, workers, bar) -> list[dict]:
     """The first chunk in this process, timed; the rest too when they would take less than
-    :data:`AUTO_SERIAL_SECONDS` here, else on local processes (same results either way)."""
+    `AUTO_SERIAL_SECONDS` here, else on local processes (same results either way)."""
     import time
 
     if not chunks:

@@ -1,8 +1,8 @@
-"""Sweep files: a ``[sweep]`` table (strict schema: :class:`mechbal.schema.SweepFile`) over a case,
+"""Sweep files: a ``[sweep]`` table (strict schema: `mechbal.schema.SweepFile`) over a case,
 and the run behind ``mechbal sweep CASE --spec FILE --out DIR``.
 
 Built-in sweep files live in ``python/mechbal/cases/sweeps/`` and in each paper's ``sweeps/``
-folder (:func:`mechbal.registry.sweep_dirs`), and are named by their stem
+folder (`mechbal.registry.sweep_dirs`), and are named by their stem
 (``mechbal sweep arm2link-balanced --spec arm2link-balanced-tolerance``).
 
 Layer: methods (docs/architecture.md)."""
@@ -54,7 +54,7 @@ def sweep_path(name_or_path: str | Path) -> Path:
 
 
 def read_sweep_file(path: str | Path):
-    """The validated :class:`mechbal.schema.SweepFile` of a sweep file."""
+    """The validated `mechbal.schema.SweepFile` of a sweep file."""
     from mechbal.config import check_case_file
     from mechbal.config import read_toml
     from mechbal.schema import SweepFile, validate_table
@@ -65,7 +65,7 @@ def read_sweep_file(path: str | Path):
 
 
 def from_toml(spec_file: str | Path, case) -> "Sweep":  # noqa: F821
-    """The :class:`mechbal.sweep.Sweep` of a sweep file over ``case`` (name, path, Mechanism);
+    """The `mechbal.sweep.Sweep` of a sweep file over ``case`` (name, path, Mechanism);
     errors name the ``sweep.`` field."""
     from mechbal.sweep.core import Parameter, Sweep, load_base
 
@@ -87,7 +87,7 @@ def from_toml(spec_file: str | Path, case) -> "Sweep":  # noqa: F821
 def run_file(case, spec_file, out, *, backend: str = "auto", workers: int | None = None,
              scheduler=None, progress: bool = True):
     """Run a sweep file over a case into the folder ``out`` (a whole run or none: results.parquet
-    or .csv, summary.json, plots); returns the :class:`mechbal.sweep.results.SweepResult`."""
+    or .csv, summary.json, plots); returns the `mechbal.sweep.results.SweepResult`."""
     from mechbal.output import check_output_dir, staged_output
     from mechbal.sweep.backends import require_extra
 

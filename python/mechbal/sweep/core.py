@@ -1,4 +1,4 @@
-"""Sweep definitions: :class:`Parameter` (a path and its distribution or grid) and :class:`Sweep`
+"""Sweep definitions: `Parameter` (a path and its distribution or grid) and `Sweep`
 (a mechanism, its parameters, metrics, workspace sample and trajectory, and the kind of sweep),
 which generates every parameter set up front from its seed and runs them on a backend.
 
@@ -28,7 +28,7 @@ CHUNK_REBUILT = 64
 
 @dataclass(frozen=True)
 class Parameter:
-    """A swept number: ``path`` (see :mod:`mechbal.sweep.parameters`) and exactly one range:
+    """A swept number: ``path`` (see `mechbal.sweep.parameters`) and exactly one range:
 
     - ``tolerance``: relative, nominal x (1 -+ tolerance); ``delta``: absolute, nominal -+ delta;
       ``lower``/``upper``: absolute bounds; the range is sampled uniformly, or with
@@ -142,7 +142,7 @@ def resolve_parameter(p: Parameter, spec, field: str) -> Resolved:
 # ---- the base mechanism ----------------------------------------------------------------------------
 
 def spec_of_mechanism(mech) -> Any:
-    """A :class:`mechbal.spec.MechanismSpec` of a built :class:`mechbal.Mechanism` (from its
+    """A `mechbal.spec.MechanismSpec` of a built `mechbal.Mechanism` (from its
     model's description: the way to sweep a URDF robot)."""
     from mechbal import _core
     from mechbal.spec import BodySpec, FrameSpec, JointSpec, LoopSpec, MechanismSpec, SpringSpec
@@ -181,8 +181,8 @@ class Base:
 
 def load_base(case, trajectory_samples: int | None = None) -> Base:
     """The base of a sweep from a built-in case name, a TOML case file (``[mechanism]`` and
-    ``[trajectory]``), a URDF file (its default trajectory), a :class:`mechbal.Mechanism` or a
-    :class:`mechbal.spec.MechanismSpec`."""
+    ``[trajectory]``), a URDF file (its default trajectory), a `mechbal.Mechanism` or a
+    `mechbal.spec.MechanismSpec`."""
     from mechbal.config import case_path, read_toml, trajectory_from_config
     from mechbal.mechanism import Mechanism
     from mechbal.schema import SerialChainCase, validate_case
@@ -221,12 +221,12 @@ def load_base(case, trajectory_samples: int | None = None) -> Base:
 # ---- the sweep --------------------------------------------------------------------------------------
 
 class Sweep:
-    """A sweep over a mechanism (see the package docstring of :mod:`mechbal.sweep`).
+    """A sweep over a mechanism (see the package docstring of `mechbal.sweep`).
 
-    ``case``: a built-in case name, a TOML or URDF path, a :class:`mechbal.Mechanism` or a
-    :class:`mechbal.spec.MechanismSpec`; ``parameters``: :class:`Parameter` objects (or dicts of
+    ``case``: a built-in case name, a TOML or URDF path, a `mechbal.Mechanism` or a
+    `mechbal.spec.MechanismSpec`; ``parameters``: `Parameter` objects (or dicts of
     their fields); ``metrics``: built-in names and/or ``{name: callable}`` (see
-    :mod:`mechbal.sweep.metrics`); ``kind``: monte_carlo (``evaluations`` draws from ``seed``),
+    `mechbal.sweep.metrics`); ``kind``: monte_carlo (``evaluations`` draws from ``seed``),
     sensitivity (nominal, then each parameter at the low and high end of its range, the others
     nominal) or grid (every combination). ``poses``: the workspace sample of the gravity metrics,
     an (P, na) array of actuated coordinates, or generated: ``pose_source`` "trajectory"
@@ -374,12 +374,12 @@ class Sweep:
     def run(self, backend: str = "auto", *, workers: int | None = None, scheduler=None,
             progress: bool = True, callback=None):
         """Evaluate every set: ``backend`` auto (serial unless the sweep would take longer than
-        :data:`mechbal.sweep.backends.AUTO_SERIAL_SECONDS` in one process, judged from its first
+        `mechbal.sweep.backends.AUTO_SERIAL_SECONDS` in one process, judged from its first
         chunk; then processes), serial, processes (``workers`` local processes, default
         every core, through Dask's process scheduler) or dask (a distributed cluster: ``scheduler``
         an address ``tcp://host:port`` or a ``distributed.Client``); ``callback(done, total)``
         is called with the chunks done after each one (progress in a notebook). Returns a
-        :class:`mechbal.sweep.results.SweepResult`; the table is the same on every backend."""
+        `mechbal.sweep.results.SweepResult`; the table is the same on every backend."""
         from mechbal.sweep.backends import run_chunks
         from mechbal.sweep.evaluate import evaluate_chunk
         from mechbal.sweep.results import SweepResult

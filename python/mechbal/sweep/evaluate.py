@@ -1,5 +1,5 @@
 """Evaluation of parameter sets: the plan shipped to workers, the per-process context built from it
-once, and :func:`evaluate_chunk`, the pure function every backend runs.
+once, and `evaluate_chunk`, the pure function every backend runs.
 
 A chunk's result depends only on the plan and the chunk's rows (never on the backend, the worker
 or the order of execution), which is what makes a seeded sweep give the same table serially, on

@@ -1,6 +1,6 @@
 """Metrics of a sweep: the built-in ones (peak and RMS of gravity torque over a workspace sample, of
 actuator torque, shaking force and shaking moment over a trajectory) and any callable of a
-:class:`mechbal.Mechanism`.
+`mechbal.Mechanism`.
 
 A built-in metric is ``<quantity>_<statistic>`` or ``<quantity>_<statistic>.<joint>``:
 

@@ -1,7 +1,7 @@
 """Sweep parameters: what a path names in a mechanism, its nominal value, its distribution, and how
 a whole matrix of values is turned into models (rebuilt) or inertial parameters (batched).
 
-A path names one number of a :class:`mechbal.spec.MechanismSpec` (the data the general model is
+A path names one number of a `mechbal.spec.MechanismSpec` (the data the general model is
 built from, whatever the source: TOML, URDF, code), or a design variable:
 
 ==========================================  ==========================================================
@@ -22,7 +22,7 @@ built from, whatever the source: TOML, URDF, code), or a design variable:
 A joint's link body is named after the joint (``bodies.elbow.mass`` is the elbow link's mass).
 The link frame is the frame right after the joint's motion: for a joint given by ``origin`` in a
 TOML file it is the frame the file uses; for a standard-DH joint the spec has already moved the
-file's values into it (see :mod:`mechbal.spec`).
+file's values into it (see `mechbal.spec`).
 
 **Body parameters are batched**: a body's mass, centre of mass and inertia enter the inertial
 parameters pi linearly or as a cheap closed form (pi = [m, m c, I_c + m (c.c 1 - c c^T)]), and
@@ -78,7 +78,7 @@ class Target:
 
 
 def parse_path(path: str, field: str = "path") -> Target:
-    """The :class:`Target` of a parameter path (ConfigError listing the forms otherwise)."""
+    """The `Target` of a parameter path (ConfigError listing the forms otherwise)."""
     if not isinstance(path, str):
         raise ConfigError(field, "must be a string", path)
     m = _BODY.match(path)
@@ -114,7 +114,7 @@ def parse_path(path: str, field: str = "path") -> Target:
 
 def rpy_of(R: np.ndarray) -> np.ndarray:
     """Roll-pitch-yaw of a rotation R = Rz(yaw) Ry(pitch) Rx(roll) (inverse of
-    :func:`mechbal.spec.rotation_rpy`)."""
+    `mechbal.spec.rotation_rpy`)."""
     yaw = math.atan2(R[1, 0], R[0, 0])
     pitch = math.atan2(-R[2, 0], math.hypot(R[2, 1], R[2, 2]))
     roll = math.atan2(R[2, 1], R[2, 2])
@@ -211,7 +211,7 @@ def apply_values(spec, targets: Sequence[Target], values: Sequence[float], nomin
 def inertial_parameters(mass: np.ndarray, com: np.ndarray, inertia: np.ndarray) -> np.ndarray:
     """pi (S, 10) = [m, m c, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] about the link origin, from masses (S,),
     centres of mass (S, 3) and inertias about the centre of mass (S, 3, 3), all in the link frame
-    (the convention of :meth:`mechbal.Mechanism.inertial_parameters` and the regressors)."""
+    (the convention of `mechbal.Mechanism.inertial_parameters` and the regressors)."""
     cc = np.einsum("si,si->s", com, com)
     Io = inertia + mass[:, None, None] * (cc[:, None, None] * np.eye(3) - com[:, :, None] * com[:, None, :])
     return np.column_stack([mass, mass[:, None] * com, Io[:, 0, 0], Io[:, 0, 1], Io[:, 1, 1],

@@ -73,7 +73,7 @@ def _point(x: float) -> np.ndarray:
 
 
 def arm2dof_mechanism(arm, counterweights=None, *, name: str = "arm2dof") -> Mechanism:
-    """The arm of Fig. 1 as a :class:`mechbal.Mechanism` (module docstring for the frames).
+    """The arm of Fig. 1 as a `mechbal.Mechanism` (module docstring for the frames).
 
     ``arm``: a ``mechbal.Arm2DofParameters`` or a mapping with its fields (the case file's
     ``[arm]`` table: m1, m2, l1, l_s1, l_s2, i_s1, i_s2, g; g defaults to 9.81).
@@ -108,7 +108,7 @@ def arm2dof_mechanism(arm, counterweights=None, *, name: str = "arm2dof") -> Mec
 
 # ---- RMS-optimal counterweights ------------------------------------------------------------------
 # RMS-optimal counterweight radii (eqs 32-59): the paper's fast path, and the regression test of
-# the general method :mod:`mechbal.balance.rms`, which the ``arm2dof`` runner sizes with.
+# the general method `mechbal.balance.rms`, which the ``arm2dof`` runner sizes with.
 #
 # Why it works for any mechanism: a point mass on a body-fixed line through a joint at signed
 # distance r has a position linear in r, so its kinetic energy is quadratic in r and its potential
@@ -134,7 +134,7 @@ def arm2dof_mechanism(arm, counterweights=None, *, name: str = "arm2dof") -> Mec
 #
 # The paper's optimum r_CW2 = 0.147 m is NOT reproduced: its own (corrected) equations give
 # 0.1913 m, confirmed by a direct numerical minimisation of the full inverse dynamics (see
-# :func:`rms_optimal_radii_numerical`, :mod:`mechbal.balance.rms` and ``mechbal run arm2dof``).
+# `rms_optimal_radii_numerical`, `mechbal.balance.rms` and ``mechbal run arm2dof``).
 
 def arm_torques(arm, counterweights, q, qd, qdd) -> np.ndarray:
     """Joint torques (N, 2) of the 2-DOF arm (closed form, eqs 14-31 corrected) along samples."""
@@ -220,7 +220,7 @@ def rms_optimal_radii(arm, m_cw1: float, m_cw2: float, q, qd, qdd) -> RadiiResul
 
 def rms_optimal_radii_numerical(arm, m_cw1: float, m_cw2: float, q, qd, qdd,
                                 bracket: tuple[float, float] = (-2.0, 2.0)) -> tuple[float, float]:
-    """Independent check of :func:`rms_optimal_radii`: scipy minimises the mean squared torque of
+    """Independent check of `rms_optimal_radii`: scipy minimises the mean squared torque of
     the full closed-form inverse dynamics (no coefficient formulas), joint 2 over r2 first, then
     joint 1 over r1 at that r2. Global over ``bracket``: a dense grid, then bounded Brent."""
     from scipy.optimize import minimize_scalar

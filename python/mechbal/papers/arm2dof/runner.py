@@ -33,7 +33,7 @@ from mechbal.papers import arm2dof as closed_forms
 
 
 def arm_from_config(table) -> "papers.Arm2DofParameters":
-    """The arm of an ``[arm]`` table (a dict or a validated :class:`mechbal.papers.arm2dof.schema.Arm2DofArm`)."""
+    """The arm of an ``[arm]`` table (a dict or a validated `mechbal.papers.arm2dof.schema.Arm2DofArm`)."""
     arm = table if isinstance(table, Arm2DofArm) else validate_table(Arm2DofArm, table, "arm")
     return papers.Arm2DofParameters(**arm.model_dump())
 
@@ -46,7 +46,7 @@ RADIUS_AGREEMENT_M = 1e-6
 
 
 def general_radii(case):
-    """The counterweight radii by the general RMS method (:mod:`mechbal.balance.rms`) on the arm as
+    """The counterweight radii by the general RMS method (`mechbal.balance.rms`) on the arm as
     a mechanism, with the case's ``[balance]`` (default: the masses of ``[counterweights]`` on the
     link extensions, direction -x) along its minimum-energy cubic law: what ``mechbal balance
     arm2dof --method rms`` runs. Returns ([r_CW1, r_CW2] [m], BalanceResult)."""

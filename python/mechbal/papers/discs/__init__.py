@@ -27,13 +27,13 @@ link's mass and centre of mass, so the disc body carries only its central inerti
 diag(J_x, J_y, J_z) (disc frame, x = spin axis) and mass 0: where its axle sits then changes no
 force, torque or momentum, only the disc's reported pose. The unbalanced designs have no discs.
 
-The planar 5R five-bar is a closed loop: :mod:`mechbal.papers.discs.five_bar` (its per-tick fast path
+The planar 5R five-bar is a closed loop: `mechbal.papers.discs.five_bar` (its per-tick fast path
 is ``mechbal.FiveBarDynamics``).
 
 **The paper's closed forms** (derivation and every correction: docs/discs_derivation.md): the
 fast path of the disc cases and the regression test of the general shaking-moment method
-(:mod:`mechbal.balance.moment`), with which the ``discs`` runner sizes the discs' gear ratios and
-the inertia conditions and which it checks against :data:`BALANCE`.
+(`mechbal.balance.moment`), with which the ``discs`` runner sizes the discs' gear ratios and
+the inertia conditions and which it checks against `BALANCE`.
 
 Procedure (the paper's order matters): static balancing first (centre-of-mass positions l_g that
 cancel gravity, eqs 8, 18, 29) makes the arm's mass matrix constant (planar) or free of
@@ -69,13 +69,15 @@ import numpy as np
 
 from mechbal import _core
 from mechbal.papers.discs import coupling as cp
+from mechbal.config import ConfigError, inertia
 from mechbal.mechanism import Mechanism
+from mechbal.schema import inertia_matrix, validate_case
 
 # the closed forms of the C++ core (cpp/src/papers/five_bar/): fast paths of the general model
 FiveBarParameters = _core.FiveBarParameters
 FiveBarDynamics = _core.FiveBarDynamics
 
-__all__ = ["FiveBarParameters", "FiveBarDynamics",
+__all__ = ["FiveBarParameters", "FiveBarDynamics", "parameters_from_config",
            "disc_arm_mechanism", "disc_design_mechanism", "SERIAL_ARMS", "BALANCE", "CORRECTIONS", "MECHANISMS",
            "design", "disc_mechanism", "evaluate", "metrics", "sensitivity", "fivebar_model", "fivebar_positions",
            "fivebar_dynamics", "is_parallelogram", "sample_states"]
@@ -98,8 +100,8 @@ def _principal(d: Mapping[str, Any], i: int) -> np.ndarray:
 
 
 def disc_design_mechanism(kind: str, design: Mapping[str, Any], *, name: str | None = None) -> Mechanism:
-    """A design of :func:`design` (balanced, unbalanced or perturbed as built) as
-    a :class:`mechbal.Mechanism` (module docstring for frames and disc couplings).
+    """A design of `design` (balanced, unbalanced or perturbed as built) as
+    a `mechbal.Mechanism` (module docstring for frames and disc couplings).
 
     Joints ``joint1..3`` (the coordinates, in order) and, with ``design['discs']``, the geared
     ``disc4..7`` joints; bodies ``link1..3`` and ``disc4..7`` in that order (the order of the
@@ -146,14 +148,13 @@ def disc_design_mechanism(kind: str, design: Mapping[str, Any], *, name: str | N
 
 def disc_arm_mechanism(case_config: Mapping[str, Any] | str | Path, balanced: bool = True) -> Mechanism:
     """The arm of a disc case (``discs-3r``, ``discs-spatial``, ``scara``: a case name, path or
-    the loaded TOML dict) as a :class:`mechbal.Mechanism`, built from the runner's parameters
-    (``mechbal.papers.discs.runner.parameters_from_config``).
+    the loaded TOML dict) as a `mechbal.Mechanism`, built from the runner's parameters
+    (`parameters_from_config`).
 
     ``balanced=True``: static balancing (eqs 8, 18, 29 generalised), the discs with the gear
     ratios of eqs 14, 25, 35 and, for the spatial arm, the corrected inertia conditions of eq 25:
     the mass matrix is then diagonal and constant (k_i of eqs 16, 27, 37) and the gravity torque
     zero. ``balanced=False``: the case's ``[unbalanced]`` baseline, no discs."""
-    from mechbal.papers.discs.runner import parameters_from_config
     from mechbal.config import load_case, require, string
 
     config = load_case(case_config) if isinstance(case_config, (str, Path)) else case_config
@@ -360,7 +361,7 @@ def arm_mechanism(joints, links) -> Mechanism:
 
 def disc_mechanism(kind: str, d: dict):
     """A serial design on the general model: mechbal.Mechanism with each disc a gear-coupled
-    joint (:func:`disc_design_mechanism`). What :func:`evaluate` and the runner use."""
+    joint (`disc_design_mechanism`). What `evaluate` and the runner use."""
     return disc_design_mechanism(kind, d)
 
 
@@ -457,7 +458,7 @@ def sample_states(kind: str, n: int, rng: np.random.Generator):
 
 def evaluate(kind: str, d: dict, q: np.ndarray, qd: np.ndarray):
     """(M (N, n, n), v (N, n), g (N, n)) of design d at N states, in C++: the general model for
-    the serial arms (:func:`disc_mechanism`: CRBA mass matrix, v = bias - gravity torque),
+    the serial arms (`disc_mechanism`: CRBA mass matrix, v = bias - gravity torque),
     FiveBarDynamics for the 5R (a closed loop; ``fivebar_model`` is its Python reference). A
     singular five-bar state raises ValueError."""
     q, qd = np.asarray(q, float), np.asarray(qd, float)
@@ -527,6 +528,63 @@ def sensitivity(kind: str, p: dict, parameters, errors, q, qd) -> list[dict]:
 
 __doc__ += "\n".join(f"  {c['id']} (eq {c['eq']}): printed {c['printed']}; correct: {c['correct']}."
                      for c in CORRECTIONS)
+
+# ---- a case's parameters (the runner, the balance adapter and the case-file generators) ----
+_SPEC = {
+    "planar3r": dict(params=("l1", "l2", "m1", "m2", "m3"),
+                     bodies=("link1", "link2", "link3", "disc4", "disc5", "disc6", "disc7"),
+                     unbalanced=("lg1", "lg2", "lg3"), n=3),
+    "spatial3r": dict(params=("l1", "l2", "m1", "m2", "m3"),
+                      bodies=("link1", "link2", "link3", "disc4", "disc5"),
+                      unbalanced=("lg2", "lg3"), n=3),
+    "scara": dict(params=("l1", "l2", "m1", "m2", "m3"),
+                  bodies=("link1", "link2", "link3", "disc4", "disc5"),
+                  unbalanced=("lg1", "lg2"), n=3),
+    "fivebar": dict(params=("a1", "a2", "b1", "b2", "d", "mp1", "mp2", "md1", "md2", "mP",
+                            "mP1_share"),
+                    bodies=("proximal1", "proximal2", "distal1", "distal2"),
+                    unbalanced=("cp1", "cp2", "cd1", "cd2"), n=2),
+}
+_FIVEBAR_KEYS = {"proximal1": "p1", "proximal2": "p2", "distal1": "d1", "distal2": "d2"}
+def _principal_moments(I: np.ndarray, field: str) -> np.ndarray:
+    if np.max(np.abs(I - np.diag(np.diag(I)))) > 0.0:
+        raise ConfigError(field, "must be principal (give [Jx, Jy, Jz] in the link frame)",
+                          I.tolist())
+    return np.diag(I).copy()
+
+
+def parameters_from_config(kind: str, config) -> dict:
+    """Flat parameter dict (the names of docs/discs_derivation.md) from a case (validated, or a
+    dict validated here); errors name the field."""
+    case = validate_case(config, warn=False)
+    if case.case.mechanism != kind:
+        raise ConfigError("case.mechanism", f"must be {kind!r} here", case.case.mechanism)
+    spec = _SPEC[kind]
+    pt, it, ut = case.parameters, case.inertia, case.unbalanced
+    p = {k: getattr(pt, k) for k in spec["params"]}
+    for b in spec["bodies"]:
+        J = _principal_moments(inertia_matrix(getattr(it, b)), f"inertia.{b}")
+        if kind == "fivebar":
+            key = _FIVEBAR_KEYS[b]
+            p[f"J{key}"] = J[0]
+            p[f"inertia_{key}"] = J
+        else:
+            i = b[-1]
+            p[f"Jx{i}"], p[f"Jy{i}"], p[f"Jz{i}"] = J
+    for k in spec["unbalanced"]:
+        p[f"{k}_unbal"] = getattr(ut, k)
+    for b in ("link1", "link2", "link3"):
+        if kind != "fivebar" and getattr(ut, b) is not None:
+            J = _principal_moments(inertia_matrix(getattr(ut, b)), f"unbalanced.{b}")
+            i = b[-1]
+            p[f"Jx{i}_unbal"], p[f"Jy{i}_unbal"], p[f"Jz{i}_unbal"] = J
+    if kind == "spatial3r":  # the inertia conditions of eq 25 must give a physical body
+        ic = balance_spatial3r(p)["inertia_conditions"]
+        for i in (2, 3):
+            J = [p[f"Jx{i}"], ic[f"Jy{i}"], p[f"Jz{i}"]]
+            inertia(J, f"inertia.link{i} with the eq 25 condition Jy{i} = {ic[f'Jy{i}']:.6g}")
+    return p
+
 
 # importing the schema registers this paper's case kind (mechbal.registry imports this package)
 from mechbal.papers.discs import schema as _schema  # noqa: E402,F401

@@ -1,9 +1,9 @@
 """``mechbal balance`` on a ``discs`` case (Coutinho & Hess Coelho: ``discs-3r``, ``discs-spatial``,
 ``scara``, ``five-bar``): the statically balanced arm of
-:func:`mechbal.papers.discs.disc_design_mechanism` without discs, its links' inertias as the case
+`mechbal.papers.discs.disc_design_mechanism` without discs, its links' inertias as the case
 gives them (``[inertia]``: the spatial arm's J_y2, J_y3 are then what the moment method's inertia
 slots choose); ``five-bar``: the leg-wise statically balanced parallelogram 5R of
-:func:`mechbal.papers.discs.five_bar.five_bar_design_mechanism`. The trajectory is the case's
+`mechbal.papers.discs.five_bar.five_bar_design_mechanism`. The trajectory is the case's
 quintic; a ``--design FILE`` replaces the ``[balance]`` table (and its ``[trajectory]``).
 
 Layer: papers (docs/architecture.md).
@@ -16,7 +16,7 @@ from mechbal.balance.run import BalanceCase, design_trajectory, register_case
 from mechbal.papers import discs as dz
 from mechbal.papers.discs import disc_design_mechanism
 from mechbal.papers.discs.five_bar import five_bar_design_mechanism, five_bar_initial_guess
-from mechbal.papers.discs.runner import parameters_from_config
+from mechbal.papers.discs import parameters_from_config
 
 
 @register_case("discs")

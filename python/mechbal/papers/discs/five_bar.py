@@ -24,7 +24,7 @@ balanced centres of mass of ``mechbal.papers.discs.balance_fivebar``).
 The closed form (``FiveBarDynamics``: positions, the coupling projection, M', v', g') and the
 five-bar motion of ``mechbal.papers.discs.runner`` equal this general model to 1e-10 along the case's
 trajectory (tests/python/test_papers_loops.py); ``python/mechbal/papers/discs/cases/five-bar-linkage.toml`` is
-:func:`five_bar_case_toml` of the shipped ``five-bar`` case (balanced), run by ``mechbal run``.
+`five_bar_case_toml` of the shipped ``five-bar`` case (balanced), run by ``mechbal run``.
 
 Layer: papers (docs/architecture.md).
 """
@@ -58,7 +58,7 @@ def five_bar_design_mechanism(d: Mapping[str, Any], *, name: str = "five-bar",
                               gravity: float = 9.81) -> Mechanism:
     """A five-bar design (``mechbal.papers.discs.design("fivebar", p, balanced)``: lengths a_i, b_i,
     d, masses mp_i, md_i, mP, centres of mass cp_i, cd_i, inertias ``inertia_p1`` ...) as a closed
-    :class:`mechbal.Mechanism` (module docstring)."""
+    `mechbal.Mechanism` (module docstring)."""
     R = _core.JointType.revolute
     joints, bodies = [], []
     for i in (1, 2):
@@ -101,8 +101,8 @@ def five_bar_mechanism(case_config: Mapping[str, Any] | str | Path = "five-bar",
                        balanced: bool = True) -> Mechanism:
     """The five-bar of a ``discs`` case with ``case.mechanism = "fivebar"`` (a case name, path or
     loaded TOML dict), balanced (leg-wise static balancing) or the case's ``[unbalanced]``
-    baseline, from the runner's parameters (``mechbal.papers.discs.runner.parameters_from_config``)."""
-    from mechbal.papers.discs.runner import parameters_from_config
+    baseline, from the runner's parameters (``mechbal.papers.discs.parameters_from_config``)."""
+    from mechbal.papers.discs import parameters_from_config
     from mechbal.papers import discs as dz
 
     config = _case(case_config)
@@ -117,7 +117,7 @@ def five_bar_case_toml(case_config: Mapping[str, Any] | str | Path = "five-bar",
     """The ``kind = "mechanism"`` case file of a five-bar case's mechanism with the case's
     trajectory (rest-to-rest in (theta1, theta2)) and the closed form's assembly as the initial
     guess: what ``python/mechbal/papers/discs/cases/five-bar-linkage.toml`` holds for the shipped case."""
-    from mechbal.papers.discs.runner import parameters_from_config
+    from mechbal.papers.discs import parameters_from_config
     from mechbal.papers._toml import case_toml
     from mechbal.papers import discs as dz
 

@@ -24,70 +24,15 @@ from mechbal import papers
 from mechbal import trajectory
 from mechbal import progress, report
 from mechbal.cases import register
-from mechbal.config import ConfigError, inertia
-from mechbal.schema import inertia_matrix, validate_case
+from mechbal.config import ConfigError
+from mechbal.schema import validate_case
 from mechbal.export import write_bodies, write_summary
 from mechbal.papers import discs as dz
+from mechbal.papers.discs import _SPEC, parameters_from_config  # noqa: F401 (re-exported)
 
-_SPEC = {
-    "planar3r": dict(params=("l1", "l2", "m1", "m2", "m3"),
-                     bodies=("link1", "link2", "link3", "disc4", "disc5", "disc6", "disc7"),
-                     unbalanced=("lg1", "lg2", "lg3"), n=3),
-    "spatial3r": dict(params=("l1", "l2", "m1", "m2", "m3"),
-                      bodies=("link1", "link2", "link3", "disc4", "disc5"),
-                      unbalanced=("lg2", "lg3"), n=3),
-    "scara": dict(params=("l1", "l2", "m1", "m2", "m3"),
-                  bodies=("link1", "link2", "link3", "disc4", "disc5"),
-                  unbalanced=("lg1", "lg2"), n=3),
-    "fivebar": dict(params=("a1", "a2", "b1", "b2", "d", "mp1", "mp2", "md1", "md2", "mP",
-                            "mP1_share"),
-                    bodies=("proximal1", "proximal2", "distal1", "distal2"),
-                    unbalanced=("cp1", "cp2", "cd1", "cd2"), n=2),
-}
-_FIVEBAR_KEYS = {"proximal1": "p1", "proximal2": "p2", "distal1": "d1", "distal2": "d2"}
 #: which corrections concern which mechanism
 _CORRECTIONS = {"planar3r": (), "spatial3r": ("C1", "C2", "C3", "C4", "C5", "C6", "C7", "C8"),
                 "scara": ("C9", "C10"), "fivebar": ("C11",)}
-
-
-def _principal(I: np.ndarray, field: str) -> np.ndarray:
-    if np.max(np.abs(I - np.diag(np.diag(I)))) > 0.0:
-        raise ConfigError(field, "must be principal (give [Jx, Jy, Jz] in the link frame)",
-                          I.tolist())
-    return np.diag(I).copy()
-
-
-def parameters_from_config(kind: str, config) -> dict:
-    """Flat parameter dict (the names of docs/discs_derivation.md) from a case (validated, or a
-    dict validated here); errors name the field."""
-    case = validate_case(config, warn=False)
-    if case.case.mechanism != kind:
-        raise ConfigError("case.mechanism", f"must be {kind!r} here", case.case.mechanism)
-    spec = _SPEC[kind]
-    pt, it, ut = case.parameters, case.inertia, case.unbalanced
-    p = {k: getattr(pt, k) for k in spec["params"]}
-    for b in spec["bodies"]:
-        J = _principal(inertia_matrix(getattr(it, b)), f"inertia.{b}")
-        if kind == "fivebar":
-            key = _FIVEBAR_KEYS[b]
-            p[f"J{key}"] = J[0]
-            p[f"inertia_{key}"] = J
-        else:
-            i = b[-1]
-            p[f"Jx{i}"], p[f"Jy{i}"], p[f"Jz{i}"] = J
-    for k in spec["unbalanced"]:
-        p[f"{k}_unbal"] = getattr(ut, k)
-    for b in ("link1", "link2", "link3"):
-        if kind != "fivebar" and getattr(ut, b) is not None:
-            J = _principal(inertia_matrix(getattr(ut, b)), f"unbalanced.{b}")
-            i = b[-1]
-            p[f"Jx{i}_unbal"], p[f"Jy{i}_unbal"], p[f"Jz{i}_unbal"] = J
-    if kind == "spatial3r":  # the inertia conditions of eq 25 must give a physical body
-        ic = dz.balance_spatial3r(p)["inertia_conditions"]
-        for i in (2, 3):
-            J = [p[f"Jx{i}"], ic[f"Jy{i}"], p[f"Jz{i}"]]
-            inertia(J, f"inertia.link{i} with the eq 25 condition Jy{i} = {ic[f'Jy{i}']:.6g}")
-    return p
 
 
 #: how far the general method's gear ratios, inertias and decoupled inertias k_i may be from the
@@ -104,11 +49,11 @@ _SIZED = {"planar3r": {"beta": ("disc5", "ratio"), "gamma": ("disc7", "ratio")},
 
 
 def general_discs(case, kind: str, closed: dict):
-    """The discs by the general shaking-moment method (:mod:`mechbal.balance.moment`) on the
+    """The discs by the general shaking-moment method (`mechbal.balance.moment`) on the
     statically balanced arm with the case's ``[balance]`` (``mechbal balance CASE --method
     moment``), next to the closed forms ``closed`` (``mechbal.papers.discs.BALANCE[kind]``).
     Returns (general values, closed-form values, largest relative difference, BalanceResult);
-    ConfigError when they differ beyond :data:`DISC_AGREEMENT_RTOL`.
+    ConfigError when they differ beyond `DISC_AGREEMENT_RTOL`.
 
     Serial arms: the chosen gear ratios (beta, gamma: eqs 14, 25, 35) and inertias (Jy2, Jy3:
     corrected eq 25) and the constant diagonal of the mass matrix (k_i: eqs 16, 27, 37). Five-bar
@@ -196,7 +141,7 @@ def _disc_bodies(kind, d, q, qd, qdd):
     and the motion arrays (N, B, ...) of mechbal.shaking_wrench.
 
     Serial arms: the links from the general model's body motion (the arm alone,
-    :func:`mechbal.papers.discs.arm_mechanism`); each disc spins at ratio * q[joint]
+    `mechbal.papers.discs.arm_mechanism`); each disc spins at ratio * q[joint]
     about its axis through the carrier's frame origin (rotation R_c Rot(axis, ratio q_j),
     omega = omega_c + ratio q_j' a, alpha = alpha_c + ratio q_j'' a + omega_c x ratio q_j' a).
     As in the model, a disc's mass is lumped into its carrier link (the link masses of the case

@@ -1,7 +1,7 @@
 """The strict schema of this paper's case files: Coutinho & Hess Coelho: the serial arms and the 5R with discs (kind ``discs``).
 
-Registered with :func:`mechbal.schema.register_case_model` when the paper package is imported
-(:mod:`mechbal.registry`); :func:`mechbal.schema.validate_case` then validates its cases.
+Registered with `mechbal.schema.register_case_model` when the paper package is imported
+(`mechbal.registry`); `mechbal.schema.validate_case` then validates its cases.
 
 Layer: papers (docs/architecture.md).
 """

@@ -1,31 +1,31 @@
 """The Orthoglide 5-axis of Martini, Troncossi, Carricato & Rivola 2015 ("Static balancing of a
 parallel kinematics machine with Linear-Delta architecture", Mech. Mach. Theory 90:128-141): the
 paper's closed forms, kept as **checks** of the general path (the mechanism itself is data:
-``python/mechbal/papers/orthoglide/cases/orthoglide.toml``; the runner is :mod:`mechbal.papers.orthoglide.runner`).
+``python/mechbal/papers/orthoglide/cases/orthoglide.toml``; the runner is `mechbal.papers.orthoglide.runner`).
 
 Frame of the paper: y vertical, gravity (0, -g, 0). Here:
 
-* :func:`linear_delta_ik` - eq 1 (with its typo corrected: the right-hand sides are the platform
+* `linear_delta_ik` - eq 1 (with its typo corrected: the right-hand sides are the platform
   point's coordinates p, not the slider positions rho), with its time derivatives;
-* :func:`distal_rate`, :func:`proximal_rate` - eqs 18-19;
-* :class:`LumpedModel` and :func:`lumped_model` - **the paper's model**, a deliberate
+* `distal_rate`, `proximal_rate` - eqs 18-19;
+* `LumpedModel` and `lumped_model` - **the paper's model**, a deliberate
   approximation of Section 3 (massless legs and links, lumped masses on the platform, the sliders
   and the spring support), its parameters *measured* on the general model (lengths between its
   named frames, masses of its bodies), so that the closed forms check the model the case file
   describes;
-* :func:`potential_energy` - eqs 5, 6, 9, 10 on the lumped model (total, for any rates): checks
+* `potential_energy` - eqs 5, 6, 9, 10 on the lumped model (total, for any rates): checks
   the general model's potential energy with its springs (``Mechanism.potential_energy``);
-* :func:`inverse_dynamics` - motor forces of the lumped model from the platform's Newton equation
+* `inverse_dynamics` - motor forces of the lumped model from the platform's Newton equation
   with the leg forces along the parallelogram directions, the sliders' and the spring support's
   Newton equations (an independent computation of what the general closed-loop inverse dynamics,
   springs on the model, gives);
-* :func:`rest_to_rest`, :func:`helix_path`, :func:`cube_path`, :func:`machining_path` - the
+* `rest_to_rest`, `helix_path`, `cube_path`, `machining_path` - the
   simulated trajectories of Section 5.1 (Paths A-F) and the cutting-force model;
 * ``PAPER_*`` - the paper's published numbers (Tables 1, 2, 4, 5, 6), for comparison only.
 
 The springs themselves are elements of the general model and are sized by the general method
-(:mod:`mechbal.balance.springs`: ``balance``, ``select_springs`` for Tables 1-2); the runner
-:mod:`mechbal.papers.orthoglide.runner` uses them, and these closed forms are its fast-path checks.
+(`mechbal.balance.springs`: ``balance``, ``select_springs`` for Tables 1-2); the runner
+`mechbal.papers.orthoglide.runner` uses them, and these closed forms are its fast-path checks.
 
 Layer: papers (docs/architecture.md).
 """
@@ -421,7 +421,7 @@ CUBE_TOUR = ["000", "100", "101", "001", "000", "010", "110", "111", "011", "010
 
 def cube_path(center, edge: float, speed: float, a_axis: float, dt: float, name: str = "B") -> PlatformPath:
     """Path B: rest-to-rest moves along the edges and the space diagonals of the workspace cube
-    (:data:`CUBE_TOUR`), speed <= ``speed``, acceleration <= ``a_axis`` on each axis."""
+    (`CUBE_TOUR`), speed <= ``speed``, acceleration <= ``a_axis`` on each axis."""
     c = np.asarray(center, float)
     pts = [c + edge * (np.array([int(ch) for ch in v], float) - 0.5) for v in CUBE_TOUR]
     return _sample([_line(pts[i], pts[i + 1], speed, a_axis) for i in range(len(pts) - 1)], dt, name)
@@ -451,7 +451,7 @@ def cutting_force(operation: str, feed: float, force: float) -> Callable:
 def machining_path(center, operation: str, feed: float, force: float, pockets, holes, drill_depth: float,
                    approach_height: float, rapid_speed: float, a_axis: float, dt: float, name: str) -> PlatformPath:
     """Paths C-F: from C, rapid moves (``rapid_speed``, ``a_axis``) to each pocket (or hole), the
-    machining at the feed ``feed`` with the cutting force of :func:`cutting_force`, rapid moves
+    machining at the feed ``feed`` with the cutting force of `cutting_force`, rapid moves
     back to C. A pocket is a contour pass of its rectangle (corner (x, y, z) relative to C, size
     along x and z); a hole is a vertical feed of ``drill_depth`` down from its point and a rapid
     retract."""

@@ -1,9 +1,9 @@
 """``mechbal balance`` on an ``orthoglide`` case: the Orthoglide 5-axis (Martini et al. 2015) as
-the runner builds it (:class:`mechbal.papers.orthoglide.runner.Orthoglide`: the case's ``[mechanism]`` without its springs,
+the runner builds it (`mechbal.papers.orthoglide.runner.Orthoglide`: the case's ``[mechanism]`` without its springs,
 the ``[[springs]]`` anchors as named frames, the ``[roles]`` initial guess as assembly mode).
 Without a ``[balance]`` table, ``--method springs`` sizes the ``[[springs]]`` slots (zero free
 length; a ``rate`` given there stays fixed) exactly as the runner does
-(:meth:`~mechbal.papers.orthoglide.runner.Orthoglide.sizing`): static balance C^T (G + K) = 0 at the
+(`sizing`): static balance C^T (G + K) = 0 at the
 sliders' positions (eq 1) of the ``[workspace]`` grid, loops closed to the runner's
 ``CLOSURE_TOLERANCE``; the rates are then eqs 18-19 (2.510052 / 11.130577 N/mm). The
 trajectory is a rest-to-rest quintic move of the three actuated sliders from the positions of

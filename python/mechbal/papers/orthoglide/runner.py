@@ -3,8 +3,8 @@
 
 Everything is computed by the general path on the mechanism of the case file (closed loops solved
 by the general loop solve, ``v = C v#``). The case's ``[[springs]]`` are slots of the general spring
-method (:mod:`mechbal.balance.springs`, zero free length); their rates are sized by
-:func:`mechbal.balance.springs.balance` so that the static motor forces C^T (G + K) vanish over the
+method (`mechbal.balance.springs`, zero free length); their rates are sized by
+`mechbal.balance.springs.balance` so that the static motor forces C^T (G + K) vanish over the
 workspace grid, and a set of springs with rates is put on the model (``Mechanism.with_springs``), so
 that the motor forces of the three sliders are
 
@@ -12,8 +12,8 @@ that the motor forces of the three sliders are
 
 with tau the model's inverse dynamics (gravity and springs included: K = dV_s/dq, V_s = K |r_B -
 r_A|^2 / 2 for a zero-free-length spring) and f_cut the cutting force on the tool frame P (J_P: its
-linear Jacobian). Catalogue clusters come from :func:`mechbal.balance.springs.select_springs`. The
-paper's closed forms (:mod:`mechbal.papers.orthoglide`: eq 1, eqs 5-19 on the paper's lumped model,
+linear Jacobian). Catalogue clusters come from `mechbal.balance.springs.select_springs`. The
+paper's closed forms (`mechbal.papers.orthoglide`: eq 1, eqs 5-19 on the paper's lumped model,
 the platform's Newton equation) check the result in the summary and the tests.
 
 Platform paths are Cartesian (Section 5.1); the sliders' motion is eq 1 and its derivatives, and
@@ -67,13 +67,13 @@ def coupling_matrix(mech: Mechanism, q) -> np.ndarray:
 
 
 class Orthoglide:
-    """The case's mechanism, its springs as :class:`~mechbal.balance.result.SpringSlot` slots of
+    """The case's mechanism, its springs as `SpringSlot` slots of
     the general spring method (zero free length; ``rate`` None until sized), and the general-path
     evaluations the tables need. A set of springs with rates is put on the model with
-    :meth:`with_springs`, so the static forces, the energy and the inverse dynamics are the
+    `with_springs`, so the static forces, the energy and the inverse dynamics are the
     model's (``cpp/include/mechbal/algorithm/springs.hpp``). The spring anchors are also named
     frames (``spring:<name>:a``, ``spring:<name>:b``): the paper's points A, B, N_1, N_2 that
-    :meth:`lumped` measures."""
+    `lumped` measures."""
 
     def __init__(self, case, *, masses: dict[str, float] | None = None,
                  anchors: dict[str, dict[str, tuple]] | None = None):
@@ -164,22 +164,22 @@ class Orthoglide:
         return np.einsum("nda,nd->na", C, self.with_springs(springs).static_torque(m.q))
 
     def size(self, p) -> BalanceResult:
-        """The general spring method (:func:`mechbal.balance.springs.balance`) over the platform
+        """The general spring method (`mechbal.balance.springs.balance`) over the platform
         points p: rates [N/m] by least squares so that C^T (G + K) = 0 at the sliders' positions
         of eq 1 (the slots' fixed rates kept)."""
         slots, rho, options = self.sizing(p)
         return spring_method.balance(self.mech, slots, rho, **options)
 
     def sizing(self, p) -> tuple[list[SpringSlot], np.ndarray, dict]:
-        """What :meth:`size` gives the general spring method for platform points p: (the slots,
+        """What `size` gives the general spring method for platform points p: (the slots,
         the sliders' positions of eq 1 (N, 3), the options ``q_guess`` and ``closure_tolerance``);
         ``mechbal balance orthoglide --method springs`` runs the same problem
-        (:func:`mechbal.balance.run.orthoglide_case`)."""
+        (`mechbal.balance.run.orthoglide_case`)."""
         rho = self.rho(np.atleast_2d(np.asarray(p, float)))
         return list(self.slots), rho, {"q_guess": self.q_guess.copy(), "closure_tolerance": CLOSURE_TOLERANCE}
 
     def size_rates(self, p) -> tuple[dict[str, float], float, int]:
-        """:meth:`size` as (rates [N/m], residual [N] max over samples and axes, rank)."""
+        """`size` as (rates [N/m], residual [N] max over samples and axes, rank)."""
         r = self.size(p)
         return {n: float(d["rate"]) for n, d in r.design.items()}, float(r.residual), int(r.rank or 0)
 
@@ -576,7 +576,7 @@ DISCREPANCIES = [
 
 
 def table6_sweep(case=None, *, rates: dict[str, float] | None = None, grid=None):
-    """The Orthoglide's Table 6 (Martini et al. 2015) as a :class:`mechbal.sweep.Sweep`
+    """The Orthoglide's Table 6 (Martini et al. 2015) as a `mechbal.sweep.Sweep`
     (sensitivity): m_p and m_s2 +-``sensitivity.relative`` (body masses of the case's
     ``roles.platform_body`` / ``roles.vertical_slider_body``), the spring rates K_D and K_P
     +-``sensitivity.relative`` and the distal spring's platform anchor +-``sensitivity.anchor_offset``

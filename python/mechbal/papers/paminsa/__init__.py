@@ -63,6 +63,7 @@ import numpy as np
 
 from mechbal import _core
 from mechbal.mechanism import Mechanism
+from mechbal.schema import validate_case
 
 # the closed forms of the C++ core (cpp/src/papers/paminsa/): fast paths of the general model
 PaminsaParameters = _core.PaminsaParameters
@@ -73,7 +74,7 @@ paminsa_reactionless_run = _core.paminsa_reactionless_run
 wrist_momentum_matrix = _core.wrist_momentum_matrix
 wrist_momentum_bias = _core.wrist_momentum_bias
 
-__all__ = ["PaminsaParameters", "PaminsaCounterweights", "PaminsaModel", "paminsa_kinematics", "paminsa_reactionless_run", "wrist_momentum_matrix", "wrist_momentum_bias",
+__all__ = ["PaminsaParameters", "parameters_from_config", "PaminsaCounterweights", "PaminsaModel", "paminsa_kinematics", "paminsa_reactionless_run", "wrist_momentum_matrix", "wrist_momentum_bias",
            "paminsa_mechanism", "paminsa_layout", "paminsa_initial_guess", "paminsa_actuated_motion",
            "paminsa_case_toml", "ACTUATED", "body_names", "CounterweightSet", "closed_form_counterweights",
            "printed_counterweights", "reported_counterweights", "counterweights_from_design",
@@ -142,7 +143,7 @@ def _T(xyz=(0.0, 0.0, 0.0), R=None) -> np.ndarray:
 # Counterweights for complete shaking-force balancing (Briot & Arakelian 2009, eqs 6-16): the
 # paper's fast path and the regression test of the general method.
 #
-# 1. :func:`closed_form_counterweights` -- the paper's closed forms, re-derived for the
+# 1. `closed_form_counterweights` -- the paper's closed forms, re-derived for the
 #    reconstructed leg. Writing every leg point as an affine combination of A, C and E
 #    (D = E + (C-E)/k, F = A + (C-E)/k, B = ((k-1)A + C)/k) and using G_A = G_C,h/(1-k),
 #    G_B = G_C,z/k, the momentum of leg i is
@@ -164,10 +165,10 @@ def _T(xyz=(0.0, 0.0, 0.0), R=None) -> np.ndarray:
 #      (1.6915); 4.49 is not reproduced by eq 14 under any misprint we tried. The reported masses
 #      leave ~17 N of shaking force (63 % of the unbalanced peak) -- see the case summary.
 #
-# 2. The general method, :mod:`mechbal.balance.force` (least squares of the linear momentum of
+# 2. The general method, `mechbal.balance.force` (least squares of the linear momentum of
 #    the general model over sampled closed motions), with the slots of ``cases/paminsa.toml``'s
 #    ``[balance]`` table: the ``paminsa`` runner sizes with it and reports the closed form beside it
-#    (:func:`counterweights_from_design` reads its design back into a :class:`CounterweightSet`).
+#    (`counterweights_from_design` reads its design back into a `CounterweightSet`).
 #    With the legs tied (identical legs) every mass is determined; untied, legs 1 and 2 (one
 #    actuator) leave combinations of their masses undetermined, as the paper's cycle alone does
 #    (no x motion).
@@ -260,7 +261,7 @@ def reported_counterweights(params, vertical: float) -> CounterweightSet:
 
 
 def counterweights_from_design(design: dict, source: str) -> CounterweightSet:
-    """A :class:`CounterweightSet` from the design of a balancing method (``BalanceResult.design``)
+    """A `CounterweightSet` from the design of a balancing method (``BalanceResult.design``)
     whose slots carry the paper's names (``leg<i>.CP1_atA``, ``leg<i>.CP2_atF``,
     ``leg<i>.CP3_atL``, ``vertical_counter_mass``: ``cases/paminsa.toml``'s ``[balance]``).
     KeyError naming the missing slot otherwise."""
@@ -281,10 +282,10 @@ def _balanced(params):
 
 
 def paminsa_mechanism(params, balanced: bool = True, *, name: str | None = None) -> Mechanism:
-    """PAMINSA as a closed :class:`mechbal.Mechanism` (module docstring) from
-    ``mechbal.PaminsaParameters`` (``mechbal.papers.paminsa.runner.parameters_from_config``).
+    """PAMINSA as a closed `mechbal.Mechanism` (module docstring) from
+    ``mechbal.PaminsaParameters`` (`parameters_from_config`).
     ``balanced=True``: the closed-form counterweights (eqs 11, 14-16 corrected:
-    :func:`closed_form_counterweights`) replace the parameters' own;
+    `closed_form_counterweights`) replace the parameters' own;
     ``balanced=False``: the parameters' counterweights as given (none in the case file)."""
     p = _balanced(params) if balanced else params
     lay = paminsa_layout(p)
@@ -363,7 +364,7 @@ def _elevation(d: np.ndarray, u: np.ndarray) -> float:
 
 
 def paminsa_initial_guess(mech: Mechanism, params, P, wrist_angles=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """Every coordinate of :func:`paminsa_mechanism` at platform position P, from the closed form's
+    """Every coordinate of `paminsa_mechanism` at platform position P, from the closed form's
     leg points (``PaminsaModel.leg_points``: the assembly of A6, elbow outward and up)."""
     model = _core.PaminsaModel(params)
     pts, status = model.leg_points(np.asarray(P, float))
@@ -387,7 +388,7 @@ def paminsa_initial_guess(mech: Mechanism, params, P, wrist_angles=(0.0, 0.0, 0.
 
 def paminsa_actuated_motion(mech: Mechanism, params, P, Pd, Pdd, wrist=None, wrist_rates=None,
                             wrist_accelerations=None):
-    """(q#, v#, a#) (N, 6) of the actuated joints of :func:`paminsa_mechanism` for a platform
+    """(q#, v#, a#) (N, 6) of the actuated joints of `paminsa_mechanism` for a platform
     motion P, Pd, Pdd (N, 3) and a wrist motion (N, 3; default still at zero): the closed-form
     inverse kinematics (``PaminsaModel.inverse_kinematics``) and its derivatives. alpha_i is the
     angle of A_h,i - M_i with A_h,i = (k B_h,i - C_h,i)/(k - 1); z_B = z_A + (z_P - l_CJ - z_A)/k."""
@@ -422,7 +423,6 @@ def paminsa_case_toml(config="paminsa", balanced: bool = True, samples: int = 50
     shipped case. Its trajectory is rest-to-rest in the actuated joints between the actuator
     positions of the case's start and end platform positions (the case itself moves P on a straight
     line: the same end points, not the same path), wrist still at the case's initial angles."""
-    from mechbal.papers.paminsa.runner import parameters_from_config
     from mechbal.config import load_case
     from mechbal.papers._toml import case_toml
 
@@ -457,6 +457,34 @@ paper's start and end platform positions (the paminsa case moves P on a straight
     comments["trajectory.start"] = "actuated joints in the model's order: " + ", ".join(mech.actuated_names)
     return case_toml(mech, name="paminsa-linkage", title=f"PAMINSA ({variant}) on the general model",
                      header=header, trajectory=traj, comments=comments)
+
+# ---- a case's parameters (the runner, the balance adapter and the case-file generator) ----
+_GEOMETRY_SCALARS = ("k", "a", "b", "c", "d", "e", "f", "length_BG", "length_AE", "length_DF",
+                     "length_CE", "length_AF", "length_CJ", "length_MS5", "length_MO", "nominal_rho",
+                     "z_A", "elbow", "vertical_mass_z0", "cp3_ratio")
+
+
+def parameters_from_config(config):
+    """mechbal.PaminsaParameters (without counterweights) from the [geometry], [masses],
+    [inertias] tables of a case (validated, or a dict validated here); ConfigError names the
+    field. The C++ model validates the rest (ValueError naming the field)."""
+    case = validate_case(config, warn=False)
+    p = PaminsaParameters()
+    g = case.geometry
+    for key in _GEOMETRY_SCALARS:
+        setattr(p, key, getattr(g, key))
+    p.nominal_platform = np.array(g.nominal_platform, float)
+    if isinstance(g.vertical_mass_xy, str):  # "centroid"
+        p.vertical_mass_at_centroid = True
+    else:
+        p.vertical_mass_at_centroid = False
+        p.vertical_mass_xy = np.array(g.vertical_mass_xy, float)
+    p.platform_mass = case.masses.platform
+    p.link_mass = [float(x) for x in case.masses.links]
+    p.link_inertia = [np.array(v, float) for v in case.inertias.links]
+    p.wrist_inertia = [np.array(v, float) for v in case.inertias.wrist]
+    return p
+
 
 # importing the schema registers this paper's case kind (mechbal.registry imports this package)
 from mechbal.papers.paminsa import schema as _schema  # noqa: E402,F401

@@ -1,5 +1,5 @@
 """``mechbal balance`` on a ``paminsa`` case (Briot & Arakelian 2009): the mechanism of
-:func:`mechbal.papers.paminsa.paminsa_mechanism` built from the case's ``[geometry]``, ``[masses]``,
+`mechbal.papers.paminsa.paminsa_mechanism` built from the case's ``[geometry]``, ``[masses]``,
 ``[inertias]``, unbalanced and without the zero-mass placeholder counterweights (so the ``[balance]``
 slots may carry the paper's names ``leg1.CP1_atA`` ...); the trajectory rest-to-rest in the actuated
 joints between the actuator positions of the case's start and end platform positions, wrist still
@@ -17,7 +17,7 @@ import numpy as np
 
 from mechbal.balance.run import BalanceCase, design_trajectory, register_case
 from mechbal.papers.paminsa import paminsa_actuated_motion, paminsa_initial_guess, paminsa_mechanism
-from mechbal.papers.paminsa.runner import parameters_from_config
+from mechbal.papers.paminsa import parameters_from_config
 
 
 @register_case("paminsa")

@@ -3,7 +3,7 @@ fully balanced (counterweights + vertical counter-mass + reactionless wrist), ov
 
 Writes bodies_{unbalanced,force_balanced,balanced}.npz (+ bodies_balanced_{euler,rk4}.npz, whose
 shaking_force/shaking_moment are the wrench of the stored poses and shaking_*_commanded the
-controller's ideal one: see :func:`pose_wrench`),
+controller's ideal one: see `pose_wrench`),
 shaking_wrench.png (the paper's Fig. 4), wrist_angles.png (Fig. 5), wrist_condition.png and
 summary.json, and prints a table.
 
@@ -27,35 +27,7 @@ from mechbal.config import ConfigError
 from mechbal.schema import validate_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences, write_bodies, write_summary
 from mechbal.papers import paminsa as paper
-
-_GEOMETRY_SCALARS = ("k", "a", "b", "c", "d", "e", "f", "length_BG", "length_AE", "length_DF",
-                     "length_CE", "length_AF", "length_CJ", "length_MS5", "length_MO", "nominal_rho",
-                     "z_A", "elbow", "vertical_mass_z0", "cp3_ratio")
-
-
-def parameters_from_config(config):
-    """mechbal.PaminsaParameters (without counterweights) from the [geometry], [masses],
-    [inertias] tables of a case (validated, or a dict validated here); ConfigError names the
-    field. The C++ model validates the rest (ValueError naming the field)."""
-    from mechbal.papers.paminsa import PaminsaParameters
-
-    case = validate_case(config, warn=False)
-    p = PaminsaParameters()
-    g = case.geometry
-    for key in _GEOMETRY_SCALARS:
-        setattr(p, key, getattr(g, key))
-    p.nominal_platform = np.array(g.nominal_platform, float)
-    if isinstance(g.vertical_mass_xy, str):  # "centroid"
-        p.vertical_mass_at_centroid = True
-    else:
-        p.vertical_mass_at_centroid = False
-        p.vertical_mass_xy = np.array(g.vertical_mass_xy, float)
-    p.platform_mass = case.masses.platform
-    p.link_mass = [float(x) for x in case.masses.links]
-    p.link_inertia = [np.array(v, float) for v in case.inertias.links]
-    p.wrist_inertia = [np.array(v, float) for v in case.inertias.wrist]
-    return p
-
+from mechbal.papers.paminsa import parameters_from_config  # noqa: F401 (re-exported)
 
 def wrist_config_from_config(config, integrator: str | None = None):
     from mechbal.control import ReactionlessWristConfig, WristIntegrator
@@ -85,10 +57,10 @@ COUNTERWEIGHT_AGREEMENT_KG = 1e-6
 
 
 def general_counterweights(config):
-    """PAMINSA's counterweights by the general shaking-force method (:mod:`mechbal.balance.force`)
-    on the case's mechanism (:func:`mechbal.papers.paminsa.paminsa_mechanism`, unbalanced) with the
+    """PAMINSA's counterweights by the general shaking-force method (`mechbal.balance.force`)
+    on the case's mechanism (`mechbal.papers.paminsa.paminsa_mechanism`, unbalanced) with the
     slots of its ``[balance]`` table, as ``mechbal balance paminsa --method force`` runs it.
-    Returns (:class:`mechbal.papers.paminsa.CounterweightSet`, the method's BalanceResult)."""
+    Returns (`mechbal.papers.paminsa.CounterweightSet`, the method's BalanceResult)."""
     from mechbal.balance.run import case_from_config, run_method
 
     case = validate_case(config, warn=False)

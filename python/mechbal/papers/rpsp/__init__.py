@@ -1,16 +1,16 @@
 """The 3(RPSP)-S spherical parallel robot of Heydari & Enferadi ("Complete dynamic shaking force
 balancing of a 3(RPSP)-S spherical parallel robot using extra linkage", Persian, research note):
 the paper's closed forms, kept as *checks* of the general model (the mechanism itself is data,
-``python/mechbal/papers/rpsp/cases/rpsp.toml``, solved by :meth:`mechbal.Mechanism.closed_motion`).
+``python/mechbal/papers/rpsp/cases/rpsp.toml``, solved by `mechbal.Mechanism.closed_motion`).
 
-* :func:`inverse_kinematics`: eqs 1-13 (platform orientation -> b_i, l_i, e_i, theta_i) with
+* `inverse_kinematics`: eqs 1-13 (platform orientation -> b_i, l_i, e_i, theta_i) with
   their first and second time derivatives in closed form, and the degenerate configurations
   (eq 8's denominator u_i . R v_i -> 0, eq 10's leg length l_i -> 0) reported instead of
   returning garbage.
-* :func:`counterweights_eqs_29_31`: the printed sizing equations; :func:`balance_coefficients`:
+* `counterweights_eqs_29_31`: the printed sizing equations; `balance_coefficients`:
   the three vector coefficients of eq 28 (first principles: the leg's mass-weighted position must
   not depend on D_i, C_i - D_i, E_i - A_i), which the masses must make zero.
-* :data:`PAPER_TABLES` and :func:`table_consistency`: Tables 1-3 as printed and which cells do not
+* `PAPER_TABLES` and `table_consistency`: Tables 1-3 as printed and which cells do not
   follow from the printed forces.
 
 Conventions (the paper's): base frame {B} at the centre of the fixed base, z up; the central
@@ -183,7 +183,7 @@ def inverse_kinematics(geometry: RpspGeometry, phi, dphi=None, ddphi=None, *, to
 
 
 def _rotations(phi, dphi, ddphi):
-    """Batch of :func:`platform_rotation`: R (N, 3, 3), w and w' (N, 3)."""
+    """Batch of `platform_rotation`: R (N, 3, 3), w and w' (N, 3)."""
     R, w, dw = zip(*(platform_rotation(p, d, dd) for p, d, dd in zip(phi, dphi, ddphi)))
     return np.array(R), np.array(w), np.array(dw)
 

@@ -1,6 +1,6 @@
 """Runner for ``kind = "rpsp"``: the 3(RPSP)-S spherical parallel robot of Heydari & Enferadi,
 balanced by an extra linkage per leg (``rpsp.toml``; the paper's closed forms are the checks in
-:mod:`mechbal.papers.rpsp`).
+`mechbal.papers.rpsp`).
 
 Everything physical comes from the general model: the mechanism of ``[mechanism]`` (legs, extra
 linkages, platform, loop closures) with the platform's spherical joint as the driven coordinates
@@ -10,9 +10,9 @@ comparison. Variants:
 
 * ``unbalanced``: the robot without the extra linkage and without counterweights (Fig. 3);
 * ``balanced``: with the extra linkage and the counterweights sized by the general
-  shaking-force method (:func:`mechbal.balance.force.balance`: least squares of the linear
+  shaking-force method (`mechbal.balance.force.balance`: least squares of the linear
   momentum over the run's closed motion, one slot per counterweight body at its given point, only
-  its mass unknown), checked against eqs 29-31 (:mod:`mechbal.papers.rpsp`);
+  its mass unknown), checked against eqs 29-31 (`mechbal.papers.rpsp`);
 * ``paper_masses``: with the extra linkage and the paper's printed masses (17.61 / 2.76 / 4.5 kg).
 
 The survey stage follows the robot over the whole period of the paper's motion, reporting the
@@ -184,7 +184,7 @@ def ik_agreement(mech: Mechanism, m, geometry, motion, t) -> dict:
 
 
 def counterweight_slots(mech: Mechanism, spec, names: list[str]):
-    """The design variables of the general method: one :class:`mechbal.balance.CounterweightSlot`
+    """The design variables of the general method: one `mechbal.balance.CounterweightSlot`
     per named counterweight body of ``spec``, on its link at its centre of mass (a fixed position,
     in the frame the link is described in: only the mass is unknown, within [0, inf)), with its
     inertia; and ``mech`` without those bodies (the robot the slots are added to)."""
@@ -202,7 +202,7 @@ def counterweight_slots(mech: Mechanism, spec, names: list[str]):
 
 
 def size_counterweights(mech: Mechanism, spec, names: list[str], platform, dplatform, q_guess=None):
-    """The general shaking-force method (:func:`mechbal.balance.force.balance`): the masses of the
+    """The general shaking-force method (`mechbal.balance.force.balance`): the masses of the
     ``names`` counterweight bodies (at their given points, bounded below by 0) that make the linear
     momentum zero over the samples (the platform's joint coordinates ``platform`` and rates
     ``dplatform``, (N, 3) in ``mech.actuated_names`` order: the loop solve gives the rest).
