@@ -109,6 +109,9 @@ class SingleSample {
                                       PyUnicode_InternFromString("angular_momentum"),
                                       PyUnicode_InternFromString("status")};
     static PyObject* const no_args = PyTuple_New(0);
+    // the values first: allocating the result (a GC-tracked object) may run a collection, whose
+    // finalizers may call this Mechanism again and overwrite data_
+    Vec3 values[4] = {d.shaking.force, d.shaking.moment, d.shaking.linear_momentum, d.shaking.angular_momentum};
     // wrench_type(**fields) without its __init__: object.__new__, then object.__setattr__ per field
     auto* type = reinterpret_cast<PyTypeObject*>(wrench_type_.ptr());
     py::object result = py::reinterpret_steal<py::object>(PyBaseObject_Type.tp_new(type, no_args, nullptr));
@@ -117,10 +120,8 @@ class SingleSample {
     // batch arrays): one data allocation instead of four
     py::object block = new_float64_array({4, 3});
     double* p = float64_array_data(block);
-    const Vec3* values[4] = {&d.shaking.force, &d.shaking.moment, &d.shaking.linear_momentum,
-                             &d.shaking.angular_momentum};
     for (int i = 0; i < 4; ++i) {
-      Eigen::Map<Vec3>(p + 3 * i) = *values[i];
+      Eigen::Map<Vec3>(p + 3 * i) = values[i];
       py::object row = row_view(block, p + 3 * i, 3);
       if (PyObject_GenericSetAttr(result.ptr(), keys[i], row.ptr()) != 0) throw py::error_already_set();
     }
