@@ -321,13 +321,13 @@ def bench_sweep(evaluations: int, repeat: int, scaling_evaluations: int = 500_00
     trajectory = law.evaluate_batch(np.linspace(0.0, 1.0, 201))
 
     def light(n=evaluations):
-        return Sweep(spec, masses, ["gravity_torque_peak", "gravity_torque_rms"], kind="monte_carlo",
+        return Sweep(spec, masses, ["peak_gravity_torque", "rms_gravity_torque"], kind="monte_carlo",
                      evaluations=n, seed=1, pose_source="uniform", pose_count=100)
 
     def heavy(n=scaling_evaluations):
         positions = [Parameter(f"bodies.counterweight{i + 1}.com[2]", delta=0.002) for i in range(7)]
-        return Sweep(spec, masses + positions, ["gravity_torque_peak", "actuator_torque_rms",
-                                                "shaking_force_peak"], kind="monte_carlo", evaluations=n,
+        return Sweep(spec, masses + positions, ["peak_gravity_torque", "rms_joint_torque",
+                                                "peak_shaking_force"], kind="monte_carlo", evaluations=n,
                      seed=2, pose_source="uniform", pose_count=100, trajectory=trajectory)
 
     out = {"arm": "7 revolute joints, 14 bodies (7 links + 7 counterweights)",

@@ -63,6 +63,25 @@ void bind_io(py::module_& m) {
       "(model, control, name) of a case file read by the C++ reader (mechbal::load_case): the "
       "[mechanism] model, the [control] table checked against it (kind 'none' without one) and "
       "[case] name.");
+  py::class_<TrajectoryConfig>(m, "TrajectoryConfig", "The [trajectory] table as the C++ reader checked it (read only)")
+      .def_readonly("present", &TrajectoryConfig::present)
+      .def_readonly("law", &TrajectoryConfig::law)
+      .def_readonly("constant_speed", &TrajectoryConfig::constant_speed)
+      .def_readonly("start", &TrajectoryConfig::start)
+      .def_readonly("end", &TrajectoryConfig::end)
+      .def_readonly("speed", &TrajectoryConfig::speed)
+      .def_readonly("duration", &TrajectoryConfig::duration)
+      .def_readonly("revolutions", &TrajectoryConfig::revolutions)
+      .def_readonly("samples", &TrajectoryConfig::samples)
+      .def_readonly("initial_guess", &TrajectoryConfig::initial_guess)
+      .def_readonly("branch", &TrajectoryConfig::branch);
+  m.def(
+      "load_case_trajectory",
+      [](const std::string& path) { return value_errors([&] { return load_case(path).trajectory; }); },
+      py::arg("path"),
+      "The [trajectory] of a mechanism case file as the C++ reader (mechbal::load_case) checked it: "
+      "constant_speed with speed [rad/s] per actuated joint (rpm converted) and duration [s] "
+      "(from revolutions when given), or a rest-to-rest law with start, end and duration.");
 }
 
 }  // namespace

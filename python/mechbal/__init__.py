@@ -32,13 +32,13 @@ from mechbal.config import ConfigError, ConfigWarning, load_case
 from mechbal.errors import PlausibilityWarning
 from mechbal.mechanism import (
     BaseReaction, BatchArray, BodyMotion, ClosedMotion, Mechanism, Momentum, ShakingWrench)
-from mechbal import balance, control, papers, simulate, trajectory
+from mechbal import assembly, balance, control, papers, simulate, trajectory
 
 __all__ = [
     "Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion", "BatchArray",
     "Joint", "JointType", "Body", "Frame", "LoopConstraint", "LoopType", "MechanismDescription", "Spring",
     "MechanismModel", "Status", "ConfigError", "ConfigWarning", "PlausibilityWarning",
-    "load_case", "balance", "control", "trajectory", "simulate", "papers", "cases", "__version__",
+    "load_case", "balance", "control", "trajectory", "simulate", "assembly", "papers", "cases", "__version__",
 ]
 
 # Names that lived here before the public modules existed (kept so that existing scripts run);

@@ -8,7 +8,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ComputedTorque', 'ControlConfig', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MAX_URDF_BYTES', 'MAX_URDF_DEPTH', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'ReactionlessCommand', 'ReactionlessController', 'ReactionlessJointController', 'ReactionlessTaskController', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'Spring', 'Status', 'TimeLaw', 'WristCommand', 'WristIntegrator', 'arm2dof_description', 'load_case_file', 'load_mechanism_file', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_toml', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_single_sample', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'read_urdf', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
+__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ComputedTorque', 'ControlConfig', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MAX_URDF_BYTES', 'MAX_URDF_DEPTH', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'PassiveController', 'ReactionlessCommand', 'ReactionlessController', 'ReactionlessJointController', 'ReactionlessTaskController', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'Spring', 'Status', 'TimeLaw', 'TrajectoryConfig', 'WristCommand', 'WristIntegrator', 'arm2dof_description', 'load_case_file', 'load_case_trajectory', 'load_mechanism_file', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_toml', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_single_sample', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'read_urdf', 'shaking_wrench', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
 class Status:
     """
     Bit flags returned by real-time algorithms
@@ -666,6 +666,43 @@ class ControlConfig:
     @property
     def torque_limit(self) -> list[float]:
         ...
+class TrajectoryConfig:
+    """
+    The [trajectory] table as the C++ reader checked it (read only)
+    """
+    @property
+    def branch(self) -> str:
+        ...
+    @property
+    def constant_speed(self) -> bool:
+        ...
+    @property
+    def duration(self) -> float:
+        ...
+    @property
+    def end(self) -> list[float]:
+        ...
+    @property
+    def initial_guess(self) -> list[float]:
+        ...
+    @property
+    def law(self) -> TimeLaw:
+        ...
+    @property
+    def present(self) -> bool:
+        ...
+    @property
+    def revolutions(self) -> float:
+        ...
+    @property
+    def samples(self) -> int:
+        ...
+    @property
+    def speed(self) -> list[float]:
+        ...
+    @property
+    def start(self) -> list[float]:
+        ...
 class PaminsaCounterweights:
     """
     Counterweight masses [kg] of PAMINSA (Briot & Arakelian 2009, eqs 11, 14-16): at_A (CP1), at_F (CP2), at_L (CP3), vertical
@@ -1262,6 +1299,37 @@ class DecoupledJointController(JointController):
     @property
     def torque_limit(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
+class PassiveController(JointController):
+    """
+    No controller: zero joint effort every tick, so the plant moves under gravity and its springs only (a passive simulation)
+    """
+    def __init__(self, dof: typing.SupportsInt | typing.SupportsIndex) -> None:
+        """
+        dof: number of actuated coordinates (>= 1)
+        """
+    def _tick(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> tuple:
+        """
+        step() with the status as an int (what the Python classes' step wraps in a JointCommand)
+        """
+    def reset(self) -> None:
+        """
+        Forget the held command (zero torque).
+        """
+    def run(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> dict:
+        """
+        N consecutive ticks in one call: q, qd [rad or m, rad/s or m/s], q_des, qd_des, qdd_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
+        """
+    def step(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> tuple:
+        """
+        One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
+        """
+    def step_into(self, q: numpy.typing.NDArray[numpy.float64], qd: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], qd_des: numpy.typing.NDArray[numpy.float64], qdd_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+        """
+        The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
+        """
+    @property
+    def dof(self) -> int:
+        ...
 class FiveBarParameters:
     """
     Planar 5R five-bar: lengths, masses, CoM positions along the links, inertias about x (vertical y-z plane, gravity -z)
@@ -1570,6 +1638,10 @@ def arm2dof_description(arm: Arm2DofParameters, counterweights: Arm2DofCounterwe
 def load_case_file(path: str) -> tuple[MechanismModel, ControlConfig, str]:
     """
     (model, control, name) of a case file read by the C++ reader (mechbal::load_case): the [mechanism] model, the [control] table checked against it (kind 'none' without one) and [case] name.
+    """
+def load_case_trajectory(path: str) -> TrajectoryConfig:
+    """
+    The [trajectory] of a mechanism case file as the C++ reader (mechbal::load_case) checked it: constant_speed with speed [rad/s] per actuated joint (rpm converted) and duration [s] (from revolutions when given), or a rest-to-rest law with start, end and duration.
     """
 def load_mechanism_file(path: str) -> MechanismModel:
     """

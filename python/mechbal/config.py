@@ -253,19 +253,34 @@ def load_case(name_or_path: str | Path) -> dict:
 
 
 def trajectory_from_config(table: Any, dof: int, field: str = "trajectory"):
-    """A `mechbal.RestToRestTrajectory` and the sample times from a ``[trajectory]`` table
-    (a dict or a validated `mechbal.schema.ChainTrajectory`) with ``law`` (quintic |
-    cubic), ``start``, ``end`` (``dof`` values), ``duration`` [s] and ``samples`` (number of
-    instants, 3 .. 1e6)."""
+    """The trajectory and the sample times from a ``[trajectory]`` table (a dict or a validated
+    `mechbal.schema.ChainTrajectory`): ``law = "quintic" | "cubic"``, ``start``, ``end``
+    (``dof`` values), ``duration`` [s]: a `mechbal.RestToRestTrajectory`; ``law =
+    "constant_speed"``, ``start``, ``speed`` [rad/s] or ``rpm`` (one number or ``dof``), and
+    ``duration`` [s] or ``revolutions``: a `mechbal.trajectory.ConstantSpeed`. ``samples``
+    instants (3 .. 1e6) over ``[0, duration]``."""
     from mechbal._core import RestToRestTrajectory, TimeLaw
 
     from mechbal.schema import ChainTrajectory, validate_table
+    from mechbal.trajectory import ConstantSpeed
 
     tr = table if isinstance(table, ChainTrajectory) else validate_table(ChainTrajectory, table, field)
-    for key in ("start", "end"):
+    keys = ("start", "speed", "rpm") if tr.law == "constant_speed" else ("start", "end")
+    for key in keys:
         v = getattr(tr, key)
-        if len(v) != dof:
-            raise ConfigError(f"{field}.{key}", f"must have {dof} values", v)
-    traj = RestToRestTrajectory(np.array(tr.start, float), np.array(tr.end, float), tr.duration,
-                                getattr(TimeLaw, tr.law))
-    return traj, np.linspace(0.0, tr.duration, tr.samples)
+        if isinstance(v, list) and len(v) != dof:
+            raise ConfigError(f"{field}.{key}", f"must have {dof} values" + (
+                " (or one number for every joint)" if key in ("speed", "rpm") else ""), v)
+    duration = tr.motion_duration()
+    if tr.law == "constant_speed":
+        traj = ConstantSpeed(np.array(tr.start, float), np.array(tr.speeds(dof), float), duration)
+    else:
+        traj = RestToRestTrajectory(np.array(tr.start, float), np.array(tr.end, float), duration,
+                                    getattr(TimeLaw, tr.law))
+    return traj, np.linspace(0.0, duration, tr.samples)
+
+
+def law_name(traj: Any) -> str:
+    """The time law of a trajectory from `trajectory_from_config` (summary.json's ``law``)."""
+    law = traj.law
+    return law if isinstance(law, str) else str(law.name)

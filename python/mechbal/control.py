@@ -8,6 +8,8 @@ calls.
   dynamics back end (Arakelian, Le Baron & Mottu 2011, eqs 2-6);
 * `DecoupledJointController`: `tau_i = k_i (qdd_des + Kp e + Kd e')` for a dynamically balanced
   arm whose mass matrix is diagonal and constant (Coutinho & Hess Coelho, eqs 15, 26, 36);
+* `PassiveController`: no controller, zero effort every tick (a passive simulation: gravity and
+  springs move the mechanism; `mechbal.simulate.passive`);
 * `ReactionlessWrist`: wrist rates that keep the total angular momentum constant, so the shaking
   moment is zero (Briot & Arakelian 2009, eqs 23-26);
 * `PaminsaController`: the fully balanced PAMINSA tick: kinematics, D (eq 19), the reactionless
@@ -50,7 +52,7 @@ import numpy.typing as npt
 from mechbal import _core
 
 __all__ = [
-    "ComputedTorque", "DecoupledJointController", "ReactionlessWrist", "ReactionlessWristConfig",
+    "ComputedTorque", "DecoupledJointController", "PassiveController", "ReactionlessWrist", "ReactionlessWristConfig",
     "WristIntegrator", "WristCommand", "PaminsaController", "JointController", "JointCommand",
     "ControlRun", "WristRun", "PaminsaRun", "InverseDynamics", "ForwardDynamics",
     "MechanismDynamics", "KdlChainDynamics", "Status", "status_text",
@@ -209,6 +211,28 @@ class DecoupledJointController(_core.DecoupledJointController):
              qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:
         """One tick: `JointCommand` (joint_torque (n,) [N m or N], status)."""
         return _joint_command(JointCommand, self._tick(q, qd, q_des, qd_des, qdd_des))
+
+    def run(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+            qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> ControlRun:
+        """N consecutive ticks over (N, n) arrays in one C++ call: `ControlRun`."""
+        return _control_run(super().run(q, qd, q_des, qd_des, qdd_des))
+
+
+class PassiveController(_core.PassiveController):
+    """No controller: ``tau = 0`` every tick, so the plant moves under gravity, its springs and its
+    inertia only (a free pendulum, a spring-balanced arm let go). Driving a plant with it in
+    `mechbal.simulate.closed_loop` is a passive simulation (`mechbal.simulate.passive`
+    does exactly that).
+
+    Args:
+        dof: number of actuated coordinates (>= 1).
+    """
+
+    def step(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
+             qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> JointCommand:
+        """One tick: `JointCommand` (zero joint_torque (n,), status)."""
+        tau, status = super().step(q, qd, q_des, qd_des, qdd_des)
+        return JointCommand(np.asarray(tau), int(status))
 
     def run(self, q: npt.ArrayLike, qd: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
             qd_des: npt.ArrayLike, qdd_des: npt.ArrayLike) -> ControlRun:

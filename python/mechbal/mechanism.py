@@ -35,7 +35,13 @@ import numpy as np
 from mechbal import _core
 
 __all__ = ["Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion",
-           "BatchArray", "UrdfRepairWarning", "urdf_reading"]
+           "BatchArray", "UrdfRepairWarning", "urdf_reading", "INERTIAL_PARAMETER_NAMES"]
+
+#: The order of a body's 10 inertial parameters in the regressors and
+#: `Mechanism.inertial_parameters` (Pinocchio's): mass, first moments m c, then the inertia about
+#: the link origin, lower triangle row by row. The TOML format's list form is ``[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]`` (moments, then
+#: products) and its named form ``{ixx, iyy, izz, ixy, ixz, iyz}``: docs/case_format.md.
+INERTIAL_PARAMETER_NAMES = ("m", "mcx", "mcy", "mcz", "ixx", "ixy", "iyy", "ixz", "iyz", "izz")
 
 
 class BatchArray(np.ndarray):
@@ -680,7 +686,8 @@ class Mechanism:
 
     def torque_regressor(self, q, v, a) -> np.ndarray:
         """Y(q, v, a) with tau = Y pi, pi the stacked 10 inertial parameters of every body
-        ([m, m c, Ixx, Ixy, Iyy, Ixz, Iyz, Izz], c and I about the link origin, link frame)."""
+        ([m, m c, Ixx, Ixy, Iyy, Ixz, Iyz, Izz], c and I about the link origin, link frame; column
+        k is ``inertial_parameter_names[k]``)."""
         single, (q, v, a) = self._args(("q", "v", "a"), (q, v, a))
         (Y,), _ = self._finish(single, _core.mechanism_torque_regressor(self.model, q, v, a), ["regressor"])
         return Y
@@ -697,8 +704,17 @@ class Mechanism:
         (Y,), _ = self._finish(single, _core.mechanism_momentum_regressor(self.model, q, v), ["regressor"])
         return Y
 
+    @property
+    def inertial_parameter_names(self) -> list[str]:
+        """The name of each entry of `inertial_parameters` and each regressor column,
+        ``<body>.<parameter>`` with the parameters in the order of ``INERTIAL_PARAMETER_NAMES``
+        (``m, mcx, mcy, mcz, ixx, ixy, iyy, ixz, iyz, izz``)."""
+        return [f"{b.name}.{p}" for b in self.model.bodies for p in INERTIAL_PARAMETER_NAMES]
+
     def inertial_parameters(self) -> np.ndarray:
-        """pi: the stacked 10 inertial parameters of every body, in the regressors' convention."""
+        """pi: the stacked 10 inertial parameters of every body, in the regressors' convention
+        (``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` per body, inertia about the link
+        origin in the link frame; `inertial_parameter_names` names each entry)."""
         out = []
         for b in self.model.bodies:
             m, c, I = b.mass, np.asarray(b.com), np.asarray(b.inertia)

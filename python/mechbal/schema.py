@@ -247,10 +247,12 @@ class Control(Table):
     "reactionless"``: the balancing joints keep the cancelled momentum components at their
     initial value (`mechbal.control.ReactionlessController`); ``mechbal run`` compares the
     motion with the balancing joints held (uncontrolled) and controlled."""
-    kind: Literal["reactionless", "computed_torque", "decoupled"] = Field(
-        description="which controller (mechbal run supports reactionless)")
-    balancing_joints: Annotated[list[Name], Field(min_length=1, max_length=MAX_JOINTS)] = Field(
-        description="actuated joints whose motion the controller computes")
+    kind: Literal["reactionless", "computed_torque", "decoupled", "passive"] = Field(
+        description="which controller (mechbal run supports reactionless, and passive: no controller, "
+                    "zero effort, the mechanism moves under gravity and springs from [trajectory]'s "
+                    "start with its initial rates, over its duration)")
+    balancing_joints: Optional[Annotated[list[Name], Field(min_length=1, max_length=MAX_JOINTS)]] = Field(
+        None, description="actuated joints whose motion the controller computes (required but for passive)")
     cancel: Annotated[list[MomentumComponentName], Field(min_length=1, max_length=9)] = ["moment"]
     integrator: Literal["euler", "rk4"] = "rk4"
     rate_hz: Rate = 1000.0
@@ -266,6 +268,13 @@ class Control(Table):
 
     @model_validator(mode="after")
     def _distinct(self):
+        if self.kind == "passive":   # no controller: only the tick rate of the log
+            for key in sorted(self.model_fields_set - {"kind", "rate_hz"}):
+                raise _custom("is not for kind = 'passive' (no controller: only rate_hz)", f".{key}",
+                              getattr(self, key))
+            return self
+        if self.balancing_joints is None:
+            raise _custom(f"is required for kind = '{self.kind}'", ".balancing_joints", None, has_value=False)
         seen = set()
         for i, name in enumerate(self.balancing_joints):
             if name in seen:
@@ -356,8 +365,8 @@ class Sweep(Table):
         None, description="monte_carlo: number of draws")
     seed: Annotated[int, Field(ge=0, le=2**63 - 1, strict=True)] = 0
     metrics: Annotated[list[Name], Field(min_length=1, max_length=64, description=(
-        "gravity_torque_peak | gravity_torque_rms | actuator_torque_peak | actuator_torque_rms | "
-        "shaking_force_peak | shaking_force_rms | shaking_moment_peak | shaking_moment_rms, "
+        "peak_gravity_torque | rms_gravity_torque | peak_joint_torque | rms_joint_torque | "
+        "peak_shaking_force | rms_shaking_force | peak_shaking_moment | rms_shaking_moment, "
         "torques optionally .<joint>"))]
     parameters: Annotated[list[SweepParameter], Field(min_length=1, max_length=256)]
     poses: SweepPoses = SweepPoses()
@@ -507,12 +516,18 @@ def _cross_checks(case: Any) -> None:
         if not names:
             raise ConfigError("mechanism.joints", "needs at least one moving joint that is not a mimic",
                               has_value=False)
-        for key in ("start", "end"):
+        for key in ("start", "end", "speed", "rpm"):
             v = getattr(case.trajectory, key)
-            if len(v) != len(names):
+            if isinstance(v, list) and len(v) != len(names):
                 raise ConfigError(f"trajectory.{key}", f"must have {len(names)} values (one per "
                                                        f"{'actuated' if spec.loops else 'independent'} "
-                                                       f"joint: {', '.join(names)})", v)
+                                                       f"joint: {', '.join(names)})"
+                                  + (" or one number" if key in ("speed", "rpm") else ""), v)
+        if not spec.loops:
+            for key in ("initial_guess", "branch"):
+                if getattr(case.trajectory, key) is not None:
+                    raise ConfigError(f"trajectory.{key}", "is for closed mechanisms (with "
+                                      "[[mechanism.loops]]); this one has no loop", getattr(case.trajectory, key))
         n_bodies = max(1, len(spec.bodies))
         if case.trajectory.samples * n_bodies > MAX_SAMPLE_BODIES:
             raise ConfigError("trajectory.samples", f"must be <= {MAX_SAMPLE_BODIES // n_bodies} for "

@@ -4,6 +4,9 @@
   (a `mechbal.Mechanism`, closed loops included, or any forward-dynamics plant such as
   ``Arm2DofDynamics``) along any trajectory (`mechbal.trajectory`), integrated by RK4 at the
   controller period.
+* `passive`: no controller; the mechanism moves under gravity and its springs with zero
+  joint effort from an initial state (RK4, the same C++ loop with
+  `mechbal.control.PassiveController`), with its energy along the run.
 * open-loop evaluation along a trajectory: `mechbal.Mechanism` (``shaking_wrench``,
   ``base_reaction``, ``inverse_dynamics`` over ``(N, n)`` samples of a trajectory).
 
@@ -25,7 +28,7 @@ from mechbal import _core
 simulate_closed_loop = _core.simulate_closed_loop
 simulate_computed_torque = _core.simulate_computed_torque
 
-__all__ = ["closed_loop", "ClosedLoopResult", "ForwardDynamics", "MechanismDynamics",
+__all__ = ["closed_loop", "ClosedLoopResult", "passive", "PassiveResult", "ForwardDynamics", "MechanismDynamics",
            "simulate_closed_loop", "simulate_computed_torque"]
 
 ForwardDynamics = _core.ForwardDynamics
@@ -215,3 +218,88 @@ def _closed_loop_mujoco(mech: Any, controller: Any, trajectory: Any, q0, qd0, *,
                             joint_torque=r.joint_torque, status=r.status,
                             saturated_ticks=r.saturated_ticks, steps_completed=r.steps_completed,
                             mujoco=r)
+
+
+@dataclass(frozen=True)
+class PassiveResult:
+    """A passive run (`passive`), one row per step k = 0 .. steps (t_k = k dt):
+
+    * ``t`` (N,) [s];
+    * ``q``, ``v`` (N, na): the actuated coordinates and their rates (every coordinate of an open
+      mechanism) [rad or m, rad/s or m/s];
+    * ``q_full``, ``v_full``, ``a_full`` (N, dof): every coordinate (the loops solved), its rate
+      and acceleration (forward dynamics at zero effort);
+    * ``kinetic_energy``, ``potential_energy`` (N,) [J]: 1/2 v^T M v, and gravity (zero at O) plus
+      springs; their sum ``energy`` is conserved by the exact motion (no effort, no friction);
+    * ``status`` (N,): per step (0 = ok); ``steps_completed`` as `ClosedLoopResult`.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    q_full: np.ndarray
+    v_full: np.ndarray
+    a_full: np.ndarray
+    kinetic_energy: np.ndarray
+    potential_energy: np.ndarray
+    status: np.ndarray
+    steps_completed: int
+
+    @property
+    def energy(self) -> np.ndarray:
+        """Kinetic plus potential energy (N,) [J]."""
+        return self.kinetic_energy + self.potential_energy
+
+    @property
+    def energy_drift(self) -> float:
+        """Largest |energy - energy at t = 0| over the run [J] (the integrator's error)."""
+        return float(np.max(np.abs(self.energy - self.energy[0])))
+
+    @property
+    def ok(self) -> bool:
+        """True when every step's status is 0 (ok)."""
+        return bool(np.all(self.status == 0))
+
+
+def passive(mech: Any, q0: npt.ArrayLike, v0: npt.ArrayLike | None = None, *, dt: float = 1e-3,
+            duration: float = 1.0, q_guess: npt.ArrayLike | None = None) -> PassiveResult:
+    """Passive simulation: no controller, zero joint effort; ``mech`` (a `mechbal.Mechanism`,
+    closed loops included) moves under gravity and its springs from ``q0`` (actuated coordinates,
+    every coordinate of an open mechanism) [rad or m] with rates ``v0`` (default at rest), RK4 with
+    step ``dt`` [s] for ``duration`` [s] (the closed loop of `closed_loop` with
+    `mechbal.control.PassiveController`). ``q_guess``: the full coordinates near the
+    assembly of a closed mechanism (its branch). The result carries the energy along the run, the
+    invariant of an unforced motion."""
+    from mechbal.control import PassiveController
+    from mechbal.mechanism import Mechanism
+    from mechbal.trajectory import RestToRest
+
+    if not isinstance(mech, Mechanism):
+        raise TypeError(f"passive simulates a mechbal.Mechanism, got {type(mech).__name__}")
+    na = len(mech.model.actuated_coordinates)
+    q0 = np.asarray(q0, dtype=float).reshape(-1)
+    v0 = np.zeros(na) if v0 is None else np.asarray(v0, dtype=float).reshape(-1)
+    for name, x in (("q0", q0), ("v0", v0)):
+        if x.shape != (na,):
+            raise ValueError(f"{name} must have {na} values (the actuated coordinates: "
+                             f"{', '.join(mech.actuated_names)}), got {x.size}")
+        if not np.all(np.isfinite(x)):
+            raise ValueError(f"{name} must be finite")
+    dt, duration = _check_timing(dt, duration)
+    held = RestToRest(q0, q0, duration)   # the controller ignores it: a placeholder desired motion
+    run = closed_loop(mech, PassiveController(na), held, q0, v0, dt=dt, duration=duration, q_guess=q_guess)
+    q, v = run.q, run.qd
+    guess = np.zeros(mech.dof) if q_guess is None else np.asarray(q_guess, float)
+    plant = _core.MechanismDynamics(mech.model, guess)   # accelerations at zero effort
+    zero = np.zeros(na)
+    aa = np.array([plant.forward_dynamics(qk, vk, zero) for qk, vk in zip(q, v)]).reshape(q.shape)
+    if mech.is_closed:
+        m = mech.closed_motion(q, v, aa, q_guess=guess)
+        qf, vf, af = m.q, m.v, m.a
+    else:
+        qf, vf, af = q, v, aa
+    M = mech.mass_matrix(qf)
+    kinetic = 0.5 * np.einsum("ni,nij,nj->n", vf, M, vf)
+    potential = np.asarray(mech.potential_energy(qf), float)
+    return PassiveResult(t=run.t, q=q, v=v, q_full=qf, v_full=vf, a_full=af, kinetic_energy=kinetic,
+                         potential_energy=potential, status=run.status, steps_completed=run.steps_completed)

@@ -197,10 +197,43 @@ def _move_body(T: np.ndarray, com: np.ndarray, inertia: np.ndarray) -> tuple[np.
     return R @ com + T[:3, 3], R @ inertia @ R.T
 
 
+#: |sin| (revolute) or |cos| (prismatic) of the angle between a joint axis and the plane normal
+#: below which a mechanism is planar for ``izz`` alone
+PLANAR_TOL = 1e-9
+
+
+def plane_normal(joints: list[JointSpec], rotation_in_o: dict, f: str, izz: float) -> np.ndarray:
+    """The normal (in O, at q = 0) of the plane a planar mechanism moves in: the common axis of its
+    revolute joints, every prismatic axis perpendicular to it (then every link rotates about it
+    only, at every q). ConfigError naming ``f`` (a body's ``izz``) when the mechanism is not
+    planar."""
+    n = None
+    for js in joints:
+        if js.type == "revolute":
+            a = rotation_in_o[js.name] @ js.axis
+            n = a / np.linalg.norm(a)
+            break
+    if n is None:
+        raise ConfigError(f, "izz alone needs a planar mechanism with a revolute joint (its axis is the "
+                             "plane's normal); give inertia = [Ixx, Iyy, Izz]", izz)
+    for js in joints:
+        if js.type not in ("revolute", "prismatic"):
+            continue
+        a = rotation_in_o[js.name] @ js.axis
+        a = a / np.linalg.norm(a)
+        off = np.linalg.norm(np.cross(a, n)) if js.type == "revolute" else abs(float(a @ n))
+        if off > PLANAR_TOL:
+            raise ConfigError(f, "izz alone needs a planar mechanism (every revolute axis parallel, every "
+                                 f"prismatic axis perpendicular to {np.round(n, 6).tolist()} in O): joint "
+                                 f"{js.name!r} ({js.type}) has axis {np.round(a, 6).tolist()}; give "
+                                 "inertia = [Ixx, Iyy, Izz]", izz)
+    return n
+
+
 def mechanism_spec(mechanism: Any, field: str = "mechanism") -> MechanismSpec:
     """The `MechanismSpec` of a ``[mechanism]`` table (a dict, validated here, or a
     validated `mechbal.tables.Mechanism`); ConfigError naming the field otherwise."""
-    from mechbal.tables import Mechanism, inertia_matrix, validate_table
+    from mechbal.tables import Mechanism, inertia_matrix, lamina_inertia, validate_table
 
     m = mechanism if isinstance(mechanism, Mechanism) else validate_table(Mechanism, mechanism, field)
     base = transform_xyz_rpy(m.base.xyz, m.base.rpy) if m.base is not None else np.eye(4)
@@ -340,16 +373,28 @@ def mechanism_spec(mechanism: Any, field: str = "mechanism") -> MechanismSpec:
         c, inertia = _move_body(frame_of_link(link), np.asarray(com, dtype=float), inertia)
         bodies.append(BodySpec(name, kind, link, float(mass), c, 0.5 * (inertia + inertia.T)))
 
+    rotation_in_o = {BASE: np.eye(3)}   # link frames in O at q = 0 (for izz alone)
+    for js in joints:
+        rotation_in_o[js.name] = rotation_in_o[js.parent] @ js.placement[:3, :3]
+
+    def lamina(link: str, izz: float, f: str) -> np.ndarray:
+        """izz alone: the lamina in the plane of motion, in the frame the user described ``link`` in."""
+        n = plane_normal(joints, rotation_in_o, f, izz)
+        return lamina_inertia(izz, (rotation_in_o[link] @ frame_of_link(link)[:3, :3]).T @ n)
+
     for i in order:
         j = m.joints[i]
         if j.link is not None:
-            add_body(names[i], "link", expansions[i][-1], j.link.mass, j.link.com,
-                     inertia_matrix(j.link.inertia), f"{jf(i)}.link")
+            link = expansions[i][-1]
+            inertia = (inertia_matrix(j.link.inertia) if j.link.izz is None
+                       else lamina(link, j.link.izz, f"{jf(i)}.link.izz"))
+            add_body(names[i], "link", link, j.link.mass, j.link.com, inertia, f"{jf(i)}.link")
     for b_i, b in enumerate(m.bodies):
         f = f"{field}.bodies[{b_i}]"
         link = resolve(b.link, f"{f}.link", "link")
         R = rotation_rpy(b.rpy)
-        add_body(b.name, b.kind, link, b.mass, b.com, R @ inertia_matrix(b.inertia) @ R.T, f"{f}.name")
+        inertia = R @ inertia_matrix(b.inertia) @ R.T if b.izz is None else lamina(link, b.izz, f"{f}.izz")
+        add_body(b.name, b.kind, link, b.mass, b.com, inertia, f"{f}.name")
 
     frames: list[FrameSpec] = []
     frame_field: dict[str, str] = {}

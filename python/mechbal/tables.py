@@ -88,23 +88,46 @@ def _is_number(x: Any) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
+#: the named form of an inertia in TOML, ``inertia = {ixx = .., iyy = .., izz = .., ixy = ..,
+#: ixz = .., iyz = ..}``, in the order of the six-value list form (products absent are 0)
+INERTIA_KEYS = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+
+
 def inertia_matrix(value: Any) -> np.ndarray:
-    """An inertia tensor about the centre of mass [kg m^2] from a 3x3 list, three principal
-    moments [Ixx, Iyy, Izz] or six values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]; it must be symmetric,
-    positive semi-definite and satisfy the triangle inequality of a physical body (the checks of
-    the C++ ``validate_rigid_body``). Raises a pydantic error (inside models) naming the entry."""
-    shape = "must be a 3x3 matrix, [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]"
-    if not isinstance(value, list):
+    """An inertia tensor about the centre of mass [kg m^2] from a table of named entries
+    ``{ixx, iyy, izz, ixy, ixz, iyz}`` (the three moments required, absent products 0, no other
+    key), six values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], three principal moments [Ixx, Iyy, Izz] or a
+    3x3 list; it must be symmetric, positive semi-definite and satisfy the triangle inequality of
+    a physical body (the checks of the C++ ``validate_rigid_body``). Raises a pydantic error
+    (inside models) naming the entry."""
+    shape = ("must be a table {ixx, iyy, izz, ixy, ixz, iyz}, a 3x3 matrix, [Ixx, Iyy, Izz] or "
+             "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]")
+    named = isinstance(value, dict)
+    if named:
+        for key in value:
+            if key not in INERTIA_KEYS:
+                absent = [k for k in INERTIA_KEYS if k not in value]
+                hint = did_you_mean(str(key), absent)
+                if "did you" not in hint:
+                    hint = did_you_mean(str(key), list(INERTIA_KEYS))
+                raise _custom("unknown key" + hint, f".{key}", has_value=False)
+        for key in INERTIA_KEYS[:3]:
+            if key not in value:
+                raise _custom("is required", f".{key}", has_value=False)
+        entries = [(f".{k}", value[k]) for k in INERTIA_KEYS if k in value]
+        rows = []
+    elif not isinstance(value, list):
         raise _custom(shape, value=value)
-    rows = [x for x in value if isinstance(x, list)]
-    if rows and (len(value) != 3 or len(rows) != 3):
-        raise _custom(shape, value=value)
-    entries = ([(f"[{i}][{k}]", x) for i, r in enumerate(value) for k, x in enumerate(r)] if rows
-               else [(f"[{i}]", x) for i, x in enumerate(value)])
-    if rows and any(len(r) != 3 for r in value):
-        raise _custom(shape, value=value)
-    if not rows and len(value) not in (3, 6):
-        raise _custom(shape, value=value)
+    else:
+        rows = [x for x in value if isinstance(x, list)]
+        if rows and (len(value) != 3 or len(rows) != 3):
+            raise _custom(shape, value=value)
+        entries = ([(f"[{i}][{k}]", x) for i, r in enumerate(value) for k, x in enumerate(r)] if rows
+                   else [(f"[{i}]", x) for i, x in enumerate(value)])
+        if rows and any(len(r) != 3 for r in value):
+            raise _custom(shape, value=value)
+        if not rows and len(value) not in (3, 6):
+            raise _custom(shape, value=value)
     for sub, x in entries:
         if not _is_number(x):
             raise _custom("must be a number", sub, x)
@@ -115,7 +138,7 @@ def inertia_matrix(value: Any) -> np.ndarray:
     if rows:
         inertia = np.array(value, dtype=float)
     else:
-        v = np.array(value, dtype=float)
+        v = np.array([value.get(k, 0.0) for k in INERTIA_KEYS] if named else value, dtype=float)
         inertia = np.diag(v[:3])
         if len(v) == 6:
             inertia[0, 1] = inertia[1, 0] = v[3]
@@ -141,9 +164,12 @@ def _check_inertia(value: Any) -> Any:
 
 
 _INERTIA_JSON = {
-    "description": "kg m^2, about the centre of mass: [Ixx, Iyy, Izz], [Ixx, Iyy, Izz, Ixy, Ixz, "
-                   "Iyz] or a 3x3 matrix (symmetric, positive semi-definite, triangle inequality)",
+    "description": "kg m^2, about the centre of mass: {ixx, iyy, izz, ixy, ixz, iyz} (products "
+                   "absent are 0), [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], [Ixx, Iyy, Izz] or a 3x3 matrix "
+                   "(symmetric, positive semi-definite, triangle inequality)",
     "anyOf": [
+        {"type": "object", "required": ["ixx", "iyy", "izz"], "additionalProperties": False,
+         "properties": {k: {"type": "number"} for k in INERTIA_KEYS}},
         {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3},
         {"type": "array", "items": {"type": "number"}, "minItems": 6, "maxItems": 6},
         {"type": "array", "minItems": 3, "maxItems": 3,
@@ -201,12 +227,47 @@ class Mimic(Table):
     offset: Num = 0.0
 
 
+#: ``izz`` alone (planar mechanisms): the moment about the normal of the plane of motion [kg m^2]
+Izz = Annotated[float, Field(ge=0, le=MAX_ABS, description="kg m^2, about the axis through the centre of "
+                             "mass normal to the plane of motion (the joints' common axis); planar "
+                             "mechanisms only, instead of inertia: a thin lamina in the plane of motion, "
+                             "izz / 2 about every in-plane axis", **_NUM)]
+
+
+def lamina_inertia(izz: float, normal=(0.0, 0.0, 1.0)) -> np.ndarray:
+    """The inertia of ``izz`` given alone: a thin lamina in the plane normal to ``normal`` (in the
+    body's axes): ``izz`` about the normal, ``izz / 2`` about every axis in the plane
+    (perpendicular axis theorem: the two in-plane moments add up to izz), no products in those
+    axes: ``izz / 2 (1 + n n^T)``. In planar motion (rotation about the normal only) the in-plane
+    moments enter no result; this is the physical body with the least of them."""
+    n = np.asarray(normal, dtype=float)
+    n = n / np.linalg.norm(n)
+    return 0.5 * float(izz) * (np.eye(3) + np.outer(n, n))
+
+
+def _one_inertia(table: Any):
+    if table.inertia is None and table.izz is None:
+        raise _custom("is required (or izz alone, for a planar mechanism)", ".inertia", None, has_value=False)
+    if table.inertia is not None and table.izz is not None:
+        raise _custom("give inertia or izz, not both", ".izz", table.izz)
+    if table.izz is not None and "rpy" in table.model_fields_set:
+        raise _custom("orients the inertia axes; izz alone is about the plane's normal: drop rpy", ".rpy",
+                      table.rpy)
+    return table
+
+
 class LinkInertial(Table):
     """The link's own body, in the link frame (the frame right after the joint's motion; for a
-    ``dh`` joint the standard DH frame of the link)."""
+    ``dh`` joint the standard DH frame of the link). ``inertia``, or ``izz`` alone where the
+    mechanism is planar."""
     mass: Mass
     com: Xyz = [0.0, 0.0, 0.0]
-    inertia: Inertia
+    inertia: Optional[Inertia] = None
+    izz: Optional[Izz] = None
+
+    @model_validator(mode="after")
+    def _inertia(self):
+        return _one_inertia(self)
 
 
 JointType = Literal["revolute", "prismatic", "fixed", "spherical"]
@@ -257,8 +318,13 @@ class Body(Table):
     link: Name = Field(description="name of the joint whose link carries it, or 'base'")
     mass: Mass
     com: Xyz = Field([0.0, 0.0, 0.0], description="m, in the link frame")
-    inertia: Inertia
+    inertia: Optional[Inertia] = None
+    izz: Optional[Izz] = None
     rpy: Rpy = Field([0.0, 0.0, 0.0], description="rad, orientation of the inertia axes in the link frame")
+
+    @model_validator(mode="after")
+    def _inertia(self):
+        return _one_inertia(self)
 
 
 class Frame(Table):
@@ -315,18 +381,116 @@ class Mechanism(Table):
     springs: Annotated[list[MechanismSpring], Field(max_length=MAX_BODIES)] = []
 
 
+#: the time laws of ``[trajectory]``: rest-to-rest (quintic, minimum-energy cubic) or a steady
+#: rotation at constant speed
+TrajectoryLaw = Literal["quintic", "cubic", "constant_speed"]
+def _check_speeds(value: Any) -> Any:
+    """A speed or rpm: a number, or a list of 1 .. MAX_JOINTS numbers (finite, within MAX_ABS)."""
+    entries = [("", value)]
+    if isinstance(value, list):
+        if not 1 <= len(value) <= MAX_JOINTS:
+            raise _custom(f"must have 1 to {MAX_JOINTS} values (one per actuated joint), or be one number",
+                          value=value)
+        entries = [(f"[{i}]", x) for i, x in enumerate(value)]
+    for sub, x in entries:
+        if not _is_number(x):
+            raise _custom("must be a number, or a list of numbers (one per actuated joint)" if not sub
+                          else "must be a number", sub, x)
+        if not math.isfinite(x):
+            raise _custom("must be finite", sub, x)
+        if abs(x) > MAX_ABS:
+            raise _custom(f"must be between -{_fmt(MAX_ABS)} and {_fmt(MAX_ABS)}", sub, x)
+    return value
+
+
+_SPEEDS_JSON = {"anyOf": [{"type": "number"},
+                          {"type": "array", "items": {"type": "number"}, "minItems": 1, "maxItems": MAX_JOINTS}]}
+#: a speed [rad/s or m/s] or rpm: one number for every actuated joint, or one per actuated joint
+Speeds = Annotated[Any, AfterValidator(_check_speeds), WithJsonSchema(_SPEEDS_JSON)]
+RPM_TO_RAD_S = 2.0 * math.pi / 60.0
+
+
 class ChainTrajectory(Table):
-    """``[trajectory]``: rest-to-rest motion of the actuated joints (every independent joint of an
-    open mechanism)."""
-    law: Literal["quintic", "cubic"] = "quintic"
+    """``[trajectory]``: the motion of the actuated joints (every independent joint of an open
+    mechanism). ``law = "quintic" | "cubic"``: rest-to-rest from ``start`` to ``end`` in
+    ``duration``; ``law = "constant_speed"``: from ``start`` at ``speed`` [rad/s or m/s] or ``rpm``
+    (exactly one) for ``duration`` seconds or ``revolutions`` turns (exactly one) of the fastest
+    joint."""
+    law: TrajectoryLaw = "quintic"
     start: JointValues = Field(description="one value per actuated joint (rad or m)")
-    end: JointValues = Field(description="one value per actuated joint (rad or m)")
-    duration: Duration
+    end: Optional[JointValues] = Field(None, description="rest-to-rest laws: one value per actuated joint (rad or m)")
+    duration: Optional[Duration] = Field(None, description="s; constant_speed: or revolutions")
+    speed: Optional[Speeds] = Field(
+        None, description="constant_speed: rad/s (or m/s), one number for every actuated joint or one "
+                          "per actuated joint; or rpm")
+    rpm: Optional[Speeds] = Field(
+        None, description="constant_speed: revolutions per minute, one number for every actuated joint "
+                          "or one per actuated joint; or speed")
+    revolutions: Optional[Annotated[float, Field(gt=0, le=1e6, **_NUM)]] = Field(
+        None, description="constant_speed: turns of the fastest joint (duration = revolutions 2 pi / "
+                          "max |speed|); or duration")
     samples: Samples = 501
     initial_guess: Optional[JointValues] = Field(
-        None, description="closed mechanisms: every joint coordinate near the assembly at start "
-                          "(picks the assembly mode of the loops), rad or m")
+        None, description="closed mechanisms: every joint coordinate near the assembly at start, or "
+                          "the actuated joints only (the passive ones are then solved on `branch`), "
+                          "rad or m")
+    branch: Optional[Literal["open", "crossed"]] = Field(
+        None, description="closed mechanisms whose loops are four-bar-like (four parallel pivots): the "
+                          "assembly at start; default open unless a full initial_guess picks it")
 
+    @model_validator(mode="after")
+    def _law_keys(self):
+        if self.law == "constant_speed":
+            for key in ("end",):
+                if getattr(self, key) is not None:
+                    raise _custom("is for the rest-to-rest laws (quintic, cubic); a constant-speed "
+                                  "motion has start, speed or rpm, and duration or revolutions",
+                                  f".{key}", getattr(self, key))
+            given = [k for k in ("speed", "rpm") if getattr(self, k) is not None]
+            if len(given) != 1:
+                if given:
+                    raise _custom("give speed (rad/s) or rpm, not both", ".rpm", self.rpm)
+                raise _custom("law = 'constant_speed' needs speed (rad/s) or rpm", ".speed", None,
+                              has_value=False)
+            timed = [k for k in ("duration", "revolutions") if getattr(self, k) is not None]
+            if len(timed) != 1:
+                if timed:
+                    raise _custom("give duration or revolutions, not both", ".revolutions", self.revolutions)
+                raise _custom("law = 'constant_speed' needs duration (s) or revolutions", ".duration",
+                              None, has_value=False)
+            if self.revolutions is not None and max(abs(x) for x in self.speeds(len(self.start))) == 0.0:
+                raise _custom("needs a non-zero speed (every speed is 0)", ".revolutions", self.revolutions)
+            if self.revolutions is not None and not 1e-3 <= self.motion_duration() <= 1e6:
+                raise _custom(f"gives a duration of {self.motion_duration():.6g} s, outside 0.001 .. "
+                              "1000000 s", ".revolutions", self.revolutions)
+        else:
+            for key in ("speed", "rpm", "revolutions"):
+                if getattr(self, key) is not None:
+                    raise _custom(f"is for law = 'constant_speed' (law is '{self.law}')", f".{key}",
+                                  getattr(self, key))
+            if self.end is None:
+                raise _custom(f"law = '{self.law}' needs end", ".end", None, has_value=False)
+            if self.duration is None:
+                raise _custom(f"law = '{self.law}' needs duration", ".duration", None, has_value=False)
+        return self
+
+    def speeds(self, n: int) -> list[float]:
+        """constant_speed: the speed of each of ``n`` actuated joints [rad/s or m/s] (rpm
+        converted; one number applies to every joint). A list of another length is returned as
+        given (the cross checks name it)."""
+        key = "speed" if self.speed is not None else "rpm"
+        value = getattr(self, key)
+        scale = 1.0 if key == "speed" else RPM_TO_RAD_S
+        if isinstance(value, list):
+            return [float(x) * scale for x in value]
+        return [float(value) * scale] * n
+
+    def motion_duration(self) -> float:
+        """The motion's duration [s] (constant_speed with revolutions: revolutions 2 pi / max |speed|)."""
+        if self.duration is not None:
+            return float(self.duration)
+        top = max(abs(x) for x in self.speeds(len(self.start)))
+        return float(self.revolutions) * 2.0 * math.pi / top
 
 
 # ---- error messages -----------------------------------------------------------------------------

@@ -30,7 +30,8 @@ gravity = [0.0, 0.0, -9.81]   # m/s^2 in the base frame
 #          or dh  = { a, alpha, d, theta }   standard Denavit-Hartenberg parameters
 #            (DH joints move about/along their z axis: no axis key)
 #   link = { mass, com, inertia }   the link after the joint: mass [kg], centre of mass [m] in the
-#          joint frame, inertia about the centre of mass [kg m^2] as [Ixx, Iyy, Izz],
+#          joint frame, inertia about the centre of mass [kg m^2] as
+#          { ixx, iyy, izz, ixy, ixz, iyz } (products absent: 0), [Ixx, Iyy, Izz],
 #          [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix
 
 [[mechanism.joints]]
@@ -45,18 +46,20 @@ name = "elbow"
 type = "revolute"
 origin = { xyz = [0.5, 0.0, 0.0] }   # 0.5 m along the first link
 axis = [0.0, -1.0, 0.0]
-link = { mass = 2.0, com = [0.2, 0.0, 0.0], inertia = [0.002, 0.03, 0.03] }
+link = { mass = 2.0, com = [0.2, 0.0, 0.0], inertia = { ixx = 0.002, iyy = 0.03, izz = 0.03 } }
 
 [trajectory]
-law = "quintic"               # quintic | cubic (minimum energy)
+law = "quintic"               # quintic | cubic (minimum energy) | constant_speed
 start = [0.0, 0.0]            # one value per joint [rad or m]
-end = [1.2, -0.9]
+end = [1.2, -0.9]             # rest-to-rest laws
 duration = 1.0                # s
 samples = 501                 # instants evaluated (at least 3)
+# law = "constant_speed" instead: start, then speed = [1.0, -2.0] (rad/s, or one number for
+# every joint) or rpm = ..., and duration or revolutions = 2 (turns of the fastest joint); no end
 '''
 
 LINKAGE = r'''# A mechbal case: a closed linkage (here a four-bar in the vertical x-z plane with a
-# counterweight on its crank) moving along a rest-to-rest motion of its actuated joint. Run it with
+# counterweight on its crank) driven by its crank at constant speed. Run it with
 #     mechbal run my.toml --out out/my
 # to get out/my/summary.json (peak shaking force and moment, actuator and base-reaction torques),
 # PNG plots and out/my/bodies_nominal.npz (every body's pose along the motion).
@@ -90,8 +93,11 @@ actuated = ["crank"]          # the motor-driven joints (one per degree of freed
 #   origin = { xyz = [...], rpy = [...] }  the joint frame in the parent link's frame
 #   axis    the joint axis in that frame
 #   link = { mass, com, inertia }  the link after the joint: mass [kg], centre of mass [m] in the
-#           joint frame, inertia about the centre of mass [kg m^2] as [Ixx, Iyy, Izz],
-#           [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix
+#           joint frame, inertia about the centre of mass [kg m^2] as
+#           { ixx, iyy, izz, ixy, ixz, iyz } (products absent: 0), [Ixx, Iyy, Izz],
+#           [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix; or, the linkage being planar,
+#           izz = ... alone: the moment about the joints' common axis (here y), the link taken
+#           as a thin lamina in the plane of motion
 
 [[mechanism.joints]]
 name = "crank"
@@ -105,7 +111,7 @@ name = "coupler"
 parent = "crank"
 origin = { xyz = [0.2, 0.0, 0.0] }   # at the crank's end: crank length 0.2 m
 axis = [0.0, -1.0, 0.0]
-link = { mass = 1.5, com = [0.25, 0.0, 0.0], inertia = [0.0005, 0.032, 0.032] }
+link = { mass = 1.5, com = [0.25, 0.0, 0.0], izz = 0.032 }   # planar: the moment about y alone
 
 [[mechanism.joints]]
 name = "rocker"
@@ -148,14 +154,17 @@ frame_a = "coupler_tip"
 frame_b = "rocker_tip"
 
 [trajectory]
-law = "quintic"               # quintic | cubic (minimum energy)
+law = "constant_speed"        # the crank turning steadily; or quintic | cubic (rest to rest:
+                              # start, end, duration)
 start = [1.0]                 # one value per actuated joint [rad or m]
-end = [2.2]
-duration = 1.0                # s
+rpm = 60                      # or speed = 6.283 (rad/s); one number, or one per actuated joint
+revolutions = 1               # turns of the crank; or duration = 1.0 (s)
 samples = 1001                # instants evaluated (at least 3)
-initial_guess = [1.0, -0.6, 1.3]  # every joint (crank, coupler, rocker) near the assembly at
-                                  # start [rad]: picks which of the linkage's assembly modes
-                                  # (elbow up or down) is followed
+branch = "open"               # the four-bar's assembly: "open" (the default) or "crossed";
+                              # summary.json says which was used
+# initial_guess = [1.0]       # or: the actuated joints only (the passive ones are solved on
+                              # branch), or every joint (crank, coupler, rocker) near the wanted
+                              # assembly at start [rad]
 '''
 
 REACTIONLESS = '''\

@@ -13,6 +13,8 @@ last point at rest (zero velocity and acceleration), as the C++ ``RestToRestTraj
 * `quintic`: rest-to-rest, `s = 10 u^3 - 15 u^4 + 6 u^5` (the C++ `RestToRestTrajectory`);
 * `minimum_energy_cubic`: rest-to-rest, `s = 3 u^2 - 2 u^3`, the law of least integral of
   squared acceleration (Arakelian, Le Baron & Mottu 2011, eq 13);
+* `ConstantSpeed`: a steady motion from ``start`` at constant ``speed`` (a crank turning at so
+  many rpm, the motion balancing textbooks quote);
 * `ViaPoints`: a piecewise quintic through given points at given times;
 * `Sampled`: a user's time series, interpolated by cubic splines.
 
@@ -30,7 +32,7 @@ import numpy.typing as npt
 
 from mechbal import _core
 
-__all__ = ["Trajectory", "RestToRest", "quintic", "minimum_energy_cubic", "ViaPoints", "Sampled",
+__all__ = ["Trajectory", "RestToRest", "quintic", "minimum_energy_cubic", "ConstantSpeed", "ViaPoints", "Sampled",
            "TimeLaw", "RestToRestTrajectory"]
 
 TimeLaw = _core.TimeLaw
@@ -158,6 +160,87 @@ def minimum_energy_cubic(start: ArrayLike, end: ArrayLike, duration: float) -> R
     Mottu 2011, eq 13): least integral of squared acceleration between two rests; positions
     [rad or m], duration [s]."""
     return RestToRest(start, end, duration, "cubic")
+
+
+class ConstantSpeed:
+    """Steady motion at constant speed: ``q(t) = start + speed t``, ``qd = speed``, ``qdd = 0``
+    for ``0 <= t <= duration`` (a crank turning at so many rpm). Outside ``[0, duration]`` it holds
+    its first or last point at rest, as every trajectory here does.
+
+    Args:
+        start: initial positions [rad or m], one per coordinate.
+        speed: speeds [rad/s or m/s], one per coordinate (a number: the same for every one).
+        duration: motion time [s], > 0.
+    """
+
+    law = "constant_speed"
+
+    def __init__(self, start: ArrayLike, speed: ArrayLike, duration: float):
+        q0 = _vector("start", start).reshape(-1)
+        w = _vector("speed", speed).reshape(-1)
+        if w.size == 1 and q0.size > 1:
+            w = np.full(q0.size, float(w[0]))
+        if w.shape != q0.shape:
+            raise ValueError(f"speed must have {q0.size} values (one per coordinate), got {w.size}")
+        if isinstance(duration, bool) or not isinstance(duration, (int, float, np.integer, np.floating)) \
+                or not np.isfinite(duration) or duration <= 0:
+            raise ValueError(f"duration must be a finite number of seconds > 0, got {duration!r}")
+        self.start, self.speed, self._duration = q0, w, float(duration)
+        if not np.all(np.isfinite(q0 + w * self._duration)):
+            raise ValueError("ConstantSpeed: start + speed * duration overflows")
+
+    @classmethod
+    def from_rpm(cls, start: ArrayLike, rpm: ArrayLike, *, duration: float | None = None,
+                 revolutions: float | None = None) -> "ConstantSpeed":
+        """From revolutions per minute, over ``duration`` [s] or ``revolutions`` turns of the
+        fastest coordinate (exactly one of them)."""
+        w = _vector("rpm", rpm) * (2.0 * np.pi / 60.0)
+        if (duration is None) == (revolutions is None):
+            raise ValueError("give duration or revolutions (exactly one)")
+        if revolutions is None:
+            assert duration is not None   # exactly one of them (checked above)
+            return cls(start, w, float(duration))
+        top = float(np.max(np.abs(w)))
+        if top == 0.0 or not revolutions > 0:
+            raise ValueError("revolutions needs a non-zero rpm and revolutions > 0")
+        return cls(start, w, float(revolutions) * 2.0 * np.pi / top)
+
+    @property
+    def dof(self) -> int:
+        """Number of coordinates."""
+        return int(self.start.size)
+
+    @property
+    def duration(self) -> float:
+        """Motion time [s]."""
+        return self._duration
+
+    @property
+    def end_time(self) -> float:
+        """Time the motion ends [s] (= ``duration``)."""
+        return self._duration
+
+    @property
+    def end(self) -> np.ndarray:
+        """Positions at the end [rad or m]."""
+        return self.start + self.speed * self._duration
+
+    def evaluate(self, t: Times) -> Motion:
+        """``(q, qd, qdd)`` at ``t`` [s]: ``(dof,)`` each for a number, ``(N, dof)`` for N times."""
+        single, ts = _times(t)
+        tc = np.clip(ts, 0.0, self._duration)[:, None]
+        inside = ((ts >= 0.0) & (ts <= self._duration))[:, None]
+        q = self.start + self.speed * tc
+        qd = np.where(inside, self.speed, 0.0)
+        qdd = np.zeros_like(q)
+        return _finite_motion("ConstantSpeed", single, q, qd, qdd)
+
+    def evaluate_batch(self, t: ArrayLike) -> Motion:
+        """``(q, qd, qdd)`` (N, dof) at N times (the interface of the C++ trajectories)."""
+        return self.evaluate(np.atleast_1d(np.asarray(t, float)))
+
+    def __repr__(self) -> str:
+        return f"<ConstantSpeed {self.dof} coordinates at {self.speed.tolist()} rad/s, {self.duration:g} s>"
 
 
 class _OverTimes:

@@ -202,7 +202,7 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
                + (["shaking_wrench.png"] if simulate else [])}
     if notes:
         summary["notes"] = notes
-    write_summary(out / "summary.json", summary)
+    write_summary(out / "summary.json", summary, command="verify")
     print(report.table(rows, ["variant", "quantity", "unit", "mechbal peak", "MuJoCo peak (inverse)",
                               "relative difference", "MuJoCo peak (simulated)"]))
     return summary
@@ -252,28 +252,28 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3) -> dict:
                        title=f"{bc.title}: tracking in MuJoCo")
     diff_F = _peak(cs.base_reaction_force - cs.predicted_base_reaction_force)
     diff_M = _peak(cs.base_reaction_moment - cs.predicted_base_reaction_moment)
-    summary = {"case": bc.name, "engine": "mujoco", "mechanism": repr(mech), "dt_s": dt,
+    summary = {"case": bc.name, "engine": "mujoco", "mechanism": repr(mech), "dt": dt,
                "controller": f"computed torque, Kp {KP:g} 1/s^2, Kd {KD:g} 1/s (mechbal's model)",
                "ok": bool(np.all(cs.status == 0)), "steps_completed": cs.steps_completed,
                "peak_tracking_error": _peak(cs.tracking_error),
                "max_constraint_violation": _peak(cs.constraint_violation),
                "base_reaction": {
                    "definition": "wrench the base exerts on the moving mechanism, gravity included, moment about O",
-                   "peak_force_mujoco_N": _peak(cs.base_reaction_force),
-                   "peak_force_mechbal_N": _peak(cs.predicted_base_reaction_force),
-                   "max_force_difference_N": diff_F,
-                   "peak_moment_mujoco_Nm": _peak(cs.base_reaction_moment),
-                   "peak_moment_mechbal_Nm": _peak(cs.predicted_base_reaction_moment),
-                   "max_moment_difference_Nm": diff_M},
-               "shaking_wrench": {"peak_force_mujoco_N": _peak(cs.shaking_force),
-                                  "peak_force_mechbal_N": _peak(cs.predicted_shaking_force),
-                                  "peak_moment_mujoco_Nm": _peak(cs.shaking_moment),
-                                  "peak_moment_mechbal_Nm": _peak(cs.predicted_shaking_moment)},
+                   "peak_force_mujoco": _peak(cs.base_reaction_force),
+                   "peak_force_mechbal": _peak(cs.predicted_base_reaction_force),
+                   "max_force_difference": diff_F,
+                   "peak_moment_mujoco": _peak(cs.base_reaction_moment),
+                   "peak_moment_mechbal": _peak(cs.predicted_base_reaction_moment),
+                   "max_moment_difference": diff_M},
+               "shaking_wrench": {"peak_force_mujoco": _peak(cs.shaking_force),
+                                  "peak_force_mechbal": _peak(cs.predicted_shaking_force),
+                                  "peak_moment_mujoco": _peak(cs.shaking_moment),
+                                  "peak_moment_mechbal": _peak(cs.predicted_shaking_moment)},
                "files": ["summary.json", "base_reaction.png", "tracking.png", "cosimulation.npz", "mechanism.xml"]}
     write_summary(out / "summary.json", summary)
-    print(report.table([["force [N]", summary["base_reaction"]["peak_force_mechbal_N"],
-                         summary["base_reaction"]["peak_force_mujoco_N"], diff_F],
-                        ["moment [N m]", summary["base_reaction"]["peak_moment_mechbal_Nm"],
-                         summary["base_reaction"]["peak_moment_mujoco_Nm"], diff_M]],
+    print(report.table([["force [N]", summary["base_reaction"]["peak_force_mechbal"],
+                         summary["base_reaction"]["peak_force_mujoco"], diff_F],
+                        ["moment [N m]", summary["base_reaction"]["peak_moment_mechbal"],
+                         summary["base_reaction"]["peak_moment_mujoco"], diff_M]],
                        ["base reaction", "mechbal peak", "MuJoCo peak", "max difference"]))
     return summary

@@ -148,6 +148,16 @@ int main() {
     check(st == mechbal::Status::ok && std::abs(tau(0) - 5.0) < 1e-12, "DecoupledJointController");
   }
 
+  // no controller: zero effort (a passive simulation's command)
+  {
+    mechbal::PassiveController passive(2);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(2), q = Eigen::VectorXd::Ones(2);
+    Eigen::VectorXd tau = Eigen::VectorXd::Ones(2);
+    const mechbal::Status st = passive.step(q, q, zero, zero, zero, tau);
+    std::printf("PassiveController: %s\n", mechbal::status_name(st));
+    check(st == mechbal::Status::ok && tau.isZero(0.0), "PassiveController");
+  }
+
   // closed loop on the closed-form arm
   {
     const Eigen::VectorXd gains = Eigen::VectorXd::Constant(2, 100.0);

@@ -1,4 +1,4 @@
-// Real-time contract: the single-instant functions allocate nothing (DESIGN.md).
+// Real-time contract: the single-instant functions allocate nothing (docs/architecture.md).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -225,3 +225,64 @@ TEST(MakeController, MadeControllersStepWithoutAllocating) {
   EXPECT_EQ(ok, 50);
   EXPECT_TRUE(tau.allFinite());
 }
+
+TEST(CaseReader, ConstantSpeedTrajectory) {
+  const std::string base = arm("origin") + "[case]\nname = \"arm\"\nkind = \"mechanism\"\n";
+  const LoadedCase c = case_from_string(base + "[trajectory]\nlaw = \"constant_speed\"\nstart = [0.1, 0.2]\n"
+                                               "rpm = 30\nrevolutions = 2\nsamples = 11\n");
+  ASSERT_TRUE(c.trajectory.constant_speed);
+  ASSERT_EQ(c.trajectory.speed.size(), 2u);
+  EXPECT_DOUBLE_EQ(c.trajectory.speed[0], M_PI);  // 30 rpm, one number for both joints
+  EXPECT_DOUBLE_EQ(c.trajectory.speed[1], M_PI);
+  EXPECT_DOUBLE_EQ(c.trajectory.duration, 4.0);   // two turns at pi rad/s
+  const LoadedCase d = case_from_string(base + "[trajectory]\nlaw = \"constant_speed\"\nstart = [0.1, 0.2]\n"
+                                               "speed = [1.0, -2.0]\nduration = 0.5\n");
+  EXPECT_EQ(d.trajectory.speed, (std::vector<double>{1.0, -2.0}));
+  EXPECT_DOUBLE_EQ(d.trajectory.duration, 0.5);
+  auto refused = [&](const std::string& table, const std::string& field) {
+    const std::string msg = message_of(base + "[trajectory]\n" + table);
+    EXPECT_EQ(msg.rfind(field + ": ", 0), 0u) << msg;
+  };
+  refused("law = \"constant_speed\"\nstart = [0, 0]\nspeed = 1.0\nrpm = 2.0\nduration = 1.0\n", "trajectory.rpm");
+  refused("law = \"constant_speed\"\nstart = [0, 0]\nduration = 1.0\n", "trajectory.speed");
+  refused("law = \"constant_speed\"\nstart = [0, 0]\nrpm = 60\n", "trajectory.duration");
+  refused("law = \"constant_speed\"\nstart = [0, 0]\nrpm = 60\nend = [1, 1]\nduration = 1.0\n", "trajectory.end");
+  refused("law = \"constant_speed\"\nstart = [0, 0]\nrpm = 0\nrevolutions = 1\n", "trajectory.revolutions");
+  refused("law = \"constant_speed\"\nstart = [0, 0]\nspeed = [1, 2, 3]\nduration = 1.0\n", "trajectory.speed");
+  refused("start = [0, 0]\nend = [1, 1]\nduration = 1.0\nrpm = 60\n", "trajectory.rpm");
+  refused("start = [0, 0]\nend = [1, 1]\nduration = 1.0\nbranch = \"open\"\n", "trajectory.branch");  // no loop
+}
+
+TEST(CaseReader, PlanarIzzIsALamina) {
+  // the 2R arm turns about z: izz alone is accepted and is the lamina diag(izz/2, izz/2, izz)
+  const std::string planar = "[mechanism]\n[[mechanism.joints]]\nname = \"a\"\nlink = {mass = 1.0, izz = 0.4}\n"
+                             "[[mechanism.joints]]\nname = \"b\"\norigin = {xyz = [0.7, 0, 0]}\naxis = [0, 0, -1]\n"
+                             "link = {mass = 1.0, com = [0.2, 0, 0], izz = 0.2}\n";
+  const MechanismModel m = mechanism_from_string(planar);
+  EXPECT_TRUE(m.description().bodies[0].inertia.isApprox(Eigen::Vector3d(0.2, 0.2, 0.4).asDiagonal().toDenseMatrix()));
+  // a joint about x makes it spatial: refused, naming the field
+  std::string spatial = planar;
+  spatial.replace(spatial.find("axis = [0, 0, -1]"), 17, "axis = [1, 0, 0] ");
+  EXPECT_EQ(field_of(spatial), "mechanism.joints[0].link.izz");
+  std::string both = planar;
+  both.replace(both.find("izz = 0.4"), 9, "izz = 0.4, inertia = [1, 1, 1]");
+  EXPECT_EQ(field_of(both), "mechanism.joints[0].link.izz");
+}
+
+TEST(MakeController, PassiveCommandsZeroWithoutAllocating) {
+  const LoadedCase c = case_from_string(arm("origin") + "[control]\nkind = \"passive\"\nrate_hz = 500\n");
+  EXPECT_EQ(c.control.kind, ControlKind::passive);
+  EXPECT_EQ(std::string(control_kind_name(c.control.kind)), "passive");
+  auto passive = make_controller(c.model, c.control);
+  ASSERT_EQ(passive->dof(), 2);
+  Eigen::Vector2d q(0.3, -0.7), qd(0.5, -0.2), tau(1.0, 1.0), bad(std::nan(""), 0.0);
+  {
+    test::AllocationScope scope;
+    EXPECT_EQ(passive->step(q, qd, q, qd, qd, tau), Status::ok);
+    EXPECT_EQ(passive->step(bad, qd, q, qd, qd, tau), Status::non_finite_input);
+    EXPECT_EQ(scope.count(), 0u);
+  }
+  EXPECT_EQ(tau, Eigen::Vector2d::Zero());
+  EXPECT_NE(message_of(arm("origin") + "[control]\nkind = \"passive\"\nkp = [1, 1]\n").find("control.kp: is not for kind = 'passive'"),
+            std::string::npos);
+}

@@ -51,3 +51,34 @@ def demo_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("arm2link")
     summary = run_case("arm2link", out)
     return out, summary
+
+
+@pytest.fixture(scope="session", autouse=True)
+def every_summary_follows_the_schema(tmp_path_factory):
+    """At the end of the session, every summary.json that the tests wrote under the session's
+    temporary folder (run, balance, verify, sweep, through the API or the command line) is
+    validated against the shipped JSON Schema (mechbal/cases/summary.schema.json): an error here
+    names each file and what is wrong with it."""
+    yield
+    try:
+        import jsonschema
+    except ImportError:  # the test extra is not installed: test_summary_schema.py is skipped too
+        return
+    import json
+    from pathlib import Path
+
+    schema = json.loads((Path(mechbal.__file__).resolve().parent / "cases" / "summary.schema.json").read_text())
+    check = jsonschema.Draft202012Validator(schema)
+    bad = []
+    for path in sorted(Path(tmp_path_factory.getbasetemp()).rglob("summary.json")):
+        try:
+            data = json.loads(path.read_text())
+        except (OSError, ValueError):
+            continue  # a test's own broken file (the CLI's refusal of a damaged run folder)
+        if not isinstance(data, dict) or not {"schema_version", "command", "case", "sweep"} & set(data):
+            continue  # not a mechbal summary (a test's planted marker file)
+        problems = [f"{'.'.join(map(str, e.absolute_path)) or '<top>'}: {e.message[:200]}"
+                    for e in check.iter_errors(data)]
+        if problems:
+            bad.append(f"{path}:\n    " + "\n    ".join(problems[:5]))
+    assert not bad, "summary.json files that do not follow the schema:\n" + "\n".join(bad[:20])

@@ -12,7 +12,7 @@ import mechbal
 from mechbal import control, papers, simulate, trajectory
 
 PUBLIC = ["mechbal", "mechbal.mechanism", "mechbal.control", "mechbal.trajectory",
-          "mechbal.simulate", "mechbal.papers", "mechbal.balance"]
+          "mechbal.simulate", "mechbal.assembly", "mechbal.papers", "mechbal.balance"]
 
 
 # ---- the surface -------------------------------------------------------------------------------

@@ -284,16 +284,16 @@ def arm2dof_run(tmp_path_factory):
 def test_case_reproduces_the_paper_or_records_why_not(arm2dof_run):
     out, s = arm2dof_run
     s = json.loads((out / "summary.json").read_text())
-    for key in ("r_cw_m", "paper_r_cw_m", "rms_torque_Nm", "peak_torque_Nm", "rms_reduction_pct",
-                "peak_reduction_pct", "first_step_readings", "max_tracking_error_rad",
+    for key in ("r_cw_general", "paper_r_cw", "rms_joint_torque", "peak_joint_torque", "rms_reduction_pct",
+                "peak_reduction_pct", "first_step_readings", "max_tracking_error",
                 "discrepancies"):
         assert key in s
     for k in ("A", "B", "C"):
-        assert len(s["rms_torque_Nm"][k]) == 2 and len(s["peak_torque_Nm"][k]) == 2
-    assert np.allclose(s["r_cw_m"], s["r_cw_numerical_m"], atol=1e-6)
+        assert len(s["rms_joint_torque"][k]) == 2 and len(s["peak_joint_torque"][k]) == 2
+    assert np.allclose(s["r_cw_general"], s["r_cw_numerical"], atol=1e-6)
     # sized by mechbal.balance.rms (Cardano on the torque regressor), the paper's cubic beside it
     r = s["r_cw"]
-    assert r["general_method"] == s["r_cw_m"] and r["general_method"] == pytest.approx([0.2509, 0.1913], abs=5e-5)
+    assert r["general_method"] == s["r_cw_general"] and r["general_method"] == pytest.approx([0.2509, 0.1913], abs=5e-5)
     assert r["max_abs_difference"] < 1e-10 < r["tolerance"]
     assert np.allclose(r["general_method"], r["closed_form"], atol=1e-10)
     assert r["method"]["coupling"] == "per_joint" and r["method"]["exact"]
@@ -307,16 +307,16 @@ def test_case_reproduces_the_paper_or_records_why_not(arm2dof_run):
     # paper radii: peaks within one point of the paper's 67/66 %
     assert np.allclose(s["peak_reduction_pct"]["C_paper_radii_vs_A"], [67, 66], atol=1.0)
     # our optimum beats the paper's radii on RMS at both joints
-    assert np.all(np.array(s["rms_torque_Nm"]["C"]) < np.array(s["rms_torque_Nm"]["C_paper_radii"]))
+    assert np.all(np.array(s["rms_joint_torque"]["C"]) < np.array(s["rms_joint_torque"]["C_paper_radii"]))
     assert any("0.147" in d for d in s["discrepancies"])
     assert s["kdl_vs_closed_form_max_rel_dev"] < 1e-9
     assert s["general_model_vs_closed_form_max_rel_dev"] < 1e-12
     cl = s["closed_loop"]
-    dev = cl["with_initial_error"]["max_deviation_from_eq6_rad"]
+    dev = cl["with_initial_error"]["max_deviation_from_eq6"]
     assert dev["exact_every_rk4_stage"] < 1e-6
     assert 1e-6 < dev["exact_zero_order_hold"] < 1e-3
     assert dev["perturbed_worst_corner"] > 1e-3
-    trk = s["max_tracking_error_rad"]
+    trk = s["max_tracking_error"]
     assert trk["exact"] < 1e-3 < trk["perturbed"] < 0.1
     assert cl["saturated_ticks"] > 0
 

@@ -60,7 +60,7 @@ def test_four_bar_force_balance_from_exported_poses(tmp_path):
     assert s["before_after"]["shaking_force"]["balanced"]["peak"] == pytest.approx(
         np.max(np.abs(b["shaking_force"]), axis=0).tolist(), abs=1e-15)
     assert main(["run", str(out / "balanced.toml"), "--out", str(tmp_path / "rerun"), "-q"]) == 0
-    assert summary_of(tmp_path / "rerun")["peak_shaking_force_N"]["nominal"] == pytest.approx([0, 0, 0], abs=1e-9)
+    assert summary_of(tmp_path / "rerun")["peak_shaking_force"]["nominal"] == pytest.approx([0, 0, 0], abs=1e-9)
 
 
 def random_arm_table(seed: int) -> dict:

@@ -36,7 +36,9 @@ def raising_case(tmp_path):
         (out / "partial.png").write_bytes(b"half a plot")
         if state["exc"] is not None:
             raise state["exc"]
-        export.write_summary(out / "summary.json", {"case": "raising", "value": state.get("value", 1.0)})
+        # a summary in the general runner's format (every summary.json follows the schema)
+        export.write_summary(out / "summary.json", {"case": "raising", "kind": "mechanism",
+                                                    "peak_shaking_force": {"nominal": state.get("value", [1.0])}})
         (out / "new.png").write_bytes(b"plot")
         return {"case": "raising"}
 
@@ -233,9 +235,9 @@ def test_summary_is_strict_json_with_notes(raising_case, tmp_path, capsys):
     assert main(["run", str(raising_case["path"]), "--out", str(tmp_path / "o")]) == 0
     text = (tmp_path / "o" / "summary.json").read_text()
     data = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-standard JSON {c}"))
-    assert data["value"] == [1.0, None, None]
-    assert data["non_finite_values"] == [{"field": "value[1]", "value": "NaN"},
-                                         {"field": "value[2]", "value": "Infinity"}]
+    assert data["peak_shaking_force"]["nominal"] == [1.0, None, None]
+    assert data["non_finite_values"] == [{"field": "peak_shaking_force.nominal[1]", "value": "NaN"},
+                                         {"field": "peak_shaking_force.nominal[2]", "value": "Infinity"}]
     assert "2 non-finite value(s)" in capsys.readouterr().err
 
 

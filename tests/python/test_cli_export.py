@@ -46,7 +46,7 @@ def test_run_writes_schema(demo_run):
     assert data["mass"].shape == (B,) and data["inertia_body"].shape == (B, 3, 3)
     assert data["com"].shape == (N, B, 3) and data["rotation"].shape == (N, B, 3, 3)
     assert data["shaking_force"].shape == (N, 3) and data["shaking_moment"].shape == (N, 3)
-    assert np.allclose(on_disk["peak_shaking_force_N"]["nominal"],
+    assert np.allclose(on_disk["peak_shaking_force"]["nominal"],
                        np.abs(data["shaking_force"]).max(axis=0))
 
 

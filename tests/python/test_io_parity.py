@@ -168,17 +168,27 @@ def test_every_balanced_toml(balanced_files):
 
 # ---- random valid cases --------------------------------------------------------------------------
 
-def _inertia(rng) -> list:
+def _inertia(rng) -> list | dict:
     a, c = rng.uniform(1.0, 2.0, 2)  # largest <= the sum of the two others
     p = np.array([a, c, 0.5 * (a + c)]) * 0.05
     form = rng.integers(3)
+    # half the list forms are written in the named form, decided by a generator of their own so
+    # that the corpus drawn from rng stays what it was
+    pick = np.random.default_rng(int(a * 1e9))
+    named = form != 2 and pick.uniform() < 0.5
     if form == 0:
+        if named:  # principal axes: the products absent (0)
+            return {"ixx": float(p[0]), "iyy": float(p[1]), "izz": float(p[2])}
         return p.tolist()
     Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
     I = Q @ np.diag(p) @ Q.T
     I = 0.5 * (I + I.T)
     if form == 1:
-        return [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
+        six = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
+        if named:  # the named form, keys in any order
+            keys = ["ixx", "iyy", "izz", "ixy", "ixz", "iyz"]
+            return {keys[k]: float(six[k]) for k in pick.permutation(6)}
+        return six
     return I.tolist()
 
 
@@ -272,7 +282,11 @@ def test_the_random_corpus_covers_the_format():
             seen.update(["unnamed"] if "name" not in j else [])
             seen.update(k for k in ("origin", "mdh", "dh", "axis", "mimic", "limits", "parent") if k in j)
         seen.update(k for k in ("base", "bodies", "frames", "loops", "springs", "actuated") if k in m)
-    assert seen >= {"unnamed", "revolute", "prismatic", "fixed", "spherical", "origin", "mdh", "dh", "axis", "mimic",
+        inertias = [j["link"]["inertia"] for j in m["joints"] if "link" in j] + [b["inertia"] for b in m.get("bodies", [])]
+        seen.update("named inertia" if isinstance(x, dict) else f"inertia of {len(x)}" for x in inertias)
+        seen.update("named inertia without products" for x in inertias if isinstance(x, dict) and len(x) == 3)
+    assert seen >= {"named inertia", "named inertia without products", "inertia of 3", "inertia of 6",
+                    "unnamed", "revolute", "prismatic", "fixed", "spherical", "origin", "mdh", "dh", "axis", "mimic",
                     "limits", "parent", "base", "bodies", "frames", "loops", "springs", "actuated"}, seen
 
 
@@ -331,6 +345,16 @@ INVALID = {
     "inertia negative": _set(("joints", 0, "link", "inertia"), [-1.0, 1.0, 1.0]),
     "inertia triangle": _set(("joints", 0, "link", "inertia"), [1.0, 1.0, 3.0]),
     "inertia entry nan": _set(("joints", 0, "link", "inertia"), [1.0, NAN, 1.0]),
+    "inertia named unknown key": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": 1.0, "izz": 1.0, "ixq": 0.0}),
+    "inertia named upper case": _set(("joints", 0, "link", "inertia"), {"Ixx": 1.0, "iyy": 1.0, "izz": 1.0}),
+    "inertia named moment missing": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "izz": 1.0}),
+    "inertia named entry string": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": "1", "izz": 1.0}),
+    "inertia named entry bool": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": 1.0, "izz": 1.0, "ixy": True}),
+    "inertia named entry nan": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": NAN, "izz": 1.0}),
+    "inertia named entry list": _set(("joints", 0, "link", "inertia"), {"ixx": [1.0], "iyy": 1.0, "izz": 1.0}),
+    "inertia named triangle": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": 1.0, "izz": 3.0}),
+    "inertia named negative": _set(("joints", 0, "link", "inertia"), {"ixx": 1.0, "iyy": 1.0, "izz": 1.0, "ixy": 2.0}),
+    "body inertia named unknown key": _append("bodies", {**BODY, "inertia": {"ixx": 0.0, "iyy": 0.0, "izz": 0.0, "iyx": 0.0}}),
     "com short": _set(("joints", 0, "link", "com"), [0.1, 0.0]),
     "com entry string": _set(("joints", 0, "link", "com"), [0.1, "x", 0.0]),
     "xyz absurd": _set(("joints", 1, "origin", "xyz"), [0.3, 0, 2e12]),
@@ -385,6 +409,12 @@ INVALID = {
     "spring anchor missing": _append("springs", {k: v for k, v in SPRING.items() if k != "anchor_b"}),
     "spring link unknown": _append("springs", {**SPRING, "link_a": "zz"}),
     "spring duplicate": lambda m: m.update(springs=[SPRING, dict(SPRING)]),
+    # izz alone: only where the mechanism is planar (this one has a spherical joint), not with inertia
+    "izz not planar": _set(("joints", 0, "link"), {"mass": 1.0, "izz": 0.01}),
+    "izz and inertia": _set(("joints", 0, "link", "izz"), 0.01),
+    "izz negative": _set(("joints", 0, "link"), {"mass": 1.0, "izz": -0.01}),
+    "body izz with rpy": _append("bodies", {"name": "cw", "link": "a", "mass": 1.0, "izz": 0.01, "rpy": [0, 0, 1]}),
+    "body izz not planar": _append("bodies", {"name": "cw", "link": "a", "mass": 1.0, "izz": 0.01}),
 }
 
 
@@ -440,3 +470,56 @@ def test_load_case_file_reads_control(tmp_path):
     path.write_text(path.read_text().replace("kd = [20, 20, 20, 20, 20]", "kd = [20, 20]"))
     with pytest.raises(ValueError, match=r"^control\.kd: must have 5 values"):
         _core.load_case_file(str(path))
+
+
+# ---- izz alone and the [trajectory] through both readers ---------------------------------------------
+
+PLANAR = {"joints": [{"name": "crank", "axis": [0, -1, 0], "link": {"mass": 0.8, "com": [0.1, 0, 0], "izz": 0.003}},
+                     {"name": "coupler", "origin": {"xyz": [0.2, 0, 0]}, "axis": [0, -1, 0],
+                      "link": {"mass": 1.5, "com": [0.25, 0, 0], "izz": 0.032}},
+                     {"name": "rocker", "parent": "base", "origin": {"xyz": [0.45, 0, 0]}, "axis": [0, 1, 0],
+                      "link": {"mass": 1.1, "com": [0.2, 0, 0], "izz": 0.015}}],
+          "bodies": [{"name": "cw", "link": "crank", "mass": 0.6, "com": [-0.08, 0, 0], "izz": 0.0001}],
+          "frames": [{"name": "ct", "link": "coupler", "origin": {"xyz": [0.5, 0, 0]}},
+                     {"name": "rt", "link": "rocker", "origin": {"xyz": [0.4, 0, 0]}}],
+          "loops": [{"name": "pin", "frame_a": "ct", "frame_b": "rt"}], "actuated": ["crank"]}
+
+
+def test_planar_izz_case():
+    """A four-bar whose links give izz alone (one joint axis reversed: still parallel)."""
+    text = toml_text({"case": {"name": "planar", "kind": "mechanism"}, "mechanism": PLANAR})
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "p.toml"
+        path.write_text(text)
+        py = Mechanism.from_toml(path)
+    assert_same_model(py.model, _core.mechanism_from_toml(text), np.random.default_rng(5))
+    crank = py.model.description.bodies[0]
+    np.testing.assert_array_equal(np.asarray(crank.inertia), np.diag([0.0015, 0.003, 0.0015]))
+
+
+TRAJECTORIES = [
+    {"law": "constant_speed", "start": [0.5], "rpm": 120, "revolutions": 2, "samples": 11, "branch": "crossed"},
+    {"law": "constant_speed", "start": [0.5], "speed": [-3.0], "duration": 0.7, "initial_guess": [0.5]},
+    {"law": "cubic", "start": [0.5], "end": [1.0], "duration": 2, "initial_guess": [0.5, -0.6, 1.3]},
+]
+
+
+@pytest.mark.parametrize("k", range(len(TRAJECTORIES)))
+def test_both_readers_read_the_trajectory(tmp_path, k):
+    from mechbal.schema import validate_case
+
+    cfg = {"case": {"name": "planar", "kind": "mechanism"}, "mechanism": PLANAR, "trajectory": TRAJECTORIES[k]}
+    path = tmp_path / "t.toml"
+    path.write_text(toml_text(cfg))
+    tr = validate_case(cfg, warn=False).trajectory
+    c = _core.load_case_trajectory(str(path))
+    assert c.present and c.constant_speed == (tr.law == "constant_speed")
+    assert c.start == tr.start and c.samples == tr.samples and c.branch == (tr.branch or "")
+    assert c.initial_guess == (tr.initial_guess or [])
+    assert c.duration == pytest.approx(tr.motion_duration(), rel=1e-15)
+    if tr.law == "constant_speed":
+        assert c.speed == pytest.approx(tr.speeds(1), rel=1e-15) and c.end == []
+    else:
+        assert c.end == tr.end and c.law.name == tr.law

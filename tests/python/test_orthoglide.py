@@ -224,7 +224,7 @@ def test_catalogue_selection_reproduces_tables_1_2(machine, grid, rates, lumped,
         letter = "D" if key == "distal" else "P"
         assert best.equivalent_rate / 1e3 == pytest.approx(t1["off_the_shelf"][f"K_{letter}_N_per_mm"], abs=5e-4)
         # the peak cable force of the chosen geometry is Table 1's to 0.1 %
-        assert rates[name] * d == pytest.approx(t1["theoretical"][f"f_{letter}_max_N"], rel=1e-3)
+        assert rates[name] * d == pytest.approx(t1["theoretical"][f"f_{letter}_max"], rel=1e-3)
     with pytest.raises(ValueError, match="rate_N_per_mm"):
         load_catalogue(__file__)
 
@@ -269,8 +269,8 @@ def test_run_writes_tables_and_files(raw, tmp_path):
     summary = og.run(small, tmp_path / "out")
     data = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert set(data["spring_rates_N_per_mm"]) == {"K_D", "K_P"}
-    assert data["acceptance"]["static_motor_force_balanced_max_N"] < 1e-9
-    assert data["acceptance"]["potential_energy_variation_J"] < 1e-9
+    assert data["acceptance"]["static_motor_force_balanced_max"] < 1e-9
+    assert data["acceptance"]["potential_energy_variation"] < 1e-9
     assert data["acceptance"]["power_balance_relative_error_max"] < 1e-9
     assert {"A1", "B1"} <= set(data["table4"]) and set(data["table5"]) == {"F"}
     assert data["table4"]["A1"]["y"]["delta_rms_pct"] < 0            # the vertical motor is relieved

@@ -78,7 +78,7 @@ def test_z_moment_ratio_depends_on_the_reference_point(paminsa_run):
     out, s = paminsa_run
     unbal = read_bodies(out / "bodies_unbalanced.npz")
     fb = read_bodies(out / "bodies_force_balanced.npz")
-    Q = np.asarray(s["z_moment_ratio_force_balanced_over_unbalanced"]["base_centre_m"])
+    Q = np.asarray(s["z_moment_ratio_force_balanced_over_unbalanced"]["base_centre"])
     Mu = unbal["shaking_moment"] - np.cross(Q, unbal["shaking_force"])
     Mf = fb["shaking_moment"] - np.cross(Q, fb["shaking_force"])
     ratio_c = np.abs(Mf[:, 2]).max() / np.abs(Mu[:, 2]).max()
@@ -94,15 +94,15 @@ def test_z_moment_ratio_depends_on_the_reference_point(paminsa_run):
 def test_summary_schema(paminsa_run):
     out, s = paminsa_run
     on_disk = json.loads((out / "summary.json").read_text())
-    for key in ("counterweights_kg", "paper_counterweights_kg", "peak_shaking_force_N",
-                "peak_shaking_moment_Nm", "peak_wrist_rate_rad_s", "tick_rate_hz", "integrator",
+    for key in ("counterweight_masses", "paper_counterweight_masses", "peak_shaking_force",
+                "peak_shaking_moment", "peak_wrist_rate", "tick_rate_hz", "integrator",
                 "condition_number_range", "z_moment_ratio_force_balanced_over_unbalanced",
                 "discrepancies"):
         assert key in on_disk, key
     for v in ("unbalanced", "force_balanced", "balanced"):
-        assert len(on_disk["peak_shaking_force_N"][v]) == 3
-        assert len(on_disk["peak_shaking_moment_Nm"][v]) == 3
-    cw = on_disk["counterweights_kg"]
+        assert len(on_disk["peak_shaking_force"][v]) == 3
+        assert len(on_disk["peak_shaking_moment"][v]) == 3
+    cw = on_disk["counterweight_masses"]
     assert len(cw["cp1"]) == len(cw["cp2"]) == len(cw["cp3"]) == 3 and cw["vertical"] > 0
     lo, hi = on_disk["condition_number_range"]
     assert 1.0 <= lo <= hi < 10.0  # the well-conditioned start keeps N far from singular
@@ -126,9 +126,9 @@ def test_runner_sizes_by_the_general_method_and_reports_the_closed_form(paminsa_
     _, s = paminsa_run
     c = s["counterweights"]
     assert s["counterweights_used"] == "general_method"
-    assert s["counterweights_kg"]["source"].startswith("general_method")
+    assert s["counterweight_masses"]["source"].startswith("general_method")
     for key in ("cp1", "cp2", "cp3"):
-        assert s["counterweights_kg"][key] == c["general_method"][key]
+        assert s["counterweight_masses"][key] == c["general_method"][key]
         np.testing.assert_allclose(c["general_method"][key], c["closed_form"][key], rtol=1e-9)
     assert c["general_method"]["vertical"] == pytest.approx(9.615, abs=1e-3)
     assert c["max_abs_difference"] < 1e-9 < c["tolerance"]
@@ -169,8 +169,8 @@ def test_paper_numbers(params):
 
 def test_paper_reported_masses_do_not_force_balance(paminsa_run):
     _, s = paminsa_run
-    F = np.asarray(s["peak_shaking_force_N"]["paper_reported_masses"])
-    assert np.linalg.norm(F) > 0.3 * s["peak_shaking_force_norm_unbalanced_N"]
+    F = np.asarray(s["peak_shaking_force"]["paper_reported_masses"])
+    assert np.linalg.norm(F) > 0.3 * s["peak_shaking_force_norm_unbalanced"]
 
 
 # ---------------------------------------------------------------------------- model
@@ -288,5 +288,5 @@ def test_balanced_files_store_the_wrench_of_their_poses(paminsa_run, integrator)
         assert 0.1 < gap < 0.5  # the commanded moment is not the moment of the poses
     assert np.abs(M_cmd).max() < 1e-9  # the ideal moment is zero to rounding
     if integrator == summary["integrator"]:
-        assert np.allclose(summary["peak_shaking_moment_Nm"]["balanced_stored_poses"],
+        assert np.allclose(summary["peak_shaking_moment"]["balanced_stored_poses"],
                            np.abs(M[INNER]).max(axis=0))

@@ -117,7 +117,7 @@ def test_five_bar_linkage_toml_is_the_generated_mechanism_and_runs(tmp_path):
     assert summary["closed"] and summary["actuated"] == ["theta1", "theta2"]
     assert summary["loops"]["max_closure_residual"] < 1e-12 and summary["loops"]["singular_instants"] == 0
     # leg-wise static balancing on the general model: the shaking force stays zero
-    assert max(summary["peak_shaking_force_N"]["nominal"]) < 1e-10
+    assert max(summary["peak_shaking_force"]["nominal"]) < 1e-10
 
 
 # ------------------------------------------------------------------------------------------------
@@ -226,4 +226,4 @@ def test_paminsa_linkage_toml_is_the_generated_mechanism_and_force_balanced(tmp_
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["closed"] and summary["loops"]["singular_instants"] == 0
     assert summary["loops"]["max_closure_residual"] < 1e-12
-    assert max(summary["peak_shaking_force_N"]["nominal"]) < 1e-9  # 27.6 N unbalanced
+    assert max(summary["peak_shaking_force"]["nominal"]) < 1e-9  # 27.6 N unbalanced

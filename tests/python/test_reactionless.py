@@ -55,7 +55,7 @@ def test_wheel_arm_run_writes_both_variants(wheel_run):
         assert (out / name).is_file(), name
     s = json.loads((out / "summary.json").read_text())
     assert s["variants"] == ["uncontrolled", "controlled"]
-    un, co = s["peak_shaking_moment_Nm"]["uncontrolled"], s["peak_shaking_moment_Nm"]["controlled"]
+    un, co = s["peak_shaking_moment"]["uncontrolled"], s["peak_shaking_moment"]["controlled"]
     assert un[2] > 0.1  # the arm's motion shakes its base about z ...
     assert co[2] < 1e-6 * un[2]  # ... and the wheel cancels it
     assert s["control"]["singular_ticks"] == 0 and s["control"]["saturated_ticks"] == 0

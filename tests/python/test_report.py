@@ -86,7 +86,7 @@ def test_serial_chain_base_reaction_with_gravity(demo_run):
     assert np.abs(R_F - F_expected).max() < 1e-9 * np.abs(R_F).max()
     assert np.abs(R_M - M_expected).max() < 1e-9 * np.abs(R_M).max()
     summary = json.loads((out / "summary.json").read_text())
-    assert np.allclose(summary["peak_base_reaction_force_N"]["nominal"], np.abs(R_F).max(axis=0))
+    assert np.allclose(summary["peak_base_reaction_force"]["nominal"], np.abs(R_F).max(axis=0))
     assert (out / "base_reaction.png").stat().st_size > 10_000
 
 

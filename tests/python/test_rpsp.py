@@ -165,8 +165,8 @@ def test_general_solve_equals_closed_form_inverse_kinematics(which):
         assert agree[f"max_abs_error_{key}"] < 1e-12, (key, agree)
         assert agree[f"max_abs_error_{key}_dot"] < 1e-9, (key, agree)
         assert agree[f"max_abs_error_{key}_ddot"] < 1e-8 * max(1.0, agree[f"max_abs_{key}_ddot"]), (key, agree)
-    assert agree["max_eq2_residual_m"] < 1e-12
-    assert agree["max_loop_residual_m"] < 1e-12
+    assert agree["max_eq2_residual"] < 1e-12
+    assert agree["max_loop_residual"] < 1e-12
 
 
 def test_forward_kinematics_with_the_motors_actuated_recovers_the_platform():
@@ -288,22 +288,22 @@ def rpsp_run(tmp_path_factory):
 def test_run_summary_has_the_issue_fields(rpsp_run):
     out, summary = rpsp_run
     written = json.loads((out / "summary.json").read_text())
-    for key in ("counterweights_kg", "paper_counterweights_kg", "peak_shaking_force_N", "rms_shaking_force_N",
-                "mean_reduction_pct", "tables", "added_mass_kg", "discrepancies", "survey", "ik_agreement"):
+    for key in ("counterweight_masses", "paper_counterweight_masses", "peak_shaking_force", "rms_shaking_force",
+                "mean_reduction_pct", "tables", "added_mass", "discrepancies", "survey", "ik_agreement"):
         assert key in written, key
-    assert set(written["counterweights_kg"]) == {"m_P", "m_N", "m_F"}
+    assert set(written["counterweight_masses"]) == {"m_P", "m_N", "m_F"}
     for v in ("unbalanced", "balanced"):
-        assert len(written["peak_shaking_force_N"][v]) == 3 and len(written["rms_shaking_force_N"][v]) == 3
+        assert len(written["peak_shaking_force"][v]) == 3 and len(written["rms_shaking_force"][v]) == 3
     assert [r["t"] for r in written["tables"]["x"]] == [0.0, 0.052, 0.1, 0.152, 0.2]
     assert all(r > 99.99 for r in written["mean_reduction_pct"])
-    assert written["counterweights_kg"]["m_N"] == pytest.approx(2.85, rel=1e-7)
+    assert written["counterweight_masses"]["m_N"] == pytest.approx(2.85, rel=1e-7)
     # sized by mechbal.balance.force, eqs 29-31 beside it
     c = written["counterweights"]
-    assert c["general_method"] == written["counterweights_kg"]
+    assert c["general_method"] == written["counterweight_masses"]
     assert c["closed_form"] == pytest.approx({"m_P": 17.97, "m_N": 2.85, "m_F": 4.5}, abs=1e-12)
     assert c["max_abs_difference"] < 1e-7 and c["tolerance"] == 1e-6
     assert written["general_method"]["exact"] and written["general_method"]["rank"] == 10
-    assert written["added_mass_kg"] == pytest.approx(
+    assert written["added_mass"] == pytest.approx(
         3 * (3.27 + 3.3 + 17.97 + 2.85 + 4.5), rel=1e-7)
     assert "non_finite_values" not in written
     for f in written["files"]:
@@ -331,14 +331,14 @@ def test_survey_reports_the_near_singularity_and_never_nan(rpsp_run):
     assert s["nan_free"]
     assert r["failed_instants"] == 0 and r["closed_form_degenerate_instants"] == 0
     assert r["shortest_leg_at_min_rcond"] == 3
-    assert 2.2 < r["t_min_rcond_s"] < 2.5
-    assert min(r["min_leg_length_m"]) < 0.03
-    assert r["near_singular_intervals_s"] and all(a < 2.35 < b for a, b in r["near_singular_intervals_s"][:1])
+    assert 2.2 < r["t_min_rcond"] < 2.5
+    assert min(r["min_leg_length"]) < 0.03
+    assert r["near_singular_intervals"] and all(a < 2.35 < b for a, b in r["near_singular_intervals"][:1])
     agree = r["ik_agreement"]
     assert agree["max_abs_error_theta"] < 1e-12 and agree["max_abs_error_l"] < 1e-12
-    assert agree["max_loop_residual_m"] < 1e-12
+    assert agree["max_loop_residual"] < 1e-12
     w = s["with_extra_linkage"]
     # the linkage (0.5 m reach) cannot follow legs 2 and 3 beyond 0.5 m: the solve says so
-    assert w["unreachable_intervals_s"] and w["failed_instants"] > 0
-    for a, b in w["unreachable_intervals_s"]:
-        assert any(fa <= a + 0.01 and fb >= b - 0.01 for fa, fb in w["failed_intervals_s"]), (a, b)
+    assert w["unreachable_intervals"] and w["failed_instants"] > 0
+    for a, b in w["unreachable_intervals"]:
+        assert any(fa <= a + 0.01 and fb >= b - 0.01 for fa, fb in w["failed_intervals"]), (a, b)

@@ -254,4 +254,4 @@ def test_kind_mechanism_runs_with_the_serial_chain_runner(tmp_path):
     p.write_text(text)
     summary = run_case(p, tmp_path / "out")
     assert summary["kind"] == "mechanism"
-    assert summary["total_mass_kg"] == pytest.approx(7.0)
+    assert summary["total_mass"] == pytest.approx(7.0)

@@ -87,13 +87,13 @@ def _direct(config: dict, poses, trajectory, q_guess=None) -> dict:
         q, v, a, torque = qa, va, aa, mech.inverse_dynamics(qa, va, aa)
     w = mech.shaking_wrench(q, v, a)
     out = {}
-    for name, x in (("gravity_torque", gravity), ("actuator_torque", torque),
+    for name, x in (("gravity_torque", gravity), ("joint_torque", torque),
                     ("shaking_force", w.shaking_force), ("shaking_moment", w.shaking_moment)):
         for s in ("peak", "rms"):
-            out[f"{name}_{s}"] = _stat(x, s)
-            if name in ("gravity_torque", "actuator_torque"):
+            out[f"{s}_{name}"] = _stat(x, s)
+            if name in ("gravity_torque", "joint_torque"):
                 for j, joint in enumerate(mech.actuated_names):
-                    out[f"{name}_{s}.{joint}"] = _stat(x, s, j)
+                    out[f"{s}_{name}.{joint}"] = _stat(x, s, j)
     return out
 
 
@@ -125,11 +125,11 @@ def _set_user_value(config: dict, path: str, value: float) -> None:
 
 def _check_against_rebuilt(config: dict, params: list[Parameter], evaluations: int, *, rel=1e-12,
                            poses_from=None, **kw):
-    metrics = [f"{q}_{s}" for q in ("gravity_torque", "actuator_torque", "shaking_force", "shaking_moment")
+    metrics = [f"{s}_{q}" for q in ("gravity_torque", "joint_torque", "shaking_force", "shaking_moment")
                for s in ("peak", "rms")]
     spec = mechanism_spec(config["mechanism"])
     names = spec.actuated if spec.loops else spec.independent_joints
-    metrics += [f"actuator_torque_rms.{names[-1]}", f"gravity_torque_peak.{names[0]}"]
+    metrics += [f"rms_joint_torque.{names[-1]}", f"peak_gravity_torque.{names[0]}"]
     sweep = Sweep(spec, params, metrics, kind="monte_carlo", evaluations=evaluations, seed=11,
                   trajectory=_trajectory(len(names), config["trajectory"]), **kw)
     assert all(p.target.batched for p in sweep.parameters)
@@ -142,7 +142,7 @@ def _check_against_rebuilt(config: dict, params: list[Parameter], evaluations: i
             _set_user_value(changed, p, float(table.at[i, p]))
         direct = _direct(changed, sweep.poses, sweep.trajectory, sweep.q_guess)
         for c in metrics:
-            scale = max(abs(nominal[c.split(".")[0].rsplit("_", 1)[0] + "_peak"]), 1.0)
+            scale = max(abs(nominal["peak_" + c.split(".")[0].split("_", 1)[1]]), 1.0)
             assert table.at[i, c] == pytest.approx(direct[c], rel=rel, abs=rel * scale), (i, c)
 
 
@@ -182,7 +182,7 @@ def test_geometric_parameters_rebuild_the_model():
     config = load_case(ARM)
     sweep = Sweep(ARM, [Parameter("joints.elbow.placement.xyz[0]", delta=0.003),
                         Parameter("bodies.counterweight1.mass", tolerance=0.02)],
-                  ["gravity_torque_peak", "actuator_torque_rms", "shaking_moment_peak"],
+                  ["peak_gravity_torque", "rms_joint_torque", "peak_shaking_moment"],
                   kind="sensitivity", trajectory_samples=41, pose_source="uniform", pose_count=20)
     assert [p.target.batched for p in sweep.parameters] == [False, True]
     table = sweep.run("serial", progress=False).table
@@ -193,11 +193,11 @@ def test_geometric_parameters_rebuild_the_model():
         for p in sweep.paths:
             _set_user_value(changed, p, float(table.at[i, p]))
         direct = _direct(changed, sweep.poses, traj)
-        for c in ("gravity_torque_peak", "actuator_torque_rms", "shaking_moment_peak"):
+        for c in ("peak_gravity_torque", "rms_joint_torque", "peak_shaking_moment"):
             assert table.at[i, c] == pytest.approx(direct[c], rel=1e-12, abs=1e-12 * 20)
     # the elbow 3 mm further out unbalances the arm; the nominal is balanced
-    assert table.at[0, "gravity_torque_peak"] < 1e-12
-    assert table.at[2, "gravity_torque_peak"] > 1e-3
+    assert table.at[0, "peak_gravity_torque"] < 1e-12
+    assert table.at[2, "peak_gravity_torque"] > 1e-3
 
 
 def test_balanced_arm_case_is_statically_balanced():
@@ -230,8 +230,8 @@ def _mixed_sweep(delay: float = 0.0, evaluations: int = 60, chunk_size: int = 8)
                        Parameter("bodies.shoulder.mass", tolerance=0.02, distribution="normal"),
                        Parameter("bodies.elbow.com[0]", delta=0.001),
                        Parameter("joints.elbow.placement.xyz[0]", values=[0.5, 0.5, 0.5, 0.501])],
-                 {"gravity_torque_peak": "gravity_torque_peak", "shaking_force_rms": "shaking_force_rms",
-                  "actuator_torque_rms.elbow": "actuator_torque_rms.elbow", "mass": total_mass},
+                 {"peak_gravity_torque": "peak_gravity_torque", "rms_shaking_force": "rms_shaking_force",
+                  "rms_joint_torque.elbow": "rms_joint_torque.elbow", "mass": total_mass},
                  kind="monte_carlo", evaluations=evaluations, seed=5, trajectory_samples=31,
                  pose_source="uniform", pose_count=20, chunk_size=chunk_size)
 
@@ -245,8 +245,8 @@ def test_serial_table_is_complete_and_seeded(serial_table):
     t = serial_table
     assert list(t["evaluation"]) == list(range(60))
     assert list(t.columns) == ["evaluation", "bodies.counterweight1.mass", "bodies.shoulder.mass",
-                               "bodies.elbow.com[0]", "joints.elbow.placement.xyz[0]", "gravity_torque_peak",
-                               "shaking_force_rms", "actuator_torque_rms.elbow", "mass.com_x", "mass.total",
+                               "bodies.elbow.com[0]", "joints.elbow.placement.xyz[0]", "peak_gravity_torque",
+                               "rms_shaking_force", "rms_joint_torque.elbow", "mass.com_x", "mass.total",
                                "status"]
     assert (t["status"] == "ok").all() and np.isfinite(t.drop(columns="status").to_numpy(float)).all()
     assert (t["joints.elbow.placement.xyz[0]"] == 0.501).any()   # some sets are rebuilt
@@ -312,7 +312,7 @@ def test_sweep_file_errors_name_the_field(tmp_path):
         p.write_text(text)
         return p
 
-    head = '[sweep]\nname = "s"\nkind = "monte_carlo"\nevaluations = 10\nmetrics = ["gravity_torque_peak"]\n'
+    head = '[sweep]\nname = "s"\nkind = "monte_carlo"\nevaluations = 10\nmetrics = ["peak_gravity_torque"]\n'
     par = '[[sweep.parameters]]\npath = "bodies.counterweight1.mass"\ntolerance = 0.02\n'
     cases = [
         (head.replace("evaluations", "evaluatons") + par, "sweep.evaluatons: unknown key (did you mean 'evaluations'?)"),
@@ -321,8 +321,8 @@ def test_sweep_file_errors_name_the_field(tmp_path):
         (head.replace("monte_carlo", "monte-carlo") + par, "sweep.kind: must be one of monte_carlo, sensitivity, grid"),
         (head + par.replace("counterweight1", "counterwieght1"), "sweep.parameters[0].path: no body named 'counterwieght1' (did you mean 'counterweight1'?)"),
         (head + par.replace("bodies.counterweight1.mass", "bodys.x.mass"), "sweep.parameters[0].path: not a parameter path (did you mean 'bodies'?)"),
-        (head.replace("gravity_torque_peak", "gravity_torque_peek") + par, "sweep.metrics[0]: unknown metric (did you mean 'gravity_torque_peak'?)"),
-        (head.replace('"gravity_torque_peak"', '"actuator_torque_rms.elbw"') + par, "no actuated joint named 'elbw' (did you mean 'elbow'?)"),
+        (head.replace("peak_gravity_torque", "peak_gravity_torqe") + par, "sweep.metrics[0]: unknown metric (did you mean 'peak_gravity_torque'?)"),
+        (head.replace('"peak_gravity_torque"', '"rms_joint_torque.elbw"') + par, "no actuated joint named 'elbw' (did you mean 'elbow'?)"),
         (head.replace("evaluations = 10", "evaluations = 10.0") + par, "sweep.evaluations: must be an integer"),
         (head.replace("evaluations = 10\n", "") + par, "sweep.evaluations: is required"),
         (head + par + '[[sweep.parameters]]\npath = "design.k"\ndelta = 1.0\n', "sweep.parameters[1].nominal: a design variable needs a nominal"),
@@ -355,16 +355,16 @@ def test_cli_sweep_writes_a_whole_run(tmp_path, capsys):
                  "--backend", "serial", "-q"]) == 0
     names = sorted(p.name for p in out.iterdir())
     assert "results.parquet" in names and "summary.json" in names
-    assert "tornado_gravity_torque_peak.png" in names
+    assert "tornado_peak_gravity_torque.png" in names
     summary = json.loads((out / "summary.json").read_text())
-    top = summary["metrics"]["gravity_torque_peak"]["parameters"][0]
+    top = summary["metrics"]["peak_gravity_torque"]["parameters"][0]
     assert top["parameter"] == "bodies.counterweight1.mass"   # the heaviest part dominates
-    assert summary["metrics"]["gravity_torque_peak"]["nominal"] < 1e-12
+    assert summary["metrics"]["peak_gravity_torque"]["nominal"] < 1e-12
     table = pd.read_parquet(out / "results.parquet")
     assert len(table) == 1 + 2 * 8 and (table["status"] == "ok").all()
     # a mistake is one line and exit code 2, and leaves no output behind
     bad = tmp_path / "bad.toml"
-    bad.write_text('[sweep]\nname = "x"\nkind = "grid"\nmetrics = ["gravity_torque_peak"]\n'
+    bad.write_text('[sweep]\nname = "x"\nkind = "grid"\nmetrics = ["peak_gravity_torque"]\n'
                    '[[sweep.parameters]]\npath = "joints.elbw.placement.xyz[0]"\ndelta = 0.01\n')
     capsys.readouterr()
     assert main(["sweep", ARM, "--spec", str(bad), "--out", str(tmp_path / "bad"), "--backend", "serial"]) == 2
@@ -386,12 +386,12 @@ def test_missing_extra_is_named(monkeypatch):
 def test_non_physical_sets_are_marked_not_evaluated():
     sweep = Sweep(ARM, [Parameter("bodies.counterweight2.mass", lower=-0.5, upper=0.5),
                         Parameter("bodies.elbow.inertia[0]", values=[0.002, 0.5])],
-                  ["gravity_torque_peak"], kind="grid", pose_count=5, trajectory_samples=11)
+                  ["peak_gravity_torque"], kind="grid", pose_count=5, trajectory_samples=11)
     t = sweep.run("serial", progress=False).table
     bad = t["status"] != "ok"
     assert list(bad) == [True, True, False, True, False, True]   # negative mass; triangle inequality
-    assert t.loc[bad, "gravity_torque_peak"].isna().all()
-    assert t.loc[~bad, "gravity_torque_peak"].notna().all()
+    assert t.loc[bad, "peak_gravity_torque"].isna().all()
+    assert t.loc[~bad, "peak_gravity_torque"].notna().all()
 
 
 def test_design_variables_reach_callable_metrics_and_grids_take_every_combination(tmp_path):
@@ -401,7 +401,7 @@ def test_design_variables_reach_callable_metrics_and_grids_take_every_combinatio
 
     sweep = Sweep(ARM, [Parameter("design.price", nominal=2.0, values=[1.0, 3.0]),
                         Parameter("bodies.counterweight1.mass", lower=4.0, upper=6.0, steps=3)],
-                  {"cost": cost, "peak": "gravity_torque_peak"}, kind="grid", pose_count=10,
+                  {"cost": cost, "peak": "peak_gravity_torque"}, kind="grid", pose_count=10,
                   trajectory_samples=11)
     result = sweep.run("serial", progress=False)
     t = result.table
@@ -433,7 +433,7 @@ def test_urdf_robot_batched_equals_rebuilt():
               Parameter("bodies.panda_link4.com[1]", delta=0.01),
               Parameter("bodies.panda_hand.mass", tolerance=0.1),
               Parameter("bodies.panda_link6.inertia[5]", delta=1e-5)]
-    sweep = Sweep(str(path), params, ["gravity_torque_peak", "actuator_torque_rms", "shaking_moment_peak"],
+    sweep = Sweep(str(path), params, ["peak_gravity_torque", "rms_joint_torque", "peak_shaking_moment"],
                   kind="monte_carlo", evaluations=6, seed=3, trajectory_samples=21, pose_source="uniform",
                   pose_count=10)
     table = sweep.run("serial", progress=False).table
@@ -443,9 +443,9 @@ def test_urdf_robot_batched_equals_rebuilt():
         mech = Mechanism.from_spec(apply_values(plan.spec, plan.targets, table.loc[i, sweep.paths].to_numpy(float),
                                                 plan.nominal))
         qa, va, aa = sweep.trajectory
-        direct = {"gravity_torque_peak": _stat(mech.gravity_torque(sweep.poses), "peak"),
-                  "actuator_torque_rms": _stat(mech.inverse_dynamics(qa, va, aa), "rms"),
-                  "shaking_moment_peak": _stat(mech.shaking_wrench(qa, va, aa).shaking_moment, "peak")}
+        direct = {"peak_gravity_torque": _stat(mech.gravity_torque(sweep.poses), "peak"),
+                  "rms_joint_torque": _stat(mech.inverse_dynamics(qa, va, aa), "rms"),
+                  "peak_shaking_moment": _stat(mech.shaking_wrench(qa, va, aa).shaking_moment, "peak")}
         for c, v in direct.items():
             assert table.at[i, c] == pytest.approx(v, rel=1e-12), (i, c)
 
@@ -460,12 +460,12 @@ def test_paminsa_counterweight_tolerance_brings_shaking_force_back():
     full = from_toml("paminsa-tolerance", "paminsa-linkage")
     assert len(full.parameters) == 10 and full.evaluations == 10_000
     sweep = Sweep(full.base, [Parameter(p.path, tolerance=0.02) for p in full.parameters],
-                  ["shaking_force_peak", "actuator_torque_rms"], kind="monte_carlo", evaluations=5,
+                  ["peak_shaking_force", "rms_joint_torque"], kind="monte_carlo", evaluations=5,
                   seed=2009, trajectory_samples=31)
     result = sweep.run("serial", progress=False)
     t = result.table
-    assert result.nominal["shaking_force_peak"] < 1e-10
-    assert (t["shaking_force_peak"] > 1e-3).all()
+    assert result.nominal["peak_shaking_force"] < 1e-10
+    assert (t["peak_shaking_force"] > 1e-3).all()
     plan = sweep.plan()
     qa, va, aa = sweep.trajectory
     for i in range(len(t)):
@@ -473,8 +473,8 @@ def test_paminsa_counterweight_tolerance_brings_shaking_force_back():
                                                 plan.nominal))
         m = mech.closed_motion(qa, va, aa, q_guess=sweep.q_guess, with_forces=True)
         w = mech.shaking_wrench(m.q, m.v, m.a)
-        assert t.at[i, "shaking_force_peak"] == pytest.approx(_stat(w.shaking_force, "peak"), rel=1e-12, abs=1e-12 * 30)
-        assert t.at[i, "actuator_torque_rms"] == pytest.approx(_stat(m.actuated_force, "rms"), rel=1e-12)
+        assert t.at[i, "peak_shaking_force"] == pytest.approx(_stat(w.shaking_force, "peak"), rel=1e-12, abs=1e-12 * 30)
+        assert t.at[i, "rms_joint_torque"] == pytest.approx(_stat(m.actuated_force, "rms"), rel=1e-12)
 
 
 def test_a_balancing_method_is_a_metric():
@@ -545,3 +545,15 @@ def test_losing_the_cluster_names_the_finished_evaluations_and_keeps_them():
     assert f"{exc.rows_done} of 60 evaluations were finished" in str(exc)
     assert sum(len(r["status"]) for _, r in exc.finished) == exc.rows_done
     assert all(isinstance(r, dict) for _, r in exc.finished)
+
+
+def test_the_metric_names_before_schema_1_are_read_with_a_warning():
+    from mechbal.sweep.metrics import RENAMED, resolve
+
+    assert RENAMED["actuator_torque_rms"] == "rms_joint_torque" and RENAMED["shaking_force_peak"] == "peak_shaking_force"
+    with pytest.warns(DeprecationWarning, match="now called 'peak_shaking_force'"):
+        (spec,) = resolve(["shaking_force_peak"], ["elbow"])
+    assert (spec.name, spec.statistic, spec.quantity) == ("peak_shaking_force", "peak", "shaking_force")
+    with pytest.warns(DeprecationWarning):
+        (spec,) = resolve({"mine": "actuator_torque_rms.elbow"}, ["elbow"])
+    assert (spec.name, spec.quantity, spec.joint) == ("mine", "joint_torque", "elbow")

@@ -399,7 +399,7 @@ def test_run_a_urdf_file_writes_the_usual_outputs(tmp_path, capsys):
     assert main(["run", str(path), "--out", str(out), "--samples", "201", "--duration", "1.5"]) == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["kind"] == "urdf" and summary["dof"] == 6 and summary["samples"] == 201
-    assert summary["duration_s"] == 1.5
+    assert summary["duration"] == 1.5
     assert np.allclose(summary["end"], 0.5)  # UR5 joints have +-2 pi: 0.5 rad each
     for name in summary["files"]:
         assert (out / name).stat().st_size > 1000
@@ -407,7 +407,7 @@ def test_run_a_urdf_file_writes_the_usual_outputs(tmp_path, capsys):
     assert list(data["names"]) == summary["body_names"]
     assert data["com"].shape == (201, len(summary["body_names"]), 3)
     F, M = data["shaking_force"], data["shaking_moment"]
-    assert np.allclose(summary["peak_shaking_force_N"]["nominal"], np.abs(F).max(axis=0))
+    assert np.allclose(summary["peak_shaking_force"]["nominal"], np.abs(F).max(axis=0))
     # what the file claims: the wrench of the poses saved beside it
     F_fd, M_fd = shaking_wrench_by_finite_differences(data)
     inner = slice(3, -3)
@@ -430,7 +430,7 @@ def test_run_default_trajectory_respects_the_limits(tmp_path):
     path = tmp_path / "two.urdf"
     path.write_text(_GOOD)
     summary = run_case(path, tmp_path / "out")
-    assert summary["samples"] == 501 and summary["duration_s"] == 2.0
+    assert summary["samples"] == 501 and summary["duration"] == 2.0
 
 
 def test_run_flags_are_for_urdf_files_only(tmp_path, capsys):

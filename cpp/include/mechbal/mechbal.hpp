@@ -34,6 +34,7 @@
 #include "mechbal/control/joint_controller.hpp"
 #include "mechbal/control/computed_torque.hpp"
 #include "mechbal/control/decoupled_control.hpp"
+#include "mechbal/control/passive.hpp"
 #include "mechbal/control/joint_limits.hpp"
 #include "mechbal/papers/paminsa/reactionless_wrist.hpp"
 #include "mechbal/control/closed_loop.hpp"

@@ -1,6 +1,6 @@
 #pragma once
 /// \file status.hpp
-/// Status values returned by real-time algorithms (DESIGN.md: algorithms never throw).
+/// Status values returned by real-time algorithms (docs/architecture.md: algorithms never throw).
 #include <cstdint>
 
 namespace mechbal {

@@ -20,7 +20,7 @@ namespace {
 using detail::check_state;
 
 /// ok when every value of the result is finite; a finite input whose result overflowed gives
-/// Status::out_of_range (DESIGN.md: never ok with a non-finite output).
+/// Status::out_of_range (docs/architecture.md, Data flow: never ok with a non-finite output).
 template <typename... T>
 Status finite_result(const T&... results) noexcept {
   return (results.allFinite() && ...) ? Status::ok : Status::out_of_range;

@@ -9,6 +9,7 @@
 #include "mechbal/control/computed_torque.hpp"
 #include "mechbal/control/decoupled_control.hpp"
 #include "mechbal/control/mechanism_dynamics.hpp"
+#include "mechbal/control/passive.hpp"
 
 namespace mechbal {
 
@@ -17,6 +18,7 @@ const char* control_kind_name(ControlKind kind) noexcept {
     case ControlKind::computed_torque: return "computed_torque";
     case ControlKind::decoupled: return "decoupled";
     case ControlKind::reactionless: return "reactionless";
+    case ControlKind::passive: return "passive";
     case ControlKind::none: break;
   }
   return "none";
@@ -99,6 +101,8 @@ std::unique_ptr<JointController> make_controller(const MechanismModel& model, co
       throw std::invalid_argument(
           "control.kind: 'reactionless' is read and checked, but this build has no reactionless controller "
           "yet (use computed_torque or decoupled)");
+    case ControlKind::passive:
+      return std::make_unique<PassiveController>(n);
     case ControlKind::none: break;
   }
   throw std::invalid_argument("control: the case has no [control] table (kind none): nothing to build");

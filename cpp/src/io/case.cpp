@@ -27,6 +27,7 @@ namespace {
 
 using Mat4 = Eigen::Matrix4d;
 constexpr double kMaxAbs = 1e12;           // schema.MAX_ABS
+constexpr double kPlanarTol = 1e-9;        // spec.PLANAR_TOL
 constexpr std::size_t kMaxJoints = 256;    // schema.MAX_JOINTS
 constexpr std::size_t kMaxBodies = 1024;   // schema.MAX_BODIES
 constexpr std::size_t kMaxFrames = 1024;   // schema.MAX_FRAMES
@@ -266,10 +267,38 @@ std::string fmt6(double x) {
   return os.str();
 }
 
-/// schema.inertia_matrix: 3x3, [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]; symmetric,
+/// The physical checks of an inertia (symmetric, positive semi-definite, triangle inequality).
+Mat3 checked_inertia(const Mat3& I, const std::string& f, const toml::node& n) {
+  const double scale = std::max(1.0, I.cwiseAbs().maxCoeff());
+  if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) fail(f, "must be symmetric", n);
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(I, Eigen::EigenvaluesOnly);
+  const Vec3 p = eig.eigenvalues();
+  const double tol = 1e-12 * scale;
+  if (p[0] < -tol) fail(f, "must be positive semi-definite, smallest principal moment is " + fmt6(p[0]), n);
+  if (p[2] > p[0] + p[1] + tol) {
+    fail(f, "violates the triangle inequality of a physical body: principal moments " + fmt6(p[0]) + ", " +
+                fmt6(p[1]) + ", " + fmt6(p[2]), n);
+  }
+  return I;
+}
+
+/// schema.inertia_matrix: a table {ixx, iyy, izz, ixy, ixz, iyz} (the moments required, absent
+/// products 0, no other key), 3x3, [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]; symmetric,
 /// positive semi-definite, triangle inequality.
 Mat3 inertia_matrix(const toml::node& n, const std::string& f) {
-  const char* shape = "must be a 3x3 matrix, [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]";
+  const char* shape = "must be a table {ixx, iyy, izz, ixy, ixz, iyz}, a 3x3 matrix, [Ixx, Iyy, Izz] or "
+                      "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]";
+  static const char* const kNamed[6] = {"ixx", "iyy", "izz", "ixy", "ixz", "iyz"};
+  if (auto t = n.as_table()) {
+    allow_keys(*t, f, {kNamed, kNamed + 6});
+    for (int k = 0; k < 3; ++k) required(*t, kNamed[k], f);
+    double v[6] = {0, 0, 0, 0, 0, 0};
+    for (int k = 0; k < 6; ++k)
+      if (const toml::node* x = get(*t, kNamed[k])) v[k] = number(*x, join(f, kNamed[k]));
+    Mat3 I;
+    I << v[0], v[3], v[4], v[3], v[1], v[5], v[4], v[5], v[2];
+    return checked_inertia(I, f, n);
+  }
   auto a = n.as_array();
   if (!a) fail(f, shape, n);
   std::size_t rows = 0;
@@ -315,17 +344,7 @@ Mat3 inertia_matrix(const toml::node& n, const std::string& f) {
       I(1, 2) = I(2, 1) = v[5];
     }
   }
-  const double scale = std::max(1.0, I.cwiseAbs().maxCoeff());
-  if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) fail(f, "must be symmetric", n);
-  Eigen::SelfAdjointEigenSolver<Mat3> eig(I, Eigen::EigenvaluesOnly);
-  const Vec3 p = eig.eigenvalues();
-  const double tol = 1e-12 * scale;
-  if (p[0] < -tol) fail(f, "must be positive semi-definite, smallest principal moment is " + fmt6(p[0]), n);
-  if (p[2] > p[0] + p[1] + tol) {
-    fail(f, "violates the triangle inequality of a physical body: principal moments " + fmt6(p[0]) + ", " +
-                fmt6(p[1]) + ", " + fmt6(p[2]), n);
-  }
-  return I;
+  return checked_inertia(I, f, n);
 }
 
 // ---- transforms (spec.py) ---------------------------------------------------------------------
@@ -367,6 +386,7 @@ struct LinkIn {
   double mass = 0;
   Vec3 com = Vec3::Zero();
   Mat3 inertia = Mat3::Zero();
+  std::optional<double> izz;  ///< given alone: a planar mechanism's lamina (lamina_inertia)
 };
 struct JointIn {
   std::optional<std::string> name, parent;
@@ -383,7 +403,26 @@ struct BodyIn {
   double mass = 0;
   Vec3 com = Vec3::Zero(), rpy = Vec3::Zero();
   Mat3 inertia = Mat3::Zero();
+  std::optional<double> izz;
 };
+
+/// tables.lamina_inertia: izz given alone is a thin lamina in the plane normal to `n` (the body's
+/// axes): izz about n, izz / 2 about every in-plane axis, izz / 2 (1 + n n^T).
+Mat3 lamina_inertia(double izz, const Vec3& normal) {
+  const Vec3 n = normal / normal.norm();
+  return 0.5 * izz * (Mat3::Identity() + n * n.transpose());
+}
+
+/// tables._one_inertia: `inertia`, or `izz` alone (checked after every key, as the Python model
+/// validator is; `rpy` orients inertia axes, which izz alone has not).
+void one_inertia(const toml::table& t, const std::string& f) {
+  const toml::node* in = get(t, "inertia");
+  const toml::node* z = get(t, "izz");
+  if (!in && !z) fail(join(f, "inertia"), "is required (or izz alone, for a planar mechanism)");
+  if (in && z) fail(join(f, "izz"), "give inertia or izz, not both", *z);
+  if (z && get(t, "rpy")) fail(join(f, "rpy"), "orients the inertia axes; izz alone is about the plane's normal: drop rpy", *get(t, "rpy"));
+}
+
 struct FrameIn {
   std::string name, link;
   OriginIn origin;
@@ -464,11 +503,13 @@ JointIn read_joint(const toml::node& n, const std::string& f) {
   if (auto x = get(t, "link")) {
     const std::string fk = join(f, "link");
     const auto& l = table_of(*x, fk);
-    allow_keys(l, fk, {"mass", "com", "inertia"});
+    allow_keys(l, fk, {"mass", "com", "inertia", "izz"});
     LinkIn li;
     li.mass = number(required(l, "mass", fk), join(fk, "mass"), 0.0);
     li.com = vec3_or(l, "com", fk, Vec3::Zero());
-    li.inertia = inertia_matrix(required(l, "inertia", fk), join(fk, "inertia"));
+    if (auto y = get(l, "inertia")) li.inertia = inertia_matrix(*y, join(fk, "inertia"));
+    if (auto y = get(l, "izz")) li.izz = number(*y, join(fk, "izz"), 0.0);
+    one_inertia(l, fk);
     j.link = li;
   }
   // Joint._consistent
@@ -501,7 +542,7 @@ JointIn read_joint(const toml::node& n, const std::string& f) {
 
 BodyIn read_body(const toml::node& n, const std::string& f) {
   const auto& t = table_of(n, f);
-  allow_keys(t, f, {"name", "kind", "link", "mass", "com", "inertia", "rpy"});
+  allow_keys(t, f, {"name", "kind", "link", "mass", "com", "inertia", "izz", "rpy"});
   BodyIn b;
   b.name = name(required(t, "name", f), join(f, "name"));
   if (auto x = get(t, "kind")) {
@@ -510,8 +551,10 @@ BodyIn read_body(const toml::node& n, const std::string& f) {
   b.link = name(required(t, "link", f), join(f, "link"));
   b.mass = number(required(t, "mass", f), join(f, "mass"), 0.0);
   b.com = vec3_or(t, "com", f, Vec3::Zero());
-  b.inertia = inertia_matrix(required(t, "inertia", f), join(f, "inertia"));
+  if (auto x = get(t, "inertia")) b.inertia = inertia_matrix(*x, join(f, "inertia"));
+  if (auto x = get(t, "izz")) b.izz = number(*x, join(f, "izz"), 0.0);
   b.rpy = vec3_or(t, "rpy", f, Vec3::Zero());
+  one_inertia(t, f);
   return b;
 }
 
@@ -797,16 +840,59 @@ MechanismDescription build_description(const MechanismIn& m, const std::string& 
     b.inertia = 0.5 * (I + I.transpose());
     desc.bodies.push_back(b);
   };
+  // izz alone (spec.plane_normal): a lamina in the plane of motion, whose normal is the joints'
+  // common axis in O at q = 0
+  std::map<std::string, Mat3> rotation_in_o{{kBase, Mat3::Identity()}};
+  for (const Joint& js : desc.joints) rotation_in_o[js.name] = rotation_in_o.at(js.parent) * js.placement.linear();
+  auto plane_normal = [&](const std::string& f, double izz) -> Vec3 {
+    const Joint* first = nullptr;
+    for (const Joint& js : desc.joints) {
+      if (js.type == JointType::revolute) {
+        first = &js;
+        break;
+      }
+    }
+    if (!first) {
+      fail(f, "izz alone needs a planar mechanism with a revolute joint (its axis is the plane's normal); give "
+              "inertia = [Ixx, Iyy, Izz]", float_repr(izz));
+    }
+    const Vec3 a0 = rotation_in_o.at(first->name) * first->axis;
+    const Vec3 n = a0 / a0.norm();
+    for (const Joint& js : desc.joints) {
+      if (js.type != JointType::revolute && js.type != JointType::prismatic) continue;
+      const Vec3 r = rotation_in_o.at(js.name) * js.axis;
+      const Vec3 a = r / r.norm();
+      const bool revolute = js.type == JointType::revolute;
+      const double off = revolute ? a.cross(n).norm() : std::abs(a.dot(n));
+      if (off > kPlanarTol) {
+        fail(f, "izz alone needs a planar mechanism (every revolute axis parallel, every prismatic axis "
+                "perpendicular to the first revolute axis in O): joint " + quote(js.name) + " (" +
+                    (revolute ? "revolute" : "prismatic") + ") is not; give inertia = [Ixx, Iyy, Izz]",
+             float_repr(izz));
+      }
+    }
+    return n;
+  };
+  auto lamina = [&](const std::string& link, double izz, const std::string& f) -> Mat3 {
+    const Vec3 n = plane_normal(f, izz);
+    const Mat3 R = rotation_in_o.at(link) * frame_of_link(link).topLeftCorner<3, 3>();
+    return lamina_inertia(izz, R.transpose() * n);
+  };
   for (std::size_t i : order) {
     const auto& j = m.joints[i];
-    if (j.link) add_body(names[i], "link", expansions[i].back(), j.link->mass, j.link->com, j.link->inertia, join(jf(i), "link"));
+    if (j.link) {
+      const std::string& link = expansions[i].back();
+      const Mat3 inertia = j.link->izz ? lamina(link, *j.link->izz, join(join(jf(i), "link"), "izz")) : j.link->inertia;
+      add_body(names[i], "link", link, j.link->mass, j.link->com, inertia, join(jf(i), "link"));
+    }
   }
   for (std::size_t k = 0; k < m.bodies.size(); ++k) {
     const auto& b = m.bodies[k];
     const std::string f = item(join(field, "bodies"), k);
     const std::string link = resolve(b.link, join(f, "link"), "link");
     const Mat3 R = rotation_rpy(b.rpy);
-    add_body(b.name, b.kind, link, b.mass, b.com, R * b.inertia * R.transpose(), join(f, "name"));
+    const Mat3 inertia = b.izz ? lamina(link, *b.izz, join(f, "izz")) : Mat3(R * b.inertia * R.transpose());
+    add_body(b.name, b.kind, link, b.mass, b.com, inertia, join(f, "name"));
   }
 
   std::map<std::string, std::string> frame_field;
@@ -964,9 +1050,11 @@ ControlConfig read_control(const toml::node& n, const MechanismModel& model) {
   all.insert(all.end(), reactionless.begin(), reactionless.end());
   allow_keys(t, f, all);
   ControlConfig c;
-  const std::string kind = choice(required(t, "kind", f), join(f, "kind"), {"computed_torque", "decoupled", "reactionless"});
+  const std::string kind =
+      choice(required(t, "kind", f), join(f, "kind"), {"computed_torque", "decoupled", "reactionless", "passive"});
   c.kind = kind == "computed_torque" ? ControlKind::computed_torque
            : kind == "decoupled"     ? ControlKind::decoupled
+           : kind == "passive"       ? ControlKind::passive
                                      : ControlKind::reactionless;
   for (auto&& [k, v] : t) {
     const std::string key(k.str());
@@ -974,6 +1062,10 @@ ControlConfig read_control(const toml::node& n, const MechanismModel& model) {
     const bool is_reactionless = std::find(reactionless.begin(), reactionless.end(), key) != reactionless.end();
     if ((is_decoupled && c.kind != ControlKind::decoupled) || (is_reactionless && c.kind != ControlKind::reactionless)) {
       fail(join(f, key), std::string("is only for kind = '") + (is_decoupled ? "decoupled" : "reactionless") + "'", v);
+    }
+    // a passive run has no controller: no gains, no torque limit (only kind and rate_hz)
+    if (c.kind == ControlKind::passive && key != "kind" && key != "rate_hz" && !is_decoupled && !is_reactionless) {
+      fail(join(f, key), "is not for kind = 'passive' (no controller: only rate_hz)", v);
     }
   }
   if (auto x = get(t, "rate_hz")) c.rate_hz = number(*x, join(f, "rate_hz"), 1.0, 1e6);
@@ -992,7 +1084,7 @@ ControlConfig read_control(const toml::node& n, const MechanismModel& model) {
     }
     return v;
   };
-  const bool gains_needed = c.kind != ControlKind::reactionless;
+  const bool gains_needed = c.kind != ControlKind::reactionless && c.kind != ControlKind::passive;
   c.kp = per_joint("kp", gains_needed);
   c.kd = per_joint("kd", gains_needed);
   if (c.kp.empty() != c.kd.empty()) fail(join(f, c.kp.empty() ? "kp" : "kd"), "is required with " + std::string(c.kp.empty() ? "kd" : "kp"));
@@ -1044,26 +1136,92 @@ std::vector<double> joint_values(const toml::node& n, const std::string& f) {
   return out;
 }
 
+/// A speed or rpm: one number (every actuated joint) or one per actuated joint (tables.Speeds).
+std::vector<double> speeds(const toml::node& n, const std::string& f, bool& scalar) {
+  scalar = !n.is_array();
+  if (scalar) return {number(n, f)};
+  return joint_values(n, f);
+}
+
 TrajectoryConfig read_trajectory(const toml::node& n, const MechanismModel& model) {
   const std::string f = "trajectory";
   const auto& t = table_of(n, f);
-  allow_keys(t, f, {"law", "start", "end", "duration", "samples", "initial_guess"});
+  allow_keys(t, f, {"law", "start", "end", "duration", "speed", "rpm", "revolutions", "samples", "initial_guess",
+                    "branch"});
   TrajectoryConfig tr;
   tr.present = true;
-  if (auto x = get(t, "law")) tr.law = choice(*x, join(f, "law"), {"quintic", "cubic"}) == "cubic" ? TimeLaw::cubic : TimeLaw::quintic;
+  std::string law = "quintic";
+  if (auto x = get(t, "law")) law = choice(*x, join(f, "law"), {"quintic", "cubic", "constant_speed"});
+  tr.law = law == "cubic" ? TimeLaw::cubic : TimeLaw::quintic;
+  tr.constant_speed = law == "constant_speed";
+  // the fields, in the Python model's order (schema.ChainTrajectory), then its checks across them
   tr.start = joint_values(required(t, "start", f), join(f, "start"));
-  tr.end = joint_values(required(t, "end", f), join(f, "end"));
-  tr.duration = number(required(t, "duration", f), join(f, "duration"), 1e-3, 1e6);
+  if (auto x = get(t, "end")) tr.end = joint_values(*x, join(f, "end"));
+  std::optional<double> duration, revolutions;
+  if (auto x = get(t, "duration")) duration = number(*x, join(f, "duration"), 1e-3, 1e6);
+  bool speed_scalar = false, rpm_scalar = false;
+  std::vector<double> speed, rpm;
+  if (auto x = get(t, "speed")) speed = speeds(*x, join(f, "speed"), speed_scalar);
+  if (auto x = get(t, "rpm")) rpm = speeds(*x, join(f, "rpm"), rpm_scalar);
+  if (auto x = get(t, "revolutions")) revolutions = number(*x, join(f, "revolutions"), 0.0, 1e6, Lo::gt);
   if (auto x = get(t, "samples")) tr.samples = static_cast<int>(integer(*x, join(f, "samples"), 3, 1000000));
   if (auto x = get(t, "initial_guess")) tr.initial_guess = joint_values(*x, join(f, "initial_guess"));
+  if (auto x = get(t, "branch")) tr.branch = choice(*x, join(f, "branch"), {"open", "crossed"});
   const std::size_t na = static_cast<std::size_t>(model.num_actuated());
-  for (const char* key : {"start", "end"}) {
-    const auto& v = std::string(key) == "start" ? tr.start : tr.end;
-    if (v.size() != na) fail(join(f, key), "must have " + std::to_string(na) + " values (one per actuated joint)", *get(t, key));
+  if (tr.constant_speed) {
+    if (get(t, "end")) {
+      fail(join(f, "end"), "is for the rest-to-rest laws (quintic, cubic); a constant-speed motion has start, speed "
+                           "or rpm, and duration or revolutions", *get(t, "end"));
+    }
+    const bool has_speed = get(t, "speed") != nullptr, has_rpm = get(t, "rpm") != nullptr;
+    if (has_speed && has_rpm) fail(join(f, "rpm"), "give speed (rad/s) or rpm, not both", *get(t, "rpm"));
+    if (!has_speed && !has_rpm) fail(join(f, "speed"), "law = 'constant_speed' needs speed (rad/s) or rpm");
+    if (duration && revolutions) fail(join(f, "revolutions"), "give duration or revolutions, not both", *get(t, "revolutions"));
+    if (!duration && !revolutions) fail(join(f, "duration"), "law = 'constant_speed' needs duration (s) or revolutions");
+    const bool scalar = has_speed ? speed_scalar : rpm_scalar;
+    tr.speed = has_speed ? speed : rpm;
+    if (has_rpm) {
+      for (double& w : tr.speed) w *= 2.0 * 3.141592653589793 / 60.0;
+    }
+    if (scalar) tr.speed.assign(tr.start.size(), tr.speed[0]);
+    if (revolutions) {
+      double top = 0.0;
+      for (double w : tr.speed) top = std::max(top, std::abs(w));
+      if (top == 0.0) fail(join(f, "revolutions"), "needs a non-zero speed (every speed is 0)", *get(t, "revolutions"));
+      tr.revolutions = *revolutions;
+      tr.duration = *revolutions * 2.0 * 3.141592653589793 / top;
+      if (!(tr.duration >= 1e-3 && tr.duration <= 1e6)) {
+        fail(join(f, "revolutions"), "gives a duration outside 0.001 .. 1000000 s", *get(t, "revolutions"));
+      }
+    } else {
+      tr.duration = *duration;
+    }
+    if (scalar) tr.speed.assign(na, tr.speed[0]);
+  } else {
+    for (const char* key : {"speed", "rpm", "revolutions"}) {
+      if (auto x = get(t, key)) fail(join(f, key), "is for law = 'constant_speed' (law is '" + law + "')", *x);
+    }
+    if (!get(t, "end")) fail(join(f, "end"), "law = '" + law + "' needs end");
+    if (!duration) fail(join(f, "duration"), "law = '" + law + "' needs duration");
+    tr.duration = *duration;
   }
-  if (!tr.initial_guess.empty() && tr.initial_guess.size() != static_cast<std::size_t>(model.dof())) {
-    fail(join(f, "initial_guess"), "must have " + std::to_string(model.dof()) + " values (every joint coordinate)",
-         *get(t, "initial_guess"));
+  for (const char* key : {"start", "end", "speed", "rpm"}) {
+    const toml::node* x = get(t, key);
+    if (!x || !x->is_array()) continue;
+    if (x->as_array()->size() != na) fail(join(f, key), "must have " + std::to_string(na) + " values (one per actuated joint)", *x);
+  }
+  if (model.is_closed()) {
+    const std::size_t dof = static_cast<std::size_t>(model.dof());
+    if (!tr.initial_guess.empty() && tr.initial_guess.size() != dof && tr.initial_guess.size() != na) {
+      fail(join(f, "initial_guess"),
+           "must have " + std::to_string(dof) + " values (every joint coordinate) or " + std::to_string(na) +
+               " (the actuated joints)",
+           *get(t, "initial_guess"));
+    }
+  } else {
+    for (const char* key : {"initial_guess", "branch"}) {
+      if (auto x = get(t, key)) fail(join(f, key), "is for closed mechanisms (with [[mechanism.loops]]); this one has no loop", *x);
+    }
   }
   return tr;
 }

@@ -61,6 +61,8 @@ class BalanceCase:
     default_slots: list
     default_design: dict | None = None
     notes: dict | None = None
+    #: closed mechanisms: the assembly at the start (`mechbal.assembly.Assembly.summary`)
+    assembly: dict | None = None
 
 
 #: what builds the BalanceCase of a validated case, and (optionally) the case written back with the
@@ -106,6 +108,9 @@ def design_trajectory(mech, design_cfg, default: dict, guess):
     (a ``[trajectory]``-like dict in the actuated joints)."""
     if design_cfg is not None and design_cfg.trajectory is not None:
         tr = design_cfg.trajectory
+        if getattr(tr, "branch", None) is not None:
+            raise ConfigError("trajectory.branch", "is read for kind = 'mechanism' cases; this case kind "
+                              "picks its assembly with a full initial_guess", tr.branch)
         g = getattr(tr, "initial_guess", None)
         guess = guess if g is None else np.array(g, float)
         t, motion, tt = _trajectory_motion(mech, tr)
@@ -173,6 +178,11 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
             raise ConfigError("--design", "a URDF has no [balance] table: give --design FILE.toml with "
                                           "[[balance.counterweights]] (and optionally a [trajectory])", has_value=False)
         rng = np.random.default_rng(design_cfg.balance.seed)
+        for key in ("initial_guess", "branch"):
+            value = getattr(design_cfg.trajectory, key, None)
+            if value is not None and not mech.is_closed:
+                raise ConfigError(f"trajectory.{key}", "is for closed mechanisms (with loops); this URDF has none",
+                                  value)
         if design_cfg.trajectory is not None:
             t, motion, tt = _trajectory_motion(mech, design_cfg.trajectory)
         else:
@@ -213,8 +223,14 @@ def case_from_config(cfg, raw: dict | None = None, design_cfg=None, *, source: s
         t, motion, tt = _trajectory_motion(mech, tr)
         if guess is not None:
             tt["initial_guess"] = list(guess)
-        return BalanceCase(name, title, mech, table, t, motion, tt,
-                           None if guess is None else np.array(guess, float), raw, cfg.case.kind, [])
+        q_guess, assembly = None if guess is None else np.array(guess, float), None
+        if mech.is_closed:   # the assembly at the start, on [trajectory] branch
+            from mechbal.assembly import assemble
+
+            asm = assemble(mech, motion[0][0], branch=getattr(tr, "branch", None), initial_guess=guess)
+            q_guess, assembly = asm.q, asm.summary()
+        return BalanceCase(name, title, mech, table, t, motion, tt, q_guess, raw, cfg.case.kind, [],
+                           assembly=assembly)
     adapter = case_adapter(cfg.case.kind)
     if adapter is not None:
         return adapter.build(cfg, raw, table, design_cfg)
@@ -259,7 +275,7 @@ def _comparison(before: dict, after: dict) -> dict:
     for key, unit in (("static_torque", "N m or N"), ("torque", "N m or N"), ("shaking_force", "N"),
                       ("shaking_moment", "N m")):
         b, a = _stats(before[key]), _stats(after[key])
-        name = "actuator_torque" if key == "torque" else key
+        name = "joint_torque" if key == "torque" else key
         out[name] = {"unit": unit, "unbalanced": b, "balanced": a,
                      "peak_reduction_pct": common.reduction_pct(b["peak"], a["peak"]),
                      "rms_reduction_pct": common.reduction_pct(b["rms"], a["rms"])}
@@ -318,8 +334,7 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
     lower = table.lower if table is not None else None
     upper = table.upper if table is not None else None
     if mech.is_closed and lower is None and upper is None:  # the trajectory's range assembles
-        lower = np.minimum(bc.trajectory_table["start"], bc.trajectory_table["end"])
-        upper = np.maximum(bc.trajectory_table["start"], bc.trajectory_table["end"])
+        lower, upper = np.min(bc.motion[0], axis=0), np.max(bc.motion[0], axis=0)
     width = len(mech.actuated_names) if mech.is_closed else mech.dof
     for key, v in (("lower", lower), ("upper", upper)):
         if v is not None and len(v) != width:
@@ -329,7 +344,7 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
 
 
 def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
-    from mechbal.balance.writers import mechanism_table, toml_text
+    from mechbal.balance.writers import inertia_table, mechanism_table, toml_text
 
     added = ([f"counterweights " + ", ".join(
         f"{k} {v['mass']:.6g} kg at {np.round(np.asarray(v['position'], float), 6).tolist()} m on {v['link']}"
@@ -368,7 +383,7 @@ def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
             com = R.T @ (np.asarray(b.com, float) - t)
             I = R.T @ np.asarray(b.inertia, float) @ R
             bodies.append({"name": b.name, "kind": "counterweight", "link": b.link, "mass": float(b.mass),
-                           "com": com.tolist(), "inertia": [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]})
+                           "com": com.tolist(), "inertia": inertia_table(I)})
         mech["bodies"] = bodies
         springs = list(mech.get("springs", []))
         own_springs = set(bc.mechanism.spring_names)
@@ -459,12 +474,14 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
                "balance": result.summary(),
                "trajectory": {k: v for k, v in bc.trajectory_table.items()},
                "before_after": _comparison(before, after),
-               "total_mass_kg": {"unbalanced": bc.mechanism.total_mass, "balanced": result.balanced.total_mass},
+               "total_mass": {"unbalanced": bc.mechanism.total_mass, "balanced": result.balanced.total_mass},
                "files": files}
     summary.update(export_notes)
+    if bc.assembly is not None:
+        summary["assembly"] = bc.assembly
     if bc.notes:
         summary["case_notes"] = bc.notes
-    write_summary(out / "summary.json", summary)
+    write_summary(out / "summary.json", summary, command="balance")
     rows = [[k, v["mass"], np.asarray(v["position"], float), ", ".join(v.get("active_bounds", [])) or "-"]
             for k, v in result.design.items() if "mass" in v]
     if rows:

@@ -743,10 +743,10 @@ class SpringCluster:
         return {"code": self.spring.code, "spring_rate_N_per_mm": self.spring.rate / 1e3,
                 "count": self.count, "pulley_ratio": self.pulley_ratio, "moving_pulleys": self.moving_pulleys,
                 "equivalent_rate_N_per_mm": self.equivalent_rate / 1e3, "rate_error": self.rate_error,
-                "peak_force_N": self.peak_force, "force_per_spring_N": self.force_per_spring,
-                "spring_max_force_N": self.spring.max_force, "force_margin": self.force_margin,
+                "peak_force": self.peak_force, "force_per_spring": self.force_per_spring,
+                "spring_max_force": self.spring.max_force, "force_margin": self.force_margin,
                 "anchor_offset_mm": None if self.anchor_offset is None else self.anchor_offset * 1e3,
-                "total_spring_mass_kg": self.total_mass}
+                "total_spring_mass": self.total_mass}
 
 
 def select_springs(rate: float, peak_force: float, catalogue: Sequence[CatalogueSpring] | str | Path | None = None,

@@ -4,7 +4,8 @@
   inside them, numbers written to round-trip exactly, strings, booleans, arrays).
 * `mechanism_table`: the ``[mechanism]`` table of a `mechbal.Mechanism` from its
   model (joints as ``origin = {xyz, rpy}`` + ``axis`` in the parent link's frame, limits, gears,
-  every body with its centre of mass and full inertia in its link frame, frames, loops, springs).
+  every body with its centre of mass and full inertia in its link frame (the named form
+  ``{ixx, iyy, izz, ixy, ixz, iyz}``), frames, loops, springs).
   The root link is written ``base`` (a URDF's may be ``world``); a frame named ``base`` (a URDF
   link of that name) is written ``base_frame``, since ``base`` is the TOML format's fixed base.
 * `urdf_text`: URDF of a tree without springs, `mechbal.export.urdf.urdf_text`
@@ -86,9 +87,12 @@ def toml_text(data: Mapping[str, Any], header: str = "") -> str:
 
 
 
-def _inertia6(I: np.ndarray) -> list[float]:
+def inertia_table(I: np.ndarray) -> dict[str, float]:
+    """The named form of an inertia, ``{ixx, iyy, izz, ixy, ixz, iyz}`` (what both case readers
+    take; docs/case_format.md)."""
     I = np.asarray(I, float)
-    return [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
+    return {"ixx": float(I[0, 0]), "iyy": float(I[1, 1]), "izz": float(I[2, 2]),
+            "ixy": float(I[0, 1]), "ixz": float(I[0, 2]), "iyz": float(I[1, 2])}
 
 
 _TYPES = {_core.JointType.revolute: "revolute", _core.JointType.prismatic: "prismatic",
@@ -120,7 +124,7 @@ def mechanism_table(mech) -> dict:
         joints.append(entry)
     bodies = [{"name": b.name, "kind": b.kind if b.kind in ("link", "counterweight", "motor", "disc", "payload")
                else "other", "link": link_name(b.link), "mass": float(b.mass), "com": np.asarray(b.com, float).tolist(),
-               "inertia": _inertia6(b.inertia)} for b in d.bodies]
+               "inertia": inertia_table(b.inertia)} for b in d.bodies]
     frames = []
     for f in d.frames:
         T = np.asarray(f.placement)

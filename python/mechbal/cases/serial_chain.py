@@ -14,7 +14,7 @@ from mechbal import control
 import mechbal
 from mechbal import progress, report
 from mechbal.cases.runners import register
-from mechbal.config import ConfigError, trajectory_from_config
+from mechbal.config import ConfigError, law_name, trajectory_from_config
 from mechbal.export import write_bodies, write_summary
 from mechbal.mechanism import Mechanism
 from mechbal.schema import validate_case
@@ -41,21 +41,42 @@ def mechanism_motion(mech: Mechanism, traj, t, q_guess=None):
     return m.q, m.v, m.a, m.actuated_force, extra
 
 
+def start_assembly(mech: Mechanism, tr, traj):
+    """The assembly of a closed mechanism at the trajectory's start (`mechbal.assembly.assemble`
+    with ``[trajectory] branch`` and ``initial_guess``), or None for an open one."""
+    if not mech.is_closed:
+        return None
+    from mechbal.assembly import assemble
+
+    qa0 = np.atleast_2d(traj.evaluate_batch(np.zeros(1))[0])[0]
+    return assemble(mech, qa0, branch=getattr(tr, "branch", None),
+                    initial_guess=getattr(tr, "initial_guess", None))
+
+
+def motion_summary(tr, traj) -> dict:
+    """What summary.json says about a constant-speed motion (empty for the rest-to-rest laws)."""
+    if getattr(tr, "law", None) != "constant_speed":
+        return {}
+    speed = np.asarray(traj.speed, float)
+    return {"speed_rad_s": speed, "speed_rpm": speed * 60.0 / (2.0 * np.pi),
+            "revolutions": float(np.max(np.abs(speed)) * traj.duration / (2.0 * np.pi))}
+
+
 @register("mechanism", stages=3)
 @register("serial_chain", stages=3)
 def run(config, out: Path) -> dict:
     case = validate_case(config, warn=False)
     mech = Mechanism.from_spec(case.spec, name=case.case.name)
     traj, t = trajectory_from_config(case.trajectory, len(mech.actuated_names))
-    guess = getattr(case.trajectory, "initial_guess", None)
-    if guess is not None and len(guess) != mech.dof:
-        raise ConfigError("trajectory.initial_guess", f"must have {mech.dof} values (every joint with a "
-                          f"coordinate: {', '.join(mech.joint_names)})", list(guess))
+    assembly = start_assembly(mech, case.trajectory, traj)
+    q_guess = None if assembly is None else assembly.q
+    if case.control is not None and case.control.kind == "passive":
+        return run_passive(mech, case, traj, out, q_guess=q_guess, assembly=assembly)
     if case.control is not None:
-        return run_controlled(mech, case, out, q_guess=None if guess is None else np.array(guess, float))
+        return run_controlled(mech, case, out, q_guess=q_guess, assembly=assembly)
     return run_mechanism(mech, traj, t, out, name=case.case.name, kind=case.case.kind,
-                         title=case.case.title or case.case.name,
-                         q_guess=None if guess is None else np.array(guess, float))
+                         title=case.case.title or case.case.name, q_guess=q_guess,
+                         summary_extra=motion_summary(case.trajectory, traj), assembly=assembly)
 
 
 def _drawing(mech: Mechanism, motion) -> dict:
@@ -69,7 +90,7 @@ def _drawing(mech: Mechanism, motion) -> dict:
 
 
 def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, title: str,
-                  q_guess=None, summary_extra: dict | None = None) -> dict:
+                  q_guess=None, summary_extra: dict | None = None, assembly=None) -> dict:
     """The run every mechanism gets (TOML case or URDF file): motion along ``traj`` at ``t``
     (loops solved for closed mechanisms), shaking wrench, base reaction, actuator torques;
     writes bodies_nominal.npz, the plots and summary.json into ``out``; returns the summary."""
@@ -122,22 +143,26 @@ def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, 
         "dof": mech.dof,
         "actuated": names,
         "closed": mech.is_closed,
-        "duration_s": float(traj.duration),
+        "duration": float(traj.duration),
         "samples": int(len(t)),
-        "law": traj.law.name,
+        "law": law_name(traj),
         "variants": ["nominal"],
-        "peak_shaking_force_N": {"nominal": report.peak_abs(F)},
-        "peak_shaking_moment_Nm": {"nominal": report.peak_abs(M)},
+        "peak_shaking_force": {"nominal": report.peak_abs(F)},
+        "peak_shaking_moment": {"nominal": report.peak_abs(M)},
         "peak_joint_torque": {"nominal": report.peak_abs(torque)},
         "rms_joint_torque": {"nominal": rms},
-        "peak_base_reaction_force_N": {"nominal": report.peak_abs(R_F)},
-        "peak_base_reaction_moment_Nm": {"nominal": report.peak_abs(R_M)},
+        "peak_base_reaction_force": {"nominal": report.peak_abs(R_F)},
+        "peak_base_reaction_moment": {"nominal": report.peak_abs(R_M)},
         "base_reaction": "wrench the base exerts on the mechanism, gravity included, moment about O",
-        "total_mass_kg": mech.total_mass,
+        "total_mass": mech.total_mass,
         "files": ["bodies_nominal.npz", "shaking_wrench.png", "base_reaction.png", "joint_torques.png"],
     }
     if extra:
         summary["loops"] = extra
+        if assembly is not None:   # the branch picked at the start, and where the motion ends
+            from mechbal.assembly import loop_branches
+
+            extra["assembly"] = {**assembly.summary(), "branch_at_end": loop_branches(mech, q[-1])}
     if mech.springs:  # springs are part of the model: the torques above include them
         static = mech.static_torque(q)
         if mech.is_closed:
@@ -175,7 +200,7 @@ def _write_variant(mech: Mechanism, out: Path, variant: str, t, q, v, a):
     return sw.shaking_force, sw.shaking_moment
 
 
-def run_controlled(mech: Mechanism, case, out: Path, q_guess=None) -> dict:
+def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None) -> dict:
     """A case with ``[control]`` (kind reactionless): the motion with the balancing joints held
     at their start (``uncontrolled``) and under the reactionless controller (``controlled``), at
     the controller's ticks; bodies_uncontrolled.npz, bodies_controlled.npz (each with the shaking
@@ -197,11 +222,18 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None) -> dict:
                               f"is not an actuated joint{did_you_mean(b, names)}", b)
     balancing = [names.index(b) for b in ctl.balancing_joints]
     task = [i for i in range(len(names)) if i not in balancing]
-    end = list(case.trajectory.end)
-    if len(end) == len(names):
-        for i in balancing:  # a balancing joint's end is ignored: held at its start
-            end[i] = case.trajectory.start[i]
-    traj, _ = trajectory_from_config(case.trajectory.model_copy(update={"end": end}), len(names))
+    if case.trajectory.law == "constant_speed":   # a balancing joint's speed is ignored: held at its start
+        speed = case.trajectory.speeds(len(names))
+        for i in balancing:
+            speed[i] = 0.0
+        held = {"speed": speed, "rpm": None}
+    else:                                        # a balancing joint's end is ignored: held at its start
+        end = list(case.trajectory.end)
+        if len(end) == len(names):
+            for i in balancing:
+                end[i] = case.trajectory.start[i]
+        held = {"end": end}
+    traj, _ = trajectory_from_config(case.trajectory.model_copy(update=held), len(names))
     dt = 1.0 / ctl.rate_hz
     steps = int(round(traj.duration / dt))
     th = np.arange(2 * steps + 1) * (0.5 * dt)
@@ -247,12 +279,12 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None) -> dict:
         "dof": mech.dof,
         "actuated": names,
         "closed": mech.is_closed,
-        "duration_s": float(traj.duration),
+        "duration": float(traj.duration),
         "samples": int(len(t)),
-        "law": traj.law.name,
+        "law": law_name(traj),
         "variants": ["uncontrolled", "controlled"],
-        "peak_shaking_force_N": {"uncontrolled": report.peak_abs(Fu), "controlled": report.peak_abs(Fc)},
-        "peak_shaking_moment_Nm": {"uncontrolled": report.peak_abs(Mu), "controlled": report.peak_abs(Mc)},
+        "peak_shaking_force": {"uncontrolled": report.peak_abs(Fu), "controlled": report.peak_abs(Fc)},
+        "peak_shaking_moment": {"uncontrolled": report.peak_abs(Mu), "controlled": report.peak_abs(Mc)},
         "control": {
             "kind": ctl.kind, "balancing_joints": bnames, "cancel": list(ctl.cancel),
             "integrator": ctl.integrator, "rate_hz": float(ctl.rate_hz), "damping": float(ctl.damping),
@@ -260,7 +292,7 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None) -> dict:
             "saturated_ticks": int(np.sum(saturated)), "max_condition": float(np.max(r.condition)),
             "peak_balancing_rate": report.peak_abs(r.v[:, balancing]),
         },
-        "total_mass_kg": mech.total_mass,
+        "total_mass": mech.total_mass,
         "files": ["bodies_uncontrolled.npz", "bodies_controlled.npz", "shaking_wrench.png",
                   "balancing_joints.png"],
     }
@@ -268,4 +300,72 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None) -> dict:
     print(report.table(
         [["uncontrolled", *report.peak_abs(Mu)], ["controlled", *report.peak_abs(Mc)]],
         ["peak shaking moment about O [N m]", "x", "y", "z"]))
+    return summary
+
+
+def run_passive(mech: Mechanism, case, traj, out: Path, q_guess=None, assembly=None) -> dict:
+    """A case with ``[control] kind = "passive"``: no controller; the mechanism starts from the
+    trajectory's start with its initial rates (zero for the rest-to-rest laws, ``speed`` for
+    constant_speed) and moves under gravity and its springs with zero effort for the trajectory's
+    duration, RK4 at ``rate_hz`` (`mechbal.simulate.passive`). Writes bodies_passive.npz (the
+    shaking wrench of its stored poses), the wrench and energy plots, and summary.json with the
+    energy balance (kinetic + gravity + springs, conserved by the exact motion)."""
+    from mechbal import simulate
+
+    ctl = case.control
+    name, title = case.case.name, case.case.title or case.case.name
+    q0, v0, _ = (np.atleast_2d(x)[0] for x in traj.evaluate_batch(np.zeros(1)))
+    progress.stage("passive simulation (zero effort: gravity and springs)")
+    r = simulate.passive(mech, q0, v0, dt=1.0 / ctl.rate_hz, duration=float(traj.duration), q_guess=q_guess)
+    if r.steps_completed < len(r.t) - 1:
+        k = r.steps_completed
+        raise ConfigError("control", f"the passive simulation stopped at t = {r.t[k]:.4g} s (status "
+                          f"{control.status_text(int(r.status[k + 1]))}): the mechanism cannot be "
+                          "assembled or its state is not finite there", has_value=False)
+    progress.stage("bodies file and plots")
+    t = r.t
+    F, M = _write_variant(mech, out, "passive", t, r.q_full, r.v_full, r.a_full)
+    report.plot_wrench(out / "shaking_wrench.png", t, {"passive": (F, M)}, title=f"{title}: passive motion",
+                       caption="Shaking force dP/dt and moment dH_O/dt about O of the mechanism moving "
+                               "with zero joint effort under gravity and its springs.")
+    report.plot_series(out / "energy.png", t, {"kinetic": r.kinetic_energy[:, None],
+                                                "potential (gravity + springs)": r.potential_energy[:, None],
+                                                "total": r.energy[:, None]},
+                       ["energy"], ["energy [J]"], title=f"{name}: energy of the passive motion",
+                       caption="Kinetic energy 1/2 v^T M v, potential energy (gravity, zero at O, plus "
+                               "springs) and their sum, which the exact unforced motion conserves: its "
+                               "drift is the integrator's error.")
+    progress.stage("summary")
+    e0 = float(r.energy[0])
+    swing = float(np.max(r.kinetic_energy) - np.min(r.kinetic_energy))
+    summary = {
+        "case": name,
+        "kind": case.case.kind,
+        "dof": mech.dof,
+        "actuated": mech.actuated_names,
+        "closed": mech.is_closed,
+        "duration_s": float(traj.duration),
+        "samples": int(len(t)),
+        "law": law_name(traj),
+        "variants": ["passive"],
+        "peak_shaking_force_N": {"passive": report.peak_abs(F)},
+        "peak_shaking_moment_Nm": {"passive": report.peak_abs(M)},
+        "passive": {
+            "rate_hz": float(ctl.rate_hz), "integrator": "rk4", "q0": q0, "v0": v0,
+            "initial_energy_J": e0, "max_energy_drift_J": r.energy_drift,
+            "kinetic_energy_swing_J": swing,
+            "relative_energy_drift": r.energy_drift / swing if swing > 0 else 0.0,
+            "energy": "kinetic 1/2 v^T M v + gravity (zero at O) + springs; conserved by the exact motion",
+            "final_q": r.q[-1], "final_v": r.v[-1],
+        },
+        "total_mass_kg": mech.total_mass,
+        "files": ["bodies_passive.npz", "shaking_wrench.png", "energy.png"],
+    }
+    if assembly is not None:
+        from mechbal.assembly import loop_branches
+
+        summary["loops"] = {"assembly": {**assembly.summary(), "branch_at_end": loop_branches(mech, r.q_full[-1])}}
+    write_summary(out / "summary.json", summary)
+    print(report.table([["energy at t = 0 [J]", e0], ["largest energy drift [J]", r.energy_drift],
+                        ["kinetic energy swing [J]", swing]], ["passive motion", "value"]))
     return summary

@@ -123,14 +123,30 @@ def to_json(summary: Mapping[str, Any]) -> tuple[str, list[dict]]:
     return json.dumps(data, indent=2, sort_keys=False, allow_nan=False) + "\n", notes
 
 
-def write_summary(path: str | Path, summary: Mapping[str, Any]) -> Path:
-    """Write ``summary`` as strict JSON. A non-finite number (NaN, +-inf: e.g. a paper value the
-    case does not give) is written as ``null`` and listed under ``non_finite_values`` with its
-    dotted field, both in the file and (when ``summary`` is a dict) in ``summary`` itself, so that
-    the caller can warn."""
+#: the version of summary.json's schema (``mechbal/cases/summary.schema.json``): every file
+#: starts with ``schema_version`` and ``command``
+SUMMARY_SCHEMA_VERSION = 1
+SUMMARY_COMMANDS = ("run", "balance", "verify", "sweep")
+
+
+def write_summary(path: str | Path, summary: Mapping[str, Any], command: str = "run") -> Path:
+    """Write ``summary`` as strict JSON, headed by ``schema_version`` and ``command`` (the
+    mechbal command that writes it: run, balance, verify, sweep); its keys follow
+    ``mechbal/cases/summary.schema.json`` (docs/summary.md). A non-finite number (NaN, +-inf:
+    e.g. a paper value the case does not give) is written as ``null`` and listed under
+    ``non_finite_values`` with its dotted field. The header and the notes go both into the file
+    and (when ``summary`` is a dict) into ``summary`` itself, so that the caller can warn."""
+    if command not in SUMMARY_COMMANDS:
+        raise ValueError(f"command: must be one of {', '.join(SUMMARY_COMMANDS)} (got {command!r})")
+    header = {"schema_version": SUMMARY_SCHEMA_VERSION, "command": command}
+    body = {k: v for k, v in summary.items() if k not in header}
+    if isinstance(summary, dict):
+        summary.clear()
+        summary.update(header)
+        summary.update(body)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    text, notes = to_json(summary)
+    text, notes = to_json({**header, **body})
     path.write_text(text)
     if notes and isinstance(summary, dict):
         summary["non_finite_values"] = notes

@@ -13,7 +13,7 @@ run::
     sweep = Sweep("arm2link-balanced",
                   [Parameter("bodies.counterweight1.mass", tolerance=0.02),
                    Parameter("bodies.shoulder.mass", tolerance=0.02)],
-                  ["gravity_torque_peak", "shaking_force_rms"],
+                  ["peak_gravity_torque", "rms_shaking_force"],
                   kind="monte_carlo", evaluations=10_000, seed=1)
     result = sweep.run("processes")           # or "serial", or "dask" with scheduler="tcp://..."
     result.table                              # pandas DataFrame, one row per evaluation

@@ -156,10 +156,10 @@ def direct_quantities(mech, plan: Plan, wanted: set[str]) -> dict[str, np.ndarra
         out["gravity_torque"] = _actuated(C, mech.gravity_torque(q))
     if wanted - set(STATIC):
         qa, va, aa = plan.trajectory
-        need_c = "actuator_torque" in wanted
+        need_c = "joint_torque" in wanted
         q, v, a, C = motion(mech, qa, va, aa, q_guess=plan.q_guess, coupling=need_c)
         if need_c:
-            out["actuator_torque"] = _actuated(C, mech.inverse_dynamics(q, v, a))
+            out["joint_torque"] = _actuated(C, mech.inverse_dynamics(q, v, a))
         if wanted & {"shaking_force", "shaking_moment"}:
             w = mech.shaking_wrench(q, v, a)
             out["shaking_force"] = w.shaking_force
@@ -226,13 +226,13 @@ class Context:
             regressors["gravity_torque"] = Y
         if wanted - set(STATIC):
             qa, va, aa = plan.trajectory
-            need_c = "actuator_torque" in wanted
+            need_c = "joint_torque" in wanted
             q, v, a, C = motion(mech, qa, va, aa, q_guess=plan.q_guess, coupling=need_c)
             if need_c:
                 Y = mech.torque_regressor(q, v, a)
                 if C is not None:
                     Y = np.einsum("tnk,tnp->tkp", C, Y)
-                regressors["actuator_torque"] = Y
+                regressors["joint_torque"] = Y
             if wanted & {"shaking_force", "shaking_moment"}:
                 Yw = self._wrench_regressor(q, v, a)
                 regressors["shaking_force"] = Yw[:, :3]

@@ -2,15 +2,21 @@
 actuator torque, shaking force and shaking moment over a trajectory) and any callable of a
 `mechbal.Mechanism`.
 
-A built-in metric is ``<quantity>_<statistic>`` or ``<quantity>_<statistic>.<joint>``:
+A built-in metric is ``<statistic>_<quantity>`` or ``<statistic>_<quantity>.<joint>`` (the names
+of summary.json: ``peak_shaking_force``, ``rms_joint_torque``, ...):
 
-- quantity ``gravity_torque`` (the actuated joints' gravity forces holding each pose of the
-  workspace sample still, C^T G for a closed mechanism) [N m or N], ``actuator_torque`` (the
-  actuated joints' forces along the trajectory, gravity included) [N m or N], ``shaking_force``
-  (dP/dt) [N], ``shaking_moment`` (dH_O/dt about O) [N m] along the trajectory;
 - statistic ``peak`` = max over the samples of the Euclidean norm of the vector (the actuated
   joints' forces, or the 3 components of the wrench), ``rms`` = sqrt(mean over the samples of its
-  squared norm); with ``.<joint>`` (torques only) the vector is that one joint's force.
+  squared norm); with ``.<joint>`` (torques only) the vector is that one joint's force. (A case
+  run's summary.json gives the same quantities per component or per joint: the peak of each
+  absolute value.)
+- quantity ``gravity_torque`` (the actuated joints' gravity forces holding each pose of the
+  workspace sample still, C^T G for a closed mechanism) [N m or N], ``joint_torque`` (the
+  actuated joints' forces along the trajectory, gravity included) [N m or N], ``shaking_force``
+  (dP/dt) [N], ``shaking_moment`` (dH_O/dt about O) [N m] along the trajectory.
+
+The names before summary.json's schema 1 (``shaking_force_peak``, ``actuator_torque_rms``, ...)
+are still read, with a DeprecationWarning (``RENAMED``).
 
 All four quantities are linear in the bodies' inertial parameters pi (Y(q) pi with the gravity,
 torque and momentum-rate regressors), which is what lets a sweep over body parameters evaluate
@@ -27,15 +33,24 @@ Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Any, Callable
 
 from mechbal.errors import ConfigError
 
-QUANTITIES = ("gravity_torque", "actuator_torque", "shaking_force", "shaking_moment")
+QUANTITIES = ("gravity_torque", "joint_torque", "shaking_force", "shaking_moment")
 STATISTICS = ("peak", "rms")
-BUILTIN = tuple(f"{q}_{s}" for q in QUANTITIES for s in STATISTICS)
-UNITS = {"gravity_torque": "N m", "actuator_torque": "N m", "shaking_force": "N", "shaking_moment": "N m"}
+BUILTIN = tuple(f"{s}_{q}" for q in QUANTITIES for s in STATISTICS)
+#: the unit of each built-in metric (``N m`` for a revolute joint, ``N`` for a prismatic one)
+UNITS = {f"{s}_{q}": u for q, u in (("gravity_torque", "N m"), ("joint_torque", "N m"), ("shaking_force", "N"),
+                                    ("shaking_moment", "N m")) for s in STATISTICS}
+#: the built-in names before summary.json's schema 1 -> their names now
+RENAMED = {f"{old}_{s}": f"{s}_{new}" for old, new in (("gravity_torque", "gravity_torque"),
+                                                        ("actuator_torque", "joint_torque"),
+                                                        ("shaking_force", "shaking_force"),
+                                                        ("shaking_moment", "shaking_moment"))
+           for s in STATISTICS}
 #: quantities evaluated over the workspace sample (poses); the others over the trajectory
 STATIC = ("gravity_torque",)
 
@@ -92,12 +107,18 @@ def resolve(metrics: Any, actuated: list[str], field: str = "metrics") -> list[M
         if not isinstance(what, str):
             raise ConfigError(f, "must be a built-in metric name or a callable", what)
         base, _, joint = what.partition(".")
+        if base in RENAMED:
+            warnings.warn(f"{f}: metric {base!r} is now called {RENAMED[base]!r} (summary.json schema 1); "
+                          "the old name goes in a later release", DeprecationWarning, stacklevel=3)
+            base = RENAMED[base]
+            if name == what:
+                name = base + (f".{joint}" if joint else "")
         if base not in BUILTIN:
             raise ConfigError(f, f"unknown metric{did_you_mean(base, list(BUILTIN))} (built-in: "
                                  f"{', '.join(BUILTIN)}, optionally .<joint>; or give a callable)", what)
-        quantity, statistic = base.rsplit("_", 1)
+        statistic, quantity = base.split("_", 1)
         if joint:
-            if quantity not in ("gravity_torque", "actuator_torque"):
+            if quantity not in ("gravity_torque", "joint_torque"):
                 raise ConfigError(f, "only torques can be taken per joint", what)
             if joint not in actuated:
                 raise ConfigError(f, f"no actuated joint named {joint!r}{did_you_mean(joint, actuated)}", what)
@@ -105,4 +126,4 @@ def resolve(metrics: Any, actuated: list[str], field: str = "metrics") -> list[M
     return out
 
 
-__all__ = ["BUILTIN", "MetricSpec", "QUANTITIES", "STATIC", "STATISTICS", "UNITS", "resolve"]
+__all__ = ["BUILTIN", "MetricSpec", "QUANTITIES", "RENAMED", "STATIC", "STATISTICS", "UNITS", "resolve"]

@@ -60,7 +60,7 @@ class SweepResult:
         units = {}
         for m in plan.metrics:
             if m.builtin:
-                units[m.name] = UNITS[m.quantity]
+                units[m.name] = UNITS[f"{m.statistic}_{m.quantity}"]
         settings = {"case": sweep.base.name, "evaluations": int(len(values)),
                     "chunk_size": sweep.default_chunk_size(),
                     "poses": None if sweep.poses is None else int(len(sweep.poses)),
@@ -146,7 +146,7 @@ class SweepResult:
         out.mkdir(parents=True, exist_ok=True)
         files = [self.write_table(out / f"results.{'csv' if fmt == 'csv' else 'parquet'}", fmt)]
         files += self.plot(out)
-        files.append(write_summary(out / "summary.json", self.summary()))
+        files.append(write_summary(out / "summary.json", self.summary(), command="sweep"))
         return files
 
     # ---- plots ------------------------------------------------------------------------------------

@@ -3,7 +3,7 @@
 /// Forward kinematics of every link, body and named frame of a MechanismModel: pose, velocity and
 /// acceleration in the base frame O (data.link_*, data.body_states, data.frame_placements).
 ///
-/// Every algorithm over a MechanismModel follows the same contract (DESIGN.md, real-time rules):
+/// Every algorithm over a MechanismModel follows the same contract (docs/architecture.md, "Data flow": real time):
 /// noexcept, allocation-free once the MechanismData exists; q, v, a have model.dof() entries
 /// (Status::bad_size otherwise, also when `data` was built for another model); non-finite input
 /// gives Status::non_finite_input; in both cases nothing in `data` is written.

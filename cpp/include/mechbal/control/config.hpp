@@ -11,9 +11,10 @@ namespace mechbal {
 
 /// Which controller the `[control]` table asks for (`kind = "..."`); `none` when the file has no
 /// `[control]` table.
-enum class ControlKind { none, computed_torque, decoupled, reactionless };
+enum class ControlKind { none, computed_torque, decoupled, reactionless, passive };
 
-/// The `kind` string of a ControlKind ("none", "computed_torque", "decoupled", "reactionless").
+/// The `kind` string of a ControlKind ("none", "computed_torque", "decoupled", "reactionless",
+/// "passive": no controller, zero effort, the mechanism moves under gravity and springs).
 const char* control_kind_name(ControlKind kind) noexcept;
 
 /// The `[control]` table. Per-joint vectors follow the model's actuated coordinates

@@ -5,7 +5,8 @@
 ///    through the loop projection), gains kp, kd, torque_limit;
 ///  - decoupled: DecoupledJointController with k (the constant diagonal of the balanced mass
 ///    matrix; from the model at q = 0 when the config leaves it empty), kp, kd, torque_limit;
-///  - reactionless: not in this build yet (std::invalid_argument saying so).
+///  - reactionless: not in this build yet (std::invalid_argument saying so);
+///  - passive: PassiveController (zero effort: gravity and springs move the mechanism).
 /// Construction time only: throws std::invalid_argument naming the `control.` field and the value.
 /// The returned controller owns everything it uses (its own copy of the model); step() is
 /// noexcept and allocation-free as the controller's own. `q_guess` (model.dof() values, or empty

@@ -1,7 +1,7 @@
 #pragma once
 /// \file control/reactionless.hpp
-/// Reactionless control of any mechanism (DESIGN.md, "Control is organised by controller over the
-/// model"): the actuated joints are split into task joints, whose motion is given, and balancing
+/// Reactionless control of any mechanism (docs/architecture.md, "The model": control is organised
+/// by controller over the model): the actuated joints are split into task joints, whose motion is given, and balancing
 /// joints, whose motion the controller computes every tick so that the selected components of the
 /// momentum about O, h = [P; H_O], stay at their target h*. The shaking wrench is dh/dt
 /// (algorithm/shaking_wrench.hpp), so a constant target cancels the selected components of it.

@@ -50,11 +50,22 @@ MechanismModel mechanism_from_string(const std::string& toml_text, const std::st
 /// coordinates near the assembly at start (closed mechanisms; empty when absent).
 struct TrajectoryConfig {
   bool present = false;
+  /// law = "quintic" | "cubic": rest-to-rest from start to end in duration (law holds which);
+  /// law = "constant_speed": constant_speed is true, q = start + speed t over duration.
   TimeLaw law = TimeLaw::quintic;
+  bool constant_speed = false;
   std::vector<double> start, end;
-  double duration = 0.0;  ///< [s]
+  /// constant_speed: one speed per actuated joint [rad/s or m/s] (`rpm` converted; one number
+  /// given applies to every joint)
+  std::vector<double> speed;
+  /// [s]; constant_speed with `revolutions`: revolutions 2 pi / max |speed|
+  double duration = 0.0;
+  double revolutions = 0.0;  ///< constant_speed: turns of the fastest joint, when given (else 0)
   int samples = 501;
+  /// every joint coordinate near the assembly at start, or the actuated joints only (the passive
+  /// ones are then solved on `branch`)
   std::vector<double> initial_guess;
+  std::string branch;  ///< "open" | "crossed" (four-bar-like loops), or empty
 };
 
 /// A case as the embedded side needs it: the model, the `[control]` table checked against it

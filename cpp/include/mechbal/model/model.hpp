@@ -1,6 +1,6 @@
 #pragma once
 /// \file model.hpp
-/// The general mechanism model (DESIGN.md, "The mechanism model"): a kinematic tree of joints,
+/// The general mechanism model (docs/architecture.md, "The model"): a kinematic tree of joints,
 /// any number of named rigid bodies on each link, gear couplings between joints, named frames and
 /// gravity. Immutable once built and validated; every algorithm is a free function over a model
 /// and a MechanismData (data.hpp), as in Pinocchio's Model/Data split.

@@ -129,23 +129,23 @@ def _closed_loop(arm, cw, cfg, traj, start):
     return dict(
         t=t, e_eq6=e_eq6, exact=exact, zoh=zoh, perturbed=worst[2],
         summary={
-            "kp": kp, "kd": kd, "rate_hz": 1.0 / dt, "duration_s": duration,
+            "kp": kp, "kd": kd, "rate_hz": 1.0 / dt, "duration": duration,
             "from_rest_on_the_trajectory": {
                 "note": "zero initial error, 1 kHz zero-order hold: the pure tracking error",
-                "max_tracking_error_rad": {"exact": err(on_track),
+                "max_tracking_error": {"exact": err(on_track),
                                            "perturbed_worst_corner": worst_on_track[0]},
                 "perturbed_worst_corner_scale_m1_m2_is1_is2": list(worst_on_track[1]),
             },
             "with_initial_error": {
-                "initial_error_rad": e0,
-                "max_deviation_from_eq6_rad": {"exact_every_rk4_stage": dev(exact),
+                "initial_error": e0,
+                "max_deviation_from_eq6": {"exact_every_rk4_stage": dev(exact),
                                                "exact_zero_order_hold": dev(zoh),
                                                "perturbed_worst_corner": worst[0]},
                 "perturbed_worst_corner_scale_m1_m2_is1_is2": list(worst[1]),
-                "perturbed_final_error_rad": (worst[2]["q_des"] - worst[2]["q"])[-1],
+                "perturbed_final_error": (worst[2]["q_des"] - worst[2]["q"])[-1],
             },
-            "torque_limit_Nm": limit, "saturated_ticks": int(sat["saturated_ticks"]),
-            "saturated_max_deviation_from_eq6_rad": dev(sat),
+            "torque_limit": limit, "saturated_ticks": int(sat["saturated_ticks"]),
+            "saturated_max_deviation_from_eq6": dev(sat),
         })
 
 
@@ -250,7 +250,7 @@ def run(config, out: Path) -> dict:
     step1 = {
         "reading_1_trajectory_only_B_vs_A": {"rms_reduction_pct": rB, "peak_reduction_pct": pB},
         "reading_2_B_with_cw_at_static_radii_vs_A": {
-            "r_cw_m": r_static, "rms_reduction_pct": rS, "peak_reduction_pct": pS},
+            "r_cw": r_static, "rms_reduction_pct": rS, "peak_reduction_pct": pS},
         "paper": {"rms_reduction_pct": paper.get("step1_rms_reduction_pct"),
                   "peak_reduction_pct": paper.get("step1_peak_reduction_pct")},
         "reproduced_by": "reading 2 (law B plus counterweights at the static-balancing radii)",
@@ -282,24 +282,24 @@ def run(config, out: Path) -> dict:
     summary = {
         "case": case.case.name, "kind": "arm2dof",
         "source": "Arakelian, Le Baron & Mottu 2011, Mechatronics 21:310-314",
-        "samples": N, "duration_s": T,
-        "r_cw_m": r_general,
+        "samples": N, "duration": T,
+        "r_cw_general": r_general,
         "r_cw": {"general_method": r_general, "closed_form": [res.r_cw1, res.r_cw2],
                  "max_abs_difference": r_difference, "tolerance": RADIUS_AGREEMENT_M, "unit": "m",
                  "method": {"name": "rms", "coupling": sized.metrics["coupling"],
                             "objective": sized.metrics["objective"], "exact": sized.exact,
                             "how": [sized.design[n].get("method") for n in ("counterweight1", "counterweight2")],
-                            "rms_torque_after_Nm": sized.metrics["rms_torque_after"]},
+                            "rms_joint_torque_after": sized.metrics["rms_torque_after"]},
                  "closed_form_source": "Arakelian et al. 2011, eqs 39-59 corrected (Cardano)"},
-        "r_cw_numerical_m": list(r_num),
-        "paper_r_cw_m": paper_r,
-        "static_balancing_r_cw_m": list(r_static),
+        "r_cw_numerical": list(r_num),
+        "paper_r_cw": paper_r,
+        "static_balancing_r_cw": list(r_static),
         "cubics": {"joint1": {"abc": res.cubic1, "real_roots": res.roots1,
                               "delta_tau": res.delta_tau1},
                    "joint2": {"abc": res.cubic2, "real_roots": res.roots2,
                               "delta_tau": res.delta_tau2}},
-        "rms_torque_Nm": {k: v for k, v in rms.items()},
-        "peak_torque_Nm": {k: v for k, v in peak.items()},
+        "rms_joint_torque": {k: v for k, v in rms.items()},
+        "peak_joint_torque": {k: v for k, v in peak.items()},
         "rms_reduction_pct": {"B_vs_A": rB, "C_vs_A": rC,
                               **({"C_paper_radii_vs_A": red("C_paper_radii")[0]}
                                  if "C_paper_radii" in rms else {})},
@@ -312,10 +312,10 @@ def run(config, out: Path) -> dict:
         "first_step_readings": step1,
         "kdl_vs_closed_form_max_rel_dev": kdl_dev,
         "general_model_vs_closed_form_max_rel_dev": general_dev,
-        "closed_loop_arm": "C (law B, counterweights at r_cw_m)",
-        "max_tracking_error_rad": {
-            "exact": cl["summary"]["from_rest_on_the_trajectory"]["max_tracking_error_rad"]["exact"],
-            "perturbed": cl["summary"]["from_rest_on_the_trajectory"]["max_tracking_error_rad"][
+        "closed_loop_arm": "C (law B, counterweights at r_cw_general)",
+        "max_tracking_error": {
+            "exact": cl["summary"]["from_rest_on_the_trajectory"]["max_tracking_error"]["exact"],
+            "perturbed": cl["summary"]["from_rest_on_the_trajectory"]["max_tracking_error"][
                 "perturbed_worst_corner"]},
         "closed_loop": cl["summary"],
         "closed_loop_bare_arm_B": cl_bare["summary"],
@@ -333,8 +333,8 @@ def run(config, out: Path) -> dict:
                         ["scipy", *r_num], ["paper", *paper_r], ["static balancing", *r_static]],
                        ["radii [m]", "r_CW1", "r_CW2"]))
     s = cl["summary"]
-    trk = s["from_rest_on_the_trajectory"]["max_tracking_error_rad"]
-    dv = s["with_initial_error"]["max_deviation_from_eq6_rad"]
+    trk = s["from_rest_on_the_trajectory"]["max_tracking_error"]
+    dv = s["with_initial_error"]["max_deviation_from_eq6"]
     print(report.table([["exact model, control in every RK4 stage", "-", dv["exact_every_rk4_stage"]],
                         ["exact model, 1 kHz zero-order hold", trk["exact"], dv["exact_zero_order_hold"]],
                         ["+-20 % model, worst corner", trk["perturbed_worst_corner"],

@@ -94,3 +94,30 @@ def unit_warnings(case) -> list[tuple[str, str]]:
 
 
 register_case_model("arm2dof", Arm2DofCase, unit_warnings=unit_warnings)
+
+
+# ---- its summary.json (mechbal.summary_schema) -------------------------------------------------
+from mechbal.summary_schema import (  # noqa: E402
+    METRICS, detail, number, numbers, register_summary, string, strings, integer)
+
+register_summary("run", "arm2dof", {
+    "source": string("The paper."), "samples": integer(), "duration": number("s"),
+    "r_cw_general": numbers("m", "Counterweight radii sized by the general rms method (used by arm C)."),
+    "r_cw": detail("The radii by the general method and the closed form, their difference [m] and the method."),
+    "r_cw_numerical": numbers("m", "Radii by direct numerical minimisation."),
+    "paper_r_cw": numbers("m", "The paper's radii."),
+    "static_balancing_r_cw": numbers("m", "Radii that balance gravity statically."),
+    "cubics": detail("The cubic of each joint's optimal radius: coefficients, real roots, torque change."),
+    "rms_joint_torque": METRICS["rms_joint_torque"], "peak_joint_torque": METRICS["peak_joint_torque"],
+    "rms_reduction_pct": detail("RMS torque reduction of each joint [%], arm B and C against A."),
+    "peak_reduction_pct": detail("Peak torque reduction of each joint [%], arm B and C against A."),
+    "paper_reduction_pct": detail("The paper's reductions [%]."),
+    "first_step_readings": detail("The two readings of the paper's first step (radii [m], reductions [%])."),
+    "kdl_vs_closed_form_max_rel_dev": number(None, "KDL against the closed-form dynamics (relative)."),
+    "general_model_vs_closed_form_max_rel_dev": number(None, "The general model against the closed form."),
+    "closed_loop_arm": string(),
+    "max_tracking_error": detail("Largest tracking error [rad]: exact and perturbed model."),
+    "closed_loop": detail("1 kHz computed torque on arm C: gains, rate_hz, duration [s], errors [rad]."),
+    "closed_loop_bare_arm_B": detail("The same on arm B."),
+    "discrepancies": strings("Where the paper's equations and numbers disagree with first principles."),
+})

@@ -487,7 +487,7 @@ def metrics(M, v, g, k=None) -> dict:
         diag_variation=float(np.max((diag.max(0) - diag.min(0)) / diag.mean(0))),
         diag_mean=diag.mean(0),
         peak_velocity_terms=float(np.max(np.abs(v))),
-        peak_gravity_torque_Nm=float(np.max(np.abs(g))))
+        peak_gravity_torque=float(np.max(np.abs(g))))
     if k is not None:
         out["diag_vs_k"] = float(np.max(np.abs(diag - np.asarray(k)) / np.asarray(k)))
     return out
@@ -521,7 +521,7 @@ def sensitivity(kind: str, p: dict, parameters, errors, q, qd) -> list[dict]:
             rows.append(dict(parameter=name, error_pct=100.0 * e,
                              offdiag_ratio=m["offdiag_ratio"], coupling=m["coupling"],
                              diag_variation=m["diag_variation"], diag_shift_vs_k=m["diag_vs_k"],
-                             gravity_peak_over_unbalanced=m["peak_gravity_torque_Nm"] / gmax,
+                             gravity_peak_over_unbalanced=m["peak_gravity_torque"] / gmax,
                              velocity_peak_over_unbalanced=m["peak_velocity_terms"] / vmax))
     return rows
 

@@ -325,8 +325,8 @@ def run(config, out: Path) -> dict:
         b = _disc_bodies(kind, d, qt, qdt, qddt)
         F, Mo = _write_bodies(out / f"bodies_{variant}.npz", t, b, qt, qdt, qddt)
         wrench[variant] = {"bodies": b["names"],
-                           "peak_shaking_force_N": float(np.max(np.linalg.norm(F, axis=1))),
-                           "peak_shaking_moment_Nm": float(np.max(np.linalg.norm(Mo, axis=1)))}
+                           "peak_shaking_force": float(np.max(np.linalg.norm(F, axis=1))),
+                           "peak_shaking_moment": float(np.max(np.linalg.norm(Mo, axis=1)))}
 
     balancing = {"l_g": bal["lg"], "k": bal["k"]}
     if "beta" in bal:
@@ -360,11 +360,11 @@ def run(config, out: Path) -> dict:
         "diag_variation_before": before["diag_variation"],
         "diag_variation_after": after["diag_variation"],
         "diag_vs_k_after": after["diag_vs_k"],
-        "peak_gravity_torque_Nm": {"before": before["peak_gravity_torque_Nm"],
-                                   "after": after["peak_gravity_torque_Nm"]},
-        "peak_velocity_terms_Nm": {"before": before["peak_velocity_terms"],
+        "peak_gravity_torque": {"before": before["peak_gravity_torque"],
+                                   "after": after["peak_gravity_torque"]},
+        "peak_velocity_terms": {"before": before["peak_velocity_terms"],
                                    "after": after["peak_velocity_terms"]},
-        "trajectory_peak_torque_Nm": {"unbalanced": report.peak_abs(tau_u),
+        "peak_joint_torque": {"unbalanced": report.peak_abs(tau_u),
                                       "balanced": report.peak_abs(tau_b)},
         "trajectory_balanced_vs_k_qdd_max_abs": float(np.max(np.abs(tau_b - tau_k))),
         "decoupled_control": control,
@@ -388,11 +388,11 @@ def run(config, out: Path) -> dict:
 
     print(report.table([[kind, before["offdiag_ratio"], after["offdiag_ratio"],
                          before["diag_variation"], after["diag_variation"],
-                         before["peak_gravity_torque_Nm"], after["peak_gravity_torque_Nm"]]],
+                         before["peak_gravity_torque"], after["peak_gravity_torque"]]],
                        ["mechanism", "offdiag before", "after", "diag var before", "after",
                         "gravity before [N m]", "after"]))
     print(report.table([[k, v] for k, v in balancing.items()], ["balancing", "value"]))
-    print(report.table([[v, wrench[v]["peak_shaking_force_N"], wrench[v]["peak_shaking_moment_Nm"]]
+    print(report.table([[v, wrench[v]["peak_shaking_force"], wrench[v]["peak_shaking_moment"]]
                         for v in ("unbalanced", "balanced")],
                        ["variant", "peak |shaking force| [N]", "peak |shaking moment| [N m]"]))
     print(report.table([[r["parameter"], r["error_pct"], r["offdiag_ratio"], r["coupling"],

@@ -229,3 +229,36 @@ def unit_warnings(case) -> list[tuple[str, str]]:
 
 register_case_model("discs", {"planar3r": Planar3rCase, "spatial3r": Spatial3rCase, "scara": ScaraCase,
                               "fivebar": FivebarCase}, unit_warnings=unit_warnings)
+
+
+# ---- its summary.json (mechbal.summary_schema) -------------------------------------------------
+from mechbal.summary_schema import (  # noqa: E402
+    METRICS, anything, detail, integer, number, numbers, per_variant, register_summary, string)
+
+register_summary("run", "discs", {
+    "mechanism": string("planar3r, spatial3r, scara or fivebar."), "source": string("The paper."),
+    "balancing": detail("Static balancing: centre-of-mass offsets l_g [m], the decoupled inertias k [kg m^2]."),
+    "discs": detail("The discs by the general method and the closed form, and their difference."),
+    "l_g": anything("Centre-of-mass offsets after static balancing [m] (a list, or by link)."),
+    "k": numbers("kg m^2", "Decoupled (constant, diagonal) inertias."),
+    "beta": number(None, "Disc gear ratio."), "gamma": number(None, "Disc gear ratio."),
+    "K_cross": number("kg m^2", "Cross inertia of the five-bar (zero when decoupled)."),
+    "inertia_conditions": detail("The spatial 3R's corrected inertia conditions [kg m^2]."),
+    "configurations": integer("Random configurations checked."), "seed": integer(),
+    **{k: number(None, "Relative measure of the mass matrix's coupling (before / after balancing).")
+       for k in ("offdiag_ratio_before", "offdiag_ratio_after", "coupling_coefficient_before",
+                 "coupling_coefficient_after", "diag_variation_before", "diag_variation_after",
+                 "diag_vs_k_after", "trajectory_balanced_vs_k_qdd_max_abs")},
+    "peak_gravity_torque": per_variant("N m", "Largest |gravity torque| over the configurations.",
+                                       vector=False),
+    "peak_velocity_terms": per_variant("N m", "Largest |velocity terms| over the configurations.",
+                                       vector=False),
+    "peak_joint_torque": METRICS["peak_joint_torque"],
+    "decoupled_control": detail("Decoupled joint control of the balanced mechanism."),
+    "shaking_wrench_on_trajectory": detail("Peak shaking force [N] and moment [N m] along the trajectory."),
+    "sensitivity": {"type": "array", "items": {"type": "object"},
+                    "description": "Coupling after a parameter error (error_pct [%])."},
+    "corrections": {"type": "array", "items": {"type": "object"},
+                    "description": "The paper's equations that are corrected, and how."},
+    "corrections_note": string(),
+})

@@ -45,17 +45,17 @@ __all__ = ["linear_delta_ik", "distal_rate", "proximal_rate", "LumpedModel", "lu
 # ---- the paper's published numbers (for comparison only) ----------------------------------------
 #: Table 1: theoretical and off-the-shelf balancing parameters (mm, N/mm, N)
 PAPER_TABLE1 = {
-    "theoretical": {"delta_y_mm": 150.00, "K_D_N_per_mm": 2.510, "f_D_max_N": 2321,
-                    "eps_y_mm": 130.00, "K_P_N_per_mm": 11.131, "f_P_max_N": 4470},
-    "off_the_shelf": {"delta_y_mm": 150.30, "K_D_N_per_mm": 2.505, "f_D_max_N": 2318,
-                      "eps_y_mm": 131.52, "K_P_N_per_mm": 11.002, "f_P_max_N": 4424},
+    "theoretical": {"delta_y_mm": 150.00, "K_D_N_per_mm": 2.510, "f_D_max": 2321,
+                    "eps_y_mm": 130.00, "K_P_N_per_mm": 11.131, "f_P_max": 4470},
+    "off_the_shelf": {"delta_y_mm": 150.30, "K_D_N_per_mm": 2.505, "f_D_max": 2318,
+                      "eps_y_mm": 131.52, "K_P_N_per_mm": 11.002, "f_P_max": 4424},
 }
 #: Table 2: the clusters
 PAPER_TABLE2 = {
-    "distal": {"spring_rate_N_per_mm": 5.009, "spring_max_force_N": 1159, "count": 8, "moving_pulleys": 2,
-               "total_spring_mass_kg": 8.087},
-    "proximal": {"spring_rate_N_per_mm": 5.501, "spring_max_force_N": 1105, "count": 8, "moving_pulleys": 1,
-                 "total_spring_mass_kg": 8.450},
+    "distal": {"spring_rate_N_per_mm": 5.009, "spring_max_force": 1159, "count": 8, "moving_pulleys": 2,
+               "total_spring_mass": 8.087},
+    "proximal": {"spring_rate_N_per_mm": 5.501, "spring_max_force": 1105, "count": 8, "moving_pulleys": 1,
+                 "total_spring_mass": 8.450},
 }
 
 

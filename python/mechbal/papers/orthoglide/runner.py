@@ -361,13 +361,13 @@ def run(config, out: Path) -> dict:
                                      rate_tolerance=case.catalogue.rate_tolerance, peak_force_at=peak_at)
         letter = "D" if sname == roles.distal_spring else "P"
         table1["theoretical"].update({f"{key}_mm": offset * 1e3, f"K_{letter}_N_per_mm": K0 / 1e3,
-                                      f"f_{letter}_max_N": K0 * d_peak})
+                                      f"f_{letter}_max": K0 * d_peak})
         if cands:
             best = cands[0]
             selection[sname] = {"chosen": best.summary(), "alternatives": [c.summary() for c in cands[1:4]]}
             table1["off_the_shelf"].update({f"{key}_mm": best.anchor_offset * 1e3,
                                             f"K_{letter}_N_per_mm": best.equivalent_rate / 1e3,
-                                            f"f_{letter}_max_N": best.peak_force})
+                                            f"f_{letter}_max": best.peak_force})
             s = next(x for x in case.springs if x.name == sname)
             a = list(s.anchor_a)
             a[1] += sign * offset * (K0 / best.equivalent_rate - 1.0)
@@ -375,7 +375,7 @@ def run(config, out: Path) -> dict:
         else:
             selection[sname] = {"chosen": None, "alternatives": [],
                                 "note": "no cluster of the catalogue meets the rate and the peak force"}
-        selection[sname]["peak_at_platform_point_m"] = where
+        selection[sname]["peak_at_platform_point"] = where
     # the off-the-shelf design: chosen rates and corrected anchors, still balanced?
     practical_residual = None
     if len(chosen_anchor) == len(offsets):
@@ -404,7 +404,7 @@ def run(config, out: Path) -> dict:
         cf_sb = paper.inverse_dynamics(lm, path.p, path.v, path.a, path.f_cut, K_D, K_P)["motor_force"]
         scale = max(float(np.max(np.abs(r_un["motor_force"]))), 1.0)
         row = compare(r_un["motor_force"], r_sb["motor_force"])
-        row["duration_s"] = float(path.t[-1])
+        row["duration"] = float(path.t[-1])
         row["samples"] = int(len(path.t))
         ref = (paper.PAPER_TABLE4 if tab == "4" else paper.PAPER_TABLE5).get(path.name)
         if ref is not None:
@@ -506,9 +506,9 @@ def run(config, out: Path) -> dict:
         "frame": "y vertical, gravity (0, -9.81, 0) m/s^2",
         "dof": nominal.mech.dof,
         "actuated": nominal.mech.actuated_names,
-        "leg_length_m": nominal.L,
-        "workspace": {"center_m": list(ws.center), "edge_m": ws.edge, "grid_points": int(len(grid))},
-        "lumped_masses_kg": {"m_p": lm.m_p, "m_s2": lm.m_s2, "m_w": lm.m_w, "m_t": lm.m_t,
+        "leg_length": nominal.L,
+        "workspace": {"center": list(ws.center), "edge": ws.edge, "grid_points": int(len(grid))},
+        "lumped_masses": {"m_p": lm.m_p, "m_s2": lm.m_s2, "m_w": lm.m_w, "m_t": lm.m_t,
                              "sliders": lm.m_slider.tolist()},
         "spring_rates_N_per_mm": {spring_names.get(n, n): k / 1e3 for n, k in rates.items()},
         "paper_spring_rates_N_per_mm": {"K_D": paper.PAPER_TABLE1["theoretical"]["K_D_N_per_mm"],
@@ -517,15 +517,15 @@ def run(config, out: Path) -> dict:
         "anchor_offsets_mm": {"delta_y": lm.delta_y * 1e3, "eps_y": lm.eps_y * 1e3},
         "rate_sizing": {"method": "mechbal.balance.springs.balance: least squares of C^T (G + K) = 0 over the "
                                   "workspace grid (springs on the model)",
-                        "rank": rank, "residual_N": size_residual},
+                        "rank": rank, "residual": size_residual},
         "acceptance": {
-            "static_motor_force_balanced_max_N": float(np.max(np.abs(F_sb))),
-            "potential_energy_variation_J": float(np.ptp(V)),
-            "potential_energy_closed_form_difference_J": float(np.ptp(V - V_closed)),
+            "static_motor_force_balanced_max": float(np.max(np.abs(F_sb))),
+            "potential_energy_variation": float(np.ptp(V)),
+            "potential_energy_closed_form_difference": float(np.ptp(V - V_closed)),
             "power_balance_relative_error_max": max(c["power_balance_relative_error"] for c in checks.values()),
             "closed_form_inverse_dynamics_relative_difference_max":
                 max(c["closed_form_relative_difference"] for c in checks.values()),
-            "off_the_shelf_static_motor_force_max_N": practical_residual,
+            "off_the_shelf_static_motor_force_max": practical_residual,
         },
         "clusters": selection,
         "table1": table1,

@@ -161,3 +161,30 @@ def _orthoglide_cross_checks(case: "OrthoglideCase") -> None:
 
 
 register_case_model("orthoglide", OrthoglideCase, cross_checks=_orthoglide_cross_checks)
+
+
+# ---- its summary.json (mechbal.summary_schema) -------------------------------------------------
+from mechbal.summary_schema import (  # noqa: E402
+    detail, integer, number, number_map, register_summary, string, strings)
+
+register_summary("run", "orthoglide", {
+    "paper": string(), "frame": string("Base frame and gravity."), "dof": integer(),
+    "actuated": strings(), "leg_length": number("m"),
+    "workspace": detail("The workspace grid: center [m], edge [m], grid_points."),
+    "lumped_masses": detail("The paper's lumped masses [kg]."),
+    "spring_rates_N_per_mm": number_map("N/mm", "Sized spring rates (the paper's unit)."),
+    "paper_spring_rates_N_per_mm": number_map("N/mm", "The paper's rates."),
+    "closed_form_spring_rates_N_per_mm": number_map("N/mm", "Rates by eqs 18-19."),
+    "anchor_offsets_mm": number_map("mm", "Spring anchor offsets (the paper's unit)."),
+    "rate_sizing": detail("How the rates were sized (general springs method), residual [N]."),
+    "acceptance": detail("Static motor force with the springs [N], potential energy variation [J]."),
+    "clusters": detail("Off-the-shelf spring clusters chosen from the catalogue."),
+    "table1": detail("The paper's Table 1, recomputed (mm, N/mm as the paper; forces [N])."),
+    "paper_table1": detail("The paper's Table 1 as printed."),
+    "paper_table2": detail("The paper's Table 2 as printed."),
+    "table4": detail("Table 4 recomputed: motor forces [N], changes [%]."),
+    "table5": detail("Table 5 recomputed."), "table6": detail("Table 6 recomputed."),
+    "checks": detail("Power balance and closed-form checks (relative)."),
+    "unbalanced_variant": string(),
+    "discrepancies": strings("Where the paper's equations and numbers disagree with first principles."),
+})

@@ -126,7 +126,7 @@ def pose_wrench(model, t, P, Pd, Pdd, wrist_angles):
     the *commanded* rates and feed-forward accelerations, zero to rounding at every tick; the
     stored angles are those rates integrated (Euler or RK4), whose motion does not have zero
     moment (Euler: 0.24 N m, 0.9 % of the unbalanced peak). A file must hold the wrench of the
-    poses it stores (DESIGN.md, Evidence), so this is what ``bodies_balanced*.npz`` calls
+    poses it stores (docs/architecture.md, Data flow: the output), so this is what ``bodies_balanced*.npz`` calls
     ``shaking_moment``; central differences of the stored poses agree with it to ~4e-5 N m (their
     own truncation error at 1 kHz)."""
     from scipy.interpolate import make_interp_spline
@@ -248,14 +248,14 @@ def run(config, out: Path) -> dict:
         "case": config.case.name,
         "kind": "paminsa",
         "paper": "Briot & Arakelian 2009, AIM, PAMINSA complete shaking force and moment balancing",
-        "duration_s": float(cycle.duration),
+        "duration": float(cycle.duration),
         "samples": int(len(t)),
         "tick_rate_hz": float(rate),
         "integrator": primary,
         "integrators_run": ["euler", "rk4"],
-        "wrist_initial_angles_rad": q0,
+        "wrist_initial_angles": q0,
         "counterweights_used": use,
-        "counterweights_kg": {"cp1": chosen.cp1, "cp2": chosen.cp2, "cp3": chosen.cp3,
+        "counterweight_masses": {"cp1": chosen.cp1, "cp2": chosen.cp2, "cp3": chosen.cp3,
                               "vertical": chosen.vertical, "source": chosen.source},
         "counterweights": {
             "general_method": general.as_dict(), "closed_form": closed.as_dict(),
@@ -265,13 +265,13 @@ def run(config, out: Path) -> dict:
                        "singular_value_ratio": result.metrics["singular_value_ratio"],
                        "residual": result.residual, "residual_before": result.residual_before,
                        "residual_units": result.residual_units, "exact": result.exact}},
-        "counterweights_paper_printed_eqs_kg": printed.as_dict(),
-        "paper_counterweights_kg": dict(paper.REPORTED_COUNTERWEIGHTS_KG, vertical=None),
-        "peak_shaking_force_N": {"unbalanced": report.peak_abs(F_unbal),
+        "counterweight_masses_paper_printed_eqs": printed.as_dict(),
+        "paper_counterweight_masses": dict(paper.REPORTED_COUNTERWEIGHTS_KG, vertical=None),
+        "peak_shaking_force": {"unbalanced": report.peak_abs(F_unbal),
                                  "force_balanced": report.peak_abs(fbal["shaking_force"]),
                                  "balanced": fd[primary][0],
                                  "paper_reported_masses": report.peak_abs(rep["shaking_force"])},
-        "peak_shaking_moment_Nm": {"unbalanced": report.peak_abs(M_unbal),
+        "peak_shaking_moment": {"unbalanced": report.peak_abs(M_unbal),
                                    "force_balanced": report.peak_abs(M_fb),
                                    "balanced": fd[primary][1],
                                    "balanced_stored_poses": report.peak_abs(posed[primary]["shaking_moment"][inner]),
@@ -281,8 +281,8 @@ def run(config, out: Path) -> dict:
                              "shaking_moment (the wrench of the stored poses, wrist on a quintic "
                              "spline through the stored angles); 'balanced_commanded' is the "
                              "controller's ideal moment (the files' shaking_moment_commanded)"),
-        "peak_shaking_force_norm_unbalanced_N": peak_F_norm,
-        "peak_shaking_moment_norm_unbalanced_Nm": peak_M_norm,
+        "peak_shaking_force_norm_unbalanced": peak_F_norm,
+        "peak_shaking_moment_norm_unbalanced": peak_M_norm,
         "balanced_moment_residual_percent_of_unbalanced_peak": {
             n: 100.0 * fd[n][1] / peak_M_norm for n in ("euler", "rk4")},
         "force_balanced_force_residual_relative": {
@@ -293,13 +293,13 @@ def run(config, out: Path) -> dict:
             "commanded rates, leaving H_n - H_target ~ (dt/2) dD/dt and a residual moment "
             "~ (dt/2) d2D/dt2 that scales with dt; RK4 is O(dt^2) in this check. The closed-form "
             "moment at each tick (rates and feed-forward accelerations) is zero to rounding."),
-        "peak_wrist_rate_rad_s": rates[primary],
-        "peak_wrist_rate_rad_s_by_integrator": rates,
-        "wrist_angle_excursion_rad": np.ptp(bal[primary]["wrist_angles"], axis=0),
+        "peak_wrist_rate": rates[primary],
+        "peak_wrist_rate_by_integrator": rates,
+        "wrist_angle_excursion": np.ptp(bal[primary]["wrist_angles"], axis=0),
         "condition_number_range": [float(cond.min()), float(cond.max())],
         "wrist_status_or": int(np.bitwise_or.reduce(bal[primary]["status_per_instant"])),
         "z_moment_ratio_force_balanced_over_unbalanced": {
-            "about_O": ratio_O, "about_base_centre": ratio_c, "base_centre_m": base_centre,
+            "about_O": ratio_O, "about_base_centre": ratio_c, "base_centre": base_centre,
             "paper": 1.35,
             "explanation": ("Once force-balanced, M is the same about every point; the unbalanced "
                             "M_z is not (M_Q = M_O - OQ x F). About the base centre (centroid of "

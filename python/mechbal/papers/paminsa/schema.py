@@ -144,3 +144,36 @@ def unit_warnings(case) -> list[tuple[str, str]]:
 
 
 register_case_model("paminsa", PaminsaCase, unit_warnings=unit_warnings)
+
+
+# ---- its summary.json (mechbal.summary_schema) -------------------------------------------------
+from mechbal.summary_schema import (  # noqa: E402
+    METRICS, detail, integer, number, numbers, register_summary, string, strings)
+
+register_summary("run", "paminsa", {
+    "paper": string(), "duration": number("s"), "samples": integer(),
+    "tick_rate_hz": number("Hz", "Wrist controller rate (the case's rate_hz)."),
+    "integrator": string(), "integrators_run": strings(),
+    "wrist_initial_angles": numbers("rad"),
+    "counterweights_used": string("general_method or closed_form."),
+    "counterweight_masses": detail("Counterweight masses used [kg], by name and leg."),
+    "counterweights": detail("Counterweights [kg] by the general method and the closed form, and their difference."),
+    "counterweight_masses_paper_printed_eqs": detail("The paper's equations as printed [kg]."),
+    "paper_counterweight_masses": detail("The paper's numbers [kg]."),
+    "peak_shaking_force": METRICS["peak_shaking_force"],
+    "peak_shaking_moment": METRICS["peak_shaking_moment"],
+    "moment_reference": string(),
+    "peak_shaking_force_norm_unbalanced": number("N"),
+    "peak_shaking_moment_norm_unbalanced": number("N m"),
+    "balanced_moment_residual_percent_of_unbalanced_peak": detail("Per integrator [%]."),
+    "force_balanced_force_residual_relative": detail("Relative residual force, per variant."),
+    "balanced_residual_explanation": string(),
+    "peak_wrist_rate": numbers("rad/s"),
+    "peak_wrist_rate_by_integrator": detail("Per integrator [rad/s]."),
+    "wrist_angle_excursion": numbers("rad"),
+    "condition_number_range": numbers(),
+    "wrist_status_or": integer("All the wrist controller's status flags or-ed."),
+    "z_moment_ratio_force_balanced_over_unbalanced": detail("About O and about the base centre [m]."),
+    "discrepancies": {"type": "array", "description": "Where the paper's equations and numbers "
+                      "disagree with first principles."},
+})

@@ -218,7 +218,7 @@ def table_consistency(tables=PAPER_TABLES, tolerance_pct=0.005):
         checked = []
         for t, before, after, printed in rows:
             recomputed = 100.0 * (1.0 - abs(after) / abs(before))
-            checked.append({"t": t, "before_N": before, "after_N": after, "printed_pct": printed,
+            checked.append({"t": t, "before": before, "after": after, "printed_pct": printed,
                             "recomputed_pct": recomputed,
                             "consistent": bool(abs(recomputed - printed) <= tolerance_pct)})
         out[axis] = {"rows": checked,

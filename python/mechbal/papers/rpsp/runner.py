@@ -124,7 +124,7 @@ def local_minima(t, x, count=5) -> list[dict]:
     """The ``count`` lowest interior local minima of ``x`` (with the ends), as {t, value}."""
     k = [i for i in range(len(x)) if (i == 0 or x[i] <= x[i - 1]) and (i == len(x) - 1 or x[i] <= x[i + 1])]
     k = sorted(k, key=lambda i: x[i])[:count]
-    return [{"t_s": float(t[i]), "value": float(x[i])} for i in sorted(k)]
+    return [{"t": float(t[i]), "value": float(x[i])} for i in sorted(k)]
 
 
 def coordinates(mech: Mechanism, q, prefix: str) -> np.ndarray:
@@ -177,8 +177,8 @@ def ik_agreement(mech: Mechanism, m, geometry, motion, t) -> dict:
             e = np.cos(thk[i]) * np.array([0.0, 0.0, 1.0]) + np.sin(thk[i]) * np.cross(u, [0.0, 0.0, 1.0])
             r = np.array([0.0, 0.0, geometry.h]) + bk[i] * v - geometry.a[i] * u - lk[i] * e
             res = max(res, float(np.max(np.abs(r))))
-    out["max_eq2_residual_m"] = res
-    out["max_loop_residual_m"] = float(np.max(m.residual[ok], initial=0.0))
+    out["max_eq2_residual"] = res
+    out["max_loop_residual"] = float(np.max(m.residual[ok], initial=0.0))
     out["closed_form_degenerate_instants"] = int(np.sum(np.any(cf["degenerate"], axis=1)))
     return out
 
@@ -315,10 +315,10 @@ def run(config, out: Path) -> dict:
     floor = 1e-9 * np.max(peak["unbalanced"])
     for ax in range(3):
         table_rows[axes[ax]] = [
-            {"t": float(tt[k]), "unbalanced_N": float(tab["unbalanced"][k, ax]),
-             "balanced_N": float(tab["balanced"][k, ax]),
+            {"t": float(tt[k]), "unbalanced": float(tab["unbalanced"][k, ax]),
+             "balanced": float(tab["balanced"][k, ax]),
              "reduction_pct": _reduction(tab["unbalanced"][k, ax], tab["balanced"][k, ax], floor),
-             "paper_masses_N": float(tab["paper_masses"][k, ax]),
+             "paper_masses": float(tab["paper_masses"][k, ax]),
              "paper_masses_reduction_pct": _reduction(tab["unbalanced"][k, ax], tab["paper_masses"][k, ax], floor)}
             for k in range(len(tt))]
     mean_red = [_mean([r["reduction_pct"] for r in table_rows[a]]) for a in axes]
@@ -339,35 +339,35 @@ def run(config, out: Path) -> dict:
     near = NEAR_SINGULAR_FRACTION * float(np.median(s_unbal.rcond))
     rc_motor = motor_rcond(spec_unbal, mech_unbal, s_unbal.q)
     survey = {
-        "duration_s": float(mo.survey_duration), "samples": int(mo.survey_samples),
+        "duration": float(mo.survey_duration), "samples": int(mo.survey_samples),
         "robot": {
-            "min_rcond": float(s_unbal.rcond[k_rc]), "t_min_rcond_s": float(ts[k_rc]),
+            "min_rcond": float(s_unbal.rcond[k_rc]), "t_min_rcond": float(ts[k_rc]),
             "shortest_leg_at_min_rcond": int(np.argmin(cf["l"][k_rc]) + 1),
             "rcond_local_minima": local_minima(ts, s_unbal.rcond),
             "near_singular_rcond": near,
             "near_singular_rule": f"rcond < {NEAR_SINGULAR_FRACTION} x its median over the survey",
-            "near_singular_intervals_s": intervals(ts, s_unbal.rcond < near),
+            "near_singular_intervals": intervals(ts, s_unbal.rcond < near),
             "motors_actuated": {
                 "what": "rcond of the loop solve with the motors theta_i as inputs (direct kinematics) at "
                         "the same configurations: its zeros are parallel singularities",
-                "min_rcond": float(np.min(rc_motor)), "t_min_rcond_s": float(ts[np.argmin(rc_motor)]),
+                "min_rcond": float(np.min(rc_motor)), "t_min_rcond": float(ts[np.argmin(rc_motor)]),
                 "rcond_at_start": float(rc_motor[0]),
                 "rcond_local_minima": local_minima(ts, rc_motor),
             },
             "singular_instants": int(np.sum((s_unbal.status & _SINGULAR) != 0)),
             "failed_instants": int(np.sum((s_unbal.status & ~_SINGULAR) != 0)),
-            "max_loop_residual_m": float(np.max(s_unbal.residual)),
-            "min_leg_length_m": l_min.tolist(),
-            "t_min_leg_length_s": [float(ts[k]) for k in np.argmin(cf["l"], axis=0)],
-            "max_leg_length_m": np.max(cf["l"], axis=0).tolist(),
+            "max_loop_residual": float(np.max(s_unbal.residual)),
+            "min_leg_length": l_min.tolist(),
+            "t_min_leg_length": [float(ts[k]) for k in np.argmin(cf["l"], axis=0)],
+            "max_leg_length": np.max(cf["l"], axis=0).tolist(),
             "min_abs_eq8_denominator": float(np.min(np.abs(cf["denominator"]))),
             "closed_form_degenerate_instants": int(np.sum(np.any(cf["degenerate"], axis=1))),
             "ik_agreement": ik_agreement(mech_unbal, s_unbal, geometry, mo, ts),
         },
         "with_extra_linkage": {
-            "linkage_reach_m": reach,
-            "unreachable_intervals_s": intervals(ts, unreachable),
-            "failed_intervals_s": intervals(ts, failed),
+            "linkage_reach": reach,
+            "unreachable_intervals": intervals(ts, unreachable),
+            "failed_intervals": intervals(ts, failed),
             "failed_instants": int(np.sum(failed)),
             "singular_instants": int(np.sum((s_full.status & _SINGULAR) != 0)),
             "min_rcond_where_solved": float(np.min(s_full.rcond[~failed], initial=np.inf)),
@@ -408,12 +408,12 @@ def run(config, out: Path) -> dict:
     summary = {
         "case": name, "kind": "rpsp", "paper": "Heydari & Enferadi, 3(RPSP)-S balancing by extra linkage",
         "variants": ["unbalanced", "balanced", "paper_masses"],
-        "duration_s": float(mo.duration), "samples": int(mo.samples),
-        "counterweights_kg": counterweights,
-        "counterweights_per_leg_kg": per_group,
-        "counterweights_eqs_29_31_kg": eqs,
-        "paper_counterweights_kg": pp.counterweights_kg.model_dump(),
-        "platform_counterweight_kg": per_group["platform"],
+        "duration": float(mo.duration), "samples": int(mo.samples),
+        "counterweight_masses": counterweights,
+        "counterweight_masses_per_leg": per_group,
+        "counterweight_masses_eqs_29_31": eqs,
+        "paper_counterweight_masses": pp.counterweights_kg.model_dump(),
+        "platform_counterweight_mass": per_group["platform"],
         "general_method": {"method": "mechbal.balance.force: least squares of the linear momentum over the "
                                      "run's closed motion, one slot per counterweight body at its given point "
                                      "(only the mass unknown, >= 0)",
@@ -425,11 +425,11 @@ def run(config, out: Path) -> dict:
         "counterweights": {"general_method": counterweights, "closed_form": closed_form,
                            "max_abs_difference": max_difference, "tolerance": COUNTERWEIGHT_AGREEMENT_KG,
                            "unit": "kg", "closed_form_source": "Heydari & Enferadi eqs 29-31"},
-        "eq28_coefficients_with_paper_masses_kg": list(coeff_paper),
-        "peak_shaking_force_N": {k: peak[k] for k in peak},
-        "rms_shaking_force_N": {k: rms[k] for k in rms},
+        "eq28_coefficients_with_paper_masses": list(coeff_paper),
+        "peak_shaking_force": {k: peak[k] for k in peak},
+        "rms_shaking_force": {k: rms[k] for k in rms},
         "balanced_over_unbalanced_peak": (peak["balanced"] / peak["unbalanced"]).tolist(),
-        "peak_platform_shaking_force_N": report.peak_abs(F_platform),
+        "peak_platform_shaking_force": report.peak_abs(F_platform),
         "mean_reduction_pct": mean_red,
         "mean_reduction_pct_paper_masses": mean_red_paper_masses,
         "rms_reduction_pct": (100.0 * (1.0 - rms["balanced"] / rms["unbalanced"])).tolist(),
@@ -440,12 +440,12 @@ def run(config, out: Path) -> dict:
                                "symmetry) has no reduction (null) and is left out of the mean",
         "tables": table_rows,
         "paper_tables": cons,
-        "total_mass_kg": {"unbalanced": mech_unbal.total_mass, "balanced": mech_bal.total_mass,
+        "total_mass": {"unbalanced": mech_unbal.total_mass, "balanced": mech_bal.total_mass,
                           "paper_masses": mech_paper.total_mass},
-        "added_mass_kg": mech_bal.total_mass - mech_unbal.total_mass,
-        "loops": {"min_rcond": float(np.min(m_full.rcond)), "t_min_rcond_s": float(t[np.argmin(m_full.rcond)]),
+        "added_mass": mech_bal.total_mass - mech_unbal.total_mass,
+        "loops": {"min_rcond": float(np.min(m_full.rcond)), "t_min_rcond": float(t[np.argmin(m_full.rcond)]),
                   "singular_instants": int(np.sum((m_full.status & _SINGULAR) != 0)),
-                  "max_closure_residual_m": float(np.max(m_full.residual))},
+                  "max_closure_residual": float(np.max(m_full.residual))},
         "ik_agreement": agreement,
         "survey": survey,
         "discrepancies": discrepancies,
@@ -478,8 +478,8 @@ def _discrepancies(eqs, pp, cw, coeff_paper, cons, survey, rows, tt) -> list[str
         bad = [r for r in v["rows"] if not r["consistent"]]
         for r in bad:
             out.append(f"Table {'xyz'.index(ax) + 1} ({ax}), t = {r['t']}: the printed reduction "
-                       f"{r['printed_pct']} % does not follow from the printed forces {r['before_N']} / "
-                       f"{r['after_N']} N ({r['recomputed_pct']:.4f} %).")
+                       f"{r['printed_pct']} % does not follow from the printed forces {r['before']} / "
+                       f"{r['after']} N ({r['recomputed_pct']:.4f} %).")
     out.append("Tables 1-3: the readings that reconcile the cells: x, t = 0.102: 98.5147 % (printed 98.0147); "
                "y, t = 0: after = 5.0244 N (printed 0.0244, gives 81.52 %); y, t = 0.1: before = -56.5087 N "
                "(printed -56.05087, gives 80.96 %); y, t = 0.102: 76.455 % (printed 76.405); z, t = 0.052: "
@@ -494,19 +494,19 @@ def _discrepancies(eqs, pp, cw, coeff_paper, cons, survey, rows, tt) -> list[str
                "come from the printed motion (T = 2 pi s: the platform turns at about 1 rad/s and the "
                "lumped masses' accelerations are below 1 m/s^2 at these instants); the ADAMS model's time "
                "scale or motion must differ, so the tables' values are compared in ratio only. Here at "
-               f"t = {tt[0]:g} s the unbalanced force is ({rows['x'][0]['unbalanced_N']:.3g}, "
-               f"{rows['y'][0]['unbalanced_N']:.3g}, {rows['z'][0]['unbalanced_N']:.3g}) N.")
+               f"t = {tt[0]:g} s the unbalanced force is ({rows['x'][0]['unbalanced']:.3g}, "
+               f"{rows['y'][0]['unbalanced']:.3g}, {rows['z'][0]['unbalanced']:.3g}) N.")
     w = survey["with_extra_linkage"]
-    if w["unreachable_intervals_s"]:
-        out.append(f"The extra linkage (|A_iD_i| + |D_iC_i| = {w['linkage_reach_m']:g} m) cannot follow the "
+    if w["unreachable_intervals"]:
+        out.append(f"The extra linkage (|A_iD_i| + |D_iC_i| = {w['linkage_reach']:g} m) cannot follow the "
                    f"printed motion over the whole period: the legs reach "
-                   f"{max(survey['robot']['max_leg_length_m']):.3f} m and the linkage cannot be assembled for t in "
-                   + ", ".join(f"[{a:.3f}, {b:.3f}]" for a, b in w["unreachable_intervals_s"])
+                   f"{max(survey['robot']['max_leg_length']):.3f} m and the linkage cannot be assembled for t in "
+                   + ", ".join(f"[{a:.3f}, {b:.3f}]" for a, b in w["unreachable_intervals"])
                    + " s; the comparison runs over the first "
                    "assemblable span.")
     r = survey["robot"]
     out.append(f"Near-singularity: leg {r['shortest_leg_at_min_rcond']} shortens to "
-               f"{min(r['min_leg_length_m']) * 1000:.1f} mm at t = {r['t_min_rcond_s']:.3f} s (rcond "
+               f"{min(r['min_leg_length']) * 1000:.1f} mm at t = {r['t_min_rcond']:.3f} s (rcond "
                f"{r['min_rcond']:.3g}); eq 10 divides by l_i, eq 13 by u_ix (written here without it).")
     rr = [r["paper_masses_reduction_pct"] for r in rows["x"]]
     out.append("Balance: with the sized counterweights the lumped-mass model is balanced to round-off "

@@ -127,3 +127,34 @@ def _rpsp_cross_checks(case: "RpspCase") -> None:
 
 register_case_model("rpsp", RpspCase, cross_checks=_rpsp_cross_checks,
                     unit_warnings=lambda case: mechanism_unit_warnings(case.mechanism))
+
+
+# ---- its summary.json (mechbal.summary_schema) -------------------------------------------------
+from mechbal.summary_schema import (  # noqa: E402
+    METRICS, detail, integer, number, number_map, numbers, register_summary, string, strings)
+
+register_summary("run", "rpsp", {
+    "paper": string(), "variants": strings(), "duration": number("s"), "samples": integer(),
+    "counterweight_masses": number_map("kg", "Sized counterweights (general method)."),
+    "counterweight_masses_per_leg": detail("Per leg [kg]."),
+    "counterweight_masses_eqs_29_31": number_map("kg", "By the paper's eqs 29-31."),
+    "paper_counterweight_masses": number_map("kg", "The paper's numbers."),
+    "platform_counterweight_mass": numbers("kg"),
+    "general_method": detail("The general force-balancing method's run."),
+    "counterweights": detail("Counterweights [kg] by the general method and the closed form, and their difference."),
+    "eq28_coefficients_with_paper_masses": numbers("kg"),
+    "peak_shaking_force": METRICS["peak_shaking_force"],
+    "rms_shaking_force": METRICS["rms_shaking_force"],
+    "balanced_over_unbalanced_peak": numbers(),
+    "peak_platform_shaking_force": numbers("N"),
+    "mean_reduction_pct": numbers("%"), "mean_reduction_pct_paper_masses": numbers("%"),
+    "rms_reduction_pct": numbers("%"), "rms_reduction_pct_paper_masses": numbers("%"),
+    "paper_mean_reduction_pct": numbers("%"), "mean_reduction_note": string(),
+    "tables": detail("The paper's tables recomputed (t [s], forces [N])."),
+    "paper_tables": detail("The paper's tables as printed (forces [N])."),
+    "total_mass": number_map("kg", "Per variant."), "added_mass": number("kg"),
+    "loops": detail("Loop solve: min_rcond, t_min_rcond [s], residuals [m]."),
+    "ik_agreement": detail("Closed-form inverse kinematics against the loop solve ([m], [rad])."),
+    "survey": detail("Survey of the workspace: reach [m], intervals [s]."),
+    "discrepancies": strings("Where the paper's equations and numbers disagree with first principles."),
+})

@@ -1,0 +1,369 @@
+"""The JSON Schema of ``summary.json``: one documented format for every case and command.
+
+Every ``summary.json`` that mechbal writes (``mechbal run`` of every case kind, ``mechbal
+balance``, ``mechbal verify``, ``mechbal sweep``) starts with ``schema_version`` and ``command``
+(``mechbal.export.write_summary`` puts them there) and follows the schema shipped as
+``mechbal/cases/summary.schema.json`` (JSON Schema 2020-12), generated from this module:
+
+    python -m mechbal.summary_schema > python/mechbal/cases/summary.schema.json
+
+Conventions (docs/summary.md):
+
+- SI units, named once here (each property's ``unit`` and ``description``), never in the keys:
+  ``peak_shaking_force``, not ``peak_shaking_force_N``. Values kept in a paper's own non-SI unit
+  (the Orthoglide's mm and N/mm) and percentages say so in their key (``_mm``, ``_N_per_mm``,
+  ``_pct``), so that nobody reads them as SI; an echo of a case-file setting keeps the case
+  file's key (``rate_hz``).
+- The metric names are the sweeps' (`mechbal.sweep.metrics`): ``<statistic>_<quantity>`` with
+  statistic ``peak`` or ``rms`` and quantity ``shaking_force``, ``shaking_moment``,
+  ``joint_torque``, ``gravity_torque``, ``static_torque``, ``base_reaction_force``,
+  ``base_reaction_moment``. In a run's summary they are given per variant (``nominal``,
+  ``unbalanced``, ``balanced``, ...) and per component (x, y, z) or per actuated joint: the peak
+  of each absolute value; a sweep's column is the norm's.
+- Unknown top-level keys are errors (``unevaluatedProperties: false``): a key that is not in the
+  schema is a key that a reader cannot rely on.
+
+**Extending it.** A new field of a general summary goes into the tables below; a case kind with
+its own summary (a paper's runner) registers its top-level fields with `register_summary` from
+its ``schema.py``:
+
+    register_summary("run", "my_kind", {
+        "peak_shaking_force": PER_VARIANT_FORCE,          # a shared metric
+        "counterweight_masses": number_map("kg", "sized counterweights by name"),
+        "closed_form": detail("the paper's closed form beside the general method"),
+    })
+
+then regenerate the file (above); ``tests/python/test_summary_schema.py`` checks that the shipped
+file is the generated one and validates every summary.json the test suite writes.
+
+Layer: Python core (docs/architecture.md).
+"""
+from __future__ import annotations
+
+import copy
+import json
+import sys
+from typing import Any
+
+from mechbal.export.bodies import SUMMARY_COMMANDS, SUMMARY_SCHEMA_VERSION
+
+Schema = dict[str, Any]
+
+NUMBER: Schema = {"type": ["number", "null"]}
+
+
+# ---- building blocks --------------------------------------------------------------------------
+
+def number(unit: str | None = None, description: str = "") -> Schema:
+    """A number (``null`` where it was not finite: listed under ``non_finite_values``)."""
+    out: Schema = {"type": ["number", "null"]}
+    if description:
+        out["description"] = description
+    if unit:
+        out["unit"] = unit
+    return out
+
+
+def integer(description: str = "") -> Schema:
+    return {"type": "integer", "description": description} if description else {"type": "integer"}
+
+
+def string(description: str = "") -> Schema:
+    return {"type": "string", "description": description} if description else {"type": "string"}
+
+
+def boolean(description: str = "") -> Schema:
+    return {"type": "boolean", "description": description} if description else {"type": "boolean"}
+
+
+def strings(description: str = "") -> Schema:
+    out: Schema = {"type": "array", "items": {"type": "string"}}
+    if description:
+        out["description"] = description
+    return out
+
+
+def numbers(unit: str | None = None, description: str = "") -> Schema:
+    """A list of numbers (a vector: x, y, z components, or one value per joint)."""
+    out: Schema = {"type": "array", "items": NUMBER}
+    if description:
+        out["description"] = description
+    if unit:
+        out["unit"] = unit
+    return out
+
+
+def number_map(unit: str | None = None, description: str = "") -> Schema:
+    """An object of named numbers (by body, by joint, by variant)."""
+    out: Schema = {"type": "object", "additionalProperties": NUMBER}
+    if description:
+        out["description"] = description
+    if unit:
+        out["unit"] = unit
+    return out
+
+
+def per_variant(unit: str | None, description: str, *, vector: bool = True) -> Schema:
+    """``{variant: value}``: a vector (components or joints) or a number per variant."""
+    return {"type": "object", "description": description + " Per variant (nominal, unbalanced, "
+            "balanced, ...).", **({"unit": unit} if unit else {}),
+            "additionalProperties": {"type": "array", "items": NUMBER} if vector else NUMBER}
+
+
+def detail(description: str) -> Schema:
+    """A nested object whose inner keys are the runner's (documented in its docstring and the
+    paper's derivation page); its numbers follow the same rules (SI, no unit in the key)."""
+    return {"type": "object", "description": description}
+
+
+def anything(description: str) -> Schema:
+    return {"description": description}
+
+
+# ---- the shared metrics -------------------------------------------------------------------------
+
+PER_VARIANT_FORCE = per_variant("N", "Peak of each component (x, y, z in O) of the shaking force "
+                                "dP/dt along the trajectory.")
+PER_VARIANT_MOMENT = per_variant("N m", "Peak of each component of the shaking moment dH_O/dt "
+                                 "about the base origin O along the trajectory.")
+METRICS: dict[str, Schema] = {
+    "peak_shaking_force": PER_VARIANT_FORCE,
+    "peak_shaking_moment": PER_VARIANT_MOMENT,
+    "rms_shaking_force": per_variant("N", "RMS of each component of the shaking force."),
+    "rms_shaking_moment": per_variant("N m", "RMS of each component of the shaking moment about O."),
+    "peak_joint_torque": per_variant("N m or N", "Peak |tau| of each actuated joint along the "
+                                     "trajectory (gravity included; N for a prismatic joint)."),
+    "rms_joint_torque": per_variant("N m or N", "RMS of tau of each actuated joint along the "
+                                    "trajectory."),
+    "peak_gravity_torque": per_variant("N m or N", "Peak |gravity torque| of each actuated joint "
+                                       "(over the poses the case samples)."),
+    "peak_static_torque": per_variant("N m or N", "Peak |torque that holds each pose still| "
+                                      "(gravity plus springs) of each actuated joint."),
+    "peak_base_reaction_force": per_variant("N", "Peak of each component of the force the base "
+                                            "exerts on the mechanism, gravity included."),
+    "peak_base_reaction_moment": per_variant("N m", "Peak of each component of the base reaction "
+                                             "moment about O, gravity included."),
+}
+
+# ---- the header every summary has ------------------------------------------------------------------
+
+HEADER: dict[str, Schema] = {
+    "schema_version": {"const": SUMMARY_SCHEMA_VERSION,
+                       "description": "Version of this schema (integer; a new one renames or "
+                                      "removes keys, docs/summary.md lists the changes)."},
+    "command": {"enum": list(SUMMARY_COMMANDS), "description": "The mechbal command that wrote "
+                "the file (``run`` also for ``demo`` and ``run --engine mujoco``)."},
+    "case": string("Case name (built-in name or the file's [case] name)."),
+    "files": strings("Files written beside summary.json."),
+    "non_finite_values": {"type": "array", "description": "Numbers that were not finite, written "
+                          "as null: their dotted field and value.",
+                          "items": {"type": "object", "required": ["field", "value"],
+                                    "additionalProperties": False,
+                                    "properties": {"field": string(), "value": string()}}},
+    "notes": anything("What the run says about itself (free text or an object of texts)."),
+}
+
+# ---- general summaries --------------------------------------------------------------------------
+
+_CONTROL = {"type": "object", "additionalProperties": False, "description": "The reactionless "
+            "controller of a case with [control] (its settings echo the case file's keys).",
+            "properties": {
+                "kind": string(), "balancing_joints": strings(), "cancel": strings(),
+                "integrator": string(), "rate_hz": number("Hz", "controller rate (the case's rate_hz)"),
+                "damping": number(None, "damped least squares damping"),
+                "ticks": integer(), "singular_ticks": integer(), "saturated_ticks": integer(),
+                "max_condition": number(None, "largest condition number of the balancing joints' "
+                                        "momentum matrix"),
+                "peak_balancing_rate": numbers("rad/s or m/s", "peak |rate| of each balancing joint")}}
+
+RUN_MECHANISM: dict[str, Schema] = {
+    "kind": string("[case] kind: serial_chain, mechanism or urdf (a URDF file)."),
+    "dof": integer("Degrees of freedom (moving joints, gears and loops not counted out)."),
+    "actuated": strings("Actuated joints, in the order of the per-joint values."),
+    "closed": boolean("True for a mechanism with loop closures."),
+    "duration": number("s", "Duration of the trajectory."),
+    "samples": integer("Instants along the trajectory."),
+    "law": string("Time law of the trajectory (quintic, cycloidal, ...)."),
+    "variants": strings("The variants the per-variant values name."),
+    **{k: METRICS[k] for k in ("peak_shaking_force", "peak_shaking_moment", "peak_joint_torque",
+                               "rms_joint_torque", "peak_base_reaction_force",
+                               "peak_base_reaction_moment", "peak_static_torque")},
+    "base_reaction": string("Definition of the base reaction."),
+    "static_torque": string("Definition of the static torque (springs)."),
+    "springs": strings("The springs of the model (their forces are in the joint torques)."),
+    "total_mass": number("kg", "Mass of every body."),
+    "loops": detail("Loop solve along the trajectory: min_rcond, singular_instants, "
+                    "max_closure_residual [m], max_newton_iterations."),
+    "control": _CONTROL,
+    "urdf": string("The URDF file (kind urdf)."),
+    "joint_names": strings(), "body_names": strings(),
+    "start": numbers("rad or m", "Start pose of the default motion (kind urdf)."),
+    "end": numbers("rad or m", "End pose of the default motion (kind urdf)."),
+    "default_motion": detail("How the default motion of a URDF file was chosen (limits)."),
+}
+
+_BASE_REACTION_PEAKS = {"type": "object", "additionalProperties": False, "properties": {
+    "definition": string(),
+    "peak_force_mujoco": number("N"), "peak_force_mechbal": number("N"),
+    "max_force_difference": number("N"), "peak_moment_mujoco": number("N m"),
+    "peak_moment_mechbal": number("N m"), "max_moment_difference": number("N m")}}
+
+RUN_MUJOCO: dict[str, Schema] = {
+    "engine": {"const": "mujoco", "description": "mechbal run --engine mujoco: co-simulation."},
+    "mechanism": string("The mechanism (its repr)."),
+    "dt": number("s", "Controller and integration step."),
+    "controller": string(),
+    "ok": boolean("Every step ok."), "steps_completed": integer(),
+    "peak_tracking_error": number("rad or m"),
+    "max_constraint_violation": number("m", "Largest loop-closure violation in MuJoCo."),
+    "base_reaction": _BASE_REACTION_PEAKS,
+    "shaking_wrench": _BASE_REACTION_PEAKS,
+}
+
+_STATS = {"type": "object", "additionalProperties": False,
+          "properties": {"peak": numbers(), "rms": numbers()}}
+_COMPARISON = {"type": "object", "additionalProperties": False, "properties": {
+    "unit": string(), "unbalanced": _STATS, "balanced": _STATS,
+    "peak_reduction_pct": numbers("%"), "rms_reduction_pct": numbers("%"),
+    "deprecated": string()}}
+
+BALANCE: dict[str, Schema] = {
+    "kind": string("[case] kind of the case balanced."),
+    "method": string("Balancing method: static, force, moment, springs or rms."),
+    "mechanism": string("The unbalanced mechanism (its repr)."),
+    "actuated": strings(), "closed": boolean(),
+    "balance": detail("BalanceResult.summary(): method, design (by element), residual, "
+                      "residual_before, residual_units, rank, unknowns, limited_by, exact, "
+                      "active_bounds, undetermined, tied, unconstrained, metrics."),
+    "trajectory": detail("The trajectory the comparison runs along (the case's [trajectory] keys)."),
+    "before_after": {"type": "object", "description": "Peak and RMS per component or joint, "
+                     "unbalanced and balanced, and the reductions [%].",
+                     "additionalProperties": False,
+                     "properties": {k: _COMPARISON for k in ("static_torque", "joint_torque",
+                                                              "shaking_force", "shaking_moment",
+                                                              "gravity_torque")}},
+    "total_mass": number_map("kg", "Total mass, unbalanced and balanced."),
+    "urdf": string("Why no balanced.urdf was written (loops or springs), or its name."),
+    "case_notes": detail("What the case's loader says (default motion, paper values)."),
+}
+
+_VERIFY_QUANTITY = {"type": "object", "additionalProperties": False, "properties": {
+    "unit": string(), "mechbal_peak": NUMBER, "mujoco_inverse_peak": NUMBER, "max_difference": NUMBER,
+    "relative_difference": NUMBER, "mujoco_simulated_peak": NUMBER, "simulated_minus_predicted": NUMBER,
+    "simulated_peak_fraction_of_unbalanced": NUMBER}}
+VERIFY: dict[str, Schema] = {
+    "method": {"type": ["string", "null"], "description": "Balancing method of the balanced variant."},
+    "variants": {"type": "object", "description": "Per variant (unbalanced, balanced): MuJoCo "
+                 "against mechbal.", "additionalProperties": {
+                     "type": "object", "additionalProperties": False, "properties": {
+                         "mechanism": string(), "mujoco": anything("MuJoCo model size"),
+                         "minimum_bodies": anything(""), "light_bodies": anything(""),
+                         "simulation": detail("ok, steps_completed, max_constraint_violation [m], "
+                                              "max_tracking_error [rad or m]"),
+                         **{k: _VERIFY_QUANTITY for k in ("shaking_force", "shaking_moment",
+                                                          "gravity_torque", "actuator_force")}}}},
+    "checks": string("What was compared, and how."),
+}
+
+SWEEP: dict[str, Schema] = {
+    "sweep": string("Sweep name."), "title": string(),
+    "kind": {"enum": ["monte_carlo", "sensitivity", "grid"]},
+    "seed": integer(), "evaluations": integer(), "chunk_size": integer(),
+    "poses": {"type": ["integer", "null"], "description": "Workspace sample size."},
+    "trajectory_samples": {"type": ["integer", "null"]},
+    "parameters": {"type": "array", "items": {"type": "object"}},
+    "failed_evaluations": integer(),
+    "failure_reasons": {"type": "object", "additionalProperties": {"type": "integer"}},
+    "units": {"type": "object", "additionalProperties": {"type": "string"},
+              "description": "Unit of each built-in metric column."},
+    "metrics": {"type": "object", "description": "Per metric column (built-in: "
+                "<peak|rms>_<quantity>[.<joint>], the names of run summaries): nominal value and "
+                "the statistics of the sweep kind.",
+                "additionalProperties": {"type": "object", "properties": {"nominal": NUMBER}}},
+}
+
+#: (command, kind or None) -> top-level properties; kind None: every kind of that command
+_SUMMARIES: dict[tuple[str, str | None], dict[str, Schema]] = {
+    ("run", "serial_chain"): RUN_MECHANISM,
+    ("run", "mechanism"): RUN_MECHANISM,
+    ("run", "urdf"): RUN_MECHANISM,
+    ("run", None): {},
+    ("balance", None): BALANCE,
+    ("verify", None): VERIFY,
+    ("sweep", None): SWEEP,
+}
+_MUJOCO_KEY = ("run", "engine:mujoco")
+_SUMMARIES[_MUJOCO_KEY] = RUN_MUJOCO
+
+
+def register_summary(command: str, kind: str, properties: dict[str, Schema]) -> None:
+    """Register the top-level fields of the summary.json of ``command`` for case kind ``kind``
+    (a paper's runner: ``register_summary("run", "paminsa", {...})`` in its ``schema.py``),
+    on top of the header. Use the shared metrics (`METRICS`) for the quantities they name."""
+    if command not in SUMMARY_COMMANDS:
+        raise ValueError(f"command: must be one of {', '.join(SUMMARY_COMMANDS)} (got {command!r})")
+    _SUMMARIES[(command, kind)] = dict(properties)
+
+
+def json_schema() -> Schema:
+    """The whole schema (every registered kind: the papers are loaded first)."""
+    from mechbal.registry import papers
+
+    papers()
+    defs: Schema = {"metrics": {"description": "The shared metrics (per variant).",
+                                "properties": copy.deepcopy(METRICS)}}
+    branches = []
+    for (command, kind), props in sorted(_SUMMARIES.items(), key=lambda x: (x[0][0], x[0][1] or "")):
+        name = f"{command}.{kind or 'any'}"
+        props = copy.deepcopy(props)
+        if kind is not None and not kind.startswith("engine:") and "kind" not in props:
+            props = {"kind": {"const": kind, "description": "[case] kind."}, **props}
+        defs[name] = {"type": "object", "properties": props}
+        if (command, kind) == _MUJOCO_KEY:
+            cond = {"properties": {"command": {"const": command}}, "required": ["command", "engine"]}
+        elif kind is None:
+            others = sorted(k for c, k in _SUMMARIES if c == command and k is not None and
+                            not k.startswith("engine:"))
+            cond = {"properties": {"command": {"const": command}}, "required": ["command"]}
+            if others:  # a kind registered on its own is validated by its own branch only
+                cond = {"allOf": [cond, {"not": {"properties": {"kind": {"enum": others}},
+                                                 "required": ["kind"]}},
+                                  {"not": {"required": ["engine"]}}]}
+        else:
+            cond = {"properties": {"command": {"const": command}, "kind": {"const": kind}},
+                    "required": ["command", "kind"]}
+        branches.append({"if": cond, "then": {"$ref": f"#/$defs/{name}"}})
+    return {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "$id": "https://mechbal.invalid/summary.schema.json",
+        "title": "mechbal summary.json",
+        "description": "What every mechbal command writes as DIR/summary.json (docs/summary.md). "
+                       "SI units, named in each property's 'unit', never in the keys.",
+        "type": "object",
+        "required": ["schema_version", "command"],
+        "properties": copy.deepcopy(HEADER),
+        "allOf": branches,
+        "unevaluatedProperties": False,
+        "$defs": defs,
+    }
+
+
+def schema_text() -> str:
+    return json.dumps(json_schema(), indent=1, sort_keys=False) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    # run as ``python -m``, this file is ``__main__``: the papers register into the imported
+    # ``mechbal.summary_schema``, so ask that one
+    import importlib
+
+    sys.stdout.write(importlib.import_module("mechbal.summary_schema").schema_text())
+    return 0
+
+
+__all__ = ["METRICS", "PER_VARIANT_FORCE", "PER_VARIANT_MOMENT", "anything", "boolean", "detail",
+           "integer", "json_schema", "number", "number_map", "numbers", "per_variant",
+           "register_summary", "schema_text", "string", "strings"]
+
+if __name__ == "__main__":
+    raise SystemExit(main())
