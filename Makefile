@@ -199,6 +199,7 @@ BENCH_FLAGS ?= --benchmark_repetitions=7 --benchmark_min_time=0.05 \
                --benchmark_report_aggregates_only=true --tail_samples=20000
 LOOP_SECONDS ?= 5
 LOOP_PAMINSA_SECONDS ?= 2
+LOOP_GENERAL_SECONDS ?= 3
 
 $(BENCH_BUILD)/build.ninja: | $(VENV)/.stamp-venv $(VENV)/.stamp-apt
 	$(VENV)/bin/cmake -S . -B $(BENCH_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release \
@@ -214,9 +215,15 @@ bench: install $(VENV)/.stamp-apt-test $(BENCH_BUILD)/build.ninja
 	  --json $(BENCH_RUN)/loop.json
 	$(BENCH_BUILD)/bench/mechbal-loop --seconds $(LOOP_PAMINSA_SECONDS) --rate 1000 --rt \
 	  --workload paminsa --json $(BENCH_RUN)/loop_paminsa.json
+	$(BENCH_BUILD)/bench/mechbal-loop --seconds $(LOOP_GENERAL_SECONDS) --rate 1000 --rt \
+	  --workload paminsa_general --json $(BENCH_RUN)/loop_paminsa_general.json
+	$(BENCH_BUILD)/bench/mechbal-loop --seconds $(LOOP_GENERAL_SECONDS) --rate 1000 --rt \
+	  --workload reactionless_general --json $(BENCH_RUN)/loop_reactionless_general.json
 	$(PY) bench/bench_python.py --out $(BENCH_RUN)/python.json
 	$(PY) bench/merge_results.py --gbench $(BENCH_RUN)/gbench.json --tail $(BENCH_RUN)/tail.json \
 	  --loop $(BENCH_RUN)/loop.json --loop-paminsa $(BENCH_RUN)/loop_paminsa.json --python $(BENCH_RUN)/python.json \
+	  --loop-extra paminsa_general=$(BENCH_RUN)/loop_paminsa_general.json \
+	  --loop-extra reactionless_general=$(BENCH_RUN)/loop_reactionless_general.json \
 	  --out-json bench/results/latest.json --out-md bench/results/latest.md
 
 clean:

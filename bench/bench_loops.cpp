@@ -101,7 +101,10 @@ Eigen::Isometry3d at(double x) {
   return T;
 }
 
-MechanismModel four_bar() {
+}  // namespace
+
+/// The four-bar of tests/cpp/test_loops.cpp (also bench_loops_pinocchio.cpp's).
+MechanismModel bench_four_bar() {
   const auto rod = [](const std::string& name, double mass, double length) {
     return Body{name, "link", name, mass, Vec3(0.5 * length, 0.01, 0.0),
                 Mat3(Vec3(1e-4, mass * length * length / 12.0, mass * length * length / 12.0).asDiagonal())};
@@ -117,8 +120,10 @@ MechanismModel four_bar() {
   return MechanismModel(d);
 }
 
+namespace {
+
 struct FourBarCase {
-  MechanismModel model{four_bar()};
+  MechanismModel model{bench_four_bar()};
   MechanismData data{model};
   std::vector<ActuatedState> in;
   Eigen::VectorXd q = (Eigen::VectorXd(3) << 1.0, -0.6, 1.75).finished();

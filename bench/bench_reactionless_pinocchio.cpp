@@ -9,13 +9,17 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <map>
 #include <pinocchio/algorithm/centroidal.hpp>
+#include <pinocchio/algorithm/constrained-dynamics.hpp>
 #include <pinocchio/algorithm/center-of-mass.hpp>
 #include <pinocchio/multibody.hpp>
 #include <vector>
 
 #include "bench_registry.hpp"
+#include "mechbal/algorithm/loops.hpp"
 #include "mechbal/control/reactionless.hpp"
+#include "mechbal/model/data.hpp"
 #include "reaction_wheel_arm.hpp"
 
 namespace mechbal::bench {
@@ -169,3 +173,170 @@ Tick pinocchio_wheel_case(bool rk4) {
 
 MECHBAL_BENCH_CASE(reactionless_wheel_euler_pinocchio) { return mechbal::bench::pinocchio_wheel_case(false); }
 MECHBAL_BENCH_CASE(reactionless_wheel_rk4_pinocchio) { return mechbal::bench::pinocchio_wheel_case(true); }
+
+// ============================================================================ closed-loop anchor
+// A closed-loop anchor (issue 26): the four-bar of bench_loops.cpp in Pinocchio's constrained
+// dynamics (constraintDynamics: a CONTACT_3D constraint between the coupler's and the rocker's tips,
+// the proximal solver), against mechbal's closed_forward_dynamics on the same mechanism and the
+// same instants.
+//  - closed_forward_four_bar_mechbal: closed_forward_dynamics from the actuated state (crank angle,
+//    rate, torque): the position solve of the two passive angles (warm-started from the last tick),
+//    the projection v = C v#, a = C a# + c, the reduced mass matrix C^T M C and the bias, the solve
+//    for a#, and the motion of all three joints (data.closed_acceleration).
+//  - closed_forward_four_bar_pinocchio: constraintDynamics from the full state (all three angles and
+//    rates, which mechbal's position solve produced: Pinocchio has no position solve), torque on the
+//    crank: crba, the Delassus matrix of the constraint, the proximal Cholesky solve, ddq of all
+//    three joints. The z row of the point constraint is identically zero (planar mechanism): the
+//    proximal damping mu handles it, as Pinocchio's documentation advises for redundant rows.
+// So mechbal's tick does strictly more (it also closes the loop from the crank angle alone).
+// Setup checks that both give the same accelerations of the three joints (1e-8) at 64 instants.
+// (In this translation unit to compile Pinocchio's headers once for both.)
+namespace mechbal::bench {
+MechanismModel bench_four_bar();  // bench_loops.cpp
+namespace four_bar_anchor {
+namespace {
+
+constexpr double kDt = 1e-3;
+constexpr int kTicks = 1024;
+
+[[noreturn]] void fail(const char* what, double value) {
+  std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
+  std::abort();
+}
+
+struct PingPong {
+  int k = 0, step = 1;
+  std::size_t next() noexcept {
+    const int out = k;
+    if (k + step < 0 || k + step >= kTicks) step = -step;
+    k += step;
+    return static_cast<std::size_t>(out);
+  }
+};
+
+/// The crank's state and torque along a swing; the torque holds the crank against gravity with a
+/// periodic excess, so that the accelerations are of the order of the bench's other motions.
+struct Instant {
+  Eigen::VectorXd qa, va, tau;
+};
+
+std::vector<Instant> crank_instants() {
+  std::vector<Instant> out;
+  for (int n = 0; n < kTicks; ++n) {
+    const double t = n * kDt;
+    out.push_back({Eigen::VectorXd::Constant(1, 1.0 + 0.4 * std::sin(2.0 * t)),
+                   Eigen::VectorXd::Constant(1, 0.8 * std::cos(2.0 * t)),
+                   Eigen::VectorXd::Constant(1, 2.0 + 1.5 * std::sin(3.0 * t))});
+  }
+  return out;
+}
+
+const Eigen::VectorXd kStart = (Eigen::VectorXd(3) << 1.0, -0.6, 1.75).finished();
+
+struct MechCase {
+  MechanismModel model{bench_four_bar()};
+  MechanismData data{model};
+  std::vector<Instant> in = crank_instants();
+  Eigen::VectorXd q = kStart;
+  PingPong order;
+  Status status = Status::ok;
+};
+
+using ConstraintModels = PINOCCHIO_STD_VECTOR_WITH_EIGEN_ALLOCATOR(pinocchio::RigidConstraintModel);
+using ConstraintDatas = PINOCCHIO_STD_VECTOR_WITH_EIGEN_ALLOCATOR(pinocchio::RigidConstraintData);
+
+/// The four-bar as a Pinocchio model: three RZ joints (crank and rocker on the base, coupler on
+/// the crank), the bodies of mechbal's description, the loop as a CONTACT_3D constraint between the
+/// frames of the tips (placements relative to the coupler's and the rocker's joint frames).
+struct PinCase {
+  explicit PinCase(const MechanismModel& m) {
+    const auto& d = m.description();
+    std::vector<pinocchio::JointIndex> id;
+    std::map<std::string, pinocchio::JointIndex> of_link;  // a link is named by the joint moving it
+    for (std::size_t i = 0; i < d.joints.size(); ++i) {
+      const Joint& j = d.joints[i];
+      if (j.type != JointType::revolute || j.axis != Vec3::UnitZ()) fail("four-bar: expected RZ joints", 0);
+      const pinocchio::JointIndex parent = j.parent == d.root_name ? 0 : of_link.at(j.parent);
+      id.push_back(model.addJoint(parent, pinocchio::JointModelRZ(),
+                                  pinocchio::SE3(j.placement.linear(), j.placement.translation()), j.name));
+      of_link[j.name] = id.back();
+      const Body& b = d.bodies[i];
+      model.appendBodyToJoint(id.back(), pinocchio::Inertia(b.mass, b.com, b.inertia), pinocchio::SE3::Identity());
+    }
+    model.gravity.linear(m.gravity());
+    const auto tip = [&](const std::string& frame) {
+      for (const Frame& f : d.frames)
+        if (f.name == frame) return std::make_pair(of_link.at(f.link),
+                                                   pinocchio::SE3(f.placement.linear(), f.placement.translation()));
+      fail("four-bar: frame not found", 0);
+    };
+    const LoopConstraint& loop = d.loops.front();
+    const auto a = tip(loop.frame_a), b = tip(loop.frame_b);
+    constraints.emplace_back(pinocchio::CONTACT_3D, model, a.first, a.second, b.first, b.second, pinocchio::LOCAL);
+    data = std::make_unique<pinocchio::Data>(model);
+    for (const auto& c : constraints) constraint_data.emplace_back(c);
+    pinocchio::initConstraintDynamics(model, *data, constraints, constraint_data);
+  }
+  pinocchio::Model model;
+  std::unique_ptr<pinocchio::Data> data;
+  ConstraintModels constraints;
+  ConstraintDatas constraint_data;
+  pinocchio::ProximalSettings settings{1e-12, 1e-12, 3};
+  std::vector<Eigen::VectorXd> q, v, tau;  // full state of each instant (from mechbal's solve)
+  PingPong order;
+};
+
+Tick mechbal_case() {
+  auto s = std::make_shared<MechCase>();
+  for (int n = 0; n < 64; ++n) {
+    const Instant& x = s->in[static_cast<std::size_t>(n)];
+    if (closed_forward_dynamics(s->model, s->data, x.qa, x.va, x.tau, s->q) != Status::ok)
+      fail("four-bar: closed_forward_dynamics failed", n);
+  }
+  s->q = kStart;
+  return [s] {
+    const Instant& x = s->in[s->order.next()];
+    s->status = closed_forward_dynamics(s->model, s->data, x.qa, x.va, x.tau, s->q);
+    benchmark::DoNotOptimize(s->status);
+    benchmark::DoNotOptimize(s->data.closed_acceleration.data());
+    benchmark::ClobberMemory();
+  };
+}
+
+Tick pinocchio_case() {
+  MechCase m;
+  auto s = std::make_shared<PinCase>(m.model);
+  double worst = 0.0;
+  for (int n = 0; n < kTicks; ++n) {
+    const Instant& x = m.in[static_cast<std::size_t>(n)];
+    if (closed_forward_dynamics(m.model, m.data, x.qa, x.va, x.tau, m.q) != Status::ok)
+      fail("four-bar: closed_forward_dynamics failed", n);
+    // mechbal's coordinates are Pinocchio's (three RZ joints in the same order); tau on the crank
+    s->q.push_back(m.data.closed_position);
+    s->v.push_back(m.data.closed_velocity);
+    Eigen::VectorXd tau = Eigen::VectorXd::Zero(3);
+    tau(m.model.actuated_coordinates().front()) = x.tau(0);
+    s->tau.push_back(tau);
+    if (n < 64) {
+      pinocchio::constraintDynamics(s->model, *s->data, s->q.back(), s->v.back(), s->tau.back(), s->constraints,
+                                    s->constraint_data, s->settings);
+      worst = std::max(worst, (s->data->ddq - m.data.closed_acceleration).cwiseAbs().maxCoeff() /
+                                  std::max(1.0, m.data.closed_acceleration.cwiseAbs().maxCoeff()));
+    }
+  }
+  if (!(worst < 1e-8)) fail("four-bar: Pinocchio's constraintDynamics != mechbal's closed_forward_dynamics", worst);
+  return [s] {
+    const std::size_t k = s->order.next();
+    pinocchio::constraintDynamics(s->model, *s->data, s->q[k], s->v[k], s->tau[k], s->constraints,
+                                  s->constraint_data, s->settings);
+    benchmark::DoNotOptimize(s->data->ddq.data());
+    benchmark::ClobberMemory();
+  };
+}
+
+}  // namespace
+}  // namespace four_bar_anchor
+}  // namespace mechbal::bench
+
+MECHBAL_BENCH_CASE(closed_forward_four_bar_mechbal) { return mechbal::bench::four_bar_anchor::mechbal_case(); }
+MECHBAL_BENCH_CASE(closed_forward_four_bar_pinocchio) { return mechbal::bench::four_bar_anchor::pinocchio_case(); }

@@ -18,10 +18,14 @@
 #include <map>
 #include <pinocchio/algorithm/centroidal.hpp>
 #include <pinocchio/algorithm/crba.hpp>
+#include <pinocchio/algorithm/frames.hpp>
+#include <pinocchio/algorithm/jacobian.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/multibody.hpp>
 
+#include "bench_reactionless_panda.hpp"
 #include "bench_urdf.hpp"
+#include "bench_urdf_pinocchio.hpp"
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
@@ -29,75 +33,6 @@
 
 namespace mechbal::bench {
 namespace {
-
-pinocchio::SE3 to_se3(const Eigen::Isometry3d& T) { return pinocchio::SE3(T.linear(), T.translation()); }
-
-/// Pinocchio's model of the description (see the file comment), and G, o with Pinocchio's
-/// joint positions = G q + o (q: mechbal's coordinates).
-struct PinModel {
-  pinocchio::Model model;
-  Eigen::MatrixXd G;
-  Eigen::VectorXd offset;
-};
-
-PinModel to_pinocchio(const MechanismModel& mech) {
-  PinModel out;
-  pinocchio::Model& pm = out.model;
-  const auto& joints = mech.description().joints;  // joint k moves link k + 1 (depth-first)
-  const int nl = mech.num_links();
-  std::vector<pinocchio::JointIndex> carrier(static_cast<std::size_t>(nl), 0);
-  std::vector<Eigen::Isometry3d> offset(static_cast<std::size_t>(nl), Eigen::Isometry3d::Identity());
-  std::map<std::string, int> pin_v;  // joint name -> Pinocchio v index
-  for (int l = 1; l < nl; ++l) {
-    const Joint& j = joints[static_cast<std::size_t>(l - 1)];
-    const auto p = static_cast<std::size_t>(mech.parent(l));
-    const Eigen::Isometry3d placement = offset[p] * j.placement;
-    if (j.type == JointType::fixed) {
-      carrier[static_cast<std::size_t>(l)] = carrier[p];
-      offset[static_cast<std::size_t>(l)] = placement;
-      continue;
-    }
-    const Vec3& a = j.axis;
-    pinocchio::JointIndex id;
-    const pinocchio::SE3 X = to_se3(placement);
-    if (j.type == JointType::revolute) {
-      if (a == Vec3::UnitX()) id = pm.addJoint(carrier[p], pinocchio::JointModelRX(), X, j.name);
-      else if (a == Vec3::UnitY()) id = pm.addJoint(carrier[p], pinocchio::JointModelRY(), X, j.name);
-      else if (a == Vec3::UnitZ()) id = pm.addJoint(carrier[p], pinocchio::JointModelRZ(), X, j.name);
-      else id = pm.addJoint(carrier[p], pinocchio::JointModelRevoluteUnaligned(a), X, j.name);
-    } else {
-      if (a == Vec3::UnitX()) id = pm.addJoint(carrier[p], pinocchio::JointModelPX(), X, j.name);
-      else if (a == Vec3::UnitY()) id = pm.addJoint(carrier[p], pinocchio::JointModelPY(), X, j.name);
-      else if (a == Vec3::UnitZ()) id = pm.addJoint(carrier[p], pinocchio::JointModelPZ(), X, j.name);
-      else id = pm.addJoint(carrier[p], pinocchio::JointModelPrismaticUnaligned(a), X, j.name);
-    }
-    carrier[static_cast<std::size_t>(l)] = id;
-    pin_v[j.name] = pm.joints[id].idx_v();
-  }
-  for (int b = 0; b < mech.num_bodies(); ++b) {
-    const Body& body = mech.body(b);
-    const auto l = static_cast<std::size_t>(mech.body_link(b));
-    pm.appendBodyToJoint(carrier[l], pinocchio::Inertia(body.mass, body.com, body.inertia), to_se3(offset[l]));
-  }
-  pm.gravity.linear(mech.gravity());
-  out.G = Eigen::MatrixXd::Zero(pm.nv, mech.dof());
-  out.offset = Eigen::VectorXd::Zero(pm.nv);
-  const auto& names = mech.coordinate_names();
-  auto coordinate = [&](const std::string& n) {
-    return static_cast<int>(std::find(names.begin(), names.end(), n) - names.begin());
-  };
-  for (const Joint& j : joints) {
-    if (j.type == JointType::fixed) continue;
-    const int iv = pin_v.at(j.name);
-    if (j.mimic_joint.empty()) {
-      out.G(iv, coordinate(j.name)) = 1.0;
-    } else {
-      out.G(iv, coordinate(j.mimic_joint)) = j.mimic_ratio;
-      out.offset(iv) = j.mimic_offset;
-    }
-  }
-  return out;
-}
 
 double rel(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
@@ -129,6 +64,9 @@ struct Pin : UrdfRobot {
       const Vec3 dH_O = data.dhg.angular() + c.cross(dP);
       worst = std::max(worst, rel(md.shaking.force, dP));
       worst = std::max(worst, rel(md.shaking.moment, dH_O));
+      gravity_torque(model, md, x.q[sk]);
+      pinocchio::computeGeneralizedGravity(pin.model, data, q[sk]);
+      worst = std::max(worst, rel(md.gravity_torque, pin.G.transpose() * data.g));
     }
     if (!(worst < 1e-9)) {
       std::fprintf(stderr, "mechbal-bench: Pinocchio disagrees with mechbal on %s (relative %g)\n",
@@ -166,6 +104,16 @@ Tick mass_case(const char* robot) {
   };
 }
 
+Tick gravity_case(const char* robot) {
+  auto s = std::make_shared<Pin>(robot);
+  return [s] {
+    const auto k = s->next();
+    pinocchio::computeGeneralizedGravity(s->pin.model, s->data, s->q[k]);
+    benchmark::DoNotOptimize(s->data.g.data());
+    benchmark::ClobberMemory();
+  };
+}
+
 Tick momentum_rate_case(const char* robot) {
   auto s = std::make_shared<Pin>(robot);
   return [s] {
@@ -177,6 +125,196 @@ Tick momentum_rate_case(const char* robot) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------- reactionless Panda
+// ReactionlessTaskController's tick (control/reactionless.cpp) written over Pinocchio, on the
+// Panda case of bench_reactionless_panda.cpp (reactionless_panda_{euler,rk4}_pinocchio; the
+// file comment there says what is compared).
+namespace panda_reactionless {
+namespace {
+
+[[noreturn]] void fail(const char* what, double value) {
+  std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
+  std::abort();
+}
+
+/// ReactionlessTaskController's tick (control/reactionless.cpp) over Pinocchio's kinematics.
+struct PinocchioTaskController {
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+  using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
+  static constexpr double huge = std::numeric_limits<double>::max();
+
+  PinocchioTaskController(const MechanismModel& m, const TaskSpaceConfig& c, const Eigen::VectorXd& q0)
+      : pin(to_pinocchio(m)), data(pin.model), config(c) {
+    n = m.dof();
+    dt = 1.0 / c.rate_hz;
+    rk4 = c.integrator == ReactionlessIntegrator::rk4;
+    frame = pin.model.getFrameId(c.frame);
+    for (int r = 0; r < 6; ++r) {
+      if (c.task_rows & (1u << r)) task_rows.push_back(r);
+      if (c.cancel & (1u << r)) rows.push_back(r);
+    }
+    const auto nt = static_cast<Eigen::Index>(task_rows.size()), nk = static_cast<Eigen::Index>(rows.size());
+    for (Eigen::VectorXd* v : {&q, &q_cmd, &v_cmd, &k1, &k2, &k3, &k4, &q_stage, &v0, &z, &w})
+      *v = Eigen::VectorXd::Zero(n);
+    q_pin = Eigen::VectorXd::Zero(pin.model.nq);
+    J6 = pinocchio::Data::Matrix6x::Zero(6, pin.model.nv);
+    JG = Eigen::MatrixXd::Zero(6, n);
+    AO = Eigen::MatrixXd::Zero(6, n);
+    A6 = Eigen::MatrixXd::Zero(6, pin.model.nv);
+    J = Eigen::MatrixXd::Zero(nt, n);
+    Jt = Eigen::MatrixXd::Zero(n, 6);
+    JpJ = Eigen::MatrixXd::Zero(n, n);
+    N = Eigen::MatrixXd::Zero(n, n);
+    M = Eigen::MatrixXd::Zero(nk, n);
+    rt = Eigen::VectorXd::Zero(nt);
+    rm = Eigen::VectorXd::Zero(nk);
+    gram = Small::Identity(6, 6);
+    eig.compute(gram, Eigen::EigenvaluesOnly);
+    llt.compute(gram);
+    y = SmallVector::Zero(6);
+    rate_limit = m.velocity_limits().cwiseMin(c.max_rate);
+    q = q0;
+    q_cmd = q0;
+    target.setZero();  // at rest
+  }
+
+  Status min_norm(const Eigen::MatrixXd& Mat, const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::VectorXd& x) {
+    const Eigen::Index rows_n = Mat.rows();
+    gram.resize(rows_n, rows_n);
+    gram.noalias() = Mat * Mat.transpose();
+    eig.compute(gram, Eigen::EigenvaluesOnly);
+    const double lmax = eig.eigenvalues()(rows_n - 1), lmin = eig.eigenvalues()(0);
+    Status st = Status::ok;
+    if (!(lmax > 0.0)) {
+      x.setZero();
+      return Status::singular;
+    }
+    const double cond = lmin > 0.0 ? std::sqrt(lmax / lmin) : huge;
+    if (cond > config.max_condition) {
+      gram.diagonal().array() += config.damping * config.damping * lmax;
+      st = Status::singular;
+    }
+    llt.compute(gram);
+    SmallVector rr(rows_n);
+    for (Eigen::Index i = 0; i < rows_n; ++i) rr(i) = r(i);
+    y = llt.solve(rr);
+    x.noalias() = Mat.transpose() * y;
+    return st;
+  }
+
+  Status rates(const Eigen::VectorXd& qc, const Vec6& twist, Eigen::VectorXd& v) {
+    q_pin.noalias() = pin.G * qc;
+    q_pin += pin.offset;
+    pinocchio::computeFrameJacobian(pin.model, data, q_pin, frame, pinocchio::LOCAL_WORLD_ALIGNED, J6);
+    JG.noalias() = J6 * pin.G;
+    for (std::size_t i = 0; i < task_rows.size(); ++i) {
+      J.row(static_cast<Eigen::Index>(i)) = JG.row(task_rows[i]);
+      rt(static_cast<Eigen::Index>(i)) = twist(task_rows[i]);
+    }
+    Status st = min_norm(J, rt, v0);
+    const Eigen::Index nt = J.rows();
+    const Small G_inv = llt.solve(Small(Small::Identity(nt, nt)));
+    Jt.leftCols(nt).noalias() = J.transpose() * G_inv;
+    JpJ.noalias() = Jt.leftCols(nt) * J;
+    N = -JpJ;
+    N.diagonal().array() += 1.0;
+    pinocchio::computeCentroidalMap(pin.model, data, q_pin);
+    A6 = data.Ag;  // about the centre of mass; about O: H_O = H_G + c x P
+    const Vec3 c = data.com[0];
+    for (Eigen::Index j = 0; j < A6.cols(); ++j) A6.col(j).tail<3>() += c.cross(Vec3(A6.col(j).head<3>()));
+    AO.noalias() = A6 * pin.G;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const auto r = static_cast<Eigen::Index>(i);
+      M.row(r).noalias() = AO.row(rows[i]) * N;
+      rm(r) = target(rows[i]) - AO.row(rows[i]).dot(v0);
+    }
+    st |= min_norm(M, rm, z);
+    v = v0;
+    v.noalias() += N * z;
+    double peak = 0.0;
+    for (int j = 0; j < n; ++j) peak = std::max(peak, std::abs(v(j)) / rate_limit(j));
+    if (peak > 1.0) {
+      v *= 1.0 / peak;
+      st |= Status::saturated;
+    }
+    return st;
+  }
+
+  Status step(const Vec6& twist, const Vec6& twist_half, const Vec6& twist_next) {
+    Status st = rates(q, twist, k1);
+    h.noalias() = AO * k1;
+    twist_cmd.noalias() = JG * k1;
+    if (rk4) {
+      w = q + (0.5 * dt) * k1;
+      st |= rates(w, twist_half, k2);
+      w = q + (0.5 * dt) * k2;
+      st |= rates(w, twist_half, k3);
+      w = q + dt * k3;
+      st |= rates(w, twist_next, k4);
+      q_stage = q + (dt / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    } else {
+      q_stage = q + dt * k1;
+    }
+    q_cmd = q;
+    v_cmd = k1;
+    q = q_stage;
+    return st;
+  }
+
+  PinModel pin;
+  pinocchio::Data data;
+  TaskSpaceConfig config;
+  int n = 0;
+  double dt = 1e-3;
+  bool rk4 = false;
+  pinocchio::FrameIndex frame = 0;
+  std::vector<int> task_rows, rows;
+  Eigen::VectorXd q, q_cmd, v_cmd, k1, k2, k3, k4, q_stage, v0, z, w, rate_limit, q_pin;
+  pinocchio::Data::Matrix6x J6;
+  Eigen::MatrixXd JG, AO, A6, J, Jt, JpJ, N, M;
+  Eigen::VectorXd rt, rm;
+  Small gram;
+  SmallVector y;
+  Eigen::SelfAdjointEigenSolver<Small> eig;
+  Eigen::LLT<Small> llt;
+  Vec6 target, h = Vec6::Zero(), twist_cmd = Vec6::Zero();
+};
+
+struct PinCase {
+  std::unique_ptr<PinocchioTaskController> ctrl;
+  TwistSamples x;
+  int k = 0;
+  Status status = Status::ok;
+};
+
+Tick panda_reactionless_case(ReactionlessIntegrator integrator) {
+  auto s = std::make_shared<PinCase>();
+  UrdfRobot panda("panda");
+  s->ctrl = std::make_unique<PinocchioTaskController>(panda.model, config(integrator), home(panda.model.dof()));
+  auto ref = mechbal_controller(integrator);
+  for (int n = 0; n < 300; ++n) {
+    const auto k = static_cast<std::size_t>(n);
+    ref->step(s->x.now[k], s->x.half[k], s->x.next[k]);
+    s->ctrl->step(s->x.now[k], s->x.half[k], s->x.next[k]);
+    const double err = std::max({(ref->v() - s->ctrl->v_cmd).cwiseAbs().maxCoeff(),
+                                 (ref->next() - s->ctrl->q).cwiseAbs().maxCoeff(),
+                                 (ref->momentum() - s->ctrl->h).cwiseAbs().maxCoeff()});
+    if (!(err < 1e-9)) fail("reactionless Panda over Pinocchio != mechbal's controller", err);
+  }
+  s->k = 300;
+  return [s] {
+    const auto k = static_cast<std::size_t>(s->k);
+    s->k = s->k + 1 == kTicks ? 0 : s->k + 1;
+    s->status = s->ctrl->step(s->x.now[k], s->x.half[k], s->x.next[k]);
+    benchmark::DoNotOptimize(s->status);
+    benchmark::DoNotOptimize(s->ctrl->v_cmd.data());
+    benchmark::ClobberMemory();
+  };
+}
+
+}  // namespace
+}  // namespace panda_reactionless
 }  // namespace mechbal::bench
 
 using namespace mechbal::bench;
@@ -186,3 +324,19 @@ MECHBAL_BENCH_CASE(momentum_rate_ur5_pinocchio) { return momentum_rate_case("ur5
 MECHBAL_BENCH_CASE(id_panda_pinocchio) { return id_case("panda"); }
 MECHBAL_BENCH_CASE(mass_panda_pinocchio) { return mass_case("panda"); }
 MECHBAL_BENCH_CASE(momentum_rate_panda_pinocchio) { return momentum_rate_case("panda"); }
+MECHBAL_BENCH_CASE(gravity_ur5_pinocchio) { return gravity_case("ur5"); }
+MECHBAL_BENCH_CASE(gravity_panda_pinocchio) { return gravity_case("panda"); }
+MECHBAL_BENCH_CASE(id_talos_pinocchio) { return id_case("talos"); }
+MECHBAL_BENCH_CASE(mass_talos_pinocchio) { return mass_case("talos"); }
+MECHBAL_BENCH_CASE(gravity_talos_pinocchio) { return gravity_case("talos"); }
+MECHBAL_BENCH_CASE(momentum_rate_talos_pinocchio) { return momentum_rate_case("talos"); }
+MECHBAL_BENCH_CASE(id_romeo_pinocchio) { return id_case("romeo"); }
+MECHBAL_BENCH_CASE(mass_romeo_pinocchio) { return mass_case("romeo"); }
+MECHBAL_BENCH_CASE(gravity_romeo_pinocchio) { return gravity_case("romeo"); }
+MECHBAL_BENCH_CASE(momentum_rate_romeo_pinocchio) { return momentum_rate_case("romeo"); }
+MECHBAL_BENCH_CASE(reactionless_panda_euler_pinocchio) {
+  return panda_reactionless::panda_reactionless_case(mechbal::ReactionlessIntegrator::euler);
+}
+MECHBAL_BENCH_CASE(reactionless_panda_rk4_pinocchio) {
+  return panda_reactionless::panda_reactionless_case(mechbal::ReactionlessIntegrator::rk4);
+}

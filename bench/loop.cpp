@@ -8,9 +8,28 @@
 //     chain, tracking a quintic rest-to-rest trajectory (back and forth) evaluated every tick;
 //   paminsa: the whole PAMINSA tick (PaminsaController::tick: mechanism kinematics at t, t + dt/2,
 //     t + dt, D, the reactionless wrist with RK4, wrist kinematics, shaking wrench of 38 bodies),
-//     the platform following a smooth 3-D motion around the nominal pose.
+//     the platform following a smooth 3-D motion around the nominal pose;
+//   paminsa_general: the general PAMINSA tick (issue 26): PAMINSA on the general model (38 bodies,
+//     9 loop closures; paminsa_general.hpp), computed torque through MechanismDynamics (loop
+//     solve warm-started from the last tick, projection, inverse dynamics, C^T tau) with the
+//     support wrench (the shaking wrench with the weights) of all bodies, along the same platform
+//     and wrist motion, the "measured" state the reference with a small tracking error;
+//   reactionless_general: the general reactionless tick (issue 21) on the same model: the
+//     ReactionlessController with the three wrist joints balancing the moment, RK4 (loop solve,
+//     projection, momentum matrix and the rate solve at four stages, feed-forward, predicted
+//     shaking wrench).
 //
-// Usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE] [--workload ct6|paminsa]
+// Every tick is timed twice: wall clock (CLOCK_MONOTONIC) and the thread's CPU time
+// (CLOCK_THREAD_CPUTIME_ID). A tick whose wall time exceeds its CPU time by more than 2 us was
+// preempted (another thread ran on the core); the JSON reports the p99.9 of the wall time over
+// the ticks that were not (p999_unpreempted_ns) beside the raw one, the number of preempted ticks,
+// and the compute overruns (wall > period) of both kinds. A VM's vCPU preemption by the host
+// (steal) is charged to the thread's CPU time on the benchmark VM (a tick's CPU time then equals
+// its wall time), so it cannot be told apart per tick: the JSON gives the machine's steal fraction
+// over the run (/proc/stat) beside the tail, to say how much of it the host's doing may be.
+//
+// Usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE]
+//                     [--workload ct6|paminsa|paminsa_general|reactionless_general]
 //   --rt: try SCHED_FIFO (priority 80) and mlockall(MCL_CURRENT | MCL_FUTURE); when not permitted
 //         (no CAP_SYS_NICE / RLIMIT_RTPRIO, RLIMIT_MEMLOCK) it says so and runs without.
 #include <sched.h>
@@ -24,11 +43,15 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mechbal/control/computed_torque.hpp"
+#include "mechbal/control/reactionless.hpp"
+#include "paminsa_general.hpp"
 #include "mechbal/papers/paminsa/paminsa.hpp"
 #include "mechbal/control/mechanism_dynamics.hpp"
 #include "mechbal/control/trajectory.hpp"
@@ -62,7 +85,7 @@ double pct(std::vector<long long> v, double p) {
 void usage() {
   std::fprintf(stderr,
                "usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE] "
-               "[--workload ct6|paminsa]\n");
+               "[--workload ct6|paminsa|paminsa_general|reactionless_general]\n");
 }
 
 /// The 6-joint computed-torque workload; tick() is noexcept and allocation-free.
@@ -133,23 +156,136 @@ struct PaminsaWorkload {
   mechbal::PaminsaController controller;
 };
 
+/// The general PAMINSA tick: computed torque over MechanismDynamics (closed loops) with the support
+/// wrench; the reference precomputed at 1 kHz along 1024 instants, back and forth (no allocation
+/// in tick()).
+struct PaminsaGeneralWorkload {
+  static constexpr const char* name = "paminsa_general";
+  static constexpr const char* description =
+      "paminsa_general: PAMINSA on the general model (38 bodies, 9 loops): computed torque through "
+      "MechanismDynamics (loop solve, projection, inverse dynamics, C^T tau) + support wrench";
+  static constexpr int kInstants = 1024;
+  PaminsaGeneralWorkload()
+      : closed(mechbal::PaminsaParameters{}),
+        model(std::make_shared<const mechbal::MechanismModel>(mechbal::bench::paminsa_description(closed))),
+        dynamics(model, mechbal::bench::initial_guess(closed, *model, mechbal::test::platform_at(0.0),
+                                                      mechbal::test::wrist_at(0.0))) {
+    for (int n = 0; n < kInstants; ++n)
+      ref.push_back(mechbal::bench::actuated(closed, *model, mechbal::test::platform_at(n * 1e-3),
+                                             mechbal::test::wrist_at(n * 1e-3)));
+    const auto na = static_cast<Eigen::Index>(model->num_actuated());
+    q = qd = v = tau = Eigen::VectorXd::Zero(na);
+  }
+  mechbal::Status tick(double t) noexcept {
+    const long k = std::lround(t * 1e3) % (2 * kInstants - 2);
+    const auto& r = ref[static_cast<std::size_t>(k < kInstants ? k : 2 * kInstants - 2 - k)];
+    q = r.q.array() + 1e-5 * std::sin(50.0 * t);
+    qd = r.v.array() - 1e-4 * std::cos(50.0 * t);
+    v = r.a + kp * (r.q - q) + kd * (r.v - qd);
+    return dynamics.inverse_dynamics(q, qd, v, tau, &force, &moment);
+  }
+  static constexpr double kp = 100.0, kd = 20.0;
+  mechbal::PaminsaModel closed;
+  std::shared_ptr<const mechbal::MechanismModel> model;
+  mechbal::MechanismDynamics dynamics;
+  std::vector<mechbal::bench::ActuatedState> ref;
+  Eigen::VectorXd q, qd, v, tau;
+  mechbal::Vec3 force, moment;
+};
+
+/// The general reactionless tick (RK4) on PAMINSA's general model, the wrist balancing the moment;
+/// the platform's task motion precomputed at t, t + dt/2, t + dt for 1024 ticks, cycled back and forth.
+struct ReactionlessGeneralWorkload {
+  static constexpr const char* name = "reactionless_general";
+  static constexpr const char* description =
+      "reactionless_general: ReactionlessController (RK4) on PAMINSA's general model, wrist "
+      "balancing the moment (loops, momentum matrix, rate solve x4, feed-forward, predicted wrench)";
+  // the motion is 2 pi periodic: kInstants samples over one period (t_n = n 2 pi / kInstants, about
+  // 1 ms apart), cycled forwards, so that each tick starts where the last one's RK4 stage ended
+  static constexpr int kInstants = 6284;
+  static constexpr double kDt = 2.0 * M_PI / kInstants;
+  struct Sample {
+    Eigen::VectorXd q, v, a, qh, vh, qn, vn;
+  };
+  ReactionlessGeneralWorkload() {
+    const mechbal::PaminsaModel closed{mechbal::PaminsaParameters{}};
+    const auto model = std::make_shared<const mechbal::MechanismModel>(mechbal::bench::paminsa_description(closed));
+    mechbal::WristMotion w0;
+    w0.angles = mechbal::Vec3(M_PI / 2, M_PI / 2, M_PI / 2);
+    const mechbal::PlatformMotion p0 = mechbal::test::platform_at(0.0);
+    const auto s0 = mechbal::bench::actuated(closed, *model, p0, w0);
+    mechbal::ReactionlessConfig c;
+    c.balancing_joints = {"wrist_phi", "wrist_theta", "wrist_psi"};
+    c.integrator = mechbal::ReactionlessIntegrator::rk4;
+    c.rate_hz = 1.0 / kDt;
+    Eigen::VectorXd v0 = s0.v;
+    for (int j = 0; j < model->num_actuated(); ++j)
+      if (model->coordinate_name(model->actuated_coordinates()[static_cast<std::size_t>(j)]).rfind("wrist_", 0) == 0)
+        v0(j) = 0.0;
+    ctrl = std::make_unique<mechbal::ReactionlessController>(model, c, s0.q, v0,
+                                                             mechbal::bench::initial_guess(closed, *model, p0, w0));
+    const auto task = [&](const Eigen::VectorXd& x) {
+      Eigen::VectorXd out(ctrl->num_task());
+      for (int i = 0; i < ctrl->num_task(); ++i) out(i) = x(ctrl->task_joints()[static_cast<std::size_t>(i)]);
+      return out;
+    };
+    for (int n = 0; n < kInstants; ++n) {
+      const auto now = mechbal::bench::actuated(closed, *model, mechbal::test::platform_at(n * kDt), w0);
+      const auto half = mechbal::bench::actuated(closed, *model, mechbal::test::platform_at((n + 0.5) * kDt), w0);
+      const auto next = mechbal::bench::actuated(closed, *model, mechbal::test::platform_at((n + 1) * kDt), w0);
+      in.push_back({task(now.q), task(now.v), task(now.a), task(half.q), task(half.v), task(next.q), task(next.v)});
+    }
+  }
+  mechbal::Status tick(double t) noexcept {
+    const long k = std::lround(t * 1e3) % kInstants;  // the tick's index (t = index / 1 kHz)
+    const Sample& x = in[static_cast<std::size_t>(k)];
+    return ctrl->step(x.q, x.v, x.a, x.qh, x.vh, x.qn, x.vn);
+  }
+  std::unique_ptr<mechbal::ReactionlessController> ctrl;
+  std::vector<Sample> in;
+};
+
+/// The machine's CPU time counters of /proc/stat's "cpu" line (USER_HZ ticks): total and steal (the
+/// time the hypervisor ran something else while a vCPU wanted to run). {0, 0} when unreadable.
+std::pair<double, double> cpu_total_and_steal() {
+  std::ifstream in("/proc/stat");
+  std::string cpu;
+  double v[8] = {0, 0, 0, 0, 0, 0, 0, 0};  // user nice system idle iowait irq softirq steal
+  if (!(in >> cpu) || cpu != "cpu") return {0.0, 0.0};
+  double total = 0.0;
+  for (double& x : v) {
+    if (!(in >> x)) return {0.0, 0.0};
+    total += x;
+  }
+  return {total, v[7]};
+}
+
+long long thread_cpu_ns() {
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return to_ns(t);
+}
+
 }  // namespace
 
 template <class W>
 void run_loop(W& work, std::size_t ticks, long long period, double rate, double seconds, bool fifo,
               bool locked, const std::string& json) {
-  std::vector<long long> compute(ticks), wake(ticks);  // allocated before the loop
+  std::vector<long long> compute(ticks), wake(ticks), cpu(ticks);  // allocated before the loop
   for (int i = 0; i < 1000; ++i) work.tick(i * 1e-3);  // warm caches
 
   std::size_t misses = 0, overruns = 0, bad_status = 0;
+  const auto stat_start = cpu_total_and_steal();
   long long release = now_ns() + period;
   for (std::size_t k = 0; k < ticks; ++k) {
     const timespec ts = from_ns(release);
     while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
     }
+    const long long cpu_start = thread_cpu_ns();
     const long long start = now_ns();
     const mechbal::Status s = work.tick(static_cast<double>(k) / rate);
     const long long end = now_ns();
+    cpu[k] = thread_cpu_ns() - cpu_start;
     if (s != mechbal::Status::ok) ++bad_status;
     if (end - start > period) ++overruns;  // the computation alone did not fit in a period
     wake[k] = start - release;
@@ -163,6 +299,23 @@ void run_loop(W& work, std::size_t ticks, long long period, double rate, double 
     release += period;
   }
 
+  const auto stat_end = cpu_total_and_steal();
+  const double stat_total = stat_end.first - stat_start.first;
+  const double steal = stat_total > 0.0 ? (stat_end.second - stat_start.second) / stat_total : -1.0;
+  // preempted ticks: wall time beyond the thread's CPU time (which also holds the two CPU-clock
+  // reads, ~0.5 us) by more than 2 us
+  std::vector<long long> unpreempted;
+  unpreempted.reserve(ticks);
+  std::size_t preempted = 0, overruns_unpreempted = 0;
+  for (std::size_t k = 0; k < ticks; ++k) {
+    if (compute[k] - cpu[k] > 2000) {
+      ++preempted;
+    } else {
+      unpreempted.push_back(compute[k]);
+      if (compute[k] > period) ++overruns_unpreempted;
+    }
+  }
+  const double clean999 = pct(unpreempted, 0.999), cpu999 = pct(cpu, 0.999);
   const double p50 = pct(compute, 0.5), p99 = pct(compute, 0.99), p999 = pct(compute, 0.999);
   const double mx = static_cast<double>(*std::max_element(compute.begin(), compute.end()));
   const double w50 = pct(wake, 0.5), w99 = pct(wake, 0.99), w999 = pct(wake, 0.999);
@@ -177,6 +330,10 @@ void run_loop(W& work, std::size_t ticks, long long period, double rate, double 
   std::printf("  deadline misses %zu / %zu (ticks ending after the next release; of which the "
               "computation alone exceeded the period: %zu), non-ok status %zu\n",
               misses, ticks, overruns, bad_status);
+  std::printf("  preempted ticks (wall - thread CPU > 2 us) %zu; without them p99.9 %8.0f ns, overruns %zu; "
+              "thread CPU time p99.9 %8.0f ns\n", preempted, clean999, overruns_unpreempted, cpu999);
+  std::printf("  machine during the run: %.1f %% of its CPU time stolen by the hypervisor (/proc/stat steal)\n",
+              100.0 * steal);
   if (!json.empty()) {
     std::ofstream out(json);
     out << "{\"workload\": \"" << W::description << "\", "
@@ -186,7 +343,9 @@ void run_loop(W& work, std::size_t ticks, long long period, double rate, double 
         << ", \"p99_ns\": " << p99 << ", \"p999_ns\": " << p999 << ", \"max_ns\": " << mx
         << ", \"wakeup_p50_ns\": " << w50 << ", \"wakeup_p99_ns\": " << w99
         << ", \"wakeup_p999_ns\": " << w999 << ", \"wakeup_max_ns\": " << wmax
-        << ", \"deadline_misses\": " << misses << ", \"compute_overruns\": " << overruns << ", \"non_ok_status\": " << bad_status << "}\n";
+        << ", \"deadline_misses\": " << misses << ", \"compute_overruns\": " << overruns << ", \"non_ok_status\": " << bad_status
+        << ", \"preempted_ticks\": " << preempted << ", \"p999_unpreempted_ns\": " << clean999
+        << ", \"compute_overruns_unpreempted\": " << overruns_unpreempted << ", \"cpu_p999_ns\": " << cpu999 << ", \"steal_fraction\": " << steal << "}\n";
   }
 }
 
@@ -220,8 +379,8 @@ int main(int argc, char** argv) {
                  seconds, rate);
     return 2;
   }
-  if (workload != "ct6" && workload != "paminsa") {
-    std::fprintf(stderr, "mechbal-loop: --workload must be ct6 or paminsa, got '%s'\n",
+  if (workload != "ct6" && workload != "paminsa" && workload != "paminsa_general" && workload != "reactionless_general") {
+    std::fprintf(stderr, "mechbal-loop: --workload must be ct6, paminsa, paminsa_general or reactionless_general, got '%s'\n",
                  workload.c_str());
     return 2;
   }
@@ -250,7 +409,13 @@ int main(int argc, char** argv) {
     }
   }
 
-  if (workload == "paminsa") {
+  if (workload == "paminsa_general") {
+    PaminsaGeneralWorkload work;
+    run_loop(work, ticks, period, rate, seconds, fifo, locked, json);
+  } else if (workload == "reactionless_general") {
+    ReactionlessGeneralWorkload work;
+    run_loop(work, ticks, period, rate, seconds, fifo, locked, json);
+  } else if (workload == "paminsa") {
     PaminsaWorkload work(rate);
     run_loop(work, ticks, period, rate, seconds, fifo, locked, json);
   } else {

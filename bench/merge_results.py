@@ -54,14 +54,26 @@ def gbench_medians(path):
 RATIO_MEASURE = "batch_median_ns"  # every ratio: the timer cost amortised over k calls
 
 
-URDF_ROBOTS = ("ur5", "panda")
-URDF_ALGORITHMS = ("id", "mass", "momentum_rate")
+URDF_ROBOTS = ("ur5", "panda", "talos", "romeo")
+URDF_ALGORITHMS = ("id", "mass", "gravity", "momentum_rate")
+
+# mechbal-bench's interleaved pairs (its tail JSON, "interleaved"): another engine's case and its
+# mechbal counterpart timed in alternating batches in the same run, so both see the same machine
+# load. A ratio of such a pair uses them; any other ratio the two batch medians.
+INTERLEAVED = {}
 
 
 def ratio(cases, slow, fast):
+    pair = INTERLEAVED.get(slow)
+    if pair and pair.get("mechbal_case") == fast and pair.get("ratio"):
+        return pair["ratio"]
     if slow in cases and fast in cases and cases[fast][RATIO_MEASURE] > 0:
         return cases[slow][RATIO_MEASURE] / cases[fast][RATIO_MEASURE]
     return None
+
+
+def _load(x):
+    return "n/a" if x is None or x < 0 else f"{x:.1f}"
 
 
 def fmt(x, digits=0):
@@ -75,19 +87,22 @@ def main(argv=None):
     ap.add_argument("--loop", required=True, type=Path)
     ap.add_argument("--loop-paminsa", type=Path, help="mechbal-loop --workload paminsa JSON")
     ap.add_argument("--python", type=Path)
+    ap.add_argument("--loop-extra", action="append", default=[], metavar="NAME=FILE",
+                    help="more mechbal-loop JSONs (other workloads), reported under their NAME")
     ap.add_argument("--out-json", required=True, type=Path)
     ap.add_argument("--out-md", required=True, type=Path)
     args = ap.parse_args(argv)
 
     medians, context = gbench_medians(args.gbench)
     tail = json.loads(args.tail.read_text())
+    INTERLEAVED.update(tail.get("interleaved", {}))
     cases = {}
     for name, m in sorted(medians.items()):
         t = tail["cases"].get(name, {})
         cases[name] = {"median_ns": t.get("p50_ns"), "p99_ns": t.get("p99_ns"),
                        "p999_ns": t.get("p999_ns"), "max_call_ns": t.get("max_ns"),
                        "batch_median_ns": t.get("batch_median_ns"),
-                       "batch_calls": t.get("batch_calls"), **m,
+                       "batch_calls": t.get("batch_calls"), "samples": t.get("samples"), **m,
                        "allocations_per_tick": t.get("allocations_per_tick")}
     missing = [n for n in cases if cases[n]["p99_ns"] is None]
     if missing:
@@ -196,13 +211,25 @@ def main(argv=None):
     loop_ratios, loop_targets, loop_notes = loop_results(cases, ratio, median, check)
     ratios.update(loop_ratios)
     targets.update(loop_targets)
+    from merge_speed import speed_results  # issue 26: big trees, closed-loop anchor, scaling, loops
+
+    loops_extra = {}
+    for item in args.loop_extra:
+        name, _, path = item.partition("=")
+        if Path(path).exists():
+            loops_extra[name] = json.loads(Path(path).read_text())
+    speed_ratios, speed_targets, speed_notes, speed_md = speed_results(cases, ratio, median, check,
+                                                                       loops_extra, INTERLEAVED)
+    ratios.update(speed_ratios)
+    targets.update(speed_targets)
     if loop_paminsa:
         targets["loop_paminsa_p999_ns < 10000"] = check(loop_paminsa["p999_ns"],
                                                         lambda v: v < 10000)
 
     result = {
         "generated": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
-        "machine": {**machine(), "gbench_context": {k: context.get(k) for k in (
+        "machine": {**machine(), "load_average_1min_mechbal_bench_start_end": [
+            tail.get("load_average_at_start"), tail.get("load_average_at_end")], "gbench_context": {k: context.get(k) for k in (
             "num_cpus", "mhz_per_cpu", "cpu_scaling_enabled", "library_build_type")}},
         "notes": {
             "median_ns": "median of individually timed ticks (wall clock, timer overhead "
@@ -249,14 +276,19 @@ def main(argv=None):
         "ratios": ratios,
         "targets": targets,
         "python": py,
+        "loops_extra": loops_extra,
+        "interleaved": INTERLEAVED,
     }
     result["notes"].update(loop_notes)
+    result["notes"].update(speed_notes)
     args.out_json.parent.mkdir(parents=True, exist_ok=True)
     args.out_json.write_text(json.dumps(result, indent=2) + "\n")
 
     m = result["machine"]
     md = [f"Measured {result['generated']} on {m['cpu']}, {m['cores']} cores "
-          f"(load average {m['load_average_1_5_15'][0]:.1f}: shared machine), kernel {m['kernel']}.",
+          f"(load average {m['load_average_1_5_15'][0]:.1f} at the end, "
+          f"{_load(tail.get('load_average_at_start'))} / {_load(tail.get('load_average_at_end'))} when "
+          f"mechbal-bench's timings started / ended: shared machine), kernel {m['kernel']}.",
           "",
           f"median, p99, p99.9: one distribution, {tail.get('samples', 'n/a')} individually timed "
           f"calls per case (wall clock minus the timer's {tail.get('clock_overhead_ns', 0):.0f} ns);"
@@ -291,6 +323,7 @@ def main(argv=None):
                f"| tick time [ns] | {fmt(lp['p50_ns'])} | {fmt(lp['p99_ns'])} | "
                f"{fmt(lp['p999_ns'])} | {fmt(lp['max_ns'])} | {lp['deadline_misses']} "
                f"({lp.get('compute_overruns', 'n/a')}) |"]
+    md += speed_md
     md += ["", "| target | value | met |", "|---|---:|---|"]
     for k, v in targets.items():
         met = "n/a" if v["met"] is None else ("yes" if v["met"] else "NO")

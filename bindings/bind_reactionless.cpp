@@ -182,9 +182,10 @@ void bind_task_controller(py::module_& m) {
       "frame, v = J^+ x' + N z, with z minimising the selected momentum components in the null space")
       .def(py::init([](const MechanismModel& model, const std::string& frame, const std::vector<std::string>& task_rows,
                        const std::vector<std::string>& cancel, const std::string& integrator, double rate_hz,
-                       double damping, double max_condition, double max_rate, const py::object& q0,
-                       const py::object& v0) {
+                       double damping, double max_condition, double max_rate, bool null_space,
+                       const py::object& q0, const py::object& v0) {
              TaskSpaceConfig c;
+             c.null_space = null_space;
              c.frame = frame;
              c.task_rows = task_mask(task_rows);
              c.cancel = cancel_mask(cancel);
@@ -204,46 +205,62 @@ void bind_task_controller(py::module_& m) {
            py::arg("cancel") = std::vector<std::string>{"moment"}, py::arg("integrator") = "euler",
            py::arg("rate_hz") = TaskSpaceConfig{}.rate_hz, py::arg("damping") = TaskSpaceConfig{}.damping,
            py::arg("max_condition") = TaskSpaceConfig{}.max_condition,
-           py::arg("max_rate") = TaskSpaceConfig{}.max_rate, py::arg("q0") = py::none(), py::arg("v0") = py::none())
+           py::arg("max_rate") = TaskSpaceConfig{}.max_rate, py::arg("null_space") = TaskSpaceConfig{}.null_space,
+           py::arg("q0") = py::none(), py::arg("v0") = py::none())
       .def_property_readonly("dof", &ReactionlessTaskController::dof)
       .def_property_readonly("dt", &ReactionlessTaskController::dt)
       .def_property_readonly("target", &ReactionlessTaskController::target)
       .def(
           "run",
-          [](ReactionlessTaskController& c, const Array& twist) {
+          [](ReactionlessTaskController& c, const Array& twist, const py::object& twist_rate_obj) {
             require_shape(twist, "twist", {-1, 6});
             const auto rows = twist.shape(0);
             if (rows < 1 || rows % 2 == 0)
               throw py::value_error("twist must have 2 steps + 1 rows (the half-step grid t_j = j dt/2), got " +
                                     std::to_string(rows));
+            Array twist_rate;
+            const bool with_rate = !twist_rate_obj.is_none();
+            if (with_rate) {
+              twist_rate = to_real_array(twist_rate_obj);
+              require_shape(twist_rate, "twist_rate", {rows, 6});
+            }
             const py::ssize_t steps = (rows - 1) / 2, N = steps + 1, n = c.dof();
-            OutArray Q = make_array({N, n}), V = make_array({N, n}), H = make_array({N, 6}), X = make_array({N, 6});
+            OutArray Q = make_array({N, n}), V = make_array({N, n}), A = make_array({N, n}), H = make_array({N, 6}),
+                     X = make_array({N, 6}), F = make_array({N, 3}), M = make_array({N, 3});
             auto status = make_status_array(N);
             {
               py::gil_scoped_release release;
               for (py::ssize_t k = 0; k < N; ++k) {
                 const py::ssize_t j = std::min<py::ssize_t>(2 * k, rows - 1);
                 const py::ssize_t jh = std::min<py::ssize_t>(j + 1, rows - 1), jn = std::min<py::ssize_t>(j + 2, rows - 1);
-                const Status s = c.step(Eigen::Map<const Vec6>(twist.data(j, 0)), Eigen::Map<const Vec6>(twist.data(jh, 0)),
-                                        Eigen::Map<const Vec6>(twist.data(jn, 0)));
+                const Eigen::Map<const Vec6> now(twist.data(j, 0)), half(twist.data(jh, 0)), next(twist.data(jn, 0));
+                const Status s = with_rate ? c.step(now, Eigen::Map<const Vec6>(twist_rate.data(j, 0)), half, next)
+                                           : c.step(now, half, next);
                 Eigen::Map<Eigen::VectorXd>(Q.mutable_data(k, 0), n) = c.q();
                 Eigen::Map<Eigen::VectorXd>(V.mutable_data(k, 0), n) = c.v();
+                Eigen::Map<Eigen::VectorXd>(A.mutable_data(k, 0), n) = c.a();
                 Eigen::Map<Vec6>(H.mutable_data(k, 0)) = c.momentum();
                 Eigen::Map<Vec6>(X.mutable_data(k, 0)) = c.frame_twist();
+                Eigen::Map<Vec3>(F.mutable_data(k, 0)) = c.shaking_force();
+                Eigen::Map<Vec3>(M.mutable_data(k, 0)) = c.shaking_moment();
                 status.mutable_data()[k] = static_cast<std::uint32_t>(s);
               }
             }
             py::dict d;
             d["q"] = Q;
             d["v"] = V;
+            d["a"] = A;
             d["momentum"] = H;
             d["frame_twist"] = X;
+            d["shaking_force"] = F;
+            d["shaking_moment"] = M;
             d["status"] = status;
             return d;
           },
-          py::arg("twist"),
-          "Ticks along the desired frame twist [v; w] (O axes) sampled every dt/2 ((2 steps + 1, 6)): q, v "
-          "(steps + 1, dof), momentum, frame_twist (steps + 1, 6), status.");
+          py::arg("twist"), py::arg("twist_rate") = py::none(),
+          "Ticks along the desired frame twist [v; w] (O axes) sampled every dt/2 ((2 steps + 1, 6)) and "
+          "optionally its rate on the same grid (else estimated from the samples): q, v, a (steps + 1, dof), "
+          "momentum, frame_twist (steps + 1, 6), predicted shaking_force, shaking_moment (steps + 1, 3), status.");
 }
 
 void bind_reactionless(py::module_& m) {

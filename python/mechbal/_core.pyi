@@ -1481,11 +1481,11 @@ class ReactionlessTaskController:
     """
     Operational-space reactionless control: a redundant open mechanism follows a desired twist of a frame, v = J^+ x' + N z, with z minimising the selected momentum components in the null space
     """
-    def __init__(self, model: MechanismModel, task_frame: str, task_rows: collections.abc.Sequence[str] = ['all'], cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, q0: typing.Any = None, v0: typing.Any = None) -> None:
+    def __init__(self, model: MechanismModel, task_frame: str, task_rows: collections.abc.Sequence[str] = ['all'], cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, null_space: bool = True, q0: typing.Any = None, v0: typing.Any = None) -> None:
         ...
-    def run(self, twist: numpy.typing.ArrayLike) -> dict:
+    def run(self, twist: numpy.typing.ArrayLike, twist_rate: typing.Any = None) -> dict:
         """
-        Ticks along the desired frame twist [v; w] (O axes) sampled every dt/2 ((2 steps + 1, 6)): q, v (steps + 1, dof), momentum, frame_twist (steps + 1, 6), status.
+        Ticks along the desired frame twist [v; w] (O axes) sampled every dt/2 ((2 steps + 1, 6)) and optionally its rate on the same grid (else estimated from the samples): q, v, a (steps + 1, dof), momentum, frame_twist (steps + 1, 6), predicted shaking_force, shaking_moment (steps + 1, 3), status.
         """
     @property
     def dof(self) -> int:

@@ -458,14 +458,18 @@ class ReactionlessController(_core.ReactionlessController):
 @dataclass(frozen=True)
 class TaskSpaceRun:
     """Ticks t_n = n dt of an operational-space run: ``t`` (N,) [s], the command ``q``, ``v``
-    (N, dof), its ``momentum`` [P; H_O] (N, 6), the frame's commanded ``frame_twist`` [v; w]
-    (N, 6) and ``status`` (N,)."""
+    and its acceleration feed-forward ``a`` (N, dof), its ``momentum`` [P; H_O] (N, 6), the
+    frame's commanded ``frame_twist`` [v; w] (N, 6), the predicted ``shaking_force`` [N] and
+    ``shaking_moment`` [N m] about O of the command (N, 3) and ``status`` (N,)."""
 
     t: np.ndarray
     q: np.ndarray
     v: np.ndarray
+    a: np.ndarray
     momentum: np.ndarray
     frame_twist: np.ndarray
+    shaking_force: np.ndarray
+    shaking_moment: np.ndarray
     status: np.ndarray
 
 
@@ -473,7 +477,10 @@ class ReactionlessTaskController(_core.ReactionlessTaskController):
     """Operational-space reactionless control (the reaction null space): a redundant open
     mechanism follows a desired twist of ``task_frame`` with ``v = J^+ x' + N z``, where ``z``
     minimises the ``cancel``-ed momentum components (their departure from the momentum at the
-    start) within the task's null space (C++ ``mechbal::ReactionlessTaskController``).
+    start) within the task's null space (C++ ``mechbal::ReactionlessTaskController``). The
+    acceleration feed-forward ``a = J^+ (x'' - J'v) + N w``, ``w = (S A N)^+ (-S W(q, v, 0) - S A
+    J^+ (x'' - J'v))``, is the joint mode's ``S K_b a_b = S dh*/dt - S K_t a_t - S W`` in the null
+    space (derivation: ``cpp/include/mechbal/control/reactionless.hpp``).
 
     Args:
         mechanism: a `mechbal.Mechanism` (open, every joint actuated).
@@ -484,6 +491,8 @@ class ReactionlessTaskController(_core.ReactionlessTaskController):
         integrator: ``"euler"`` or ``"rk4"``.
         rate_hz: tick rate [Hz].
         damping: damped least squares factor relative to the largest singular value.
+        null_space: ``False`` drops the null-space term (``v = J^+ x'``): the reference that
+            shows what the redundancy buys.
         q0: every coordinate at the start [rad or m] (default zeros).
         v0: every rate at the start [rad/s or m/s] (default rest).
         **options: ``max_condition``, ``max_rate`` [rad/s].
@@ -491,15 +500,19 @@ class ReactionlessTaskController(_core.ReactionlessTaskController):
 
     def __init__(self, mechanism: Any, task_frame: str, task_rows: Any = "all", cancel: Any = "moment",
                  integrator: str = "euler", rate_hz: float = 1000.0, damping: float = 1e-2, *,
-                 q0: npt.ArrayLike | None = None, v0: npt.ArrayLike | None = None, **options: Any):
+                 null_space: bool = True, q0: npt.ArrayLike | None = None,
+                 v0: npt.ArrayLike | None = None, **options: Any):
         model = getattr(mechanism, "model", mechanism)
         q0 = np.zeros(model.dof) if q0 is None else q0
         super().__init__(model, task_frame, _cancel_list(task_rows), _cancel_list(cancel), integrator,
-                         rate_hz, damping, q0=q0, v0=v0, **options)
+                         rate_hz, damping, null_space=bool(null_space), q0=q0, v0=v0, **options)
 
-    def run(self, twist: npt.ArrayLike) -> TaskSpaceRun:  # type: ignore[override]
+    def run(self, twist: npt.ArrayLike,  # type: ignore[override]
+            twist_rate: npt.ArrayLike | None = None) -> TaskSpaceRun:
         """Ticks along the desired frame twist [v (m/s); w (rad/s)] (O axes) sampled every dt/2
-        ((2 steps + 1, 6)): `TaskSpaceRun` at the steps + 1 ticks."""
-        r = super().run(twist)
+        ((2 steps + 1, 6)) and, for the acceleration feed-forward, its rate [m/s^2; rad/s^2] on
+        the same grid (default: estimated from the samples, second order in dt):
+        `TaskSpaceRun` at the steps + 1 ticks."""
+        r = super().run(twist, twist_rate)
         N = np.asarray(r["q"]).shape[0]
         return TaskSpaceRun(t=np.arange(N) * self.dt, **{k: np.asarray(v) for k, v in r.items()})

@@ -242,6 +242,10 @@ MomentumComponentName = Literal["moment", "force", "both", "moment_x", "moment_y
                                 "force_x", "force_y", "force_z"]
 
 
+#: the twist components an operational-space controller tracks ([control].task_rows)
+TwistComponentName = Literal["all", "linear", "angular", "v_x", "v_y", "v_z", "w_x", "w_y", "w_z"]
+
+
 class Control(Table):
     """``[control]``: a real-time controller run along the case's trajectory. ``kind =
     "reactionless"``: the balancing joints keep the cancelled momentum components at their
@@ -263,8 +267,11 @@ class Control(Table):
     home_gain: NonNeg = Field(0.0, description="redundant balancing joints: pull towards the start pose (1/s)")
     limit_gain: NonNeg = Field(0.0, description="redundant balancing joints: push away from the joint limits")
     task_frame: Optional[Name] = Field(
-        None, description="operational-space mode: [trajectory] is then the frame's path "
-                          "(not yet supported by mechbal run)")
+        None, description="operational-space mode: a named frame; [trajectory] is then the frame's "
+                          "path, from its pose at start to its pose at end (joint positions)")
+    task_rows: Optional[Annotated[list[TwistComponentName], Field(min_length=1, max_length=8)]] = Field(
+        None, description="operational-space mode: the frame's tracked twist components "
+                          "(default all: linear and angular)")
 
     @model_validator(mode="after")
     def _distinct(self):
@@ -280,6 +287,8 @@ class Control(Table):
             if name in seen:
                 raise _custom("is listed twice", f".balancing_joints[{i}]", name)
             seen.add(name)
+        if self.task_rows is not None and self.task_frame is None:
+            raise _custom("is for the operational-space mode: give task_frame", ".task_rows", self.task_rows)
         return self
 
 

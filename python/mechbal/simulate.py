@@ -159,6 +159,11 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
     """
     from mechbal.trajectory import RestToRest, as_trajectory
 
+    if hasattr(controller, "joint_controller"):  # a ReactionlessController with its CT stage
+        if controller.joint_controller is None:
+            raise TypeError("a ReactionlessController drives a plant through its computed-torque "
+                            "stage: construct it with kp and kd")
+        controller = controller.joint_controller
     if engine == "mujoco":
         return _closed_loop_mujoco(mechanism_or_plant, controller, trajectory, q0, qd0, dt=dt,
                                    duration=duration, sampling=sampling, q_guess=q_guess, **engine_options)
@@ -167,11 +172,6 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
     if engine_options:
         raise TypeError(f"unexpected options for the mechbal engine: {', '.join(engine_options)}")
     plant = _plant(mechanism_or_plant, q_guess)
-    if hasattr(controller, "joint_controller"):  # a ReactionlessController with its CT stage
-        if controller.joint_controller is None:
-            raise TypeError("a ReactionlessController drives a plant through its computed-torque "
-                            "stage: construct it with kp and kd")
-        controller = controller.joint_controller
     if not isinstance(controller, _core.JointController):
         raise TypeError("controller must be a joint controller (mechbal.control.ComputedTorque, "
                         f"DecoupledJointController), got {type(controller).__name__}")

@@ -174,7 +174,15 @@ _CONTROL = {"type": "object", "additionalProperties": False, "description": "The
                 "ticks": integer(), "singular_ticks": integer(), "saturated_ticks": integer(),
                 "max_condition": number(None, "largest condition number of the balancing joints' "
                                         "momentum matrix"),
-                "peak_balancing_rate": numbers("rad/s or m/s", "peak |rate| of each balancing joint")}}
+                "peak_balancing_rate": numbers("rad/s or m/s", "peak |rate| of each balancing joint"),
+                "mode": string("operational space (task_frame): the reaction null space"),
+                "task_frame": string(), "task_rows": strings(),
+                "variants": detail("What each variant is (operational-space mode)."),
+                "frame_path_error": detail("Largest distance [m] (and angle [rad], tracked rows) of the "
+                                           "task frame from its path, per variant."),
+                "peak_joint_rate": detail("Peak |rate| of each joint [rad/s or m/s], per variant."),
+                "feed_forward": detail("The acceleration feed-forward against the stored motion's "
+                                       "acceleration [rad/s^2] and its predicted moment [N m].")}}
 
 RUN_MECHANISM: dict[str, Schema] = {
     "kind": string("[case] kind: serial_chain, mechanism or urdf (a URDF file)."),
@@ -183,7 +191,10 @@ RUN_MECHANISM: dict[str, Schema] = {
     "closed": boolean("True for a mechanism with loop closures."),
     "duration": number("s", "Duration of the trajectory."),
     "samples": integer("Instants along the trajectory."),
-    "law": string("Time law of the trajectory (quintic, cycloidal, ...)."),
+    "law": string("Time law of the trajectory (quintic, cycloidal, constant_speed, ...)."),
+    "speed": numbers("rad/s or m/s", "Speed of each actuated joint (law constant_speed)."),
+    "rpm": numbers("rev/min", "The same speeds in turns per minute (the case file's rpm key)."),
+    "revolutions": number(None, "Turns of the fastest joint over the run (law constant_speed)."),
     "variants": strings("The variants the per-variant values name."),
     **{k: METRICS[k] for k in ("peak_shaking_force", "peak_shaking_moment", "peak_joint_torque",
                                "rms_joint_torque", "peak_base_reaction_force",
@@ -195,6 +206,12 @@ RUN_MECHANISM: dict[str, Schema] = {
     "loops": detail("Loop solve along the trajectory: min_rcond, singular_instants, "
                     "max_closure_residual [m], max_newton_iterations."),
     "control": _CONTROL,
+    "passive": detail("[control] kind = passive: rate_hz, integrator, q0, v0, initial_energy [J], "
+                      "max_energy_drift [J], kinetic_energy_swing [J], relative_energy_drift, "
+                      "energy (definition), final_q, final_v."),
+    "shaking_moment_reduction": detail("Operational-space mode: peak |shaking moment| [N m] without "
+                                       "(pseudo-inverse) and with the null-space term, their ratio "
+                                       "and the reduction [%]."),
     "urdf": string("The URDF file (kind urdf)."),
     "joint_names": strings(), "body_names": strings(),
     "start": numbers("rad or m", "Start pose of the default motion (kind urdf)."),
@@ -245,11 +262,15 @@ BALANCE: dict[str, Schema] = {
     "total_mass": number_map("kg", "Total mass, unbalanced and balanced."),
     "urdf": string("Why no balanced.urdf was written (loops or springs), or its name."),
     "case_notes": detail("What the case's loader says (default motion, paper values)."),
+    "assembly": detail("Loop assembly: the branch (open or crossed), how it was chosen (branch, "
+                       "initial_guess or default) and the branch at the end."),
 }
 
+_PEAKS = {"type": ["number", "null", "array"], "items": NUMBER,
+          "description": "A peak, or one per component (x, y, z: reactionless cases)."}
 _VERIFY_QUANTITY = {"type": "object", "additionalProperties": False, "properties": {
-    "unit": string(), "mechbal_peak": NUMBER, "mujoco_inverse_peak": NUMBER, "max_difference": NUMBER,
-    "relative_difference": NUMBER, "mujoco_simulated_peak": NUMBER, "simulated_minus_predicted": NUMBER,
+    "unit": string(), "mechbal_peak": _PEAKS, "mujoco_inverse_peak": _PEAKS, "max_difference": NUMBER,
+    "relative_difference": NUMBER, "mujoco_simulated_peak": _PEAKS, "simulated_minus_predicted": NUMBER,
     "simulated_peak_fraction_of_unbalanced": NUMBER}}
 VERIFY: dict[str, Schema] = {
     "method": {"type": ["string", "null"], "description": "Balancing method of the balanced variant."},
@@ -263,6 +284,13 @@ VERIFY: dict[str, Schema] = {
                          **{k: _VERIFY_QUANTITY for k in ("shaking_force", "shaking_moment",
                                                           "gravity_torque", "actuator_force")}}}},
     "checks": string("What was compared, and how."),
+    "kind": string("reactionless: a case checked under its reactionless controller."),
+    "mechanism": string("The mechanism (its repr)."), "mujoco": anything("MuJoCo model size"),
+    "dt": number("s", "Controller tick and MuJoCo step (reactionless cases)."),
+    "balancing_joints": strings(), "cancel": strings(),
+    "residual": detail("Per cancelled component: the uncontrolled peak and the controlled peak as "
+                       "a fraction of it (mechbal, MuJoCo inverse, MuJoCo simulated)."),
+    "limited_by": string("What limits the simulated residual."),
 }
 
 SWEEP: dict[str, Schema] = {

@@ -222,4 +222,7 @@ damping = 1e-3                # damped least squares near singularities (relativ
 # max_rate = 100.0            # balancing joints' rate limit [rad/s]
 # home_gain = 0.0             # with more balancing joints than cancelled components: pull
 # limit_gain = 0.0            #   towards the start pose / away from the joint limits [1/s]
+# task_frame = "tool"         # operational-space mode (a redundant arm, every joint listed in
+# task_rows = ["linear"]      #   balancing_joints): [trajectory] is then the frame's path from its
+#                             #   pose at start to its pose at end (see panda-reactionless.toml)
 '''

@@ -13,6 +13,7 @@
 
 #include "../../bench/paminsa_general.hpp"
 #include "alloc_counter.hpp"
+#include "mechbal/algorithm/jacobian.hpp"
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/control/reactionless.hpp"
@@ -373,6 +374,9 @@ TEST(Reactionless, PaminsaGeneralReproducesTheClosedFormWrist) {
                   "rates %.2e (rad/s, relative to 1 + |rate|)\n", static_cast<int>(integrator), wrist0(1), angle_err, rate_err);
       // and the general tick's predicted moment is the closed form's (zero): the wrench of all 38 bodies
       EXPECT_LT((general.command().shaking_moment - closed.wrench().moment).norm(), 1e-7);
+      // so is its force (force balanced: zero), whose loop acceleration bias c needs this tick's
+      // task velocities (a stale c gave 0.05 N)
+      EXPECT_LT((general.command().shaking_force - closed.wrench().force).norm(), 1e-7);
     }
   }
 }
@@ -451,17 +455,44 @@ TEST(Reactionless, OperationalSpaceKeepsToolPathAndMomentum) {
       x(1) = 0.2 * std::cos(2.0 * t);
       return x;
     };
-    double twist_err = 0.0, h_err = 0.0;
+    const auto twist_rate_at = [](double t) {
+      Vec6 x = Vec6::Zero();
+      x(0) = -0.4 * std::cos(2.0 * t);
+      x(1) = -0.4 * std::sin(2.0 * t);
+      return x;
+    };
+    double twist_err = 0.0, h_err = 0.0, moment_err = 0.0, accel_err = 0.0, peak_force = 0.0;
     Status all = Status::ok;
+    MechanismData check(*model);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(4);
     for (int n = 0; n < 1000; ++n) {
       const double t = n * 1e-3;
-      all |= ctrl.step(twist_at(t), twist_at(t + 5e-4), twist_at(t + 1e-3));
+      all |= ctrl.step(twist_at(t), twist_rate_at(t), twist_at(t + 5e-4), twist_at(t + 1e-3));
       twist_err = std::max(twist_err, (ctrl.frame_twist().head<2>() - twist_at(t).head<2>()).cwiseAbs().maxCoeff());
       h_err = std::max(h_err, std::abs(ctrl.momentum()(5) - ctrl.target()(5)));
+      // the feed-forward keeps the moment rate about z at zero: the predicted wrench, and the
+      // general algorithm's wrench of the command (q, v, a)
+      moment_err = std::max(moment_err, std::abs(ctrl.shaking_moment()(2)));
+      ASSERT_EQ(shaking_wrench(*model, check, ctrl.q(), ctrl.v(), ctrl.a()), Status::ok);
+      moment_err = std::max(moment_err, std::abs(check.shaking.moment(2)));
+      EXPECT_LT((check.shaking.force - ctrl.shaking_force()).norm(), 1e-12);
+      peak_force = std::max(peak_force, check.shaking.force.norm());
+      // and the tool's acceleration: J a + J'v = x'' (J'v by central differences of J along v)
+      const double h = 1e-6;
+      ASSERT_EQ(frame_jacobian(*model, check, ctrl.q() + h * ctrl.v(), 0), Status::ok);
+      const Eigen::MatrixXd Jp = check.frame_jacobian;
+      ASSERT_EQ(frame_jacobian(*model, check, ctrl.q() - h * ctrl.v(), 0), Status::ok);
+      const Eigen::MatrixXd Jm = check.frame_jacobian;
+      ASSERT_EQ(frame_jacobian(*model, check, ctrl.q(), 0), Status::ok);
+      const Vec6 tool = check.frame_jacobian * ctrl.a() + (Jp - Jm) / (2.0 * h) * ctrl.v();
+      accel_err = std::max(accel_err, (tool.head<2>() - twist_rate_at(t).head<2>()).cwiseAbs().maxCoeff());
     }
     EXPECT_EQ(all, Status::ok);
     EXPECT_LT(twist_err, 1e-12);
     EXPECT_LT(h_err, 1e-12);
+    EXPECT_LT(moment_err, 1e-10);
+    EXPECT_GT(peak_force, 0.1);  // the arm moves: the uncancelled force is not zero
+    EXPECT_LT(accel_err, 1e-7);
     test::AllocationScope scope;
     for (int n = 0; n < 10; ++n) ctrl.step(twist_at(1.0), twist_at(1.0), twist_at(1.0));
     const Vec6 bad = Vec6::Constant(std::nan(""));

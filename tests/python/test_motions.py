@@ -100,8 +100,8 @@ def test_four_bar_at_constant_speed_matches_the_closed_form(tmp_path, forms, bra
     out = tmp_path / "run"
     s = run_case(path, out)
     assert s["law"] == "constant_speed"
-    assert s["duration_s"] == pytest.approx(60.0 / rpm, rel=1e-15)
-    assert s["speed_rpm"] == pytest.approx([rpm], rel=1e-14) and s["revolutions"] == pytest.approx(1.0, rel=1e-14)
+    assert s["duration"] == pytest.approx(60.0 / rpm, rel=1e-15)
+    assert s["rpm"] == pytest.approx([rpm], rel=1e-14) and s["revolutions"] == pytest.approx(1.0, rel=1e-14)
     assert s["loops"]["assembly"]["branch"] == {"coupler_rocker": branch}
     assert s["loops"]["assembly"]["branch_at_end"] == {"coupler_rocker": branch}   # a crank-rocker keeps its circuit
     b = read_bodies(out / "bodies_nominal.npz")
@@ -122,7 +122,7 @@ def test_four_bar_at_constant_speed_matches_the_closed_form(tmp_path, forms, bra
     assert scale > 1.0                                             # a four-bar shakes
     assert np.max(np.abs(F[:, [0, 2]] - F_cf)) < 1e-8 * scale
     assert np.max(np.abs(F[:, 1])) < 1e-12 * scale                 # planar: nothing along y
-    assert s["peak_shaking_force_N"]["nominal"][0] == pytest.approx(np.max(np.abs(F_cf[:, 0])), rel=1e-8)
+    assert s["peak_shaking_force"]["nominal"][0] == pytest.approx(np.max(np.abs(F_cf[:, 0])), rel=1e-8)
     # the branch is a circuit: the same label over the whole turn (a crank-rocker has no toggle)
     from mechbal.assembly import loop_branches
 
@@ -163,7 +163,7 @@ def test_constant_speed_of_an_open_chain(tmp_path):
                          "samples": 101}
     cfg.pop("balance", None)
     s = run_case(write(tmp_path, cfg), tmp_path / "arm")
-    assert s["duration_s"] == pytest.approx(2 * 2 * math.pi / 3.0, rel=1e-15)   # turns of the fastest joint
+    assert s["duration"] == pytest.approx(2 * 2 * math.pi / 3.0, rel=1e-15)   # turns of the fastest joint
     b = read_bodies(tmp_path / "arm" / "bodies_nominal.npz")
     t = np.asarray(b["t"])
     assert np.allclose(b["q"], np.array([0.1, -0.2]) + np.outer(t, [1.5, -3.0]), rtol=0, atol=1e-14)
@@ -201,7 +201,7 @@ def test_balance_at_constant_speed_cancels_the_shaking_force(tmp_path, capsys):
     back = tomllib.loads((out / "balanced.toml").read_text())
     assert back["trajectory"]["rpm"] == 120.0 and back["trajectory"]["branch"] == "crossed"
     s2 = run_case(out / "balanced.toml", tmp_path / "again")
-    assert max(s2["peak_shaking_force_N"]["nominal"]) < 1e-9 * max(force["unbalanced"]["peak"])
+    assert max(s2["peak_shaking_force"]["nominal"]) < 1e-9 * max(force["unbalanced"]["peak"])
 
 
 # ---- strict validation ----------------------------------------------------------------------------
@@ -279,5 +279,5 @@ def test_init_linkage_template_turns_at_constant_speed(tmp_path, capsys):
     path.write_text(capsys.readouterr().out)
     assert main(["run", str(path), "--out", str(tmp_path / "o"), "-q"]) == 0
     s = summary_of(tmp_path / "o")
-    assert s["law"] == "constant_speed" and s["speed_rpm"] == pytest.approx([60.0], rel=1e-14) and s["duration_s"] == pytest.approx(1.0)
+    assert s["law"] == "constant_speed" and s["rpm"] == pytest.approx([60.0], rel=1e-14) and s["duration"] == pytest.approx(1.0)
     assert s["loops"]["assembly"]["branch"] == {"coupler_rocker": "open"}

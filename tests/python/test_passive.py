@@ -145,7 +145,7 @@ def test_mechbal_run_passive_case(tmp_path):
     p = s["passive"]
     assert s["variants"] == ["passive"] and s["samples"] == 1001
     assert p["v0"] == [2.5] and p["q0"] == [-0.4]
-    assert p["max_energy_drift_J"] < 1e-10 and abs(p["final_v"][0] - 2.5) < 1e-10
+    assert p["max_energy_drift"] < 1e-10 and abs(p["final_v"][0] - 2.5) < 1e-10
     b = read_bodies(tmp_path / "out" / "bodies_passive.npz")
     assert np.max(np.abs(np.asarray(b["q"])[:, 0] - (-0.4 + 2.5 * np.asarray(b["t"])))) < 1e-10
     assert (tmp_path / "out" / "energy.png").is_file()

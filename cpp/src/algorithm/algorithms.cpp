@@ -8,6 +8,7 @@
 #include "mechbal/algorithm/regressor.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/algorithm/springs.hpp"
+#include "mechbal/detail/placed.hpp"
 #include "mechbal/detail/tree.hpp"
 
 #include <algorithm>
@@ -206,6 +207,19 @@ Status center_of_mass(const MechanismModel& model, MechanismData& data, const Co
 
 // ---- momentum and shaking wrench ----------------------------------------------------------------
 
+namespace {
+
+/// The shaking wrench from placed links and the joints' rates.
+Status shaking_wrench_of_placed(const MechanismModel& model, MechanismData& data) noexcept {
+  detail::forward_pass<true, true, false, true>(model, data);
+  sum_momenta(model, data);
+  sum_wrenches(model, data);
+  return finite_result(data.shaking.linear_momentum, data.shaking.angular_momentum, data.shaking.force,
+                       data.shaking.moment);
+}
+
+}  // namespace
+
 Status momentum(const MechanismModel& model, MechanismData& data, const ConstVector& q,
                 const ConstVector& v) noexcept {
   if (Status s = check_state(model, data, &q, &v); s != Status::ok) return s;
@@ -220,6 +234,10 @@ Status momentum_matrix(const MechanismModel& model, MechanismData& data, const C
   if (Status s = check_state(model, data, &q); s != Status::ok) return s;
   detail::joint_state<false, false>(model, data, q, q, q);
   detail::place(model, data);
+  return detail::momentum_matrix_placed(model, data);
+}
+
+Status detail::momentum_matrix_placed(const MechanismModel& model, MechanismData& data) noexcept {
   detail::composite_inertias(model, data);
   data.momentum_matrix.setZero();
   for (int l = 1; l < model.num_links(); ++l) {
@@ -247,11 +265,13 @@ Status shaking_wrench(const MechanismModel& model, MechanismData& data, const Co
   if (Status s = check_state(model, data, &q, &v, &a); s != Status::ok) return s;
   detail::joint_state<true, true>(model, data, q, v, a);
   detail::place(model, data);
-  detail::forward_pass<true, true, false, true>(model, data);
-  sum_momenta(model, data);
-  sum_wrenches(model, data);
-  return finite_result(data.shaking.linear_momentum, data.shaking.angular_momentum, data.shaking.force,
-                       data.shaking.moment);
+  return shaking_wrench_of_placed(model, data);
+}
+
+Status detail::shaking_wrench_placed(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                                     const ConstVector& v, const ConstVector& a) noexcept {
+  detail::joint_state<true, true>(model, data, q, v, a);  // the rates (the positions are q's already)
+  return shaking_wrench_of_placed(model, data);
 }
 
 Status base_reaction(const MechanismModel& model, MechanismData& data, const ConstVector& q,

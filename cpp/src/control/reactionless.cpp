@@ -7,8 +7,10 @@
 #include <stdexcept>
 
 #include "mechbal/algorithm/jacobian.hpp"
+#include "mechbal/algorithm/kinematics.hpp"
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/detail/placed.hpp"
 
 namespace mechbal {
 
@@ -178,6 +180,8 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
   // buffers
   q_full_ = q_guess.size() != 0 ? q_guess : Eigen::VectorXd(Eigen::VectorXd::Zero(n_));
   q_act_ = Eigen::VectorXd::Zero(na_);
+  stage_q_ = Eigen::VectorXd::Zero(nt_);
+  stage_v_ = Eigen::VectorXd::Zero(nt_);
   v_act_ = Eigen::VectorXd::Zero(na_);
   a_act_ = Eigen::VectorXd::Zero(na_);
   v_full_ = Eigen::VectorXd::Zero(n_);
@@ -219,6 +223,7 @@ Status ReactionlessController::reset(const Eigen::Ref<const Eigen::VectorXd>& q0
                   v0.cwiseAbs().maxCoeff() > config_.task_range.max_speed))
     return Status::out_of_range;
   Status st = Status::ok;
+  stage_cache_ = false;
   q_act_ = q0;
   v_act_ = v0;
   a_act_.setZero();
@@ -277,7 +282,8 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
     // positions (warm-started from the last solve), C and c (c with the current velocity guess)
     st = closed_motion(*model_, data_, q_act_, v_act_, a_act_, q_full_, config_.loop_options);
     if (failed(st)) return st;
-    const Status sm = momentum_matrix(*model_, data_, q_full_);
+    // the solve left the links placed at its solution q_full_: no second placement
+    const Status sm = detail::momentum_matrix_placed(*model_, data_);
     if (sm != Status::ok) return st | sm;
     K_.noalias() = data_.momentum_matrix * data_.loop_projection;
   } else {
@@ -474,8 +480,12 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
       (rk4 && (!task_in_range(*q_half, *v_half, nullptr) || !task_in_range(*q_next, *v_next, nullptr))))
     return hold(Status::out_of_range);
 
-  // ---- t_n: pose, rates, velocities
-  Status st = evaluate(q_t, q_b_);
+  // ---- t_n: pose, rates, velocities. The task velocities first: the loops' acceleration bias c
+  // that evaluate() leaves in data_ depends on them (not on balancing joints outside the loops)
+  for (int i = 0; i < nt_; ++i) v_act_(task_[static_cast<std::size_t>(i)]) = v_t(i);
+  const bool reuse = stage_cache_ && q_t == stage_q_ && v_t == stage_v_;  // exactly the last stage's
+  stage_cache_ = false;
+  Status st = reuse ? stage_cache_status_ | rebalance(q_b_) : evaluate(q_t, q_b_);
   if (failed(st)) return hold(only(st, hard));
   double cond = 1.0;
   st |= rates(v_t, target_, q_b_, k1_, &cond);
@@ -504,7 +514,8 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
     a_full_.setZero();
   }
   // ---- feed-forward: S K_b a_b = S dh*/dt - S K_t a_t - S W(q, v, c)
-  if (const Status s = shaking_wrench(*model_, data_, q_full_, v_full_, a_full_); s != Status::ok)
+  // the links are placed at q_full_ (evaluate(), or closed_motion just above, at the same q)
+  if (const Status s = detail::shaking_wrench_placed(*model_, data_, q_full_, v_full_, a_full_); s != Status::ok)
     return hold(Status::out_of_range);
   Vec6 W;
   W << data_.shaking.force, data_.shaking.moment;
@@ -562,17 +573,26 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
 
   // ---- integration to t_n + dt
   Eigen::VectorXd& next = command_.next_balancing;
+  Status last_stage = Status::solver_error;  // RK4's evaluation at t_n + dt (for the next tick)
   if (rk4) {
     Status ss = Status::ok;
+    // each stage's loop projection with the task's rates of that instant (c, at t_n + dt, is then
+    // the next tick's: see stage_cache_)
+    const auto task_rates = [this](const Eigen::Ref<const Eigen::VectorXd>& v) {
+      for (int i = 0; i < nt_; ++i) v_act_(task_[static_cast<std::size_t>(i)]) = v(i);
+    };
     q_stage_ = q_b_ + (0.5 * dt_) * k1_;
+    task_rates(*v_half);
     ss |= evaluate(*q_half, q_stage_);
     if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k2_, nullptr);
     q_stage_ = q_b_ + (0.5 * dt_) * k2_;
     if (!failed(ss)) ss |= closed_ && !balancing_in_loops_ ? rebalance(q_stage_) : evaluate(*q_half, q_stage_);
     if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k3_, nullptr);
     q_stage_ = q_b_ + dt_ * k3_;
-    if (!failed(ss)) ss |= evaluate(*q_next, q_stage_);
+    task_rates(*v_next);
+    if (!failed(ss)) ss |= last_stage = evaluate(*q_next, q_stage_);
     if (!failed(ss)) ss |= rates(*v_next, target_ + dt_ * target_rate_, q_stage_, k4_, nullptr);
+    task_rates(v_t);
     if (failed(ss)) {
       return hold(only(ss, hard));
     }
@@ -619,6 +639,12 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
   }
   q_b_ = next;
   command_.status = st;
+  if (rk4 && closed_ && !balancing_in_loops_ && !failed(last_stage)) {
+    stage_cache_ = true;
+    stage_cache_status_ = last_stage;
+    stage_q_ = *q_next;
+    stage_v_ = *v_next;
+  }
   return st;
 }
 
@@ -689,6 +715,8 @@ ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const Mec
     fail("reactionless.max_rate", "must be finite and > 0", config_.max_rate);
   if (!(std::isfinite(config_.max_twist) && config_.max_twist > 0.0))
     fail("max_twist", "must be finite and > 0", config_.max_twist);
+  if (!(std::isfinite(config_.max_twist_rate) && config_.max_twist_rate > 0.0))
+    fail("max_twist_rate", "must be finite and > 0", config_.max_twist_rate);
   n_ = m.dof();
   dt_ = 1.0 / config_.rate_hz;
   for (int r = 0; r < 6; ++r) {
@@ -700,7 +728,7 @@ ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const Mec
   if (v0.size() != 0 && (v0.size() != n_ || !v0.allFinite()))
     fail("v0 must have " + std::to_string(n_) + " finite values, got " + std::to_string(v0.size()));
   const int nt = static_cast<int>(task_rows_.size()), k = static_cast<int>(rows_.size());
-  for (Eigen::VectorXd* v : {&q_, &q_cmd_, &v_cmd_, &k1_, &k2_, &k3_, &k4_, &q_stage_, &v0_, &z_, &w_})
+  for (Eigen::VectorXd* v : {&q_, &q_cmd_, &v_cmd_, &a_cmd_, &zero_, &a0_, &k1_, &k2_, &k3_, &k4_, &q_stage_, &v0_, &z_, &w_})
     *v = Eigen::VectorXd::Zero(n_);
   rate_limit_ = m.velocity_limits().cwiseMin(config_.max_rate);
   J_ = Eigen::MatrixXd::Zero(nt, n_);
@@ -766,14 +794,16 @@ Status ReactionlessTaskController::rates(const Eigen::VectorXd& q, const Vec6& t
   N_ = -JpJ_;
   N_.diagonal().array() += 1.0;
   if (momentum_matrix(m, data_, q) != Status::ok) return Status::out_of_range;
-  for (std::size_t i = 0; i < rows_.size(); ++i) {
-    const auto r = static_cast<Eigen::Index>(i);
-    M_.row(r).noalias() = data_.momentum_matrix.row(rows_[i]) * N_;
-    rm_(r) = target_(rows_[i]) - data_.momentum_matrix.row(rows_[i]).dot(v0_);
-  }
-  st |= min_norm(M_, rm_, z_);
   v = v0_;
-  v.noalias() += N_ * z_;
+  if (config_.null_space) {
+    for (std::size_t i = 0; i < rows_.size(); ++i) {
+      const auto r = static_cast<Eigen::Index>(i);
+      M_.row(r).noalias() = data_.momentum_matrix.row(rows_[i]) * N_;
+      rm_(r) = target_(rows_[i]) - data_.momentum_matrix.row(rows_[i]).dot(v0_);
+    }
+    st |= min_norm(M_, rm_, z_);
+    v.noalias() += N_ * z_;
+  }
   if (!v.allFinite()) {
     v.setZero();
     return st | Status::out_of_range;
@@ -787,19 +817,72 @@ Status ReactionlessTaskController::rates(const Eigen::VectorXd& q, const Vec6& t
   return st;
 }
 
+Status ReactionlessTaskController::acceleration(const Eigen::VectorXd& v, const Vec6& twist_rate, bool saturated) noexcept {
+  const MechanismModel& m = *model_;
+  // J'v: the frame's acceleration with zero joint accelerations
+  if (forward_kinematics(m, data_, q_, v, zero_) != Status::ok) return Status::out_of_range;
+  const auto link = static_cast<std::size_t>(m.frame_link(frame_));
+  const Vec3 r = data_.frame_placements[static_cast<std::size_t>(frame_)].translation() - data_.link_position[link];
+  const Vec3& w = data_.link_angular_velocity[link];
+  const Vec3& alpha = data_.link_angular_acceleration[link];
+  Vec6 bias;
+  bias.head<3>() = data_.link_acceleration[link] + alpha.cross(r) + w.cross(w.cross(r));
+  bias.tail<3>() = alpha;
+  // W(q, v, 0) = (dA/dt) v: the shaking wrench of the rates alone
+  if (shaking_wrench(m, data_, q_, v, zero_) != Status::ok) return Status::out_of_range;
+  Vec6 W;
+  W << data_.shaking.force, data_.shaking.moment;
+  const Eigen::Index nt = J_.rows();
+  for (Eigen::Index i = 0; i < nt; ++i) {
+    const int row = task_rows_[static_cast<std::size_t>(i)];
+    rt_(i) = twist_rate(row) - bias(row);
+  }
+  a0_.noalias() = Jt_.leftCols(nt) * rt_;  // J^+ (x'' - J'v), J^+ of the rates at q_
+  a_cmd_ = a0_;
+  Status st = Status::ok;
+  if (saturated) {
+    a_cmd_.setZero();  // the scaled rates no longer follow the law: no feed-forward
+  } else if (config_.null_space) {
+    // S A N w = S dh*/dt - S W(q, v, 0) - S A a0 (a constant target: dh*/dt = 0); M_ = S A N at q_
+    for (std::size_t i = 0; i < rows_.size(); ++i)
+      rm_(static_cast<Eigen::Index>(i)) = -W(rows_[i]) - data_.momentum_matrix.row(rows_[i]).dot(a0_);
+    st |= min_norm(M_, rm_, z_);
+    a_cmd_.noalias() += N_ * z_;
+  }
+  if (!a_cmd_.allFinite()) return Status::out_of_range;
+  Vec6 predicted;
+  predicted.noalias() = data_.momentum_matrix * a_cmd_;
+  predicted += W;
+  if (!predicted.allFinite()) return Status::out_of_range;
+  force_ = predicted.head<3>();
+  moment_ = predicted.tail<3>();
+  return st;
+}
+
 Status ReactionlessTaskController::step(const Vec6& twist, const Vec6& twist_half, const Vec6& twist_next) noexcept {
+  Vec6 rate = (-3.0 * twist + 4.0 * twist_half - twist_next) / dt_;
+  if (!rate.allFinite()) rate.setZero();  // the tick below reports the non-finite input
+  return step(twist, rate, twist_half, twist_next);
+}
+
+Status ReactionlessTaskController::step(const Vec6& twist, const Vec6& twist_rate, const Vec6& twist_half,
+                                        const Vec6& twist_next) noexcept {
   const bool rk4 = config_.integrator == ReactionlessIntegrator::rk4;
   const auto hold = [this](Status why) {
     q_cmd_ = q_;
     v_cmd_.setZero();
+    a_cmd_.setZero();
     h_.setZero();
     twist_cmd_.setZero();
+    force_.setZero();
+    moment_.setZero();
     status_ = why;
     return why;
   };
-  if (!twist.allFinite() || (rk4 && (!twist_half.allFinite() || !twist_next.allFinite())))
+  if (!twist.allFinite() || !twist_rate.allFinite() ||
+      (rk4 && (!twist_half.allFinite() || !twist_next.allFinite())))
     return hold(Status::non_finite_input);
-  if (twist.cwiseAbs().maxCoeff() > config_.max_twist ||
+  if (twist.cwiseAbs().maxCoeff() > config_.max_twist || twist_rate.cwiseAbs().maxCoeff() > config_.max_twist_rate ||
       (rk4 && (twist_half.cwiseAbs().maxCoeff() > config_.max_twist || twist_next.cwiseAbs().maxCoeff() > config_.max_twist)))
     return hold(Status::out_of_range);
   Status st = rates(q_, twist, k1_);
@@ -807,6 +890,10 @@ Status ReactionlessTaskController::step(const Vec6& twist, const Vec6& twist_hal
   // the command at t_n: momentum and twist of the commanded rates (data_ is at q_)
   h_.noalias() = data_.momentum_matrix * k1_;
   twist_cmd_.noalias() = data_.frame_jacobian * k1_;
+  // the acceleration feed-forward at t_n (before the RK4 stages overwrite J^+, N and S A N)
+  const Status sa = acceleration(k1_, twist_rate, has(st, Status::saturated));
+  if (has(sa, Status::out_of_range)) return hold(Status::out_of_range);
+  st |= sa;
   Eigen::VectorXd& next = q_stage_;
   if (rk4) {
     Status ss = Status::ok;

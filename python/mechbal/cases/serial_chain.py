@@ -58,7 +58,7 @@ def motion_summary(tr, traj) -> dict:
     if getattr(tr, "law", None) != "constant_speed":
         return {}
     speed = np.asarray(traj.speed, float)
-    return {"speed_rad_s": speed, "speed_rpm": speed * 60.0 / (2.0 * np.pi),
+    return {"speed": speed, "rpm": speed * 60.0 / (2.0 * np.pi),
             "revolutions": float(np.max(np.abs(speed)) * traj.duration / (2.0 * np.pi))}
 
 
@@ -213,8 +213,7 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None
         raise ConfigError("control.kind", "mechbal run simulates kind 'reactionless' (computed_torque "
                           "and decoupled controllers: mechbal.simulate.closed_loop)", ctl.kind)
     if ctl.task_frame is not None:
-        raise ConfigError("control.task_frame", "the operational-space mode is not available in "
-                          "mechbal run yet", ctl.task_frame)
+        return run_task_space(mech, case, out)
     names = mech.actuated_names
     for i, b in enumerate(ctl.balancing_joints):
         if b not in names:
@@ -303,6 +302,186 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None
     return summary
 
 
+def _rotation_vector(R: np.ndarray) -> np.ndarray:
+    """theta k of a rotation R = exp(theta [k]x), theta in [0, pi]."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_matrix(R).as_rotvec()
+
+
+def frame_path(mech: Mechanism, frame: str, start, end, duration: float, law: str, t):
+    """The operational-space mode's path of ``frame`` at times ``t``: from its pose at the joint
+    positions ``start`` to its pose at ``end`` along the time law s(t) (0 to 1), the origin on the
+    straight line and the orientation about the fixed axis of the relative rotation
+    (R(t) = exp(s theta [k]x) R0). Returns (position (N, 3), rotation (N, 3, 3), twist (N, 6),
+    twist_rate (N, 6)), twists [v; w] of the origin in O axes."""
+    from scipy.spatial.transform import Rotation
+
+    from mechbal.trajectory import RestToRest
+
+    T0, T1 = (np.asarray(mech.frame_placement(np.asarray(x, float), frame)) for x in (start, end))
+    dp = T1[:3, 3] - T0[:3, 3]
+    rv = _rotation_vector(T1[:3, :3] @ T0[:3, :3].T)
+    s, sd, sdd = (np.asarray(x)[:, 0] for x in RestToRest([0.0], [1.0], duration, law).evaluate(t))
+    position = T0[:3, 3] + s[:, None] * dp
+    rotation = Rotation.from_rotvec(s[:, None] * rv).as_matrix() @ T0[:3, :3]
+    twist = np.concatenate([sd[:, None] * dp, sd[:, None] * rv], axis=1)
+    twist_rate = np.concatenate([sdd[:, None] * dp, sdd[:, None] * rv], axis=1)
+    return position, rotation, twist, twist_rate
+
+
+def _motion_acceleration(t, v):
+    """dv/dt of the integrated motion at the ticks: the derivative of the quintic spline through
+    the commanded rates (the stored poses' own acceleration, whatever the feed-forward)."""
+    from scipy.interpolate import make_interp_spline
+
+    return make_interp_spline(t, v, k=5)(t, 1)
+
+
+def run_task_space(mech: Mechanism, case, out: Path) -> dict:
+    """A case whose ``[control]`` names a ``task_frame`` (the operational-space mode,
+    `mechbal.control.ReactionlessTaskController`): ``[trajectory]`` is the frame's path,
+    from its pose at ``start`` to its pose at ``end`` (joint positions; `frame_path`), and
+    the arm starts at ``start``. The path is run twice at the controller's ticks: with the
+    pseudo-inverse alone, v = J^+ x' (``uncontrolled``: no null-space term), and in the reaction
+    null space, v = J^+ x' + N z (``controlled``); bodies_uncontrolled.npz and
+    bodies_controlled.npz hold each motion (rates integrated, the accelerations those of the
+    stored motion) with the wrench of its poses; summary.json reports the shaking-moment
+    reduction that the redundancy buys."""
+    from mechbal.schema import did_you_mean
+
+    ctl = case.control
+    name, title = case.case.name, case.case.title or case.case.name
+    names = mech.actuated_names
+    if mech.is_closed or len(names) != mech.dof:
+        raise ConfigError("control.task_frame", "the operational-space mode drives open mechanisms with "
+                          "every joint actuated", ctl.task_frame)
+    if ctl.task_frame not in mech.frame_names:
+        raise ConfigError("control.task_frame", "is not a frame of the mechanism"
+                          + did_you_mean(ctl.task_frame, list(mech.frame_names)), ctl.task_frame)
+    missing = [n for n in names if n not in ctl.balancing_joints]
+    for i, b in enumerate(ctl.balancing_joints):
+        if b not in names:
+            raise ConfigError(f"control.balancing_joints[{i}]",
+                              f"is not an actuated joint{did_you_mean(b, names)}", b)
+    if missing:
+        raise ConfigError("control.balancing_joints", "in the operational-space mode (task_frame) the "
+                          "controller moves every joint: list them all (missing: " + ", ".join(missing) + ")",
+                          list(ctl.balancing_joints))
+    tr = case.trajectory
+    if tr.law not in ("quintic", "cubic"):
+        raise ConfigError("trajectory.law", "the operational-space mode's path is rest-to-rest between the "
+                          "frame's poses at start and end: quintic or cubic", tr.law)
+    for key in ("start", "end"):
+        if getattr(tr, key) is None or len(getattr(tr, key)) != len(names):
+            raise ConfigError(f"trajectory.{key}", f"must have {len(names)} values (joint positions: the "
+                              "task frame's path runs from its pose at start to its pose at end)",
+                              getattr(tr, key))
+    start = np.array(tr.start, float)
+    dt = 1.0 / ctl.rate_hz
+    steps = int(round(tr.duration / dt))
+    th = np.arange(2 * steps + 1) * (0.5 * dt)
+    t = th[::2]
+    position, rotation, twist, twist_rate = frame_path(mech, ctl.task_frame, tr.start, tr.end, tr.duration,
+                                                       tr.law, th)
+    rows = list(ctl.task_rows) if ctl.task_rows is not None else ["all"]
+
+    progress.stage("operational space: pseudo-inverse alone and in the reaction null space")
+    runs = {}
+    for variant, null_space in (("uncontrolled", False), ("controlled", True)):
+        try:
+            ctrl = control.ReactionlessTaskController(
+                mech, ctl.task_frame, rows, list(ctl.cancel), ctl.integrator, ctl.rate_hz, ctl.damping,
+                null_space=null_space, q0=start, max_rate=ctl.max_rate)
+        except ValueError as exc:
+            raise ConfigError("control", str(exc), has_value=False) from None
+        r = ctrl.run(twist, twist_rate)
+        held = (r.status & np.uint32(int(control.Status.non_finite_input) | int(control.Status.out_of_range)
+                                          | int(control.Status.solver_error))) != 0
+        if np.any(held):
+            k = int(np.argmax(held))
+            raise ConfigError("control", f"the operational-space controller ({variant}) held its command at "
+                              f"t = {t[k]:.4g} s (status {control.status_text(int(r.status[k]))})",
+                              has_value=False)
+        runs[variant] = r
+
+    progress.stage("bodies files and plots")
+    wrench, frame_error = {}, {}
+    for variant, r in runs.items():
+        a = _motion_acceleration(t, r.v)
+        wrench[variant] = _write_variant(mech, out, variant, t, r.q, r.v, a)
+        T = np.asarray(mech.frame_placement(r.q, ctl.task_frame))
+        dR = np.einsum("nij,nkj->nik", T[:, :3, :3], rotation[::2])
+        angle = np.arccos(np.clip((np.trace(dR, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+        frame_error[variant] = {"position": float(np.max(np.linalg.norm(T[:, :3, 3] - position[::2], axis=1)))}
+        if any(r_ in ("all", "angular") or r_.startswith("w_") for r_ in rows):
+            frame_error[variant]["orientation"] = float(np.max(angle))
+    (Fu, Mu), (Fc, Mc) = wrench["uncontrolled"], wrench["controlled"]
+    report.plot_wrench(out / "shaking_wrench.png", t, {"uncontrolled (J^+ x')": (Fu, Mu),
+                                                      "controlled (J^+ x' + N z)": (Fc, Mc)},
+                       title=f"{title}: reaction null space",
+                       caption=f"Shaking force and moment about O while the frame {ctl.task_frame} follows the "
+                               "same path: by the pseudo-inverse alone (uncontrolled) and with the null-space "
+                               f"term minimising {', '.join(ctl.cancel)} (controlled).")
+    report.plot_series(out / "balancing_joints.png", t, {"pseudo-inverse": runs["uncontrolled"].q,
+                                                         "reaction null space": runs["controlled"].q},
+                       names, "rad or m", title=f"{name}: joint positions",
+                       caption="Joint positions along the path, without and with the null-space term.")
+
+    progress.stage("summary")
+    rc = runs["controlled"]
+    singular = (rc.status & np.uint32(int(control.Status.singular))) != 0
+    saturated = (rc.status & np.uint32(int(control.Status.saturated))) != 0
+    peak_u = float(np.max(np.linalg.norm(Mu, axis=1)))
+    peak_c = float(np.max(np.linalg.norm(Mc, axis=1)))
+    # the feed-forward against the stored motion's own acceleration, on the tracked rows and the
+    # predicted moment
+    a_motion = _motion_acceleration(t, rc.v)
+    inner = slice(3, -3)
+    summary = {
+        "case": name,
+        "kind": case.case.kind,
+        "dof": mech.dof,
+        "actuated": names,
+        "closed": False,
+        "duration": float(tr.duration),
+        "samples": int(len(t)),
+        "law": tr.law,
+        "variants": ["uncontrolled", "controlled"],
+        "peak_shaking_force": {"uncontrolled": report.peak_abs(Fu), "controlled": report.peak_abs(Fc)},
+        "peak_shaking_moment": {"uncontrolled": report.peak_abs(Mu), "controlled": report.peak_abs(Mc)},
+        "shaking_moment_reduction": {
+            "peak_norm_without_null_space": peak_u, "peak_norm_with_null_space": peak_c,
+            "ratio": peak_c / peak_u if peak_u > 0 else None,
+            "reduction_pct": 100.0 * (1.0 - peak_c / peak_u) if peak_u > 0 else None},
+        "control": {
+            "kind": ctl.kind, "mode": "operational space (reaction null space)", "task_frame": ctl.task_frame,
+            "task_rows": rows, "cancel": list(ctl.cancel), "integrator": ctl.integrator,
+            "rate_hz": float(ctl.rate_hz), "damping": float(ctl.damping),
+            "variants": {"uncontrolled": "v = J^+ x' (the pseudo-inverse alone: no null-space term)",
+                         "controlled": "v = J^+ x' + N z, z minimising the cancelled momentum components"},
+            "ticks": int(len(t)), "singular_ticks": int(np.sum(singular)),
+            "saturated_ticks": int(np.sum(saturated)),
+            "frame_path_error": frame_error,
+            "peak_joint_rate": {k: report.peak_abs(r.v) for k, r in runs.items()},
+            "feed_forward": {
+                "max_acceleration_difference": float(np.max(np.abs(rc.a - a_motion)[inner])),
+                "max_predicted_moment_difference": float(np.max(np.abs(rc.shaking_moment - Mc)[inner])),
+                "meaning": "commanded acceleration feed-forward and its predicted shaking moment against "
+                           "the stored motion's (derivative of the integrated rates), away from the ends"},
+        },
+        "total_mass": mech.total_mass,
+        "files": ["bodies_uncontrolled.npz", "bodies_controlled.npz", "shaking_wrench.png",
+                  "balancing_joints.png"],
+    }
+    write_summary(out / "summary.json", summary)
+    print(report.table(
+        [["uncontrolled (J^+ x')", *report.peak_abs(Mu), peak_u],
+         ["controlled (J^+ x' + N z)", *report.peak_abs(Mc), peak_c]],
+        ["peak shaking moment about O [N m]", "x", "y", "z", "|M|"]))
+    return summary
+
+
 def run_passive(mech: Mechanism, case, traj, out: Path, q_guess=None, assembly=None) -> dict:
     """A case with ``[control] kind = "passive"``: no controller; the mechanism starts from the
     trajectory's start with its initial rates (zero for the rest-to-rest laws, ``speed`` for
@@ -344,21 +523,21 @@ def run_passive(mech: Mechanism, case, traj, out: Path, q_guess=None, assembly=N
         "dof": mech.dof,
         "actuated": mech.actuated_names,
         "closed": mech.is_closed,
-        "duration_s": float(traj.duration),
+        "duration": float(traj.duration),
         "samples": int(len(t)),
         "law": law_name(traj),
         "variants": ["passive"],
-        "peak_shaking_force_N": {"passive": report.peak_abs(F)},
-        "peak_shaking_moment_Nm": {"passive": report.peak_abs(M)},
+        "peak_shaking_force": {"passive": report.peak_abs(F)},
+        "peak_shaking_moment": {"passive": report.peak_abs(M)},
         "passive": {
             "rate_hz": float(ctl.rate_hz), "integrator": "rk4", "q0": q0, "v0": v0,
-            "initial_energy_J": e0, "max_energy_drift_J": r.energy_drift,
-            "kinetic_energy_swing_J": swing,
+            "initial_energy": e0, "max_energy_drift": r.energy_drift,
+            "kinetic_energy_swing": swing,
             "relative_energy_drift": r.energy_drift / swing if swing > 0 else 0.0,
             "energy": "kinetic 1/2 v^T M v + gravity (zero at O) + springs; conserved by the exact motion",
             "final_q": r.q[-1], "final_v": r.v[-1],
         },
-        "total_mass_kg": mech.total_mass,
+        "total_mass": mech.total_mass,
         "files": ["bodies_passive.npz", "shaking_wrench.png", "energy.png"],
     }
     if assembly is not None:

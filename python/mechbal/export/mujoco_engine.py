@@ -372,9 +372,11 @@ def co_simulate(mech, controller, trajectory, q0=None, qd0=None, *, dt: float = 
         qk, vk = sim.coordinates()
         qa, va = qk[act], vk[act]
         cmd = controller.step(qa, va, q_des[k], qd_des[k], qdd_des[k])
-        tau = np.asarray(cmd.joint_torque, float)
-        status[k] = int(cmd.status)
-        if int(cmd.status) & int(_core.Status.saturated):
+        # a wrapped controller returns a JointCommand, a bare core one (tau, status)
+        tau_k, status_k = (cmd.joint_torque, cmd.status) if hasattr(cmd, "joint_torque") else cmd
+        tau = np.asarray(tau_k, float)
+        status[k] = int(status_k)
+        if int(status_k) & int(_core.Status.saturated):
             saturated += 1
         d.ctrl[:] = tau
         mj.mj_forward(m, d)

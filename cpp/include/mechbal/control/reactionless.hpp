@@ -222,6 +222,13 @@ class ReactionlessController {
   Eigen::VectorXd rate_limit_, lower_, upper_, home_;
   // state
   Eigen::VectorXd q_b_;
+  // RK4's last stage solved the loops at (q_t_next, v_t_next) with the momentum of the same loop
+  // solution: when the next tick starts at exactly those task positions and rates (a sampled
+  // trajectory), its t_n evaluation reuses them (the loop solve, C and c do not depend on the
+  // balancing joints when these move no loop frame): only A is recomputed (rebalance)
+  bool stage_cache_ = false;
+  Status stage_cache_status_ = Status::ok;
+  Eigen::VectorXd stage_q_, stage_v_;
   Vec6 target_ = Vec6::Zero(), target_rate_ = Vec6::Zero();
   ReactionlessCommand command_;
   // scratch (sized at construction)
@@ -287,8 +294,23 @@ class ReactionlessJointController : public JointController {
 /// so the frame follows x' exactly (while J has full row rank) and the momentum components are
 /// cancelled as far as the null space allows (exactly when it is rich enough: n >= task rows +
 /// cancelled rows at a regular pose). Positions are integrated (Euler, or RK4 with the twist at
-/// t + dt/2 and t + dt). The command carries no acceleration feed-forward. Real time as
-/// ReactionlessController (noexcept, allocation-free, held command on bad input).
+/// t + dt/2 and t + dt). `null_space = false` drops N z: the pseudo-inverse path, the reference
+/// that shows what the redundancy buys.
+///
+/// Acceleration feed-forward (the joint mode's S K_b a_b = S dh*/dt - S K_t a_t - S W(q, v, 0),
+/// generalised to the null-space mode): differentiating J v = x' and S A v = S h* along the motion,
+///
+///     a0 = J^+ (x'' - J'v)                          (J'v: the frame's acceleration at a = 0)
+///     w  = (S A N)^+ (S dh*/dt - S W(q, v, 0) - S A a0)
+///     a  = a0 + N w                                 (a = a0 when null_space is false)
+///
+/// with the same damped factorisations as the rates. The commanded acceleration then keeps the
+/// task rows exactly and the cancelled momentum rates at their target as far as the null space
+/// allows; like the rates it is the minimum-norm one, so it differs from the time derivative of
+/// the rate law by a drift inside the null space of [J; S A N] (the derivative of the
+/// pseudo-inverses), which moves neither the frame nor the cancelled components. The predicted
+/// shaking wrench of the command is W(q, v, 0) + A a. Real time as ReactionlessController
+/// (noexcept, allocation-free, held command on bad input).
 struct TaskSpaceConfig {
   std::string frame;                    ///< the task frame (a named frame of the model)
   std::uint32_t task_rows = cancel_both;  ///< rows of [v; w] tracked (MomentumComponent bit order:
@@ -300,6 +322,9 @@ struct TaskSpaceConfig {
   double max_condition = 1e4;
   double max_rate = 100.0;     ///< per joint [rad/s or m/s]: scaled down, Status::saturated
   double max_twist = 1e2;      ///< input range of the desired twist (per component)
+  double max_twist_rate = 1e4; ///< input range of the desired twist's rate (per component)
+  /// false: v = J^+ x' only (no null-space term): the reference without the reaction null space
+  bool null_space = true;
 };
 
 class ReactionlessTaskController {
@@ -314,19 +339,30 @@ class ReactionlessTaskController {
   double dt() const noexcept { return dt_; }
   int frame() const noexcept { return frame_; }
   const Vec6& target() const noexcept { return target_; }
-  /// One tick: the desired twist of the frame at t_n (and, for RK4, at t_n + dt/2 and t_n + dt).
+  /// One tick: the desired twist of the frame at t_n, its rate (for the acceleration
+  /// feed-forward) and, for RK4, the twist at t_n + dt/2 and t_n + dt.
+  Status step(const Vec6& twist, const Vec6& twist_rate, const Vec6& twist_half, const Vec6& twist_next) noexcept;
+  /// The same with the twist's rate estimated from the three samples, (-3 x'(t_n) + 4 x'(t_n + dt/2)
+  /// - x'(t_n + dt)) / dt (second order in dt; zero when the three are equal).
   Status step(const Vec6& twist, const Vec6& twist_half, const Vec6& twist_next) noexcept;
-  /// The command at t_n: q (positions), v (rates), the momentum h = A v, the frame's twist J v;
+  /// The command at t_n: q (positions), v (rates), a (the acceleration feed-forward), the
+  /// momentum h = A v, the frame's twist J v, the predicted shaking wrench W(q, v, 0) + A a;
   /// next: q at t_n + dt.
   const Eigen::VectorXd& q() const noexcept { return q_cmd_; }
   const Eigen::VectorXd& v() const noexcept { return v_cmd_; }
+  const Eigen::VectorXd& a() const noexcept { return a_cmd_; }
   const Eigen::VectorXd& next() const noexcept { return q_; }
   const Vec6& momentum() const noexcept { return h_; }
   const Vec6& frame_twist() const noexcept { return twist_cmd_; }
+  const Vec3& shaking_force() const noexcept { return force_; }
+  const Vec3& shaking_moment() const noexcept { return moment_; }
   Status status() const noexcept { return status_; }
 
  private:
   Status rates(const Eigen::VectorXd& q, const Vec6& twist, Eigen::VectorXd& v) noexcept;
+  /// a_cmd_, force_, moment_ at q_ with rates v (right after rates(q_, ...): J^+, N, S A N are
+  /// those of q_); saturated: the rates were scaled down, a = 0.
+  Status acceleration(const Eigen::VectorXd& v, const Vec6& twist_rate, bool saturated) noexcept;
   /// x = M^T (M M^T + lambda^2)^-1 r (lambda = 0 while cond(M) <= max_condition), M (rows x n).
   Status min_norm(const Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::VectorXd& x) noexcept;
 
@@ -338,7 +374,7 @@ class ReactionlessTaskController {
   int n_ = 0, frame_ = -1;
   double dt_ = 1e-3;
   std::vector<int> task_rows_, rows_;
-  Eigen::VectorXd q_, q_cmd_, v_cmd_, k1_, k2_, k3_, k4_, q_stage_, v0_, z_, w_, rate_limit_;
+  Eigen::VectorXd q_, q_cmd_, v_cmd_, a_cmd_, zero_, a0_, k1_, k2_, k3_, k4_, q_stage_, v0_, z_, w_, rate_limit_;
   Eigen::MatrixXd J_, JpJ_, N_, M_, Jt_;
   Eigen::VectorXd rt_, rm_;
   Small gram_;
@@ -346,6 +382,7 @@ class ReactionlessTaskController {
   Eigen::SelfAdjointEigenSolver<Small> eig_;
   Eigen::LLT<Small> llt_;
   Vec6 target_ = Vec6::Zero(), h_ = Vec6::Zero(), twist_cmd_ = Vec6::Zero();
+  Vec3 force_ = Vec3::Zero(), moment_ = Vec3::Zero();
   Status status_ = Status::ok;
 };
 
