@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -85,6 +86,153 @@ def median_per_call_ns(fn, calls):
         fn()
         samples[i] = time.perf_counter_ns() - t0
     return float(np.median(samples)), float(np.percentile(samples, 99))
+
+
+# ---- single calls beside Pinocchio's (issue 26) -----------------------------------------------------
+
+#: robot -> (URDF path under example-robot-data's robots/, the frame of the frame rows)
+PINOCCHIO_ROBOTS = {
+    "ur5": (("ur_description", "urdf", "ur5_robot.urdf"), "tool0"),
+    "panda": (("panda_description", "urdf", "panda.urdf"), "panda_hand"),
+}
+
+
+def robot_file(*parts) -> Path | None:
+    """A URDF of example-robot-data (the `test` extra: a cmeel package), or None."""
+    for entry in sys.path:
+        for prefix in (Path(entry) / "cmeel.prefix",
+                       Path(entry).parents[2] if len(Path(entry).parents) > 2 else None):
+            if prefix is None:
+                continue
+            path = prefix / "share" / "example-robot-data" / "robots" / Path(*parts)
+            if path.is_file():
+                return path
+    return None
+
+
+def pinocchio_map(mech, pm):
+    """G (nv_pin, dof), offset: Pinocchio's model of the URDF keeps a <mimic> joint independent
+    (its default), so its coordinates are G q + offset and tau = G^T tau_pin, M = G^T M_pin G.
+    Every joint of the two robots has one coordinate in both (no continuous joint)."""
+    desc = {j.name: j for j in mech.model.description.joints}
+    names = mech.joint_names
+    G, offset = np.zeros((pm.nv, mech.dof)), np.zeros(pm.nv)
+    for jid in range(1, pm.njoints):
+        if pm.nvs[jid] == 0:
+            continue
+        if pm.nqs[jid] != 1 or pm.nvs[jid] != 1:
+            raise SystemExit(f"{pm.names[jid]}: a joint with {pm.nqs[jid]} coordinates (not a robot of this bench)")
+        iv, j = pm.idx_vs[jid], desc[pm.names[jid]]
+        if j.mimic_joint:
+            G[iv, names.index(j.mimic_joint)], offset[iv] = j.mimic_ratio, j.mimic_offset
+        else:
+            G[iv, names.index(j.name)] = 1.0
+    return G, offset
+
+
+def check_against_pinocchio(robot, mech, pm, pd, G, offset, frame, states):
+    """mechbal's single calls equal Pinocchio's (through the mimic map) at the bench states, or exit:
+    the two sides of every row compute the same quantity."""
+    import pinocchio as pin
+    from pinocchio_checks import _base_fixed_mass_moment, _rel
+
+    fid = pm.getFrameId(frame)
+    m_pin = pin.computeTotalMass(pm)
+    worst = 0.0
+    for q, v, a in states:
+        qp, vp, ap = G @ q + offset, G @ v, G @ a
+        errors = {"id": _rel(mech.inverse_dynamics(q, v, a), G.T @ pin.rnea(pm, pd, qp, vp, ap))}
+        M = pin.crba(pm, pd, qp)
+        errors["mass"] = _rel(mech.mass_matrix(q), G.T @ (np.triu(M) + np.triu(M, 1).T) @ G)
+        errors["gravity"] = _rel(mech.gravity_torque(q), G.T @ pin.computeGeneralizedGravity(pm, pd, qp))
+        # Pinocchio's centre of mass leaves out the bodies fixed to the base; mechbal's has them
+        c = pin.centerOfMass(pm, pd, qp).copy()
+        errors["com"] = _rel(mech.center_of_mass(q),
+                             (m_pin * c + _base_fixed_mass_moment(mech, q)) / mech.total_mass)
+        # centroidal momentum rate, shifted from the centre of mass to O
+        pin.computeCentroidalMomentumTimeVariation(pm, pd, qp, vp, ap)
+        sw = mech.shaking_wrench(q, v, a)
+        dP = pd.dhg.linear.copy()
+        errors["momentum_rate"] = max(_rel(sw.shaking_force, dP),
+                                      _rel(sw.shaking_moment, pd.dhg.angular + np.cross(pd.com[0], dP)))
+        pin.forwardKinematics(pm, pd, qp)
+        errors["frame_placement"] = _rel(mech.frame_placement(q, frame),
+                                         pin.updateFramePlacement(pm, pd, fid).homogeneous)
+        J = pin.computeFrameJacobian(pm, pd, qp, fid, pin.LOCAL_WORLD_ALIGNED)
+        errors["frame_jacobian"] = _rel(mech.frame_jacobian(q, frame), J @ G)
+        bad = {k: e for k, e in errors.items() if not e < 1e-9}
+        if bad:
+            raise SystemExit(f"{robot}: mechbal and Pinocchio disagree (relative): {bad}")
+        worst = max(worst, *errors.values())
+    return worst
+
+
+def bench_single_calls_vs_pinocchio(rounds: int, number: int) -> dict:
+    """Each per-sample Mechanism call beside Pinocchio's on the same robot in this process:
+    interleaved (for every round and every quantity, mechbal's block of `number` calls and
+    Pinocchio's, in alternating order), at a new random state each round, the call inline in a
+    timeit loop on both sides; per-call medians over the rounds and the median of the per-round
+    ratios Pinocchio / mechbal (the load of the machine changes both sides of a round alike)."""
+    import timeit
+
+    try:
+        import pinocchio as pin
+    except ImportError as exc:
+        return {"skipped": f"pinocchio is not installed ({exc}): pip install '.[test]'"}
+    rows = {  # quantity -> (mechbal call, Pinocchio call): the statement timed
+        "id": ("mech.inverse_dynamics(q, v, a)", "pin.rnea(pm, pd, qp, vp, ap)"),
+        "mass": ("mech.mass_matrix(q)", "pin.crba(pm, pd, qp)"),
+        "gravity": ("mech.gravity_torque(q)", "pin.computeGeneralizedGravity(pm, pd, qp)"),
+        "com": ("mech.center_of_mass(q)", "pin.centerOfMass(pm, pd, qp)"),
+        "momentum_rate": ("mech.shaking_wrench(q, v, a)",
+                          "pin.computeCentroidalMomentumTimeVariation(pm, pd, qp, vp, ap)"),
+        "frame_placement": ("mech.frame_placement(q, frame)",
+                            "pin.forwardKinematics(pm, pd, qp); pin.updateFramePlacement(pm, pd, fid)"),
+        "frame_jacobian": ("mech.frame_jacobian(q, frame)",
+                           "pin.computeFrameJacobian(pm, pd, qp, fid, pin.LOCAL_WORLD_ALIGNED)"),
+    }
+    out = {"method": "interleaved blocks of calls, one process, CPU time of the thread; median over rounds",
+           "rounds": rounds,
+           "calls_per_block": number, "pinocchio_version": pin.__version__,
+           "load_average_before": list(os.getloadavg()),
+           "pinocchio_calls": {k: v[1] for k, v in rows.items()},
+           "mechbal_calls": {k: v[0] for k, v in rows.items()}, "robots": {}}
+    ratios = {}
+    for robot, (parts, frame) in PINOCCHIO_ROBOTS.items():
+        path = robot_file(*parts)
+        if path is None:
+            out["robots"][robot] = {"skipped": "example-robot-data is not installed: pip install '.[test]'"}
+            continue
+        mech = mechbal.Mechanism.from_urdf(path)
+        pm = pin.buildModelFromUrdf(str(path))
+        pd = pm.createData()
+        G, offset = pinocchio_map(mech, pm)
+        rng = np.random.default_rng(26)
+        states = [(rng.uniform(-2, 2, mech.dof), rng.normal(size=mech.dof), rng.normal(size=mech.dof))
+                  for _ in range(rounds)]
+        worst = check_against_pinocchio(robot, mech, pm, pd, G, offset, frame, states[:8])
+        ns = {"mech": mech, "pin": pin, "pm": pm, "pd": pd, "frame": frame, "fid": pm.getFrameId(frame)}
+        # CPU time of this thread: on the shared machine a block is often preempted, and wall time
+        # would charge the other jobs' time slices to whichever side was running
+        timers = {k: tuple(timeit.Timer(stmt, timer=time.thread_time, globals=ns) for stmt in pair)
+                  for k, pair in rows.items()}
+        per_call = {k: ([], []) for k in rows}
+        for r, (q, v, a) in enumerate(states):
+            ns.update(q=q, v=v, a=a, qp=G @ q + offset, vp=G @ v, ap=G @ a)
+            for k, pair in timers.items():
+                for side in ((0, 1) if r % 2 == 0 else (1, 0)):
+                    per_call[k][side].append(pair[side].timeit(number) / number * 1e9)
+        res = {"dof": mech.dof, "pinocchio_nq": pm.nq, "frame": frame, "agreement_relative": worst}
+        for k, (mb, pn) in per_call.items():
+            mb, pn = np.array(mb), np.array(pn)
+            ratio = float(np.median(pn / mb))
+            res[k] = {"mechbal_ns": float(np.median(mb)), "pinocchio_ns": float(np.median(pn)),
+                      "pinocchio_over_mechbal": ratio}
+            ratios[f"pinocchio_over_mechbal_{k}_{robot}_python"] = ratio
+        out["robots"][robot] = res
+    out["ratios"] = ratios
+    out["load_average_after"] = list(os.getloadavg())
+    return out
 
 
 def seven_joint_arm():
@@ -205,11 +353,21 @@ def main(argv=None):
     ap.add_argument("--instants", type=int, default=100_000)
     ap.add_argument("--bodies", type=int, default=10)
     ap.add_argument("--quick", action="store_true", help="fewer repetitions")
-    ap.add_argument("--only", choices=("sweep",), help="run one section only")
+    ap.add_argument("--only", choices=("sweep", "pinocchio"), help="run one section only")
+    ap.add_argument("--rounds", type=int, default=41,
+                    help="rounds of the interleaved single calls beside Pinocchio's")
     ap.add_argument("--sweep-evaluations", type=int, default=100_000)
     args = ap.parse_args(argv)
     if args.only == "sweep":
         text = json.dumps({"sweep": bench_sweep(args.sweep_evaluations, 2 if args.quick else 3)}, indent=2)
+        print(text)
+        if args.out:
+            args.out.parent.mkdir(parents=True, exist_ok=True)
+            args.out.write_text(text + "\n")
+        return
+    if args.only == "pinocchio":
+        text = json.dumps({"vs_pinocchio": bench_single_calls_vs_pinocchio(
+            args.rounds, 500 if args.quick else 2000)}, indent=2)
         print(text)
         if args.out:
             args.out.parent.mkdir(parents=True, exist_ok=True)
@@ -268,6 +426,9 @@ def main(argv=None):
         command = np.zeros((3, 3))
         med, p99 = median_per_call_ns(lambda: wrist.step_into(D, Dd, D, D, command), calls)
         results["per_call"][f"{name}_step_into"] = {"median_ns": med, "p99_ns": p99}
+
+    # single Mechanism calls beside Pinocchio's, interleaved in this process (issue 26)
+    results["vs_pinocchio"] = bench_single_calls_vs_pinocchio(args.rounds, 500 if args.quick else 2000)
 
     # ---- 2. batch throughput against numpy ------------------------------------------------------
     chain = mechbal.Mechanism(chain_from_specs(random_chain_specs(rng, "R" * args.bodies)))

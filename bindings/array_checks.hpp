@@ -49,9 +49,60 @@ inline std::string describe_dtype(const pybind11::dtype& dt) {
 
 }  // namespace detail
 
+/// The data of `h` when it is already what the algorithms read: a numpy array (ndarray itself,
+/// not a subclass) of native float64 values, C-contiguous and aligned, with `nd` dimensions
+/// (dims[i] < 0 matches any extent); nullptr otherwise (nothing raised: the caller takes its
+/// general path). The fast path of single calls (issue 26): a few loads from the array header.
+inline double* float64_data(pybind11::handle h, int nd, const pybind11::ssize_t* dims) noexcept {
+  namespace pd = pybind11::detail;
+  const auto& api = pd::npy_api::get();
+  if (Py_TYPE(h.ptr()) != api.PyArray_Type_) return nullptr;
+  const pd::PyArray_Proxy* a = pd::array_proxy(h.ptr());
+  constexpr int need = pd::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | pd::npy_api::NPY_ARRAY_ALIGNED_;
+  if (a->nd != nd || (a->flags & need) != need) return nullptr;
+  for (int i = 0; i < nd; ++i)
+    if (dims[i] >= 0 && a->dimensions[i] != dims[i]) return nullptr;
+  const pd::PyArrayDescr_Proxy* d = pd::array_descriptor_proxy(a->descr);
+  if (d->type_num != pd::npy_api::NPY_DOUBLE_ || d->byteorder == '>') return nullptr;
+  return reinterpret_cast<double*>(a->data);
+}
+
+/// float64_data of a 1-D array of n values.
+inline const double* float64_vector(pybind11::handle h, pybind11::ssize_t n) noexcept {
+  return float64_data(h, 1, &n);
+}
+
+/// A new, uninitialised float64 C-order numpy array (the numpy C API directly: no shape vectors).
+inline pybind11::object new_float64_array(std::initializer_list<pybind11::ssize_t> shape) {
+  namespace pd = pybind11::detail;
+  const auto& api = pd::npy_api::get();
+  Py_intptr_t dims[4];
+  int nd = 0;
+  for (auto s : shape) dims[nd++] = static_cast<Py_intptr_t>(s);
+  static PyObject* const float64 = api.PyArray_DescrFromType_(pd::npy_api::NPY_DOUBLE_);  // kept
+  Py_INCREF(float64);  // stolen by PyArray_NewFromDescr
+  PyObject* a = api.PyArray_NewFromDescr_(api.PyArray_Type_, float64, nd, dims, nullptr, nullptr, 0, nullptr);
+  if (!a) throw pybind11::error_already_set();
+  return pybind11::reinterpret_steal<pybind11::object>(a);
+}
+
+/// The data of an array made by new_float64_array.
+inline double* float64_array_data(const pybind11::object& a) noexcept {
+  return reinterpret_cast<double*>(pybind11::detail::array_proxy(a.ptr())->data);
+}
+
 /// The checked conversion (also usable on any handle).
 inline Array to_real_array(pybind11::handle src) {
   namespace py = pybind11;
+  // already float64, C-contiguous, aligned: used as it is (what OutArray::ensure would return)
+  const auto& api = py::detail::npy_api::get();
+  if (Py_TYPE(src.ptr()) == api.PyArray_Type_) {
+    const auto* a = py::detail::array_proxy(src.ptr());
+    constexpr int need = py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ | py::detail::npy_api::NPY_ARRAY_ALIGNED_;
+    const auto* d = py::detail::array_descriptor_proxy(a->descr);
+    if ((a->flags & need) == need && d->type_num == py::detail::npy_api::NPY_DOUBLE_ && d->byteorder != '>')
+      return Array(py::reinterpret_borrow<OutArray>(src));
+  }
   py::array a;
   if (py::isinstance<py::array>(src)) {
     a = py::reinterpret_borrow<py::array>(src);

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "array_checks.hpp"
 #include "mechbal/status.hpp"
@@ -23,6 +24,12 @@ struct FastArg {
   pybind11::handle h;
 };
 
+/// An argument of step(): the Python object as is, any real array-like (typed so in the
+/// signature); the binding reads a float64 array in place and converts anything else.
+struct ArrayLikeArg {
+  pybind11::handle h;
+};
+
 }  // namespace mechbal::pyb
 
 namespace pybind11::detail {
@@ -34,6 +41,17 @@ struct type_caster<mechbal::pyb::FastArg> {
     return true;
   }
   static handle cast(const mechbal::pyb::FastArg& a, return_value_policy, handle) {
+    return a.h.inc_ref();
+  }
+};
+template <>
+struct type_caster<mechbal::pyb::ArrayLikeArg> {
+  PYBIND11_TYPE_CASTER(mechbal::pyb::ArrayLikeArg, const_name("numpy.typing.ArrayLike"));
+  bool load(handle src, bool) {
+    value.h = src;
+    return true;
+  }
+  static handle cast(const mechbal::pyb::ArrayLikeArg& a, return_value_policy, handle) {
     return a.h.inc_ref();
   }
 };
@@ -54,6 +72,35 @@ pybind11::tuple controller_step(Controller& c, const Array& q, const Array& qd, 
   Eigen::VectorXd tau = c.last_command();
   const Status s = c.step(q_, qd_, q_des_, qd_des_, qdd_des_, tau);
   return pybind11::make_tuple(tau, s);
+}
+
+/// One tick from Python (issue 26: step() at most 1.5 us): (tau (n,) numpy array, status). When
+/// every argument is already a 1-D C-contiguous float64 numpy array of n values it is read in
+/// place and the torque written straight into the new result array; anything else goes through
+/// the checked conversion of controller_step (same errors). `Int`: the status as an int, else as
+/// mechbal.Status.
+template <typename Controller, bool Int = true>
+pybind11::tuple controller_tick(Controller& c, ArrayLikeArg q, ArrayLikeArg qd, ArrayLikeArg q_des,
+                                ArrayLikeArg qd_des, ArrayLikeArg qdd_des) {
+  const auto n = static_cast<pybind11::ssize_t>(c.dof());
+  const double* pq = float64_vector(q.h, n);
+  const double* pqd = float64_vector(qd.h, n);
+  const double* pq_des = float64_vector(q_des.h, n);
+  const double* pqd_des = float64_vector(qd_des.h, n);
+  const double* pqdd_des = float64_vector(qdd_des.h, n);
+  if (!pq || !pqd || !pq_des || !pqd_des || !pqdd_des) {
+    pybind11::tuple r = controller_step(c, to_real_array(q.h), to_real_array(qd.h), to_real_array(q_des.h),
+                                        to_real_array(qd_des.h), to_real_array(qdd_des.h));
+    if (Int) r = pybind11::make_tuple(r[0], static_cast<std::uint32_t>(r[1].cast<Status>()));
+    return r;
+  }
+  using CMap = Eigen::Map<const Eigen::VectorXd>;
+  pybind11::object tau = new_float64_array({n});
+  Eigen::Map<Eigen::VectorXd> t(float64_array_data(tau), n);
+  t = c.last_command();
+  const Status s = c.step(CMap(pq, n), CMap(pqd, n), CMap(pq_des, n), CMap(pqd_des, n), CMap(pqdd_des, n), t);
+  if (Int) return pybind11::make_tuple(std::move(tau), static_cast<std::uint32_t>(s));
+  return pybind11::make_tuple(std::move(tau), s);
 }
 
 /// The fast tick (issue 15: at most 1.5 us from Python). The arguments arrive as plain handles
@@ -216,10 +263,13 @@ void bind_joint_controller_ticks(PyClass& cls) {
   namespace py = pybind11;
   static constexpr const char* deprecated_doc =
       "Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release";
-  cls.def("step", &controller_step<Controller>, py::arg("q"), py::arg("v"), py::arg("q_des"),
+  cls.def("step", &controller_tick<Controller, false>, py::arg("q"), py::arg("v"), py::arg("q_des"),
           py::arg("v_des"), py::arg("a_des"),
           "One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or "
           "out-of-range input returns the held command and a non-ok status.")
+      .def("_tick", &controller_tick<Controller, true>, py::arg("q"), py::arg("v"), py::arg("q_des"),
+           py::arg("v_des"), py::arg("a_des"),
+           "step() with the status as an int (what the Python classes' step wraps in a JointCommand)")
       .def("step_into", &controller_step_into<Controller>, py::arg("q"), py::arg("v"),
            py::arg("q_des"), py::arg("v_des"), py::arg("a_des"), py::arg("out"),
            "The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n "

@@ -282,6 +282,10 @@ class PaminsaRun:
     status: np.ndarray
 
 
+#: JointCommand from the binding's (tau, int status) tuple without a Python-level __new__
+_joint_command = tuple.__new__
+
+
 def _control_run(result: dict[str, Any]) -> ControlRun:
     return ControlRun(joint_torque=np.asarray(result["joint_torque"]),
                       status=np.asarray(result["status"]))
@@ -331,8 +335,7 @@ class ComputedTorque(_core.ComputedTorque):
     def step(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
              v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> JointCommand:
         """One tick: `JointCommand` (joint_torque (n,) [N m or N], status)."""
-        tau, status = super().step(q, v, q_des, v_des, a_des)
-        return JointCommand(np.asarray(tau), int(status))
+        return _joint_command(JointCommand, self._tick(q, v, q_des, v_des, a_des))
 
     @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
     def run(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
@@ -360,8 +363,7 @@ class DecoupledJointController(_core.DecoupledJointController):
     def step(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
              v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> JointCommand:
         """One tick: `JointCommand` (joint_torque (n,) [N m or N], status)."""
-        tau, status = super().step(q, v, q_des, v_des, a_des)
-        return JointCommand(np.asarray(tau), int(status))
+        return _joint_command(JointCommand, self._tick(q, v, q_des, v_des, a_des))
 
     @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
     def run(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]

@@ -5,7 +5,10 @@ joints, any number of named bodies on each link, gear couplings, named frames an
 ``cpp/include/mechbal/model/model.hpp`` for the frame conventions) and exposes every algorithm over it.
 
 Every method takes either one sample (1-D arrays of ``dof`` values) or a batch ((N, dof) arrays),
-evaluated in one C++ call. One sample returns plain arrays and raises `ValueError` when the
+evaluated in one C++ call. A single sample given as 1-D float64 numpy arrays goes straight to the
+C++ algorithm (no conversion, no Python-level checking: about Pinocchio's cost per call,
+``bench/bench_python.py``); any other input takes the general path, which converts and checks it.
+One sample returns plain arrays and raises `ValueError` when the
 input is rejected (wrong size, non-finite, overflow); a batch returns arrays with a leading N axis
 and a per-instant status (0 = ok; see `mechbal.Status`): the result dataclasses have a
 ``status`` field, and the plain-array results are `BatchArray` with a ``status``
@@ -22,6 +25,7 @@ from __future__ import annotations
 
 import contextlib as _contextlib
 import contextvars as _contextvars
+from types import SimpleNamespace as _SimpleNamespace
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Sequence
@@ -177,6 +181,10 @@ def _real_array(value, name: str) -> np.ndarray:
     return np.asarray(a, dtype=float)
 
 
+#: the status of an accepted single instant (what ``status[0]`` of a batch of one reads)
+_OK = np.uint32(0)
+
+
 def _status_text(code: int) -> str:
     names = [s.name for s in _core.Status.__members__.values() if int(s) and int(code) & int(s)]
     return " | ".join(names) or "ok"
@@ -192,7 +200,7 @@ class Mechanism:
                  source: str | None = None, link_frames=None):
         if not isinstance(model, _core.MechanismModel):
             raise TypeError(f"model must be a mechbal._core.MechanismModel, got {type(model).__name__}")
-        self.model = model
+        self.model = model  # also builds the per-sample workspace (see the ``model`` property)
         self.name = name
         self.source = source
         #: link -> (4, 4) placement in the link frame of the frame the user described the link in
@@ -201,6 +209,31 @@ class Mechanism:
         from mechbal import plausibility
 
         plausibility.warn(plausibility.mechanism_problems(self))
+
+    @property
+    def model(self) -> "_core.MechanismModel":
+        """The C++ ``MechanismModel`` (immutable)."""
+        return self._model
+
+    @model.setter
+    def model(self, model: "_core.MechanismModel") -> None:
+        self._model = model
+        # one MechanismData for the per-sample calls: a 1-D float64 array goes straight to the
+        # C++ algorithm; anything else (or a rejected instant) takes the general path below
+        self._single = _SimpleNamespace(**_core.mechanism_single_sample(model, _OK, ShakingWrench))
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state.pop("_single", None)  # rebuilt from the model
+        return state
+
+    def __setstate__(self, state):
+        state = dict(state)
+        model = state.pop("_model", None)
+        if model is None:
+            model = state.pop("model")
+        self.__dict__.update(state)
+        self.model = model
 
     # ---- construction ------------------------------------------------------------------------
     @classmethod
@@ -503,6 +536,9 @@ class Mechanism:
         forces, `spring_torque`), gear couplings projected.
         A batch returns a `BatchArray` (N, dof) whose ``status`` (N,) flags the rejected
         instants (their rows are NaN)."""
+        tau = self._single.inverse_dynamics(q, v, a)
+        if tau is not None:
+            return tau
         single, (q, v, a) = self._args(("q", "v", "a"), (q, v, a))
         (tau,), _ = self._finish(single, _core.mechanism_inverse_dynamics(self.model, q, v, a),
                                  ["joint_torque"])
@@ -510,6 +546,9 @@ class Mechanism:
 
     def mass_matrix(self, q: npt.ArrayLike) -> FloatArray:
         """Joint-space mass matrix M(q) (dof, dof) [kg m^2, kg]; a batch gives (N, dof, dof)."""
+        M = self._single.mass_matrix(q)
+        if M is not None:
+            return M
         single, (q,) = self._args(("q",), (q,))
         (M,), _ = self._finish(single, _core.mechanism_mass_matrix(self.model, q), ["mass_matrix"])
         return M
@@ -517,6 +556,9 @@ class Mechanism:
     def gravity_torque(self, q: npt.ArrayLike) -> FloatArray:
         """Gravity torques G(q): the joint forces that hold the weights still [N m or N]; with
         springs, `static_torque` is what holds the mechanism still."""
+        g = self._single.gravity_torque(q)
+        if g is not None:
+            return g
         single, (q,) = self._args(("q",), (q,))
         (g,), _ = self._finish(single, _core.mechanism_gravity_torque(self.model, q), ["gravity_torque"])
         return g
@@ -566,6 +608,9 @@ class Mechanism:
 
     def center_of_mass(self, q: npt.ArrayLike) -> FloatArray:
         """Centre of mass of all bodies in O [m]: (3,) or (N, 3)."""
+        c = self._single.center_of_mass(q)
+        if c is not None:
+            return c
         single, (q,) = self._args(("q",), (q,))
         (c,), _ = self._finish(single, _core.mechanism_center_of_mass(self.model, q), ["center_of_mass"])
         return c
@@ -586,6 +631,9 @@ class Mechanism:
     def shaking_wrench(self, q: npt.ArrayLike, v: npt.ArrayLike, a: npt.ArrayLike) -> ShakingWrench:
         """Shaking force F = dP/dt [N] and shaking moment M_O = dH_O/dt [N m] about O, with the
         momenta, for the motion (q, v, a) (Briot & Arakelian 2009, eqs 1-4)."""
+        w = self._single.shaking_wrench(q, v, a)
+        if w is not None:
+            return w
         single, (q, v, a) = self._args(("q", "v", "a"), (q, v, a))
         (F, M, P, H), st = self._finish(
             single, _core.mechanism_shaking_wrench(self.model, q, v, a, False),
@@ -624,6 +672,9 @@ class Mechanism:
 
     def frame_placement(self, q: npt.ArrayLike, frame: str) -> FloatArray:
         """4x4 placement of a named frame in O."""
+        T = self._single.frame_placement(q, frame)
+        if T is not None:
+            return T
         i = self._frame(frame)
         m = self.body_motion(q)
         T = m.frame_placement[..., i, :, :]
@@ -631,6 +682,9 @@ class Mechanism:
 
     def frame_jacobian(self, q: npt.ArrayLike, frame: str) -> FloatArray:
         """[v; w] = J(q) qdot of a named frame's origin, O's axes: (6, dof)."""
+        J = self._single.frame_jacobian(q, frame)
+        if J is not None:
+            return J
         self._frame(frame)
         single, (q,) = self._args(("q",), (q,))
         (J,), _ = self._finish(single, _core.mechanism_frame_jacobian(self.model, q, frame), ["jacobian"])

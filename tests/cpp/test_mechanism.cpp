@@ -207,11 +207,48 @@ TEST(Mechanism, AlgorithmsAllocateNothing) {
     EXPECT_EQ(bias_torque(model, data, q, v), Status::ok);
     EXPECT_EQ(mass_matrix(model, data, q), Status::ok);
     EXPECT_EQ(frame_jacobian(model, data, q, 0), Status::ok);
+    EXPECT_EQ(frame_placement(model, data, q, 1), Status::ok);
     EXPECT_EQ(torque_regressor(model, data, q, v, a), Status::ok);
     EXPECT_EQ(gravity_regressor(model, data, q), Status::ok);
     EXPECT_EQ(momentum_regressor(model, data, q, v), Status::ok);
   }
   EXPECT_EQ(scope.count(), 0u);
+}
+
+// frame_placement (one frame from the link placements) is the frame forward_kinematics places,
+// to the last bit, and accepts and refuses the same instants.
+TEST(Mechanism, FramePlacementIsTheKinematicsFrame) {
+  std::mt19937 rng(26);
+  const MechanismModel model = random_tree(rng, "RPRFRRPR", true);
+  MechanismData one(model), all(model);
+  const int n = model.dof();
+  for (int k = 0; k < 20; ++k) {
+    const Eigen::VectorXd q = test::random_vector(rng, n, 3.0);
+    ASSERT_EQ(forward_kinematics(model, all, q), Status::ok);
+    for (int f = 0; f < model.num_frames(); ++f) {
+      ASSERT_EQ(frame_placement(model, one, q, f), Status::ok);
+      EXPECT_EQ(one.frame_placements[static_cast<std::size_t>(f)].matrix(),
+                all.frame_placements[static_cast<std::size_t>(f)].matrix());
+    }
+  }
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
+  q(1) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(frame_placement(model, one, q, 0), Status::non_finite_input);
+  // huge coordinates: a prismatic joint's placement overflows; the same verdict as the kinematics
+  int refused = 0;
+  for (int i = 0; i < n; ++i) {
+    for (double x : {std::numeric_limits<double>::max(), -std::numeric_limits<double>::max(), 1e308}) {
+      q.setConstant(0.2);
+      q(i) = x;
+      if (i + 1 < n) q(i + 1) = x;
+      const Status s = forward_kinematics(model, all, q);
+      refused += s == Status::out_of_range;
+      for (int f = 0; f < model.num_frames(); ++f) EXPECT_EQ(frame_placement(model, one, q, f), s);
+    }
+  }
+  EXPECT_GT(refused, 0);
+  EXPECT_EQ(frame_placement(model, one, Eigen::VectorXd::Zero(n), model.num_frames()), Status::bad_size);
+  EXPECT_EQ(frame_placement(model, one, Eigen::VectorXd::Zero(n), -1), Status::bad_size);
 }
 
 TEST(Mechanism, BadInputGivesAStatusAndWritesNothing) {

@@ -11,6 +11,7 @@
 #include "mechbal/detail/placed.hpp"
 #include "mechbal/detail/tree.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace mechbal {
@@ -158,6 +159,41 @@ Status forward_kinematics(const MechanismModel& model, MechanismData& data, cons
   detail::forward_pass<true, true, false, false>(model, data);
   world_kinematics(model, data);
   return kinematics_finite(data) ? Status::ok : Status::out_of_range;
+}
+
+Status frame_placement(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                       int frame) noexcept {
+  if (frame < 0 || frame >= model.num_frames()) return Status::bad_size;
+  if (Status s = check_state(model, data, &q); s != Status::ok) return s;
+  detail::joint_state<false, false>(model, data, q, q, q);
+  detail::place(model, data);
+  // what forward_kinematics (and so the batch kinematics) would accept: every link placed finite,
+  // every body's centre finite (link_rotation and body com computed as in world_kinematics)
+  double reach = 0.0;  // the largest |coordinate| of a link origin
+  for (int l = 0; l < model.num_links(); ++l) {
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    if (!W.world_position.allFinite() || !W.world_rotation.allFinite()) return Status::out_of_range;
+    reach = std::max(reach, W.world_position.cwiseAbs().maxCoeff());
+  }
+  // |R c| <= |c|_1 for a rotation R: a body's centre can only overflow when that sum is near the
+  // largest double, and is computed then
+  constexpr double kSafe = 1e307;
+  for (int b = 0; b < model.num_bodies(); ++b) {
+    const Vec3& com = model.bodies()[static_cast<std::size_t>(b)].com;
+    if (reach <= kSafe && com.lpNorm<1>() <= kSafe) continue;
+    const int l = model.body_link(b);
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    const Mat3 R = W.world_rotation * model.link_constants(l).aligned.transpose();
+    if (!(W.world_position + R * com).allFinite()) return Status::out_of_range;
+  }
+  const int l = model.frame_link(frame);
+  const auto& W = data.work[static_cast<std::size_t>(l)];
+  Eigen::Isometry3d T;
+  T.linear().noalias() = W.world_rotation * model.link_constants(l).aligned.transpose();
+  T.translation() = W.world_position;
+  T.makeAffine();
+  data.frame_placements[static_cast<std::size_t>(frame)] = T * model.frame(frame).placement;
+  return Status::ok;
 }
 
 Status center_of_mass(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {

@@ -25,5 +25,11 @@ Status forward_kinematics(const MechanismModel& model, MechanismData& data, cons
 /// Positions, velocities and accelerations (gravity excluded from the accelerations).
 Status forward_kinematics(const MechanismModel& model, MechanismData& data, const ConstVector& q,
                           const ConstVector& v, const ConstVector& a) noexcept;
+/// data.frame_placements[frame] only: the placement in O of one named frame (positions only, no
+/// body or other frame written), at the cost of the link placements. Accepted exactly when the
+/// positions-only forward_kinematics is (every link placement and every body's centre finite;
+/// Status::out_of_range otherwise); Status::bad_size for a frame index out of range.
+Status frame_placement(const MechanismModel& model, MechanismData& data, const ConstVector& q,
+                       int frame) noexcept;
 
 }  // namespace mechbal
