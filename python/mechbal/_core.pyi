@@ -8,7 +8,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ComputedTorque', 'ControlConfig', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MAX_URDF_BYTES', 'MAX_URDF_DEPTH', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'PassiveController', 'ReactionlessCommand', 'ReactionlessController', 'ReactionlessJointController', 'ReactionlessTaskController', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'Spring', 'Status', 'TimeLaw', 'TrajectoryConfig', 'WristCommand', 'WristIntegrator', 'arm2dof_description', 'load_case_file', 'load_case_trajectory', 'load_mechanism_file', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_toml', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'read_urdf', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
+__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ComputedTorque', 'ControlConfig', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MAX_URDF_BYTES', 'MAX_URDF_DEPTH', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'PassiveController', 'ReactionlessCommand', 'ReactionlessController', 'ReactionlessJointController', 'ReactionlessTaskController', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'Spring', 'Status', 'TimeLaw', 'TrajectoryConfig', 'WristCommand', 'WristIntegrator', 'arm2dof_description', 'case_from_toml', 'load_case_file', 'load_case_trajectory', 'load_mechanism_file', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_toml', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_single_sample', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'read_urdf', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
 class Status:
     """
     Bit flags returned by real-time algorithms
@@ -150,11 +150,11 @@ class RestToRestTrajectory:
         ...
     def evaluate(self, t: typing.SupportsFloat | typing.SupportsIndex) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
         """
-        (q, qd, qdd) at time t
+        (q, v, a) at time t
         """
     def evaluate_batch(self, times: numpy.typing.ArrayLike) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
         """
-        (q, qd, qdd), each (N, size), at the N given times
+        (q, v, a), each (N, size), at the N given times
         """
     @property
     def duration(self) -> float:
@@ -568,15 +568,15 @@ class MechanismDynamics(InverseDynamics, ForwardDynamics):
         """
         Dynamics in the actuated coordinates (loops solved each call, warm-started from q_guess, the full coordinates near the assembly)
         """
-    def bias(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    def bias(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
-        Bias torques C(q, qd) qd + G(q) + K(q) (springs included)
+        Bias torques C(q, v) v + G(q) + K(q) (springs included)
         """
-    def coriolis(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    def coriolis(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
-        Coriolis and centrifugal torques C(q, qd) qd
+        Coriolis and centrifugal torques C(q, v) v
         """
-    def forward_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    def forward_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Accelerations a = M^-1 (tau - b) (actuated coordinates)
         """
@@ -584,9 +584,9 @@ class MechanismDynamics(InverseDynamics, ForwardDynamics):
         """
         Gravity torques G(q) (gravity alone; with springs see static_torque)
         """
-    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+    def inverse_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
         """
-        Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, support_moment about the base origin, (N, 3)); q, qd, qdd each (N, dof). Instants with non-finite input give zeros and set their flag in `status`.
+        Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, support_moment about the base origin, (N, 3)); q, v, a each (N, dof). Instants with non-finite input give zeros and set their flag in `status`.
         """
     def mass_matrix(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         """
@@ -610,15 +610,15 @@ class KdlChainDynamics(InverseDynamics):
         """
         From the general MechanismModel when it is a serial chain (bodies lumped per link); ValueError naming the link or joint otherwise
         """
-    def coriolis(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    def coriolis(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
-        Coriolis and centrifugal torques C(q, qd) qd
+        Coriolis and centrifugal torques C(q, v) v
         """
     def gravity(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Gravity torques G(q)
         """
-    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+    def inverse_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
         """
         Joint torques (N, dof) and the wrench the base exerts on the chain (support_force, support_moment about the base origin, (N, 3)) by KDL's ChainIdSolver_RNE.
         """
@@ -643,6 +643,9 @@ class ControlConfig:
     def damping(self) -> float:
         ...
     @property
+    def home_gain(self) -> float:
+        ...
+    @property
     def integrator(self) -> str:
         ...
     @property
@@ -656,6 +659,12 @@ class ControlConfig:
         ...
     @property
     def kp(self) -> list[float]:
+        ...
+    @property
+    def limit_gain(self) -> float:
+        ...
+    @property
+    def max_rate(self) -> float:
         ...
     @property
     def rate_hz(self) -> float:
@@ -1188,23 +1197,23 @@ class Arm2DofDynamics(InverseDynamics, ForwardDynamics):
     """
     def __init__(self, arm: Arm2DofParameters, counterweights: Arm2DofCounterweights = ...) -> None:
         ...
-    def coriolis_matrix(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 2]"]:
+    def coriolis_matrix(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 2]"]:
         """
-        C(q, qd) (2, 2), Christoffel form
+        C(q, v) (2, 2), Christoffel form
         """
-    def forward_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike) -> dict:
+    def forward_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike) -> dict:
         """
-        Accelerations (N, 2): {'qdd', 'status'}
+        Accelerations (N, 2): {'a', 'status'}
         """
     def gravity(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 1]"]:
         """
         Q(q) (2,), eqs 21-22
         """
-    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+    def inverse_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
         """
         Joint torques (N, 2): {'tau', 'status'}
         """
-    def kinetic_energy(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> float:
+    def kinetic_energy(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> float:
         ...
     def mass_matrix(self, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[2, 2]"]:
         """
@@ -1230,21 +1239,43 @@ class ComputedTorque(JointController):
     @typing.overload
     def __init__(self, model: FiveBarDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
         ...
+    def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
+        """
+        step() with the status as an int (what the Python classes' step wraps in a JointCommand)
+        """
     def reset(self) -> None:
         """
         Forget the held command (zero torque).
         """
-    def run(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> dict:
+    @typing.overload
+    def run(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> dict:
         """
-        N consecutive ticks in one call: q, qd [rad or m, rad/s or m/s], q_des, qd_des, qdd_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
+        N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
         """
-    def step(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> tuple:
+    @typing.overload
+    def run(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """
         One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
         """
-    def step_into(self, q: numpy.typing.NDArray[numpy.float64], qd: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], qd_des: numpy.typing.NDArray[numpy.float64], qdd_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+    @typing.overload
+    def step(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step_into(self, q: numpy.typing.NDArray[numpy.float64], v: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], v_des: numpy.typing.NDArray[numpy.float64], a_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
         """
         The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
+        """
+    @typing.overload
+    def step_into(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
         """
     @property
     def dof(self) -> int:
@@ -1257,27 +1288,49 @@ class ComputedTorque(JointController):
         ...
 class DecoupledJointController(JointController):
     """
-    tau_i = k_i (qdd_d + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho eqs 15, 26, 36)
+    tau_i = k_i (a_des + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho eqs 15, 26, 36)
     """
     def __init__(self, k: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
         """
         k, kp, kd: one value per joint; torque_limit: one per joint (default and +inf: mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range of a tick (beyond it: the held command and Status.out_of_range)
         """
+    def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
+        """
+        step() with the status as an int (what the Python classes' step wraps in a JointCommand)
+        """
     def reset(self) -> None:
         """
         Forget the held command (zero torque).
         """
-    def run(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> dict:
+    @typing.overload
+    def run(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> dict:
         """
-        N consecutive ticks in one call: q, qd [rad or m, rad/s or m/s], q_des, qd_des, qdd_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
+        N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
         """
-    def step(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> tuple:
+    @typing.overload
+    def run(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """
         One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
         """
-    def step_into(self, q: numpy.typing.NDArray[numpy.float64], qd: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], qd_des: numpy.typing.NDArray[numpy.float64], qdd_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+    @typing.overload
+    def step(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step_into(self, q: numpy.typing.NDArray[numpy.float64], v: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], v_des: numpy.typing.NDArray[numpy.float64], a_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
         """
         The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
+        """
+    @typing.overload
+    def step_into(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
         """
     @property
     def dof(self) -> int:
@@ -1299,21 +1352,43 @@ class PassiveController(JointController):
         """
         dof: number of actuated coordinates (>= 1)
         """
+    def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
+        """
+        step() with the status as an int (what the Python classes' step wraps in a JointCommand)
+        """
     def reset(self) -> None:
         """
         Forget the held command (zero torque).
         """
-    def run(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> dict:
+    @typing.overload
+    def run(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> dict:
         """
-        N consecutive ticks in one call: q, qd [rad or m, rad/s or m/s], q_des, qd_des, qdd_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
+        N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
         """
-    def step(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> tuple:
+    @typing.overload
+    def run(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """
         One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
         """
-    def step_into(self, q: numpy.typing.NDArray[numpy.float64], qd: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], qd_des: numpy.typing.NDArray[numpy.float64], qdd_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+    @typing.overload
+    def step(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step_into(self, q: numpy.typing.NDArray[numpy.float64], v: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], v_des: numpy.typing.NDArray[numpy.float64], a_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
         """
         The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
+        """
+    @typing.overload
+    def step_into(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
         """
     @property
     def dof(self) -> int:
@@ -1444,15 +1519,15 @@ class FiveBarDynamics:
     """
     def __init__(self, parameters: FiveBarParameters, singular_tolerance: typing.SupportsFloat | typing.SupportsIndex = 1e-06) -> None:
         ...
-    def evaluate(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> dict:
+    def evaluate(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike) -> dict:
         """
         For N states (q, qd each (N, 2)): {'mass' (N, 2, 2), 'velocity', 'gravity' (N, 2), 'ok' (N,), 'reciprocal_condition' (N,), 'status_per_instant' (N,), 'status' (OR)}; failed states give zeros
         """
-    def inverse_dynamics(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+    def inverse_dynamics(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
         """
         Joint torques (N, 2): {'tau', 'status_per_instant' (N,), 'status' (OR)}
         """
-    def motion(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+    def motion(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
         """
         Joint angles/rates/accelerations (N, 4) in the order (theta1, theta12, theta2, theta22) and the end effector (y, z) position/velocity/acceleration (N, 2); status_per_instant (N,) and their OR, status; failed instants give zeros
         """
@@ -1590,21 +1665,43 @@ class ReactionlessJointController(JointController):
     """
     def __init__(self, model: MechanismModel, balancing_joints: collections.abc.Sequence[str], q0: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, position_limits: bool = True, home_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, limit_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, home: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_task_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, torque_limit: typing.Any = None, q_guess: typing.Any = None) -> None:
         ...
+    def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
+        """
+        step() with the status as an int (what the Python classes' step wraps in a JointCommand)
+        """
     def reset(self) -> None:
         """
         Forget the held command (zero torque).
         """
-    def run(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> dict:
+    @typing.overload
+    def run(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> dict:
         """
-        N consecutive ticks in one call: q, qd [rad or m, rad/s or m/s], q_des, qd_des, qdd_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
+        N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
         """
-    def step(self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike) -> tuple:
+    @typing.overload
+    def run(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """
         One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
         """
-    def step_into(self, q: numpy.typing.NDArray[numpy.float64], qd: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], qd_des: numpy.typing.NDArray[numpy.float64], qdd_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+    @typing.overload
+    def step(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step_into(self, q: numpy.typing.NDArray[numpy.float64], v: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], v_des: numpy.typing.NDArray[numpy.float64], a_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
         """
         The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
+        """
+    @typing.overload
+    def step_into(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
         """
     @property
     def dof(self) -> int:
@@ -1618,6 +1715,10 @@ class ReactionlessJointController(JointController):
 def arm2dof_description(arm: Arm2DofParameters, counterweights: Arm2DofCounterweights = ...) -> MechanismDescription:
     """
     The 2-DOF arm (counterweights merged into the links) as a general MechanismDescription: x-z plane, joints 'shoulder' and 'elbow' with axes along -y, gravity (0, 0, -g)
+    """
+def case_from_toml(text: str, source: str = 'string') -> tuple[MechanismModel, ControlConfig, str]:
+    """
+    As load_case_file, from TOML text (the whole document).
     """
 def load_case_file(path: str) -> tuple[MechanismModel, ControlConfig, str]:
     """
@@ -1677,6 +1778,10 @@ def mechanism_momentum_regressor(model: MechanismModel, q: numpy.typing.ArrayLik
     ...
 def mechanism_shaking_wrench(model: MechanismModel, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike, with_gravity: bool = True) -> dict:
     ...
+def mechanism_single_sample(model: typing.Any, status_ok: typing.Any, wrench_type: type) -> dict:
+    """
+    The per-sample calls of a MechanismModel from float64 arrays (what mechbal.Mechanism uses first), sharing one MechanismData: {name: function}, each returning None when its arguments are not 1-D C-contiguous float64 numpy arrays of dof values, or the instant is rejected (the caller then takes its general path). shaking_wrench returns a `wrench_type` (a class with the fields shaking_force, shaking_moment, linear_momentum, angular_momentum and status, set without calling its __init__; status: `status_ok`).
+    """
 def mechanism_springs(model: MechanismModel, q: numpy.typing.ArrayLike) -> dict:
     """
     Springs over a batch of configurations (N, dof): spring_length (anchor distance d [m]) and spring_tension (T at the anchors [N]) (N, S), spring_torque K(q) = dV_s/dq (N, dof), spring_energy [J] and potential_energy (gravity plus springs [J]) (N,), status (N,)
@@ -1687,7 +1792,7 @@ def mechanism_static_torque(model: MechanismModel, q: numpy.typing.ArrayLike) ->
     """
 def mechanism_torque_regressor(model: MechanismModel, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
     ...
-def paminsa_kinematics(model: PaminsaModel, P: numpy.typing.ArrayLike, Pd: numpy.typing.ArrayLike, Pdd: numpy.typing.ArrayLike, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> dict:
+def paminsa_kinematics(model: PaminsaModel, P: numpy.typing.ArrayLike, Pd: numpy.typing.ArrayLike, Pdd: numpy.typing.ArrayLike, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, a: numpy.typing.ArrayLike) -> dict:
     """
     Every body's motion (N, 38, ...), the shaking wrench about O and D, dD/dt (eq 19) for platform motion and prescribed wrist motion, each (N, 3).
     """
@@ -1703,11 +1808,11 @@ def read_urdf(path: str, strict: bool = False, allow_massless: bool = False) -> 
     """
     (MechanismModel, warnings) of a URDF file: strict refuses the defects that the lenient reading repairs with one warning each (mechbal/io/urdf.hpp, UrdfOptions); a URDF with no <inertial> on any moving link is refused unless allow_massless.
     """
-def simulate_closed_loop(plant: ForwardDynamics, controller: JointController, desired: RestToRestTrajectory, q0: numpy.typing.ArrayLike, qd0: numpy.typing.ArrayLike, dt: typing.SupportsFloat | typing.SupportsIndex = 0.001, duration: typing.SupportsFloat | typing.SupportsIndex = 1.0, sampling: str = 'zero_order_hold') -> dict:
+def simulate_closed_loop(plant: ForwardDynamics, controller: JointController, desired: RestToRestTrajectory, q0: numpy.typing.ArrayLike, v0: numpy.typing.ArrayLike, dt: typing.SupportsFloat | typing.SupportsIndex = 0.001, duration: typing.SupportsFloat | typing.SupportsIndex = 1.0, sampling: str = 'zero_order_hold') -> dict:
     """
-    RK4 closed loop of `plant` (any ForwardDynamics: Arm2DofDynamics, MechanismDynamics of any mechanism) under `controller` (any JointController) tracking `desired`; returns a dict of arrays t (N+1,), q, qd, q_des, qd_des, tau (N+1, dof), status, saturated_ticks, steps_completed.
+    RK4 closed loop of `plant` (any ForwardDynamics: Arm2DofDynamics, MechanismDynamics of any mechanism) under `controller` (any JointController) tracking `desired`; returns a dict of arrays t (N+1,), q, v, q_des, v_des, tau (N+1, dof), status, saturated_ticks, steps_completed.
     """
-def simulate_closed_loop_sampled(plant: ForwardDynamics, controller: JointController, q_des: numpy.typing.ArrayLike, qd_des: numpy.typing.ArrayLike, qdd_des: numpy.typing.ArrayLike, q0: numpy.typing.ArrayLike, qd0: numpy.typing.ArrayLike, dt: typing.SupportsFloat | typing.SupportsIndex = 0.001, duration: typing.SupportsFloat | typing.SupportsIndex = 1.0, sampling: str = 'zero_order_hold') -> dict:
+def simulate_closed_loop_sampled(plant: ForwardDynamics, controller: JointController, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike, q0: numpy.typing.ArrayLike, v0: numpy.typing.ArrayLike, dt: typing.SupportsFloat | typing.SupportsIndex = 0.001, duration: typing.SupportsFloat | typing.SupportsIndex = 1.0, sampling: str = 'zero_order_hold') -> dict:
     """
     simulate_closed_loop tracking a sampled desired motion: q_des, qd_des, qdd_des each (2 steps + 1, dof), sampled every dt/2 from t = 0 (steps = round(duration / dt)).
     """
