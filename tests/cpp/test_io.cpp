@@ -410,6 +410,7 @@ TEST(MakeController, TaskControllerTicksAsOneBuiltDirectly) {
   }
   EXPECT_LE(worst, 1e-12);
   EXPECT_EQ(allocations, 0u);
+}
 
 TEST(CaseReader, ConstantSpeedTrajectory) {
   const std::string base = arm("origin") + "[case]\nname = \"arm\"\nkind = \"mechanism\"\n";
