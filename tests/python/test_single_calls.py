@@ -160,7 +160,7 @@ def test_controller_step_fast_and_general_inputs_agree(index):
         raw_tau, raw_status = _core.ComputedTorque.step(ctrl, *x) if isinstance(ctrl, _core.ComputedTorque) \
             else _core.DecoupledJointController.step(ctrl, *x)
         assert isinstance(raw_status, _core.Status) and raw_status == status
-    with pytest.raises(ValueError, match=rf"qd must have shape \({n},\) \(the controller has {n} joints\)"):
+    with pytest.raises(ValueError, match=rf"v must have shape \({n},\) \(the controller has {n} joints\)"):
         ctrl.step(np.zeros(n), np.zeros(n + 1), np.zeros(n), np.zeros(n), np.zeros(n))
     with pytest.raises(TypeError, match="q_des must be an array of real numbers"):
         ctrl.step(np.zeros(n), np.zeros(n), np.zeros(n, complex), np.zeros(n), np.zeros(n))

@@ -1217,9 +1217,9 @@ ControlConfig read_control(const toml::node& n, const MechanismModel& model) {
   const auto& t = table_of(n, f);
   const std::vector<std::string> decoupled{"k"};
   const std::vector<std::string> reactionless{"balancing_joints", "cancel", "integrator", "damping",
-                                              "max_rate", "home_gain", "limit_gain", "task_frame"};
+                                              "max_rate", "home_gain", "limit_gain", "task_frame", "task_rows"};
   const std::vector<std::string> all{"kind", "balancing_joints", "cancel", "integrator", "rate_hz", "damping", "max_rate",
-                               "home_gain", "limit_gain", "task_frame", "kp", "kd", "torque_limit", "k"};
+                               "home_gain", "limit_gain", "task_frame", "task_rows", "kp", "kd", "torque_limit", "k"};
   allow_keys(t, f, all);
   ControlConfig c;
   // the table's own fields (types, ranges), in the Python model's order
@@ -1249,6 +1249,15 @@ ControlConfig read_control(const toml::node& n, const MechanismModel& model) {
   if (auto x = get(t, "home_gain")) c.home_gain = number(*x, join(f, "home_gain"), 0.0);
   if (auto x = get(t, "limit_gain")) c.limit_gain = number(*x, join(f, "limit_gain"), 0.0);
   if (auto x = get(t, "task_frame")) c.task_frame = name(*x, join(f, "task_frame"));
+  if (auto x = get(t, "task_rows")) {
+    const std::string fr = join(f, "task_rows");
+    const toml::array& a = array_of(*x, fr, 1, 8);
+    c.task_rows.clear();
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      c.task_rows.push_back(
+          choice(*a.get(k), item(fr, k), {"all", "linear", "angular", "v_x", "v_y", "v_z", "w_x", "w_y", "w_z"}));
+    }
+  }
   std::vector<std::vector<double>*> per_joint{&c.kp, &c.kd, &c.torque_limit, &c.k};
   const char* per_joint_keys[] = {"kp", "kd", "torque_limit", "k"};
   for (std::size_t i = 0; i < per_joint.size(); ++i) {
@@ -1288,6 +1297,9 @@ ControlConfig read_control(const toml::node& n, const MechanismModel& model) {
   }
   if (get(t, "kp") && !get(t, "kd")) fail(join(f, "kd"), "is required with kp (the computed-torque stage)");
   if (get(t, "kd") && !get(t, "kp")) fail(join(f, "kp"), "is required with kd (the computed-torque stage)");
+  if (get(t, "task_rows") && !get(t, "task_frame")) {
+    fail(join(f, "task_rows"), "is for the operational-space mode: give task_frame", *get(t, "task_rows"));
+  }
   // against the mechanism (schema._cross_checks)
   std::vector<std::string> actuated;
   for (int i : model.actuated_coordinates()) actuated.push_back(model.coordinate_name(i));

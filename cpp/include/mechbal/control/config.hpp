@@ -44,6 +44,9 @@ struct ControlConfig {
   double limit_gain = 0.0;         ///< redundant balancing joints: push away from the joint limits
   /// Operational-space mode: the frame whose path [trajectory] gives (empty: joint-space mode).
   std::string task_frame;
+  /// Operational-space mode: the frame's tracked twist components, "all" (default), "linear",
+  /// "angular", "v_x" ... "w_z" (only with task_frame).
+  std::vector<std::string> task_rows{"all"};
 };
 
 }  // namespace mechbal
