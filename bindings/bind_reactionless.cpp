@@ -15,6 +15,7 @@
 #include "bindings.hpp"
 #include "controller_step.hpp"
 #include "motion_tick.hpp"
+#include "mechbal/control/factory.hpp"
 #include "mechbal/control/reactionless.hpp"
 
 namespace py = pybind11;
@@ -154,25 +155,6 @@ py::dict run(ReactionlessController& c, const Array& q, const Array& v, const Ar
   return d;
 }
 
-std::uint32_t task_mask(const std::vector<std::string>& rows) {
-  static const std::pair<const char*, std::uint32_t> names[] = {
-      {"linear", cancel_force}, {"angular", cancel_moment}, {"all", cancel_both}, {"v_x", force_x},
-      {"v_y", force_y},         {"v_z", force_z},          {"w_x", moment_x},  {"w_y", moment_y},
-      {"w_z", moment_z}};
-  if (rows.empty()) throw py::value_error("task_rows must name at least one twist component");
-  std::uint32_t mask = 0;
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    std::uint32_t bit = 0;
-    for (const auto& n : names)
-      if (rows[i] == n.first) bit = n.second;
-    if (bit == 0)
-      throw py::value_error("task_rows[" + std::to_string(i) + "]: '" + rows[i] +
-                            "' is not a twist component (linear, angular, all, v_x, v_y, v_z, w_x, w_y, w_z)");
-    mask |= bit;
-  }
-  return mask;
-}
-
 void bind_task_controller(py::module_& m) {
   py::class_<ReactionlessTaskController>(
       m, "ReactionlessTaskController",
@@ -185,7 +167,7 @@ void bind_task_controller(py::module_& m) {
              TaskSpaceConfig c;
              c.null_space = null_space;
              c.frame = frame;
-             c.task_rows = task_mask(task_rows);
+             c.task_rows = task_rows_mask(task_rows, "task_rows");  // the factory's table and messages
              c.cancel = cancel_mask(cancel);
              c.integrator = integrator_of(integrator);
              c.rate_hz = rate_hz;

@@ -358,6 +358,19 @@ duration = 1.0
 """
 
 
+def test_operational_space_task_rows_errors_are_the_factory_messages(tmp_path):
+    """The Python ReactionlessTaskController reads task_rows through the C++ factory's table
+    (mechbal::task_rows_mask): the factory's message, with the argument's name."""
+    (tmp_path / "arm4.toml").write_text(ARM4)
+    mech = mechbal.Mechanism.from_toml(tmp_path / "arm4.toml")
+    with pytest.raises(ValueError) as e:
+        control.ReactionlessTaskController(mech, "tool", ["v_x", "lineal"], "moment_z")
+    assert str(e.value) == ("task_rows[1]: 'lineal' is not a twist component (all, linear, angular, v_x, "
+                            "v_y, v_z, w_x, w_y, w_z)")
+    with pytest.raises(ValueError, match=r"^task_rows: must name at least one twist component$"):
+        control.ReactionlessTaskController(mech, "tool", [], "moment_z")
+
+
 def test_operational_space_uses_redundancy_to_cancel_the_moment(tmp_path):
     """A planar 3R arm with a disc joint (4 joints; the tool on the third link) follows a circle:
     with v = J^+ x' alone the arm shakes its base about z; in the reaction null space
