@@ -15,6 +15,7 @@
 #include "bindings.hpp"
 #include "controller_step.hpp"
 #include "motion_tick.hpp"
+#include "value_errors.hpp"
 #include "mechbal/control/factory.hpp"
 #include "mechbal/control/reactionless.hpp"
 
@@ -71,15 +72,6 @@ ReactionlessConfig make_config(const std::vector<std::string>& balancing, const 
 Eigen::VectorXd optional_vector(const py::object& o, const char* name, py::ssize_t n) {
   if (o.is_none()) return Eigen::VectorXd();
   return vector_arg(to_real_array(o), name, n);
-}
-
-template <typename T, typename Fn>
-T translate(Fn fn) {
-  try {
-    return fn();
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error(e.what());
-  }
 }
 
 std::vector<std::string> names_of(const ReactionlessController& c, const std::vector<int>& idx) {
@@ -177,7 +169,7 @@ void bind_task_controller(py::module_& m) {
              const Eigen::VectorXd q = q0.is_none() ? Eigen::VectorXd(Eigen::VectorXd::Zero(model.dof()))
                                                     : vector_arg(to_real_array(q0), "q0", model.dof(), true);
              const Eigen::VectorXd v = optional_vector(v0, "v0", model.dof());
-             return translate<ReactionlessTaskController*>([&] {
+             return value_errors([&] {
                return new ReactionlessTaskController(std::make_shared<const MechanismModel>(model), c, q, v);
              });
            }),
@@ -279,7 +271,7 @@ void bind_reactionless(py::module_& m) {
                               : vector_arg(to_real_array(q0), "q0", model.num_actuated(), true);
              const Eigen::VectorXd v0_ = optional_vector(v0, "v0", model.num_actuated());
              const Eigen::VectorXd guess = optional_vector(q_guess, "q_guess", model.dof());
-             return translate<ReactionlessController*>([&] {
+             return value_errors([&] {
                return new ReactionlessController(std::make_shared<const MechanismModel>(model), c, q0_, v0_, guess);
              });
            }),
@@ -379,7 +371,7 @@ void bind_reactionless(py::module_& m) {
            const Eigen::VectorXd limit = optional_vector(torque_limit, "torque_limit", -1);
            const Eigen::VectorXd guess = optional_vector(q_guess, "q_guess", model.dof());
            const Eigen::VectorXd kp_ = vector_arg(kp, "kp", -1), kd_ = vector_arg(kd, "kd", -1);
-           return translate<ReactionlessJointController*>([&] {
+           return value_errors([&] {
              return new ReactionlessJointController(std::make_shared<const MechanismModel>(model), c, q0_, kp_, kd_,
                                                     limit, JointInputRange{}, guess);
            });
