@@ -43,7 +43,7 @@ class SingleSample {
  public:
   SingleSample(const py::object& model, const py::object& status_ok, const py::object& wrench_type)
       : owner_(model), status_ok_(status_ok), wrench_type_(wrench_type), model_(model.cast<const MechanismModel*>()), data_(*model_),
-        n_(model_->dof()), reaction_bounds_(*model_) {}
+        n_(model_->dof()), bounds_(*model_) {}
 
   py::object inverse_dynamics(py::handle q, py::handle v, py::handle a) {
     const double *pq = vec(q), *pv = vec(v), *pa = vec(a);
@@ -82,16 +82,16 @@ class SingleSample {
 
   /// A `wrench_type` (mechbal.ShakingWrench, a frozen dataclass) with its fields shaking_force,
   /// shaking_moment, linear_momentum, angular_momentum and status (`status_ok`) set as
-  /// wrench_type(**fields) sets them, without the Python-level __init__ (a third of the call). Accepted exactly when the general path (which
-  /// runs base_reaction) accepts: base_reaction only runs here when the bounds cannot tell. base_reaction, as the general path, so that the same
-  /// instants are accepted.
+  /// wrench_type(**fields) sets them, without the Python-level __init__ (a third of the call).
+  /// Accepted exactly when the general path accepts: finite reactions too, base_reaction running
+  /// only when their bounds (reaction_bounds.hpp) cannot tell, as in the general path.
   py::object shaking_wrench(py::handle q, py::handle v, py::handle a) {
     const double *pq = vec(q), *pv = vec(v), *pa = vec(a);
     if (!pq || !pv || !pa) return py::none();
     const auto& d = data_;
     const CMap qm(pq, n_), vm(pv, n_), am(pa, n_);
     if (mechbal::shaking_wrench(*model_, data_, qm, vm, am) != Status::ok) return py::none();
-    if (!reaction_bounds_.surely_finite(data_)) {  // the general path's verdict, computed
+    if (!bounds_.surely_finite(data_)) {  // the general path's verdict, computed
       if (base_reaction(*model_, data_, qm, vm, am) != Status::ok ||
           !(d.base_reaction.force.allFinite() && d.base_reaction.moment.allFinite() &&
             d.support_reaction.force.allFinite() && d.support_reaction.moment.allFinite()))
@@ -198,7 +198,7 @@ class SingleSample {
   const MechanismModel* model_;
   MechanismData data_;
   py::ssize_t n_;
-  ReactionBounds reaction_bounds_;  ///< when shaking_wrench's verdict is base_reaction's
+  ReactionBounds bounds_;
 };
 
 // ---- the calls: METH_FASTCALL builtin functions bound to a capsule of the SingleSample (a

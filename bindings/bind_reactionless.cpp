@@ -15,6 +15,8 @@
 #include "bindings.hpp"
 #include "controller_step.hpp"
 #include "motion_tick.hpp"
+#include "value_errors.hpp"
+#include "mechbal/control/factory.hpp"
 #include "mechbal/control/reactionless.hpp"
 
 namespace py = pybind11;
@@ -70,15 +72,6 @@ ReactionlessConfig make_config(const std::vector<std::string>& balancing, const 
 Eigen::VectorXd optional_vector(const py::object& o, const char* name, py::ssize_t n) {
   if (o.is_none()) return Eigen::VectorXd();
   return vector_arg(to_real_array(o), name, n);
-}
-
-template <typename T, typename Fn>
-T translate(Fn fn) {
-  try {
-    return fn();
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error(e.what());
-  }
 }
 
 std::vector<std::string> names_of(const ReactionlessController& c, const std::vector<int>& idx) {
@@ -154,25 +147,6 @@ py::dict run(ReactionlessController& c, const Array& q, const Array& v, const Ar
   return d;
 }
 
-std::uint32_t task_mask(const std::vector<std::string>& rows) {
-  static const std::pair<const char*, std::uint32_t> names[] = {
-      {"linear", cancel_force}, {"angular", cancel_moment}, {"all", cancel_both}, {"v_x", force_x},
-      {"v_y", force_y},         {"v_z", force_z},          {"w_x", moment_x},  {"w_y", moment_y},
-      {"w_z", moment_z}};
-  if (rows.empty()) throw py::value_error("task_rows must name at least one twist component");
-  std::uint32_t mask = 0;
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    std::uint32_t bit = 0;
-    for (const auto& n : names)
-      if (rows[i] == n.first) bit = n.second;
-    if (bit == 0)
-      throw py::value_error("task_rows[" + std::to_string(i) + "]: '" + rows[i] +
-                            "' is not a twist component (linear, angular, all, v_x, v_y, v_z, w_x, w_y, w_z)");
-    mask |= bit;
-  }
-  return mask;
-}
-
 void bind_task_controller(py::module_& m) {
   py::class_<ReactionlessTaskController>(
       m, "ReactionlessTaskController",
@@ -185,7 +159,7 @@ void bind_task_controller(py::module_& m) {
              TaskSpaceConfig c;
              c.null_space = null_space;
              c.frame = frame;
-             c.task_rows = task_mask(task_rows);
+             c.task_rows = task_rows_mask(task_rows, "task_rows");  // the factory's table and messages
              c.cancel = cancel_mask(cancel);
              c.integrator = integrator_of(integrator);
              c.rate_hz = rate_hz;
@@ -195,7 +169,7 @@ void bind_task_controller(py::module_& m) {
              const Eigen::VectorXd q = q0.is_none() ? Eigen::VectorXd(Eigen::VectorXd::Zero(model.dof()))
                                                     : vector_arg(to_real_array(q0), "q0", model.dof(), true);
              const Eigen::VectorXd v = optional_vector(v0, "v0", model.dof());
-             return translate<ReactionlessTaskController*>([&] {
+             return value_errors([&] {
                return new ReactionlessTaskController(std::make_shared<const MechanismModel>(model), c, q, v);
              });
            }),
@@ -297,7 +271,7 @@ void bind_reactionless(py::module_& m) {
                               : vector_arg(to_real_array(q0), "q0", model.num_actuated(), true);
              const Eigen::VectorXd v0_ = optional_vector(v0, "v0", model.num_actuated());
              const Eigen::VectorXd guess = optional_vector(q_guess, "q_guess", model.dof());
-             return translate<ReactionlessController*>([&] {
+             return value_errors([&] {
                return new ReactionlessController(std::make_shared<const MechanismModel>(model), c, q0_, v0_, guess);
              });
            }),
@@ -397,7 +371,7 @@ void bind_reactionless(py::module_& m) {
            const Eigen::VectorXd limit = optional_vector(torque_limit, "torque_limit", -1);
            const Eigen::VectorXd guess = optional_vector(q_guess, "q_guess", model.dof());
            const Eigen::VectorXd kp_ = vector_arg(kp, "kp", -1), kd_ = vector_arg(kd, "kd", -1);
-           return translate<ReactionlessJointController*>([&] {
+           return value_errors([&] {
              return new ReactionlessJointController(std::make_shared<const MechanismModel>(model), c, q0_, kp_, kd_,
                                                     limit, JointInputRange{}, guess);
            });
