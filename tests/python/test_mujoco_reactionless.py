@@ -205,3 +205,19 @@ def test_run_mujoco_panda_operational_space(tmp_path):
     assert red["peak_norm_uncontrolled"] > 0.1
     assert red["ratio"] < 1e-2
     assert s["cosimulation"]["controlled"]["peak_tracking_error"] < 1e-4
+
+
+def test_verify_cli_without_simulation(tmp_path):
+    """``mechbal verify CASE --no-simulation`` on a reactionless case: the prescribed-motion checks
+    alone (no co-simulation, no time step study, no plot)."""
+    from mechbal.cli import main
+
+    out = tmp_path / "out"
+    assert main(["verify", "reaction-wheel-arm", "--no-simulation", "--out", str(out), "-q"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["mode"] == "joint" and "time_step" not in s and "shaking_wrench.png" not in s["files"]
+    assert not (out / "shaking_wrench.png").exists()
+    for label in ("uncontrolled", "controlled"):
+        assert "simulation" not in s["variants"][label]
+        assert s["variants"][label]["shaking_moment"]["relative_difference"] < 1e-9
+    assert s["residual"]["moment_z"]["mujoco_inverse_controlled_fraction"] < 1e-9
