@@ -183,6 +183,39 @@ void bind_task_controller(py::module_& m) {
       .def_property_readonly("dt", &ReactionlessTaskController::dt)
       .def_property_readonly("target", &ReactionlessTaskController::target)
       .def(
+          "step",
+          [](ReactionlessTaskController& c, const Array& twist, const py::object& twist_rate,
+             const py::object& twist_half, const py::object& twist_next) {
+            const Vec6 now = fixed_vector<6>(twist, "twist");
+            const Vec6 half = twist_half.is_none() ? now : fixed_vector<6>(to_real_array(twist_half), "twist_half");
+            const Vec6 next = twist_next.is_none() ? now : fixed_vector<6>(to_real_array(twist_next), "twist_next");
+            if (twist_rate.is_none()) return static_cast<std::uint32_t>(c.step(now, half, next));
+            return static_cast<std::uint32_t>(
+                c.step(now, fixed_vector<6>(to_real_array(twist_rate), "twist_rate"), half, next));
+          },
+          py::arg("twist"), py::arg("twist_rate") = py::none(), py::arg("twist_half") = py::none(),
+          py::arg("twist_next") = py::none(),
+          "One tick: the desired frame twist [v; w] (O axes) at t_n, its rate (default: estimated from the "
+          "three samples) and, for RK4, the twist at t_n + dt/2 and t_n + dt (default: the twist at t_n). "
+          "Returns the status (int, 0 = ok); the command is in q, v, a, momentum, frame_twist, "
+          "shaking_force, shaking_moment. run() gives the same commands over a whole motion.")
+      .def_property_readonly("q", [](const ReactionlessTaskController& c) { return Eigen::VectorXd(c.q()); },
+                             "Commanded positions at t_n [rad or m] (dof,)")
+      .def_property_readonly("v", [](const ReactionlessTaskController& c) { return Eigen::VectorXd(c.v()); },
+                             "Commanded rates at t_n [rad/s or m/s] (dof,)")
+      .def_property_readonly("a", [](const ReactionlessTaskController& c) { return Eigen::VectorXd(c.a()); },
+                             "Acceleration feed-forward at t_n [rad/s^2 or m/s^2] (dof,)")
+      .def_property_readonly("momentum", [](const ReactionlessTaskController& c) { return Vec6(c.momentum()); },
+                             "Momentum [P; H_O] of the command (6,)")
+      .def_property_readonly("frame_twist", [](const ReactionlessTaskController& c) { return Vec6(c.frame_twist()); },
+                             "The frame's twist J v of the command [v; w] (6,)")
+      .def_property_readonly("shaking_force", [](const ReactionlessTaskController& c) { return Vec3(c.shaking_force()); },
+                             "Predicted shaking force of the command [N] (3,)")
+      .def_property_readonly("shaking_moment", [](const ReactionlessTaskController& c) { return Vec3(c.shaking_moment()); },
+                             "Predicted shaking moment about O of the command [N m] (3,)")
+      .def_property_readonly("status", [](const ReactionlessTaskController& c) { return static_cast<std::uint32_t>(c.status()); },
+                             "Status of the last tick (int, 0 = ok)")
+      .def(
           "run",
           [](ReactionlessTaskController& c, const Array& twist, const py::object& twist_rate_obj) {
             require_shape(twist, "twist", {-1, 6});
