@@ -350,6 +350,11 @@ def main(argv=None):
                f"mechbal [instants/s] | {fmt(b['mechbal_instants_per_s'])} |",
                f"| same, pure numpy [instants/s] | {fmt(b['numpy_instants_per_s'])} |",
                f"| numpy time / mechbal time | {fmt(b['numpy_over_mechbal'], 1)} |"]
+        if "numpy_with_kinematics_over_mechbal" in b:  # the same work: numpy from q, v, a too
+            md += [f"| same work in numpy, kinematics from q, v, a included [instants/s] | "
+                   f"{fmt(b['numpy_with_kinematics_instants_per_s'])} |",
+                   f"| numpy time / mechbal time, same work | "
+                   f"{fmt(b['numpy_with_kinematics_over_mechbal'], 1)} |"]
         for name, v in py.get("batch_controllers", {}).items():
             md.append(f"| {name} batch, {v['ticks']:,} ticks: ticks/s (ns per tick) | "
                       f"{fmt(v['ticks_per_s'])} ({fmt(v['ns_per_tick'])}) |")

@@ -14,6 +14,7 @@
 
 #include "array_checks.hpp"
 #include "bindings.hpp"
+#include "reaction_bounds.hpp"
 #include "mechbal/algorithm/center_of_mass.hpp"
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/jacobian.hpp"
@@ -779,9 +780,35 @@ void bind_mechanism(py::module_& m) {
         batch_rows(mo, v, "v", N);
         batch_rows(mo, a, "a", N);
         const auto n = static_cast<Eigen::Index>(mo.dof());
-        Array F = make_array({N, 3}), M = make_array({N, 3}), P = make_array({N, 3}), H = make_array({N, 3}),
-              RF = make_array({N, 3}), RM = make_array({N, 3}), SF = make_array({N, 3}),
-              SM = make_array({N, 3});
+        Array F = make_array({N, 3}), M = make_array({N, 3}), P = make_array({N, 3}), H = make_array({N, 3});
+        if (!with_gravity) {
+          // the shaking wrench only: base_reaction (the mass moments, the reactions) runs only
+          // where the bounds cannot tell that it accepts the instant, so the statuses are those
+          // of the call with gravity
+          const ReactionBounds bounds(mo);
+          auto status = run_batch(
+              mo, N,
+              [&](py::ssize_t k, MechanismData& d) {
+                const CVec qk(row(q, k), n), vk(row(v, k), n), ak(row(a, k), n);
+                const Status s = shaking_wrench(mo, d, qk, vk, ak);
+                return s != Status::ok || bounds.surely_finite(d) ? s : base_reaction(mo, d, qk, vk, ak);
+              },
+              finite_wrench,
+              [&](py::ssize_t k, const MechanismData& d, bool ok) {
+                put3(F, k, 0, d.shaking.force, ok);
+                put3(M, k, 0, d.shaking.moment, ok);
+                put3(P, k, 0, d.shaking.linear_momentum, ok);
+                put3(H, k, 0, d.shaking.angular_momentum, ok);
+              });
+          py::dict out;
+          out["shaking_force"] = F;
+          out["shaking_moment"] = M;
+          out["linear_momentum"] = P;
+          out["angular_momentum"] = H;
+          out["status"] = status;
+          return out;
+        }
+        Array RF = make_array({N, 3}), RM = make_array({N, 3}), SF = make_array({N, 3}), SM = make_array({N, 3});
         auto status = run_batch(
             mo, N,
             [&](py::ssize_t k, MechanismData& d) {
@@ -806,12 +833,10 @@ void bind_mechanism(py::module_& m) {
         out["shaking_moment"] = M;
         out["linear_momentum"] = P;
         out["angular_momentum"] = H;
-        if (with_gravity) {
-          out["base_reaction_force"] = RF;
-          out["base_reaction_moment"] = RM;
-          out["support_reaction_force"] = SF;
-          out["support_reaction_moment"] = SM;
-        }
+        out["base_reaction_force"] = RF;
+        out["base_reaction_moment"] = RM;
+        out["support_reaction_force"] = SF;
+        out["support_reaction_moment"] = SM;
         out["status"] = status;
         return out;
       },

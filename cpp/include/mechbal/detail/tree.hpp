@@ -61,15 +61,22 @@ inline void joint_state(const MechanismModel& model, MechanismData& data,
 
 /// Link placements relative to their parents and, with World, in O (L frames). The passes that
 /// work in the links' own frames only (inverse dynamics, gravity, bias, mass matrix) skip World:
-/// work[].world_* are then left as they were (and marked stale).
+/// work[].world_* are then left as they were (and marked stale). `visit(l, work[l])` runs on each
+/// link right after it is placed (in tree order, links 1..n-1), while its data is in cache: an
+/// algorithm that needs one more quantity per placed link folds it into this pass instead of
+/// sweeping the links again.
 /// Incremental: a link whose joint position is the one its placement was last computed at
 /// (LinkWork::placed_at) keeps its rotation and translation, and its pose in O when neither it
 /// nor its parent moved since that pose was computed: an algorithm called at the q the links are
 /// already placed at (shaking_wrench after closed_motion, the momentum matrix at a pose where
 /// only a few joints moved) pays for the moved links only. The skipped values are exactly those
 /// that would be recomputed (same inputs, same operations), so results are bit for bit the same.
-template <bool World = true>
-inline void place(const MechanismModel& model, MechanismData& data) noexcept {
+struct NoVisit {
+  void operator()(int, const MechanismData::LinkWork&) const noexcept {}
+};
+
+template <bool World = true, class Visit = NoVisit>
+inline void place(const MechanismModel& model, MechanismData& data, Visit&& visit = Visit{}) noexcept {
   const int nl = model.num_links();
   for (int l = 1; l < nl; ++l) {
     const auto k = static_cast<std::size_t>(l);
@@ -116,6 +123,7 @@ inline void place(const MechanismModel& model, MechanismData& data) noexcept {
     } else if (local) {
       w.world_stale = true;  // world_* no longer that of rotation / translation
     }
+    visit(l, static_cast<const MechanismData::LinkWork&>(w));
   }
 }
 
