@@ -11,6 +11,7 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "alloc_counter.hpp"
@@ -146,13 +147,23 @@ Pair measure_pair(const mechbal::bench::Tick& other, const Tail& other_tail, con
 }
 
 /// The mechbal case another engine's case is compared with: X_pinocchio* -> X_mechbal or X,
-/// X_kdl_raw -> X_mechbal (the names of bench_registry.hpp's cases); -1 when there is none.
+/// X_kdl_raw -> X_mechbal (the names of bench_registry.hpp's cases); a general-model case -> the
+/// paper's closed form of the same tick (its ratio is then general / closed form); -1 when there
+/// is none.
 int counterpart(const std::vector<mechbal::bench::CaseEntry>& cases, const std::string& name) {
   auto find = [&](const std::string& n) {
     for (std::size_t i = 0; i < cases.size(); ++i)
       if (cases[i].name == n) return static_cast<int>(i);
     return -1;
   };
+  // the general path over the closed form (fast path) of the same quantities
+  static const std::pair<const char*, const char*> closed_forms[] = {
+      {"paminsa_general_wrench", "paminsa_wrench"},
+      {"reactionless_paminsa_euler", "paminsa_tick_euler"},
+      {"reactionless_paminsa_rk4", "paminsa_tick_rk4"}};
+  for (const auto& [general, closed] : closed_forms) {
+    if (name == general) return find(closed);
+  }
   for (const char* tag : {"_pinocchio", "_kdl_raw"}) {
     const auto at = name.rfind(tag);
     if (at == std::string::npos || at + std::strlen(tag) != name.size()) continue;

@@ -96,7 +96,10 @@ def speed_results(cases, ratio, median, check, loops_extra, interleaved):
         "interleaved": "every ratio of another engine's case (*_pinocchio, *_kdl_raw) over its mechbal "
                        "counterpart uses mechbal-bench's interleaved pass: rounds of one batch (~5 us of "
                        "calls) of each, alternating which goes first, so both see the same load; the "
-                       "ratio is the ratio of the two medians (the IQR of the per-round ratios is kept)",
+                       "ratio is the ratio of the two medians (the IQR of the per-round ratios is kept); "
+                       "so does every general-model case over its paper's closed form "
+                       "(paminsa_general_wrench / paminsa_wrench, reactionless_paminsa_* / paminsa_tick_*: "
+                       "'other' is then the general path, 'mechbal' the closed form)",
         "big_trees": "talos: talos_reduced.urdf (32 revolute joints; its gripper's <mimic> tags sit on "
                      "fixed joints and are ignored, so 32 coordinates in both engines); romeo: romeo.urdf "
                      "(55 revolute joints, 22 finger joints follow another by <mimic>). mechbal projects "

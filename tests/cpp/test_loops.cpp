@@ -4,7 +4,12 @@
 // per tick in the solve, the projection and the projected dynamics).
 #include <gtest/gtest.h>
 
+#include <Eigen/SVD>
+
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <string>
 
 #include "alloc_counter.hpp"
 #include "mechbal/algorithm/loops.hpp"
@@ -56,6 +61,27 @@ MechanismModel five_bar() {
   return MechanismModel(d);
 }
 
+/// The four-bar (point loop) carrying a two-joint arm on its coupler and a slide on the base, all
+/// three actuated and outside the loop: C's columns of these are unit vectors, the projection
+/// solves for the crank's column only (MechanismData::loop_actuated_columns).
+MechanismModel four_bar_with_arm() {
+  MechanismDescription d;
+  d.gravity = Vec3(0.0, -9.81, 0.0);
+  Eigen::Isometry3d tilted = at(0.25, 0.02, 0);
+  tilted.linear() = Eigen::AngleAxisd(0.4, Vec3(1.0, 0.3, 0.0).normalized()).toRotationMatrix();
+  Joint slide{"slide", JointType::prismatic, "base", at(0, 0, 0.3)};
+  slide.axis = Vec3(0.0, 1.0, 0.0);
+  d.joints = {Joint{"crank", JointType::revolute, "base"}, Joint{"coupler", JointType::revolute, "crank", at(0.2, 0, 0)},
+              Joint{"wrist", JointType::revolute, "coupler", tilted}, Joint{"tool", JointType::revolute, "wrist", at(0.1, 0, 0)},
+              Joint{"rocker", JointType::revolute, "base", at(0.45, 0, 0)}, slide};
+  d.bodies = {rod("crank", "crank", 0.8, 0.2), rod("coupler", "coupler", 1.5, 0.5), rod("rocker", "rocker", 1.1, 0.4),
+              rod("wrist", "wrist", 0.3, 0.1), rod("tool", "tool", 0.2, 0.15), rod("slide", "slide", 0.5, 0.1)};
+  d.frames = {Frame{"coupler_tip", "coupler", at(0.5, 0, 0)}, Frame{"rocker_tip", "rocker", at(0.4, 0, 0)}};
+  d.loops = {LoopConstraint{"tip", LoopType::point, "coupler_tip", "rocker_tip"}};
+  d.actuated = {"crank", "wrist", "tool", "slide"};
+  return MechanismModel(d);
+}
+
 /// q near an assembly (the order of the coordinates is the joints', depth first)
 Eigen::VectorXd four_bar_guess() { return (Eigen::VectorXd(3) << 1.0, -0.6, 1.75).finished(); }
 Eigen::VectorXd five_bar_guess() { return (Eigen::VectorXd(4) << 2.0, -1.2, 1.1, 1.2).finished(); }
@@ -82,6 +108,15 @@ std::vector<Case> cases() {
     out.push_back(Case{name, four_bar(type), four_bar_guess(), (Eigen::VectorXd(1) << 1.0).finished()});
   }
   out.push_back(Case{"five_bar", five_bar(), five_bar_guess(), (Eigen::VectorXd(2) << 2.0, 1.1).finished()});
+  {
+    MechanismModel model = four_bar_with_arm();
+    Eigen::VectorXd guess = Eigen::VectorXd::Zero(model.dof()), qa(model.num_actuated());
+    const std::map<std::string, double> near{{"crank", 1.0}, {"coupler", -0.6}, {"rocker", 1.75},
+                                             {"wrist", 0.5}, {"tool", -0.8}, {"slide", 0.05}};
+    for (int c = 0; c < model.dof(); ++c) guess(c) = near.at(model.coordinate_name(c));
+    for (int i = 0; i < model.num_actuated(); ++i) qa(i) = guess(model.actuated_coordinates()[static_cast<std::size_t>(i)]);
+    out.push_back(Case{"four_bar_with_arm", std::move(model), guess, qa});
+  }
   return out;
 }
 
@@ -134,6 +169,41 @@ TEST(Loops, CouplingMatrixAndBiasMatchFiniteDifferences) {
     ASSERT_EQ(closed_motion(model, data, c.qa, va, aa, q), Status::ok);
     EXPECT_LT((data.closed_velocity - C * va).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT((data.closed_acceleration - (C * aa + c_bias)).cwiseAbs().maxCoeff(), 1e-12);
+  }
+}
+
+TEST(Loops, ProjectionEqualsTheDenseLeastSquaresSolution) {
+  // C from the sparse LDL^T over the loops' structure, for the actuated columns that move a loop
+  // only, equals the dense least-squares solution -pinv(A°) A# of the whole Jacobian (SVD), and the
+  // columns of the actuated joints outside every loop are unit vectors
+  for (const auto& c : cases()) {
+    const MechanismModel& model = c.model;
+    MechanismData data(model);
+    const int na = model.num_actuated(), np = model.num_passive();
+    Eigen::VectorXd q = c.guess;
+    const Eigen::VectorXd va = Eigen::VectorXd::LinSpaced(na, 0.7, -1.3), aa = Eigen::VectorXd::LinSpaced(na, -0.4, 0.9);
+    for (int k = 0; k < 5; ++k) {
+      const Eigen::VectorXd qa = c.qa + Eigen::VectorXd::Constant(na, 0.1 * k);
+      ASSERT_EQ(closed_motion(model, data, qa, va, aa, q), Status::ok) << c.name;
+      Eigen::MatrixXd Ap(model.num_constraints(), np), Aa(model.num_constraints(), na);
+      for (int j = 0; j < np; ++j) Ap.col(j) = data.loop_jacobian.col(model.passive_coordinates()[static_cast<std::size_t>(j)]);
+      for (int i = 0; i < na; ++i) Aa.col(i) = data.loop_jacobian.col(model.actuated_coordinates()[static_cast<std::size_t>(i)]);
+      const Eigen::MatrixXd X = -Ap.jacobiSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(Aa);
+      for (int j = 0; j < np; ++j) {
+        const int row = model.passive_coordinates()[static_cast<std::size_t>(j)];
+        EXPECT_LT((data.loop_projection.row(row) - X.row(j)).cwiseAbs().maxCoeff(), 1e-12) << c.name;
+      }
+      for (int i = 0; i < na; ++i) {
+        const bool in_loop = std::find(data.loop_actuated_columns.begin(), data.loop_actuated_columns.end(), i) !=
+                             data.loop_actuated_columns.end();
+        EXPECT_EQ(in_loop, Aa.col(i).cwiseAbs().maxCoeff() > 0.0) << c.name << " actuated " << i;
+        if (in_loop) continue;
+        Eigen::VectorXd unit = Eigen::VectorXd::Zero(model.dof());
+        unit(model.actuated_coordinates()[static_cast<std::size_t>(i)]) = 1.0;
+        EXPECT_TRUE((data.loop_projection.col(i).array() == unit.array()).all()) << c.name << " actuated " << i;
+      }
+    }
+    if (std::string(c.name) == "four_bar_with_arm") EXPECT_EQ(data.loop_actuated_columns.size(), 1u);
   }
 }
 
@@ -202,6 +272,37 @@ TEST(Loops, ChordStepsFallBackToNewtonAfterAJump) {
   }
 }
 
+TEST(Loops, VelocityMotionIsClosedMotionWithoutAccelerations) {
+  // closed_velocity_motion: the same solve, C and v as closed_motion (to the last bit, from the
+  // same warm start), and c / the accelerations left as they were
+  for (const auto& c : cases()) {
+    const MechanismModel& model = c.model;
+    MechanismData full(model), velocity(model);
+    const int na = model.num_actuated();
+    Eigen::VectorXd q_full = c.guess, q_velocity = c.guess, qa = c.qa, va(na), aa(na);
+    for (int k = 0; k < 30; ++k) {
+      qa.setConstant(0.3 * std::sin(0.05 * k));
+      qa += c.qa;
+      va.setConstant(0.5 * std::cos(0.05 * k));
+      aa.setConstant(-0.2);
+      if (k % 3 == 0) {  // both: the warm starts stay the same
+        ASSERT_EQ(closed_motion(model, full, qa, va, aa, q_full), Status::ok) << c.name;
+        ASSERT_EQ(closed_motion(model, velocity, qa, va, aa, q_velocity), Status::ok) << c.name;
+        continue;
+      }
+      ASSERT_EQ(closed_motion(model, full, qa, va, aa, q_full), Status::ok) << c.name;
+      const Eigen::VectorXd c_before = velocity.loop_acceleration_bias;
+      ASSERT_EQ(closed_velocity_motion(model, velocity, qa, va, q_velocity), Status::ok) << c.name;
+      EXPECT_TRUE((q_full.array() == q_velocity.array()).all()) << c.name << " tick " << k;
+      EXPECT_TRUE((full.loop_projection.array() == velocity.loop_projection.array()).all()) << c.name;
+      EXPECT_TRUE((full.closed_velocity.array() == velocity.closed_velocity.array()).all()) << c.name;
+      EXPECT_TRUE((velocity.loop_acceleration_bias.array() == c_before.array()).all()) << c.name;
+      // and back in step: the next full tick starts from the same place in both
+      velocity.loop_acceleration_bias = full.loop_acceleration_bias;
+    }
+  }
+}
+
 TEST(Loops, TicksAllocateNothing) {
   LoopSolveOptions refined;  // the refinement path too
   refined.refine_rcond = 1.0;
@@ -227,6 +328,7 @@ TEST(Loops, TicksAllocateNothing) {
       EXPECT_EQ(closed_mass_matrix(model, data, qa, q), Status::ok) << c.name;
       EXPECT_EQ(closed_forward_dynamics(model, data, qa, va, tau, q), Status::ok) << c.name;
       EXPECT_EQ(closed_motion(model, data, qa, va, aa, q, refined), Status::ok) << c.name;
+      EXPECT_EQ(closed_velocity_motion(model, data, qa, va, q), Status::ok) << c.name;
     }
     EXPECT_EQ(scope.count(), 0u) << c.name;
   }

@@ -21,11 +21,14 @@ struct FramePose {
   Mat3 rotation;
 };
 
-FramePose frame_pose(const MechanismModel& model, const MechanismData& data, int frame) noexcept {
+/// (the rotation only when `rotation`: a point loop's rows need the origins alone)
+FramePose frame_pose(const MechanismModel& model, const MechanismData& data, int frame, bool rotation) noexcept {
   const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
   const auto f = static_cast<std::size_t>(frame);
-  return {W.world_position + W.world_rotation * data.frame_position_in_link[f],
-          W.world_rotation * data.frame_rotation_in_link[f]};
+  FramePose pose;
+  pose.position = W.world_position + W.world_rotation * data.frame_position_in_link[f];
+  if (rotation) pose.rotation.noalias() = W.world_rotation * data.frame_rotation_in_link[f];
+  return pose;
 }
 
 /// Each closure row is a linear function of the frames' relative motion:
@@ -58,10 +61,10 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
   if (jacobian) jac.setZero();
   for (int i = 0; i < model.num_loops(); ++i) {
     const int row = model.loop_row(i), fa = model.loop_frame_a(i), fb = model.loop_frame_b(i);
-    const FramePose A = frame_pose(model, data, fa);
-    const FramePose B = frame_pose(model, data, fb);
-    const Vec3 d = B.position - A.position;
     const LoopType type = model.loop(i).type;
+    const FramePose A = frame_pose(model, data, fa, type != LoopType::point);
+    const FramePose B = frame_pose(model, data, fb, type == LoopType::axis || type == LoopType::weld);
+    const Vec3 d = B.position - A.position;
     RowFunctional f[6];
     int rows = 0;
     if (type == LoopType::planar_point) {
@@ -106,14 +109,33 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
   }
 }
 
+/// detail::frame_motion from the frames' placements in their links (data.frame_*_in_link, as
+/// frame_pose), the rotation only when the loop's bias needs it (a point loop does not).
+detail::FrameMotion loop_frame_motion(const MechanismModel& model, const MechanismData& data, int frame,
+                                      bool rotation) noexcept {
+  const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
+  const auto f = static_cast<std::size_t>(frame);
+  const Mat3& R = W.world_rotation;
+  detail::FrameMotion m;
+  const Vec3 r = R * data.frame_position_in_link[f];
+  m.position = W.world_position + r;
+  if (rotation) m.rotation.noalias() = R * data.frame_rotation_in_link[f];
+  m.angular_velocity.noalias() = R * W.w;
+  m.angular_acceleration.noalias() = R * W.alpha;
+  m.velocity = R * W.vel + m.angular_velocity.cross(r);
+  m.acceleration = R * W.acc + m.angular_acceleration.cross(r) + m.angular_velocity.cross(m.angular_velocity.cross(r));
+  return m;
+}
+
 /// gamma = dA/dt v from a forward pass with velocities (accelerations at a = 0).
 void constraint_bias(const MechanismModel& model, MechanismData& data) noexcept {
   for (int i = 0; i < model.num_loops(); ++i) {
     const int row = model.loop_row(i);
-    const detail::FrameMotion A = detail::frame_motion(model, data, model.loop_frame_a(i));
-    const detail::FrameMotion B = detail::frame_motion(model, data, model.loop_frame_b(i));
-    const Vec3 d = B.position - A.position, dd = B.velocity - A.velocity, ddd = B.acceleration - A.acceleration;
     const LoopType type = model.loop(i).type;
+    const bool rotation = type == LoopType::planar_point || type == LoopType::axis;
+    const detail::FrameMotion A = loop_frame_motion(model, data, model.loop_frame_a(i), rotation);
+    const detail::FrameMotion B = loop_frame_motion(model, data, model.loop_frame_b(i), type == LoopType::axis);
+    const Vec3 d = B.position - A.position, dd = B.velocity - A.velocity, ddd = B.acceleration - A.acceleration;
     if (type == LoopType::planar_point) {
       for (int k = 0; k < 2; ++k) {
         const Vec3 x = A.rotation.col(k);
@@ -241,45 +263,45 @@ double factor_passive(MechanismData& data) noexcept {
   const auto np = static_cast<Eigen::Index>(order.size());
   const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
   const auto m = static_cast<int>(Ap.rows());
-  // A°'s columns in the elimination order, and the rows holding each column's nonzeros (a loop's
-  // rows involve only the coordinates of its two frames' branches)
+  // A°'s columns in the elimination order, over the rows each can be nonzero in (the rows of the
+  // loops whose frames it moves, fixed at construction: data.loop_passive_rows); the other
+  // entries of A° stay zero
   for (Eigen::Index j = 0; j < np; ++j) {
-    data.loop_passive_jacobian.col(j) = data.loop_jacobian.col(order[static_cast<std::size_t>(j)]);
-    const double* a = Ap.data() + j * m;
-    int first = 0, last = m - 1;
-    while (first < m && a[first] == 0.0) ++first;
-    while (last > first && a[last] == 0.0) --last;
-    if (first == m) last = -1;
-    int count = 0;
-    for (int r = first; r <= last; ++r) {
-      if (a[r] != 0.0) data.loop_passive_rows(count++, j) = r;
-    }
-    data.loop_passive_count(j) = count;
-    data.loop_passive_first(j) = first;
-    data.loop_passive_last(j) = last;
+    const double* from = data.loop_jacobian.data() + static_cast<Eigen::Index>(order[static_cast<std::size_t>(j)]) * m;
+    double* to = data.loop_passive_jacobian.data() + j * m;
+    const int* rows = data.loop_passive_rows.data() + j * data.loop_passive_rows.rows();
+    for (int p = 0; p < data.loop_passive_count(j); ++p) to[rows[p]] = from[rows[p]];
   }
-  // N = A°^T A° on the structure of L (which holds N's), each entry a dot product over the rows
-  // where both columns can be nonzero
+  // N = A°^T A° on the structure of L (which holds N's): the sum over the loops of the products
+  // of their own columns over their own rows (2 to 6 rows, a handful of columns each)
   Eigen::MatrixXd& N = data.loop_normal;
-  const auto dot = [&](Eigen::Index i, Eigen::Index j) {
-    const int lo = std::max(data.loop_passive_first(i), data.loop_passive_first(j));
-    const int hi = std::min(data.loop_passive_last(i), data.loop_passive_last(j));
-    const double* ai = Ap.data() + i * m;
-    const double* aj = Ap.data() + j * m;
-    double sum = 0.0;
-    for (int r = lo; r <= hi; ++r) sum += ai[r] * aj[r];
-    return sum;
-  };
-  double scale = 1.0;
   for (Eigen::Index i = 0; i < np; ++i) {
-    N(i, i) = dot(i, i);
-    scale = std::max(scale, N(i, i));
+    N(i, i) = 0.0;
     const int end = data.loop_factor_start[static_cast<std::size_t>(i) + 1];
     for (int p = data.loop_factor_start[static_cast<std::size_t>(i)]; p < end; ++p) {
-      const int j = data.loop_factor_rows[static_cast<std::size_t>(p)];
-      N(j, i) = dot(i, j);
+      N(data.loop_factor_rows[static_cast<std::size_t>(p)], i) = 0.0;
     }
   }
+  const int nloops = static_cast<int>(data.loop_member_start.size()) - 1;
+  for (int l = 0; l < nloops; ++l) {
+    const int r0 = data.loop_row_start[static_cast<std::size_t>(l)];
+    const int rows = data.loop_row_start[static_cast<std::size_t>(l) + 1] - r0;
+    const int* members = data.loop_members.data() + data.loop_member_start[static_cast<std::size_t>(l)];
+    const int count = data.loop_member_start[static_cast<std::size_t>(l) + 1] - data.loop_member_start[static_cast<std::size_t>(l)];
+    for (int a = 0; a < count; ++a) {
+      const Eigen::Index i = members[a];
+      const double* ai = Ap.data() + i * m + r0;
+      for (int b = a; b < count; ++b) {
+        const Eigen::Index j = members[b];
+        const double* aj = Ap.data() + j * m + r0;
+        double sum = 0.0;
+        for (int r = 0; r < rows; ++r) sum += ai[r] * aj[r];
+        N(j, i) += sum;  // j >= i: the lower triangle (L's structure)
+      }
+    }
+  }
+  double scale = 1.0;
+  for (Eigen::Index i = 0; i < np; ++i) scale = std::max(scale, N(i, i));
   for (Eigen::Index i = 0; i < np; ++i) N(i, i) += kDamping * scale;
   ldl_factor(data);
   const Eigen::VectorXd& D = data.loop_normal_pivots;
@@ -324,9 +346,11 @@ Status loop_constraints(const MechanismModel& model, MechanismData& data, const 
   return Status::ok;
 }
 
-Status solve_loop_positions(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
-                            Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
-  if (Status s = check(model, data, q, &q_actuated); s != Status::ok) return s;
+namespace {
+
+/// solve_loop_positions after its input checks (the closed_* functions check once).
+Status solve_positions(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                       Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
   const auto& actuated = model.actuated_coordinates();
   const auto& passive = model.passive_coordinates();
   Eigen::VectorXd& trial = data.loop_trial;
@@ -446,6 +470,14 @@ Status solve_loop_positions(const MechanismModel& model, MechanismData& data, co
   return data.loop_rcond < options.singular_rcond ? Status::singular : Status::ok;
 }
 
+}  // namespace
+
+Status solve_loop_positions(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                            Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
+  if (Status s = check(model, data, q, &q_actuated); s != Status::ok) return s;
+  return solve_positions(model, data, q_actuated, q, options);
+}
+
 namespace {
 
 /// One step of iterative refinement of x, the least-squares solution of A° x = -b from the factored
@@ -473,11 +505,12 @@ void refine(MechanismData& data, const B& b, X&& x) noexcept {
 /// data.loop_jacobian, the factorisation of A° and data.loop_rcond are already those of q (its last
 /// evaluation) and are not recomputed.
 Status project(const MechanismModel& model, MechanismData& data, const ConstVector& q,
-               const ConstVector& v_actuated, const LoopSolveOptions& options, bool solved) noexcept {
+               const ConstVector& v_actuated, const LoopSolveOptions& options, bool solved,
+               bool acceleration = true) noexcept {
   const auto& actuated = model.actuated_coordinates();
   const auto& passive = model.passive_coordinates();
   Status status = Status::ok;
-  data.loop_acceleration_bias.setZero();
+  if (acceleration) data.loop_acceleration_bias.setZero();
   data.closed_position = q;
   if (!model.is_closed()) {
     data.loop_rcond = 1.0;
@@ -490,8 +523,11 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   }
   if (data.loop_rcond < options.singular_rcond) status = Status::singular;
   // C: passive rows -(A°^T A°)^-1 A°^T A#
-  for (std::size_t i = 0; i < actuated.size(); ++i) {
-    data.loop_actuated_jacobian.col(static_cast<Eigen::Index>(i)) = data.loop_jacobian.col(actuated[i]);
+  // (only the columns of the actuated coordinates that move a loop: C's others are unit vectors)
+  const auto& columns = data.loop_actuated_columns;
+  for (std::size_t t = 0; t < columns.size(); ++t) {
+    data.loop_actuated_jacobian.col(static_cast<Eigen::Index>(t)) =
+        data.loop_jacobian.col(actuated[static_cast<std::size_t>(columns[t])]);
   }
   const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
   // X = -A°^T A# (each column of A° over its nonzero rows), solved for all columns at once, then
@@ -536,14 +572,36 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
     X += S;
   }
   for (std::size_t j = 0; j < passive.size(); ++j) {
-    data.loop_projection.row(data.loop_elimination[j]) = data.loop_solution.row(static_cast<Eigen::Index>(j));
+    const double* x = X.data() + static_cast<Eigen::Index>(j) * w;
+    for (Eigen::Index t = 0; t < w; ++t) data.loop_projection(data.loop_elimination[j], columns[static_cast<std::size_t>(t)]) = x[t];
   }
   data.closed_velocity.noalias() = data.loop_projection * v_actuated;
   // the loops must accept the actuated velocities (A v = 0); they do not at a serial singularity of
   // the closure or when the actuators over-constrain the mechanism
-  data.loop_constraint_work.noalias() = data.loop_jacobian * data.closed_velocity;
-  const double scale = 1.0 + data.loop_jacobian.cwiseAbs().maxCoeff() * data.closed_velocity.cwiseAbs().maxCoeff();
-  if (!(data.loop_constraint_work.cwiseAbs().maxCoeff() <= 1e-8 * scale)) status = Status::singular;
+  // (A v over A's nonzeros: A°'s in each column's rows, A#'s loop columns; the others are zero)
+  Eigen::VectorXd& Av = data.loop_constraint_work;
+  double biggest = 0.0;
+  for (Eigen::Index r = 0; r < Aa.rows(); ++r) {
+    double sum = 0.0;
+    for (Eigen::Index t = 0; t < w; ++t) {
+      const double a = Aa(r, t);
+      sum += a * data.closed_velocity(actuated[static_cast<std::size_t>(columns[static_cast<std::size_t>(t)])]);
+      biggest = std::max(biggest, std::abs(a));
+    }
+    Av(r) = sum;
+  }
+  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+    const double* a = column(i);
+    const double vi = data.closed_velocity(data.loop_elimination[static_cast<std::size_t>(i)]);
+    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+    for (int p = 0; p < data.loop_passive_count(i); ++p) {
+      Av(rows[p]) += a[rows[p]] * vi;
+      biggest = std::max(biggest, std::abs(a[rows[p]]));
+    }
+  }
+  const double scale = 1.0 + biggest * data.closed_velocity.cwiseAbs().maxCoeff();
+  if (!(Av.cwiseAbs().maxCoeff() <= 1e-8 * scale)) status = Status::singular;
+  if (!acceleration) return data.loop_projection.allFinite() ? status : status | Status::singular;
   // gamma at (q, v), then c = [0; -(A°^T A°)^-1 A°^T gamma]
   detail::joint_state<true, false>(model, data, q, data.closed_velocity, data.closed_velocity);
   // (the links are placed at q: by the solve's last evaluation, or by evaluate above)
@@ -574,13 +632,23 @@ Status closed_motion(const MechanismModel& model, MechanismData& data, const Con
                      const ConstVector& v_actuated, const ConstVector& a_actuated, Eigen::Ref<Eigen::VectorXd> q,
                      const LoopSolveOptions& options) noexcept {
   if (Status s = check(model, data, q, &q_actuated, &v_actuated, &a_actuated); s != Status::ok) return s;
-  Status status = solve_loop_positions(model, data, q_actuated, q, options);
+  Status status = solve_positions(model, data, q_actuated, q, options);
   if (has(status, Status::solver_error)) return status;
   data.closed_position = q;
   status |= project(model, data, q, v_actuated, options, true);
   data.closed_acceleration = data.loop_acceleration_bias;
   data.closed_acceleration.noalias() += data.loop_projection * a_actuated;
   return status;
+}
+
+Status closed_velocity_motion(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                              const ConstVector& v_actuated, Eigen::Ref<Eigen::VectorXd> q,
+                              const LoopSolveOptions& options) noexcept {
+  if (Status s = check(model, data, q, &q_actuated, &v_actuated); s != Status::ok) return s;
+  Status status = solve_positions(model, data, q_actuated, q, options);
+  if (has(status, Status::solver_error)) return status;
+  data.closed_position = q;
+  return status | project(model, data, q, v_actuated, options, true, false);
 }
 
 Status closed_inverse_dynamics(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
@@ -599,7 +667,7 @@ Status closed_inverse_dynamics(const MechanismModel& model, MechanismData& data,
 Status closed_mass_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
                           Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
   if (Status s = check(model, data, q, &q_actuated); s != Status::ok) return s;
-  Status status = solve_loop_positions(model, data, q_actuated, q, options);
+  Status status = solve_positions(model, data, q_actuated, q, options);
   if (has(status, Status::solver_error)) return status;
   data.closed_position = q;
   data.actuated_force.setZero();  // v# = 0 for the projection only
@@ -619,7 +687,7 @@ Status closed_forward_dynamics(const MechanismModel& model, MechanismData& data,
                                const ConstVector& v_actuated, const ConstVector& tau_actuated,
                                Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
   if (Status s = check(model, data, q, &q_actuated, &v_actuated, &tau_actuated); s != Status::ok) return s;
-  Status status = solve_loop_positions(model, data, q_actuated, q, options);
+  Status status = solve_positions(model, data, q_actuated, q, options);
   if (has(status, Status::solver_error)) return status;
   data.closed_position = q;
   status |= project(model, data, q, v_actuated, options, true);

@@ -238,7 +238,7 @@ Status ReactionlessController::reset(const Eigen::Ref<const Eigen::VectorXd>& q0
     st = closed_motion(*model_, data_, q_act_, v_act_, a_act_, q, config_.loop_options);
     if (failed(st)) return st;
     momentum_matrix(*model_, data_, q_full_);
-    K_.noalias() = data_.momentum_matrix * data_.loop_projection;
+    momentum_projection();
     v_full_ = data_.closed_velocity;
   } else {
     q_full_ = q_act_;
@@ -280,18 +280,19 @@ Status ReactionlessController::set_target(const Vec6& momentum, const Vec6& mome
 }
 
 Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>& q_t,
-                                        const Eigen::VectorXd& q_b) noexcept {
+                                        const Eigen::VectorXd& q_b, bool acceleration) noexcept {
   for (int i = 0; i < nt_; ++i) q_act_(task_[static_cast<std::size_t>(i)]) = q_t(i);
   for (int j = 0; j < nb_; ++j) q_act_(balancing_[static_cast<std::size_t>(j)]) = q_b(j);
   Status st = Status::ok;
   if (closed_) {
     // positions (warm-started from the last solve), C and c (c with the current velocity guess)
-    st = closed_motion(*model_, data_, q_act_, v_act_, a_act_, q_full_, config_.loop_options);
+    st = acceleration ? closed_motion(*model_, data_, q_act_, v_act_, a_act_, q_full_, config_.loop_options)
+                      : closed_velocity_motion(*model_, data_, q_act_, v_act_, q_full_, config_.loop_options);
     if (failed(st)) return st;
     // the solve left the links placed at its solution q_full_: no second placement
     const Status sm = detail::momentum_matrix_placed(*model_, data_);
     if (sm != Status::ok) return st | sm;
-    K_.noalias() = data_.momentum_matrix * data_.loop_projection;
+    momentum_projection();
   } else {
     q_full_ = q_act_;
     st = momentum_matrix(*model_, data_, q_full_);
@@ -301,6 +302,23 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
   for (int i = 0; i < k_; ++i)
     for (int j = 0; j < nb_; ++j) Kb_(i, j) = K_(rows_[static_cast<std::size_t>(i)], balancing_[static_cast<std::size_t>(j)]);
   return st;
+}
+
+void ReactionlessController::momentum_projection() noexcept {
+  // K = A C over C's nonzeros: C's columns of the actuated joints that move no loop are unit
+  // vectors, the others nonzero on the passive rows (a dense 6 x n x na product would go through
+  // Eigen's blocked GEMM, whose packing costs more than the product at these sizes)
+  const Eigen::MatrixXd& A = data_.momentum_matrix;
+  const Eigen::MatrixXd& C = data_.loop_projection;
+  const Eigen::Index n = C.rows();
+  for (Eigen::Index i = 0; i < C.cols(); ++i) {
+    Vec6 k = Vec6::Zero();
+    const double* c = C.data() + i * n;
+    for (Eigen::Index j = 0; j < n; ++j) {
+      if (c[j] != 0.0) k += c[j] * Vec6(A.col(j));
+    }
+    K_.col(i) = k;
+  }
 }
 
 Status ReactionlessController::rebalance(const Eigen::VectorXd& q_b) noexcept {
@@ -314,7 +332,7 @@ Status ReactionlessController::rebalance(const Eigen::VectorXd& q_b) noexcept {
   }
   const Status st = momentum_matrix(*model_, data_, q_full_);
   if (st != Status::ok) return st;
-  K_.noalias() = data_.momentum_matrix * data_.loop_projection;
+  momentum_projection();
   for (int i = 0; i < k_; ++i)
     for (int j = 0; j < nb_; ++j) Kb_(i, j) = K_(rows_[static_cast<std::size_t>(i)], balancing_[static_cast<std::size_t>(j)]);
   return Status::ok;
@@ -587,12 +605,14 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
     const auto task_rates = [this](const Eigen::Ref<const Eigen::VectorXd>& v) {
       for (int i = 0; i < nt_; ++i) v_act_(task_[static_cast<std::size_t>(i)]) = v(i);
     };
+    // (stages 2 and 3 need K only: no acceleration level of the loops)
     q_stage_ = q_b_ + (0.5 * dt_) * k1_;
     task_rates(*v_half);
-    ss |= evaluate(*q_half, q_stage_);
+    ss |= evaluate(*q_half, q_stage_, false);
     if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k2_, nullptr);
     q_stage_ = q_b_ + (0.5 * dt_) * k2_;
-    if (!failed(ss)) ss |= closed_ && !balancing_in_loops_ ? rebalance(q_stage_) : evaluate(*q_half, q_stage_);
+    if (!failed(ss))
+      ss |= closed_ && !balancing_in_loops_ ? rebalance(q_stage_) : evaluate(*q_half, q_stage_, false);
     if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k3_, nullptr);
     q_stage_ = q_b_ + dt_ * k3_;
     task_rates(*v_next);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <new>
 #include <sstream>
@@ -569,6 +570,25 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
       }
     }
   }
+  // the actuated coordinates that move a loop frame: C's other columns are unit vectors (their
+  // passive rows zero), so the projection solves for these columns only
+  data.loop_actuated_columns.clear();
+  const auto& actuated = model.actuated_coordinates();
+  for (std::size_t i = 0; i < actuated.size(); ++i) {
+    bool in_loop = false;
+    for (int l = 0; l < model.num_loops() && !in_loop; ++l) {
+      for (int frame : {model.loop_frame_a(l), model.loop_frame_b(l)}) {
+        for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) in_loop = in_loop || model.coordinate(k) == actuated[i];
+      }
+    }
+    if (in_loop) data.loop_actuated_columns.push_back(static_cast<int>(i));
+  }
+  const auto nla = static_cast<Eigen::Index>(data.loop_actuated_columns.size());
+  const Eigen::Index m = model.num_constraints();
+  data.loop_actuated_jacobian = MechanismData::RowMajorMatrix::Zero(m, nla);
+  data.loop_block_residual = MechanismData::RowMajorMatrix::Zero(m, nla);
+  data.loop_block_step = MechanismData::RowMajorMatrix::Zero(static_cast<Eigen::Index>(np), nla);
+  data.loop_solution = MechanismData::RowMajorMatrix::Zero(static_cast<Eigen::Index>(np), nla);
   // minimum-degree elimination (ties: the lowest index), recording each column's rows of L: the
   // neighbours not yet eliminated, fill included
   std::vector<char> eliminated(np, 0);
@@ -607,6 +627,52 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     std::sort(rows.begin(), rows.end());
     data.loop_factor_rows.insert(data.loop_factor_rows.end(), rows.begin(), rows.end());
     data.loop_factor_start.push_back(static_cast<int>(data.loop_factor_rows.size()));
+  }
+  // each loop's passive columns (elimination positions, increasing): N = A°^T A° is the sum over
+  // the loops of their rows' small dense products
+  data.loop_member_start.assign(1, 0);
+  data.loop_members.clear();
+  data.loop_row_start.clear();
+  for (int i = 0; i < model.num_loops(); ++i) data.loop_row_start.push_back(model.loop_row(i));
+  data.loop_row_start.push_back(model.num_constraints());
+  for (int i = 0; i < model.num_loops(); ++i) {
+    std::vector<int> own;
+    for (int frame : {model.loop_frame_a(i), model.loop_frame_b(i)}) {
+      for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) {
+        const int c = model.coordinate(k);
+        if (c >= 0 && slot[static_cast<std::size_t>(c)] >= 0)
+          own.push_back(position[static_cast<std::size_t>(slot[static_cast<std::size_t>(c)])]);
+      }
+    }
+    std::sort(own.begin(), own.end());
+    own.erase(std::unique(own.begin(), own.end()), own.end());
+    data.loop_members.insert(data.loop_members.end(), own.begin(), own.end());
+    data.loop_member_start.push_back(static_cast<int>(data.loop_members.size()));
+  }
+  // the rows of A° each passive column can be nonzero in (elimination order): the rows of the
+  // loops whose frames it moves; the factorisation reads A° over these only
+  data.loop_passive_rows.setZero(m, static_cast<Eigen::Index>(np));
+  data.loop_passive_count.setZero(static_cast<Eigen::Index>(np));
+  data.loop_passive_first.setZero(static_cast<Eigen::Index>(np));
+  data.loop_passive_last.setConstant(static_cast<Eigen::Index>(np), -1);
+  for (std::size_t k = 0; k < np; ++k) {
+    const int coordinate = data.loop_elimination[k];
+    const auto j = static_cast<Eigen::Index>(k);
+    int count = 0;
+    for (int i = 0; i < model.num_loops(); ++i) {
+      bool moves = false;
+      for (int frame : {model.loop_frame_a(i), model.loop_frame_b(i)}) {
+        for (int l = model.frame_link(frame); l >= 1; l = model.parent(l)) moves = moves || model.coordinate(l) == coordinate;
+      }
+      if (!moves) continue;
+      const int end = i + 1 < model.num_loops() ? model.loop_row(i + 1) : model.num_constraints();
+      for (int r = model.loop_row(i); r < end; ++r) data.loop_passive_rows(count++, j) = r;
+    }
+    data.loop_passive_count(j) = count;
+    if (count > 0) {
+      data.loop_passive_first(j) = data.loop_passive_rows(0, j);
+      data.loop_passive_last(j) = data.loop_passive_rows(count - 1, j);
+    }
   }
 }
 
@@ -661,6 +727,10 @@ MechanismData::MechanismData(const MechanismModel& model)
     w.composite_mass = 0.0;
     w.composite_first_moment = Vec3::Zero();
     w.composite_inertia = Mat3::Zero();
+    w.placed_at = std::numeric_limits<double>::quiet_NaN();  // the first placement computes every link
+    w.world_stale = true;
+    w.world_moved = false;  // the base (link 0) never moves
+    w.composite_current = false;
   }
   const int m = model.num_constraints(), na = model.num_actuated(), np = model.num_passive();
   loop_residual = Eigen::VectorXd::Zero(m);

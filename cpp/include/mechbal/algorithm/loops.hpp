@@ -69,6 +69,16 @@ Status closed_motion(const MechanismModel& model, MechanismData& data, const Con
                      const ConstVector& v_actuated, const ConstVector& a_actuated, Eigen::Ref<Eigen::VectorXd> q,
                      const LoopSolveOptions& options = {}) noexcept;
 
+/// closed_motion up to the velocities: positions solved (q in/out), data.loop_projection (C),
+/// data.closed_position and data.closed_velocity = C v#, without the acceleration level (no
+/// gamma, no c: the pass over the links' velocities and its solve are skipped). For callers that
+/// need C at a pose and not the accelerations (the stages of an integrator). data.loop_bias,
+/// loop_acceleration_bias and closed_acceleration keep their last values: the next position
+/// solve's warm start still uses that c as its curvature estimate.
+Status closed_velocity_motion(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                              const ConstVector& v_actuated, Eigen::Ref<Eigen::VectorXd> q,
+                              const LoopSolveOptions& options = {}) noexcept;
+
 /// Actuated forces of the closed mechanism for the motion: data.actuated_force = C^T tau(q, v, a)
 /// (tau of inverse_dynamics: springs included)
 /// (after closed_motion with the same arguments; also fills data.joint_torque of the tree).

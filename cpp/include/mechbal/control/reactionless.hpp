@@ -185,12 +185,16 @@ class ReactionlessController {
 
  private:
   void build(const Eigen::VectorXd& q0, const Eigen::VectorXd& v0, const Eigen::VectorXd& q_guess);
-  /// K = A C at actuated positions (q_t, q_b) (loops solved into q_full_); v_hint: actuated
-  /// velocities for the loops' projection. Fills K_, Kb_, Kt_.
-  Status evaluate(const Eigen::Ref<const Eigen::VectorXd>& q_t, const Eigen::VectorXd& q_b) noexcept;
+  /// K = A C at actuated positions (q_t, q_b) (loops solved into q_full_); v_act_: actuated
+  /// velocities for the loops' projection. Fills K_, Kb_. With `acceleration`, also the loops'
+  /// acceleration bias c (the feed-forward at t_n needs it; an RK4 stage that only needs K not).
+  Status evaluate(const Eigen::Ref<const Eigen::VectorXd>& q_t, const Eigen::VectorXd& q_b,
+                  bool acceleration = true) noexcept;
   /// evaluate() at the same task positions with other balancing positions, for a closed
   /// mechanism whose loops the balancing joints do not move (no loop solve).
   Status rebalance(const Eigen::VectorXd& q_b) noexcept;
+  /// K_ = A C from data_'s momentum matrix and loop projection.
+  void momentum_projection() noexcept;
   /// Factorise S K_b (cond, damping); then solve() applies the operator.
   Status factorise(double& condition) noexcept;
   void solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::VectorXd& x) noexcept;

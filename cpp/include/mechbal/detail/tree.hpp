@@ -61,9 +61,16 @@ inline void joint_state(const MechanismModel& model, MechanismData& data,
 
 /// Link placements relative to their parents and, with World, in O (L frames). The passes that
 /// work in the links' own frames only (inverse dynamics, gravity, bias, mass matrix) skip World:
-/// work[].world_* are then left as they were. `visit(l, work[l])` runs on each link right after
-/// it is placed (in tree order, links 1..n-1), while its data is in cache: an algorithm that needs
-/// one more quantity per placed link folds it into this pass instead of sweeping the links again.
+/// work[].world_* are then left as they were (and marked stale). `visit(l, work[l])` runs on each
+/// link right after it is placed (in tree order, links 1..n-1), while its data is in cache: an
+/// algorithm that needs one more quantity per placed link folds it into this pass instead of
+/// sweeping the links again.
+/// Incremental: a link whose joint position is the one its placement was last computed at
+/// (LinkWork::placed_at) keeps its rotation and translation, and its pose in O when neither it
+/// nor its parent moved since that pose was computed: an algorithm called at the q the links are
+/// already placed at (shaking_wrench after closed_motion, the momentum matrix at a pose where
+/// only a few joints moved) pays for the moved links only. The skipped values are exactly those
+/// that would be recomputed (same inputs, same operations), so results are bit for bit the same.
 struct NoVisit {
   void operator()(int, const MechanismData::LinkWork&) const noexcept {}
 };
@@ -73,32 +80,48 @@ inline void place(const MechanismModel& model, MechanismData& data, Visit&& visi
   const int nl = model.num_links();
   for (int l = 1; l < nl; ++l) {
     const auto k = static_cast<std::size_t>(l);
-    const auto& c = model.link_constants(l);
     auto& w = data.work[k];
-    switch (model.joint_type(l)) {
-      case JointType::revolute: {
-        // C_R Rz(q): only the first two columns change
-        const double qk = data.joint_position[k];
-        const double cs = std::cos(qk), sn = std::sin(qk);
-        w.rotation.col(0) = cs * c.rotation.col(0) + sn * c.rotation.col(1);
-        w.rotation.col(1) = cs * c.rotation.col(1) - sn * c.rotation.col(0);
-        w.rotation.col(2) = c.rotation.col(2);
-        w.translation = c.translation;
-        break;
+    const double qk = data.joint_position[k];
+    const bool local = !(qk == w.placed_at);  // never placed: NaN
+    if (local) {
+      const auto& c = model.link_constants(l);
+      switch (model.joint_type(l)) {
+        case JointType::revolute: {
+          // C_R Rz(q): only the first two columns change
+          const double cs = std::cos(qk), sn = std::sin(qk);
+          w.rotation.col(0) = cs * c.rotation.col(0) + sn * c.rotation.col(1);
+          w.rotation.col(1) = cs * c.rotation.col(1) - sn * c.rotation.col(0);
+          w.rotation.col(2) = c.rotation.col(2);
+          w.translation = c.translation;
+          break;
+        }
+        case JointType::prismatic:
+          w.rotation = c.rotation;
+          w.translation = c.translation + c.rotation.col(2) * qk;
+          break;
+        case JointType::fixed:
+          w.rotation = c.rotation;
+          w.translation = c.translation;
+          break;
       }
-      case JointType::prismatic:
-        w.rotation = c.rotation;
-        w.translation = c.translation + c.rotation.col(2) * data.joint_position[k];
-        break;
-      case JointType::fixed:
-        w.rotation = c.rotation;
-        w.translation = c.translation;
-        break;
+      w.placed_at = qk;
+      // the composites of every ancestor hold this link's old placement (composite_inertias);
+      // a stale link's ancestors are all stale already
+      for (int j = model.parent(l); j > 0 && data.work[static_cast<std::size_t>(j)].composite_current;
+           j = model.parent(j)) {
+        data.work[static_cast<std::size_t>(j)].composite_current = false;
+      }
     }
     if (World) {
       const auto& p = data.work[static_cast<std::size_t>(model.parent(l))];
-      w.world_rotation.noalias() = p.world_rotation * w.rotation;
-      w.world_position = p.world_position + p.world_rotation * w.translation;
+      w.world_moved = local || w.world_stale || p.world_moved;
+      if (w.world_moved) {
+        w.world_rotation.noalias() = p.world_rotation * w.rotation;
+        w.world_position = p.world_position + p.world_rotation * w.translation;
+        w.world_stale = false;
+      }
+    } else if (local) {
+      w.world_stale = true;  // world_* no longer that of rotation / translation
     }
     visit(l, static_cast<const MechanismData::LinkWork&>(w));
   }
@@ -215,11 +238,16 @@ inline void backward_pass(const MechanismModel& model, MechanismData& data, Tau&
 /// entry (link 0) keeps only its own bodies: nothing above the joints uses the whole tree's
 /// composite, and not carrying subtrees onto the base saves a transform per base child. Massless
 /// subtrees (a tool frame's link) are not transformed either: they add nothing.
+/// Incremental: a link's composite (in its own frame) depends only on the placements of the links
+/// below it, so only the links marked stale by place() (LinkWork::composite_current: the
+/// ancestors of a link whose placement changed) are recomputed, each from its own bodies and its
+/// children in the same order as a full pass: bit for bit the same result.
 inline void composite_inertias(const MechanismModel& model, MechanismData& data) noexcept {
   const int nl = model.num_links();
   for (int l = 0; l < nl; ++l) {
-    const auto& c = model.link_constants(l);
     auto& W = data.work[static_cast<std::size_t>(l)];
+    if (W.composite_current) continue;
+    const auto& c = model.link_constants(l);
     W.composite_mass = c.mass;
     W.composite_first_moment = c.first_moment;
     W.composite_inertia = c.inertia_origin;
@@ -227,10 +255,11 @@ inline void composite_inertias(const MechanismModel& model, MechanismData& data)
   for (int l = nl - 1; l >= 1; --l) {
     const int parent = model.parent(l);
     if (parent == 0) continue;
+    auto& P = data.work[static_cast<std::size_t>(parent)];
+    if (P.composite_current) continue;
     const auto& W = data.work[static_cast<std::size_t>(l)];
     // massless: m = 0 and a zero inertia (positive semi-definite with zero trace)
     if (W.composite_mass == 0.0 && W.composite_inertia.trace() == 0.0) continue;
-    auto& P = data.work[static_cast<std::size_t>(parent)];
     // I_O' = R I R^T + m ((p.p) 1 - p p^T) + 2 (p.h) 1 - h p^T - p h^T with h = R h_child,
     // on the six distinct entries of the symmetric result.
     const double m = W.composite_mass;
@@ -255,6 +284,7 @@ inline void composite_inertias(const MechanismModel& model, MechanismData& data)
     P.composite_mass += m;
     P.composite_first_moment += mp_h;
   }
+  for (int l = 0; l < nl; ++l) data.work[static_cast<std::size_t>(l)].composite_current = true;
 }
 
 /// World placement and motion of a named frame from placed links and a forward pass: origin

@@ -124,9 +124,12 @@ struct MechanismData {
   // scratch of the loop algorithms
   Eigen::MatrixXd loop_passive_jacobian;   ///< A° (m x np)
   using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  RowMajorMatrix loop_actuated_jacobian;   ///< A# (m x na), row-major: the solves run over all columns at once
-  RowMajorMatrix loop_block_residual;      ///< m x na
-  RowMajorMatrix loop_block_step;          ///< np x na
+  /// The actuated coordinates (indices into model.actuated_coordinates()) that move a loop frame,
+  /// fixed at construction: only their columns of C need a solve (the others are unit vectors)
+  std::vector<int> loop_actuated_columns;
+  RowMajorMatrix loop_actuated_jacobian;   ///< A#'s loop_actuated_columns (m x nla), row-major: the solves run over all columns at once
+  RowMajorMatrix loop_block_residual;      ///< m x nla
+  RowMajorMatrix loop_block_step;          ///< np x nla
   Eigen::VectorXd loop_constraint_work;    ///< m
   Eigen::VectorXd loop_refine_solution;    ///< np
   Eigen::LDLT<Eigen::MatrixXd> reduced_ldlt;  ///< of C^T M C (na x na)
@@ -142,13 +145,17 @@ struct MechanismData {
   /// Structure of L in N = L D L^T: the rows (elimination positions, increasing) that column k may
   /// fill are loop_factor_rows[loop_factor_start[k] .. loop_factor_start[k + 1]).
   std::vector<int> loop_factor_start, loop_factor_rows;
+  /// The passive columns (elimination positions, increasing) each loop's rows involve:
+  /// loop_members[loop_member_start[i] .. loop_member_start[i + 1]) for loop i.
+  std::vector<int> loop_member_start, loop_members;
+  std::vector<int> loop_row_start;  ///< loop i's rows: loop_row_start[i] .. loop_row_start[i + 1]
   /// Each named frame in its link's joint-aligned frame L (model.hpp): the loop equations place the
   /// closure frames with one product each.
   std::vector<Mat3> frame_rotation_in_link;
   std::vector<Vec3> frame_position_in_link;
   Eigen::VectorXd loop_normal_pivots;      ///< D of N = L D L^T (L in loop_normal's lower triangle) (np)
   Eigen::VectorXd loop_step, loop_trial;   ///< np, n
-  RowMajorMatrix loop_solution;            ///< np x na (elimination order)
+  RowMajorMatrix loop_solution;            ///< np x nla (elimination order)
   Eigen::MatrixXd loop_reduced_work;       ///< n x na
   Eigen::VectorXd loop_vector_work;        ///< n
 
@@ -167,6 +174,14 @@ struct MechanismData {
     double composite_mass;
     Vec3 composite_first_moment;
     Mat3 composite_inertia;
+    /// detail::place's bookkeeping: the joint position rotation / translation were computed at
+    /// (NaN: never), world_* not yet updated after a local-only placement, world_* recomputed
+    /// by the last placement in O (its children's poses in O must follow).
+    double placed_at;
+    bool world_stale;
+    bool world_moved;
+    /// composite_* are those of the current placements of the links below (composite_inertias)
+    bool composite_current;
   };
   std::vector<LinkWork, detail::LargeBufferAllocator<LinkWork>> work;  ///< huge pages for big trees
   Eigen::MatrixXd link_regressor;           ///< dof x 10 scratch: one link's torque regressor
