@@ -28,8 +28,17 @@
 // its wall time), so it cannot be told apart per tick: the JSON gives the machine's steal fraction
 // over the run (/proc/stat) beside the tail, to say how much of it the host's doing may be.
 //
-// Usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE]
+// Twin ticks (compute separated from host preemption): the loop builds the workload twice and
+// feeds both copies the same inputs every period, one right after the other (order alternating),
+// so that both compute exactly the same thing. A tick's own cost (data-dependent iterations, a
+// slow path) shows in both copies; a host stall of the vCPU, which the guest cannot see, rarely
+// hits both. The JSON's twin_* fields are percentiles of min(copy A, copy B) per period: the
+// compute tail with single stalls filtered out. The raw percentiles above stay copy A's; a
+// deadline miss is counted when the two copies together end after the next release.
+//
+// Usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE] [--spin-us S]
 //                     [--workload ct6|paminsa|paminsa_general|reactionless_general]
+//   --spin-us: sleep until S us before each release, then poll the clock (0: sleep to the release)
 //   --rt: try SCHED_FIFO (priority 80) and mlockall(MCL_CURRENT | MCL_FUTURE); when not permitted
 //         (no CAP_SYS_NICE / RLIMIT_RTPRIO, RLIMIT_MEMLOCK) it says so and runs without.
 #include <sched.h>
@@ -84,7 +93,7 @@ double pct(std::vector<long long> v, double p) {
 
 void usage() {
   std::fprintf(stderr,
-               "usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE] "
+               "usage: mechbal-loop [--seconds S] [--rate HZ] [--rt] [--json FILE] [--spin-us S] "
                "[--workload ct6|paminsa|paminsa_general|reactionless_general]\n");
 }
 
@@ -269,32 +278,61 @@ long long thread_cpu_ns() {
 }  // namespace
 
 template <class W>
-void run_loop(W& work, std::size_t ticks, long long period, double rate, double seconds, bool fifo,
-              bool locked, const std::string& json) {
-  std::vector<long long> compute(ticks), wake(ticks), cpu(ticks);  // allocated before the loop
-  for (int i = 0; i < 1000; ++i) work.tick(i * 1e-3);  // warm caches
+void run_loop(W& work, W& twin, std::size_t ticks, long long period, double rate, double seconds,
+              bool fifo, bool locked, long long spin_ns, const std::string& json) {
+  // allocated before the loop
+  std::vector<long long> compute(ticks), wake(ticks), cpu(ticks), twin_min(ticks);
+  for (int i = 0; i < 1000; ++i) {  // warm caches
+    work.tick(i * 1e-3);
+    twin.tick(i * 1e-3);
+  }
+  std::size_t twin_mismatch = 0;  // periods whose two copies returned different statuses
 
   std::size_t misses = 0, overruns = 0, bad_status = 0;
   const auto stat_start = cpu_total_and_steal();
   long long release = now_ns() + period;
   for (std::size_t k = 0; k < ticks; ++k) {
-    const timespec ts = from_ns(release);
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+    if (spin_ns > 0) {  // sleep to spin_ns before the release, then poll the clock
+      const timespec ts = from_ns(release - spin_ns);
+      while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+      }
+      while (now_ns() < release) {
+      }
+    } else {
+      const timespec ts = from_ns(release);
+      while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+      }
+    }
+    wake[k] = now_ns() - release;
+    const double t = static_cast<double>(k) / rate;
+    long long twin_ns = 0;
+    mechbal::Status twin_status = mechbal::Status::ok;
+    if (k % 2 == 1) {  // odd periods: the twin first
+      const long long t0 = now_ns();
+      twin_status = twin.tick(t);
+      twin_ns = now_ns() - t0;
     }
     const long long cpu_start = thread_cpu_ns();
     const long long start = now_ns();
-    const mechbal::Status s = work.tick(static_cast<double>(k) / rate);
+    const mechbal::Status s = work.tick(t);
     const long long end = now_ns();
     cpu[k] = thread_cpu_ns() - cpu_start;
+    if (k % 2 == 0) {  // even periods: the twin second
+      const long long t0 = now_ns();
+      twin_status = twin.tick(t);
+      twin_ns = now_ns() - t0;
+    }
+    if (twin_status != s) ++twin_mismatch;
+    twin_min[k] = std::min(end - start, twin_ns);
     if (s != mechbal::Status::ok) ++bad_status;
     if (end - start > period) ++overruns;  // the computation alone did not fit in a period
-    wake[k] = start - release;
     compute[k] = end - start;
     const long long next = release + period;
-    if (end > next) {
+    const long long done = now_ns();  // both copies computed
+    if (done > next) {
       ++misses;
       // skip the releases already missed, keep the absolute grid
-      while (release + period < end) release += period;
+      while (release + period < done) release += period;
     }
     release += period;
   }
@@ -316,6 +354,10 @@ void run_loop(W& work, std::size_t ticks, long long period, double rate, double 
     }
   }
   const double clean999 = pct(unpreempted, 0.999), cpu999 = pct(cpu, 0.999);
+  std::size_t twin_overruns = 0;
+  for (const long long x : twin_min) twin_overruns += x > period ? 1 : 0;
+  const double tw50 = pct(twin_min, 0.5), tw999 = pct(twin_min, 0.999);
+  const double twmax = static_cast<double>(*std::max_element(twin_min.begin(), twin_min.end()));
   const double p50 = pct(compute, 0.5), p99 = pct(compute, 0.99), p999 = pct(compute, 0.999);
   const double mx = static_cast<double>(*std::max_element(compute.begin(), compute.end()));
   const double w50 = pct(wake, 0.5), w99 = pct(wake, 0.99), w999 = pct(wake, 0.999);
@@ -334,6 +376,8 @@ void run_loop(W& work, std::size_t ticks, long long period, double rate, double 
               "thread CPU time p99.9 %8.0f ns\n", preempted, clean999, overruns_unpreempted, cpu999);
   std::printf("  machine during the run: %.1f %% of its CPU time stolen by the hypervisor (/proc/stat steal)\n",
               100.0 * steal);
+  std::printf("  twin ticks min(A, B): p50 %8.0f ns  p99.9 %8.0f ns  max %8.0f ns; compute overruns %zu; "
+              "status mismatches %zu\n", tw50, tw999, twmax, twin_overruns, twin_mismatch);
   if (!json.empty()) {
     std::ofstream out(json);
     out << "{\"workload\": \"" << W::description << "\", "
@@ -345,12 +389,14 @@ void run_loop(W& work, std::size_t ticks, long long period, double rate, double 
         << ", \"wakeup_p999_ns\": " << w999 << ", \"wakeup_max_ns\": " << wmax
         << ", \"deadline_misses\": " << misses << ", \"compute_overruns\": " << overruns << ", \"non_ok_status\": " << bad_status
         << ", \"preempted_ticks\": " << preempted << ", \"p999_unpreempted_ns\": " << clean999
-        << ", \"compute_overruns_unpreempted\": " << overruns_unpreempted << ", \"cpu_p999_ns\": " << cpu999 << ", \"steal_fraction\": " << steal << "}\n";
+        << ", \"compute_overruns_unpreempted\": " << overruns_unpreempted << ", \"cpu_p999_ns\": " << cpu999 << ", \"steal_fraction\": " << steal
+        << ", \"twin_p50_ns\": " << tw50 << ", \"twin_p999_ns\": " << tw999 << ", \"twin_max_ns\": " << twmax
+        << ", \"twin_compute_overruns\": " << twin_overruns << ", \"twin_status_mismatches\": " << twin_mismatch << "}\n";
   }
 }
 
 int main(int argc, char** argv) {
-  double seconds = 5.0, rate = 1000.0;
+  double seconds = 5.0, rate = 1000.0, spin_us = 0.0;
   bool rt = false;
   std::string json, workload = "ct6";
   for (int i = 1; i < argc; ++i) {
@@ -363,6 +409,8 @@ int main(int argc, char** argv) {
       rt = true;
     } else if (a == "--workload" && i + 1 < argc) {
       workload = argv[++i];
+    } else if (a == "--spin-us" && i + 1 < argc) {
+      spin_us = std::atof(argv[++i]);
     } else if (a == "--json" && i + 1 < argc) {
       json = argv[++i];
     } else if (a == "--help" || a == "-h") {
@@ -385,6 +433,11 @@ int main(int argc, char** argv) {
     return 2;
   }
   const long long period = static_cast<long long>(std::llround(1e9 / rate));
+  if (!(spin_us >= 0.0) || spin_us * 1e3 > static_cast<double>(period)) {
+    std::fprintf(stderr, "mechbal-loop: --spin-us must be in [0, period], got %g\n", spin_us);
+    return 2;
+  }
+  const auto spin_ns = static_cast<long long>(std::llround(spin_us * 1e3));
   const auto ticks = static_cast<std::size_t>(std::llround(seconds * rate));
 
   bool fifo = false, locked = false;
@@ -410,17 +463,17 @@ int main(int argc, char** argv) {
   }
 
   if (workload == "paminsa_general") {
-    PaminsaGeneralWorkload work;
-    run_loop(work, ticks, period, rate, seconds, fifo, locked, json);
+    PaminsaGeneralWorkload work, twin;
+    run_loop(work, twin, ticks, period, rate, seconds, fifo, locked, spin_ns, json);
   } else if (workload == "reactionless_general") {
-    ReactionlessGeneralWorkload work;
-    run_loop(work, ticks, period, rate, seconds, fifo, locked, json);
+    ReactionlessGeneralWorkload work, twin;
+    run_loop(work, twin, ticks, period, rate, seconds, fifo, locked, spin_ns, json);
   } else if (workload == "paminsa") {
-    PaminsaWorkload work(rate);
-    run_loop(work, ticks, period, rate, seconds, fifo, locked, json);
+    PaminsaWorkload work(rate), twin(rate);
+    run_loop(work, twin, ticks, period, rate, seconds, fifo, locked, spin_ns, json);
   } else {
-    ComputedTorqueWorkload work;
-    run_loop(work, ticks, period, rate, seconds, fifo, locked, json);
+    ComputedTorqueWorkload work, twin;
+    run_loop(work, twin, ticks, period, rate, seconds, fifo, locked, spin_ns, json);
   }
   return 0;
 }

@@ -171,7 +171,9 @@ def main(argv=None):
     def check(value, ok):
         return {"value": value, "met": None if value is None else bool(ok(value))}
 
-    allocs = {n: c["allocations_per_tick"] for n, c in cases.items()}
+    # mechbal's own cases: another engine's allocations (Pinocchio's constraintDynamics) are its own
+    allocs = {n: c["allocations_per_tick"] for n, c in cases.items()
+              if not any(tag in n for tag in ("_pinocchio", "_kdl"))}
     targets = {
         "wrist_euler_median_ns <= 500": check(median("wrist_euler"), lambda v: v <= 500),
         "wrist_rk4_median_ns <= 500": check(median("wrist_rk4"), lambda v: v <= 500),
@@ -180,13 +182,14 @@ def main(argv=None):
         "paminsa_tick_rk4_median_ns <= 2000": check(median("paminsa_tick_rk4"),
                                                     lambda v: v <= 2000),
         "loop_ct6_p999_ns < 10000": check(loop["p999_ns"], lambda v: v < 10000),
+        "loop_ct6_twin_p999_ns < 10000": check(loop.get("twin_p999_ns"), lambda v: v < 10000),
         "kdl_over_mechbal_ct6 >= 2": check(ratios["kdl_over_mechbal_ct6"], lambda v: v >= 2),
         "mechbal_over_pinocchio_ct6 <= 1.2": check(
             None if not ratios["pinocchio_over_mechbal_ct6"]
             else 1.0 / ratios["pinocchio_over_mechbal_ct6"], lambda v: v <= 1.2),
         "numpy_over_mechbal_batch >= 10": check(ratios.get("numpy_over_mechbal_batch"),
                                                 lambda v: v >= 10),
-        "allocations_per_tick == 0 (every case)": check(max(allocs.values()), lambda v: v == 0),
+        "allocations_per_tick == 0 (every mechbal case)": check(max(allocs.values()), lambda v: v == 0),
     }
     if py:  # issue 15: one controller tick from Python (the fast step_into) <= 1.5 us median
         for name in ("ct6_step_into", "ct2_step_into", "decoupled3_step_into",
@@ -211,7 +214,7 @@ def main(argv=None):
     loop_ratios, loop_targets, loop_notes = loop_results(cases, ratio, median, check)
     ratios.update(loop_ratios)
     targets.update(loop_targets)
-    from merge_speed import speed_results  # issue 26: big trees, closed-loop anchor, scaling, loops
+    from merge_speed import _twin_rows, speed_results  # issue 26: big trees, anchor, scaling, loops
 
     loops_extra = {}
     for item in args.loop_extra:
@@ -225,6 +228,8 @@ def main(argv=None):
     if loop_paminsa:
         targets["loop_paminsa_p999_ns < 10000"] = check(loop_paminsa["p999_ns"],
                                                         lambda v: v < 10000)
+        targets["loop_paminsa_twin_p999_ns < 10000"] = check(loop_paminsa.get("twin_p999_ns"),
+                                                             lambda v: v < 10000)
 
     result = {
         "generated": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
@@ -314,6 +319,7 @@ def main(argv=None):
            f"({loop.get('compute_overruns', 'n/a')}) |",
            f"| wake-up latency [ns] | {fmt(loop['wakeup_p50_ns'])} | {fmt(loop['wakeup_p99_ns'])} | "
            f"{fmt(loop['wakeup_p999_ns'])} | {fmt(loop['wakeup_max_ns'])} | |"]
+    md += _twin_rows(loop)
     if loop_paminsa:
         lp = loop_paminsa
         md += ["", f"mechbal-loop --workload paminsa: {lp['ticks']} ticks at {lp['rate_hz']:.0f} Hz,"
@@ -323,6 +329,7 @@ def main(argv=None):
                f"| tick time [ns] | {fmt(lp['p50_ns'])} | {fmt(lp['p99_ns'])} | "
                f"{fmt(lp['p999_ns'])} | {fmt(lp['max_ns'])} | {lp['deadline_misses']} "
                f"({lp.get('compute_overruns', 'n/a')}) |"]
+        md += _twin_rows(lp)
     md += speed_md
     md += ["", "| target | value | met |", "|---|---:|---|"]
     for k, v in targets.items():
