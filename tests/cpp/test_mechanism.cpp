@@ -285,6 +285,76 @@ TEST(Mechanism, IncrementalPlacementIsBitForBitAFreshPlacement) {
   }
 }
 
+// The mass matrix's backward pass (a subtree's momenta carried together, the gear couplings
+// applied pair by pair) against the dense projection G^T M_joint G of the same tree with every
+// joint free, and against the inverse dynamics' columns (M e_c = ID(q, 0, e_c) - ID(q, 0, 0), an
+// independent recursion), on random trees with several gear couplings (on the same path as their
+// master, on another branch, one following another), fixed joints and massless links.
+TEST(Mechanism, MassMatrixIsTheDenseGearProjection) {
+  std::mt19937 rng(27);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  for (int trial = 0; trial < 20; ++trial) {
+    MechanismDescription d;
+    std::vector<std::string> links{d.root_name}, moving;
+    const char* types = trial % 2 ? "RRPRFRRRPRRFRR" : "RPRRRRFRRRRRRR";
+    for (int i = 0; types[i]; ++i) {
+      Joint j;
+      j.name = "j" + std::to_string(i + 1);
+      j.type = types[i] == 'P' ? JointType::prismatic : types[i] == 'F' ? JointType::fixed : JointType::revolute;
+      j.parent = links[std::uniform_int_distribution<std::size_t>(0, links.size() - 1)(rng)];
+      j.placement = test::random_pose(rng);
+      j.axis = Vec3(u(rng), u(rng), u(rng)).normalized();
+      // every fourth moving joint follows an earlier one (possibly itself a follower)
+      if (j.type != JointType::fixed && !moving.empty() && moving.size() % 4 == 3) {
+        j.mimic_joint = moving[std::uniform_int_distribution<std::size_t>(0, moving.size() - 1)(rng)];
+        j.mimic_ratio = std::uniform_real_distribution<double>(-2.0, 2.0)(rng);
+        j.mimic_offset = u(rng);
+      }
+      d.joints.push_back(j);
+      if (j.type != JointType::fixed) moving.push_back(j.name);
+      if ((i + trial) % 5 != 4) {  // otherwise a massless link
+        const RigidBody rb = test::random_body(rng);
+        d.bodies.push_back(Body{j.name + "_b", "link", j.name, rb.mass, Vec3(u(rng), u(rng), u(rng)), rb.inertia_body});
+      }
+      links.push_back(j.name);
+    }
+    const MechanismModel model(d);
+    MechanismDescription free = d;
+    for (auto& j : free.joints) j.mimic_joint.clear();
+    const MechanismModel free_model(free);
+    ASSERT_EQ(free_model.num_links(), model.num_links());
+    const int n = model.dof(), nf = free_model.dof();
+    ASSERT_LT(n, nf);
+    MechanismData data(model), free_data(free_model);
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::VectorXd q = test::random_vector(rng, n, 2.0);
+      Eigen::MatrixXd G = Eigen::MatrixXd::Zero(nf, n);
+      Eigen::VectorXd qf(nf);
+      for (int l = 1; l < model.num_links(); ++l) {
+        const int c = model.coordinate(l), cf = free_model.coordinate(l);
+        if (c < 0) continue;
+        G(cf, c) = model.coordinate_ratio(l);
+        qf(cf) = model.coordinate_ratio(l) * q(c) + model.coordinate_offset(l);
+      }
+      ASSERT_EQ(mass_matrix(free_model, free_data, qf), Status::ok);
+      const Eigen::MatrixXd dense = G.transpose() * free_data.mass_matrix * G;
+      ASSERT_EQ(mass_matrix(model, data, q), Status::ok);
+      const Eigen::MatrixXd M = data.mass_matrix;
+      EXPECT_LT(rel(M, dense), 1e-13) << trial;
+      EXPECT_EQ(M, M.transpose());
+      Eigen::MatrixXd columns(n, n);
+      const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+      ASSERT_EQ(inverse_dynamics(model, data, q, zero, zero), Status::ok);
+      const Eigen::VectorXd bias = data.joint_torque;
+      for (int c = 0; c < n; ++c) {
+        ASSERT_EQ(inverse_dynamics(model, data, q, zero, Eigen::VectorXd::Unit(n, c)), Status::ok);
+        columns.col(c) = data.joint_torque - bias;
+      }
+      EXPECT_LT(rel(M, columns), 1e-12) << trial;
+    }
+  }
+}
+
 TEST(Mechanism, AlgorithmsAllocateNothing) {
   std::mt19937 rng(24);
   const MechanismModel model = random_tree(rng, "RRPFRRRF", true);

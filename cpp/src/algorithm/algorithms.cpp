@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace mechbal {
 
@@ -387,6 +388,31 @@ Status potential_energy(const MechanismModel& model, MechanismData& data, const 
 
 // ---- mass matrix --------------------------------------------------------------------------------
 
+namespace {
+
+/// One past the last link of the subtree rooted at link i: links are depth-first (model.hpp), so
+/// the subtree is [i, end) and ends at the first later link whose parent comes before i.
+inline int subtree_end(const MechanismModel& model, int i) noexcept {
+  int end = i + 1;
+  while (end < model.num_links() && model.parent(end) >= i) ++end;
+  return end;
+}
+
+/// True when x is a finite double (a NaN fails the comparison).
+inline bool finite(double x) noexcept { return std::abs(x) <= std::numeric_limits<double>::max(); }
+
+}  // namespace
+
+// One backward pass of the composite rigid body algorithm (Featherstone 2008, alg. 6.2) with
+// Pinocchio's subtree blocks. work[l].force / .moment hold P_l / L_l, the momentum of link l's
+// composite body under a unit rate of joint l (L about the frame's origin), carried up the tree:
+// when link i is reached, the columns of its whole subtree are in L_i. Row i of M is S_i^T of
+// every column of the subtree (the pairs (i, descendant): the support paths only; a branch's
+// entries against another branch are never computed), then the subtree's columns move to the
+// parent's frame with a rotation and a cross product each. The columns of a subtree do not depend
+// on each other (no dependent chain of transforms per column, as a walk up from each link has).
+// Gear couplings are applied as the pairs come, M(c_i, c_l) += r_i r_l S_i^T F_l: the projection
+// G^T M_joint G without a dense product. Only the written entries are checked for finiteness.
 Status mass_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
   if (Status s = check_state(model, data, &q); s != Status::ok) return s;
   detail::joint_state<false, false>(model, data, q, q, q);
@@ -395,39 +421,54 @@ Status mass_matrix(const MechanismModel& model, MechanismData& data, const Const
   detail::composite_inertias(model, data);
   Eigen::MatrixXd& M = data.mass_matrix;
   M.setZero();
-  for (int l = 1; l < model.num_links(); ++l) {
-    const int cl = model.coordinate(l);
-    if (cl < 0) continue;
-    const auto& W = data.work[static_cast<std::size_t>(l)];
-    const double rl = model.coordinate_ratio(l);
-    Vec3 L, P;  // momentum of composite l under a unit rate of joint l, about L_l's origin
-    double diag;
-    if (model.joint_type(l) == JointType::revolute) {
-      L = W.composite_inertia.col(2);
-      P = -detail::cross_ez(W.composite_first_moment);
-      diag = L.z();
+  bool ok = true;
+  const int nl = model.num_links();
+  for (int i = nl - 1; i >= 1; --i) {
+    auto& W = data.work[static_cast<std::size_t>(i)];
+    const int end = subtree_end(model, i);
+    const int ci = model.coordinate(i);
+    if (ci >= 0) {
+      const bool revolute = model.joint_type(i) == JointType::revolute;
+      if (revolute) {
+        W.moment = W.composite_inertia.col(2);
+        W.force = -detail::cross_ez(W.composite_first_moment);
+      } else {
+        W.moment = detail::cross_ez(W.composite_first_moment);
+        W.force = Vec3(0.0, 0.0, W.composite_mass);
+      }
+      const double ri = model.coordinate_ratio(i);
+      double& d = M(ci, ci);
+      d += ri * ri * (revolute ? W.moment.z() : W.force.z());
+      ok &= finite(d);
+      for (int l = i + 1; l < end; ++l) {
+        const int cl = model.coordinate(l);
+        if (cl < 0) continue;
+        const auto& C = data.work[static_cast<std::size_t>(l)];
+        const double value = ri * model.coordinate_ratio(l) * (revolute ? C.moment.z() : C.force.z());
+        M(cl, ci) += value;
+        double& e = M(ci, cl);
+        e += value;
+        ok &= finite(e);  // M(cl, ci) == M(ci, cl): both receive the same values
+      }
     } else {
-      L = detail::cross_ez(W.composite_first_moment);
-      P = Vec3(0.0, 0.0, W.composite_mass);
-      diag = P.z();
+      W.force.setZero();
+      W.moment.setZero();
     }
-    M(cl, cl) += rl * rl * diag;
-    // carry it to every ancestor: M(j, l) = S_j . (momentum about j's origin)
-    int k = l;
-    for (int j = model.parent(l); j >= 1; k = j, j = model.parent(j)) {
-      const int cj = model.coordinate(j);
-      if (cj < 0 && model.parent(j) == 0) break;  // a link welded to the base: nothing above
-      const auto& K = data.work[static_cast<std::size_t>(k)];
-      P = K.rotation * P;
-      L = K.rotation * L + K.translation.cross(P);
-      if (cj < 0) continue;
-      const double value = rl * model.coordinate_ratio(j) *
-                           (model.joint_type(j) == JointType::revolute ? L.z() : P.z());
-      M(cl, cj) += value;
-      M(cj, cl) += value;
+    const int parent = model.parent(i);
+    if (parent == 0) continue;  // nothing above
+    // a massless subtree (m = 0, zero inertia: composite_inertias does not carry it either):
+    // its columns are zero in every frame
+    if (W.composite_mass == 0.0 && W.composite_inertia.trace() == 0.0) continue;
+    const Mat3& R = W.rotation;
+    const Vec3& t = W.translation;
+    for (int l = i; l < end; ++l) {
+      auto& C = data.work[static_cast<std::size_t>(l)];
+      const Vec3 P = R * C.force;
+      C.moment = R * C.moment + t.cross(P);
+      C.force = P;
     }
   }
-  return finite_result(M);
+  return ok ? Status::ok : Status::out_of_range;
 }
 
 // ---- Jacobians ----------------------------------------------------------------------------------
