@@ -15,11 +15,15 @@
    C++ call) against a pure-numpy implementation of the same formula (Briot & Arakelian 2009,
    eqs 1-4) given the bodies' motion, which numpy is not timed for (it comes from
    Mechanism.body_motion): F = sum m a_G; M_O = sum (m OG x a_G + I alpha + w x I w),
-   I = R I_body R^T. The two are checked to agree (1e-9 relative) before anything is timed.
+   I = R I_body R^T. That is less work than mechbal's call (numpy_over_mechbal); the same work,
+   numpy computing the chain's kinematics from q, v, a too (numpy_chain_motion), gives
+   numpy_with_kinematics_over_mechbal. They are checked to agree (1e-9 relative) before
+   anything is timed.
 4. Sizing (issue 11): static balancing by counterweights (mechbal.balance.static: batched C++
    gravity regressor of the probe bodies, least squares, bounds) of a random spatial 7-joint arm
    with a counterweight slot on each of links 2-7, over 10 000 random poses (target < 1 s on one
-   core: run with OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1).
+   core: BLAS is held to one thread through threadpoolctl, the 'sweep' extra; without it, run with
+   OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1).
 3. Controllers in batch: paminsa_reactionless_run (RK4 wrist, 2000 ticks, also writing every
    body's motion) and simulate_computed_torque (2-DOF closed loop, 2000 ticks), ticks per second.
    These are sequential closed loops: there is no vectorised numpy equivalent to compare with.
@@ -65,6 +69,43 @@ def numpy_shaking_wrench(mass, inertia_body, com, acc, rotation, w, alpha):
     moment = (np.einsum("b,nbi->ni", mass, np.cross(com, acc))
               + Ial.sum(axis=1) + np.cross(w, Iw).sum(axis=1))
     return force, moment
+
+
+def numpy_chain_motion(specs, q, v, a):
+    """Every body's motion in O for the serial revolute chain of ``specs`` (``chain_from_specs``:
+    link frame = parent link frame x origin x rotation about the axis by q, one body per link),
+    vectorised over instants: (com, com acceleration, rotation, angular velocity, angular
+    acceleration), each (N, B, ...). The kinematics that Mechanism.shaking_wrench does in its C++
+    call, so that numpy can be timed on the same work (from q, v, a)."""
+    n = q.shape[0]
+    R = np.broadcast_to(np.eye(3), (n, 3, 3))
+    p, w, al, acc = (np.zeros((n, 3)) for _ in range(4))   # link origin, its motion
+    out = {k: [] for k in ("com", "acc", "rot", "w", "al")}
+    for i, s in enumerate(specs):
+        origin, u = np.asarray(s["origin"], float), np.asarray(s["axis"], float)
+        r = R @ origin[:3, 3]                                  # parent origin -> this origin
+        acc = acc + np.cross(al, r) + np.cross(w, np.cross(w, r))
+        p = p + r
+        R = R @ origin[:3, :3]
+        axis = R @ u                                           # the joint axis in O
+        K = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
+        sn, cs = np.sin(q[:, i])[:, None, None], np.cos(q[:, i])[:, None, None]
+        R = R @ (np.eye(3) + sn * K + (1.0 - cs) * (K @ K))   # Rodrigues
+        rate = axis * v[:, i:i + 1]
+        al = al + axis * a[:, i:i + 1] + np.cross(w, rate)
+        w = w + rate
+        c = R @ np.asarray(s["com"], float)
+        out["com"].append(p + c)
+        out["acc"].append(acc + np.cross(al, c) + np.cross(w, np.cross(w, c)))
+        out["rot"].append(R), out["w"].append(w), out["al"].append(al)
+    return tuple(np.stack(out[k], axis=1) for k in ("com", "acc", "rot", "w", "al"))
+
+
+def numpy_chain_shaking_wrench(specs, mass, inertia_body, q, v, a):
+    """numpy_shaking_wrench of the chain's motion from (q, v, a): the work of one
+    Mechanism.shaking_wrench batch call."""
+    com, acc, rot, w, al = numpy_chain_motion(specs, q, v, a)
+    return numpy_shaking_wrench(mass, inertia_body, com, acc, rot, w, al)
 
 
 def best_time(fn, repeat, number=1):
@@ -431,7 +472,8 @@ def main(argv=None):
     results["vs_pinocchio"] = bench_single_calls_vs_pinocchio(args.rounds, 500 if args.quick else 2000)
 
     # ---- 2. batch throughput against numpy ------------------------------------------------------
-    chain = mechbal.Mechanism(chain_from_specs(random_chain_specs(rng, "R" * args.bodies)))
+    specs = random_chain_specs(rng, "R" * args.bodies)
+    chain = mechbal.Mechanism(chain_from_specs(specs))
     qn, vn, an = (np.ascontiguousarray(rng.uniform(-1.5, 1.5, (args.instants, args.bodies))) for _ in range(3))
     m = chain.body_motion(qn, vn, an)
     bodies = chain.model.bodies
@@ -447,11 +489,18 @@ def main(argv=None):
     if not (err_F < 1e-9 and err_M < 1e-9):
         raise SystemExit(f"mechbal and numpy shaking wrench disagree: force {err_F:g}, "
                          f"moment {err_M:g} (relative)")
+    F_kin, M_kin = numpy_chain_shaking_wrench(specs, data["mass"], data["inertia_body"], qn, vn, an)
+    err_kin = max(np.linalg.norm(mb.shaking_force - F_kin) / np.linalg.norm(F_kin),
+                  np.linalg.norm(mb.shaking_moment - M_kin) / np.linalg.norm(M_kin))
+    if not err_kin < 1e-9:
+        raise SystemExit(f"mechbal and numpy (kinematics included) shaking wrench disagree: {err_kin:g}")
     repeat = 3 if args.quick else 7
     t_mb = best_time(lambda: chain.shaking_wrench(qn, vn, an), repeat)
     t_np = best_time(lambda: numpy_shaking_wrench(
         data["mass"], data["inertia_body"], data["com"], data["com_acceleration"],
         data["rotation"], data["angular_velocity"], data["angular_acceleration"]), repeat)
+    t_np_kin = best_time(lambda: numpy_chain_shaking_wrench(specs, data["mass"], data["inertia_body"],
+                                                            qn, vn, an), repeat)
     results["batch"] = {
         "instants": args.instants, "bodies": args.bodies,
         "agreement_relative": {"force": float(err_F), "moment": float(err_M)},
@@ -459,6 +508,10 @@ def main(argv=None):
         "mechbal_instants_per_s": args.instants / t_mb,
         "numpy_instants_per_s": args.instants / t_np,
         "numpy_over_mechbal": t_np / t_mb,
+        # the same work as mechbal's call: numpy also computes the kinematics from q, v, a
+        "numpy_with_kinematics_s": t_np_kin,
+        "numpy_with_kinematics_instants_per_s": args.instants / t_np_kin,
+        "numpy_with_kinematics_over_mechbal": t_np_kin / t_mb,
     }
     # ---- 3. controllers in batch (sequential closed loops: no vectorised numpy equivalent) -------
     # PAMINSA fully balanced run with the RK4 reactionless wrist, 1 kHz, platform motion sampled on
@@ -520,6 +573,16 @@ def random_seven_joint_arm(seed: int = 7):
 
 
 def bench_sizing(repeat: int) -> dict:
+    try:  # the target is on one core: BLAS on one thread (two threads on a loaded 2-core host
+        # cost the QR and SVD of the 70 000-row least squares several times their single-thread time)
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # the 'sweep' extra is missing: run with OPENBLAS_NUM_THREADS=1
+        return bench_sizing_timed(repeat, "as the environment sets")
+    with threadpool_limits(limits=1, user_api="blas"):
+        return bench_sizing_timed(repeat, 1)
+
+
+def bench_sizing_timed(repeat: int, blas_threads) -> dict:
     from mechbal.balance import CounterweightSlot, static
 
     mech = random_seven_joint_arm()
@@ -531,7 +594,7 @@ def bench_sizing(repeat: int) -> dict:
         seconds = best_time(lambda: static.balance(mech, slots, 10_000), max(1, min(repeat, 3)))
         out[label] = {"seconds": seconds, "poses": 10_000, "slots": len(slots), "exact": res.exact,
                       "residual_Nm": res.residual, "residual_before_Nm": res.residual_before,
-                      "target_s": 1.0}
+                      "target_s": 1.0, "blas_threads": blas_threads}
     return out
 
 

@@ -5,10 +5,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <stdexcept>
 #include <string>
 
 #include "bindings.hpp"
+#include "value_errors.hpp"
 #include "mechbal/io/case.hpp"
 
 namespace py = pybind11;
@@ -16,15 +16,6 @@ namespace py = pybind11;
 namespace mechbal::pyb {
 
 namespace {
-
-template <typename Fn>
-auto value_errors(Fn fn) -> decltype(fn()) {
-  try {
-    return fn();
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error(e.what());
-  }
-}
 
 void bind_io(py::module_& m) {
   m.def(

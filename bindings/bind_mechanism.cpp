@@ -14,6 +14,7 @@
 
 #include "array_checks.hpp"
 #include "bindings.hpp"
+#include "reaction_bounds.hpp"
 #include "mechbal/algorithm/center_of_mass.hpp"
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/jacobian.hpp"
@@ -779,23 +780,34 @@ void bind_mechanism(py::module_& m) {
         batch_rows(mo, v, "v", N);
         batch_rows(mo, a, "a", N);
         const auto n = static_cast<Eigen::Index>(mo.dof());
+        const py::ssize_t NR = with_gravity ? N : 0;  // the reactions' arrays: only when asked for
         Array F = make_array({N, 3}), M = make_array({N, 3}), P = make_array({N, 3}), H = make_array({N, 3}),
-              RF = make_array({N, 3}), RM = make_array({N, 3}), SF = make_array({N, 3}),
-              SM = make_array({N, 3});
+              RF = make_array({NR, 3}), RM = make_array({NR, 3}), SF = make_array({NR, 3}),
+              SM = make_array({NR, 3});
+        // Without with_gravity the reactions are computed only when their bounds cannot tell that
+        // they are finite: an instant is accepted exactly when base_reaction accepts it.
+        const ReactionBounds bounds(mo);
+        bool reactions = with_gravity;  // the reactions of the current instant were computed
         auto status = run_batch(
             mo, N,
             [&](py::ssize_t k, MechanismData& d) {
-              return base_reaction(mo, d, CVec(row(q, k), n), CVec(row(v, k), n), CVec(row(a, k), n));
+              const CVec qk(row(q, k), n), vk(row(v, k), n), ak(row(a, k), n);
+              if (with_gravity) return base_reaction(mo, d, qk, vk, ak);
+              const Status s = shaking_wrench(mo, d, qk, vk, ak);
+              reactions = s == Status::ok && !bounds.surely_finite(d);
+              return reactions ? base_reaction(mo, d, qk, vk, ak) : s;
             },
-            [](const MechanismData& d) {
-              return finite_wrench(d) && d.base_reaction.force.allFinite() && d.base_reaction.moment.allFinite() &&
-                     d.support_reaction.force.allFinite() && d.support_reaction.moment.allFinite();
+            [&](const MechanismData& d) {
+              return finite_wrench(d) &&
+                     (!reactions || (d.base_reaction.force.allFinite() && d.base_reaction.moment.allFinite() &&
+                                     d.support_reaction.force.allFinite() && d.support_reaction.moment.allFinite()));
             },
             [&](py::ssize_t k, const MechanismData& d, bool ok) {
               put3(F, k, 0, d.shaking.force, ok);
               put3(M, k, 0, d.shaking.moment, ok);
               put3(P, k, 0, d.shaking.linear_momentum, ok);
               put3(H, k, 0, d.shaking.angular_momentum, ok);
+              if (!with_gravity) return;
               put3(RF, k, 0, d.base_reaction.force, ok);
               put3(RM, k, 0, d.base_reaction.moment, ok);
               put3(SF, k, 0, d.support_reaction.force, ok);

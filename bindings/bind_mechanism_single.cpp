@@ -19,6 +19,7 @@
 
 #include "array_checks.hpp"
 #include "bindings.hpp"
+#include "reaction_bounds.hpp"
 #include "mechbal/algorithm/center_of_mass.hpp"
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/jacobian.hpp"
@@ -42,13 +43,7 @@ class SingleSample {
  public:
   SingleSample(const py::object& model, const py::object& status_ok, const py::object& wrench_type)
       : owner_(model), status_ok_(status_ok), wrench_type_(wrench_type), model_(model.cast<const MechanismModel*>()), data_(*model_),
-        n_(model_->dof()) {
-    for (int l = 0; l < model_->num_links(); ++l) {
-      mass_ += std::abs(model_->link_constants(l).mass);
-      first_moments_ += model_->link_constants(l).first_moment.lpNorm<1>();
-    }
-    gravity_ = model_->gravity().cwiseAbs().maxCoeff();
-  }
+        n_(model_->dof()), bounds_(*model_) {}
 
   py::object inverse_dynamics(py::handle q, py::handle v, py::handle a) {
     const double *pq = vec(q), *pv = vec(v), *pa = vec(a);
@@ -87,16 +82,16 @@ class SingleSample {
 
   /// A `wrench_type` (mechbal.ShakingWrench, a frozen dataclass) with its fields shaking_force,
   /// shaking_moment, linear_momentum, angular_momentum and status (`status_ok`) set as
-  /// wrench_type(**fields) sets them, without the Python-level __init__ (a third of the call). Accepted exactly when the general path (which
-  /// runs base_reaction) accepts: base_reaction only runs here when the bounds cannot tell. base_reaction, as the general path, so that the same
-  /// instants are accepted.
+  /// wrench_type(**fields) sets them, without the Python-level __init__ (a third of the call).
+  /// Accepted exactly when the general path accepts: finite reactions too, base_reaction running
+  /// only when their bounds (reaction_bounds.hpp) cannot tell, as in the general path.
   py::object shaking_wrench(py::handle q, py::handle v, py::handle a) {
     const double *pq = vec(q), *pv = vec(v), *pa = vec(a);
     if (!pq || !pv || !pa) return py::none();
     const auto& d = data_;
     const CMap qm(pq, n_), vm(pv, n_), am(pa, n_);
     if (mechbal::shaking_wrench(*model_, data_, qm, vm, am) != Status::ok) return py::none();
-    if (!reactions_surely_finite()) {  // the general path's verdict, computed
+    if (!bounds_.surely_finite(data_)) {  // the general path's verdict, computed
       if (base_reaction(*model_, data_, qm, vm, am) != Status::ok ||
           !(d.base_reaction.force.allFinite() && d.base_reaction.moment.allFinite() &&
             d.support_reaction.force.allFinite() && d.support_reaction.moment.allFinite()))
@@ -157,21 +152,6 @@ class SingleSample {
  private:
   const double* vec(py::handle h) const noexcept { return float64_vector(h, n_); }
 
-  /// After shaking_wrench (finite momenta and rates): whether the base and support reactions the
-  /// general path also requires finite (base_reaction: F - m g and M - (m c) x g over some or all
-  /// links) surely are, from bounds: |m c|_inf <= B = mass * reach + sum |m c_link|_1 (reach: the
-  /// largest |coordinate| of a link origin; |R x|_inf <= |x|_1), so |(m c - m c_still) x g|_inf
-  /// <= 4 B |g|_inf. Otherwise the caller computes them.
-  bool reactions_surely_finite() const noexcept {
-    constexpr double kSafe = 1e306;
-    const auto& s = data_.shaking;
-    if (s.force.cwiseAbs().maxCoeff() > kSafe || s.moment.cwiseAbs().maxCoeff() > kSafe) return false;
-    double reach = 0.0;
-    for (const auto& w : data_.work) reach = std::max(reach, w.world_position.cwiseAbs().maxCoeff());
-    if (!(reach <= kSafe)) return false;  // (NaN too)
-    return mass_ * gravity_ <= kSafe && 4.0 * (mass_ * reach + first_moments_) * gravity_ <= kSafe;
-  }
-
   /// Index of the frame named by a str, -1 for anything else (the general path reports it). The
   /// last name's index is kept (a script passes the same str object every call).
   int frame_of(py::handle name) {
@@ -218,7 +198,7 @@ class SingleSample {
   const MechanismModel* model_;
   MechanismData data_;
   py::ssize_t n_;
-  double mass_ = 0.0, first_moments_ = 0.0, gravity_ = 0.0;  ///< bounds of reactions_surely_finite
+  ReactionBounds bounds_;
 };
 
 // ---- the calls: METH_FASTCALL builtin functions bound to a capsule of the SingleSample (a

@@ -15,6 +15,8 @@
 #include "bindings.hpp"
 #include "controller_step.hpp"
 #include "motion_tick.hpp"
+#include "value_errors.hpp"
+#include "mechbal/control/factory.hpp"
 #include "mechbal/control/reactionless.hpp"
 
 namespace py = pybind11;
@@ -70,15 +72,6 @@ ReactionlessConfig make_config(const std::vector<std::string>& balancing, const 
 Eigen::VectorXd optional_vector(const py::object& o, const char* name, py::ssize_t n) {
   if (o.is_none()) return Eigen::VectorXd();
   return vector_arg(to_real_array(o), name, n);
-}
-
-template <typename T, typename Fn>
-T translate(Fn fn) {
-  try {
-    return fn();
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error(e.what());
-  }
 }
 
 std::vector<std::string> names_of(const ReactionlessController& c, const std::vector<int>& idx) {
@@ -154,25 +147,6 @@ py::dict run(ReactionlessController& c, const Array& q, const Array& v, const Ar
   return d;
 }
 
-std::uint32_t task_mask(const std::vector<std::string>& rows) {
-  static const std::pair<const char*, std::uint32_t> names[] = {
-      {"linear", cancel_force}, {"angular", cancel_moment}, {"all", cancel_both}, {"v_x", force_x},
-      {"v_y", force_y},         {"v_z", force_z},          {"w_x", moment_x},  {"w_y", moment_y},
-      {"w_z", moment_z}};
-  if (rows.empty()) throw py::value_error("task_rows must name at least one twist component");
-  std::uint32_t mask = 0;
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    std::uint32_t bit = 0;
-    for (const auto& n : names)
-      if (rows[i] == n.first) bit = n.second;
-    if (bit == 0)
-      throw py::value_error("task_rows[" + std::to_string(i) + "]: '" + rows[i] +
-                            "' is not a twist component (linear, angular, all, v_x, v_y, v_z, w_x, w_y, w_z)");
-    mask |= bit;
-  }
-  return mask;
-}
-
 void bind_task_controller(py::module_& m) {
   py::class_<ReactionlessTaskController>(
       m, "ReactionlessTaskController",
@@ -185,7 +159,7 @@ void bind_task_controller(py::module_& m) {
              TaskSpaceConfig c;
              c.null_space = null_space;
              c.frame = frame;
-             c.task_rows = task_mask(task_rows);
+             c.task_rows = task_rows_mask(task_rows, "task_rows");  // the factory's table and messages
              c.cancel = cancel_mask(cancel);
              c.integrator = integrator_of(integrator);
              c.rate_hz = rate_hz;
@@ -195,7 +169,7 @@ void bind_task_controller(py::module_& m) {
              const Eigen::VectorXd q = q0.is_none() ? Eigen::VectorXd(Eigen::VectorXd::Zero(model.dof()))
                                                     : vector_arg(to_real_array(q0), "q0", model.dof(), true);
              const Eigen::VectorXd v = optional_vector(v0, "v0", model.dof());
-             return translate<ReactionlessTaskController*>([&] {
+             return value_errors([&] {
                return new ReactionlessTaskController(std::make_shared<const MechanismModel>(model), c, q, v);
              });
            }),
@@ -208,6 +182,39 @@ void bind_task_controller(py::module_& m) {
       .def_property_readonly("dof", &ReactionlessTaskController::dof)
       .def_property_readonly("dt", &ReactionlessTaskController::dt)
       .def_property_readonly("target", &ReactionlessTaskController::target)
+      .def(
+          "step",
+          [](ReactionlessTaskController& c, const Array& twist, const py::object& twist_rate,
+             const py::object& twist_half, const py::object& twist_next) {
+            const Vec6 now = fixed_vector<6>(twist, "twist");
+            const Vec6 half = twist_half.is_none() ? now : fixed_vector<6>(to_real_array(twist_half), "twist_half");
+            const Vec6 next = twist_next.is_none() ? now : fixed_vector<6>(to_real_array(twist_next), "twist_next");
+            if (twist_rate.is_none()) return static_cast<std::uint32_t>(c.step(now, half, next));
+            return static_cast<std::uint32_t>(
+                c.step(now, fixed_vector<6>(to_real_array(twist_rate), "twist_rate"), half, next));
+          },
+          py::arg("twist"), py::arg("twist_rate") = py::none(), py::arg("twist_half") = py::none(),
+          py::arg("twist_next") = py::none(),
+          "One tick: the desired frame twist [v; w] (O axes) at t_n, its rate (default: estimated from the "
+          "three samples) and, for RK4, the twist at t_n + dt/2 and t_n + dt (default: the twist at t_n). "
+          "Returns the status (int, 0 = ok); the command is in q, v, a, momentum, frame_twist, "
+          "shaking_force, shaking_moment. run() gives the same commands over a whole motion.")
+      .def_property_readonly("q", [](const ReactionlessTaskController& c) { return Eigen::VectorXd(c.q()); },
+                             "Commanded positions at t_n [rad or m] (dof,)")
+      .def_property_readonly("v", [](const ReactionlessTaskController& c) { return Eigen::VectorXd(c.v()); },
+                             "Commanded rates at t_n [rad/s or m/s] (dof,)")
+      .def_property_readonly("a", [](const ReactionlessTaskController& c) { return Eigen::VectorXd(c.a()); },
+                             "Acceleration feed-forward at t_n [rad/s^2 or m/s^2] (dof,)")
+      .def_property_readonly("momentum", [](const ReactionlessTaskController& c) { return Vec6(c.momentum()); },
+                             "Momentum [P; H_O] of the command (6,)")
+      .def_property_readonly("frame_twist", [](const ReactionlessTaskController& c) { return Vec6(c.frame_twist()); },
+                             "The frame's twist J v of the command [v; w] (6,)")
+      .def_property_readonly("shaking_force", [](const ReactionlessTaskController& c) { return Vec3(c.shaking_force()); },
+                             "Predicted shaking force of the command [N] (3,)")
+      .def_property_readonly("shaking_moment", [](const ReactionlessTaskController& c) { return Vec3(c.shaking_moment()); },
+                             "Predicted shaking moment about O of the command [N m] (3,)")
+      .def_property_readonly("status", [](const ReactionlessTaskController& c) { return static_cast<std::uint32_t>(c.status()); },
+                             "Status of the last tick (int, 0 = ok)")
       .def(
           "run",
           [](ReactionlessTaskController& c, const Array& twist, const py::object& twist_rate_obj) {
@@ -297,7 +304,7 @@ void bind_reactionless(py::module_& m) {
                               : vector_arg(to_real_array(q0), "q0", model.num_actuated(), true);
              const Eigen::VectorXd v0_ = optional_vector(v0, "v0", model.num_actuated());
              const Eigen::VectorXd guess = optional_vector(q_guess, "q_guess", model.dof());
-             return translate<ReactionlessController*>([&] {
+             return value_errors([&] {
                return new ReactionlessController(std::make_shared<const MechanismModel>(model), c, q0_, v0_, guess);
              });
            }),
@@ -397,7 +404,7 @@ void bind_reactionless(py::module_& m) {
            const Eigen::VectorXd limit = optional_vector(torque_limit, "torque_limit", -1);
            const Eigen::VectorXd guess = optional_vector(q_guess, "q_guess", model.dof());
            const Eigen::VectorXd kp_ = vector_arg(kp, "kp", -1), kd_ = vector_arg(kd, "kd", -1);
-           return translate<ReactionlessJointController*>([&] {
+           return value_errors([&] {
              return new ReactionlessJointController(std::make_shared<const MechanismModel>(model), c, q0_, kp_, kd_,
                                                     limit, JointInputRange{}, guess);
            });

@@ -4,10 +4,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <stdexcept>
 #include <string>
 
 #include "bindings.hpp"
+#include "value_errors.hpp"
 #include "mechbal/io/urdf.hpp"
 
 namespace py = pybind11;
@@ -15,15 +15,6 @@ namespace py = pybind11;
 namespace mechbal::pyb {
 
 namespace {
-
-template <typename Fn>
-auto value_errors(Fn fn) -> decltype(fn()) {
-  try {
-    return fn();
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error(e.what());
-  }
-}
 
 void bind_urdf(py::module_& m) {
   m.attr("MAX_URDF_BYTES") = kMaxUrdfBytes;

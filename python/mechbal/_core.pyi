@@ -1550,6 +1550,15 @@ class ReactionlessTaskController:
         """
         Ticks along the desired frame twist [v; w] (O axes) sampled every dt/2 ((2 steps + 1, 6)) and optionally its rate on the same grid (else estimated from the samples): q, v, a (steps + 1, dof), momentum, frame_twist (steps + 1, 6), predicted shaking_force, shaking_moment (steps + 1, 3), status.
         """
+    def step(self, twist: numpy.typing.ArrayLike, twist_rate: typing.Any = None, twist_half: typing.Any = None, twist_next: typing.Any = None) -> int:
+        """
+        One tick: the desired frame twist [v; w] (O axes) at t_n, its rate (default: estimated from the three samples) and, for RK4, the twist at t_n + dt/2 and t_n + dt (default: the twist at t_n). Returns the status (int, 0 = ok); the command is in q, v, a, momentum, frame_twist, shaking_force, shaking_moment. run() gives the same commands over a whole motion.
+        """
+    @property
+    def a(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Acceleration feed-forward at t_n [rad/s^2 or m/s^2] (dof,)
+        """
     @property
     def dof(self) -> int:
         ...
@@ -1557,8 +1566,43 @@ class ReactionlessTaskController:
     def dt(self) -> float:
         ...
     @property
+    def frame_twist(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[6, 1]"]:
+        """
+        The frame's twist J v of the command [v; w] (6,)
+        """
+    @property
+    def momentum(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[6, 1]"]:
+        """
+        Momentum [P; H_O] of the command (6,)
+        """
+    @property
+    def q(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Commanded positions at t_n [rad or m] (dof,)
+        """
+    @property
+    def shaking_force(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        Predicted shaking force of the command [N] (3,)
+        """
+    @property
+    def shaking_moment(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        Predicted shaking moment about O of the command [N m] (3,)
+        """
+    @property
+    def status(self) -> int:
+        """
+        Status of the last tick (int, 0 = ok)
+        """
+    @property
     def target(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[6, 1]"]:
         ...
+    @property
+    def v(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Commanded rates at t_n [rad/s or m/s] (dof,)
+        """
 class ReactionlessCommand:
     """
     One reactionless tick's command: actuated q, v, a (task as given, balancing computed), every coordinate q_full, v_full, a_full, the balancing joints' next positions, momentum [P; H_O], the predicted shaking_force [N] and shaking_moment [N m], condition, status

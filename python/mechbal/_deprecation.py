@@ -58,6 +58,24 @@ def renamed_kwargs(**renames: str) -> Callable[[Callable[P, R]], Callable[P, R]]
     return decorate
 
 
+def renamed_method_kwargs(**renames: str) -> Callable[[Callable[P, R]], Callable[P, R]]:
+    """As `renamed_kwargs`, for a method defined once in a mixin: the warning names the class of
+    the instance (``ComputedTorque.step``), not the mixin."""
+
+    def decorate(func: Callable[P, R]) -> Callable[P, R]:
+        name = func.__name__
+
+        @functools.wraps(func)
+        def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
+            if kwargs and not renames.keys().isdisjoint(kwargs):
+                rename_kwargs(f"{type(args[0]).__name__}.{name}", kwargs, renames)
+            return func(*args, **kwargs)
+
+        return wrapper
+
+    return decorate
+
+
 class DeprecatedAttributes:
     """Mixin of result dataclasses: ``_renamed`` maps old attribute names to new ones (read with
     a DeprecationWarning); ``_dict_keys`` maps the keys of the dict the result replaces to

@@ -291,9 +291,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--samples", type=int, metavar="N",
                    help="URDF files: number of instants of the default trajectory (default: 501)")
     s.add_argument("--engine", choices=("mechbal", "mujoco"), default="mechbal",
-                   help="mechbal: the case's own runner (default); mujoco: mechbal's computed-torque "
-                        "controller ticked at 1 kHz against MuJoCo integrating the case's MJCF export, "
-                        "MuJoCo's base reaction beside mechbal's (needs the 'mujoco' extra)")
+                   help="mechbal: the case's own runner (default); mujoco: mechbal's controller ticked "
+                        "at 1 kHz against MuJoCo integrating the case's MJCF export (computed torque; a "
+                        "case with a reactionless [control]: its reactionless controller, uncontrolled and "
+                        "controlled), MuJoCo's base reaction beside mechbal's (needs the 'mujoco' extra)")
     s.add_argument("--animate", action="store_true",
                    help="also write DIR/animation_<variant>.gif: the mechanism moving, with the "
                         "shaking force and moment drawn at its base")

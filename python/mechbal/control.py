@@ -48,13 +48,13 @@ Layer: Python core (docs/architecture.md).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, ClassVar, NamedTuple
+from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
 from mechbal import _core
-from mechbal._deprecation import DeprecatedAttributes, renamed_kwargs
+from mechbal._deprecation import DeprecatedAttributes, renamed_kwargs, renamed_method_kwargs
 
 __all__ = [
     "ComputedTorque", "DecoupledJointController", "PassiveController", "ReactionlessWrist", "ReactionlessWristConfig",
@@ -72,7 +72,6 @@ ForwardDynamics = _core.ForwardDynamics
 ReactionlessWristConfig = _core.ReactionlessWristConfig
 WristIntegrator = _core.WristIntegrator
 WristCommand = _core.WristCommand
-ReactionlessJointController = _core.ReactionlessJointController
 
 
 def status_text(status: int) -> str:
@@ -236,11 +235,15 @@ class JointCommand(NamedTuple):
 
 
 @dataclass(frozen=True)
-class ControlRun:
-    """N ticks of a joint controller: ``joint_torque`` (N, n) [N m or N], ``status`` (N,)."""
+class ControlRun(DeprecatedAttributes):
+    """N ticks of a joint controller: ``joint_torque`` (N, n) [N m or N], ``status`` (N,).
+    ``result["joint_torque"]`` and ``["status"]`` (the dict of earlier releases of
+    `ReactionlessJointController.run`) still work for one release, with a DeprecationWarning."""
 
     joint_torque: np.ndarray
     status: np.ndarray
+
+    _dict_keys: ClassVar[dict[str, str]] = {"joint_torque": "joint_torque", "status": "status"}
 
 
 @dataclass(frozen=True)
@@ -303,7 +306,32 @@ def _dynamics(model: Any, q_guess: npt.ArrayLike | None) -> Any:
     return model
 
 
-class ComputedTorque(_core.ComputedTorque):
+class _JointTicks:
+    """``step`` and ``run`` of the joint controllers (`ComputedTorque`,
+    `DecoupledJointController`, `PassiveController`), mixed in before their C++ class: a tick is
+    the binding's single call ``_tick`` (the status as an int) wrapped in a `JointCommand`
+    without a Python-level ``__new__``; ``run`` is the binding's batch in a `ControlRun`. The
+    keyword names of earlier releases (``qd``, ``qd_des``, ``qdd_des``) are renamed with a
+    DeprecationWarning."""
+
+    if TYPE_CHECKING:
+        def _tick(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike, v_des: npt.ArrayLike,
+                  a_des: npt.ArrayLike) -> tuple[FloatArray, int]: ...
+
+    @renamed_method_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
+    def step(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,
+             v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> JointCommand:
+        """One tick: `JointCommand` (joint_torque (n,) [N m or N], status)."""
+        return _joint_command(JointCommand, self._tick(q, v, q_des, v_des, a_des))
+
+    @renamed_method_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
+    def run(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,
+            v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> ControlRun:
+        """N consecutive ticks over (N, n) arrays in one C++ call: `ControlRun`."""
+        return _control_run(super().run(q, v, q_des, v_des, a_des))  # type: ignore[misc]
+
+
+class ComputedTorque(_JointTicks, _core.ComputedTorque):  # type: ignore[misc]
     """Computed-torque control (Arakelian, Le Baron & Mottu 2011, eqs 2-6):
     ``tau = M(q) (a_des + Kp (q_des - q) + Kd (v_des - v)) + C(q, v) v + G(q)``, clipped
     to ``torque_limit``; with an exact model the error obeys ``e'' + Kd e' + Kp e = 0`` (eq 6).
@@ -331,20 +359,8 @@ class ComputedTorque(_core.ComputedTorque):
                  **input_range: float):
         super().__init__(_dynamics(model, q_guess), kp, kd, torque_limit, **input_range)
 
-    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
-    def step(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-             v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> JointCommand:
-        """One tick: `JointCommand` (joint_torque (n,) [N m or N], status)."""
-        return _joint_command(JointCommand, self._tick(q, v, q_des, v_des, a_des))
 
-    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
-    def run(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-            v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> ControlRun:
-        """N consecutive ticks over (N, n) arrays in one C++ call: `ControlRun`."""
-        return _control_run(super().run(q, v, q_des, v_des, a_des))
-
-
-class DecoupledJointController(_core.DecoupledJointController):
+class DecoupledJointController(_JointTicks, _core.DecoupledJointController):  # type: ignore[misc]
     """Decoupled joint control of a dynamically balanced arm (Coutinho & Hess Coelho, eqs 15,
     26, 36): ``tau_i = k_i (a_des_i + Kp_i e_i + Kd_i e'_i)``, exact when counter-rotating
     discs make the mass matrix diagonal and constant and gravity is balanced.
@@ -359,20 +375,8 @@ class DecoupledJointController(_core.DecoupledJointController):
     tick as for `ComputedTorque`.
     """
 
-    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
-    def step(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-             v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> JointCommand:
-        """One tick: `JointCommand` (joint_torque (n,) [N m or N], status)."""
-        return _joint_command(JointCommand, self._tick(q, v, q_des, v_des, a_des))
 
-    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
-    def run(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-            v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> ControlRun:
-        """N consecutive ticks over (N, n) arrays in one C++ call: `ControlRun`."""
-        return _control_run(super().run(q, v, q_des, v_des, a_des))
-
-
-class PassiveController(_core.PassiveController):
+class PassiveController(_JointTicks, _core.PassiveController):  # type: ignore[misc]
     """No controller: ``tau = 0`` every tick, so the plant moves under gravity, its springs and its
     inertia only (a free pendulum, a spring-balanced arm let go). Driving a plant with it in
     `mechbal.simulate.closed_loop` is a passive simulation (`mechbal.simulate.passive`
@@ -380,20 +384,9 @@ class PassiveController(_core.PassiveController):
 
     Args:
         dof: number of actuated coordinates (>= 1).
+
+    ``step`` returns a zero ``joint_torque`` (n,) and the status of the input check.
     """
-
-    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
-    def step(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-             v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> JointCommand:
-        """One tick: `JointCommand` (zero joint_torque (n,), status)."""
-        tau, status = super().step(q, v, q_des, v_des, a_des)
-        return JointCommand(np.asarray(tau), int(status))
-
-    @renamed_kwargs(qd="v", qd_des="v_des", qdd_des="a_des")
-    def run(self, q: npt.ArrayLike, v: npt.ArrayLike, q_des: npt.ArrayLike,  # type: ignore[override]
-            v_des: npt.ArrayLike, a_des: npt.ArrayLike) -> ControlRun:
-        """N consecutive ticks over (N, n) arrays in one C++ call: `ControlRun`."""
-        return _control_run(super().run(q, v, q_des, v_des, a_des))
 
 
 class ReactionlessWrist(_core.ReactionlessWrist):
@@ -569,7 +562,7 @@ class ReactionlessController(_core.ReactionlessController):
         if kp is not None or kd is not None:
             if kp is None or kd is None:
                 raise ValueError("the computed-torque stage needs both kp and kd")
-            self.joint_controller = _core.ReactionlessJointController(
+            self.joint_controller = ReactionlessJointController(
                 model, q0=q0, kp=kp, kd=kd, torque_limit=torque_limit, q_guess=q_guess, **kwargs)
 
     def step(self, q_task: npt.ArrayLike, v_task: npt.ArrayLike,  # type: ignore[override]
@@ -609,6 +602,27 @@ class ReactionlessController(_core.ReactionlessController):
         return self.run(np.ascontiguousarray(np.atleast_2d(q)[:, task]),
                         np.ascontiguousarray(np.atleast_2d(v)[:, task]),
                         np.ascontiguousarray(np.atleast_2d(a)[:, task]))
+
+
+class ReactionlessJointController(_JointTicks, _core.ReactionlessJointController):  # type: ignore[misc]
+    """The reactionless controller followed by computed torque over the model (C++
+    ``mechbal::ReactionlessJointController``): a joint controller over the actuated coordinates
+    whose balancing joints follow the reactionless command (their desired entries are ignored),
+    for `mechbal.simulate.closed_loop`; `ReactionlessController` with ``kp`` and ``kd`` builds
+    one (its ``joint_controller``).
+
+    Args:
+        model: the ``MechanismModel``.
+        balancing_joints: names of actuated joints.
+        q0: actuated coordinates at the start [rad or m].
+        kp: proportional gains [1/s^2], one per actuated joint.
+        kd: derivative gains [1/s].
+        **options: as `ReactionlessController` (``cancel``, ``integrator``, ``rate_hz``, ...),
+            and ``torque_limit``, ``q_guess``.
+
+    Ticks: ``step`` -> `JointCommand`, ``step_into``, ``run`` -> `ControlRun` (see
+    `mechbal.control`); ``reactionless``: the reactionless controller inside.
+    """
 
 
 @dataclass(frozen=True)

@@ -299,7 +299,7 @@ def passive(mech: Any, q0: npt.ArrayLike, v0: npt.ArrayLike | None = None, *, dt
     dt, duration = _check_timing(dt, duration)
     held = RestToRest(q0, q0, duration)   # the controller ignores it: a placeholder desired motion
     run = closed_loop(mech, PassiveController(na), held, q0, v0, dt=dt, duration=duration, q_guess=q_guess)
-    q, v = run.q, run.qd
+    q, v = run.q, run.v
     guess = np.zeros(mech.dof) if q_guess is None else np.asarray(q_guess, float)
     plant = _core.MechanismDynamics(mech.model, guess)   # accelerations at zero effort
     zero = np.zeros(na)

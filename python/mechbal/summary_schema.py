@@ -235,6 +235,24 @@ RUN_MUJOCO: dict[str, Schema] = {
     "max_constraint_violation": number("m", "Largest loop-closure violation in MuJoCo."),
     "base_reaction": _BASE_REACTION_PEAKS,
     "shaking_wrench": _BASE_REACTION_PEAKS,
+    # a case with a reactionless [control]: what `mechbal run` writes for it, of MuJoCo's motion
+    **{k: RUN_MECHANISM[k] for k in ("kind", "dof", "actuated", "closed", "duration", "samples", "law",
+                                     "variants", "peak_shaking_force", "peak_shaking_moment", "control",
+                                     "total_mass")},
+    "shaking_moment_reduction": detail("Reactionless cases: peak |shaking moment| [N m] of MuJoCo's motion, "
+                                       "uncontrolled and controlled, their ratio and the reduction [%]."),
+    "cosimulation": {"type": "object", "description": "Reactionless cases, per variant: MuJoCo's realised "
+                     "base reaction and shaking wrench beside mechbal's prediction for the controller's "
+                     "command, the tracking and the stored poses' wrench against MuJoCo's.",
+                     "additionalProperties": {
+                         "type": "object", "additionalProperties": False, "properties": {
+                             "ok": boolean(), "steps_completed": integer(),
+                             "peak_tracking_error": number("rad or m"),
+                             "max_constraint_violation": number("m"),
+                             "base_reaction": _BASE_REACTION_PEAKS, "shaking_wrench": _BASE_REACTION_PEAKS,
+                             "stored_poses_wrench_difference": detail(
+                                 "mechbal's shaking wrench of the stored poses against MuJoCo's realised "
+                                 "one: force [N], moment [N m].")}}},
 }
 
 _STATS = {"type": "object", "additionalProperties": False,
@@ -287,10 +305,19 @@ VERIFY: dict[str, Schema] = {
     "kind": string("reactionless: a case checked under its reactionless controller."),
     "mechanism": string("The mechanism (its repr)."), "mujoco": anything("MuJoCo model size"),
     "dt": number("s", "Controller tick and MuJoCo step (reactionless cases)."),
+    "duration": number("s", "Horizon of the check (reactionless cases)."),
+    "mode": {"enum": ["joint", "task"], "description": "Reactionless cases: balancing joints (joint) or "
+             "operational space (task: the reaction null space of task_frame)."},
+    "task_frame": string("Operational-space mode: the frame that follows its path."),
+    "variant_meaning": detail("Reactionless cases: what the uncontrolled and controlled variants are."),
     "balancing_joints": strings(), "cancel": strings(),
-    "residual": detail("Per cancelled component: the uncontrolled peak and the controlled peak as "
-                       "a fraction of it (mechbal, MuJoCo inverse, MuJoCo simulated)."),
-    "limited_by": string("What limits the simulated residual."),
+    "residual": detail("Per cancelled component: the uncontrolled peak and the peaks as a fraction "
+                       "of it (mechbal controlled, MuJoCo inverse controlled, MuJoCo simulated "
+                       "uncontrolled and controlled)."),
+    "time_step": detail("The controlled variant co-simulated at dt and dt / 2: the largest cancelled "
+                        "component's residual (fraction of its uncontrolled peak) and the largest tracking "
+                        "error [rad or m] at each, and their ratios."),
+    "limited_by": string("What limits the simulated residual (measured: time_step)."),
 }
 
 SWEEP: dict[str, Schema] = {

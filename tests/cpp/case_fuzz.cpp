@@ -6,16 +6,20 @@
 // controller it describes built or refused with std::invalid_argument) or gives a one-line
 // ConfigError naming a field. `make test-sanitize` runs this corpus under AddressSanitizer and
 // UndefinedBehaviorSanitizer, like the URDF reader's (test_parser_fuzz.cpp); its own executable
-// (mechbal_case_fuzz).
+// (mechbal_case_fuzz). To find the document behind an abort (a failed assertion in a library, a
+// sanitizer report), set MECHBAL_CASE_FUZZ_DUMP to a file path: each document is written there,
+// with its mutation number on the first line, before it is read, so the file holds the last one.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "mechbal/algorithm/center_of_mass.hpp"
@@ -225,12 +229,15 @@ TEST(CaseFuzz, DeterministicMutationCorpus) {
   std::mt19937 rng(27);
   Outcome out;
   const int mutations = 6000;
+  const char* dump = std::getenv("MECHBAL_CASE_FUZZ_DUMP");
   for (int i = 0; i < mutations; ++i) {
     const std::size_t s = static_cast<std::size_t>(i) % seeds.size();
     std::string doc = seeds[s];
     if (doc.find("\n[control]") != std::string::npos) doc = doc.substr(0, doc.find("\n[control]"));
     doc += control_table(i / static_cast<int>(seeds.size()), actuated[s], names[s]);
-    check(mutate(rng, doc), out);
+    doc = mutate(rng, doc);
+    if (dump) std::ofstream(dump, std::ios::binary | std::ios::trunc) << "# mutation " << i << "\n" << doc;
+    check(doc, out);
   }
   std::printf("case reader fuzz: %d documents: %d loaded (%d controllers built, %d refused), %d refused, %d other\n",
               mutations, out.loaded, out.controllers, out.controllers_refused, out.refused, out.other);
@@ -286,6 +293,143 @@ TEST(CaseFuzz, FilesThatAreNotCases) {
       ADD_FAILURE() << path;
     } catch (const ConfigError& e) {
       EXPECT_EQ(e.field(), "case") << e.what();
+    }
+  }
+}
+
+// Three kinds of text on which toml++ 3.3.0 breaks an assumption of its own (an abort in a debug
+// build, undefined behaviour in a release build), each found by the mutation corpus above: a table
+// header whose `[` or `[[` is followed by a character that starts no key (parse_key asserts; fixed
+// upstream after 3.4.0, marzer/tomlplusplus#301), a `}` where an array expects a value
+// (parse_value asserts), a character that is not ASCII outside strings and comments
+// (is_horizontal_whitespace reaches __builtin_unreachable; fixed upstream after 3.4.0,
+// marzer/tomlplusplus#305). The reader refuses them before toml++ reads them, with the line and
+// column of that character, or at toml++'s own error when one comes before.
+namespace {
+
+std::string refusal(const std::string& doc) {
+  try {
+    case_from_string(doc, "header.toml");
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.field(), "header.toml") << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "accepted:\n" << doc;
+  return "";
+}
+
+}  // namespace
+
+TEST(CaseFuzz, TableHeaderWithoutAKey) {
+  const std::string base = read(MECHBAL_SOURCE_DIR "/python/mechbal/cases/reaction-wheel-arm.toml");
+  const auto line = std::to_string(std::count(base.begin(), base.end(), '\n') + 1);
+  const std::string header = "is not valid TOML: a table header must start with a key";
+  // the document of the mutation corpus that tripped the assertion (mutation 1146: a slice of the
+  // four-bar's `origin = { xyz = [0.2, 0.0, 0.0] }   # crank length 0.2 m` copied between the two
+  // brackets of `[[mechanism.frames]]`), minimised to its first two bytes
+  EXPECT_EQ(refusal("[."), "header.toml: " + header + ", saw '.' after '[' (line 1, column 2)");
+  const std::string four_bar = read(MECHBAL_SOURCE_DIR "/python/mechbal/cases/four-bar.toml");
+  EXPECT_EQ(refusal(four_bar + "[.2, 0.0, 0.0] }   # crank length 0.2 m\n"),
+            "header.toml: " + header + ", saw '.' after '[' (line " +
+                std::to_string(std::count(four_bar.begin(), four_bar.end(), '\n') + 1) + ", column 2)");
+  // more of its kind, after a valid case (the text before the header is valid TOML)
+  for (const auto& [tail, saw, column] : std::vector<std::tuple<std::string, std::string, int>>{
+           {"[\n", "the end of the line after '['", 2},
+           {"[[[1]]]\n", "'[' after '[['", 3},
+           {"[=\n", "'=' after '['", 2},
+           {"[[ =]]\n", "'=' after '[['", 4},
+           {"  [\t# x\n", "'#' after '['", 5},
+           {"[\r\n", "the end of the line after '['", 2},
+           {"[\xc3\xa9]\n", "U+00E9 after '['", 2},
+           {"[\xff]\n", "byte 0xff after '['", 2},
+           {"[{a}]\n", "'{' after '['", 2}}) {
+    EXPECT_EQ(refusal(base + tail),
+              "header.toml: " + header + ", saw " + saw + " (line " + line + ", column " + std::to_string(column) + ")")
+        << tail;
+  }
+  // an error before that line comes first, as toml++ and tomllib report it
+  EXPECT_NE(refusal("a = 1 1\n[\n" + base).find("(line 1, column"), std::string::npos);
+  // every byte after each opening, on the first line and after a valid case: a ConfigError naming
+  // the file (the assertion, were it reached, would abort the sanitizer build)
+  for (const std::string opening : {"[", "[[", "[ ", "[[ ", "\t[", "\xEF\xBB\xBF["}) {
+    for (int b = 0; b < 256; ++b) {
+      const std::string line = opening + static_cast<char>(b) + "\n";
+      refusal(line + "x = 1\n" + base);
+      refusal(base + line);
+    }
+  }
+}
+
+TEST(CaseFuzz, BracketsAtTheStartOfALineInsideValuesStillLoad) {
+  // a `[` first on its line opens a header only outside strings, comments, arrays and inline tables
+  const std::string base = read(MECHBAL_SOURCE_DIR "/python/mechbal/cases/reaction-wheel-arm.toml");
+  const std::string values =
+      "x = [\n[1, 2],\n  [ 3, 4 ],\n[\n\"a\",\n],\n[\n# [\n]\n]\n"
+      "y = \"\"\"\n[\n[=\n\\\"\"\"\n[\n\"\"\"\n"
+      "z = '''\n[=\n[[ ]]\n''''\n"
+      "w = { a = [\n[1]] }\n"
+      "\"q[\" = '['\n"
+      "# [=\n"
+      "[ \"spaced\" ]  # [=\n"
+      "[[ 'arr' ]]\n"
+      "[[arr]]\n";
+  for (const std::string& doc : {values + base, base + "\n[extra]\n" + values}) {
+    EXPECT_NO_THROW(case_from_string(doc, "values.toml")) << doc;
+  }
+}
+
+TEST(CaseFuzz, BraceWhereAnArrayExpectsAValue) {
+  const std::string base = read(MECHBAL_SOURCE_DIR "/python/mechbal/cases/reaction-wheel-arm.toml");
+  const long lines = std::count(base.begin(), base.end(), '\n');
+  const std::string what = "header.toml: is not valid TOML: expected a value or ']' in an array, saw '}'";
+  // mutation 3903 of the corpus (a PAMINSA joint's `axis = [0.0, }`), minimised
+  EXPECT_EQ(refusal("s=[}"), what + " (line 1, column 4)");
+  EXPECT_EQ(refusal(base + "axis = [0.0, }\n"), what + " (line " + std::to_string(lines + 1) + ", column 14)");
+  for (const auto& [tail, line, column] : std::vector<std::tuple<std::string, int, int>>{
+           {"x = [ }\n", 1, 7}, {"x = [[1], }\n", 1, 11}, {"x = [\n  1,\n# }\n}\n", 4, 1}, {"x = { a = [} }\n", 1, 12}}) {
+    EXPECT_EQ(refusal(base + tail),
+              what + " (line " + std::to_string(lines + line) + ", column " + std::to_string(column) + ")")
+        << tail;
+  }
+  // after a value the brace is toml++'s own error (no assumption broken there)
+  EXPECT_NE(refusal(base + "x = [1 }\n").find("expected comma or closing ']'"), std::string::npos);
+}
+
+TEST(CaseFuzz, NonAsciiOutsideStringsAndComments) {
+  const std::string base = read(MECHBAL_SOURCE_DIR "/python/mechbal/cases/reaction-wheel-arm.toml");
+  const auto line = std::to_string(std::count(base.begin(), base.end(), '\n') + 1);
+  const std::string what = "header.toml: is not valid TOML: the character ";
+  const std::string rest = " is not ASCII: outside strings and comments TOML allows only ASCII";
+  for (const auto& [tail, shown, column] : std::vector<std::tuple<std::string, std::string, int>>{
+           {"\xc3\xa9 = 1\n", "U+00E9", 1},           // a key
+           {"x = 1\xc3\xa9\n", "U+00E9", 6},          // after a number
+           {"x = \"a\" \xe3\x80\x80\n", "U+3000", 9},  // an ideographic space
+           {"x = [\xe2\x80\xa8]\n", "U+2028", 6},      // a line separator for an array's value
+           {"[a]\xcc\xaa\n", "U+032A", 4},             // after a header
+           {"[a.\xef\xb9\x90]\n", "U+FE50", 4},        // in a header's key
+           {"x = {a = 1\xc2\xa1}\n", "U+00A1", 11},
+           {"x = 1 \xff\n", "byte 0xff", 7}}) {
+    EXPECT_EQ(refusal(base + tail), what + shown + rest + " (line " + line + ", column " + std::to_string(column) + ")")
+        << tail;
+  }
+  // in strings and comments they are fine, and a string that a line-ending backslash wraps onto a
+  // line that starts with one (toml++ would ask is_horizontal_whitespace about it) reads the same
+  for (const auto& [name, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"\"arm\xc3\xa9\"  # \xc3\xa9\xe3\x80\x80", "arm\xc3\xa9"},
+           {"'\xc3\xa9'", "\xc3\xa9"},
+           {"\"\"\"\xc3\xa9\"\"\"", "\xc3\xa9"},
+           {"'''\n\xc3\xa9'''", "\xc3\xa9"},
+           {"\"\"\"arm\\\n    \xc3\xa9\\\n\n \xf0\x9f\xa4\x96 \\\r\n\t\xcc\xaa\"\"\"", "arm\xc3\xa9\xf0\x9f\xa4\x96 \xcc\xaa"},
+           {"\"\"\"a\\\n\\u00e9\"\"\"", "a\xc3\xa9"}}) {
+    std::string doc = base;
+    const std::string from = "name = \"reaction-wheel-arm\"";
+    ASSERT_NE(doc.find(from), std::string::npos);
+    doc.replace(doc.find(from), from.size(), "name = " + name);
+    try {
+      EXPECT_EQ(case_from_string(doc, "names.toml").name, expected) << name;
+    } catch (const ConfigError& e) {
+      ADD_FAILURE() << name << ": " << e.what();
     }
   }
 }

@@ -455,6 +455,26 @@ TEST(CaseReader, PlanarIzzIsALamina) {
   EXPECT_EQ(field_of(both), "mechanism.joints[0].link.izz");
 }
 
+TEST(MakeController, TaskRowsHaveOneNameTableForEveryCaller) {
+  // make_task_controller and the Python ReactionlessTaskController read task_rows through
+  // task_rows_mask: the same bits and the same messages, only the field named differs
+  EXPECT_EQ(task_rows_mask({"linear", "w_z"}), cancel_force | moment_z);
+  EXPECT_EQ(task_rows_mask({"all"}, "task_rows"), cancel_both);
+  EXPECT_EQ(task_rows_mask({"v_x", "v_y", "angular"}), force_x | force_y | cancel_moment);
+  const auto message = [](const std::vector<std::string>& rows, const std::string& field) {
+    try {
+      task_rows_mask(rows, field);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message({"all", "lineal"}, "control.task_rows"),
+            "control.task_rows[1]: 'lineal' is not a twist component (all, linear, angular, v_x, v_y, v_z, w_x, "
+            "w_y, w_z)");
+  EXPECT_EQ(message({}, "task_rows"), "task_rows: must name at least one twist component");
+}
+
 TEST(MakeController, PassiveCommandsZeroWithoutAllocating) {
   const LoadedCase c = case_from_string(arm("origin") + "[control]\nkind = \"passive\"\nrate_hz = 500\n");
   EXPECT_EQ(c.control.kind, ControlKind::passive);

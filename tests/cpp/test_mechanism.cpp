@@ -3,7 +3,9 @@
 // its own invariants on random trees, and the real-time contract (no allocation, statuses).
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <random>
+#include <string>
 
 #include "alloc_counter.hpp"
 #include "mechbal/algorithm/center_of_mass.hpp"
@@ -97,6 +99,31 @@ TEST(Mechanism, ShakingWrenchEqualsTheSumOverBodies) {
     EXPECT_LT(rel(data.shaking.linear_momentum, per_body.linear_momentum), 1e-12);
     EXPECT_LT(rel(data.shaking.angular_momentum, per_body.angular_momentum), 1e-12);
   }
+}
+
+// A chain long enough that its per-link buffers take the large-buffer path (2 MiB and more:
+// 2 MiB-aligned, marked for huge pages): the buffers are aligned, and the centre of mass summed
+// while the links are placed equals the body-by-body sum over forward kinematics' body states.
+TEST(Mechanism, BigChainBuffersAndFusedCentreOfMass) {
+  std::mt19937 rng(4242);
+  const std::string types(6000, 'R');
+  const MechanismModel model(test::random_chain(rng, types.c_str()));
+  MechanismData data(model);
+  ASSERT_GE(data.work.size() * sizeof(MechanismData::LinkWork), std::size_t{2} << 20);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(data.work.data()) % (std::uintptr_t{2} << 20), 0u);
+  const MechanismData copy = data;  // copies through the same allocator
+  EXPECT_EQ(copy.work.size(), data.work.size());
+  const Eigen::VectorXd q = test::random_vector(rng, model.dof(), 0.3);
+  ASSERT_EQ(forward_kinematics(model, data, q), Status::ok);
+  Vec3 mc = Vec3::Zero();
+  double m = 0.0;
+  for (std::size_t b = 0; b < data.body_states.size(); ++b) {
+    mc += data.body_inertias[b].mass * data.body_states[b].com;
+    m += data.body_inertias[b].mass;
+  }
+  ASSERT_EQ(center_of_mass(model, data, q), Status::ok);
+  EXPECT_NEAR(data.mass, m, 1e-9 * m);
+  EXPECT_LT(rel(data.center_of_mass, Vec3(mc / m)), 1e-10);
 }
 
 TEST(Mechanism, BaseReactionCountsTheMovingBodiesOnly) {

@@ -210,3 +210,40 @@ def test_four_joint_arm_where_a_local_search_stopped_at_four_times_the_mass():
     assert lb - 1e-7 <= mass <= lb * (1 + 2e-3)
     assert mass == pytest.approx(22.59, abs=0.01)
     assert r.residual < 1e-9 * r.residual_before
+
+
+def test_cone_cuts_stop_when_the_lp_optimum_stops_moving(monkeypatch):
+    """The cuts are met to the LP's feasibility tolerance (1e-10), which is above CONE_RTOL: on a
+    7R arm with a ball slot on every link the optimum stops moving after a few dozen rounds while
+    a cone stays over CONE_RTOL by less than that tolerance, and every further round added the same
+    cut and solved the same LP again, up to MAX_CUT_ROUNDS. No LP is solved twice in a row now,
+    and the design still reaches the least squares within every bound."""
+    import scipy.optimize
+
+    from mechbal.balance import common
+
+    rng = np.random.default_rng(7)
+    joints = [{"name": f"j{i + 1}", "origin": {"xyz": rng.uniform(-0.3, 0.3, 3).tolist(),
+                                                "rpy": rng.uniform(-1.5, 1.5, 3).tolist()},
+               "axis": rng.normal(size=3).tolist(),
+               "link": {"mass": float(rng.uniform(0.5, 4.0)), "com": rng.uniform(-0.2, 0.2, 3).tolist(),
+                        "inertia": [0.02, 0.03, 0.04]}} for i in range(7)]
+    mech = Mechanism.from_spec(mechanism_spec({"joints": joints}))
+    slots = [CounterweightSlot(f"cw{i}", f"j{i}", 0.0, 50.0, max_radius=0.4) for i in range(1, 8)]
+    optima = []
+    real = scipy.optimize.linprog
+
+    def recording(*args, **kwargs):
+        res = real(*args, **kwargs)
+        optima.append(np.array(res.x, copy=True))
+        return res
+
+    monkeypatch.setattr(scipy.optimize, "linprog", recording)
+    r = static.balance(mech, slots, 500)
+    assert r.exact and r.residual < 1e-9 * r.residual_before
+    for d in r.design.values():
+        assert 0.0 <= d.mass <= 50.0 and d.radius <= 0.4 * (1 + 1e-7)
+    assert 2 < len(optima) < common.MAX_CUT_ROUNDS
+    # the last LP only tells that the one before it did not move: no LP repeats the one before
+    assert np.array_equal(optima[-1], optima[-2])
+    assert not any(np.array_equal(a, b) for a, b in zip(optima[:-2], optima[1:-1]))

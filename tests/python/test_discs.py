@@ -390,12 +390,12 @@ def test_cpp_five_bar_equals_the_python_coupling_model():
         else:
             q, qd = dz.sample_states("fivebar", 40, rng)
         r = dz.fivebar_dynamics(d).evaluate(q, qd)
-        assert r["status"] == _core.Status.ok and np.all(r["ok"]), label
+        assert np.all(r.status == 0) and np.all(r.ok), label
         for k in range(len(q)):
             ref = dz.fivebar_model(d, q[k], qd[k])
             s = np.max(np.abs(ref.mass))
-            for ours, theirs in ((r["mass"][k], ref.mass), (r["velocity"][k], ref.velocity),
-                                 (r["gravity"][k], ref.gravity)):
+            for ours, theirs in ((r.mass_matrix[k], ref.mass), (r.coriolis_torque[k], ref.velocity),
+                                 (r.gravity_torque[k], ref.gravity)):
                 err = np.max(np.abs(ours - theirs)) / max(s, np.max(np.abs(theirs)))
                 worst = max(worst, err)
                 assert err < 1e-12, (label, k, err)
@@ -406,10 +406,12 @@ def test_cpp_five_bar_singular_pose_gives_a_status_and_no_nan():
     dyn = dz.fivebar_dynamics(d)
     q = np.array([[0.4, 0.4], [0.4, 0.4 + np.pi], [0.4, 1.4]])
     r = dyn.evaluate(q, np.ones_like(q))
-    assert list(r["ok"]) == [False, False, True]
-    assert r["status"] == _core.Status.singular
-    assert np.all(np.isfinite(r["mass"])) and np.all(np.isfinite(r["velocity"]))
-    assert np.all(r["reciprocal_condition"][:2] < 1e-6) and r["reciprocal_condition"][2] > 1e-3
+    assert list(r.ok) == [False, False, True]
+    assert list(r.status) == [int(_core.Status.singular)] * 2 + [0]
+    assert np.all(np.isfinite(r.mass_matrix)) and np.all(np.isfinite(r.coriolis_torque))
+    assert np.all(r.reciprocal_condition[:2] < 1e-6) and r.reciprocal_condition[2] > 1e-3
+    with pytest.raises(ValueError, match="singularity"):   # one sample: a ValueError
+        dyn.evaluate(q[0], np.ones(2))
     with pytest.raises(ValueError, match="singular"):
         dz.evaluate("fivebar", d, q, np.ones_like(q))
     with pytest.raises(ValueError, match="five_bar.a1"):

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 import tomllib
 from pathlib import Path
 
@@ -455,6 +456,64 @@ def test_cpp_messages_name_the_value():
     assert msg("unknown parent") == "mechanism.joints[1].parent: unknown parent joint (allowed: a, b, s_z, s_y, s_x, s, base) (got 'c')" \
         or "(got 'c')" in msg("unknown parent")
     assert "(got 'revolut')" in msg("joint type") and "did you mean 'revolute'" in msg("joint type")
+
+
+# ---- text that breaks toml++ 3.3.0's own assumptions: both readers refuse it at the same place ------
+# toml++ 3.3.0 asserts (an abort in a debug build, undefined behaviour in a release one) on a table
+# header that starts no key (fixed upstream after 3.4.0) and on a `}` where an array expects a
+# value, and reaches __builtin_unreachable on most characters that are not ASCII outside strings and
+# comments (fixed upstream after 3.4.0): the C++ reader refuses them before toml++ reads them.
+# Found by the C++ case-reader fuzz corpus (tests/cpp/case_fuzz.cpp); each is invalid TOML.
+
+TOML_HAZARDS = {
+    "header, fuzz corpus minimised": (b"[.", "a table header must start with a key"),
+    "header, fuzz corpus line": (b"[.2, 0.0, 0.0] }   # crank length 0.2 m\n", "a table header must start with a key"),
+    "header, bracket alone": (b"[\n", "a table header must start with a key"),
+    "header, three brackets": (b"[[[1]]]\n", "a table header must start with a key"),
+    "header, array spaced": (b"[[ =]]\n", "a table header must start with a key"),
+    "header, comment": (b"  [\t# x\n", "a table header must start with a key"),
+    "header, crlf": (b"[\r\n", "a table header must start with a key"),
+    "header, non-ascii": ("[\u00e9]\n".encode(), "a table header must start with a key"),
+    "brace, fuzz corpus minimised": (b"s=[}", "expected a value or ']' in an array"),
+    "brace, fuzz corpus line": (b"axis = [0.0, }\n", "expected a value or ']' in an array"),
+    "brace, multi-line": (b"x = [\n  1,\n# }\n}\n", "expected a value or ']' in an array"),
+    "brace, in an inline table": (b"x = { a = [} }\n", "expected a value or ']' in an array"),
+    "non-ascii key": ("\u00e9 = 1\n".encode(), "is not ASCII"),
+    "non-ascii after a number": ("x = 1\u00e9\n".encode(), "is not ASCII"),
+    "ideographic space": ('x = "a" \u3000\n'.encode(), "is not ASCII"),
+    "line separator in an array": ("x = [\u2028]\n".encode(), "is not ASCII"),
+    "non-ascii after a header": ("[a]\u032a\n".encode(), "is not ASCII"),
+}
+
+
+@pytest.mark.parametrize("name", list(TOML_HAZARDS))
+def test_both_readers_refuse_toml_hazards(tmp_path, name):
+    tail, cpp_says = TOML_HAZARDS[name]
+    path = tmp_path / "hazard.toml"
+    path.write_bytes((PKG / "cases" / "reaction-wheel-arm.toml").read_bytes() + tail)
+    with pytest.raises(ConfigError) as py_exc:
+        Mechanism.from_toml(path)
+    with pytest.raises(ValueError) as cpp_exc:
+        _core.load_mechanism_file(str(path))
+    py_msg, cpp_msg = str(py_exc.value), str(cpp_exc.value)
+    assert py_exc.value.field == str(path) and "is not valid TOML" in py_msg, py_msg
+    assert cpp_msg.startswith(f"{path}: is not valid TOML: ") and cpp_says in cpp_msg, cpp_msg
+    # the same place: tomllib's "(at line L, column C)", the C++ reader's "(line L, column C)"
+    where = lambda msg: re.search(r"line (\d+), column (\d+)\)$", msg).groups()  # noqa: E731
+    assert where(py_msg) == where(cpp_msg), f"Python: {py_msg}\nC++:    {cpp_msg}"
+
+
+def test_both_readers_read_non_ascii_after_a_line_ending_backslash(tmp_path):
+    """A multi-line string wrapped by a line-ending backslash onto a line that starts with a
+    character that is not ASCII (which the C++ reader hands to toml++ as its escape)."""
+    text = (PKG / "cases" / "reaction-wheel-arm.toml").read_text()
+    text = text.replace('name = "elbow"', 'name = """el\\\n    b\u00f6w\\\n\n \u2028\u00e9"""')
+    path = tmp_path / "wrapped.toml"
+    path.write_text(text, encoding="utf-8")
+    py = Mechanism.from_toml(path)
+    cpp = _core.load_mechanism_file(str(path))
+    assert [j.name for j in cpp.description.joints] == [j.name for j in py.model.description.joints]
+    assert "elb\u00f6w\u2028\u00e9" in [j.name for j in py.model.description.joints]
 
 
 # ---- [control] through the C++ reader ---------------------------------------------------------------

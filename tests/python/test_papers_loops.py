@@ -65,8 +65,8 @@ def _five_bar_closed_form_bodies(d: dict, q, qd, qdd) -> dict:
 
     N = len(q)
     m = dz.fivebar_dynamics(d).motion(q, qd, qdd)
-    assert m["status"] == _core.Status.ok
-    th, w, al = m["angles"], m["rates"], m["accelerations"]
+    assert np.all(m.status == 0)
+    th, w, al = m.q, m.v, m.a
     names, mass, inertia = [], [], []
     com, vel, acc, rot, omg, alp = ([] for _ in range(6))
     e = lambda t: np.stack([np.zeros_like(t), np.cos(t), np.sin(t)], -1)  # noqa: E731
@@ -103,9 +103,9 @@ def _five_bar_closed_form_bodies(d: dict, q, qd, qdd) -> dict:
     mass.append(d["mP"])
     inertia.append(np.zeros((3, 3)))
     z = np.zeros((N, 1))
-    com.append(np.hstack([z, m["end_effector"]]))
-    vel.append(np.hstack([z, m["end_effector_velocity"]]))
-    acc.append(np.hstack([z, m["end_effector_acceleration"]]))
+    com.append(np.hstack([z, m.end_effector]))
+    vel.append(np.hstack([z, m.end_effector_velocity]))
+    acc.append(np.hstack([z, m.end_effector_acceleration]))
     rot.append(np.tile(np.eye(3), (N, 1, 1)))
     omg.append(np.zeros((N, 3))), alp.append(np.zeros((N, 3)))
     stack = lambda xs: np.stack(xs, 1)  # noqa: E731

@@ -297,6 +297,30 @@ def test_closed_loop_with_reactionless_computed_torque():
         simulate.closed_loop(mech, control.ReactionlessController(mech, ["wheel"], "moment_z"), traj)
 
 
+def test_reactionless_joint_controller_ticks_are_typed_and_keep_the_dict_keys():
+    """The computed-torque stage answers as every joint controller: step -> JointCommand, run ->
+    ControlRun (the dict keys of earlier releases warn), the same torques both ways."""
+    mech = _wheel_mech()
+    jc = control.ReactionlessController(mech, ["wheel"], "moment_z", kp=[400.0] * 3,
+                                        kd=[40.0] * 3).joint_controller
+    assert isinstance(jc, control.ReactionlessJointController)
+    twin = control.ReactionlessJointController(mech.model, ["wheel"], np.zeros(3), [400.0] * 3, [40.0] * 3,
+                                               cancel=["moment_z"])
+    q, v = np.array([0.1, 0.2, 0.0]), np.array([0.5, -0.3, 0.0])
+    cmd = jc.step(q, v, q + 0.01, v, np.zeros(3))
+    assert isinstance(cmd, control.JointCommand) and cmd.status == 0 and cmd.joint_torque.shape == (3,)
+    N = 4
+    run = twin.run(np.tile(q, (N, 1)), np.tile(v, (N, 1)), np.tile(q + 0.01, (N, 1)), np.tile(v, (N, 1)),
+                   np.zeros((N, 3)))
+    assert isinstance(run, control.ControlRun) and run.joint_torque.shape == (N, 3) and np.all(run.status == 0)
+    np.testing.assert_array_equal(run.joint_torque[0], cmd.joint_torque)
+    for key in ("joint_torque", "status"):
+        with pytest.warns(DeprecationWarning, match=rf"result\['{key}'\] is deprecated"):
+            np.testing.assert_array_equal(run[key], getattr(run, key))
+    with pytest.warns(DeprecationWarning, match="ReactionlessJointController.step: 'qd' is deprecated"):
+        jc.step(q, qd=v, q_des=q, v_des=v, a_des=np.zeros(3))
+
+
 # ---- operational-space mode (the reaction null space) ----------------------------------------------
 
 ARM4 = """
@@ -332,6 +356,19 @@ start = [0.3, 0.8, 0.6, 0.4]
 end = [0.3, 0.8, 0.6, 0.4]
 duration = 1.0
 """
+
+
+def test_operational_space_task_rows_errors_are_the_factory_messages(tmp_path):
+    """The Python ReactionlessTaskController reads task_rows through the C++ factory's table
+    (mechbal::task_rows_mask): the factory's message, with the argument's name."""
+    (tmp_path / "arm4.toml").write_text(ARM4)
+    mech = mechbal.Mechanism.from_toml(tmp_path / "arm4.toml")
+    with pytest.raises(ValueError) as e:
+        control.ReactionlessTaskController(mech, "tool", ["v_x", "lineal"], "moment_z")
+    assert str(e.value) == ("task_rows[1]: 'lineal' is not a twist component (all, linear, angular, v_x, "
+                            "v_y, v_z, w_x, w_y, w_z)")
+    with pytest.raises(ValueError, match=r"^task_rows: must name at least one twist component$"):
+        control.ReactionlessTaskController(mech, "tool", [], "moment_z")
 
 
 def test_operational_space_uses_redundancy_to_cancel_the_moment(tmp_path):

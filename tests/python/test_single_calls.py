@@ -199,3 +199,26 @@ def test_huge_inputs_get_the_same_verdict_on_both_paths(mech):
                     assert fast == slow, (name, i, x, v_scale)
                     verdicts.add(fast[0])
     assert verdicts == {"raised", "value"}
+
+
+def test_batch_shaking_wrench_without_reactions_keeps_the_verdicts(mech):
+    """The batch shaking wrench not asked for the reactions computes them only when their bounds
+    cannot tell they are finite (reaction_bounds.hpp): instant by instant it gives the statuses
+    and values of the path that computes them, huge inputs included, and no reaction arrays."""
+    n = mech.dof
+    Q, V = [], []
+    for i in range(n):
+        for x in (0.3, 1e307, -1e307, 1e300, 1e200, np.finfo(float).max):
+            for v_scale in (0.0, 1e150):
+                q = np.full(n, 0.3)
+                q[i] = x
+                Q.append(q)
+                V.append(np.full(n, v_scale))
+    Q, V = np.array(Q), np.array(V)
+    lazy = _core.mechanism_shaking_wrench(mech.model, Q, V, V, False)
+    full = _core.mechanism_shaking_wrench(mech.model, Q, V, V, True)
+    np.testing.assert_array_equal(lazy["status"], full["status"])
+    assert (lazy["status"] == 0).any() and (lazy["status"] != 0).any()
+    for key in ("shaking_force", "shaking_moment", "linear_momentum", "angular_momentum"):
+        np.testing.assert_array_equal(lazy[key], full[key])
+    assert "base_reaction_force" not in lazy and "support_reaction_moment" not in lazy

@@ -168,6 +168,98 @@ def test_arm2dof_dynamics_returns_arrays_like_mechanism_and_keeps_the_dict_keys(
         assert tau["status"] == 0
 
 
+@pytest.fixture(scope="module")
+def five_bar():
+    """The balanced five-bar of the shipped case, its typed dynamics and the raw binding (the dict
+    of earlier releases), and N states along a quintic, away from the flat poses."""
+    from mechbal import _core
+    from mechbal.config import load_case
+    from mechbal.papers import discs
+
+    d = discs.design("fivebar", discs.parameters_from_config("fivebar", load_case("five-bar")), True)
+    typed = discs.fivebar_dynamics(d)
+    raw = _core.FiveBarDynamics(typed.parameters)
+    q, v, a = trajectory.quintic([0.6, 1.9], [0.9, 2.3], 1.0).evaluate(np.linspace(0, 1, 7))
+    return typed, raw, q, v, a
+
+
+def test_five_bar_inverse_dynamics_returns_arrays_like_mechanism(five_bar):
+    from mechbal.mechanism import BatchArray
+    from mechbal.papers import discs
+
+    dyn, raw, q, v, a = five_bar
+    assert isinstance(dyn, discs.FiveBarDynamics) and mechbal.FiveBarDynamics is discs.FiveBarDynamics
+    tau = dyn.inverse_dynamics(q, v, a)
+    assert isinstance(tau, BatchArray) and tau.shape == (7, 2) and np.all(tau.status == 0)
+    # tau = M' a + v' + g' of evaluate, and the raw binding's torques
+    terms = dyn.evaluate(q, v)
+    np.testing.assert_allclose(tau, np.einsum("nij,nj->ni", terms.mass_matrix, a) + terms.coriolis_torque
+                               + terms.gravity_torque, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(tau, raw.inverse_dynamics(q, v, a)["tau"])
+    one = dyn.inverse_dynamics(q[3], v[3], a[3])      # one sample, as Mechanism
+    assert one.shape == (2,)
+    np.testing.assert_allclose(one, tau[3], rtol=1e-14)
+    with pytest.raises(ValueError, match="input rejected"):
+        dyn.inverse_dynamics(np.array([np.nan, 1.0]), v[3], a[3])
+    bad = dyn.inverse_dynamics(np.vstack([q[:1], [[np.nan, 1.0]]]), v[:2], a[:2])
+    assert list(bad.ok) == [True, False] and bad.status[1] != 0
+    with pytest.warns(DeprecationWarning, match="'qdd' is deprecated, use 'a'"):
+        _same(dyn.inverse_dynamics(q, qd=v, qdd=a), np.asarray(tau))
+
+
+@pytest.mark.parametrize("key", ["tau", "status", "status_per_instant"])
+def test_five_bar_inverse_dynamics_keeps_each_dict_key_with_a_warning(five_bar, key):
+    dyn, raw, q, v, a = five_bar
+    old = raw.inverse_dynamics(q, v, a)[key]
+    new = dyn.inverse_dynamics(q, v, a)
+    with pytest.warns(DeprecationWarning, match=rf"result\['{key}'\] is deprecated"):
+        value = new[key]
+    _same(value, np.asarray(old) if isinstance(old, np.ndarray) else int(old))
+
+
+@pytest.mark.parametrize("key", ["mass", "velocity", "gravity", "reciprocal_condition", "ok", "status",
+                                 "status_per_instant"])
+def test_five_bar_evaluate_is_typed_and_keeps_each_dict_key_with_a_warning(five_bar, key):
+    from mechbal.papers import discs
+
+    dyn, raw, q, v, _ = five_bar
+    new = dyn.evaluate(q, v)
+    assert isinstance(new, discs.FiveBarTerms) and new.mass_matrix.shape == (7, 2, 2)
+    old = raw.evaluate(q, v)[key]
+    with pytest.warns(DeprecationWarning, match=rf"result\['{key}'\] is deprecated \(the result is no "
+                                                r"longer a dict\), use result\."):
+        value = new[key]
+    _same(value, np.asarray(old) if isinstance(old, np.ndarray) else int(old))
+    assert key in new and key in new.keys()
+
+
+@pytest.mark.parametrize("key", ["angles", "rates", "accelerations", "end_effector", "end_effector_velocity",
+                                 "end_effector_acceleration", "status", "status_per_instant"])
+def test_five_bar_motion_is_typed_and_keeps_each_dict_key_with_a_warning(five_bar, key):
+    from mechbal.papers import discs
+
+    dyn, raw, q, v, a = five_bar
+    new = dyn.motion(q, v, a)
+    assert isinstance(new, discs.FiveBarMotion) and new.q.shape == (7, 4) and new.end_effector.shape == (7, 2)
+    old = raw.motion(q, v, a)[key]
+    with pytest.warns(DeprecationWarning, match=rf"result\['{key}'\] is deprecated"):
+        value = new[key]
+    _same(value, np.asarray(old) if isinstance(old, np.ndarray) else int(old))
+
+
+def test_five_bar_single_samples_drop_the_batch_axis(five_bar):
+    dyn, _, q, v, a = five_bar
+    terms, motion = dyn.evaluate(q[2], v[2]), dyn.motion(q[2], v[2], a[2])
+    batch_terms, batch_motion = dyn.evaluate(q, v), dyn.motion(q, v, a)
+    assert terms.mass_matrix.shape == (2, 2) and terms.status.shape == () and bool(terms.ok)
+    np.testing.assert_allclose(terms.mass_matrix, batch_terms.mass_matrix[2], rtol=1e-14)
+    assert motion.q.shape == (4,) and motion.end_effector.shape == (2,)
+    np.testing.assert_allclose(motion.a, batch_motion.a[2], rtol=1e-14)
+    np.testing.assert_allclose(motion.q[[0, 2]], q[2], rtol=1e-14)   # the actuated angles are q
+    with pytest.raises(ValueError, match="singularity"):
+        dyn.motion(np.array([0.4, 0.4]), v[2], a[2])   # the flat pose of the parallelogram
+
+
 def test_balance_design_is_typed_and_keeps_the_dict_access(arm):
     from mechbal.balance import CounterweightDesign, static
 
@@ -204,3 +296,10 @@ def test_no_deprecation_warning_from_the_new_names(arm):
         traj = trajectory.quintic([0.0, 0.0], [0.3, -0.2], 0.1)
         simulate.closed_loop(arm, ct, traj, dt=1e-3)
         control.MechanismDynamics(arm.model).inverse_dynamics(np.zeros(2), np.zeros(2), np.zeros(2))
+        from mechbal.config import load_case
+        from mechbal.papers import discs
+
+        fb = discs.fivebar_dynamics(discs.design("fivebar", discs.parameters_from_config(
+            "fivebar", load_case("five-bar")), True))
+        q = np.array([[0.6, 1.9]])
+        fb.inverse_dynamics(q, q, q), fb.evaluate(q, q), fb.motion(q, q, q)

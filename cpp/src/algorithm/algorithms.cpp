@@ -199,9 +199,17 @@ Status frame_placement(const MechanismModel& model, MechanismData& data, const C
 Status center_of_mass(const MechanismModel& model, MechanismData& data, const ConstVector& q) noexcept {
   if (Status s = check_state(model, data, &q); s != Status::ok) return s;
   detail::joint_state<false, false>(model, data, q, q, q);
-  detail::place(model, data);
+  // the mass moment summed while the links are placed (one sweep over their data, so the cost per
+  // link stays flat when a long chain outgrows the cache), in mass_moment's order: the base first
+  const auto& base = model.link_constants(0);
+  const auto& w0 = data.work[0];
+  Vec3 mc = base.mass * w0.world_position + w0.world_rotation * base.first_moment;
+  detail::place(model, data, [&model, &mc](int l, const MechanismData::LinkWork& w) noexcept {
+    const auto& c = model.link_constants(l);
+    mc += c.mass * w.world_position + w.world_rotation * c.first_moment;
+  });
   data.mass = model.total_mass();
-  data.center_of_mass = data.mass > 0.0 ? Vec3(mass_moment(model, data) / data.mass) : Vec3::Zero();
+  data.center_of_mass = data.mass > 0.0 ? Vec3(mc / data.mass) : Vec3::Zero();
   return finite_result(data.center_of_mass);
 }
 

@@ -101,28 +101,6 @@ T rename_errors(Fn fn) {
   }
 }
 
-/// [control].task_rows -> TaskSpaceConfig::task_rows (the MomentumComponent bits of [v; w]).
-std::uint32_t task_rows_mask(const std::vector<std::string>& rows) {
-  static const std::pair<const char*, std::uint32_t> names[] = {
-      {"linear", cancel_force}, {"angular", cancel_moment}, {"all", cancel_both}, {"v_x", force_x},
-      {"v_y", force_y},         {"v_z", force_z},          {"w_x", moment_x},  {"w_y", moment_y},
-      {"w_z", moment_z}};
-  if (rows.empty()) fail("task_rows", "must name at least one twist component");
-  std::uint32_t mask = 0;
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    std::uint32_t bit = 0;
-    for (const auto& n : names)
-      if (rows[i] == n.first) bit = n.second;
-    if (bit == 0) {
-      fail("task_rows[" + std::to_string(i) + "]", "'" + rows[i] +
-                                                       "' is not a twist component (all, linear, angular, v_x, v_y, "
-                                                       "v_z, w_x, w_y, w_z)");
-    }
-    mask |= bit;
-  }
-  return mask;
-}
-
 std::uint32_t cancel_mask(const std::vector<std::string>& cancel) {
   if (cancel.empty()) fail("cancel", "must name at least one momentum component");
   std::uint32_t mask = 0;
@@ -145,6 +123,27 @@ ReactionlessIntegrator integrator_of(const std::string& name) {
 }
 
 }  // namespace
+
+std::uint32_t task_rows_mask(const std::vector<std::string>& rows, const std::string& field) {
+  static const std::pair<const char*, std::uint32_t> names[] = {
+      {"linear", cancel_force}, {"angular", cancel_moment}, {"all", cancel_both}, {"v_x", force_x},
+      {"v_y", force_y},         {"v_z", force_z},          {"w_x", moment_x},  {"w_y", moment_y},
+      {"w_z", moment_z}};
+  if (rows.empty()) throw std::invalid_argument(field + ": must name at least one twist component");
+  std::uint32_t mask = 0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    std::uint32_t bit = 0;
+    for (const auto& n : names)
+      if (rows[i] == n.first) bit = n.second;
+    if (bit == 0) {
+      throw std::invalid_argument(field + "[" + std::to_string(i) + "]: '" + rows[i] +
+                                  "' is not a twist component (all, linear, angular, v_x, v_y, v_z, w_x, w_y, "
+                                  "w_z)");
+    }
+    mask |= bit;
+  }
+  return mask;
+}
 
 ReactionlessConfig reactionless_config(const ControlConfig& control) {
   require_kind(control, ControlKind::reactionless, "a reactionless controller");

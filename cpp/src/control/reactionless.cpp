@@ -38,6 +38,20 @@ bool failed(Status s) noexcept {
          has(s, Status::out_of_range);
 }
 
+/// The fields both reactionless controllers (joint space and operational space) share, checked
+/// in this order; std::invalid_argument naming the first bad one and its value.
+void validate_shared_fields(std::uint32_t cancel, double rate_hz, double damping, double max_condition,
+                            double max_rate) {
+  if (cancel == 0u || (cancel & ~cancel_both) != 0u)
+    fail("reactionless.cancel", "must select at least one of the six momentum components (bit mask 1..63)",
+         static_cast<double>(cancel));
+  if (!(rate_hz >= 1.0 && rate_hz <= 1e6)) fail("reactionless.rate_hz", "must be in [1, 1e6] Hz", rate_hz);
+  if (!(damping > 0.0 && damping < 1.0)) fail("reactionless.damping", "must be in (0, 1)", damping);
+  if (!(std::isfinite(max_condition) && max_condition > 1.0))
+    fail("reactionless.max_condition", "must be finite and > 1", max_condition);
+  if (!(std::isfinite(max_rate) && max_rate > 0.0)) fail("reactionless.max_rate", "must be finite and > 0", max_rate);
+}
+
 }  // namespace
 
 std::uint32_t momentum_component(const std::string& name) noexcept {
@@ -55,17 +69,9 @@ std::uint32_t momentum_component(const std::string& name) noexcept {
 
 void validate_reactionless_config(const ReactionlessConfig& c) {
   if (c.balancing_joints.empty()) fail("reactionless.balancing_joints must name at least one joint");
-  if (c.cancel == 0u || (c.cancel & ~cancel_both) != 0u)
-    fail("reactionless.cancel", "must select at least one of the six momentum components (bit mask 1..63)",
-         static_cast<double>(c.cancel));
   if (c.integrator != ReactionlessIntegrator::euler && c.integrator != ReactionlessIntegrator::rk4)
     fail("reactionless.integrator", "must be euler or rk4", static_cast<double>(c.integrator));
-  if (!(c.rate_hz >= 1.0 && c.rate_hz <= 1e6)) fail("reactionless.rate_hz", "must be in [1, 1e6] Hz", c.rate_hz);
-  if (!(c.damping > 0.0 && c.damping < 1.0)) fail("reactionless.damping", "must be in (0, 1)", c.damping);
-  if (!(std::isfinite(c.max_condition) && c.max_condition > 1.0))
-    fail("reactionless.max_condition", "must be finite and > 1", c.max_condition);
-  if (!(std::isfinite(c.max_rate) && c.max_rate > 0.0))
-    fail("reactionless.max_rate", "must be finite and > 0", c.max_rate);
+  validate_shared_fields(c.cancel, c.rate_hz, c.damping, c.max_condition, c.max_rate);
   if (!(std::isfinite(c.max_acceleration) && c.max_acceleration > 0.0))
     fail("reactionless.max_acceleration", "must be finite and > 0", c.max_acceleration);
   if (!(std::isfinite(c.home_gain) && c.home_gain >= 0.0))
@@ -705,15 +711,7 @@ ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const Mec
   if (config_.task_rows == 0u || (config_.task_rows & ~cancel_both) != 0u)
     fail("task_rows", "must select at least one of the six twist components (bit mask 1..63)",
          static_cast<double>(config_.task_rows));
-  if (config_.cancel == 0u || (config_.cancel & ~cancel_both) != 0u)
-    fail("reactionless.cancel", "must select at least one of the six momentum components (bit mask 1..63)",
-         static_cast<double>(config_.cancel));
-  if (!(config_.rate_hz >= 1.0 && config_.rate_hz <= 1e6)) fail("reactionless.rate_hz", "must be in [1, 1e6] Hz", config_.rate_hz);
-  if (!(config_.damping > 0.0 && config_.damping < 1.0)) fail("reactionless.damping", "must be in (0, 1)", config_.damping);
-  if (!(std::isfinite(config_.max_condition) && config_.max_condition > 1.0))
-    fail("reactionless.max_condition", "must be finite and > 1", config_.max_condition);
-  if (!(std::isfinite(config_.max_rate) && config_.max_rate > 0.0))
-    fail("reactionless.max_rate", "must be finite and > 0", config_.max_rate);
+  validate_shared_fields(config_.cancel, config_.rate_hz, config_.damping, config_.max_condition, config_.max_rate);
   if (!(std::isfinite(config_.max_twist) && config_.max_twist > 0.0))
     fail("max_twist", "must be finite and > 0", config_.max_twist);
   if (!(std::isfinite(config_.max_twist_rate) && config_.max_twist_rate > 0.0))

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <optional>
@@ -1083,6 +1084,37 @@ constexpr int kMaxCaseDepth = 32;
                    " deep, too deeply to be a case file");
 }
 
+/// The position just after the string (basic, literal, single- or multi-line) that opens at
+/// text[i], or the end of its line when it is not closed there (the parser says so). `after_wrap`,
+/// when given, receives the offset of each non-ASCII character that follows a line-ending
+/// backslash of a multi-line basic string (see toml_safe_text).
+std::size_t skip_string(const std::string& text, std::size_t i, std::vector<std::size_t>* after_wrap = nullptr) {
+  const char q = text[i];
+  const std::size_t n = text.size();
+  const bool triple = i + 2 < n && text[i + 1] == q && text[i + 2] == q;
+  i += triple ? 3 : 1;
+  while (i < n) {
+    if (q == '"' && text[i] == '\\') {
+      std::size_t j = i + 1;
+      if (triple && after_wrap) {
+        while (j < n && (text[j] == ' ' || text[j] == '\t' || text[j] == '\r' || text[j] == '\n')) ++j;
+        if (j > i + 1 && j < n && static_cast<unsigned char>(text[j]) >= 0x80) after_wrap->push_back(j);
+      }
+      i = std::max(j, i + 2);
+    } else if (!triple && text[i] == '\n') {
+      return i;
+    } else if (text[i] == q && (!triple || (i + 2 < n && text[i + 1] == q && text[i + 2] == q))) {
+      if (!triple) return i + 1;
+      i += 3;
+      for (int extra = 0; extra < 2 && i < n && text[i] == q; ++extra) ++i;  // """a"""" is 'a"'
+      return i;
+    } else {
+      ++i;
+    }
+  }
+  return n;
+}
+
 /// Refuses, before parsing, a dotted key or table header of more than kMaxCaseDepth segments
 /// (`a.b.c. ... = 1`): each segment is a table level, and toml++ walks a deep tree recursively (a
 /// stack overflow for ~1e5 levels). Outside strings and comments, a run of key characters and
@@ -1096,18 +1128,7 @@ void check_dotted_depth(const std::string& text, const std::string& source) {
       while (i < n && text[i] != '\n') ++i;
       dots = 0;
     } else if (c == '"' || c == '\'') {
-      const bool triple = i + 2 < n && text[i + 1] == c && text[i + 2] == c;
-      i += triple ? 3 : 1;
-      for (; i < n; ++i) {
-        if (c == '"' && text[i] == '\\') {
-          ++i;
-        } else if (text[i] == c && (!triple || (i + 2 < n && text[i + 1] == c && text[i + 2] == c))) {
-          if (triple) i += 2;
-          break;
-        } else if (!triple && text[i] == '\n') {
-          break;  // an unterminated string: the parser says so
-        }
-      }
+      i = skip_string(text, i) - 1;
     } else if (c == '.') {
       if (++dots > kMaxCaseDepth) too_deep(source);
     } else if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '+' || c == ' ' ||
@@ -1115,6 +1136,127 @@ void check_dotted_depth(const std::string& text, const std::string& source) {
       dots = 0;
     }
   }
+}
+
+/// A place in a document where toml++ 3.3.0 would break one of its own assumptions (see
+/// toml_hazard): what it is and the offset of the character.
+struct TomlHazard {
+  enum Kind { header_without_key, brace_for_value, non_ascii } kind;
+  std::size_t at;
+  bool array_header;  // header_without_key: after `[[`
+};
+
+/// The first place where toml++ 3.3.0, reading `text`, would break an assumption of its own: an
+/// abort in a debug build (a failed assertion), undefined behaviour in a release one.
+/// - header_without_key: a table header whose `[` or `[[` (and the spaces or tabs after it) is
+///   followed by a character that starts no key (`[.`, `[=`, `[[[1]]]`, `[` alone on its line):
+///   parse_table_header hands it to parse_key, which asserts that a key starts there (fixed after
+///   3.4.0, marzer/tomlplusplus#301).
+/// - brace_for_value: a `}` where an array expects a value (`x = [1, }`): parse_array hands it
+///   to parse_value, which asserts that no value terminator starts a value.
+/// - non_ascii: a character that is not ASCII outside strings and comments (`x = 1é`, `é = 1`).
+///   toml++ asks is_horizontal_whitespace about it, and for most of U+00A1-U+0499, U+2C6E-U+3067
+///   and U+FC06-U+FEFE that function reaches __builtin_unreachable (fixed after 3.4.0,
+///   marzer/tomlplusplus#305). Valid TOML holds such characters only in strings and comments.
+/// Outside strings and comments, a `[` first on its line (after spaces or tabs) and outside the
+/// arrays and inline tables of values opens a header. toml++ reaches the hazard only when the text
+/// before it is valid TOML; parse() leaves the rest to toml++.
+std::optional<TomlHazard> toml_hazard(const std::string& text) {
+  auto blank = [](char c) { return c == ' ' || c == '\t'; };
+  auto starts_key = [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+           c == '"' || c == '\'';
+  };
+  const std::size_t n = text.size();
+  std::size_t i = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // toml++ skips a byte-order mark
+  std::vector<char> open;   // the arrays ('[') and inline tables ('{') of values open here
+  bool want_value = false;  // the innermost array expects a value (after its `[` or a comma)
+  bool line_start = true;   // nothing but spaces or tabs since the line break (outside values)
+  bool header = false;      // on a table header's line
+  while (i < n) {
+    const char c = text[i];
+    if (c == '\n') {
+      if (open.empty()) line_start = true, header = false;
+      ++i;
+    } else if (blank(c) || c == '\r') {
+      ++i;
+    } else if (c == '#') {
+      while (i < n && text[i] != '\n') ++i;
+    } else if (static_cast<unsigned char>(c) >= 0x80) {
+      return TomlHazard{TomlHazard::non_ascii, i, false};
+    } else if (c == '"' || c == '\'') {
+      i = skip_string(text, i);
+      line_start = want_value = false;
+    } else if (c == '}' && want_value && !open.empty() && open.back() == '[') {
+      return TomlHazard{TomlHazard::brace_for_value, i, false};
+    } else if (c == '[' && open.empty() && line_start) {
+      std::size_t j = i + 1;
+      bool spaced = false;
+      for (; j < n && blank(text[j]); ++j) spaced = true;
+      const bool array = j < n && text[j] == '[' && !spaced;  // `[ [` is refused by toml++ itself
+      if (array)
+        for (++j; j < n && blank(text[j]);) ++j;
+      if (j < n && text[j] != ']' && !(text[j] == '[' && spaced) && !starts_key(text[j])) {
+        return TomlHazard{TomlHazard::header_without_key, j, array};
+      }
+      header = true;
+      line_start = false;
+      i = j;
+    } else {
+      line_start = false;
+      if (!header && (c == '[' || c == '{')) {
+        open.push_back(c);
+        want_value = c == '[';
+      } else if (!header && (c == ']' || c == '}') && !open.empty()) {
+        open.pop_back();
+        want_value = false;
+      } else {
+        want_value = c == ',' && !open.empty() && open.back() == '[';
+      }
+      ++i;
+    }
+  }
+  return std::nullopt;
+}
+
+/// `text` as toml++ 3.3.0 can read it without breaking its assumptions when it is valid TOML: a
+/// non-ASCII character right after the spaces and line breaks that a line-ending backslash of a
+/// multi-line basic string trims (`"""a\` at the end of a line, `é"""` on the next) is handed to
+/// toml++ as its \u escape. toml++ would otherwise ask is_horizontal_whitespace about it (see
+/// toml_hazard); the escape is the same character, so the string reads the same.
+std::string toml_safe_text(const std::string& text) {
+  std::vector<std::size_t> wraps;
+  for (std::size_t i = 0; i < text.size();) {
+    if (text[i] == '#') {
+      while (i < text.size() && text[i] != '\n') ++i;
+    } else if (text[i] == '"' || text[i] == '\'') {
+      i = skip_string(text, i, &wraps);
+    } else {
+      ++i;
+    }
+  }
+  if (wraps.empty()) return text;
+  std::string out;
+  out.reserve(text.size() + 10 * wraps.size());
+  std::size_t from = 0;
+  for (const std::size_t at : wraps) {
+    const unsigned char c = static_cast<unsigned char>(text[at]);
+    const int len = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
+    if (len == 0 || at + static_cast<std::size_t>(len) > text.size()) continue;  // not UTF-8: toml++ says so
+    unsigned long code = len == 2 ? c & 0x1Fu : len == 3 ? c & 0x0Fu : c & 0x07u;
+    bool whole = true;
+    for (int k = 1; k < len; ++k) {
+      const unsigned char cont = static_cast<unsigned char>(text[at + static_cast<std::size_t>(k)]);
+      whole = whole && (cont & 0xC0) == 0x80;
+      code = (code << 6) | (cont & 0x3Fu);
+    }
+    if (!whole || code < 0x80 || (code >= 0xD800 && code <= 0xDFFF) || code > 0x10FFFF) continue;
+    char escape[16];
+    std::snprintf(escape, sizeof escape, code > 0xFFFF ? "\\U%08lX" : "\\u%04lX", code);
+    out.append(text, from, at - from).append(escape);
+    from = at + static_cast<std::size_t>(len);
+  }
+  return out.append(text, from, std::string::npos);
 }
 
 /// config._nesting_depth: the deepest nesting of tables and arrays (the document is depth 1),
@@ -1138,18 +1280,87 @@ int nesting_depth(const toml::table& doc) {
   return deepest;
 }
 
-toml::table parse(const std::string& text, const std::string& source) {
-  check_dotted_depth(text, source);
-  toml::table doc;
+/// "U+00E9" for the (UTF-8) character at text[at], "byte 0xNN" when it is not one, "'c'" for a
+/// printable ASCII one, "the end of the line" for a line break (the message stays ASCII).
+std::string shown_character(const std::string& text, std::size_t at) {
+  const unsigned char c = static_cast<unsigned char>(text[at]);
+  if (c == '\n' || (c == '\r' && at + 1 < text.size() && text[at + 1] == '\n')) return "the end of the line";
+  if (c > 0x20 && c < 0x7F) return std::string("'") + static_cast<char>(c) + "'";
+  const int len = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 1;
+  unsigned long code = len == 2 ? c & 0x1Fu : len == 3 ? c & 0x0Fu : c & 0x07u;
+  bool whole = len > 1 && at + static_cast<std::size_t>(len) <= text.size();
+  for (int k = 1; whole && k < len; ++k) {
+    const unsigned char cont = static_cast<unsigned char>(text[at + static_cast<std::size_t>(k)]);
+    whole = (cont & 0xC0) == 0x80;
+    code = (code << 6) | (cont & 0x3Fu);
+  }
+  char buf[16];
+  if (whole) {
+    std::snprintf(buf, sizeof buf, "U+%04lX", code);
+  } else {
+    std::snprintf(buf, sizeof buf, "byte 0x%02x", static_cast<unsigned>(c));
+  }
+  return buf;
+}
+
+/// The line and column of text[at], both from 1, columns counting characters (as toml++ and tomllib).
+std::pair<std::size_t, std::size_t> line_and_column(const std::string& text, std::size_t at) {
+  std::size_t line = 1, column = 1;
+  for (std::size_t k = 0; k < at; ++k) {
+    if (text[k] == '\n') {
+      ++line;
+      column = 1;
+    } else if ((static_cast<unsigned char>(text[k]) & 0xC0) != 0x80) {  // not a UTF-8 continuation byte
+      ++column;
+    }
+  }
+  return {line, column};
+}
+
+[[noreturn]] void not_toml(const std::string& source, const std::string& what, std::size_t line, std::size_t column) {
+  fail(source, "is not valid TOML: " + what + " (line " + std::to_string(line) + ", column " + std::to_string(column) +
+                   ")");
+}
+
+/// toml++ on `text`, or a one-line ConfigError naming `source`, the line and the column. A text
+/// with a toml_hazard is refused without toml++ reading the hazard: at toml++'s own first error
+/// when that comes before the hazard (toml++ reads the text up to it, the hazard excluded), else
+/// at the hazard.
+toml::table parse_toml(const std::string& text, const std::string& source) {
+  const std::string safe = toml_safe_text(text);
+  const std::optional<TomlHazard> hazard = toml_hazard(safe);
+  const auto hazard_at = hazard ? line_and_column(safe, hazard->at) : std::pair<std::size_t, std::size_t>{};
   try {
-    doc = toml::parse(text, source);
+    if (!hazard) return toml::parse(safe, source);
+    (void)toml::parse(std::string_view(safe).substr(0, hazard->at), source);
   } catch (const toml::parse_error& e) {
     if (e.description().find("TOML_MAX_NESTED_VALUES") != std::string_view::npos) too_deep(source);
-    std::ostringstream os;
-    os << "is not valid TOML: " << one_line(e.description()) << " (line " << e.source().begin.line << ", column "
-       << e.source().begin.column << ")";
-    fail(source, os.str());
+    const std::pair<std::size_t, std::size_t> at{e.source().begin.line, e.source().begin.column};
+    // toml++ says where the text up to the hazard ends early (end-of-file, EOF): not an error of its own
+    const bool cut = hazard && (e.description().find("end-of-file") != std::string_view::npos ||
+                                e.description().find("EOF") != std::string_view::npos);
+    if (!hazard || (at < hazard_at && !cut)) not_toml(source, one_line(e.description()), at.first, at.second);
   }
+  std::string what;
+  switch (hazard->kind) {
+    case TomlHazard::header_without_key:
+      what = "a table header must start with a key, saw " + shown_character(safe, hazard->at) + " after '" +
+             (hazard->array_header ? "[[" : "[") + "'";
+      break;
+    case TomlHazard::brace_for_value:
+      what = "expected a value or ']' in an array, saw '}'";
+      break;
+    case TomlHazard::non_ascii:
+      what = "the character " + shown_character(safe, hazard->at) +
+             " is not ASCII: outside strings and comments TOML allows only ASCII";
+      break;
+  }
+  not_toml(source, what, hazard_at.first, hazard_at.second);
+}
+
+toml::table parse(const std::string& text, const std::string& source) {
+  check_dotted_depth(text, source);
+  toml::table doc = parse_toml(text, source);
   if (nesting_depth(doc) > kMaxCaseDepth) too_deep(source);
   return doc;
 }

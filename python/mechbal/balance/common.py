@@ -650,6 +650,7 @@ def lightest_within_bounds(dsg: "_Design", y0: np.ndarray, Z: np.ndarray, mscale
             a, r = cut(k, u)
             rows.append(a[None, :]), rhs.append(np.array([r]))
     bound = None
+    z_last = None
     for _ in range(MAX_CUT_ROUNDS):
         A_ub = np.vstack(rows) if rows else None
         b_ub = np.concatenate(rhs) if rhs else None
@@ -660,6 +661,12 @@ def lightest_within_bounds(dsg: "_Design", y0: np.ndarray, Z: np.ndarray, mscale
         z = res.x
         y = y0 + Z @ z
         bound = float(dsg.mass_row @ y)
+        if z_last is not None and np.array_equal(z, z_last):
+            # stalled: the last round's cuts did not move the optimum (they are met to the LP's
+            # feasibility tolerance, 1e-10, above CONE_RTOL), so every further round would add the
+            # same cuts again and solve the same LP; the polish below meets the cones instead
+            break
+        z_last = z
         worst, added = 0.0, False
         for k in dsg.cones:
             m, _ = dsg._mass(k, y)

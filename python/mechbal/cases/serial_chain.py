@@ -200,20 +200,15 @@ def _write_variant(mech: Mechanism, out: Path, variant: str, t, q, v, a):
     return sw.shaking_force, sw.shaking_moment
 
 
-def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None) -> dict:
-    """A case with ``[control]`` (kind reactionless): the motion with the balancing joints held
-    at their start (``uncontrolled``) and under the reactionless controller (``controlled``), at
-    the controller's ticks; bodies_uncontrolled.npz, bodies_controlled.npz (each with the shaking
-    wrench of its stored poses), the plots and both variants' peaks in summary.json."""
+def held_trajectory(mech: Mechanism, case):
+    """(trajectory, balancing, task) of a validated case with a reactionless ``[control]`` in the
+    joint mode: the ``[trajectory]`` of every actuated joint with the balancing joints held at
+    their start (their end or speed is ignored: the controller computes them; the uncontrolled
+    motion), and the indices of the balancing and task joints among the actuated ones.
+    ConfigError naming a balancing joint that is not actuated."""
     from mechbal.schema import did_you_mean
 
     ctl = case.control
-    name, title = case.case.name, case.case.title or case.case.name
-    if ctl.kind != "reactionless":
-        raise ConfigError("control.kind", "mechbal run simulates kind 'reactionless' (computed_torque "
-                          "and decoupled controllers: mechbal.simulate.closed_loop)", ctl.kind)
-    if ctl.task_frame is not None:
-        return run_task_space(mech, case, out)
     names = mech.actuated_names
     for i, b in enumerate(ctl.balancing_joints):
         if b not in names:
@@ -233,6 +228,23 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None
                 end[i] = case.trajectory.start[i]
         held = {"end": end}
     traj, _ = trajectory_from_config(case.trajectory.model_copy(update=held), len(names))
+    return traj, balancing, task
+
+
+def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None) -> dict:
+    """A case with ``[control]`` (kind reactionless): the motion with the balancing joints held
+    at their start (``uncontrolled``) and under the reactionless controller (``controlled``), at
+    the controller's ticks; bodies_uncontrolled.npz, bodies_controlled.npz (each with the shaking
+    wrench of its stored poses), the plots and both variants' peaks in summary.json."""
+    ctl = case.control
+    name, title = case.case.name, case.case.title or case.case.name
+    if ctl.kind != "reactionless":
+        raise ConfigError("control.kind", "mechbal run simulates kind 'reactionless' (computed_torque "
+                          "and decoupled controllers: mechbal.simulate.closed_loop)", ctl.kind)
+    if ctl.task_frame is not None:
+        return run_task_space(mech, case, out)
+    names = mech.actuated_names
+    traj, balancing, task = held_trajectory(mech, case)
     dt = 1.0 / ctl.rate_hz
     steps = int(round(traj.duration / dt))
     th = np.arange(2 * steps + 1) * (0.5 * dt)
@@ -338,20 +350,14 @@ def _motion_acceleration(t, v):
     return make_interp_spline(t, v, k=5)(t, 1)
 
 
-def run_task_space(mech: Mechanism, case, out: Path) -> dict:
-    """A case whose ``[control]`` names a ``task_frame`` (the operational-space mode,
-    `mechbal.control.ReactionlessTaskController`): ``[trajectory]`` is the frame's path,
-    from its pose at ``start`` to its pose at ``end`` (joint positions; `frame_path`), and
-    the arm starts at ``start``. The path is run twice at the controller's ticks: with the
-    pseudo-inverse alone, v = J^+ x' (``uncontrolled``: no null-space term), and in the reaction
-    null space, v = J^+ x' + N z (``controlled``); bodies_uncontrolled.npz and
-    bodies_controlled.npz hold each motion (rates integrated, the accelerations those of the
-    stored motion) with the wrench of its poses; summary.json reports the shaking-moment
-    reduction that the redundancy buys."""
+def check_task_space(mech: Mechanism, case) -> None:
+    """ConfigError naming the field unless the validated ``case``'s operational-space mode
+    (``[control] task_frame``) fits ``mech``: an open mechanism with every joint actuated and
+    listed as balancing, a named task frame, a quintic or cubic ``[trajectory]`` whose ``start``
+    and ``end`` are joint positions."""
     from mechbal.schema import did_you_mean
 
     ctl = case.control
-    name, title = case.case.name, case.case.title or case.case.name
     names = mech.actuated_names
     if mech.is_closed or len(names) != mech.dof:
         raise ConfigError("control.task_frame", "the operational-space mode drives open mechanisms with "
@@ -377,6 +383,23 @@ def run_task_space(mech: Mechanism, case, out: Path) -> dict:
             raise ConfigError(f"trajectory.{key}", f"must have {len(names)} values (joint positions: the "
                               "task frame's path runs from its pose at start to its pose at end)",
                               getattr(tr, key))
+
+
+def run_task_space(mech: Mechanism, case, out: Path) -> dict:
+    """A case whose ``[control]`` names a ``task_frame`` (the operational-space mode,
+    `mechbal.control.ReactionlessTaskController`): ``[trajectory]`` is the frame's path,
+    from its pose at ``start`` to its pose at ``end`` (joint positions; `frame_path`), and
+    the arm starts at ``start``. The path is run twice at the controller's ticks: with the
+    pseudo-inverse alone, v = J^+ x' (``uncontrolled``: no null-space term), and in the reaction
+    null space, v = J^+ x' + N z (``controlled``); bodies_uncontrolled.npz and
+    bodies_controlled.npz hold each motion (rates integrated, the accelerations those of the
+    stored motion) with the wrench of its poses; summary.json reports the shaking-moment
+    reduction that the redundancy buys."""
+    ctl = case.control
+    name, title = case.case.name, case.case.title or case.case.name
+    names = mech.actuated_names
+    check_task_space(mech, case)
+    tr = case.trajectory
     start = np.array(tr.start, float)
     dt = 1.0 / ctl.rate_hz
     steps = int(round(tr.duration / dt))

@@ -161,6 +161,12 @@ class MujocoMechanism:
         didx = [self.dof_adr[n] for n in self.mech.joint_names]
         return np.array(self.data.qpos[idx]), np.array(self.data.qvel[didx])
 
+    def accelerations(self) -> np.ndarray:
+        """mechbal's a (dof,) of MuJoCo's current ``qacc`` (after ``mj_forward``: the acceleration
+        its step integrates; the independent joints' values)."""
+        didx = [self.dof_adr[n] for n in self.mech.joint_names]
+        return np.array(self.data.qacc[didx])
+
     # ---- inverse dynamics --------------------------------------------------------------------
     def _wrench_at_O(self, bodies, field: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         F, M = np.zeros(3), np.zeros(3)
@@ -241,11 +247,25 @@ MINIMUM_FRACTION = 1e-6
 CONSTRAINT_WEIGHT = 1e-4
 
 
+def cosimulated_mechanism(mech, minimum_mass: float | None = None):
+    """The mechanism `co_simulate` integrates in MuJoCo: ``mech`` with the bodies added to its
+    massless moving links (`mechbal.export.mjcf.minimum_bodies`; ``minimum_mass`` [kg], default
+    `MINIMUM_FRACTION` of the total mass), ``mech`` itself when it has none. mechbal's
+    predictions of a co-simulation are of this mechanism."""
+    if minimum_mass is None:
+        minimum_mass = max(MINIMUM_FRACTION * mech.total_mass, MINIMUM)
+    bodies = minimum_bodies(mech, minimum_mass)
+    return mech.with_bodies(bodies) if bodies else mech
+
+
 @dataclass(frozen=True)
 class CoSimulation(DeprecatedAttributes):
     """A 1 kHz co-simulation (`co_simulate`): the controller's log, one row per tick
     k = 0 .. steps (``t``, ``q``, ``v``, ``q_des``, ``v_des``, ``joint_torque``, ``status``, in
-    the controller's coordinates: the actuated joints of a closed mechanism), MuJoCo's base
+    the controller's coordinates: the actuated joints of a closed mechanism), every coordinate of
+    MuJoCo's state and its acceleration at each tick in mechbal's coordinates (``q_full``,
+    ``v_full``, ``a_full`` (N, dof): the motion MuJoCo realised, ``a_full`` its ``qacc`` after
+    the tick's torque), MuJoCo's base
     reaction at each tick (``base_reaction_force`` / ``_moment``: the moving bodies' momentum rate
     minus their weight, `MujocoMechanism.momentum_rate`) beside mechbal's prediction along
     the desired motion (``predicted_base_reaction_force`` / ``_moment``), the moving mass ``mass``
@@ -269,6 +289,9 @@ class CoSimulation(DeprecatedAttributes):
     mass_moment: np.ndarray
     predicted_mass_moment: np.ndarray
     constraint_violation: np.ndarray
+    q_full: np.ndarray | None = None
+    v_full: np.ndarray | None = None
+    a_full: np.ndarray | None = None
 
     _renamed: ClassVar[dict[str, str]] = {"qd": "v", "qd_des": "v_des"}
 
@@ -363,6 +386,7 @@ def co_simulate(mech, controller, trajectory, q0=None, v0=None, *, dt: float = 1
     moving = sim.moving_bodies
     n = len(act)
     log = {k: np.zeros((steps + 1, n)) for k in ("q", "v", "tau")}
+    full = {k: np.zeros((steps + 1, mech.dof)) for k in ("q", "v", "a")}
     status = np.zeros(steps + 1, dtype=np.uint32)
     F = np.zeros((steps + 1, 3))
     M = np.zeros((steps + 1, 3))
@@ -385,6 +409,7 @@ def co_simulate(mech, controller, trajectory, q0=None, v0=None, *, dt: float = 1
         d.ctrl[:] = tau
         mj.mj_forward(m, d)
         F[k], M[k] = sim.momentum_rate()
+        full["q"][k], full["v"][k], full["a"][k] = qk, vk, sim.accelerations()
         mc[k] = sum(m.body_mass[b] * d.xipos[b] for b in moving) if moving else np.zeros(3)
         viol[k] = float(np.max(np.abs(d.efc_pos[:d.ne]))) if d.ne else 0.0
         log["q"][k], log["v"][k], log["tau"][k] = qa, va, tau
@@ -406,7 +431,7 @@ def co_simulate(mech, controller, trajectory, q0=None, v0=None, *, dt: float = 1
                         predicted_base_reaction_force=np.asarray(br.base_reaction_force),
                         predicted_base_reaction_moment=np.asarray(br.base_reaction_moment),
                         gravity=g, mass=mass, mass_moment=mc, predicted_mass_moment=mc_pred,
-                        constraint_violation=viol)
+                        constraint_violation=viol, q_full=full["q"], v_full=full["v"], a_full=full["a"])
 
 
 def _still_bodies(mech) -> set[str]:

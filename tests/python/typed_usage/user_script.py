@@ -11,6 +11,7 @@ import numpy.typing as npt
 
 import mechbal
 from mechbal import control, simulate, trajectory
+from mechbal.papers.discs import FiveBarDynamics, FiveBarMotion, FiveBarParameters, FiveBarTerms
 from mechbal.balance import (
     BalanceResult, CounterweightDesign, CounterweightSlot, DiscDesign, DiscSlot, InertiaDesign,
     SpringDesign, SpringSlot, force, method, moment, rms, springs, static)
@@ -77,6 +78,16 @@ def main() -> None:
     run: simulate.ClosedLoopResult = simulate.closed_loop(
         arm, ct, trajectory.quintic([0.0, 0.0], [0.3, -0.2], 0.2), v0=[0.0, 0.0], dt=1e-3)
     print("tracking", peak(run.tracking_error), run.ok, run.v.shape)
+
+    # ---- a paper's closed form: the parallelogram five-bar ------------------------------------
+    five_bar = FiveBarDynamics(FiveBarParameters(
+        a1=0.3, a2=0.25, b1=0.25, b2=0.3, mp1=1.0, mp2=1.0, md1=0.8, md2=0.8, mP=0.5, cp1=0.1,
+        cp2=0.1, cd1=0.1, cd2=0.1, Jp1=0.01, Jp2=0.01, Jd1=0.01, Jd2=0.01))
+    q5 = np.array([[0.6, 1.9], [0.7, 2.0]])
+    tau5: npt.NDArray[np.float64] = five_bar.inverse_dynamics(q5, q5 * 0.0, q5 * 0.0)
+    terms: FiveBarTerms = five_bar.evaluate(q5, q5 * 0.0)
+    legs: FiveBarMotion = five_bar.motion(q5[0], q5[0] * 0.0, q5[0] * 0.0)
+    print("five-bar", peak(tau5 - terms.gravity_torque), terms.ok.all(), legs.end_effector)
 
     # ---- trajectory --------------------------------------------------------------------------
     via = trajectory.ViaPoints([0.0, 0.5, 1.0], [[0.0, 0.0], [0.6, -0.2], [1.2, -0.9]])

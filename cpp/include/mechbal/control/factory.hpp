@@ -22,7 +22,10 @@
 /// coordinates near the assembly the loops of a closed mechanism start from (the assembly mode; a
 /// case's `[trajectory] initial_guess`). `q0`, `v0`: the start (empty: zeros, rest).
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "mechbal/control/config.hpp"
 #include "mechbal/control/joint_controller.hpp"
@@ -40,6 +43,12 @@ std::unique_ptr<JointController> make_controller(const MechanismModel& model, co
 ReactionlessConfig reactionless_config(const ControlConfig& control);
 /// The TaskSpaceConfig of a `[control]` table of kind reactionless with a task_frame.
 TaskSpaceConfig task_space_config(const ControlConfig& control);
+
+/// The TaskSpaceConfig::task_rows mask (MomentumComponent bits of [v; w]) of twist component names:
+/// "all", "linear", "angular", "v_x", "v_y", "v_z", "w_x", "w_y", "w_z" (at least one). Throws
+/// std::invalid_argument naming `field` (the `[control]` table's, or "task_rows" for a caller's
+/// own argument) and the entry: every reader of task_rows gives the same message.
+std::uint32_t task_rows_mask(const std::vector<std::string>& rows, const std::string& field = "control.task_rows");
 
 /// `q0`, `v0`: actuated coordinates (empty: zeros, rest).
 std::unique_ptr<ReactionlessController> make_reactionless_controller(

@@ -61,9 +61,15 @@ inline void joint_state(const MechanismModel& model, MechanismData& data,
 
 /// Link placements relative to their parents and, with World, in O (L frames). The passes that
 /// work in the links' own frames only (inverse dynamics, gravity, bias, mass matrix) skip World:
-/// work[].world_* are then left as they were.
-template <bool World = true>
-inline void place(const MechanismModel& model, MechanismData& data) noexcept {
+/// work[].world_* are then left as they were. `visit(l, work[l])` runs on each link right after
+/// it is placed (in tree order, links 1..n-1), while its data is in cache: an algorithm that needs
+/// one more quantity per placed link folds it into this pass instead of sweeping the links again.
+struct NoVisit {
+  void operator()(int, const MechanismData::LinkWork&) const noexcept {}
+};
+
+template <bool World = true, class Visit = NoVisit>
+inline void place(const MechanismModel& model, MechanismData& data, Visit&& visit = Visit{}) noexcept {
   const int nl = model.num_links();
   for (int l = 1; l < nl; ++l) {
     const auto k = static_cast<std::size_t>(l);
@@ -94,6 +100,7 @@ inline void place(const MechanismModel& model, MechanismData& data) noexcept {
       w.world_rotation.noalias() = p.world_rotation * w.rotation;
       w.world_position = p.world_position + p.world_rotation * w.translation;
     }
+    visit(l, static_cast<const MechanismData::LinkWork&>(w));
   }
 }
 

@@ -153,19 +153,22 @@ struct MechanismData {
   Eigen::VectorXd loop_vector_work;        ///< n
 
   // ---- internal buffers (per link, in the joint-aligned frames L_i of model.hpp) ----
+  // Field order: what one pass touches sits together (the placement, relative and in O, then the
+  // motion and wrench of the Newton-Euler passes), so that a pass over a long chain that no longer
+  // fits in the cache loads as few cache lines per link as it can.
   struct LinkWork {
     Mat3 rotation;     ///< L_i relative to L_parent at the current q
     Vec3 translation;  ///< origin of L_i in L_parent
+    Mat3 world_rotation;   ///< L_i -> O
+    Vec3 world_position;   ///< origin of L_i in O
     Vec3 w, alpha, acc;    ///< angular velocity, angular acceleration, origin acceleration (in L_i)
     Vec3 vel;              ///< origin velocity (in L_i)
     Vec3 force, moment;    ///< wrench from the parent on link i (moment about L_i's origin)
-    Mat3 world_rotation;   ///< L_i -> O
-    Vec3 world_position;   ///< origin of L_i in O
     double composite_mass;
     Vec3 composite_first_moment;
     Mat3 composite_inertia;
   };
-  std::vector<LinkWork> work;
+  std::vector<LinkWork, detail::LargeBufferAllocator<LinkWork>> work;  ///< huge pages for big trees
   Eigen::MatrixXd link_regressor;           ///< dof x 10 scratch: one link's torque regressor
   Eigen::MatrixXd link_momentum_regressor;  ///< 6 x 10 scratch: one link's momentum regressor
 };

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "mechbal/detail/large_buffer.hpp"
 #include "mechbal/model/joint_type.hpp"
 #include "mechbal/model/rigid_body.hpp"
 
@@ -225,13 +226,15 @@ class MechanismModel {
 
   /// Precomputed per-link constants the algorithms use (joint-aligned frames, lumped inertia).
   /// Implementation detail made public for the algorithm files; see model.cpp.
+  // Field order: the per-tick passes read rotation .. inertia_origin; `aligned` (world quantities
+  // of links, rarely per tick) last, so that a pass over a long chain loads fewer cache lines.
   struct LinkConstants {
-    Mat3 aligned;          ///< A_i: F_i -> L_i rotation with A_i e_z = axis (identity when fixed)
     Mat3 rotation;         ///< L_i at q = 0 relative to L_parent
     Vec3 translation;      ///< origin of L_i in L_parent
     double mass;           ///< lumped mass of the link's bodies
     Vec3 first_moment;     ///< m c of the lumped bodies, in L_i
     Mat3 inertia_origin;   ///< lumped inertia about L_i's origin, in L_i
+    Mat3 aligned;          ///< A_i: F_i -> L_i rotation with A_i e_z = axis (identity when fixed)
   };
   const LinkConstants& link_constants(int link) const noexcept { return constants_[static_cast<std::size_t>(link)]; }
 
@@ -253,7 +256,7 @@ class MechanismModel {
   std::vector<int> body_link_;
   std::vector<Frame> frames_;
   std::vector<int> frame_link_;
-  std::vector<LinkConstants> constants_;
+  std::vector<LinkConstants, detail::LargeBufferAllocator<LinkConstants>> constants_;
   std::vector<Spring> springs_;
   std::vector<SpringConstants> spring_constants_;
   std::vector<LoopConstraint> loops_;

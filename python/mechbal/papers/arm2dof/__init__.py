@@ -28,7 +28,6 @@ Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
@@ -39,57 +38,13 @@ from mechbal.balance.rms import cubic_real_roots, squared_sum, stationarity_cubi
 
 from mechbal import _core
 from mechbal._deprecation import renamed_kwargs
-from mechbal.mechanism import BatchArray, Mechanism
+from mechbal.mechanism import Mechanism
+from mechbal.papers._closed_form import AccelerationBatch, TorqueBatch, closed_form_batch
 
 # the closed forms of the C++ core (cpp/src/papers/arm2dof/): fast paths of the general model
 Arm2DofParameters = _core.Arm2DofParameters
 Arm2DofCounterweights = _core.Arm2DofCounterweights
 pd_error_analytic = _core.pd_error_analytic
-
-
-class _LegacyKeys(BatchArray):
-    """A batch result that also answers the dict keys of earlier releases (``["tau"]`` or
-    ``["qdd"]``: the array itself; ``["status"]``: the OR of the statuses) for one release, with
-    a DeprecationWarning."""
-
-    _key: str = ""
-
-    def __getitem__(self, key: Any) -> Any:
-        if isinstance(key, str):
-            if key == self._key:
-                warnings.warn(f"result[{key!r}] is deprecated: the result is the array itself "
-                              "(its per-instant status in .status)", DeprecationWarning, stacklevel=2)
-                return np.asarray(self)
-            if key == "status":
-                warnings.warn("result['status'] is deprecated: use result.status (per instant)",
-                              DeprecationWarning, stacklevel=2)
-                return int(np.bitwise_or.reduce(np.atleast_1d(self.status)))
-            raise KeyError(key)
-        return super().__getitem__(key)
-
-
-class _TorqueBatch(_LegacyKeys):
-    _key = "tau"
-
-
-class _AccelerationBatch(_LegacyKeys):
-    _key = "qdd"
-
-
-def _closed_form_batch(where: str, call: Any, cls: type[_LegacyKeys], out_key: str,
-                       **arrays: npt.ArrayLike) -> npt.NDArray[np.float64]:
-    single = np.ndim(next(iter(arrays.values()))) == 1
-    rows = [np.atleast_2d(np.asarray(x, dtype=float)) for x in arrays.values()]
-    r = call(*rows)
-    values, status = np.asarray(r[out_key]), np.asarray(r["status_per_instant"]
-                                                        if "status_per_instant" in r else r["status"])
-    status = np.broadcast_to(status, values.shape[:1]).astype(np.uint32)
-    if single:
-        if status[0] != 0:
-            raise ValueError(f"{where}: input rejected (status {int(status[0])}); the arguments "
-                             "must be finite and give finite results")
-        return values[0]
-    return cls(values, status)
 
 
 class Arm2DofDynamics(_core.Arm2DofDynamics):
@@ -110,15 +65,15 @@ class Arm2DofDynamics(_core.Arm2DofDynamics):
     def inverse_dynamics(self, q: npt.ArrayLike, v: npt.ArrayLike,  # type: ignore[override]
                          a: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Joint torques tau [N m], (2,) or (N, 2)."""
-        return _closed_form_batch("Arm2DofDynamics.inverse_dynamics", super().inverse_dynamics,
-                                  _TorqueBatch, "tau", q=q, v=v, a=a)
+        return closed_form_batch("Arm2DofDynamics.inverse_dynamics", super().inverse_dynamics,
+                                 TorqueBatch, "tau", q=q, v=v, a=a)
 
     @renamed_kwargs(qd="v")
     def forward_dynamics(self, q: npt.ArrayLike, v: npt.ArrayLike,  # type: ignore[override]
                          tau: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Joint accelerations a [rad/s^2], (2,) or (N, 2)."""
-        return _closed_form_batch("Arm2DofDynamics.forward_dynamics", super().forward_dynamics,
-                                  _AccelerationBatch, "a", q=q, v=v, tau=tau)
+        return closed_form_batch("Arm2DofDynamics.forward_dynamics", super().forward_dynamics,
+                                 AccelerationBatch, "a", q=q, v=v, tau=tau)
 
 __all__ = ["Arm2DofParameters", "Arm2DofCounterweights", "Arm2DofDynamics", "pd_error_analytic",
            "arm2dof_mechanism", "arm_torques", "static_balancing_radii", "cw_coefficients",

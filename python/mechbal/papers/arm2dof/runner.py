@@ -201,7 +201,7 @@ def run(config, out: Path) -> dict:
     for k, (law, c) in runs.items():
         mech = arm2dof_mechanism(arm, c)
         scale = np.max(np.abs(tau[k]))
-        tk = control.KdlChainDynamics(mech.model).inverse_dynamics(*motion[law])["tau"]
+        tk = control.KdlChainDynamics(mech.model).inverse_dynamics(*motion[law]).joint_torque
         kdl_dev = max(kdl_dev, float(np.max(np.abs(tk - tau[k])) / scale))
         tg = mech.inverse_dynamics(*motion[law])
         general_dev = max(general_dev, float(np.max(np.abs(tg - tau[k])) / scale))

@@ -70,15 +70,16 @@ import numpy as np
 from mechbal import _core
 from mechbal._deprecation import renamed_kwargs
 from mechbal.papers.discs import coupling as cp
+from mechbal.papers.discs.five_bar_dynamics import FiveBarDynamics, FiveBarMotion, FiveBarTerms
 from mechbal.config import ConfigError, inertia
 from mechbal.mechanism import Mechanism
 from mechbal.schema import inertia_matrix, validate_case
 
 # the closed forms of the C++ core (cpp/src/papers/five_bar/): fast paths of the general model
+# (FiveBarDynamics: its typed Python face in five_bar_dynamics.py)
 FiveBarParameters = _core.FiveBarParameters
-FiveBarDynamics = _core.FiveBarDynamics
 
-__all__ = ["FiveBarParameters", "FiveBarDynamics", "parameters_from_config",
+__all__ = ["FiveBarParameters", "FiveBarDynamics", "FiveBarTerms", "FiveBarMotion", "parameters_from_config",
            "disc_arm_mechanism", "disc_design_mechanism", "SERIAL_ARMS", "BALANCE", "CORRECTIONS", "MECHANISMS",
            "design", "disc_mechanism", "evaluate", "metrics", "sensitivity", "fivebar_model", "fivebar_positions",
            "fivebar_dynamics", "is_parallelogram", "sample_states"]
@@ -431,14 +432,14 @@ def fivebar_model(d: dict, q, v) -> cp.CoupledModel:
     return cp.couple([s1, s2, sP], A, indep, -np.concatenate([b1, b2]), qd)
 
 
-def fivebar_dynamics(d: dict):
-    """The C++ per-tick evaluator (mechbal._core.FiveBarDynamics) of a five-bar design; in-plane
+def fivebar_dynamics(d: dict) -> FiveBarDynamics:
+    """The C++ per-tick evaluator (`FiveBarDynamics`) of a five-bar design; in-plane
     inertias are the x components of ``inertia_*`` (as in ``fivebar_model``)."""
     keys = ("a1", "a2", "b1", "b2", "d", "mp1", "mp2", "md1", "md2", "mP", "cp1", "cp2", "cd1", "cd2")
     fp = _core.FiveBarParameters(**{k: float(d[k]) for k in keys},
                                  **{f"J{k}": float(d[f"inertia_{k}"][0]) for k in ("p1", "p2", "d1", "d2")},
                                  gravity=G)
-    return _core.FiveBarDynamics(fp)
+    return FiveBarDynamics(fp)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -469,11 +470,11 @@ def evaluate(kind: str, d: dict, q: np.ndarray, v: np.ndarray):
     q, qd = np.asarray(q, float), np.asarray(qd, float)
     if kind == "fivebar":
         r = fivebar_dynamics(d).evaluate(q, qd)
-        if not np.all(r["ok"]):
-            bad = np.flatnonzero(~r["ok"])
+        if not np.all(r.ok):
+            bad = np.flatnonzero(~r.ok)
             raise ValueError(f"five-bar singular or not assembled at {len(bad)} states, first "
                              f"q = {q[bad[0]].tolist()}")
-        return r["mass"], r["velocity"], r["gravity"]
+        return r.mass_matrix, r.coriolis_torque, r.gravity_torque
     mech = disc_mechanism(kind, d)
     M, g = mech.mass_matrix(q), mech.gravity_torque(q)
     return M, mech.bias_torque(q, qd) - g, g

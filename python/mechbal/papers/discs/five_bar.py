@@ -21,8 +21,10 @@ y-z plane, every joint axis along x, z up, gravity (0, 0, -g). Leg i is a 2R arm
 The five-bar has no counter-rotating discs: its balancing is leg-wise static balancing (the
 balanced centres of mass of ``mechbal.papers.discs.balance_fivebar``).
 
-The closed form (``FiveBarDynamics``: positions, the coupling projection, M', v', g', the passive
-motion) equals this general model to 1e-10 along the case's trajectory
+The closed form (`FiveBarDynamics`, the C++ per-tick evaluator with typed results, in
+`mechbal.papers.discs.five_bar_dynamics`: its torques as an array like
+`mechbal.Mechanism.inverse_dynamics`, `FiveBarTerms` M', v', g' and `FiveBarMotion`, the
+passive motion from the coupling projection) equals this general model to 1e-10 along the case's trajectory
 (tests/python/test_papers_loops.py); the ``discs`` runner writes the five-bar's bodies files and
 shaking wrench from this model, its loop solved along the trajectory; ``python/mechbal/papers/discs/cases/five-bar-linkage.toml`` is
 `five_bar_case_toml` of the shipped ``five-bar`` case (balanced), run by ``mechbal run``.
@@ -38,9 +40,11 @@ import numpy as np
 
 from mechbal import _core
 from mechbal.mechanism import Mechanism
+from mechbal.papers.discs.five_bar_dynamics import FiveBarDynamics, FiveBarMotion, FiveBarTerms
 
-__all__ = ["five_bar_mechanism", "five_bar_design_mechanism", "five_bar_initial_guess",
-           "five_bar_case_toml"]
+__all__ = ["FiveBarDynamics", "FiveBarTerms", "FiveBarMotion", "five_bar_mechanism",
+           "five_bar_design_mechanism", "five_bar_initial_guess", "five_bar_case_toml"]
+
 
 _EX = np.array([1.0, 0.0, 0.0])
 #: a frame whose z axis is the link frame's x (the joint axis): columns (y, z, x)
