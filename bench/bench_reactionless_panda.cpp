@@ -4,13 +4,18 @@
 //    velocity rows of its twist), and the null space of the task (8 coordinates: 7 arm joints and
 //    the finger, whose twin follows it by <mimic>) minimises the angular momentum about O (3 rows):
 //    frame Jacobian, momentum matrix, J^+ and N = I - J^+ J, the damped least squares in the null
-//    space, rate limits, Euler or RK4 (three more rate evaluations).
+//    space, rate limits; the acceleration feed-forward (J'v and W(q, v, 0) = (dA/dt) v from a
+//    forward pass with the rates, a = J^+ (x'' - J'v) + N w with the rates' factorisations) and the
+//    predicted shaking wrench; Euler or RK4 (three more rate evaluations).
 //  - reactionless_panda_{euler,rk4}_pinocchio: the same tick over Pinocchio: computeFrameJacobian
 //    (LOCAL_WORLD_ALIGNED: [v; w] of the frame's origin, world axes) and computeCentroidalMap (A_G,
 //    moved to O: A_O = [A_lin; A_ang + c x A_lin]), both times the mimic map G (Pinocchio models the
-//    second finger as its own joint: 9 velocities), then the very same linear algebra as mechbal's
-//    controller (eigenvalues of the 3 x 3 Gram matrices for the conditioning, LLT solves).
-// Setup checks that both controllers give the same rates and positions (1e-9) over 300 ticks. The
+//    second finger as its own joint: 9 velocities); the feed-forward from one
+//    computeCentroidalMomentumTimeVariation(q, v, 0) (its forwardKinematics(q, v, 0) also gives
+//    getFrameClassicalAcceleration, J'v; dh_G/dt moved to O), then the very same linear algebra as
+//    mechbal's controller (eigenvalues of the 3 x 3 Gram matrices for the conditioning, LLT solves).
+// Setup checks that both controllers give the same rates, positions, momenta, accelerations and
+// predicted shaking wrenches (1e-9) over 300 ticks. The
 // Pinocchio half lives in bench_urdf_pinocchio.cpp (one translation unit of Pinocchio's templates
 // fewer to compile).
 #include <cmath>

@@ -138,11 +138,24 @@ namespace {
   std::abort();
 }
 
-/// ReactionlessTaskController's tick (control/reactionless.cpp) over Pinocchio's kinematics.
+/// ReactionlessTaskController's tick (control/reactionless.cpp) over Pinocchio's kinematics: the
+/// rates (J^+, N, S A N, their factorisations) and the acceleration feed-forward (J'v and
+/// W(q, v, 0) = (dA/dt) v from one computeCentroidalMomentumTimeVariation at a = 0, then the
+/// same two solves with the rates' factorisations), Euler or RK4 (three more rate evaluations).
 struct PinocchioTaskController {
   using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
   using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
   static constexpr double huge = std::numeric_limits<double>::max();
+
+  /// mechbal's MinNorm with the path this case takes (every row independent: Cholesky of M M^T,
+  /// damped when cond(M) > max_condition)
+  struct MinNorm {
+    bool zero = true;
+    Small gram, inverse;
+    SmallVector y, rhs;
+    Eigen::SelfAdjointEigenSolver<Small> eig;
+    Eigen::LLT<Small> llt;
+  };
 
   PinocchioTaskController(const MechanismModel& m, const TaskSpaceConfig& c, const Eigen::VectorXd& q0)
       : pin(to_pinocchio(m)), data(pin.model), config(c) {
@@ -155,9 +168,12 @@ struct PinocchioTaskController {
       if (c.cancel & (1u << r)) rows.push_back(r);
     }
     const auto nt = static_cast<Eigen::Index>(task_rows.size()), nk = static_cast<Eigen::Index>(rows.size());
-    for (Eigen::VectorXd* v : {&q, &q_cmd, &v_cmd, &k1, &k2, &k3, &k4, &q_stage, &v0, &z, &w})
+    if (nt > n || nk > n - nt) fail("reactionless Panda over Pinocchio: rows beyond the ranks (not this case)", 0);
+    for (Eigen::VectorXd* v : {&q, &q_cmd, &v_cmd, &a_cmd, &a0, &k1, &k2, &k3, &k4, &q_stage, &v0, &z, &w})
       *v = Eigen::VectorXd::Zero(n);
     q_pin = Eigen::VectorXd::Zero(pin.model.nq);
+    v_pin = Eigen::VectorXd::Zero(pin.model.nv);
+    zero_pin = Eigen::VectorXd::Zero(pin.model.nv);
     J6 = pinocchio::Data::Matrix6x::Zero(6, pin.model.nv);
     JG = Eigen::MatrixXd::Zero(6, n);
     AO = Eigen::MatrixXd::Zero(6, n);
@@ -169,38 +185,61 @@ struct PinocchioTaskController {
     M = Eigen::MatrixXd::Zero(nk, n);
     rt = Eigen::VectorXd::Zero(nt);
     rm = Eigen::VectorXd::Zero(nk);
-    gram = Small::Identity(6, 6);
-    eig.compute(gram, Eigen::EigenvaluesOnly);
-    llt.compute(gram);
-    y = SmallVector::Zero(6);
+    for (MinNorm* f : {&task, &null}) {
+      f->gram = Small::Identity(6, 6);
+      f->inverse = Small::Identity(6, 6);
+      f->eig.compute(f->gram, Eigen::EigenvaluesOnly);
+      f->llt.compute(f->gram);
+      f->y = f->rhs = SmallVector::Zero(6);
+    }
     rate_limit = m.velocity_limits().cwiseMin(c.max_rate);
     q = q0;
     q_cmd = q0;
     target.setZero();  // at rest
   }
 
-  Status min_norm(const Eigen::MatrixXd& Mat, const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::VectorXd& x) {
+  Status factorise(MinNorm& f, const Eigen::MatrixXd& Mat) const {
     const Eigen::Index rows_n = Mat.rows();
-    gram.resize(rows_n, rows_n);
-    gram.noalias() = Mat * Mat.transpose();
-    eig.compute(gram, Eigen::EigenvaluesOnly);
-    const double lmax = eig.eigenvalues()(rows_n - 1), lmin = eig.eigenvalues()(0);
+    f.gram.resize(rows_n, rows_n);
+    f.gram.noalias() = Mat * Mat.transpose();
+    f.zero = true;
+    if (!f.gram.allFinite()) return Status::out_of_range;
+    f.eig.compute(f.gram, Eigen::EigenvaluesOnly);
+    const double lmax = f.eig.eigenvalues()(rows_n - 1), lmin = f.eig.eigenvalues()(0);
+    if (!(lmax > 0.0)) return Status::singular;
     Status st = Status::ok;
-    if (!(lmax > 0.0)) {
-      x.setZero();
-      return Status::singular;
-    }
     const double cond = lmin > 0.0 ? std::sqrt(lmax / lmin) : huge;
     if (cond > config.max_condition) {
-      gram.diagonal().array() += config.damping * config.damping * lmax;
+      f.gram.diagonal().array() += config.damping * config.damping * lmax;
       st = Status::singular;
     }
-    llt.compute(gram);
-    SmallVector rr(rows_n);
-    for (Eigen::Index i = 0; i < rows_n; ++i) rr(i) = r(i);
-    y = llt.solve(rr);
-    x.noalias() = Mat.transpose() * y;
+    f.llt.compute(f.gram);
+    f.zero = false;
     return st;
+  }
+
+  static void solve(MinNorm& f, const Eigen::MatrixXd& Mat, const Eigen::Ref<const Eigen::VectorXd>& r,
+                    Eigen::VectorXd& x) {
+    if (f.zero) {
+      x.setZero();
+      return;
+    }
+    const Eigen::Index rows_n = Mat.rows();
+    f.rhs.resize(rows_n);
+    for (Eigen::Index i = 0; i < rows_n; ++i) f.rhs(i) = r(i);
+    f.y = f.llt.solve(f.rhs);
+    x.noalias() = Mat.transpose() * f.y;
+  }
+
+  static void gram_inverse(MinNorm& f) {
+    const Eigen::Index rows_n = f.gram.rows();
+    f.inverse.resize(rows_n, rows_n);
+    if (f.zero) {
+      f.inverse.setZero();
+    } else {
+      f.inverse.setIdentity();
+      f.llt.solveInPlace(f.inverse);
+    }
   }
 
   Status rates(const Eigen::VectorXd& qc, const Vec6& twist, Eigen::VectorXd& v) {
@@ -208,28 +247,30 @@ struct PinocchioTaskController {
     q_pin += pin.offset;
     pinocchio::computeFrameJacobian(pin.model, data, q_pin, frame, pinocchio::LOCAL_WORLD_ALIGNED, J6);
     JG.noalias() = J6 * pin.G;
-    for (std::size_t i = 0; i < task_rows.size(); ++i) {
-      J.row(static_cast<Eigen::Index>(i)) = JG.row(task_rows[i]);
-      rt(static_cast<Eigen::Index>(i)) = twist(task_rows[i]);
-    }
-    Status st = min_norm(J, rt, v0);
-    const Eigen::Index nt = J.rows();
-    const Small G_inv = llt.solve(Small(Small::Identity(nt, nt)));
-    Jt.leftCols(nt).noalias() = J.transpose() * G_inv;
-    JpJ.noalias() = Jt.leftCols(nt) * J;
-    N = -JpJ;
-    N.diagonal().array() += 1.0;
     pinocchio::computeCentroidalMap(pin.model, data, q_pin);
     A6 = data.Ag;  // about the centre of mass; about O: H_O = H_G + c x P
     const Vec3 c = data.com[0];
     for (Eigen::Index j = 0; j < A6.cols(); ++j) A6.col(j).tail<3>() += c.cross(Vec3(A6.col(j).head<3>()));
     AO.noalias() = A6 * pin.G;
+    for (std::size_t i = 0; i < task_rows.size(); ++i) {
+      J.row(static_cast<Eigen::Index>(i)) = JG.row(task_rows[i]);
+      rt(static_cast<Eigen::Index>(i)) = twist(task_rows[i]);
+    }
+    Status st = factorise(task, J);
+    solve(task, J, rt, v0);
+    const Eigen::Index nt = J.rows();
+    gram_inverse(task);
+    Jt.leftCols(nt).noalias() = J.transpose() * task.inverse;
+    JpJ.noalias() = Jt.leftCols(nt) * J;
+    N = -JpJ;
+    N.diagonal().array() += 1.0;
     for (std::size_t i = 0; i < rows.size(); ++i) {
       const auto r = static_cast<Eigen::Index>(i);
       M.row(r).noalias() = AO.row(rows[i]) * N;
       rm(r) = target(rows[i]) - AO.row(rows[i]).dot(v0);
     }
-    st |= min_norm(M, rm, z);
+    st |= factorise(null, M);
+    solve(null, M, rm, z);
     v = v0;
     v.noalias() += N * z;
     double peak = 0.0;
@@ -241,10 +282,47 @@ struct PinocchioTaskController {
     return st;
   }
 
+  /// the feed-forward at q (right after rates(q, ...)): J'v and W(q, v, 0) from one forward pass
+  /// with the rates at a = 0 (computeCentroidalMomentumTimeVariation runs forwardKinematics(q, v,
+  /// 0), which getFrameClassicalAcceleration reads), then a = J^+ (x'' - J'v) + N w
+  void acceleration(const Eigen::VectorXd& v, const Vec6& twist_rate, bool saturated) {
+    v_pin.noalias() = pin.G * v;
+    pinocchio::computeCentroidalMomentumTimeVariation(pin.model, data, q_pin, v_pin, zero_pin);
+    const pinocchio::Motion acc =
+        pinocchio::getFrameClassicalAcceleration(pin.model, data, frame, pinocchio::LOCAL_WORLD_ALIGNED);
+    Vec6 bias;
+    bias << acc.linear(), acc.angular();
+    Vec6 W;  // dh_G/dt moved to O: dH_O/dt = dH_G/dt + c x dP/dt
+    W.head<3>() = data.dhg.linear();
+    W.tail<3>() = data.dhg.angular() + data.com[0].cross(data.dhg.linear());
+    const Eigen::Index nt = J.rows();
+    for (Eigen::Index i = 0; i < nt; ++i) {
+      const int row = task_rows[static_cast<std::size_t>(i)];
+      rt(i) = twist_rate(row) - bias(row);
+    }
+    a0.noalias() = Jt.leftCols(nt) * rt;
+    a_cmd = a0;
+    if (saturated) {
+      a_cmd.setZero();
+    } else {
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        rm(static_cast<Eigen::Index>(i)) = -W(rows[i]) - AO.row(rows[i]).dot(a0);
+      solve(null, M, rm, z);
+      a_cmd.noalias() += N * z;
+    }
+    Vec6 predicted;
+    predicted.noalias() = AO * a_cmd;
+    predicted += W;
+    force = predicted.head<3>();
+    moment = predicted.tail<3>();
+  }
+
   Status step(const Vec6& twist, const Vec6& twist_half, const Vec6& twist_next) {
+    const Vec6 twist_rate = (-3.0 * twist + 4.0 * twist_half - twist_next) / dt;  // as mechbal's step
     Status st = rates(q, twist, k1);
     h.noalias() = AO * k1;
     twist_cmd.noalias() = JG * k1;
+    acceleration(k1, twist_rate, has(st, Status::saturated));
     if (rk4) {
       w = q + (0.5 * dt) * k1;
       st |= rates(w, twist_half, k2);
@@ -270,15 +348,13 @@ struct PinocchioTaskController {
   bool rk4 = false;
   pinocchio::FrameIndex frame = 0;
   std::vector<int> task_rows, rows;
-  Eigen::VectorXd q, q_cmd, v_cmd, k1, k2, k3, k4, q_stage, v0, z, w, rate_limit, q_pin;
+  Eigen::VectorXd q, q_cmd, v_cmd, a_cmd, a0, k1, k2, k3, k4, q_stage, v0, z, w, rate_limit, q_pin, v_pin, zero_pin;
   pinocchio::Data::Matrix6x J6;
   Eigen::MatrixXd JG, AO, A6, J, Jt, JpJ, N, M;
   Eigen::VectorXd rt, rm;
-  Small gram;
-  SmallVector y;
-  Eigen::SelfAdjointEigenSolver<Small> eig;
-  Eigen::LLT<Small> llt;
+  MinNorm task, null;
   Vec6 target, h = Vec6::Zero(), twist_cmd = Vec6::Zero();
+  Vec3 force = Vec3::Zero(), moment = Vec3::Zero();
 };
 
 struct PinCase {
@@ -299,7 +375,10 @@ Tick panda_reactionless_case(ReactionlessIntegrator integrator) {
     s->ctrl->step(s->x.now[k], s->x.half[k], s->x.next[k]);
     const double err = std::max({(ref->v() - s->ctrl->v_cmd).cwiseAbs().maxCoeff(),
                                  (ref->next() - s->ctrl->q).cwiseAbs().maxCoeff(),
-                                 (ref->momentum() - s->ctrl->h).cwiseAbs().maxCoeff()});
+                                 (ref->momentum() - s->ctrl->h).cwiseAbs().maxCoeff(),
+                                 (ref->a() - s->ctrl->a_cmd).cwiseAbs().maxCoeff() / std::max(1.0, ref->a().cwiseAbs().maxCoeff()),
+                                 (ref->shaking_force() - s->ctrl->force).cwiseAbs().maxCoeff(),
+                                 (ref->shaking_moment() - s->ctrl->moment).cwiseAbs().maxCoeff()});
     if (!(err < 1e-9)) fail("reactionless Panda over Pinocchio != mechbal's controller", err);
   }
   s->k = 300;

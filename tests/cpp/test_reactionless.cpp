@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -504,4 +505,99 @@ TEST(Reactionless, OperationalSpaceKeepsToolPathAndMomentum) {
     EXPECT_EQ(ctrl.v().norm(), 0.0);
     EXPECT_EQ(scope.count(), 0u);
   }
+}
+
+// Operational-space mode with more cancelled components than the task's null space has
+// dimensions: a spatial 4R arm tracks its tool's linear velocity (3 rows: a 1-dimensional null
+// space) and cancels the whole moment (3 components). S A N has rank 1 by construction, which is
+// no singularity: every tick is ok (not Status::singular) and the rates are the exact
+// least-squares, minimum-norm ones over the null space, checked against an independent SVD (null
+// basis Z of J, u = (S A Z)^+ (h* - S A v0), v = J^+ x' + Z u) and by the optimality of the
+// momentum residual and of the predicted shaking moment within the null space; allocation-free.
+// With as many task rows as joints (no null space) the rates are J^-1 x', also ok.
+TEST(Reactionless, OperationalSpaceMoreCancelledRowsThanNullSpace) {
+  MechanismDescription d;
+  d.joints.push_back(revolute("j1", "base", at(0.0, 0.0, 0.1), Vec3::UnitZ()));
+  d.joints.push_back(revolute("j2", "j1", at(0.0, 0.0, 0.3), Vec3::UnitY()));
+  d.joints.push_back(revolute("j3", "j2", at(0.4), Vec3::UnitY()));
+  d.joints.push_back(revolute("j4", "j3", at(0.35), Vec3::UnitX()));
+  Mat3 I4 = diag(0.004, 0.006, 0.007);
+  I4(0, 1) = I4(1, 0) = 0.001;
+  d.bodies.push_back(Body{"b1", "link", "j1", 2.0, Vec3(0.0, 0.02, 0.1), diag(0.02, 0.02, 0.01)});
+  d.bodies.push_back(Body{"b2", "link", "j2", 1.5, Vec3(0.2, 0.0, 0.01), diag(0.004, 0.02, 0.02)});
+  d.bodies.push_back(Body{"b3", "link", "j3", 1.0, Vec3(0.17, 0.01, 0.0), diag(0.003, 0.012, 0.012)});
+  d.bodies.push_back(Body{"b4", "link", "j4", 0.6, Vec3(0.03, 0.02, 0.015), I4});
+  d.frames.push_back(Frame{"tool", "j4", at(0.08)});
+  const auto model = std::make_shared<const MechanismModel>(d);
+  const Eigen::Vector4d q0(0.3, -0.6, 1.1, 0.4);
+  const auto twist_at = [](double t) {
+    Vec6 x = Vec6::Zero();
+    x(0) = -0.05 * std::sin(t);
+    x(1) = 0.05 * std::cos(t);
+    x(2) = 0.02 * std::cos(2.0 * t);
+    return x;
+  };
+  MechanismData check(*model);
+  for (auto integrator : {ReactionlessIntegrator::euler, ReactionlessIntegrator::rk4}) {
+    TaskSpaceConfig c;
+    c.frame = "tool";
+    c.task_rows = cancel_force;  // v_x, v_y, v_z of the tool
+    c.cancel = cancel_moment;    // 3 components, 1 null-space dimension
+    c.integrator = integrator;
+    c.max_rate = 1e3;
+    ReactionlessTaskController ctrl(model, c, q0);
+    double twist_err = 0.0, rate_err = 0.0, gradient = 0.0, moment_gradient = 0.0;
+    Status all = Status::ok;
+    for (int n = 0; n < 400; ++n) {
+      const double t = n * 1e-3;
+      const Eigen::VectorXd q = ctrl.next();  // this tick's positions
+      all |= ctrl.step(twist_at(t), twist_at(t + 5e-4), twist_at(t + 1e-3));
+      ASSERT_EQ((ctrl.q() - q).norm(), 0.0);
+      twist_err = std::max(twist_err, (ctrl.frame_twist().head<3>() - twist_at(t).head<3>()).cwiseAbs().maxCoeff());
+      // the independent solution at q
+      ASSERT_EQ(frame_jacobian(*model, check, q, 0), Status::ok);
+      const Eigen::MatrixXd J = check.frame_jacobian.topRows<3>();
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      ASSERT_EQ(svd.rank(), 3);
+      const Eigen::VectorXd v0 = svd.solve(Eigen::Vector3d(twist_at(t).head<3>()));
+      const Eigen::MatrixXd Z = svd.matrixV().rightCols(1);
+      ASSERT_EQ(momentum_matrix(*model, check, q), Status::ok);
+      const Eigen::MatrixXd SA = check.momentum_matrix.bottomRows<3>();
+      const Eigen::MatrixXd SAZ = SA * Z;
+      const Eigen::VectorXd u =
+          SAZ.jacobiSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(Eigen::VectorXd(ctrl.target().tail<3>() - SA * v0));
+      const Eigen::VectorXd v_ref = v0 + Z * u;
+      rate_err = std::max(rate_err, (ctrl.v() - v_ref).cwiseAbs().maxCoeff() / std::max(1.0, v_ref.cwiseAbs().maxCoeff()));
+      // least squares within the null space: Z^T (S A)^T (S A v - h*) = 0, and likewise for the
+      // predicted shaking moment S (A a + W) (the feed-forward's residual)
+      const Eigen::VectorXd residual = SA * ctrl.v() - ctrl.target().tail<3>();
+      gradient = std::max(gradient, std::abs((SAZ.transpose() * residual)(0)) / (SAZ.norm() * std::max(1e-3, residual.norm())));
+      const Eigen::VectorXd moment = ctrl.shaking_moment();
+      moment_gradient = std::max(moment_gradient,
+                                 std::abs((SAZ.transpose() * moment)(0)) / (SAZ.norm() * std::max(1e-3, moment.norm())));
+    }
+    EXPECT_EQ(all, Status::ok);  // rank 1 by construction: not singular
+    EXPECT_LT(twist_err, 1e-12);
+    EXPECT_LT(rate_err, 1e-9);
+    EXPECT_LT(gradient, 1e-9);
+    EXPECT_LT(moment_gradient, 1e-9);
+    test::AllocationScope scope;
+    for (int n = 0; n < 10; ++n) ctrl.step(twist_at(1.0), twist_at(1.0), twist_at(1.0));
+    EXPECT_EQ(scope.count(), 0u);
+  }
+  // no null space: as many tracked rows as joints (the linear velocity and w_x)
+  TaskSpaceConfig c;
+  c.frame = "tool";
+  c.task_rows = cancel_force | moment_x;
+  c.cancel = cancel_moment;
+  c.max_rate = 1e3;
+  ReactionlessTaskController ctrl(model, c, q0);
+  Vec6 x = twist_at(0.3);
+  x(3) = 0.03;
+  EXPECT_EQ(ctrl.step(x, x, x), Status::ok);
+  ASSERT_EQ(frame_jacobian(*model, check, q0, 0), Status::ok);
+  Eigen::Matrix4d J;
+  J << check.frame_jacobian.topRows<4>();
+  const Eigen::Vector4d v_ref = J.partialPivLu().solve(Eigen::Vector4d(x.head<4>()));
+  EXPECT_LT((ctrl.v() - v_ref).cwiseAbs().maxCoeff(), 1e-10 * std::max(1.0, v_ref.cwiseAbs().maxCoeff()));
 }

@@ -11,6 +11,7 @@
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/detail/placed.hpp"
+#include "mechbal/detail/tree.hpp"
 
 namespace mechbal {
 
@@ -756,10 +757,16 @@ ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const Mec
   M_ = Eigen::MatrixXd::Zero(k, n_);
   rt_ = Eigen::VectorXd::Zero(nt);
   rm_ = Eigen::VectorXd::Zero(k);
-  gram_ = Small::Identity(6, 6);
-  eig_.compute(gram_, Eigen::EigenvaluesOnly);
-  llt_.compute(gram_);
-  y_ = SmallVector::Zero(6);
+  // J has at most min(nt, n) independent rows; S A N at most the null space's dimension
+  rank_J_ = std::min(nt, n_);
+  rank_M_ = std::min<Eigen::Index>(k, n_ - rank_J_);
+  for (MinNorm* f : {&task_, &null_}) {
+    f->gram = Small::Identity(6, 6);
+    f->inverse = Small::Identity(6, 6);
+    f->eig.compute(f->gram);
+    f->llt.compute(f->gram);
+    for (SmallVector* v : {&f->y, &f->rhs, &f->scale, &f->projected}) *v = SmallVector::Zero(6);
+  }
   q_ = q0;
   q_cmd_ = q0;
   const Eigen::VectorXd v_start = v0.size() ? v0 : Eigen::VectorXd(Eigen::VectorXd::Zero(n_));
@@ -767,51 +774,105 @@ ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const Mec
   target_ << data_.shaking.linear_momentum, data_.shaking.angular_momentum;
 }
 
-Status ReactionlessTaskController::min_norm(const Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::VectorXd>& r,
-                                            Eigen::VectorXd& x) noexcept {
+Status ReactionlessTaskController::factorise(MinNorm& f, const Eigen::MatrixXd& M, Eigen::Index rank) const noexcept {
   const Eigen::Index rows = M.rows();
-  gram_.resize(rows, rows);
-  gram_.noalias() = M * M.transpose();
-  if (!gram_.allFinite()) {
-    x.setZero();
-    return Status::out_of_range;
+  f.gram.resize(rows, rows);
+  f.gram.noalias() = M * M.transpose();
+  f.kind = MinNorm::Kind::zero;
+  if (!f.gram.allFinite()) return Status::out_of_range;
+  rank = std::min(rank, rows);
+  if (rank == 0) return Status::ok;  // nothing can move these rows (an empty null space): x = 0
+  if (rank == rows) {
+    f.eig.compute(f.gram, Eigen::EigenvaluesOnly);
+    const double lmax = f.eig.eigenvalues()(rows - 1), lmin = f.eig.eigenvalues()(0);
+    if (!(lmax > 0.0)) return Status::singular;
+    Status st = Status::ok;
+    const double cond = lmin > 0.0 ? std::sqrt(lmax / lmin) : huge;
+    if (cond > config_.max_condition) {
+      f.gram.diagonal().array() += config_.damping * config_.damping * lmax;
+      st = Status::singular;
+    }
+    f.llt.compute(f.gram);
+    f.kind = MinNorm::Kind::cholesky;
+    return st;
   }
-  eig_.compute(gram_, Eigen::EigenvaluesOnly);
-  const double lmax = eig_.eigenvalues()(rows - 1), lmin = eig_.eigenvalues()(0);
+  // more rows than M's rank can be: M M^T has rows - rank zero eigenvalues by construction (no
+  // singularity); the least-squares, minimum-norm solution M^T (M M^T)^+ r over the others, whose
+  // condition decides the damping as above
+  f.eig.compute(f.gram, Eigen::ComputeEigenvectors);
+  const auto& lambda = f.eig.eigenvalues();  // ascending
+  const double lmax = lambda(rows - 1), lmin = lambda(rows - rank);
+  if (!(lmax > 0.0)) return Status::singular;
   Status st = Status::ok;
-  if (!(lmax > 0.0)) {
-    x.setZero();
-    return Status::singular;
-  }
-  const double cond = lmin > 0.0 ? std::sqrt(lmax / lmin) : huge;
-  if (cond > config_.max_condition) {
-    gram_.diagonal().array() += config_.damping * config_.damping * lmax;
+  double damping = 0.0;
+  if (!(lmin > 0.0 && std::sqrt(lmax / lmin) <= config_.max_condition)) {
+    damping = config_.damping * config_.damping * lmax;
     st = Status::singular;
   }
-  llt_.compute(gram_);
-  SmallVector rr(rows);
-  for (Eigen::Index i = 0; i < rows; ++i) rr(i) = r(i);
-  y_ = llt_.solve(rr);
-  x.noalias() = M.transpose() * y_;
+  f.scale.resize(rows);
+  for (Eigen::Index i = 0; i < rows; ++i) f.scale(i) = i >= rows - rank ? 1.0 / (lambda(i) + damping) : 0.0;
+  f.kind = MinNorm::Kind::eigen;
   return st;
+}
+
+void ReactionlessTaskController::solve(MinNorm& f, const Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::VectorXd>& r,
+                                       Eigen::VectorXd& x) noexcept {
+  const Eigen::Index rows = M.rows();
+  if (f.kind == MinNorm::Kind::zero) {
+    x.setZero();
+    return;
+  }
+  f.rhs.resize(rows);
+  for (Eigen::Index i = 0; i < rows; ++i) f.rhs(i) = r(i);
+  if (f.kind == MinNorm::Kind::cholesky) {
+    f.y = f.llt.solve(f.rhs);
+  } else {
+    const Small& V = f.eig.eigenvectors();
+    f.projected.noalias() = V.transpose() * f.rhs;
+    f.projected.array() *= f.scale.array();
+    f.y.noalias() = V * f.projected;
+  }
+  x.noalias() = M.transpose() * f.y;
+}
+
+void ReactionlessTaskController::gram_inverse(MinNorm& f) noexcept {
+  const Eigen::Index rows = f.gram.rows();
+  f.inverse.resize(rows, rows);
+  if (f.kind == MinNorm::Kind::zero) {
+    f.inverse.setZero();
+  } else if (f.kind == MinNorm::Kind::cholesky) {
+    f.inverse.setIdentity();
+    f.llt.solveInPlace(f.inverse);
+  } else {
+    const Small& V = f.eig.eigenvectors();
+    f.inverse.noalias() = V * f.scale.asDiagonal() * V.transpose();
+  }
 }
 
 Status ReactionlessTaskController::rates(const Eigen::VectorXd& q, const Vec6& twist, Eigen::VectorXd& v) noexcept {
   const MechanismModel& m = *model_;
-  if (frame_jacobian(m, data_, q, frame_) != Status::ok) return Status::out_of_range;
+  // one placement of the links at q for the frame Jacobian and the momentum matrix
+  const Eigen::Ref<const Eigen::VectorXd> qr(q);
+  if (detail::check_state(m, data_, &qr) != Status::ok) return Status::out_of_range;
+  detail::joint_state<false, false>(m, data_, qr, qr, qr);
+  detail::place(m, data_);
+  detail::frame_jacobian_placed(m, data_, frame_, data_.frame_jacobian);
+  if (!data_.frame_jacobian.allFinite()) return Status::out_of_range;
+  if (detail::momentum_matrix_placed(m, data_) != Status::ok) return Status::out_of_range;
   for (std::size_t i = 0; i < task_rows_.size(); ++i) {
     J_.row(static_cast<Eigen::Index>(i)) = data_.frame_jacobian.row(task_rows_[i]);
     rt_(static_cast<Eigen::Index>(i)) = twist(task_rows_[i]);
   }
-  Status st = min_norm(J_, rt_, v0_);  // v0 = J^+ x'
-  // N = I - J^+ J, J^+ J = J^T (J J^T + lambda^2)^-1 J: columns of J^+ from the same factorisation
+  Status st = factorise(task_, J_, rank_J_);
+  if (has(st, Status::out_of_range)) return st;
+  solve(task_, J_, rt_, v0_);  // v0 = J^+ x'
+  // N = I - J^+ J, J^+ = J^T (J J^T)^+ (damped as v0's): columns of J^+ from the same factorisation
   const Eigen::Index nt = J_.rows();
-  const Small G_inv = llt_.solve(Small(Small::Identity(nt, nt)));
-  Jt_.leftCols(nt).noalias() = J_.transpose() * G_inv;  // J^+ = J^T (J J^T + lambda^2)^-1
+  gram_inverse(task_);
+  Jt_.leftCols(nt).noalias() = J_.transpose() * task_.inverse;
   JpJ_.noalias() = Jt_.leftCols(nt) * J_;
   N_ = -JpJ_;
   N_.diagonal().array() += 1.0;
-  if (momentum_matrix(m, data_, q) != Status::ok) return Status::out_of_range;
   v = v0_;
   if (config_.null_space) {
     for (std::size_t i = 0; i < rows_.size(); ++i) {
@@ -819,7 +880,10 @@ Status ReactionlessTaskController::rates(const Eigen::VectorXd& q, const Vec6& t
       M_.row(r).noalias() = data_.momentum_matrix.row(rows_[i]) * N_;
       rm_(r) = target_(rows_[i]) - data_.momentum_matrix.row(rows_[i]).dot(v0_);
     }
-    st |= min_norm(M_, rm_, z_);
+    const Status sm = factorise(null_, M_, rank_M_);
+    if (has(sm, Status::out_of_range)) return st | sm;
+    st |= sm;
+    solve(null_, M_, rm_, z_);
     v.noalias() += N_ * z_;
   }
   if (!v.allFinite()) {
@@ -837,17 +901,13 @@ Status ReactionlessTaskController::rates(const Eigen::VectorXd& q, const Vec6& t
 
 Status ReactionlessTaskController::acceleration(const Eigen::VectorXd& v, const Vec6& twist_rate, bool saturated) noexcept {
   const MechanismModel& m = *model_;
-  // J'v: the frame's acceleration with zero joint accelerations
-  if (forward_kinematics(m, data_, q_, v, zero_) != Status::ok) return Status::out_of_range;
-  const auto link = static_cast<std::size_t>(m.frame_link(frame_));
-  const Vec3 r = data_.frame_placements[static_cast<std::size_t>(frame_)].translation() - data_.link_position[link];
-  const Vec3& w = data_.link_angular_velocity[link];
-  const Vec3& alpha = data_.link_angular_acceleration[link];
+  // the links are placed at q_ (rates(q_, ...) just ran): one forward pass with the rates gives
+  // W(q, v, 0) = (dA/dt) v, the shaking wrench of the rates alone, and J'v, the frame's
+  // acceleration with zero joint accelerations
+  if (detail::shaking_wrench_placed(m, data_, q_, v, zero_) != Status::ok) return Status::out_of_range;
+  const detail::FrameMotion frame = detail::frame_motion(m, data_, frame_);
   Vec6 bias;
-  bias.head<3>() = data_.link_acceleration[link] + alpha.cross(r) + w.cross(w.cross(r));
-  bias.tail<3>() = alpha;
-  // W(q, v, 0) = (dA/dt) v: the shaking wrench of the rates alone
-  if (shaking_wrench(m, data_, q_, v, zero_) != Status::ok) return Status::out_of_range;
+  bias << frame.acceleration, frame.angular_acceleration;
   Vec6 W;
   W << data_.shaking.force, data_.shaking.moment;
   const Eigen::Index nt = J_.rows();
@@ -857,14 +917,14 @@ Status ReactionlessTaskController::acceleration(const Eigen::VectorXd& v, const 
   }
   a0_.noalias() = Jt_.leftCols(nt) * rt_;  // J^+ (x'' - J'v), J^+ of the rates at q_
   a_cmd_ = a0_;
-  Status st = Status::ok;
   if (saturated) {
     a_cmd_.setZero();  // the scaled rates no longer follow the law: no feed-forward
   } else if (config_.null_space) {
-    // S A N w = S dh*/dt - S W(q, v, 0) - S A a0 (a constant target: dh*/dt = 0); M_ = S A N at q_
+    // S A N w = S dh*/dt - S W(q, v, 0) - S A a0 (a constant target: dh*/dt = 0), with S A N at q_
+    // as the rates factorised it (its status is the rates')
     for (std::size_t i = 0; i < rows_.size(); ++i)
       rm_(static_cast<Eigen::Index>(i)) = -W(rows_[i]) - data_.momentum_matrix.row(rows_[i]).dot(a0_);
-    st |= min_norm(M_, rm_, z_);
+    solve(null_, M_, rm_, z_);
     a_cmd_.noalias() += N_ * z_;
   }
   if (!a_cmd_.allFinite()) return Status::out_of_range;
@@ -874,7 +934,7 @@ Status ReactionlessTaskController::acceleration(const Eigen::VectorXd& v, const 
   if (!predicted.allFinite()) return Status::out_of_range;
   force_ = predicted.head<3>();
   moment_ = predicted.tail<3>();
-  return st;
+  return Status::ok;
 }
 
 Status ReactionlessTaskController::step(const Vec6& twist, const Vec6& twist_half, const Vec6& twist_next) noexcept {

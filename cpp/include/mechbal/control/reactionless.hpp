@@ -297,9 +297,12 @@ class ReactionlessJointController : public JointController {
 ///
 /// so the frame follows x' exactly (while J has full row rank) and the momentum components are
 /// cancelled as far as the null space allows (exactly when it is rich enough: n >= task rows +
-/// cancelled rows at a regular pose). Positions are integrated (Euler, or RK4 with the twist at
-/// t + dt/2 and t + dt). `null_space = false` drops N z: the pseudo-inverse path, the reference
-/// that shows what the redundancy buys.
+/// cancelled rows at a regular pose). With fewer null-space dimensions d = n - task rows than
+/// cancelled rows k, S K N has rank d at most by construction: z is then the least-squares,
+/// minimum-norm solution over those d directions (the joint mode's n_b < k), Status::singular only
+/// when they are ill-conditioned; likewise J with more task rows than joints (d = 0: z = 0).
+/// Positions are integrated (Euler, or RK4 with the twist at t + dt/2 and t + dt). `null_space =
+/// false` drops N z: the pseudo-inverse path, the reference that shows what the redundancy buys.
 ///
 /// Acceleration feed-forward (the joint mode's S K_b a_b = S dh*/dt - S K_t a_t - S W(q, v, 0),
 /// generalised to the null-space mode): differentiating J v = x' and S A v = S h* along the motion,
@@ -367,11 +370,32 @@ class ReactionlessTaskController {
   /// a_cmd_, force_, moment_ at q_ with rates v (right after rates(q_, ...): J^+, N, S A N are
   /// those of q_); saturated: the rates were scaled down, a = 0.
   Status acceleration(const Eigen::VectorXd& v, const Vec6& twist_rate, bool saturated) noexcept;
-  /// x = M^T (M M^T + lambda^2)^-1 r (lambda = 0 while cond(M) <= max_condition), M (rows x n).
-  Status min_norm(const Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::VectorXd& x) noexcept;
 
   using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
   using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
+  /// The minimum-norm least-squares operator x = M^+ r = M^T (M M^T)^+ r of a (rows x n) matrix M
+  /// whose rank is at most `rank` by construction (J: min(task rows, n); S A N: min(cancelled
+  /// rows, n - rank of J)). rank = rows: Cholesky of M M^T (+ lambda^2 when cond(M) >
+  /// max_condition, lambda^2 = damping^2 lambda_max: Status::singular). rank < rows (more rows
+  /// than the dimensions that reach them): the pseudo-inverse over the `rank` largest
+  /// eigenvalues of M M^T, whose condition decides the damping; the structurally zero ones are
+  /// no singularity. rank = 0: x = 0.
+  struct MinNorm {
+    enum class Kind { zero, cholesky, eigen };
+    Kind kind = Kind::zero;
+    Small gram, inverse;
+    SmallVector y, rhs, scale, projected;
+    Eigen::SelfAdjointEigenSolver<Small> eig;
+    Eigen::LLT<Small> llt;
+  };
+  /// Factorise M into f (M's rank at most `rank`); the status: ok, singular (damped, or M = 0),
+  /// out_of_range (M M^T not finite: f gives x = 0).
+  Status factorise(MinNorm& f, const Eigen::MatrixXd& M, Eigen::Index rank) const noexcept;
+  /// x = M^+ r with f = factorise(M).
+  static void solve(MinNorm& f, const Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::VectorXd>& r,
+                    Eigen::VectorXd& x) noexcept;
+  /// (M M^T)^+ (damped as factorised) into f.inverse.
+  static void gram_inverse(MinNorm& f) noexcept;
   std::shared_ptr<const MechanismModel> model_;
   TaskSpaceConfig config_;
   MechanismData data_;
@@ -381,10 +405,8 @@ class ReactionlessTaskController {
   Eigen::VectorXd q_, q_cmd_, v_cmd_, a_cmd_, zero_, a0_, k1_, k2_, k3_, k4_, q_stage_, v0_, z_, w_, rate_limit_;
   Eigen::MatrixXd J_, JpJ_, N_, M_, Jt_;
   Eigen::VectorXd rt_, rm_;
-  Small gram_;
-  SmallVector y_;
-  Eigen::SelfAdjointEigenSolver<Small> eig_;
-  Eigen::LLT<Small> llt_;
+  Eigen::Index rank_J_ = 0, rank_M_ = 0;  ///< the ranks of J and S A N at most (MinNorm)
+  MinNorm task_, null_;  ///< J's and S A N's at the last rates(): the feed-forward reuses null_
   Vec6 target_ = Vec6::Zero(), h_ = Vec6::Zero(), twist_cmd_ = Vec6::Zero();
   Vec3 force_ = Vec3::Zero(), moment_ = Vec3::Zero();
   Status status_ = Status::ok;
