@@ -611,14 +611,15 @@ class ReactionlessJointController(_JointTicks, _core.ReactionlessJointController
     for `mechbal.simulate.closed_loop`; `ReactionlessController` with ``kp`` and ``kd`` builds
     one (its ``joint_controller``).
 
-    Args:
-        model: the ``MechanismModel``.
-        balancing_joints: names of actuated joints.
-        q0: actuated coordinates at the start [rad or m].
-        kp: proportional gains [1/s^2], one per actuated joint.
-        kd: derivative gains [1/s].
-        **options: as `ReactionlessController` (``cancel``, ``integrator``, ``rate_hz``, ...),
-            and ``torque_limit``, ``q_guess``.
+    Built as ``ReactionlessJointController(model, balancing_joints, q0, kp, kd, **options)``
+    (the constructor is the C++ one):
+
+    - ``model``: the ``MechanismModel``;
+    - ``balancing_joints``: names of actuated joints;
+    - ``q0``: actuated coordinates at the start [rad or m];
+    - ``kp``: proportional gains [1/s^2], one per actuated joint; ``kd``: derivative gains [1/s];
+    - ``options``: as `ReactionlessController` (``cancel``, ``integrator``, ``rate_hz``, ...),
+      and ``torque_limit``, ``q_guess``.
 
     Ticks: ``step`` -> `JointCommand`, ``step_into``, ``run`` -> `ControlRun` (see
     `mechbal.control`); ``reactionless``: the reactionless controller inside.
