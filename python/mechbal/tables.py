@@ -110,7 +110,8 @@ def inertia_matrix(value: Any) -> np.ndarray:
                 hint = did_you_mean(str(key), absent)
                 if "did you" not in hint:
                     hint = did_you_mean(str(key), list(INERTIA_KEYS))
-                raise _custom("unknown key" + hint, f".{key}", has_value=False)
+                # the key as _path writes one (quoted when it holds a newline, a dot, ...)
+                raise _custom("unknown key" + hint, "." + _path((str(key),)), has_value=False)
         for key in INERTIA_KEYS[:3]:
             if key not in value:
                 raise _custom("is required", f".{key}", has_value=False)

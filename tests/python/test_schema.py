@@ -342,6 +342,16 @@ def test_shipped_cases_with_one_random_value_only_raise_config_error(name, data)
     _check(config)
 
 
+def test_an_unknown_inertia_key_with_a_newline_stays_one_line():
+    # found by the test above: a named inertia table's unknown key went into the field raw
+    config = copy.deepcopy(CASES["arm2link-balanced"])
+    config["mechanism"]["joints"][0]["link"]["inertia"] = {"\n": None}
+    with pytest.raises(ConfigError) as exc:
+        validate_case(config, warn=False)
+    assert "\n" not in str(exc.value)
+    assert str(exc.value).startswith("mechanism.joints[0].link.inertia.'\\n': unknown key")
+
+
 names = st.sampled_from(["a", "b", "c", "s", "base", "s_z", "s_x", "d"])
 joint_names = st.sampled_from(["a", "b", "c", "s"])
 origin = st.fixed_dictionaries({}, optional={"xyz": st.lists(st.floats(-2, 2), min_size=3, max_size=3),
