@@ -7,10 +7,21 @@
 /// noexcept and allocation-free.
 #include <Eigen/Core>
 #include <cmath>
+#include <limits>
 
 #include "mechbal/model/data.hpp"
 #include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
+
+/// The per-link passes below are called once per tick on every link: GCC's inliner, short of
+/// budget in a translation unit that grew (algorithms.cpp), left Eigen's 3x3 products as calls
+/// inside them (every call spills the pass's registers: inverse dynamics 15-20 % slower). flatten
+/// inlines everything these passes call, whatever the size of the unit that instantiates them.
+#if defined(__GNUC__) || defined(__clang__)
+#define MECHBAL_FLATTEN __attribute__((flatten))
+#else
+#define MECHBAL_FLATTEN
+#endif
 
 namespace mechbal::detail {
 
@@ -24,6 +35,15 @@ inline bool data_matches(const MechanismModel& model, const MechanismData& data)
          static_cast<int>(data.work.size()) == model.num_links();
 }
 
+/// True when every entry of x is finite (a NaN fails the comparison). One branch-free loop that
+/// the compiler vectorises, whatever it decides about inlining Eigen's allFinite.
+inline bool all_finite(const Eigen::Ref<const Eigen::VectorXd>& x) noexcept {
+  constexpr double kMax = std::numeric_limits<double>::max();
+  bool finite = true;
+  for (Eigen::Index i = 0; i < x.size(); ++i) finite &= std::abs(x(i)) <= kMax;
+  return finite;
+}
+
 /// Sizes and finiteness of up to three state vectors (null = not used).
 inline Status check_state(const MechanismModel& model, const MechanismData& data,
                           const Eigen::Ref<const Eigen::VectorXd>* q,
@@ -32,7 +52,7 @@ inline Status check_state(const MechanismModel& model, const MechanismData& data
   if (!data_matches(model, data)) return Status::bad_size;
   const Eigen::Index n = model.dof();
   if ((q && q->size() != n) || (v && v->size() != n) || (a && a->size() != n)) return Status::bad_size;
-  if ((q && !q->allFinite()) || (v && !v->allFinite()) || (a && !a->allFinite())) {
+  if ((q && !all_finite(*q)) || (v && !all_finite(*v)) || (a && !all_finite(*a))) {
     return Status::non_finite_input;
   }
   return Status::ok;
@@ -76,7 +96,7 @@ struct NoVisit {
 };
 
 template <bool World = true, class Visit = NoVisit>
-inline void place(const MechanismModel& model, MechanismData& data, Visit&& visit = Visit{}) noexcept {
+MECHBAL_FLATTEN inline void place(const MechanismModel& model, MechanismData& data, Visit&& visit = Visit{}) noexcept {
   const int nl = model.num_links();
   for (int l = 1; l < nl; ++l) {
     const auto k = static_cast<std::size_t>(l);
@@ -144,7 +164,7 @@ inline Mat3 rotate_symmetric(const Mat3& R, const Mat3& S) noexcept {
 /// net wrench each link needs (force, moment about its origin). Gravity enters as an upward
 /// acceleration -g of the base (Luh et al.), so with Gravity the wrenches include the weights.
 template <bool Velocity, bool Acceleration, bool Gravity, bool Forces>
-inline void forward_pass(const MechanismModel& model, MechanismData& data) noexcept {
+MECHBAL_FLATTEN inline void forward_pass(const MechanismModel& model, MechanismData& data) noexcept {
   auto& base = data.work[0];
   base.w.setZero();
   base.alpha.setZero();
@@ -215,7 +235,7 @@ inline void forward_pass(const MechanismModel& model, MechanismData& data) noexc
 /// base's entry receives the wrench the base exerts on the moving links, in O), projected on the
 /// joint axes and through the gear couplings into `tau` (size dof).
 template <typename Tau>
-inline void backward_pass(const MechanismModel& model, MechanismData& data, Tau& tau) noexcept {
+MECHBAL_FLATTEN inline void backward_pass(const MechanismModel& model, MechanismData& data, Tau& tau) noexcept {
   data.work[0].force.setZero();
   data.work[0].moment.setZero();
   tau.setZero();
