@@ -88,9 +88,12 @@ Vec3 mass_moment(const MechanismModel& model, const MechanismData& data) noexcep
   return mc;
 }
 
-/// Momenta about O of all links, from a forward pass with velocities.
-void sum_momenta(const MechanismModel& model, MechanismData& data) noexcept {
-  Vec3 P = Vec3::Zero(), H = Vec3::Zero();
+/// Momenta about O of all links, from a forward pass with velocities, and with Wrenches their
+/// rates: the sum of every link's Newton-Euler wrench (moment about its origin n_o, so about O:
+/// n_o + p x f). One sweep over the links for both (each sum in link order).
+template <bool Wrenches>
+void sum_links(const MechanismModel& model, MechanismData& data) noexcept {
+  Vec3 P = Vec3::Zero(), H = Vec3::Zero(), F = Vec3::Zero(), M = Vec3::Zero();
   for (int l = 1; l < model.num_links(); ++l) {
     const auto& c = model.link_constants(l);
     const auto& W = data.work[static_cast<std::size_t>(l)];
@@ -99,23 +102,18 @@ void sum_momenta(const MechanismModel& model, MechanismData& data) noexcept {
     const Vec3 p_world = W.world_rotation * p_local;
     P += p_world;
     H += W.world_rotation * h_local + W.world_position.cross(p_world);
+    if (Wrenches) {
+      const Vec3 f = W.world_rotation * W.force;
+      F += f;
+      M += W.world_rotation * W.moment + W.world_position.cross(f);
+    }
   }
   data.shaking.linear_momentum = P;
   data.shaking.angular_momentum = H;
-}
-
-/// Rates of the momenta about O: the sum of every link's Newton-Euler wrench (moment about its
-/// origin n_o, so about O: n_o + p x f).
-void sum_wrenches(const MechanismModel& model, MechanismData& data) noexcept {
-  Vec3 F = Vec3::Zero(), M = Vec3::Zero();
-  for (int l = 1; l < model.num_links(); ++l) {
-    const auto& W = data.work[static_cast<std::size_t>(l)];
-    const Vec3 f = W.world_rotation * W.force;
-    F += f;
-    M += W.world_rotation * W.moment + W.world_position.cross(f);
+  if (Wrenches) {
+    data.shaking.force = F;
+    data.shaking.moment = M;
   }
-  data.shaking.force = F;
-  data.shaking.moment = M;
 }
 
 /// With springs: data.spring_torque = K(q) from placed links, added to tau. The base's entry of
@@ -221,8 +219,7 @@ namespace {
 /// The shaking wrench from placed links and the joints' rates.
 Status shaking_wrench_of_placed(const MechanismModel& model, MechanismData& data) noexcept {
   detail::forward_pass<true, true, false, true>(model, data);
-  sum_momenta(model, data);
-  sum_wrenches(model, data);
+  sum_links<true>(model, data);
   return finite_result(data.shaking.linear_momentum, data.shaking.angular_momentum, data.shaking.force,
                        data.shaking.moment);
 }
@@ -235,7 +232,7 @@ Status momentum(const MechanismModel& model, MechanismData& data, const ConstVec
   detail::joint_state<true, false>(model, data, q, v, v);
   detail::place(model, data);
   detail::forward_pass<true, false, false, false>(model, data);
-  sum_momenta(model, data);
+  sum_links<false>(model, data);
   return finite_result(data.shaking.linear_momentum, data.shaking.angular_momentum);
 }
 
@@ -319,7 +316,7 @@ Status inverse_dynamics(const MechanismModel& model, MechanismData& data, const 
   if (Status s = check_state(model, data, &q, &v, &a); s != Status::ok) return s;
   detail::joint_state<true, true>(model, data, q, v, a);
   detail::place_for_springs(model, data);
-  detail::forward_pass<true, true, true, true>(model, data);
+  detail::forward_pass<true, true, true, true, false>(model, data);
   detail::backward_pass(model, data, data.joint_torque);
   add_springs(model, data, data.joint_torque);
   return finite_result(data.joint_torque);
@@ -339,7 +336,7 @@ Status bias_torque(const MechanismModel& model, MechanismData& data, const Const
   if (Status s = check_state(model, data, &q, &v); s != Status::ok) return s;
   detail::joint_state<true, false>(model, data, q, v, v);
   detail::place_for_springs(model, data);
-  detail::forward_pass<true, false, true, true>(model, data);
+  detail::forward_pass<true, false, true, true, false>(model, data);
   detail::backward_pass(model, data, data.bias_torque);
   add_springs(model, data, data.bias_torque);
   return finite_result(data.bias_torque);

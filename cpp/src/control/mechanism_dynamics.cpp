@@ -154,7 +154,7 @@ Status MechanismDynamics::coriolis(const Eigen::Ref<const Eigen::VectorXd>& q,
   if (Status s = detail::check_state(*model_, data_, &q, &qd); s != Status::ok) return s;
   detail::joint_state<true, false>(*model_, data_, q, qd, qd);
   detail::place<false>(*model_, data_);
-  detail::forward_pass<true, false, false, true>(*model_, data_);
+  detail::forward_pass<true, false, false, true, false>(*model_, data_);
   detail::backward_pass(*model_, data_, c);
   return c.allFinite() ? Status::ok : Status::out_of_range;  // finite input can overflow (qd = 1e300)
 }

@@ -35,8 +35,8 @@ inline bool data_matches(const MechanismModel& model, const MechanismData& data)
          static_cast<int>(data.work.size()) == model.num_links();
 }
 
-/// True when every entry of x is finite (a NaN fails the comparison). One branch-free loop that
-/// the compiler vectorises, whatever it decides about inlining Eigen's allFinite.
+/// True when every entry of x is finite (a NaN fails the comparison): one loop without branches,
+/// inlined where Eigen's allFinite was left as a call in a big translation unit.
 inline bool all_finite(const Eigen::Ref<const Eigen::VectorXd>& x) noexcept {
   constexpr double kMax = std::numeric_limits<double>::max();
   bool finite = true;
@@ -163,7 +163,10 @@ inline Mat3 rotate_symmetric(const Mat3& R, const Mat3& S) noexcept {
 /// Forward pass: velocity, acceleration of every link in its own L frame and, when Forces, the
 /// net wrench each link needs (force, moment about its origin). Gravity enters as an upward
 /// acceleration -g of the base (Luh et al.), so with Gravity the wrenches include the weights.
-template <bool Velocity, bool Acceleration, bool Gravity, bool Forces>
+/// OriginVelocity = false skips the velocities of the link origins (work[].vel, left as they
+/// were): the joint torques need only the angular velocities, the accelerations and the wrenches
+/// (inverse dynamics, bias and Coriolis torques), while the momenta and frame motions need them.
+template <bool Velocity, bool Acceleration, bool Gravity, bool Forces, bool OriginVelocity = true>
 MECHBAL_FLATTEN inline void forward_pass(const MechanismModel& model, MechanismData& data) noexcept {
   auto& base = data.work[0];
   base.w.setZero();
@@ -187,7 +190,7 @@ MECHBAL_FLATTEN inline void forward_pass(const MechanismModel& model, MechanismD
     W.acc.noalias() = R.transpose() * a_lin;
     if (Velocity) {
       W.w.noalias() = R.transpose() * P.w;
-      W.vel.noalias() = R.transpose() * (P.vel + P.w.cross(p));
+      if (OriginVelocity) W.vel.noalias() = R.transpose() * (P.vel + P.w.cross(p));
     } else {
       W.w.setZero();
       W.vel.setZero();
@@ -210,7 +213,7 @@ MECHBAL_FLATTEN inline void forward_pass(const MechanismModel& model, MechanismD
       case JointType::prismatic:
         if (Velocity) {
           W.acc += cross_ez(W.w) * (2.0 * qd);
-          W.vel.z() += qd;
+          if (OriginVelocity) W.vel.z() += qd;
         }
         if (Acceleration) W.acc.z() += qdd;
         break;
