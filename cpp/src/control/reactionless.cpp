@@ -237,7 +237,10 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
   gram_ = Small::Identity(g, g);
   eig_.compute(gram_, Eigen::EigenvaluesOnly);
   llt_.compute(gram_);
-  if (square_) lu_.compute(Small(Small::Identity(k_, k_)));
+  if (square_) {
+    lu_.compute(Small(Small::Identity(k_, k_)));
+    lu3_.compute(Eigen::Matrix3d::Identity());
+  }
   command_.q = command_.v = command_.a = Eigen::VectorXd::Zero(na_);
   command_.q_full = command_.v_full = command_.a_full = Eigen::VectorXd::Zero(n_);
   command_.next_balancing = Eigen::VectorXd::Zero(nb_);
@@ -397,7 +400,13 @@ Status ReactionlessController::factorise(double& condition) noexcept {
   if (condition <= config_.max_condition) {
     damped_ = false;
     if (square_) {
-      lu_.compute(Small(Kb_));
+      // 3 x 3 (a wrist cancelling the moment) at fixed size: Eigen's dynamic LU dispatch costs
+      // more than the factorisation itself
+      if (k_ == 3) {
+        lu3_.compute(Eigen::Matrix3d(Kb_));
+      } else {
+        lu_.compute(Small(Kb_));
+      }
     } else {
       llt_.compute(gram_);
     }
@@ -415,7 +424,11 @@ void ReactionlessController::solve(const Eigen::Ref<const Eigen::VectorXd>& r, E
     y_ = llt_.solve(r_);
     x.noalias() = Kb_.transpose() * y_;
   } else if (square_ && !damped_) {
-    y_ = lu_.solve(r_);
+    if (k_ == 3) {
+      y_ = lu3_.solve(Eigen::Vector3d(r_));
+    } else {
+      y_ = lu_.solve(r_);
+    }
     x = y_;
   } else {
     SmallVector b(nb_);
