@@ -139,6 +139,7 @@ MECHBAL_FLATTEN inline void place(const MechanismModel& model, MechanismData& da
         w.world_rotation.noalias() = p.world_rotation * w.rotation;
         w.world_position = p.world_position + p.world_rotation * w.translation;
         w.world_stale = false;
+        w.momentum_current = false;
       }
     } else if (local) {
       w.world_stale = true;  // world_* no longer that of rotation / translation
@@ -270,6 +271,7 @@ inline void composite_inertias(const MechanismModel& model, MechanismData& data)
   for (int l = 0; l < nl; ++l) {
     auto& W = data.work[static_cast<std::size_t>(l)];
     if (W.composite_current) continue;
+    W.momentum_current = false;  // its momentum-matrix column follows its composite
     const auto& c = model.link_constants(l);
     W.composite_mass = c.mass;
     W.composite_first_moment = c.first_moment;
