@@ -341,19 +341,22 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
 }
 
 void ReactionlessController::momentum_projection() noexcept {
-  // K = A C over C's nonzeros: C's columns of the actuated joints that move no loop are unit
-  // vectors, the others nonzero on the passive rows (a dense 6 x n x na product would go through
-  // Eigen's blocked GEMM, whose packing costs more than the product at these sizes)
+  // K = A C over C's nonzeros: the column of an actuated coordinate that moves no loop is the unit
+  // vector of that coordinate (K's column is A's); a loop-moving one (data_.loop_actuated_columns)
+  // adds its passive entries (a dense 6 x n x na product would go through Eigen's blocked GEMM,
+  // whose packing costs more than the product at these sizes)
   const Eigen::MatrixXd& A = data_.momentum_matrix;
   const Eigen::MatrixXd& C = data_.loop_projection;
-  const Eigen::Index n = C.rows();
-  for (Eigen::Index i = 0; i < C.cols(); ++i) {
-    Vec6 k = Vec6::Zero();
-    const double* c = C.data() + i * n;
-    for (Eigen::Index j = 0; j < n; ++j) {
-      if (c[j] != 0.0) k += c[j] * Vec6(A.col(j));
+  const auto& actuated = model_->actuated_coordinates();
+  const auto& passive = model_->passive_coordinates();
+  for (int i = 0; i < na_; ++i) K_.col(i) = A.col(actuated[static_cast<std::size_t>(i)]);
+  for (const int t : data_.loop_actuated_columns) {
+    Vec6 k = K_.col(t);
+    for (const int j : passive) {
+      const double c = C(j, t);
+      if (c != 0.0) k += c * Vec6(A.col(j));
     }
-    K_.col(i) = k;
+    K_.col(t) = k;
   }
 }
 
