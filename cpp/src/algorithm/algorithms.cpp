@@ -246,7 +246,7 @@ Status momentum_matrix(const MechanismModel& model, MechanismData& data, const C
   return detail::momentum_matrix_placed(model, data);
 }
 
-Status detail::momentum_matrix_placed(const MechanismModel& model, MechanismData& data) noexcept {
+MECHBAL_FLATTEN Status detail::momentum_matrix_placed(const MechanismModel& model, MechanismData& data) noexcept {
   detail::composite_inertias(model, data);
   // Incremental: a link's term depends on its pose in O and its composite only, so a column is
   // recomputed (from zero, its links in the same order: bit for bit a full pass) when one of its

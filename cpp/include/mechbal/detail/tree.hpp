@@ -266,7 +266,7 @@ MECHBAL_FLATTEN inline void backward_pass(const MechanismModel& model, Mechanism
 /// below it, so only the links marked stale by place() (LinkWork::composite_current: the
 /// ancestors of a link whose placement changed) are recomputed, each from its own bodies and its
 /// children in the same order as a full pass: bit for bit the same result.
-inline void composite_inertias(const MechanismModel& model, MechanismData& data) noexcept {
+MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, MechanismData& data) noexcept {
   const int nl = model.num_links();
   for (int l = 0; l < nl; ++l) {
     auto& W = data.work[static_cast<std::size_t>(l)];
