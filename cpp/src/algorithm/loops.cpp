@@ -118,7 +118,8 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
           const int c = model.coordinate(k);
           if (c < 0) continue;
           double* column = jac.data() + static_cast<Eigen::Index>(c) * jac.rows() + row;
-          for (int r = 0; r < rows; ++r) column[r] = 0.0;
+          column[0] = column[1] = 0.0;  // every loop type has at least 2 rows
+          for (int r = 2; r < rows; ++r) column[r] = 0.0;
         }
       }
       const bool point = type == LoopType::point;
@@ -130,18 +131,22 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
 
 /// detail::frame_motion from the frames' placements in their links (data.frame_*_in_link, as
 /// frame_pose), the rotation only when the loop's bias needs it (a point loop does not).
+/// (the position and velocity only with `translation`: of the loop types only planar_point's
+/// bias reads them)
 detail::FrameMotion loop_frame_motion(const MechanismModel& model, const MechanismData& data, int frame,
-                                      bool rotation) noexcept {
+                                      bool rotation, bool translation) noexcept {
   const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
   const auto f = static_cast<std::size_t>(frame);
   const Mat3& R = W.world_rotation;
   detail::FrameMotion m;
   const Vec3 r = R * data.frame_position_in_link[f];
-  m.position = W.world_position + r;
   if (rotation) m.rotation.noalias() = R * data.frame_rotation_in_link[f];
   m.angular_velocity.noalias() = R * W.w;
   m.angular_acceleration.noalias() = R * W.alpha;
-  m.velocity = R * W.vel + m.angular_velocity.cross(r);
+  if (translation) {
+    m.position = W.world_position + r;
+    m.velocity = R * W.vel + m.angular_velocity.cross(r);
+  }
   m.acceleration = R * W.acc + m.angular_acceleration.cross(r) + m.angular_velocity.cross(m.angular_velocity.cross(r));
   return m;
 }
@@ -152,10 +157,12 @@ void constraint_bias(const MechanismModel& model, MechanismData& data) noexcept 
     const int row = model.loop_row(i);
     const LoopType type = model.loop(i).type;
     const bool rotation = type == LoopType::planar_point || type == LoopType::axis;
-    const detail::FrameMotion A = loop_frame_motion(model, data, model.loop_frame_a(i), rotation);
-    const detail::FrameMotion B = loop_frame_motion(model, data, model.loop_frame_b(i), type == LoopType::axis);
-    const Vec3 d = B.position - A.position, dd = B.velocity - A.velocity, ddd = B.acceleration - A.acceleration;
-    if (type == LoopType::planar_point) {
+    const bool planar = type == LoopType::planar_point;
+    const detail::FrameMotion A = loop_frame_motion(model, data, model.loop_frame_a(i), rotation, planar);
+    const detail::FrameMotion B = loop_frame_motion(model, data, model.loop_frame_b(i), type == LoopType::axis, planar);
+    const Vec3 ddd = B.acceleration - A.acceleration;
+    if (planar) {
+      const Vec3 d = B.position - A.position, dd = B.velocity - A.velocity;
       for (int k = 0; k < 2; ++k) {
         const Vec3 x = A.rotation.col(k);
         const Vec3 xd = A.angular_velocity.cross(x);
@@ -210,14 +217,24 @@ void ldl_factor(MechanismData& data) noexcept {
       for (int p = begin; p < end; ++p) lk[rows[p]] = 0.0;
       continue;
     }
+    // the column's multipliers l_jk = N_jk / d, divided once (kept aside while the unscaled column
+    // updates the rest; a column with more structural entries than the buffer divides twice)
+    constexpr int kBuffer = 32;
+    double scaled[kBuffer];
+    const bool buffered = end - begin <= kBuffer;
     for (int p = begin; p < end; ++p) {
       const int j = rows[p];
       const double f = lk[j] / d;
+      if (buffered) scaled[p - begin] = f;
       if (f == 0.0) continue;
       double* nj = N.data() + j * n;
       for (int r = p; r < end; ++r) nj[rows[r]] -= f * lk[rows[r]];
     }
-    for (int p = begin; p < end; ++p) lk[rows[p]] /= d;
+    if (buffered) {
+      for (int p = begin; p < end; ++p) lk[rows[p]] = scaled[p - begin];
+    } else {
+      for (int p = begin; p < end; ++p) lk[rows[p]] /= d;
+    }
   }
 }
 
@@ -284,6 +301,23 @@ void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X
     case 3: return ldl_solve_block_width<3>(data, X);
     case 4: return ldl_solve_block_width<4>(data, X);
     default: return ldl_solve_block_width<0>(data, X);
+  }
+}
+
+/// X = -A°^T B (np x w, row-major; B m x w row-major) over A°'s structural nonzeros, w = W (0: B's).
+template <int W>
+void passive_transpose_times(const MechanismData& data, const MechanismData::RowMajorMatrix& B,
+                             MechanismData::RowMajorMatrix& X) noexcept {
+  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
+  const Eigen::Index w = W > 0 ? W : B.cols();
+  X.setZero();
+  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+    const double* a = Ap.data() + i * Ap.rows();
+    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+    for (int p = 0; p < data.loop_passive_count(i); ++p) {
+      const int r = rows[p];
+      axpy<W>(X.data() + i * w, -a[r], B.data() + r * w, w);
+    }
   }
 }
 
@@ -692,14 +726,12 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   const MechanismData::RowMajorMatrix& Aa = data.loop_actuated_jacobian;
   const Eigen::Index w = X.cols();
   const auto column = [&](Eigen::Index i) { return Ap.data() + i * Ap.rows(); };
-  X.setZero();
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-    const double* a = column(i);
-    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-    for (int p = 0; p < data.loop_passive_count(i); ++p) {
-      const int r = rows[p];
-      axpy(X.data() + i * w, -a[r], Aa.data() + r * w, w);
-    }
+  switch (w) {
+    case 1: passive_transpose_times<1>(data, Aa, X); break;
+    case 2: passive_transpose_times<2>(data, Aa, X); break;
+    case 3: passive_transpose_times<3>(data, Aa, X); break;
+    case 4: passive_transpose_times<4>(data, Aa, X); break;
+    default: passive_transpose_times<0>(data, Aa, X); break;
   }
   ldl_solve_block(data, X);
   const bool refine_solves = data.loop_rcond < options.refine_rcond;
