@@ -282,9 +282,13 @@ void run_loop(W& work, W& twin, std::size_t ticks, long long period, double rate
               bool fifo, bool locked, long long spin_ns, const std::string& json) {
   // allocated before the loop
   std::vector<long long> compute(ticks), wake(ticks), cpu(ticks), twin_min(ticks);
-  for (int i = 0; i < 1000; ++i) {  // warm caches
-    work.tick(i * 1e-3);
-    twin.tick(i * 1e-3);
+  // warm caches; the timed ticks continue the same time line (a jump back to t = 0 would restart
+  // a loop solve's warm start one second away: one tick of full Newton iterations in both twins,
+  // which no controller following its trajectory sees)
+  constexpr std::size_t warmup = 1000;
+  for (std::size_t i = 0; i < warmup; ++i) {
+    work.tick(static_cast<double>(i) / rate);
+    twin.tick(static_cast<double>(i) / rate);
   }
   std::size_t twin_mismatch = 0;  // periods whose two copies returned different statuses
 
@@ -304,7 +308,7 @@ void run_loop(W& work, W& twin, std::size_t ticks, long long period, double rate
       }
     }
     wake[k] = now_ns() - release;
-    const double t = static_cast<double>(k) / rate;
+    const double t = static_cast<double>(warmup + k) / rate;
     long long twin_ns = 0;
     mechbal::Status twin_status = mechbal::Status::ok;
     if (k % 2 == 1) {  // odd periods: the twin first

@@ -25,7 +25,10 @@ using detail::check_state;
 /// Status::out_of_range (docs/architecture.md, Data flow: never ok with a non-finite output).
 template <typename... T>
 Status finite_result(const T&... results) noexcept {
-  return (results.allFinite() && ...) ? Status::ok : Status::out_of_range;
+  // x * 0 is 0 for a finite x and NaN for an infinite or NaN one: one vectorised sum per result
+  // (Eigen's allFinite compares x - x with itself entry by entry, about 4x slower on a 6 x 30
+  // momentum matrix, which the reactionless controller builds four times a tick)
+  return (((results.array() * 0.0).sum() == 0.0) && ...) ? Status::ok : Status::out_of_range;
 }
 
 /// World quantities of links, bodies and frames from the L-frame work buffers.
@@ -248,10 +251,23 @@ Status momentum_matrix(const MechanismModel& model, MechanismData& data, const C
 
 Status detail::momentum_matrix_placed(const MechanismModel& model, MechanismData& data) noexcept {
   detail::composite_inertias(model, data);
-  data.momentum_matrix.setZero();
-  for (int l = 1; l < model.num_links(); ++l) {
+  // Incremental: a link's term depends on its pose in O and its composite only, so a column is
+  // recomputed (from zero, its links in the same order: bit for bit a full pass) when one of its
+  // links moved in O or had its composite recomputed (LinkWork::momentum_current, cleared by
+  // place and composite_inertias); the others keep their values. A reactionless controller that
+  // turns its wrist re-derives the wrist's and its ancestors' columns, not the legs'.
+  auto& stale = data.momentum_column_stale;
+  const int nl = model.num_links();
+  for (int l = 1; l < nl; ++l) {
     const int c = model.coordinate(l);
-    if (c < 0) continue;
+    if (c >= 0 && !data.work[static_cast<std::size_t>(l)].momentum_current) stale[static_cast<std::size_t>(c)] = 1;
+  }
+  for (Eigen::Index c = 0; c < data.momentum_matrix.cols(); ++c) {
+    if (stale[static_cast<std::size_t>(c)]) data.momentum_matrix.col(c).setZero();
+  }
+  for (int l = 1; l < nl; ++l) {
+    const int c = model.coordinate(l);
+    if (c < 0 || !stale[static_cast<std::size_t>(c)]) continue;
     const auto& W = data.work[static_cast<std::size_t>(l)];
     Vec3 P, L;  // momentum of the subtree under a unit joint rate, in L_l (L about its origin)
     if (model.joint_type(l) == JointType::revolute) {
@@ -266,6 +282,8 @@ Status detail::momentum_matrix_placed(const MechanismModel& model, MechanismData
     data.momentum_matrix.col(c).head<3>() += r * Pw;
     data.momentum_matrix.col(c).tail<3>() += r * (W.world_rotation * L + W.world_position.cross(Pw));
   }
+  for (int l = 1; l < nl; ++l) data.work[static_cast<std::size_t>(l)].momentum_current = true;
+  std::fill(stale.begin(), stale.end(), static_cast<unsigned char>(0));
   return finite_result(data.momentum_matrix);
 }
 

@@ -52,6 +52,38 @@ void validate_shared_fields(std::uint32_t cancel, double rate_hz, double damping
   if (!(std::isfinite(max_rate) && max_rate > 0.0)) fail("reactionless.max_rate", "must be finite and > 0", max_rate);
 }
 
+/// The smallest and largest eigenvalues of a small symmetric positive semi-definite matrix (at most
+/// 6 x 6): Eigen's closed forms for 1 x 1 to 3 x 3 (computeDirect: a few hundred flops where the
+/// iterative tridiagonal QR costs about 500 ns at 3 x 3), the iterative solver `fallback` for
+/// larger matrices and whenever the closed form finds the matrix ill-conditioned (lmin < 1e-6
+/// lmax), where its absolute error of a few eps lmax would matter to the condition number.
+template <typename Small, typename Solver>
+void extreme_eigenvalues(const Small& S, Solver& fallback, double& lmin, double& lmax) noexcept {
+  const Eigen::Index n = S.rows();
+  if (n == 1) {
+    lmin = lmax = S(0, 0);
+    return;
+  }
+  if (n == 2 || n == 3) {
+    if (n == 2) {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> direct;
+      direct.computeDirect(Eigen::Matrix2d(S.template topLeftCorner<2, 2>()), Eigen::EigenvaluesOnly);
+      lmin = direct.eigenvalues()(0);
+      lmax = direct.eigenvalues()(1);
+    } else {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> direct;
+      direct.computeDirect(Eigen::Matrix3d(S.template topLeftCorner<3, 3>()), Eigen::EigenvaluesOnly);
+      lmin = direct.eigenvalues()(0);
+      lmax = direct.eigenvalues()(2);
+    }
+    if (lmax > 0.0 && lmin >= 1e-6 * lmax) return;  // well-conditioned (also false on NaN)
+  }
+  fallback.compute(S, Eigen::EigenvaluesOnly);
+  const auto& lambda = fallback.eigenvalues();  // ascending
+  lmin = lambda(0);
+  lmax = lambda(lambda.size() - 1);
+}
+
 }  // namespace
 
 std::uint32_t momentum_component(const std::string& name) noexcept {
@@ -205,7 +237,10 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
   gram_ = Small::Identity(g, g);
   eig_.compute(gram_, Eigen::EigenvaluesOnly);
   llt_.compute(gram_);
-  if (square_) lu_.compute(Small(Small::Identity(k_, k_)));
+  if (square_) {
+    lu_.compute(Small(Small::Identity(k_, k_)));
+    lu3_.compute(Eigen::Matrix3d::Identity());
+  }
   command_.q = command_.v = command_.a = Eigen::VectorXd::Zero(na_);
   command_.q_full = command_.v_full = command_.a_full = Eigen::VectorXd::Zero(n_);
   command_.next_balancing = Eigen::VectorXd::Zero(nb_);
@@ -306,19 +341,22 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
 }
 
 void ReactionlessController::momentum_projection() noexcept {
-  // K = A C over C's nonzeros: C's columns of the actuated joints that move no loop are unit
-  // vectors, the others nonzero on the passive rows (a dense 6 x n x na product would go through
-  // Eigen's blocked GEMM, whose packing costs more than the product at these sizes)
+  // K = A C over C's nonzeros: the column of an actuated coordinate that moves no loop is the unit
+  // vector of that coordinate (K's column is A's); a loop-moving one (data_.loop_actuated_columns)
+  // adds its passive entries (a dense 6 x n x na product would go through Eigen's blocked GEMM,
+  // whose packing costs more than the product at these sizes)
   const Eigen::MatrixXd& A = data_.momentum_matrix;
   const Eigen::MatrixXd& C = data_.loop_projection;
-  const Eigen::Index n = C.rows();
-  for (Eigen::Index i = 0; i < C.cols(); ++i) {
-    Vec6 k = Vec6::Zero();
-    const double* c = C.data() + i * n;
-    for (Eigen::Index j = 0; j < n; ++j) {
-      if (c[j] != 0.0) k += c[j] * Vec6(A.col(j));
+  const auto& actuated = model_->actuated_coordinates();
+  const auto& passive = model_->passive_coordinates();
+  for (int i = 0; i < na_; ++i) K_.col(i) = A.col(actuated[static_cast<std::size_t>(i)]);
+  for (const int t : data_.loop_actuated_columns) {
+    Vec6 k = K_.col(t);
+    for (const int j : passive) {
+      const double c = C(j, t);
+      if (c != 0.0) k += c * Vec6(A.col(j));
     }
-    K_.col(i) = k;
+    K_.col(t) = k;
   }
 }
 
@@ -352,9 +390,8 @@ Status ReactionlessController::factorise(double& condition) noexcept {
     llt_.compute(gram_);
     return Status::singular | Status::out_of_range;
   }
-  eig_.compute(gram_, Eigen::EigenvaluesOnly);
-  const auto& lambda = eig_.eigenvalues();  // ascending
-  const double lmax = lambda(lambda.size() - 1), lmin = lambda(0);
+  double lmin = 0.0, lmax = 0.0;
+  extreme_eigenvalues(gram_, eig_, lmin, lmax);
   if (!(lmax > 0.0)) {  // S K_b = 0: the balancing joints cannot act on the cancelled components
     condition = huge;
     damped_ = true;
@@ -366,7 +403,13 @@ Status ReactionlessController::factorise(double& condition) noexcept {
   if (condition <= config_.max_condition) {
     damped_ = false;
     if (square_) {
-      lu_.compute(Small(Kb_));
+      // 3 x 3 (a wrist cancelling the moment) at fixed size: Eigen's dynamic LU dispatch costs
+      // more than the factorisation itself
+      if (k_ == 3) {
+        lu3_.compute(Eigen::Matrix3d(Kb_));
+      } else {
+        lu_.compute(Small(Kb_));
+      }
     } else {
       llt_.compute(gram_);
     }
@@ -384,7 +427,11 @@ void ReactionlessController::solve(const Eigen::Ref<const Eigen::VectorXd>& r, E
     y_ = llt_.solve(r_);
     x.noalias() = Kb_.transpose() * y_;
   } else if (square_ && !damped_) {
-    y_ = lu_.solve(r_);
+    if (k_ == 3) {
+      y_ = lu3_.solve(Eigen::Vector3d(r_));
+    } else {
+      y_ = lu_.solve(r_);
+    }
     x = y_;
   } else {
     SmallVector b(nb_);
@@ -783,8 +830,8 @@ Status ReactionlessTaskController::factorise(MinNorm& f, const Eigen::MatrixXd& 
   rank = std::min(rank, rows);
   if (rank == 0) return Status::ok;  // nothing can move these rows (an empty null space): x = 0
   if (rank == rows) {
-    f.eig.compute(f.gram, Eigen::EigenvaluesOnly);
-    const double lmax = f.eig.eigenvalues()(rows - 1), lmin = f.eig.eigenvalues()(0);
+    double lmin = 0.0, lmax = 0.0;
+    extreme_eigenvalues(f.gram, f.eig, lmin, lmax);
     if (!(lmax > 0.0)) return Status::singular;
     Status st = Status::ok;
     const double cond = lmin > 0.0 ? std::sqrt(lmax / lmin) : huge;

@@ -731,7 +731,9 @@ MechanismData::MechanismData(const MechanismModel& model)
     w.world_stale = true;
     w.world_moved = false;  // the base (link 0) never moves
     w.composite_current = false;
+    w.momentum_current = false;
   }
+  momentum_column_stale.assign(static_cast<std::size_t>(dof), 0);
   const int m = model.num_constraints(), na = model.num_actuated(), np = model.num_passive();
   loop_residual = Eigen::VectorXd::Zero(m);
   loop_jacobian = Eigen::MatrixXd::Zero(m, dof);

@@ -246,6 +246,7 @@ class ReactionlessController {
   Eigen::SelfAdjointEigenSolver<Small> eig_;
   Eigen::LLT<Small> llt_;
   Eigen::PartialPivLU<Small> lu_;
+  Eigen::PartialPivLU<Eigen::Matrix3d> lu3_;  ///< lu_ when S K_b is 3 x 3
 };
 
 /// The reactionless controller followed by a computed-torque stage (computed_torque.hpp over the

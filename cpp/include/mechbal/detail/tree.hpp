@@ -119,6 +119,7 @@ inline void place(const MechanismModel& model, MechanismData& data, Visit&& visi
         w.world_rotation.noalias() = p.world_rotation * w.rotation;
         w.world_position = p.world_position + p.world_rotation * w.translation;
         w.world_stale = false;
+        w.momentum_current = false;
       }
     } else if (local) {
       w.world_stale = true;  // world_* no longer that of rotation / translation
@@ -247,6 +248,7 @@ inline void composite_inertias(const MechanismModel& model, MechanismData& data)
   for (int l = 0; l < nl; ++l) {
     auto& W = data.work[static_cast<std::size_t>(l)];
     if (W.composite_current) continue;
+    W.momentum_current = false;  // its momentum-matrix column follows its composite
     const auto& c = model.link_constants(l);
     W.composite_mass = c.mass;
     W.composite_first_moment = c.first_moment;

@@ -192,10 +192,14 @@ struct MechanismData {
     bool world_moved;
     /// composite_* are those of the current placements of the links below (composite_inertias)
     bool composite_current;
+    /// momentum_matrix holds this link's column term at its current pose in O and composite
+    /// (momentum_matrix_placed recomputes only the columns of links that moved or whose subtree did)
+    bool momentum_current;
   };
   std::vector<LinkWork, detail::LargeBufferAllocator<LinkWork>> work;  ///< huge pages for big trees
   Eigen::MatrixXd link_regressor;           ///< dof x 10 scratch: one link's torque regressor
   Eigen::MatrixXd link_momentum_regressor;  ///< 6 x 10 scratch: one link's momentum regressor
+  std::vector<unsigned char> momentum_column_stale;  ///< dof scratch of momentum_matrix_placed
 };
 
 }  // namespace mechbal
