@@ -448,9 +448,11 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
   // exceed options.max_step.
   const bool tangent = model.is_closed() && q == data.closed_position;
   double vv = 0.0, dv = 0.0;
+  bool moved = false;  // the actuators moved since q (a solve at the same q# from its solution returns it)
   for (std::size_t i = 0; i < actuated.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     const double step = q_actuated(k) - q(actuated[i]), rate = data.closed_velocity(actuated[i]);
+    moved = moved || step != 0.0;
     if (tangent) trial.noalias() += data.loop_projection.col(k) * step;
     trial(actuated[i]) = q_actuated(k);
     vv += rate * rate;
@@ -485,7 +487,7 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
         c_last *= 1.0 + k;
       }
     }
-    if (history && data.loop_prediction_offset_valid) {
+    if (history && moved && data.loop_prediction_offset_valid) {
       for (std::size_t j = 0; j < passive.size(); ++j) {
         trial(data.loop_elimination[j]) += data.loop_prediction_offset(static_cast<Eigen::Index>(j));
       }
