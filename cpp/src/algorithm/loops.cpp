@@ -522,9 +522,13 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
   // step does not reduce the residual fourfold, the solve switches to full Newton (Jacobian and
   // factorisation at every iterate), as it does from the start without a warm start.
   bool chord = tangent;
-  bool jacobian_at_trial = false;  // data.loop_jacobian is that of `trial`
-  bool placed_at_trial = true;     // the links are placed at `trial` (the last evaluation)
-  evaluate(model, data, trial, false);
+  // when the last warm-started solve closed the loops at its prediction (no Newton step), this
+  // one most likely does too and then needs the Jacobian there: computed with the residual, from
+  // the same frame poses, instead of after it
+  const bool likely_solved = history && moved && data.loop_prediction_offset_valid;
+  bool jacobian_at_trial = likely_solved;  // data.loop_jacobian is that of `trial`
+  bool placed_at_trial = true;             // the links are placed at `trial` (the last evaluation)
+  evaluate(model, data, trial, likely_solved);
   double norm = data.loop_residual.cwiseAbs().maxCoeff();
   Eigen::VectorXd& candidate = data.loop_vector_work;
   for (int it = 0; it < options.max_iterations && norm > options.tolerance && !passive.empty(); ++it) {
