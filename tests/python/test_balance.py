@@ -184,8 +184,14 @@ def test_force_four_bar_closed_form(four_bar, tmp_path):
     assert res.exact and res.rank == 4 and res.unknowns == 8
     assert res.design["cw_crank"].mass == pytest.approx(abs(h_crank) / 0.1, rel=1e-9)
     assert res.design["cw_rocker"].mass == pytest.approx(abs(h_rocker) / 0.1, rel=1e-9)
-    assert np.allclose(res.design["cw_crank"].position, [-0.1, 0, 0], atol=1e-9)
-    assert np.allclose(res.design["cw_rocker"].position, [-0.1, 0, 0], atol=1e-9)
+    # in the plane of motion to 1e-9; out of it (y) the mass moment is undetermined
+    # (res.undetermined) and the lightest-mass program picks it on a polyhedral approximation of
+    # the radius cone, to ~5e-7: 150 or 151 samples, or sampled poses that differ by 1e-12, give
+    # 1e-11 or 4.8e-7
+    for slot in ("cw_crank", "cw_rocker"):
+        assert np.allclose(res.design[slot].position[[0, 2]], [-0.1, 0], atol=1e-9)
+        assert abs(res.design[slot].position[1]) < 1e-6
+    assert "cw_crank.mass_moment_y" in res.undetermined and "cw_rocker.mass_moment_y" in res.undetermined
     # a random smooth crank motion (sum of sines), solved by the loops
     t = np.linspace(0.0, 2.0, 4001)
     rng = np.random.default_rng(4)

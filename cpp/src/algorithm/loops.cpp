@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "mechbal/algorithm/inverse_dynamics.hpp"
@@ -42,7 +43,15 @@ struct RowFunctional {
 /// it by r z (revolute); `side` -1 for frame A, +1 for frame B. Only the loop's own coordinates are
 /// touched (no dense 6 x n frame Jacobians).
 void add_path_columns(const MechanismModel& model, const MechanismData& data, int link, const Vec3& p, double side,
-                      const RowFunctional* f, int rows, int row0, Eigen::MatrixXd& jac) noexcept {
+                      const RowFunctional* f, int rows, int row0, Eigen::MatrixXd& jac, bool point) noexcept {
+  if (point) {  // a point loop's rows are d itself (a = e_k, b = e = 0): the columns are +-(z x (p - p_k)) or +-z
+    detail::for_each_path_joint(model, data, link, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
+      double* column = jac.data() + static_cast<Eigen::Index>(c) * jac.rows() + row0;
+      const Vec3 rate = revolute ? Vec3(z.cross(p - pk)) : z;
+      for (int r = 0; r < 3; ++r) column[r] += side * rate(r);
+    });
+    return;
+  }
   detail::for_each_path_joint(model, data, link, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
     if (revolute) {
       const Vec3 lin = z.cross(p - pk);
@@ -57,8 +66,9 @@ void add_path_columns(const MechanismModel& model, const MechanismData& data, in
 
 /// Residual (and Jacobian) of every loop, from placed links (world poses computed).
 void constraint_rows(const MechanismModel& model, MechanismData& data, bool jacobian) noexcept {
+  // (A's entries outside the loops' path columns are zero from construction and never written:
+  // only the columns each loop's rows accumulate into are cleared, not the whole m x n matrix)
   Eigen::MatrixXd& jac = data.loop_jacobian;
-  if (jacobian) jac.setZero();
   for (int i = 0; i < model.num_loops(); ++i) {
     const int row = model.loop_row(i), fa = model.loop_frame_a(i), fb = model.loop_frame_b(i);
     const LoopType type = model.loop(i).type;
@@ -103,26 +113,40 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
       }
     }
     if (jacobian) {
-      add_path_columns(model, data, model.frame_link(fa), A.position, -1.0, f, rows, row, jac);
-      add_path_columns(model, data, model.frame_link(fb), B.position, 1.0, f, rows, row, jac);
+      for (const int frame : {fa, fb}) {
+        for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) {
+          const int c = model.coordinate(k);
+          if (c < 0) continue;
+          double* column = jac.data() + static_cast<Eigen::Index>(c) * jac.rows() + row;
+          column[0] = column[1] = 0.0;  // every loop type has at least 2 rows
+          for (int r = 2; r < rows; ++r) column[r] = 0.0;
+        }
+      }
+      const bool point = type == LoopType::point;
+      add_path_columns(model, data, model.frame_link(fa), A.position, -1.0, f, rows, row, jac, point);
+      add_path_columns(model, data, model.frame_link(fb), B.position, 1.0, f, rows, row, jac, point);
     }
   }
 }
 
 /// detail::frame_motion from the frames' placements in their links (data.frame_*_in_link, as
 /// frame_pose), the rotation only when the loop's bias needs it (a point loop does not).
+/// (the position and velocity only with `translation`: of the loop types only planar_point's
+/// bias reads them)
 detail::FrameMotion loop_frame_motion(const MechanismModel& model, const MechanismData& data, int frame,
-                                      bool rotation) noexcept {
+                                      bool rotation, bool translation) noexcept {
   const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
   const auto f = static_cast<std::size_t>(frame);
   const Mat3& R = W.world_rotation;
   detail::FrameMotion m;
   const Vec3 r = R * data.frame_position_in_link[f];
-  m.position = W.world_position + r;
   if (rotation) m.rotation.noalias() = R * data.frame_rotation_in_link[f];
   m.angular_velocity.noalias() = R * W.w;
   m.angular_acceleration.noalias() = R * W.alpha;
-  m.velocity = R * W.vel + m.angular_velocity.cross(r);
+  if (translation) {
+    m.position = W.world_position + r;
+    m.velocity = R * W.vel + m.angular_velocity.cross(r);
+  }
   m.acceleration = R * W.acc + m.angular_acceleration.cross(r) + m.angular_velocity.cross(m.angular_velocity.cross(r));
   return m;
 }
@@ -133,10 +157,12 @@ void constraint_bias(const MechanismModel& model, MechanismData& data) noexcept 
     const int row = model.loop_row(i);
     const LoopType type = model.loop(i).type;
     const bool rotation = type == LoopType::planar_point || type == LoopType::axis;
-    const detail::FrameMotion A = loop_frame_motion(model, data, model.loop_frame_a(i), rotation);
-    const detail::FrameMotion B = loop_frame_motion(model, data, model.loop_frame_b(i), type == LoopType::axis);
-    const Vec3 d = B.position - A.position, dd = B.velocity - A.velocity, ddd = B.acceleration - A.acceleration;
-    if (type == LoopType::planar_point) {
+    const bool planar = type == LoopType::planar_point;
+    const detail::FrameMotion A = loop_frame_motion(model, data, model.loop_frame_a(i), rotation, planar);
+    const detail::FrameMotion B = loop_frame_motion(model, data, model.loop_frame_b(i), type == LoopType::axis, planar);
+    const Vec3 ddd = B.acceleration - A.acceleration;
+    if (planar) {
+      const Vec3 d = B.position - A.position, dd = B.velocity - A.velocity;
       for (int k = 0; k < 2; ++k) {
         const Vec3 x = A.rotation.col(k);
         const Vec3 xd = A.angular_velocity.cross(x);
@@ -191,14 +217,24 @@ void ldl_factor(MechanismData& data) noexcept {
       for (int p = begin; p < end; ++p) lk[rows[p]] = 0.0;
       continue;
     }
+    // the column's multipliers l_jk = N_jk / d, divided once (kept aside while the unscaled column
+    // updates the rest; a column with more structural entries than the buffer divides twice)
+    constexpr int kBuffer = 32;
+    double scaled[kBuffer];
+    const bool buffered = end - begin <= kBuffer;
     for (int p = begin; p < end; ++p) {
       const int j = rows[p];
       const double f = lk[j] / d;
+      if (buffered) scaled[p - begin] = f;
       if (f == 0.0) continue;
       double* nj = N.data() + j * n;
       for (int r = p; r < end; ++r) nj[rows[r]] -= f * lk[rows[r]];
     }
-    for (int p = begin; p < end; ++p) lk[rows[p]] /= d;
+    if (buffered) {
+      for (int p = begin; p < end; ++p) lk[rows[p]] = scaled[p - begin];
+    } else {
+      for (int p = begin; p < end; ++p) lk[rows[p]] /= d;
+    }
   }
 }
 
@@ -225,24 +261,26 @@ void ldl_solve(const MechanismData& data, Eigen::Ref<Eigen::VectorXd> x) noexcep
   }
 }
 
-/// y += a x over n contiguous entries (rows of the row-major blocks: a handful of actuated columns,
-/// too short for Eigen's dynamic-size expressions to pay off).
+/// y += a x over W contiguous entries (rows of the row-major blocks: a handful of actuated columns,
+/// too short for Eigen's dynamic-size expressions to pay off); W = 0: n entries.
+template <int W = 0>
 inline void axpy(double* y, double a, const double* x, Eigen::Index n) noexcept {
-  for (Eigen::Index j = 0; j < n; ++j) y[j] += a * x[j];
+  const Eigen::Index count = W > 0 ? W : n;
+  for (Eigen::Index j = 0; j < count; ++j) y[j] += a * x[j];
 }
 
-/// X = (L D L^T)^-1 X for a block of right-hand sides (np x na, row-major): one pass over L for
-/// all of them (the columns of C).
-void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
+/// ldl_solve_block with w = W columns (0: X.cols()), unrolled for the usual one to four.
+template <int W>
+void ldl_solve_block_width(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
   const Eigen::MatrixXd& L = data.loop_normal;
   const Eigen::VectorXd& D = data.loop_normal_pivots;
   const int* rows = data.loop_factor_rows.data();
   const int* start = data.loop_factor_start.data();
-  const Eigen::Index n = L.rows(), w = X.cols();
+  const Eigen::Index n = L.rows(), w = W > 0 ? W : X.cols();
   double* x = X.data();
   for (Eigen::Index k = 0; k < n; ++k) {
     const double* l = L.data() + k * n;
-    for (int p = start[k]; p < start[k + 1]; ++p) axpy(x + rows[p] * w, -l[rows[p]], x + k * w, w);
+    for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(x + rows[p] * w, -l[rows[p]], x + k * w, w);
   }
   for (Eigen::Index k = 0; k < n; ++k) {
     const double inv = D(k) > 0.0 ? 1.0 / D(k) : 0.0;
@@ -250,12 +288,61 @@ void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X
   }
   for (Eigen::Index k = n - 1; k >= 0; --k) {
     const double* l = L.data() + k * n;
-    for (int p = start[k]; p < start[k + 1]; ++p) axpy(x + k * w, -l[rows[p]], x + rows[p] * w, w);
+    for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(x + k * w, -l[rows[p]], x + rows[p] * w, w);
+  }
+}
+
+/// X = (L D L^T)^-1 X for a block of right-hand sides (np x na, row-major): one pass over L for
+/// all of them (the columns of C).
+void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
+  switch (X.cols()) {
+    case 1: return ldl_solve_block_width<1>(data, X);
+    case 2: return ldl_solve_block_width<2>(data, X);
+    case 3: return ldl_solve_block_width<3>(data, X);
+    case 4: return ldl_solve_block_width<4>(data, X);
+    default: return ldl_solve_block_width<0>(data, X);
+  }
+}
+
+/// X = -A°^T B (np x w, row-major; B m x w row-major) over A°'s structural nonzeros, w = W (0: B's).
+template <int W>
+void passive_transpose_times(const MechanismData& data, const MechanismData::RowMajorMatrix& B,
+                             MechanismData::RowMajorMatrix& X) noexcept {
+  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
+  const Eigen::Index w = W > 0 ? W : B.cols();
+  X.setZero();
+  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
+    const double* a = Ap.data() + i * Ap.rows();
+    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+    for (int p = 0; p < data.loop_passive_count(i); ++p) {
+      const int r = rows[p];
+      axpy<W>(X.data() + i * w, -a[r], B.data() + r * w, w);
+    }
   }
 }
 
 /// Relative damping of the normal equations: keeps the solves bounded at a singular A° (Status::singular).
 constexpr double kDamping = 1e-16;
+
+/// N(j, i) += A°(rows of one loop, j) . A°(those rows, i) over the loop's passive columns
+/// (`members`, increasing: j >= i, the lower triangle, L's structure); R = rows (0: `rows`).
+template <int R>
+void add_loop_products(const Eigen::MatrixXd& Ap, Eigen::MatrixXd& N, int r0, int rows, const int* members,
+                       int count) noexcept {
+  const Eigen::Index m = Ap.rows();
+  const int nr = R > 0 ? R : rows;
+  for (int a = 0; a < count; ++a) {
+    const Eigen::Index i = members[a];
+    const double* ai = Ap.data() + i * m + r0;
+    double* ni = N.data() + i * N.rows();
+    for (int b = a; b < count; ++b) {
+      const double* aj = Ap.data() + members[b] * m + r0;
+      double sum = 0.0;
+      for (int r = 0; r < nr; ++r) sum += ai[r] * aj[r];
+      ni[members[b]] += sum;
+    }
+  }
+}
 
 /// N = A°^T A° + damping from data.loop_jacobian, factorised; returns the rcond estimate of A°.
 double factor_passive(MechanismData& data) noexcept {
@@ -288,16 +375,13 @@ double factor_passive(MechanismData& data) noexcept {
     const int rows = data.loop_row_start[static_cast<std::size_t>(l) + 1] - r0;
     const int* members = data.loop_members.data() + data.loop_member_start[static_cast<std::size_t>(l)];
     const int count = data.loop_member_start[static_cast<std::size_t>(l) + 1] - data.loop_member_start[static_cast<std::size_t>(l)];
-    for (int a = 0; a < count; ++a) {
-      const Eigen::Index i = members[a];
-      const double* ai = Ap.data() + i * m + r0;
-      for (int b = a; b < count; ++b) {
-        const Eigen::Index j = members[b];
-        const double* aj = Ap.data() + j * m + r0;
-        double sum = 0.0;
-        for (int r = 0; r < rows; ++r) sum += ai[r] * aj[r];
-        N(j, i) += sum;  // j >= i: the lower triangle (L's structure)
-      }
+    // (the loop types' row counts unrolled: 2 planar_point, 3 point, 5 axis, 6 weld)
+    switch (rows) {
+      case 2: add_loop_products<2>(Ap, N, r0, rows, members, count); break;
+      case 3: add_loop_products<3>(Ap, N, r0, rows, members, count); break;
+      case 5: add_loop_products<5>(Ap, N, r0, rows, members, count); break;
+      case 6: add_loop_products<6>(Ap, N, r0, rows, members, count); break;
+      default: add_loop_products<0>(Ap, N, r0, rows, members, count); break;
     }
   }
   double scale = 1.0;
@@ -364,21 +448,65 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
   // exceed options.max_step.
   const bool tangent = model.is_closed() && q == data.closed_position;
   double vv = 0.0, dv = 0.0;
+  bool moved = false;  // the actuators moved since q (a solve at the same q# from its solution returns it)
   for (std::size_t i = 0; i < actuated.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     const double step = q_actuated(k) - q(actuated[i]), rate = data.closed_velocity(actuated[i]);
+    moved = moved || step != 0.0;
     if (tangent) trial.noalias() += data.loop_projection.col(k) * step;
     trial(actuated[i]) = q_actuated(k);
     vv += rate * rate;
     dv += step * rate;
   }
+  // Third and fourth order: the last warm-started tick's prediction error (its solution minus its
+  // second-order prediction) is e = E s^3 + O(s^4) along the path; E s^3 from it, scaled to this
+  // step, removes the O(s^3) term of this prediction, and E extrapolated linearly from the last two
+  // ticks (steps in the same direction) the O(s^4) one, so that the warm start often closes the
+  // loops within the tolerance with no Newton step at control rates. Only when q is the solution
+  // the last error was recorded at, and the steps are comparable; Newton then converges as before.
+  Eigen::VectorXd& raw = data.loop_prediction_error;  // the second-order prediction, then its error
+  Eigen::VectorXd& older = data.loop_prediction_error_old;
+  double s = 0.0;
+  bool record = false;
+  const bool history = tangent && q == data.loop_prediction_origin;
   if (tangent && vv > 0.0) {
-    const double s = dv / vv;
+    s = dv / vv;
     trial.noalias() += (0.5 * s * s) * data.loop_acceleration_bias;  // zero on the actuated rows
+    const double last = data.loop_prediction_step, before = data.loop_prediction_step_old;
+    const double ratio = history && last != 0.0 ? s / last : 0.0;
+    double c_last = 0.0, c_before = 0.0;  // trial += c_last e_last + c_before e_before
+    if (std::abs(ratio) <= 2.0) {
+      c_last = ratio * ratio * ratio;
+      const double previous = before != 0.0 ? last / before : 0.0;
+      // (the errors are known to about the tolerance, the solutions' accuracy: their difference
+      // only carries the O(s^4) term when they are well above it)
+      if (data.loop_prediction_depth >= 2 && ratio >= 0.5 && previous >= 0.5 && previous <= 2.0 &&
+          !(data.loop_prediction_size < 1e3 * options.tolerance)) {
+        const double k = (s + last) / (last + before), r = s / before;  // E = E_last + k (E_last - E_before)
+        c_before = -k * r * r * r;
+        c_last *= 1.0 + k;
+      }
+    }
+    if (history && moved && data.loop_prediction_offset_valid) {
+      for (std::size_t j = 0; j < passive.size(); ++j) {
+        trial(data.loop_elimination[j]) += data.loop_prediction_offset(static_cast<Eigen::Index>(j));
+      }
+    }
+    for (Eigen::Index i = 0; i < trial.size(); ++i) {
+      const double e = raw(i), e_before = older(i);
+      older(i) = e;
+      raw(i) = trial(i);
+      trial(i) += c_last * e + c_before * e_before;
+    }
+    record = true;
   }
   if (tangent && !((trial - q).cwiseAbs().maxCoeff() <= options.max_step)) {
     trial = q;
     for (std::size_t i = 0; i < actuated.size(); ++i) trial(actuated[i]) = q_actuated(static_cast<Eigen::Index>(i));
+    record = false;
+  }
+  if (!record && data.loop_prediction_origin.size() > 0) {
+    data.loop_prediction_origin(0) = std::numeric_limits<double>::quiet_NaN();
   }
   data.loop_iterations = 0;
   if (!model.is_closed()) {
@@ -394,9 +522,13 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
   // step does not reduce the residual fourfold, the solve switches to full Newton (Jacobian and
   // factorisation at every iterate), as it does from the start without a warm start.
   bool chord = tangent;
-  bool jacobian_at_trial = false;  // data.loop_jacobian is that of `trial`
-  bool placed_at_trial = true;     // the links are placed at `trial` (the last evaluation)
-  evaluate(model, data, trial, false);
+  // when the last warm-started solve closed the loops at its prediction (no Newton step), this
+  // one most likely does too and then needs the Jacobian there: computed with the residual, from
+  // the same frame poses, instead of after it
+  const bool likely_solved = history && moved && data.loop_prediction_offset_valid;
+  bool jacobian_at_trial = likely_solved;  // data.loop_jacobian is that of `trial`
+  bool placed_at_trial = true;             // the links are placed at `trial` (the last evaluation)
+  evaluate(model, data, trial, likely_solved);
   double norm = data.loop_residual.cwiseAbs().maxCoeff();
   Eigen::VectorXd& candidate = data.loop_vector_work;
   for (int it = 0; it < options.max_iterations && norm > options.tolerance && !passive.empty(); ++it) {
@@ -434,14 +566,17 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
       for (std::size_t j = 0; j < passive.size(); ++j) {
         candidate(data.loop_elimination[j]) += data.loop_step(static_cast<Eigen::Index>(j));
       }
-      evaluate(model, data, candidate, false);
+      // a chord step's candidate is usually the solution (one step at control rates): its Jacobian
+      // comes with its residual, from the same frame poses (the chord steps themselves read A°
+      // of the old factorisation, not data.loop_jacobian)
+      evaluate(model, data, candidate, chord);
       const double n = data.loop_residual.cwiseAbs().maxCoeff();
       if (n < norm) {
+        jacobian_at_trial = chord;
         if (chord && !(n <= 0.25 * norm)) chord = false;  // slow: full Newton from here
         trial = candidate;
         norm = n;
         improved = true;
-        jacobian_at_trial = false;
         placed_at_trial = true;
         break;
       }
@@ -465,8 +600,29 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
     constraint_rows(model, data, true);
   }
   data.loop_rcond = passive.empty() ? 1.0 : factor_passive(data);
-  if (!(norm <= options.tolerance)) return Status::solver_error;
+  if (!(norm <= options.tolerance)) {
+    if (data.loop_prediction_origin.size() > 0) data.loop_prediction_origin(0) = std::numeric_limits<double>::quiet_NaN();
+    return Status::solver_error;
+  }
   q = trial;
+  if (record) {
+    raw = trial - raw;
+    // with no Newton step the solution is the prediction, within the tolerance but no closer: one
+    // Newton step from the factorisation at hand (not applied to q, which the links are placed at)
+    // estimates the exact solution, which the error and the next prediction then start from
+    Eigen::VectorXd& offset = data.loop_prediction_offset;
+    data.loop_prediction_offset_valid = data.loop_iterations == 0 && norm > 0.0 && !passive.empty();
+    if (data.loop_prediction_offset_valid) {
+      for (Eigen::Index i = 0; i < offset.size(); ++i) offset(i) = -column_dot(data, i, data.loop_residual.data());
+      ldl_solve(data, offset);
+      for (std::size_t j = 0; j < passive.size(); ++j) raw(data.loop_elimination[j]) += offset(static_cast<Eigen::Index>(j));
+    }
+    data.loop_prediction_size = raw.cwiseAbs().maxCoeff();
+    data.loop_prediction_origin = trial;
+    data.loop_prediction_step_old = data.loop_prediction_step;
+    data.loop_prediction_step = s;
+    data.loop_prediction_depth = history ? 2 : 1;
+  }
   return data.loop_rcond < options.singular_rcond ? Status::singular : Status::ok;
 }
 
@@ -499,6 +655,44 @@ void refine(MechanismData& data, const B& b, X&& x) noexcept {
   for (Eigen::Index i = 0; i < Ap.cols(); ++i) step(i) = column_dot(data, i, r.data());
   ldl_solve(data, step);
   x += step;
+}
+
+/// y = C x (or y += C x with `add`) over C's structure, after project: the actuated rows are x, the
+/// passive rows X x over the actuated coordinates that move a loop (data.loop_solution; C's other
+/// passive entries are zero). An open model's C is the selection of the actuated coordinates.
+void apply_projection(const MechanismModel& model, const MechanismData& data, const ConstVector& x,
+                      Eigen::VectorXd& y, bool add = false) noexcept {
+  const auto& actuated = model.actuated_coordinates();
+  if (!add) y.setZero();
+  for (std::size_t i = 0; i < actuated.size(); ++i) y(actuated[i]) += x(static_cast<Eigen::Index>(i));
+  if (!model.is_closed()) return;
+  const auto& columns = data.loop_actuated_columns;
+  const MechanismData::RowMajorMatrix& X = data.loop_solution;
+  const Eigen::Index w = X.cols();
+  for (std::size_t j = 0; j < data.loop_elimination.size(); ++j) {
+    const double* row = X.data() + static_cast<Eigen::Index>(j) * w;
+    double sum = 0.0;
+    for (Eigen::Index t = 0; t < w; ++t) sum += row[t] * x(columns[static_cast<std::size_t>(t)]);
+    y(data.loop_elimination[j]) += sum;
+  }
+}
+
+/// out = C^T y over C's structure, after project (as apply_projection).
+void apply_projection_transpose(const MechanismModel& model, const MechanismData& data, const Eigen::VectorXd& y,
+                                Eigen::VectorXd& out) noexcept {
+  const auto& actuated = model.actuated_coordinates();
+  for (std::size_t i = 0; i < actuated.size(); ++i) out(static_cast<Eigen::Index>(i)) = y(actuated[i]);
+  if (!model.is_closed()) return;
+  const auto& columns = data.loop_actuated_columns;
+  const MechanismData::RowMajorMatrix& X = data.loop_solution;
+  const Eigen::Index w = X.cols();
+  for (Eigen::Index t = 0; t < w; ++t) {
+    double sum = 0.0;
+    for (std::size_t j = 0; j < data.loop_elimination.size(); ++j) {
+      sum += X(static_cast<Eigen::Index>(j), t) * y(data.loop_elimination[j]);
+    }
+    out(columns[static_cast<std::size_t>(t)]) += sum;
+  }
 }
 
 /// loop_projection at q (checked); `solved`: q is where solve_loop_positions just converged, so
@@ -538,14 +732,12 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   const MechanismData::RowMajorMatrix& Aa = data.loop_actuated_jacobian;
   const Eigen::Index w = X.cols();
   const auto column = [&](Eigen::Index i) { return Ap.data() + i * Ap.rows(); };
-  X.setZero();
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-    const double* a = column(i);
-    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-    for (int p = 0; p < data.loop_passive_count(i); ++p) {
-      const int r = rows[p];
-      axpy(X.data() + i * w, -a[r], Aa.data() + r * w, w);
-    }
+  switch (w) {
+    case 1: passive_transpose_times<1>(data, Aa, X); break;
+    case 2: passive_transpose_times<2>(data, Aa, X); break;
+    case 3: passive_transpose_times<3>(data, Aa, X); break;
+    case 4: passive_transpose_times<4>(data, Aa, X); break;
+    default: passive_transpose_times<0>(data, Aa, X); break;
   }
   ldl_solve_block(data, X);
   const bool refine_solves = data.loop_rcond < options.refine_rcond;
@@ -571,37 +763,45 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
     ldl_solve_block(data, S);
     X += S;
   }
+  bool finite = true;  // C's other entries are 0 and 1
   for (std::size_t j = 0; j < passive.size(); ++j) {
     const double* x = X.data() + static_cast<Eigen::Index>(j) * w;
-    for (Eigen::Index t = 0; t < w; ++t) data.loop_projection(data.loop_elimination[j], columns[static_cast<std::size_t>(t)]) = x[t];
+    for (Eigen::Index t = 0; t < w; ++t) {
+      data.loop_projection(data.loop_elimination[j], columns[static_cast<std::size_t>(t)]) = x[t];
+      finite = finite && std::abs(x[t]) <= std::numeric_limits<double>::max();
+    }
   }
-  data.closed_velocity.noalias() = data.loop_projection * v_actuated;
+  apply_projection(model, data, v_actuated, data.closed_velocity);
   // the loops must accept the actuated velocities (A v = 0); they do not at a serial singularity of
   // the closure or when the actuators over-constrain the mechanism
   // (A v over A's nonzeros: A°'s in each column's rows, A#'s loop columns; the others are zero)
+  // (the largest |entry| per column first: short, independent chains of max)
   Eigen::VectorXd& Av = data.loop_constraint_work;
   double biggest = 0.0;
   for (Eigen::Index r = 0; r < Aa.rows(); ++r) {
-    double sum = 0.0;
+    double sum = 0.0, row_max = 0.0;
     for (Eigen::Index t = 0; t < w; ++t) {
       const double a = Aa(r, t);
       sum += a * data.closed_velocity(actuated[static_cast<std::size_t>(columns[static_cast<std::size_t>(t)])]);
-      biggest = std::max(biggest, std::abs(a));
+      row_max = std::max(row_max, std::abs(a));
     }
     Av(r) = sum;
+    biggest = std::max(biggest, row_max);
   }
   for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
     const double* a = column(i);
     const double vi = data.closed_velocity(data.loop_elimination[static_cast<std::size_t>(i)]);
     const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
+    double column_max = 0.0;
     for (int p = 0; p < data.loop_passive_count(i); ++p) {
       Av(rows[p]) += a[rows[p]] * vi;
-      biggest = std::max(biggest, std::abs(a[rows[p]]));
+      column_max = std::max(column_max, std::abs(a[rows[p]]));
     }
+    biggest = std::max(biggest, column_max);
   }
   const double scale = 1.0 + biggest * data.closed_velocity.cwiseAbs().maxCoeff();
   if (!(Av.cwiseAbs().maxCoeff() <= 1e-8 * scale)) status = Status::singular;
-  if (!acceleration) return data.loop_projection.allFinite() ? status : status | Status::singular;
+  if (!acceleration) return finite ? status : status | Status::singular;
   // gamma at (q, v), then c = [0; -(A°^T A°)^-1 A°^T gamma]
   detail::joint_state<true, false>(model, data, q, data.closed_velocity, data.closed_velocity);
   // (the links are placed at q: by the solve's last evaluation, or by evaluate above)
@@ -614,9 +814,7 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   for (std::size_t j = 0; j < passive.size(); ++j) {
     data.loop_acceleration_bias(data.loop_elimination[j]) = data.loop_refine_solution(static_cast<Eigen::Index>(j));
   }
-  if (!data.loop_projection.allFinite() || !data.loop_acceleration_bias.allFinite()) {
-    return status | Status::singular;
-  }
+  if (!finite || !data.loop_acceleration_bias.allFinite()) return status | Status::singular;
   return status;
 }
 
@@ -637,7 +835,7 @@ Status closed_motion(const MechanismModel& model, MechanismData& data, const Con
   data.closed_position = q;
   status |= project(model, data, q, v_actuated, options, true);
   data.closed_acceleration = data.loop_acceleration_bias;
-  data.closed_acceleration.noalias() += data.loop_projection * a_actuated;
+  apply_projection(model, data, a_actuated, data.closed_acceleration, true);
   return status;
 }
 
@@ -659,7 +857,7 @@ Status closed_inverse_dynamics(const MechanismModel& model, MechanismData& data,
     return status;
   }
   status |= inverse_dynamics(model, data, data.closed_position, data.closed_velocity, data.closed_acceleration);
-  data.actuated_force.noalias() = data.loop_projection.transpose() * data.joint_torque;
+  apply_projection_transpose(model, data, data.joint_torque, data.actuated_force);
   if (!data.actuated_force.allFinite()) status |= Status::out_of_range;
   return status;
 }

@@ -764,6 +764,10 @@ MechanismData::MechanismData(const MechanismModel& model)
   loop_trial = Eigen::VectorXd::Zero(dof);
   loop_solution = RowMajorMatrix::Zero(np, na);
   loop_vector_work = Eigen::VectorXd::Zero(dof);
+  loop_prediction_error = Eigen::VectorXd::Zero(dof);
+  loop_prediction_error_old = Eigen::VectorXd::Zero(dof);
+  loop_prediction_offset = Eigen::VectorXd::Zero(np);
+  loop_prediction_origin = Eigen::VectorXd::Constant(dof, std::numeric_limits<double>::quiet_NaN());
   loop_factor_structure(model, *this);
 }
 

@@ -53,7 +53,10 @@ Status loop_constraints(const MechanismModel& model, MechanismData& data, const 
 /// unchanged. data.loop_iterations, data.loop_residual_norm report the solve. When `q` is the
 /// position of the last projection (data.closed_position: the usual tick passes back the q it got),
 /// the warm start is first moved along the closure manifold to second order (q + C d + s^2 c / 2,
-/// d the change of the actuated coordinates), which saves Newton iterations at control rates.
+/// d the change of the actuated coordinates), plus the third- and fourth-order terms estimated
+/// from the last ticks' prediction errors and, when the last solve took no Newton step, one
+/// Newton step of its residual: at control rates most ticks then close the loops at the
+/// prediction, with no Newton step (data.loop_iterations = 0).
 Status solve_loop_positions(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
                             Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options = {}) noexcept;
 

@@ -158,6 +158,16 @@ struct MechanismData {
   RowMajorMatrix loop_solution;            ///< np x nla (elimination order)
   Eigen::MatrixXd loop_reduced_work;       ///< n x na
   Eigen::VectorXd loop_vector_work;        ///< n
+  /// The warm start's third- and fourth-order terms (loops.cpp, solve_positions): after a
+  /// warm-started solve, the solution minus the second-order prediction it started from (n), the
+  /// same one tick earlier, the solution they are valid at, the step parameters s of those
+  /// predictions, the largest |entry| of the last error and how many of the two errors are
+  /// consecutive (0 to 2).
+  Eigen::VectorXd loop_prediction_error, loop_prediction_error_old, loop_prediction_origin;
+  double loop_prediction_step = 0.0, loop_prediction_step_old = 0.0, loop_prediction_size = 0.0;
+  int loop_prediction_depth = 0;
+  Eigen::VectorXd loop_prediction_offset;  ///< np: a Newton step from the last solution, when it took none
+  bool loop_prediction_offset_valid = false;
 
   // ---- internal buffers (per link, in the joint-aligned frames L_i of model.hpp) ----
   // Field order: what one pass touches sits together (the placement, relative and in O, then the
