@@ -389,6 +389,39 @@ def test_paminsa_force_balanced_in_mujoco():
     assert peaks["balanced"] < peaks["mujoco_weights"] < 1e-2 * peaks["unbalanced"]
 
 
+
+@pytest.mark.parametrize("torque, first_bad", [(1e30, 20), (1e9, 21)])
+def test_co_simulation_stops_where_mujoco_refuses_the_torque_or_resets(torque, first_bad):
+    """MuJoCo does not fail on a bad tick: it zeroes a huge control (1e30: mjWARN_BADCTRL, the
+    tick's own wrench is then without it) and resets a state its step made diverge (1e9:
+    mjWARN_BADQACC, back to the model's rest pose), then goes on. The co-simulation stops at that
+    tick (steps_completed 20, Status.out_of_range from the first bad row on) and the later rows
+    repeat the last one written, as mechbal's own simulator does; before, it ran to the end with
+    every status 0."""
+    from mechbal.balance.run import load_case
+    from mechbal.config import trajectory_from_config
+
+    bc = load_case("four-bar")
+    mech = bc.mechanism
+    n = len(mech.actuated_names)
+    traj, _ = trajectory_from_config({k: v for k, v in bc.trajectory_table.items() if k != "initial_guess"}, n)
+
+    class Runaway:   # a controller whose torque blows up at its 21st tick (k = 20)
+        ticks = 0
+
+        def step(self, q, v, q_des, v_des, a_des):
+            self.ticks += 1
+            return np.full(n, torque if self.ticks > 20 else 0.0), 0
+
+    cs = co_simulate(mech, Runaway(), traj, q_guess=bc.q_guess, duration=0.1)
+    assert cs.steps_completed == 20 and len(cs.t) == 101
+    bad = (cs.status & int(_core.Status.out_of_range)) != 0
+    assert not bad[:first_bad].any() and bad[first_bad:].all()
+    for series in (cs.q, cs.v, cs.joint_torque, cs.base_reaction_force, cs.base_reaction_moment, cs.q_full,
+                   cs.a_full, cs.constraint_violation):
+        assert np.array_equal(series[21:], np.broadcast_to(series[20], series[21:].shape))
+    assert np.all(np.isfinite(cs.q)) and abs(cs.q[20, 0] - cs.q[19, 0]) < 1e-2   # not MuJoCo's reset pose
+
 def test_verify_four_bar(tmp_path):
     from mechbal.cli import main
 

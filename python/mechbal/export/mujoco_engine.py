@@ -270,7 +270,11 @@ class CoSimulation(DeprecatedAttributes):
     minus their weight, `MujocoMechanism.momentum_rate`) beside mechbal's prediction along
     the desired motion (``predicted_base_reaction_force`` / ``_moment``), the moving mass ``mass``
     and first moment ``mass_moment`` (N, 3) that turn them into shaking wrenches, and the largest
-    loop-closure violation ``constraint_violation`` (N,) [m or rad] of MuJoCo's soft constraints."""
+    loop-closure violation ``constraint_violation`` (N,) [m or rad] of MuJoCo's soft constraints.
+    ``steps_completed`` is ``steps`` unless MuJoCo failed: a non-finite state, or its own
+    instability warnings (it zeroes a non-finite or huge control and resets a diverging state
+    rather than stop). The failed tick and the later ones then have ``Status.out_of_range`` in
+    ``status``, and the rows after the last one written repeat it."""
     t: np.ndarray
     q: np.ndarray
     v: np.ndarray
@@ -396,6 +400,16 @@ def co_simulate(mech, controller, trajectory, q0=None, v0=None, *, dt: float = 1
     completed = steps
     mass = sim.moving_mass()
     tau = np.zeros(n)
+    # MuJoCo does not fail on a bad state or control: it zeroes a non-finite or huge control
+    # (mjWARN_BADCTRL) and resets its state on a diverging one (BADQACC, BADQPOS, BADQVEL), then
+    # goes on. A new count of those warnings ends the co-simulation as a non-finite state does.
+    unstable = [getattr(mj.mjtWarning, f"mjWARN_{w}") for w in ("BADCTRL", "BADQACC", "BADQPOS", "BADQVEL")]
+
+    def warnings() -> int:
+        return sum(int(d.warning[int(w)].number) for w in unstable)
+
+    warned = warnings()
+    last = steps   # the last row written
     for k in range(steps + 1):
         qk, vk = sim.coordinates()
         qa, va = qk[act], vk[act]
@@ -413,14 +427,21 @@ def co_simulate(mech, controller, trajectory, q0=None, v0=None, *, dt: float = 1
         mc[k] = sum(m.body_mass[b] * d.xipos[b] for b in moving) if moving else np.zeros(3)
         viol[k] = float(np.max(np.abs(d.efc_pos[:d.ne]))) if d.ne else 0.0
         log["q"][k], log["v"][k], log["tau"][k] = qa, va, tau
+        if warnings() != warned:   # MuJoCo refused this tick's torque (the row's wrench is without it)
+            completed, last = k, k
+            status[k:] |= np.uint32(int(_core.Status.out_of_range))
+            break
         if k == steps:
             break
         for _ in range(int(substeps)):
             mj.mj_step(m, d)
-        if not (np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel))):
-            completed = k
+        if warnings() != warned or not (np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel))):
+            completed, last = k, k
             status[k + 1:] = int(_core.Status.out_of_range)
             break
+    # after a failure the later rows repeat the last one written (as mechbal's own simulator does)
+    for series in (*log.values(), *full.values(), F, M, mc, viol):
+        series[last + 1:] = series[last]
     bm = model.body_motion(Q)
     still_bodies = _still_bodies(model)
     masses = np.array([0.0 if b.name in still_bodies else float(b.mass) for b in model.bodies])
