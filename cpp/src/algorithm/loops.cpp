@@ -416,7 +416,8 @@ Status check(const MechanismModel& model, MechanismData& data, const Eigen::Ref<
   if (q.size() != model.dof() || (qa && qa->size() != na) || (va && va->size() != na) || (aa && aa->size() != na)) {
     return Status::bad_size;
   }
-  if (!q.allFinite() || (qa && !qa->allFinite()) || (va && !va->allFinite()) || (aa && !aa->allFinite())) {
+  if (!detail::all_finite(q) || (qa && !detail::all_finite(*qa)) || (va && !detail::all_finite(*va)) ||
+      (aa && !detail::all_finite(*aa))) {
     return Status::non_finite_input;
   }
   return Status::ok;

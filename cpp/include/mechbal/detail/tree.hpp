@@ -35,12 +35,17 @@ inline bool data_matches(const MechanismModel& model, const MechanismData& data)
          static_cast<int>(data.work.size()) == model.num_links();
 }
 
-/// True when every entry of x is finite (a NaN fails the comparison): one loop without branches,
-/// inlined where Eigen's allFinite was left as a call in a big translation unit.
-inline bool all_finite(const Eigen::Ref<const Eigen::VectorXd>& x) noexcept {
+/// True when every entry of x (a vector or a matrix) is finite (a NaN fails the comparison): one
+/// loop without branches, inlined where Eigen's allFinite (x - x compared with itself entry by
+/// entry) was left as a call in a big translation unit. The input checks and the algorithms'
+/// result checks (finite_result) share it.
+template <typename Derived>
+inline bool all_finite(const Eigen::DenseBase<Derived>& x) noexcept {
   constexpr double kMax = std::numeric_limits<double>::max();
+  const Derived& m = x.derived();
   bool finite = true;
-  for (Eigen::Index i = 0; i < x.size(); ++i) finite &= std::abs(x(i)) <= kMax;
+  for (Eigen::Index j = 0; j < m.cols(); ++j)
+    for (Eigen::Index i = 0; i < m.rows(); ++i) finite &= std::abs(m.coeff(i, j)) <= kMax;
   return finite;
 }
 
