@@ -195,68 +195,53 @@ void evaluate(const MechanismModel& model, MechanismData& data, const Eigen::Ref
   constraint_rows(model, data, jacobian);
 }
 
-/// N = L D L^T in place, without pivoting, over the structure of data.loop_factor_rows (N is
-/// symmetric positive semi-definite: the normal matrix of A° plus a small damping; its rows and
-/// columns in the elimination order): L in N's strict lower triangle (unit diagonal implied, only
-/// the structural entries are read or written), D in `D`. Written out for the small, sparse
-/// systems of loop closures, where a dense LDLT (pivot search, blocked triangular solves) costs
-/// several times more. A pivot that is not positive (a singular A°) is kept as is and its
-/// component is zeroed by ldl_solve, as Eigen's LDLT does (pseudo-inverse of D).
+/// N = L D L^T in place (data.loop_factor_values: N's pivots and lower triangle on L's structure,
+/// assembled by factor_passive), without pivoting: D in the first np entries, L's strict lower
+/// part (unit diagonal implied) after them, in loop_factor_rows' order. N is symmetric positive
+/// semi-definite (the normal matrix of A° plus a small damping, in the elimination order). The
+/// updates run down the list precomputed at construction (loop_factor_updates: which entry each
+/// product of a column's multipliers updates), so the numeric factorisation is straight loops over
+/// contiguous arrays. A pivot that is not positive (a singular A°) is kept as is and its component
+/// is zeroed by the solves, as Eigen's LDLT does (pseudo-inverse of D: loop_pivot_inverse, which
+/// the solves multiply by, holds 0 there).
 void ldl_factor(MechanismData& data) noexcept {
-  Eigen::MatrixXd& N = data.loop_normal;
-  Eigen::VectorXd& D = data.loop_normal_pivots;
-  const int* rows = data.loop_factor_rows.data();
-  const Eigen::Index n = N.rows();
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double d = N(k, k);
-    D(k) = d;
-    const int begin = data.loop_factor_start[static_cast<std::size_t>(k)];
-    const int end = data.loop_factor_start[static_cast<std::size_t>(k) + 1];
-    double* lk = N.data() + k * n;
-    if (!(d > 0.0)) {
-      for (int p = begin; p < end; ++p) lk[rows[p]] = 0.0;
-      continue;
-    }
-    // the column's multipliers l_jk = N_jk / d, divided once (kept aside while the unscaled column
-    // updates the rest; a column with more structural entries than the buffer divides twice)
-    constexpr int kBuffer = 32;
-    double scaled[kBuffer];
-    const bool buffered = end - begin <= kBuffer;
+  double* const V = data.loop_factor_values.data();
+  const auto np = static_cast<int>(data.loop_elimination.size());
+  double* const L = V + np;
+  const int* start = data.loop_factor_start.data();
+  double* const inverse = data.loop_pivot_inverse.data();
+  const int* target = data.loop_factor_updates.data();
+  for (int k = 0; k < np; ++k) {
+    const double d = V[k];
+    const double inv = d > 0.0 ? 1.0 / d : 0.0;
+    inverse[k] = inv;
+    const int begin = start[k], end = start[k + 1];
+    // the column's multipliers l_jk = N_jk / d (0 below a pivot that is not positive); N_jk itself
+    // (unscaled) updates the rest of row j and is replaced by l_jk once no later update reads it
     for (int p = begin; p < end; ++p) {
-      const int j = rows[p];
-      const double f = lk[j] / d;
-      if (buffered) scaled[p - begin] = f;
-      if (f == 0.0) continue;
-      double* nj = N.data() + j * n;
-      for (int r = p; r < end; ++r) nj[rows[r]] -= f * lk[rows[r]];
-    }
-    if (buffered) {
-      for (int p = begin; p < end; ++p) lk[rows[p]] = scaled[p - begin];
-    } else {
-      for (int p = begin; p < end; ++p) lk[rows[p]] /= d;
+      const double f = L[p] * inv;
+      for (int r = p; r < end; ++r) V[*target++] -= f * L[r];
+      L[p] = f;
     }
   }
 }
 
 /// x = (L D L^T)^-1 x with the factors of ldl_factor.
 void ldl_solve(const MechanismData& data, Eigen::Ref<Eigen::VectorXd> x) noexcept {
-  const Eigen::MatrixXd& L = data.loop_normal;
-  const Eigen::VectorXd& D = data.loop_normal_pivots;
+  const auto np = static_cast<int>(data.loop_elimination.size());
+  const double* const L = data.loop_factor_values.data() + np;  // (after the pivots)
   const int* rows = data.loop_factor_rows.data();
   const int* start = data.loop_factor_start.data();
-  const Eigen::Index n = L.rows();
   double* const v = x.data();
-  for (Eigen::Index k = 0; k < n; ++k) {
+  for (int k = 0; k < np; ++k) {
     const double xk = v[k];
-    if (xk == 0.0) continue;
-    const double* l = L.data() + k * n;
-    for (int p = start[k]; p < start[k + 1]; ++p) v[rows[p]] -= xk * l[rows[p]];
+    for (int p = start[k]; p < start[k + 1]; ++p) v[rows[p]] -= xk * L[p];
   }
-  for (Eigen::Index k = 0; k < n; ++k) v[k] = D(k) > 0.0 ? v[k] / D(k) : 0.0;
-  for (Eigen::Index k = n - 1; k >= 0; --k) {
-    const double* l = L.data() + k * n;
+  const double* const inverse = data.loop_pivot_inverse.data();
+  for (int k = 0; k < np; ++k) v[k] *= inverse[k];
+  for (int k = np - 1; k >= 0; --k) {
     double sum = 0.0;
-    for (int p = start[k]; p < start[k + 1]; ++p) sum += l[rows[p]] * v[rows[p]];
+    for (int p = start[k]; p < start[k + 1]; ++p) sum += L[p] * v[rows[p]];
     v[k] -= sum;
   }
 }
@@ -272,23 +257,21 @@ inline void axpy(double* y, double a, const double* x, Eigen::Index n) noexcept 
 /// ldl_solve_block with w = W columns (0: X.cols()), unrolled for the usual one to four.
 template <int W>
 void ldl_solve_block_width(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
-  const Eigen::MatrixXd& L = data.loop_normal;
-  const Eigen::VectorXd& D = data.loop_normal_pivots;
+  const auto np = static_cast<int>(data.loop_elimination.size());
+  const double* const L = data.loop_factor_values.data() + np;  // (after the pivots)
   const int* rows = data.loop_factor_rows.data();
   const int* start = data.loop_factor_start.data();
-  const Eigen::Index n = L.rows(), w = W > 0 ? W : X.cols();
+  const Eigen::Index w = W > 0 ? W : X.cols();
   double* x = X.data();
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double* l = L.data() + k * n;
-    for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(x + rows[p] * w, -l[rows[p]], x + k * w, w);
+  for (int k = 0; k < np; ++k) {
+    for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(x + rows[p] * w, -L[p], x + k * w, w);
   }
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double inv = D(k) > 0.0 ? 1.0 / D(k) : 0.0;
+  for (int k = 0; k < np; ++k) {
+    const double inv = data.loop_pivot_inverse(k);
     for (Eigen::Index j = 0; j < w; ++j) x[k * w + j] *= inv;
   }
-  for (Eigen::Index k = n - 1; k >= 0; --k) {
-    const double* l = L.data() + k * n;
-    for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(x + k * w, -l[rows[p]], x + rows[p] * w, w);
+  for (int k = np - 1; k >= 0; --k) {
+    for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(x + k * w, -L[p], x + rows[p] * w, w);
   }
 }
 
@@ -304,19 +287,59 @@ void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X
   }
 }
 
-/// X = -A°^T B (np x w, row-major; B m x w row-major) over A°'s structural nonzeros, w = W (0: B's).
+/// Loop l's slice of A° (data.loop_passive_blocks): its first row and row count, its passive
+/// columns (elimination positions) and their block (rows x count, column-major).
+struct LoopBlock {
+  int r0, rows, count;
+  const int* members;
+  int offset;  // into data.loop_passive_blocks
+};
+
+inline LoopBlock loop_block(const MechanismData& data, int l) noexcept {
+  const auto i = static_cast<std::size_t>(l);
+  LoopBlock b;
+  b.r0 = data.loop_row_start[i];
+  b.rows = data.loop_row_start[i + 1] - b.r0;
+  b.members = data.loop_members.data() + data.loop_member_start[i];
+  b.count = data.loop_member_start[i + 1] - data.loop_member_start[i];
+  b.offset = data.loop_block_start[i];
+  return b;
+}
+
+inline int num_loop_blocks(const MechanismData& data) noexcept {
+  return static_cast<int>(data.loop_block_start.size()) - 1;
+}
+
+/// X = -A°^T B (np x w, row-major; B m x w row-major) over A°'s blocks, w = W (0: B's).
 template <int W>
 void passive_transpose_times(const MechanismData& data, const MechanismData::RowMajorMatrix& B,
                              MechanismData::RowMajorMatrix& X) noexcept {
-  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
   const Eigen::Index w = W > 0 ? W : B.cols();
   X.setZero();
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-    const double* a = Ap.data() + i * Ap.rows();
-    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-    for (int p = 0; p < data.loop_passive_count(i); ++p) {
-      const int r = rows[p];
-      axpy<W>(X.data() + i * w, -a[r], B.data() + r * w, w);
+  for (int l = 0; l < num_loop_blocks(data); ++l) {
+    const LoopBlock lb = loop_block(data, l);
+    const double* a = data.loop_passive_blocks.data() + lb.offset;
+    const double* b = B.data() + lb.r0 * w;
+    for (int c = 0; c < lb.count; ++c, a += lb.rows) {
+      double* x = X.data() + lb.members[c] * w;
+      for (int r = 0; r < lb.rows; ++r) axpy<W>(x, -a[r], b + r * w, w);
+    }
+  }
+}
+
+/// out = A°^T y (or -A°^T y with `Negate`) over A°'s blocks (np).
+template <bool Negate>
+void passive_transpose_apply(const MechanismData& data, const double* y, Eigen::VectorXd& out) noexcept {
+  out.setZero();
+  double* o = out.data();
+  for (int l = 0; l < num_loop_blocks(data); ++l) {
+    const LoopBlock lb = loop_block(data, l);
+    const double* a = data.loop_passive_blocks.data() + lb.offset;
+    const double* yl = y + lb.r0;
+    for (int c = 0; c < lb.count; ++c, a += lb.rows) {
+      double sum = 0.0;
+      for (int r = 0; r < lb.rows; ++r) sum += a[r] * yl[r];
+      o[lb.members[c]] += Negate ? -sum : sum;
     }
   }
 }
@@ -324,85 +347,62 @@ void passive_transpose_times(const MechanismData& data, const MechanismData::Row
 /// Relative damping of the normal equations: keeps the solves bounded at a singular A° (Status::singular).
 constexpr double kDamping = 1e-16;
 
-/// N(j, i) += A°(rows of one loop, j) . A°(those rows, i) over the loop's passive columns
-/// (`members`, increasing: j >= i, the lower triangle, L's structure); R = rows (0: `rows`).
+/// One loop's block of A° from A (its rows, R of them (0: `rows`), of its passive columns), then
+/// N += the products of its columns (column pairs a <= b in order, into the entries `target`
+/// lists: symbolic factorisation).
 template <int R>
-void add_loop_products(const Eigen::MatrixXd& Ap, Eigen::MatrixXd& N, int r0, int rows, const int* members,
-                       int count) noexcept {
-  const Eigen::Index m = Ap.rows();
-  const int nr = R > 0 ? R : rows;
+const int* add_loop_products(const MechanismData& data, const LoopBlock& lb, double* block, double* V,
+                             const int* target) noexcept {
+  const int nr = R > 0 ? R : lb.rows;
+  const int count = lb.count;
+  const Eigen::Index m = data.loop_jacobian.rows();
+  for (int c = 0; c < count; ++c) {
+    const double* from = data.loop_jacobian.data() +
+                         static_cast<Eigen::Index>(data.loop_elimination[static_cast<std::size_t>(lb.members[c])]) * m + lb.r0;
+    for (int r = 0; r < nr; ++r) block[c * nr + r] = from[r];
+  }
   for (int a = 0; a < count; ++a) {
-    const Eigen::Index i = members[a];
-    const double* ai = Ap.data() + i * m + r0;
-    double* ni = N.data() + i * N.rows();
+    const double* ai = block + a * nr;
     for (int b = a; b < count; ++b) {
-      const double* aj = Ap.data() + members[b] * m + r0;
+      const double* aj = block + b * nr;
       double sum = 0.0;
       for (int r = 0; r < nr; ++r) sum += ai[r] * aj[r];
-      ni[members[b]] += sum;
+      V[*target++] += sum;
     }
   }
+  return target;
 }
 
 /// N = A°^T A° + damping from data.loop_jacobian, factorised; returns the rcond estimate of A°.
 double factor_passive(MechanismData& data) noexcept {
-  const auto& order = data.loop_elimination;
-  const auto np = static_cast<Eigen::Index>(order.size());
-  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
-  const auto m = static_cast<int>(Ap.rows());
-  // A°'s columns in the elimination order, over the rows each can be nonzero in (the rows of the
-  // loops whose frames it moves, fixed at construction: data.loop_passive_rows); the other
-  // entries of A° stay zero
-  for (Eigen::Index j = 0; j < np; ++j) {
-    const double* from = data.loop_jacobian.data() + static_cast<Eigen::Index>(order[static_cast<std::size_t>(j)]) * m;
-    double* to = data.loop_passive_jacobian.data() + j * m;
-    const int* rows = data.loop_passive_rows.data() + j * data.loop_passive_rows.rows();
-    for (int p = 0; p < data.loop_passive_count(j); ++p) to[rows[p]] = from[rows[p]];
-  }
-  // N = A°^T A° on the structure of L (which holds N's): the sum over the loops of the products
-  // of their own columns over their own rows (2 to 6 rows, a handful of columns each)
-  Eigen::MatrixXd& N = data.loop_normal;
-  for (Eigen::Index i = 0; i < np; ++i) {
-    N(i, i) = 0.0;
-    const int end = data.loop_factor_start[static_cast<std::size_t>(i) + 1];
-    for (int p = data.loop_factor_start[static_cast<std::size_t>(i)]; p < end; ++p) {
-      N(data.loop_factor_rows[static_cast<std::size_t>(p)], i) = 0.0;
-    }
-  }
-  const int nloops = static_cast<int>(data.loop_member_start.size()) - 1;
-  for (int l = 0; l < nloops; ++l) {
-    const int r0 = data.loop_row_start[static_cast<std::size_t>(l)];
-    const int rows = data.loop_row_start[static_cast<std::size_t>(l) + 1] - r0;
-    const int* members = data.loop_members.data() + data.loop_member_start[static_cast<std::size_t>(l)];
-    const int count = data.loop_member_start[static_cast<std::size_t>(l) + 1] - data.loop_member_start[static_cast<std::size_t>(l)];
+  const auto np = static_cast<int>(data.loop_elimination.size());
+  // A°'s blocks from A (each loop's rows of its passive columns; A°'s other entries are zero),
+  // then N = A°^T A° on the structure of L: the sum over the loops of the products of their own
+  // columns over their own rows (2 to 6 rows, a handful of columns each)
+  double* const V = data.loop_factor_values.data();
+  const auto size = static_cast<int>(data.loop_factor_values.size());
+  for (int i = 0; i < size; ++i) V[i] = 0.0;
+  const int* target = data.loop_normal_targets.data();
+  for (int l = 0; l < num_loop_blocks(data); ++l) {
+    const LoopBlock lb = loop_block(data, l);
+    double* block = data.loop_passive_blocks.data() + lb.offset;
     // (the loop types' row counts unrolled: 2 planar_point, 3 point, 5 axis, 6 weld)
-    switch (rows) {
-      case 2: add_loop_products<2>(Ap, N, r0, rows, members, count); break;
-      case 3: add_loop_products<3>(Ap, N, r0, rows, members, count); break;
-      case 5: add_loop_products<5>(Ap, N, r0, rows, members, count); break;
-      case 6: add_loop_products<6>(Ap, N, r0, rows, members, count); break;
-      default: add_loop_products<0>(Ap, N, r0, rows, members, count); break;
+    switch (lb.rows) {
+      case 2: target = add_loop_products<2>(data, lb, block, V, target); break;
+      case 3: target = add_loop_products<3>(data, lb, block, V, target); break;
+      case 5: target = add_loop_products<5>(data, lb, block, V, target); break;
+      case 6: target = add_loop_products<6>(data, lb, block, V, target); break;
+      default: target = add_loop_products<0>(data, lb, block, V, target); break;
     }
   }
   double scale = 1.0;
-  for (Eigen::Index i = 0; i < np; ++i) scale = std::max(scale, N(i, i));
-  for (Eigen::Index i = 0; i < np; ++i) N(i, i) += kDamping * scale;
+  for (int i = 0; i < np; ++i) scale = std::max(scale, V[i]);
+  for (int i = 0; i < np; ++i) V[i] += kDamping * scale;
   ldl_factor(data);
-  const Eigen::VectorXd& D = data.loop_normal_pivots;
   if (np == 0) return 1.0;
+  const auto D = data.loop_factor_values.head(np);
   const double dmax = D.cwiseAbs().maxCoeff(), dmin = D.cwiseAbs().minCoeff();
   return dmax > 0.0 ? std::sqrt(std::max(0.0, dmin - kDamping * scale) / dmax) : 0.0;
-}
-
-/// (A°^T y)_i: column i of A° (elimination order) against y, over the rows holding the column's
-/// nonzeros (data.loop_passive_rows, from factor_passive).
-double column_dot(const MechanismData& data, Eigen::Index i, const double* y) noexcept {
-  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
-  const double* a = Ap.data() + i * Ap.rows();
-  double sum = 0.0;
-  const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-  for (int p = 0; p < data.loop_passive_count(i); ++p) sum += a[rows[p]] * y[rows[p]];
-  return sum;
 }
 
 Status check(const MechanismModel& model, MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,
@@ -548,9 +548,7 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
       evaluate(model, data, trial, false);  // the residual at trial (the step needs it)
       placed_at_trial = true;
     }
-    for (Eigen::Index i = 0; i < data.loop_step.size(); ++i) {
-      data.loop_step(i) = -column_dot(data, i, data.loop_residual.data());
-    }
+    passive_transpose_apply<true>(data, data.loop_residual.data(), data.loop_step);
     ldl_solve(data, data.loop_step);
     const double biggest = data.loop_step.cwiseAbs().maxCoeff();
     if (!(biggest < 1e300)) {  // non-finite step: cannot assemble here
@@ -614,7 +612,7 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
     Eigen::VectorXd& offset = data.loop_prediction_offset;
     data.loop_prediction_offset_valid = data.loop_iterations == 0 && norm > 0.0 && !passive.empty();
     if (data.loop_prediction_offset_valid) {
-      for (Eigen::Index i = 0; i < offset.size(); ++i) offset(i) = -column_dot(data, i, data.loop_residual.data());
+      passive_transpose_apply<true>(data, data.loop_residual.data(), offset);
       ldl_solve(data, offset);
       for (std::size_t j = 0; j < passive.size(); ++j) raw(data.loop_elimination[j]) += offset(static_cast<Eigen::Index>(j));
     }
@@ -643,17 +641,18 @@ namespace {
 /// machine's internal spring forces of thousands of newtons multiply C's error: Orthoglide).
 template <typename B, typename X>
 void refine(MechanismData& data, const B& b, X&& x) noexcept {
-  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
   Eigen::VectorXd& r = data.loop_constraint_work;
   r = -b;
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-    const double xi = x(i);
-    const double* a = Ap.data() + i * Ap.rows();
-    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-    for (int p = 0; p < data.loop_passive_count(i); ++p) r(rows[p]) -= a[rows[p]] * xi;
+  for (int l = 0; l < num_loop_blocks(data); ++l) {
+    const LoopBlock lb = loop_block(data, l);
+    const double* a = data.loop_passive_blocks.data() + lb.offset;
+    for (int c = 0; c < lb.count; ++c, a += lb.rows) {
+      const double xi = x(lb.members[c]);
+      for (int k = 0; k < lb.rows; ++k) r(lb.r0 + k) -= a[k] * xi;
+    }
   }
   Eigen::VectorXd& step = data.loop_step;
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) step(i) = column_dot(data, i, r.data());
+  passive_transpose_apply<false>(data, r.data(), step);
   ldl_solve(data, step);
   x += step;
 }
@@ -724,7 +723,6 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
     data.loop_actuated_jacobian.col(static_cast<Eigen::Index>(t)) =
         data.loop_jacobian.col(actuated[static_cast<std::size_t>(columns[t])]);
   }
-  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
   // X = -A°^T A# (each column of A° over its nonzero rows), solved for all columns at once, then
   // one step of iterative refinement (see refine): R = -A# - A° X, X += (A°^T A°)^-1 A°^T R
   MechanismData::RowMajorMatrix& X = data.loop_solution;
@@ -732,7 +730,6 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   MechanismData::RowMajorMatrix& S = data.loop_block_step;
   const MechanismData::RowMajorMatrix& Aa = data.loop_actuated_jacobian;
   const Eigen::Index w = X.cols();
-  const auto column = [&](Eigen::Index i) { return Ap.data() + i * Ap.rows(); };
   switch (w) {
     case 1: passive_transpose_times<1>(data, Aa, X); break;
     case 2: passive_transpose_times<2>(data, Aa, X); break;
@@ -745,20 +742,20 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   if (refine_solves) {
     R = -Aa;
     S.setZero();
-    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-      const double* a = column(i);
-      const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-      for (int p = 0; p < data.loop_passive_count(i); ++p) {
-        const int r = rows[p];
-        axpy(R.data() + r * w, -a[r], X.data() + i * w, w);
+    for (int l = 0; l < num_loop_blocks(data); ++l) {
+      const LoopBlock lb = loop_block(data, l);
+      const double* a = data.loop_passive_blocks.data() + lb.offset;
+      for (int c = 0; c < lb.count; ++c, a += lb.rows) {
+        const double* x = X.data() + lb.members[c] * w;
+        for (int k = 0; k < lb.rows; ++k) axpy(R.data() + (lb.r0 + k) * w, -a[k], x, w);
       }
     }
-    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-      const double* a = column(i);
-      const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-      for (int p = 0; p < data.loop_passive_count(i); ++p) {
-        const int r = rows[p];
-        axpy(S.data() + i * w, a[r], R.data() + r * w, w);
+    for (int l = 0; l < num_loop_blocks(data); ++l) {
+      const LoopBlock lb = loop_block(data, l);
+      const double* a = data.loop_passive_blocks.data() + lb.offset;
+      for (int c = 0; c < lb.count; ++c, a += lb.rows) {
+        double* si = S.data() + lb.members[c] * w;
+        for (int k = 0; k < lb.rows; ++k) axpy(si, a[k], R.data() + (lb.r0 + k) * w, w);
       }
     }
     ldl_solve_block(data, S);
@@ -775,7 +772,7 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   apply_projection(model, data, v_actuated, data.closed_velocity);
   // the loops must accept the actuated velocities (A v = 0); they do not at a serial singularity of
   // the closure or when the actuators over-constrain the mechanism
-  // (A v over A's nonzeros: A°'s in each column's rows, A#'s loop columns; the others are zero)
+  // (A v over A's nonzeros: A°'s blocks, A#'s loop columns; the others are zero)
   // (the largest |entry| per column first: short, independent chains of max)
   Eigen::VectorXd& Av = data.loop_constraint_work;
   double biggest = 0.0;
@@ -789,16 +786,19 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
     Av(r) = sum;
     biggest = std::max(biggest, row_max);
   }
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-    const double* a = column(i);
-    const double vi = data.closed_velocity(data.loop_elimination[static_cast<std::size_t>(i)]);
-    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-    double column_max = 0.0;
-    for (int p = 0; p < data.loop_passive_count(i); ++p) {
-      Av(rows[p]) += a[rows[p]] * vi;
-      column_max = std::max(column_max, std::abs(a[rows[p]]));
+  for (int l = 0; l < num_loop_blocks(data); ++l) {
+    const LoopBlock lb = loop_block(data, l);
+    const double* a = data.loop_passive_blocks.data() + lb.offset;
+    double* av = Av.data() + lb.r0;
+    for (int c = 0; c < lb.count; ++c, a += lb.rows) {
+      const double vi = data.closed_velocity(data.loop_elimination[static_cast<std::size_t>(lb.members[c])]);
+      double column_max = 0.0;
+      for (int k = 0; k < lb.rows; ++k) {
+        av[k] += a[k] * vi;
+        column_max = std::max(column_max, std::abs(a[k]));
+      }
+      biggest = std::max(biggest, column_max);
     }
-    biggest = std::max(biggest, column_max);
   }
   const double scale = 1.0 + biggest * data.closed_velocity.cwiseAbs().maxCoeff();
   if (!(Av.cwiseAbs().maxCoeff() <= 1e-8 * scale)) status = Status::singular;
@@ -808,7 +808,7 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   // (the links are placed at q: by the solve's last evaluation, or by evaluate above)
   detail::forward_pass<true, false, false, false>(model, data);
   constraint_bias(model, data);
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) data.loop_step(i) = -column_dot(data, i, data.loop_bias.data());
+  passive_transpose_apply<true>(data, data.loop_bias.data(), data.loop_step);
   ldl_solve(data, data.loop_step);
   data.loop_refine_solution = data.loop_step;
   if (refine_solves) refine(data, data.loop_bias, data.loop_refine_solution);

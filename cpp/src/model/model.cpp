@@ -649,29 +649,46 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     data.loop_members.insert(data.loop_members.end(), own.begin(), own.end());
     data.loop_member_start.push_back(static_cast<int>(data.loop_members.size()));
   }
-  // the rows of A° each passive column can be nonzero in (elimination order): the rows of the
-  // loops whose frames it moves; the factorisation reads A° over these only
-  data.loop_passive_rows.setZero(m, static_cast<Eigen::Index>(np));
-  data.loop_passive_count.setZero(static_cast<Eigen::Index>(np));
-  data.loop_passive_first.setZero(static_cast<Eigen::Index>(np));
-  data.loop_passive_last.setConstant(static_cast<Eigen::Index>(np), -1);
-  for (std::size_t k = 0; k < np; ++k) {
-    const int coordinate = data.loop_elimination[k];
-    const auto j = static_cast<Eigen::Index>(k);
-    int count = 0;
-    for (int i = 0; i < model.num_loops(); ++i) {
-      bool moves = false;
-      for (int frame : {model.loop_frame_a(i), model.loop_frame_b(i)}) {
-        for (int l = model.frame_link(frame); l >= 1; l = model.parent(l)) moves = moves || model.coordinate(l) == coordinate;
+  // A° by loop (loop_block_start): loop i's rows over its passive columns, the structural nonzeros
+  // of A° (a passive column is nonzero in the rows of the loops whose frames it moves)
+  data.loop_block_start.assign(1, 0);
+  for (int i = 0; i < model.num_loops(); ++i) {
+    const int rows = data.loop_row_start[static_cast<std::size_t>(i) + 1] - data.loop_row_start[static_cast<std::size_t>(i)];
+    const int count = data.loop_member_start[static_cast<std::size_t>(i) + 1] - data.loop_member_start[static_cast<std::size_t>(i)];
+    data.loop_block_start.push_back(data.loop_block_start.back() + rows * count);
+  }
+  data.loop_passive_blocks = Eigen::VectorXd::Zero(data.loop_block_start.back());
+  // the numeric LDL^T as straight lists: N's (and L's) entries in loop_factor_values (the np
+  // pivots, then L's entries in loop_factor_rows' order); where each loop's products of its
+  // columns add into N, and where each column's elimination updates the columns after it
+  const auto entry = [&](int column, int row) {  // (row, column) of N's lower triangle
+    if (row == column) return column;
+    const auto first = data.loop_factor_rows.begin() + data.loop_factor_start[static_cast<std::size_t>(column)];
+    const auto last = data.loop_factor_rows.begin() + data.loop_factor_start[static_cast<std::size_t>(column) + 1];
+    const auto at = std::lower_bound(first, last, row);
+    if (at == last || *at != row) throw std::logic_error("loop factor structure: missing fill entry");
+    return static_cast<int>(np) + static_cast<int>(at - data.loop_factor_rows.begin());
+  };
+  data.loop_factor_values = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(np + data.loop_factor_rows.size()));
+  data.loop_factor_values.head(static_cast<Eigen::Index>(np)).setOnes();  // N = I until the first factorisation
+  data.loop_pivot_inverse = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(np));
+  data.loop_normal_targets.clear();
+  for (int i = 0; i < model.num_loops(); ++i) {
+    const int begin = data.loop_member_start[static_cast<std::size_t>(i)];
+    const int end = data.loop_member_start[static_cast<std::size_t>(i) + 1];
+    for (int a = begin; a < end; ++a) {
+      for (int b = a; b < end; ++b) {
+        data.loop_normal_targets.push_back(entry(data.loop_members[static_cast<std::size_t>(a)], data.loop_members[static_cast<std::size_t>(b)]));
       }
-      if (!moves) continue;
-      const int end = i + 1 < model.num_loops() ? model.loop_row(i + 1) : model.num_constraints();
-      for (int r = model.loop_row(i); r < end; ++r) data.loop_passive_rows(count++, j) = r;
     }
-    data.loop_passive_count(j) = count;
-    if (count > 0) {
-      data.loop_passive_first(j) = data.loop_passive_rows(0, j);
-      data.loop_passive_last(j) = data.loop_passive_rows(count - 1, j);
+  }
+  data.loop_factor_updates.clear();
+  for (std::size_t k = 0; k < np; ++k) {
+    const int begin = data.loop_factor_start[k], end = data.loop_factor_start[k + 1];
+    for (int p = begin; p < end; ++p) {
+      for (int r = p; r < end; ++r) {
+        data.loop_factor_updates.push_back(entry(data.loop_factor_rows[static_cast<std::size_t>(p)], data.loop_factor_rows[static_cast<std::size_t>(r)]));
+      }
     }
   }
 }
@@ -748,18 +765,11 @@ MechanismData::MechanismData(const MechanismModel& model)
   actuated_gravity = Eigen::VectorXd::Zero(na);
   actuated_static_torque = Eigen::VectorXd::Zero(na);
   actuated_acceleration = Eigen::VectorXd::Zero(na);
-  loop_passive_jacobian = Eigen::MatrixXd::Zero(m, np);
   loop_actuated_jacobian = RowMajorMatrix::Zero(m, na);
   loop_block_residual = RowMajorMatrix::Zero(m, na);
   loop_block_step = RowMajorMatrix::Zero(np, na);
   loop_constraint_work = Eigen::VectorXd::Zero(m);
   loop_refine_solution = Eigen::VectorXd::Zero(np);
-  loop_normal = Eigen::MatrixXd::Identity(np, np);
-  loop_passive_first = Eigen::VectorXi::Zero(np);
-  loop_passive_last = Eigen::VectorXi::Zero(np);
-  loop_passive_rows = Eigen::MatrixXi::Zero(m, np);
-  loop_passive_count = Eigen::VectorXi::Zero(np);
-  loop_normal_pivots = Eigen::VectorXd::Ones(np);
   loop_step = Eigen::VectorXd::Zero(np);
   loop_trial = Eigen::VectorXd::Zero(dof);
   loop_solution = RowMajorMatrix::Zero(np, na);

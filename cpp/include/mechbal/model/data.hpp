@@ -122,7 +122,6 @@ struct MechanismData {
   Eigen::VectorXd actuated_acceleration;   ///< a# of the forward dynamics (na)
   Eigen::MatrixXd reduced_mass_matrix;     ///< C^T M C (na x na)
   // scratch of the loop algorithms
-  Eigen::MatrixXd loop_passive_jacobian;   ///< A° (m x np)
   using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   /// The actuated coordinates (indices into model.actuated_coordinates()) that move a loop frame,
   /// fixed at construction: only their columns of C need a solve (the others are unit vectors)
@@ -133,10 +132,6 @@ struct MechanismData {
   Eigen::VectorXd loop_constraint_work;    ///< m
   Eigen::VectorXd loop_refine_solution;    ///< np
   Eigen::LDLT<Eigen::MatrixXd> reduced_ldlt;  ///< of C^T M C (na x na)
-  Eigen::MatrixXd loop_normal;             ///< A°^T A° + damping (np x np)
-  Eigen::VectorXi loop_passive_first, loop_passive_last;  ///< rows of A° holding each column's nonzeros (np)
-  Eigen::MatrixXi loop_passive_rows;  ///< m x np: column j lists the rows of A°'s nonzeros in column j
-  Eigen::VectorXi loop_passive_count; ///< np: how many (the rest of loop_passive_rows' column is unused)
   /// The passive coordinates in the elimination order of N = A°^T A° (a minimum-degree ordering of
   /// the loops' structure, fixed at construction: PAMINSA's legs before the platform they share, so
   /// that the factor keeps the legs' blocks apart); A°'s columns, the Newton step and the solution
@@ -149,11 +144,22 @@ struct MechanismData {
   /// loop_members[loop_member_start[i] .. loop_member_start[i + 1]) for loop i.
   std::vector<int> loop_member_start, loop_members;
   std::vector<int> loop_row_start;  ///< loop i's rows: loop_row_start[i] .. loop_row_start[i + 1]
+  /// A° by loop, its structural nonzeros only: loop i's rows over its passive columns
+  /// (loop_members' of loop i), column-major, from loop_passive_blocks[loop_block_start[i]].
+  std::vector<int> loop_block_start;
+  Eigen::VectorXd loop_passive_blocks;
+  /// N = A°^T A° + damping, then its factors N = L D L^T: the np pivots (D after the
+  /// factorisation), then the entries of L's columns in loop_factor_rows' order (np + nnz(L)).
+  Eigen::VectorXd loop_factor_values;
+  Eigen::VectorXd loop_pivot_inverse;  ///< 1 / D, 0 where a pivot is not positive (np)
+  /// Symbolic factorisation (construction): the entry of loop_factor_values each product of two
+  /// of a loop's passive columns adds into (per loop, its column pairs a <= b in order), and the
+  /// entry each step of the elimination updates (per column k, its row pairs p <= r in order).
+  std::vector<int> loop_normal_targets, loop_factor_updates;
   /// Each named frame in its link's joint-aligned frame L (model.hpp): the loop equations place the
   /// closure frames with one product each.
   std::vector<Mat3> frame_rotation_in_link;
   std::vector<Vec3> frame_position_in_link;
-  Eigen::VectorXd loop_normal_pivots;      ///< D of N = L D L^T (L in loop_normal's lower triangle) (np)
   Eigen::VectorXd loop_step, loop_trial;   ///< np, n
   RowMajorMatrix loop_solution;            ///< np x nla (elimination order)
   Eigen::MatrixXd loop_reduced_work;       ///< n x na
