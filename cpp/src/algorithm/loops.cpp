@@ -38,21 +38,37 @@ struct RowFunctional {
   Vec3 a = Vec3::Zero(), b = Vec3::Zero(), e = Vec3::Zero();
 };
 
-/// Adds the columns of the joints on the path from `link` to the root to the loop's rows:
+/// Calls f(c, r z, p_k, revolute) for the joints with a coordinate on the path from `link` up to
+/// (not including) the link `stop` (0: to the root): coordinate c, ratio r, axis z, origin p_k (O).
+template <class F>
+inline void for_each_loop_joint(const MechanismModel& model, const MechanismData& data, int link, int stop,
+                                F&& f) noexcept {
+  for (int k = link; k >= 1 && k != stop; k = model.parent(k)) {
+    const int c = model.coordinate(k);
+    if (c < 0) continue;
+    const auto& K = data.work[static_cast<std::size_t>(k)];
+    f(c, Vec3(model.coordinate_ratio(k) * K.world_rotation.col(2)), K.world_position,
+      model.joint_type(k) == JointType::revolute);
+  }
+}
+
+/// Adds the columns of the joints on the path from `link` towards the root (up to `stop`,
+/// data.loop_path_stop) to the loop's rows:
 /// joint k moves the frame's origin p by r z x (p - p_k) (revolute) or r z (prismatic) and turns
 /// it by r z (revolute); `side` -1 for frame A, +1 for frame B. Only the loop's own coordinates are
 /// touched (no dense 6 x n frame Jacobians).
-void add_path_columns(const MechanismModel& model, const MechanismData& data, int link, const Vec3& p, double side,
-                      const RowFunctional* f, int rows, int row0, Eigen::MatrixXd& jac, bool point) noexcept {
+void add_path_columns(const MechanismModel& model, const MechanismData& data, int link, int stop, const Vec3& p,
+                      double side, const RowFunctional* f, int rows, int row0, Eigen::MatrixXd& jac,
+                      bool point) noexcept {
   if (point) {  // a point loop's rows are d itself (a = e_k, b = e = 0): the columns are +-(z x (p - p_k)) or +-z
-    detail::for_each_path_joint(model, data, link, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
+    for_each_loop_joint(model, data, link, stop, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
       double* column = jac.data() + static_cast<Eigen::Index>(c) * jac.rows() + row0;
       const Vec3 rate = revolute ? Vec3(z.cross(p - pk)) : z;
       for (int r = 0; r < 3; ++r) column[r] += side * rate(r);
     });
     return;
   }
-  detail::for_each_path_joint(model, data, link, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
+  for_each_loop_joint(model, data, link, stop, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
     if (revolute) {
       const Vec3 lin = z.cross(p - pk);
       for (int r = 0; r < rows; ++r) {
@@ -113,8 +129,11 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
       }
     }
     if (jacobian) {
+      // (the columns above a planar_point loop's common ancestor are zero from construction: no
+      // loop type writes them in its rows)
+      const int stop = data.loop_path_stop[static_cast<std::size_t>(i)];
       for (const int frame : {fa, fb}) {
-        for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) {
+        for (int k = model.frame_link(frame); k >= 1 && k != stop; k = model.parent(k)) {
           const int c = model.coordinate(k);
           if (c < 0) continue;
           double* column = jac.data() + static_cast<Eigen::Index>(c) * jac.rows() + row;
@@ -123,8 +142,8 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
         }
       }
       const bool point = type == LoopType::point;
-      add_path_columns(model, data, model.frame_link(fa), A.position, -1.0, f, rows, row, jac, point);
-      add_path_columns(model, data, model.frame_link(fb), B.position, 1.0, f, rows, row, jac, point);
+      add_path_columns(model, data, model.frame_link(fa), stop, A.position, -1.0, f, rows, row, jac, point);
+      add_path_columns(model, data, model.frame_link(fb), stop, B.position, 1.0, f, rows, row, jac, point);
     }
   }
 }

@@ -548,6 +548,26 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     data.frame_rotation_in_link.push_back(aligned_t * model.frame(f).placement.linear());
     data.frame_position_in_link.push_back(aligned_t * model.frame(f).placement.translation());
   }
+  // where each loop's walks from its frames' links towards the root stop (loop_path_stop): at the
+  // root, or for a planar_point loop at the two frames' deepest common ancestor, whose joint and
+  // those above it move both frames rigidly together and leave its rows (x_A . (p_B - p_A))
+  // unchanged: their columns are zero (computed, they cancel to round-off)
+  data.loop_path_stop.assign(static_cast<std::size_t>(model.num_loops()), 0);
+  for (int i = 0; i < model.num_loops(); ++i) {
+    if (model.loop(i).type != LoopType::planar_point) continue;
+    std::vector<char> above_a(static_cast<std::size_t>(model.num_links()), 0);
+    for (int k = model.frame_link(model.loop_frame_a(i)); k >= 1; k = model.parent(k)) above_a[static_cast<std::size_t>(k)] = 1;
+    int k = model.frame_link(model.loop_frame_b(i));
+    while (k >= 1 && !above_a[static_cast<std::size_t>(k)]) k = model.parent(k);
+    data.loop_path_stop[static_cast<std::size_t>(i)] = std::max(k, 0);
+  }
+  const auto path = [&](int i, int frame) {  // the links whose joints can move loop i's rows
+    std::vector<int> links;
+    for (int k = model.frame_link(frame); k >= 1 && k != data.loop_path_stop[static_cast<std::size_t>(i)]; k = model.parent(k)) {
+      links.push_back(k);
+    }
+    return links;
+  };
   const auto& passive = model.passive_coordinates();
   const auto np = passive.size();
   std::vector<int> slot(static_cast<std::size_t>(model.dof()), -1);  // coordinate -> passive index
@@ -559,7 +579,7 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
   for (int i = 0; i < model.num_loops(); ++i) {
     members.clear();
     for (int frame : {model.loop_frame_a(i), model.loop_frame_b(i)}) {
-      for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) {
+      for (int k : path(i, frame)) {
         const int c = model.coordinate(k);
         if (c >= 0 && slot[static_cast<std::size_t>(c)] >= 0) members.push_back(slot[static_cast<std::size_t>(c)]);
       }
@@ -578,7 +598,7 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     bool in_loop = false;
     for (int l = 0; l < model.num_loops() && !in_loop; ++l) {
       for (int frame : {model.loop_frame_a(l), model.loop_frame_b(l)}) {
-        for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) in_loop = in_loop || model.coordinate(k) == actuated[i];
+        for (int k : path(l, frame)) in_loop = in_loop || model.coordinate(k) == actuated[i];
       }
     }
     if (in_loop) data.loop_actuated_columns.push_back(static_cast<int>(i));
@@ -638,7 +658,7 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
   for (int i = 0; i < model.num_loops(); ++i) {
     std::vector<int> own;
     for (int frame : {model.loop_frame_a(i), model.loop_frame_b(i)}) {
-      for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) {
+      for (int k : path(i, frame)) {
         const int c = model.coordinate(k);
         if (c >= 0 && slot[static_cast<std::size_t>(c)] >= 0)
           own.push_back(position[static_cast<std::size_t>(slot[static_cast<std::size_t>(c)])]);

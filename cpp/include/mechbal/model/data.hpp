@@ -144,6 +144,10 @@ struct MechanismData {
   /// loop_members[loop_member_start[i] .. loop_member_start[i + 1]) for loop i.
   std::vector<int> loop_member_start, loop_members;
   std::vector<int> loop_row_start;  ///< loop i's rows: loop_row_start[i] .. loop_row_start[i + 1]
+  /// Loop i's Jacobian columns are those of the joints from its frames' links up to (not
+  /// including) the link loop_path_stop[i]: 0 (the root), or for a planar_point loop the frames'
+  /// deepest common ancestor (the joints from it up move both frames together: zero columns).
+  std::vector<int> loop_path_stop;
   /// A° by loop, its structural nonzeros only: loop i's rows over its passive columns
   /// (loop_members' of loop i), column-major, from loop_passive_blocks[loop_block_start[i]].
   std::vector<int> loop_block_start;
