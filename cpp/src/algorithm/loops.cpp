@@ -306,42 +306,24 @@ void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X
   }
 }
 
-/// Loop l's slice of A° (data.loop_passive_blocks): its first row and row count, its passive
-/// columns (elimination positions) and their block (rows x count, column-major).
-struct LoopBlock {
-  int r0, rows, count;
-  const int* members;
-  int offset;  // into data.loop_passive_blocks
-};
-
-inline LoopBlock loop_block(const MechanismData& data, int l) noexcept {
-  const auto i = static_cast<std::size_t>(l);
-  LoopBlock b;
-  b.r0 = data.loop_row_start[i];
-  b.rows = data.loop_row_start[i + 1] - b.r0;
-  b.members = data.loop_members.data() + data.loop_member_start[i];
-  b.count = data.loop_member_start[i + 1] - data.loop_member_start[i];
-  b.offset = data.loop_block_start[i];
-  return b;
-}
-
-inline int num_loop_blocks(const MechanismData& data) noexcept {
-  return static_cast<int>(data.loop_block_start.size()) - 1;
-}
-
-/// X = -A°^T B (np x w, row-major; B m x w row-major) over A°'s blocks, w = W (0: B's).
-template <int W>
-void passive_transpose_times(const MechanismData& data, const MechanismData::RowMajorMatrix& B,
-                             MechanismData::RowMajorMatrix& X) noexcept {
-  const Eigen::Index w = W > 0 ? W : B.cols();
+/// X = -A°^T A# (np x w, row-major) over the loops' blocks of A° and A# (data.loop_blocks: the
+/// products of each loop's passive and actuated columns over its rows).
+void passive_transpose_actuated(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
+  const Eigen::Index w = X.cols();
   X.setZero();
-  for (int l = 0; l < num_loop_blocks(data); ++l) {
-    const LoopBlock lb = loop_block(data, l);
-    const double* a = data.loop_passive_blocks.data() + lb.offset;
-    const double* b = B.data() + lb.r0 * w;
+  for (const auto& lb : data.loop_blocks) {
+    if (lb.actuated_count == 0) continue;
+    const double* a = data.loop_passive_blocks.data() + lb.block;
+    const int* members = data.loop_members.data() + lb.member;
+    const int* actuated = data.loop_actuated_members.data() + lb.actuated;
     for (int c = 0; c < lb.count; ++c, a += lb.rows) {
-      double* x = X.data() + lb.members[c] * w;
-      for (int r = 0; r < lb.rows; ++r) axpy<W>(x, -a[r], b + r * w, w);
+      double* x = X.data() + members[c] * w;
+      const double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
+      for (int t = 0; t < lb.actuated_count; ++t, b += lb.rows) {
+        double sum = 0.0;
+        for (int r = 0; r < lb.rows; ++r) sum += a[r] * b[r];
+        x[actuated[t]] -= sum;
+      }
     }
   }
 }
@@ -349,16 +331,16 @@ void passive_transpose_times(const MechanismData& data, const MechanismData::Row
 /// out = A°^T y (or -A°^T y with `Negate`) over A°'s blocks (np).
 template <bool Negate>
 void passive_transpose_apply(const MechanismData& data, const double* y, Eigen::VectorXd& out) noexcept {
-  out.setZero();
   double* o = out.data();
-  for (int l = 0; l < num_loop_blocks(data); ++l) {
-    const LoopBlock lb = loop_block(data, l);
-    const double* a = data.loop_passive_blocks.data() + lb.offset;
-    const double* yl = y + lb.r0;
+  for (Eigen::Index i = 0; i < out.size(); ++i) o[i] = 0.0;
+  for (const auto& lb : data.loop_blocks) {
+    const double* a = data.loop_passive_blocks.data() + lb.block;
+    const int* members = data.loop_members.data() + lb.member;
+    const double* yl = y + lb.row;
     for (int c = 0; c < lb.count; ++c, a += lb.rows) {
       double sum = 0.0;
       for (int r = 0; r < lb.rows; ++r) sum += a[r] * yl[r];
-      o[lb.members[c]] += Negate ? -sum : sum;
+      o[members[c]] += Negate ? -sum : sum;
     }
   }
 }
@@ -368,16 +350,17 @@ constexpr double kDamping = 1e-16;
 
 /// One loop's block of A° from A (its rows, R of them (0: `rows`), of its passive columns), then
 /// N += the products of its columns (column pairs a <= b in order, into the entries `target`
-/// lists: symbolic factorisation).
+/// lists, ~entry for an entry's first product: symbolic factorisation).
 template <int R>
-const int* add_loop_products(const MechanismData& data, const LoopBlock& lb, double* block, double* V,
-                             const int* target) noexcept {
+const int* add_loop_products(const MechanismData& data, const MechanismData::LoopBlockInfo& lb, double* block,
+                             double* V, const int* target) noexcept {
   const int nr = R > 0 ? R : lb.rows;
   const int count = lb.count;
+  const int* members = data.loop_members.data() + lb.member;
   const Eigen::Index m = data.loop_jacobian.rows();
   for (int c = 0; c < count; ++c) {
     const double* from = data.loop_jacobian.data() +
-                         static_cast<Eigen::Index>(data.loop_elimination[static_cast<std::size_t>(lb.members[c])]) * m + lb.r0;
+                         static_cast<Eigen::Index>(data.loop_elimination[static_cast<std::size_t>(members[c])]) * m + lb.row;
     for (int r = 0; r < nr; ++r) block[c * nr + r] = from[r];
   }
   for (int a = 0; a < count; ++a) {
@@ -386,7 +369,12 @@ const int* add_loop_products(const MechanismData& data, const LoopBlock& lb, dou
       const double* aj = block + b * nr;
       double sum = 0.0;
       for (int r = 0; r < nr; ++r) sum += ai[r] * aj[r];
-      V[*target++] += sum;
+      const int t = *target++;
+      if (t < 0) {
+        V[~t] = sum;
+      } else {
+        V[t] += sum;
+      }
     }
   }
   return target;
@@ -399,12 +387,10 @@ double factor_passive(MechanismData& data) noexcept {
   // then N = A°^T A° on the structure of L: the sum over the loops of the products of their own
   // columns over their own rows (2 to 6 rows, a handful of columns each)
   double* const V = data.loop_factor_values.data();
-  const auto size = static_cast<int>(data.loop_factor_values.size());
-  for (int i = 0; i < size; ++i) V[i] = 0.0;
+  for (const int t : data.loop_factor_clear) V[t] = 0.0;
   const int* target = data.loop_normal_targets.data();
-  for (int l = 0; l < num_loop_blocks(data); ++l) {
-    const LoopBlock lb = loop_block(data, l);
-    double* block = data.loop_passive_blocks.data() + lb.offset;
+  for (const auto& lb : data.loop_blocks) {
+    double* block = data.loop_passive_blocks.data() + lb.block;
     // (the loop types' row counts unrolled: 2 planar_point, 3 point, 5 axis, 6 weld)
     switch (lb.rows) {
       case 2: target = add_loop_products<2>(data, lb, block, V, target); break;
@@ -419,8 +405,11 @@ double factor_passive(MechanismData& data) noexcept {
   for (int i = 0; i < np; ++i) V[i] += kDamping * scale;
   ldl_factor(data);
   if (np == 0) return 1.0;
-  const auto D = data.loop_factor_values.head(np);
-  const double dmax = D.cwiseAbs().maxCoeff(), dmin = D.cwiseAbs().minCoeff();
+  double dmax = 0.0, dmin = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < np; ++i) {
+    dmax = std::max(dmax, std::abs(V[i]));
+    dmin = std::min(dmin, std::abs(V[i]));
+  }
   return dmax > 0.0 ? std::sqrt(std::max(0.0, dmin - kDamping * scale) / dmax) : 0.0;
 }
 
@@ -662,12 +651,12 @@ template <typename B, typename X>
 void refine(MechanismData& data, const B& b, X&& x) noexcept {
   Eigen::VectorXd& r = data.loop_constraint_work;
   r = -b;
-  for (int l = 0; l < num_loop_blocks(data); ++l) {
-    const LoopBlock lb = loop_block(data, l);
-    const double* a = data.loop_passive_blocks.data() + lb.offset;
+  for (const auto& lb : data.loop_blocks) {
+    const double* a = data.loop_passive_blocks.data() + lb.block;
+    const int* members = data.loop_members.data() + lb.member;
     for (int c = 0; c < lb.count; ++c, a += lb.rows) {
-      const double xi = x(lb.members[c]);
-      for (int k = 0; k < lb.rows; ++k) r(lb.r0 + k) -= a[k] * xi;
+      const double xi = x(members[c]);
+      for (int k = 0; k < lb.rows; ++k) r(lb.row + k) -= a[k] * xi;
     }
   }
   Eigen::VectorXd& step = data.loop_step;
@@ -737,44 +726,46 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   if (data.loop_rcond < options.singular_rcond) status = Status::singular;
   // C: passive rows -(A°^T A°)^-1 A°^T A#
   // (only the columns of the actuated coordinates that move a loop: C's others are unit vectors)
+  // (A#'s blocks: each loop's rows of the actuated columns that move it)
   const auto& columns = data.loop_actuated_columns;
-  for (std::size_t t = 0; t < columns.size(); ++t) {
-    data.loop_actuated_jacobian.col(static_cast<Eigen::Index>(t)) =
-        data.loop_jacobian.col(actuated[static_cast<std::size_t>(columns[t])]);
+  const Eigen::Index m = data.loop_jacobian.rows();
+  for (const auto& lb : data.loop_blocks) {
+    double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
+    const int* members = data.loop_actuated_members.data() + lb.actuated;
+    for (int t = 0; t < lb.actuated_count; ++t, b += lb.rows) {
+      const int coordinate = actuated[static_cast<std::size_t>(columns[static_cast<std::size_t>(members[t])])];
+      const double* from = data.loop_jacobian.data() + static_cast<Eigen::Index>(coordinate) * m + lb.row;
+      for (int r = 0; r < lb.rows; ++r) b[r] = from[r];
+    }
   }
-  // X = -A°^T A# (each column of A° over its nonzero rows), solved for all columns at once, then
-  // one step of iterative refinement (see refine): R = -A# - A° X, X += (A°^T A°)^-1 A°^T R
+  // X = -A°^T A# (over the loops' blocks), solved for all columns at once, then one step of
+  // iterative refinement (see refine): R = -A# - A° X, X += (A°^T A°)^-1 A°^T R
   MechanismData::RowMajorMatrix& X = data.loop_solution;
-  MechanismData::RowMajorMatrix& R = data.loop_block_residual;
-  MechanismData::RowMajorMatrix& S = data.loop_block_step;
-  const MechanismData::RowMajorMatrix& Aa = data.loop_actuated_jacobian;
   const Eigen::Index w = X.cols();
-  switch (w) {
-    case 1: passive_transpose_times<1>(data, Aa, X); break;
-    case 2: passive_transpose_times<2>(data, Aa, X); break;
-    case 3: passive_transpose_times<3>(data, Aa, X); break;
-    case 4: passive_transpose_times<4>(data, Aa, X); break;
-    default: passive_transpose_times<0>(data, Aa, X); break;
-  }
+  passive_transpose_actuated(data, X);
   ldl_solve_block(data, X);
   const bool refine_solves = data.loop_rcond < options.refine_rcond;
   if (refine_solves) {
-    R = -Aa;
+    MechanismData::RowMajorMatrix& R = data.loop_block_residual;
+    MechanismData::RowMajorMatrix& S = data.loop_block_step;
+    for (std::size_t t = 0; t < columns.size(); ++t) {
+      R.col(static_cast<Eigen::Index>(t)) = -data.loop_jacobian.col(actuated[static_cast<std::size_t>(columns[t])]);
+    }
     S.setZero();
-    for (int l = 0; l < num_loop_blocks(data); ++l) {
-      const LoopBlock lb = loop_block(data, l);
-      const double* a = data.loop_passive_blocks.data() + lb.offset;
+    for (const auto& lb : data.loop_blocks) {
+      const double* a = data.loop_passive_blocks.data() + lb.block;
+      const int* members = data.loop_members.data() + lb.member;
       for (int c = 0; c < lb.count; ++c, a += lb.rows) {
-        const double* x = X.data() + lb.members[c] * w;
-        for (int k = 0; k < lb.rows; ++k) axpy(R.data() + (lb.r0 + k) * w, -a[k], x, w);
+        const double* x = X.data() + members[c] * w;
+        for (int k = 0; k < lb.rows; ++k) axpy(R.data() + (lb.row + k) * w, -a[k], x, w);
       }
     }
-    for (int l = 0; l < num_loop_blocks(data); ++l) {
-      const LoopBlock lb = loop_block(data, l);
-      const double* a = data.loop_passive_blocks.data() + lb.offset;
+    for (const auto& lb : data.loop_blocks) {
+      const double* a = data.loop_passive_blocks.data() + lb.block;
+      const int* members = data.loop_members.data() + lb.member;
       for (int c = 0; c < lb.count; ++c, a += lb.rows) {
-        double* si = S.data() + lb.members[c] * w;
-        for (int k = 0; k < lb.rows; ++k) axpy(si, a[k], R.data() + (lb.r0 + k) * w, w);
+        double* si = S.data() + members[c] * w;
+        for (int k = 0; k < lb.rows; ++k) axpy(si, a[k], R.data() + (lb.row + k) * w, w);
       }
     }
     ldl_solve_block(data, S);
@@ -791,26 +782,29 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   apply_projection(model, data, v_actuated, data.closed_velocity);
   // the loops must accept the actuated velocities (A v = 0); they do not at a serial singularity of
   // the closure or when the actuators over-constrain the mechanism
-  // (A v over A's nonzeros: A°'s blocks, A#'s loop columns; the others are zero)
+  // (A v over A's nonzeros, the loops' blocks of A# and A°; the others are zero)
   // (the largest |entry| per column first: short, independent chains of max)
   Eigen::VectorXd& Av = data.loop_constraint_work;
   double biggest = 0.0;
-  for (Eigen::Index r = 0; r < Aa.rows(); ++r) {
-    double sum = 0.0, row_max = 0.0;
-    for (Eigen::Index t = 0; t < w; ++t) {
-      const double a = Aa(r, t);
-      sum += a * data.closed_velocity(actuated[static_cast<std::size_t>(columns[static_cast<std::size_t>(t)])]);
-      row_max = std::max(row_max, std::abs(a));
+  for (const auto& lb : data.loop_blocks) {
+    double* av = Av.data() + lb.row;
+    for (int k = 0; k < lb.rows; ++k) av[k] = 0.0;
+    const double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
+    const int* actuated_members = data.loop_actuated_members.data() + lb.actuated;
+    for (int t = 0; t < lb.actuated_count; ++t, b += lb.rows) {
+      const double vt = data.closed_velocity(
+          actuated[static_cast<std::size_t>(columns[static_cast<std::size_t>(actuated_members[t])])]);
+      double column_max = 0.0;
+      for (int k = 0; k < lb.rows; ++k) {
+        av[k] += b[k] * vt;
+        column_max = std::max(column_max, std::abs(b[k]));
+      }
+      biggest = std::max(biggest, column_max);
     }
-    Av(r) = sum;
-    biggest = std::max(biggest, row_max);
-  }
-  for (int l = 0; l < num_loop_blocks(data); ++l) {
-    const LoopBlock lb = loop_block(data, l);
-    const double* a = data.loop_passive_blocks.data() + lb.offset;
-    double* av = Av.data() + lb.r0;
+    const double* a = data.loop_passive_blocks.data() + lb.block;
+    const int* members = data.loop_members.data() + lb.member;
     for (int c = 0; c < lb.count; ++c, a += lb.rows) {
-      const double vi = data.closed_velocity(data.loop_elimination[static_cast<std::size_t>(lb.members[c])]);
+      const double vi = data.closed_velocity(data.loop_elimination[static_cast<std::size_t>(members[c])]);
       double column_max = 0.0;
       for (int k = 0; k < lb.rows; ++k) {
         av[k] += a[k] * vi;

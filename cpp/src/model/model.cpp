@@ -605,7 +605,6 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
   }
   const auto nla = static_cast<Eigen::Index>(data.loop_actuated_columns.size());
   const Eigen::Index m = model.num_constraints();
-  data.loop_actuated_jacobian = MechanismData::RowMajorMatrix::Zero(m, nla);
   data.loop_block_residual = MechanismData::RowMajorMatrix::Zero(m, nla);
   data.loop_block_step = MechanismData::RowMajorMatrix::Zero(static_cast<Eigen::Index>(np), nla);
   data.loop_solution = MechanismData::RowMajorMatrix::Zero(static_cast<Eigen::Index>(np), nla);
@@ -669,15 +668,37 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     data.loop_members.insert(data.loop_members.end(), own.begin(), own.end());
     data.loop_member_start.push_back(static_cast<int>(data.loop_members.size()));
   }
-  // A° by loop (loop_block_start): loop i's rows over its passive columns, the structural nonzeros
-  // of A° (a passive column is nonzero in the rows of the loops whose frames it moves)
-  data.loop_block_start.assign(1, 0);
+  // each loop's slice of A (loop_blocks): its rows over its passive columns (A°'s structural
+  // nonzeros: a passive column is nonzero in the rows of the loops whose joints it moves) and over
+  // the actuated columns that move it (A#'s)
+  data.loop_blocks.clear();
+  data.loop_actuated_members.clear();
+  int passive_size = 0, actuated_size = 0;
   for (int i = 0; i < model.num_loops(); ++i) {
-    const int rows = data.loop_row_start[static_cast<std::size_t>(i) + 1] - data.loop_row_start[static_cast<std::size_t>(i)];
-    const int count = data.loop_member_start[static_cast<std::size_t>(i) + 1] - data.loop_member_start[static_cast<std::size_t>(i)];
-    data.loop_block_start.push_back(data.loop_block_start.back() + rows * count);
+    const auto li = static_cast<std::size_t>(i);
+    MechanismData::LoopBlockInfo info;
+    info.row = data.loop_row_start[li];
+    info.rows = data.loop_row_start[li + 1] - info.row;
+    info.member = data.loop_member_start[li];
+    info.count = data.loop_member_start[li + 1] - info.member;
+    info.block = passive_size;
+    passive_size += info.rows * info.count;
+    info.actuated = static_cast<int>(data.loop_actuated_members.size());
+    for (std::size_t t = 0; t < data.loop_actuated_columns.size(); ++t) {
+      const int coordinate = actuated[static_cast<std::size_t>(data.loop_actuated_columns[t])];
+      bool moves = false;
+      for (int frame : {model.loop_frame_a(i), model.loop_frame_b(i)}) {
+        for (int k : path(i, frame)) moves = moves || model.coordinate(k) == coordinate;
+      }
+      if (moves) data.loop_actuated_members.push_back(static_cast<int>(t));
+    }
+    info.actuated_count = static_cast<int>(data.loop_actuated_members.size()) - info.actuated;
+    info.actuated_block = actuated_size;
+    actuated_size += info.rows * info.actuated_count;
+    data.loop_blocks.push_back(info);
   }
-  data.loop_passive_blocks = Eigen::VectorXd::Zero(data.loop_block_start.back());
+  data.loop_passive_blocks = Eigen::VectorXd::Zero(passive_size);
+  data.loop_actuated_blocks = Eigen::VectorXd::Zero(actuated_size);
   // the numeric LDL^T as straight lists: N's (and L's) entries in loop_factor_values (the np
   // pivots, then L's entries in loop_factor_rows' order); where each loop's products of its
   // columns add into N, and where each column's elimination updates the columns after it
@@ -689,18 +710,28 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     if (at == last || *at != row) throw std::logic_error("loop factor structure: missing fill entry");
     return static_cast<int>(np) + static_cast<int>(at - data.loop_factor_rows.begin());
   };
-  data.loop_factor_values = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(np + data.loop_factor_rows.size()));
+  const auto nvalues = static_cast<Eigen::Index>(np + data.loop_factor_rows.size());
+  data.loop_factor_values = Eigen::VectorXd::Zero(nvalues);
   data.loop_factor_values.head(static_cast<Eigen::Index>(np)).setOnes();  // N = I until the first factorisation
   data.loop_pivot_inverse = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(np));
+  // (an entry's first product is stored, ~target, the others added: N needs no clearing but of
+  // the entries no product reaches, fill, loop_factor_clear)
   data.loop_normal_targets.clear();
+  std::vector<char> reached(static_cast<std::size_t>(nvalues), 0);
   for (int i = 0; i < model.num_loops(); ++i) {
     const int begin = data.loop_member_start[static_cast<std::size_t>(i)];
     const int end = data.loop_member_start[static_cast<std::size_t>(i) + 1];
     for (int a = begin; a < end; ++a) {
       for (int b = a; b < end; ++b) {
-        data.loop_normal_targets.push_back(entry(data.loop_members[static_cast<std::size_t>(a)], data.loop_members[static_cast<std::size_t>(b)]));
+        const int t = entry(data.loop_members[static_cast<std::size_t>(a)], data.loop_members[static_cast<std::size_t>(b)]);
+        data.loop_normal_targets.push_back(reached[static_cast<std::size_t>(t)] ? t : ~t);
+        reached[static_cast<std::size_t>(t)] = 1;
       }
     }
+  }
+  data.loop_factor_clear.clear();
+  for (Eigen::Index t = 0; t < nvalues; ++t) {
+    if (!reached[static_cast<std::size_t>(t)]) data.loop_factor_clear.push_back(static_cast<int>(t));
   }
   data.loop_factor_updates.clear();
   for (std::size_t k = 0; k < np; ++k) {
@@ -785,7 +816,6 @@ MechanismData::MechanismData(const MechanismModel& model)
   actuated_gravity = Eigen::VectorXd::Zero(na);
   actuated_static_torque = Eigen::VectorXd::Zero(na);
   actuated_acceleration = Eigen::VectorXd::Zero(na);
-  loop_actuated_jacobian = RowMajorMatrix::Zero(m, na);
   loop_block_residual = RowMajorMatrix::Zero(m, na);
   loop_block_step = RowMajorMatrix::Zero(np, na);
   loop_constraint_work = Eigen::VectorXd::Zero(m);

@@ -126,8 +126,7 @@ struct MechanismData {
   /// The actuated coordinates (indices into model.actuated_coordinates()) that move a loop frame,
   /// fixed at construction: only their columns of C need a solve (the others are unit vectors)
   std::vector<int> loop_actuated_columns;
-  RowMajorMatrix loop_actuated_jacobian;   ///< A#'s loop_actuated_columns (m x nla), row-major: the solves run over all columns at once
-  RowMajorMatrix loop_block_residual;      ///< m x nla
+  RowMajorMatrix loop_block_residual;      ///< m x nla (the refinement's -A# - A° X over loop_actuated_columns)
   RowMajorMatrix loop_block_step;          ///< np x nla
   Eigen::VectorXd loop_constraint_work;    ///< m
   Eigen::VectorXd loop_refine_solution;    ///< np
@@ -148,18 +147,28 @@ struct MechanismData {
   /// including) the link loop_path_stop[i]: 0 (the root), or for a planar_point loop the frames'
   /// deepest common ancestor (the joints from it up move both frames together: zero columns).
   std::vector<int> loop_path_stop;
-  /// A° by loop, its structural nonzeros only: loop i's rows over its passive columns
-  /// (loop_members' of loop i), column-major, from loop_passive_blocks[loop_block_start[i]].
-  std::vector<int> loop_block_start;
-  Eigen::VectorXd loop_passive_blocks;
+  /// Each loop's slice of A, fixed at construction: its rows (row .. row + rows), its passive
+  /// columns (loop_members[member .. member + count]: elimination positions, increasing) with
+  /// their block of A° (loop_passive_blocks from `block`: rows x count, column-major; A°'s
+  /// structural nonzeros), and the columns of A# that move it (loop_actuated_members[actuated ..
+  /// actuated + actuated_count]: indices into loop_actuated_columns) with their block
+  /// (loop_actuated_blocks from `actuated_block`, the same layout).
+  struct LoopBlockInfo {
+    int row = 0, rows = 0, member = 0, count = 0, block = 0, actuated = 0, actuated_count = 0, actuated_block = 0;
+  };
+  std::vector<LoopBlockInfo> loop_blocks;
+  std::vector<int> loop_actuated_members;
+  Eigen::VectorXd loop_passive_blocks, loop_actuated_blocks;
   /// N = A°^T A° + damping, then its factors N = L D L^T: the np pivots (D after the
   /// factorisation), then the entries of L's columns in loop_factor_rows' order (np + nnz(L)).
   Eigen::VectorXd loop_factor_values;
   Eigen::VectorXd loop_pivot_inverse;  ///< 1 / D, 0 where a pivot is not positive (np)
   /// Symbolic factorisation (construction): the entry of loop_factor_values each product of two
-  /// of a loop's passive columns adds into (per loop, its column pairs a <= b in order), and the
-  /// entry each step of the elimination updates (per column k, its row pairs p <= r in order).
-  std::vector<int> loop_normal_targets, loop_factor_updates;
+  /// of a loop's passive columns adds into (per loop, its column pairs a <= b in order; ~entry for
+  /// the entry's first product, which is stored instead), the entries no product reaches (fill:
+  /// cleared before the assembly) and the entry each step of the elimination updates (per column
+  /// k, its row pairs p <= r in order).
+  std::vector<int> loop_normal_targets, loop_factor_clear, loop_factor_updates;
   /// Each named frame in its link's joint-aligned frame L (model.hpp): the loop equations place the
   /// closure frames with one product each.
   std::vector<Mat3> frame_rotation_in_link;
