@@ -228,41 +228,36 @@ void ldl_factor(MechanismData& data) noexcept {
   const auto np = static_cast<int>(data.loop_elimination.size());
   double* const L = V + np;
   const int* start = data.loop_factor_start.data();
+  const int* update_start = data.loop_factor_update_start.data();
   double* const inverse = data.loop_pivot_inverse.data();
-  const int* target = data.loop_factor_updates.data();
+  const int* update = data.loop_factor_updates.data();
   for (int k = 0; k < np; ++k) {
     const double d = V[k];
     const double inv = d > 0.0 ? 1.0 / d : 0.0;
     inverse[k] = inv;
-    const int begin = start[k], end = start[k + 1];
-    // the column's multipliers l_jk = N_jk / d (0 below a pivot that is not positive); N_jk itself
-    // (unscaled) updates the rest of row j and is replaced by l_jk once no later update reads it
-    for (int p = begin; p < end; ++p) {
-      const double f = L[p] * inv;
-      for (int r = p; r < end; ++r) V[*target++] -= f * L[r];
-      L[p] = f;
+    // N_rj -= l_jk N_rk over the column's pairs (l_jk = N_jk / d: 0 below a pivot that is not
+    // positive), then the column's entries become the multipliers
+    for (int u = update_start[k]; u < update_start[k + 1]; ++u, update += 3) {
+      V[update[0]] -= (L[update[1]] * inv) * L[update[2]];
     }
+    for (int p = start[k]; p < start[k + 1]; ++p) L[p] *= inv;
   }
 }
 
-/// x = (L D L^T)^-1 x with the factors of ldl_factor.
+/// x = (L D L^T)^-1 x with the factors of ldl_factor: the triangular solves as one pass each over
+/// L's entries (column by column: an entry of column k reads x_k once every entry that updates
+/// x_k, in the columns before, is done; backwards, the reverse).
 void ldl_solve(const MechanismData& data, Eigen::Ref<Eigen::VectorXd> x) noexcept {
   const auto np = static_cast<int>(data.loop_elimination.size());
+  const auto nnz = static_cast<int>(data.loop_factor_rows.size());
   const double* const L = data.loop_factor_values.data() + np;  // (after the pivots)
   const int* rows = data.loop_factor_rows.data();
-  const int* start = data.loop_factor_start.data();
-  double* const v = x.data();
-  for (int k = 0; k < np; ++k) {
-    const double xk = v[k];
-    for (int p = start[k]; p < start[k + 1]; ++p) v[rows[p]] -= xk * L[p];
-  }
+  const int* columns = data.loop_factor_columns.data();
   const double* const inverse = data.loop_pivot_inverse.data();
+  double* const v = x.data();
+  for (int p = 0; p < nnz; ++p) v[rows[p]] -= v[columns[p]] * L[p];
   for (int k = 0; k < np; ++k) v[k] *= inverse[k];
-  for (int k = np - 1; k >= 0; --k) {
-    double sum = 0.0;
-    for (int p = start[k]; p < start[k + 1]; ++p) sum += L[p] * v[rows[p]];
-    v[k] -= sum;
-  }
+  for (int p = nnz - 1; p >= 0; --p) v[columns[p]] -= L[p] * v[rows[p]];
 }
 
 /// y += a x over W contiguous entries (rows of the row-major blocks: a handful of actuated columns,
@@ -278,20 +273,17 @@ template <int W>
 void ldl_solve_block_width(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
   const auto np = static_cast<int>(data.loop_elimination.size());
   const double* const L = data.loop_factor_values.data() + np;  // (after the pivots)
+  const auto nnz = static_cast<int>(data.loop_factor_rows.size());
   const int* rows = data.loop_factor_rows.data();
-  const int* start = data.loop_factor_start.data();
+  const int* columns = data.loop_factor_columns.data();
   const Eigen::Index w = W > 0 ? W : X.cols();
   double* x = X.data();
-  for (int k = 0; k < np; ++k) {
-    for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(x + rows[p] * w, -L[p], x + k * w, w);
-  }
+  for (int p = 0; p < nnz; ++p) axpy<W>(x + rows[p] * w, -L[p], x + columns[p] * w, w);
   for (int k = 0; k < np; ++k) {
     const double inv = data.loop_pivot_inverse(k);
     for (Eigen::Index j = 0; j < w; ++j) x[k * w + j] *= inv;
   }
-  for (int k = np - 1; k >= 0; --k) {
-    for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(x + k * w, -L[p], x + rows[p] * w, w);
-  }
+  for (int p = nnz - 1; p >= 0; --p) axpy<W>(x + columns[p] * w, -L[p], x + rows[p] * w, w);
 }
 
 /// X = (L D L^T)^-1 X for a block of right-hand sides (np x na, row-major): one pass over L for
@@ -363,18 +355,17 @@ const int* add_loop_products(const MechanismData& data, const MechanismData::Loo
                          static_cast<Eigen::Index>(data.loop_elimination[static_cast<std::size_t>(members[c])]) * m + lb.row;
     for (int r = 0; r < nr; ++r) block[c * nr + r] = from[r];
   }
-  for (int a = 0; a < count; ++a) {
-    const double* ai = block + a * nr;
-    for (int b = a; b < count; ++b) {
-      const double* aj = block + b * nr;
-      double sum = 0.0;
-      for (int r = 0; r < nr; ++r) sum += ai[r] * aj[r];
-      const int t = *target++;
-      if (t < 0) {
-        V[~t] = sum;
-      } else {
-        V[t] += sum;
-      }
+  const int* const end = target + 3 * (count * (count + 1) / 2);
+  for (; target != end; target += 3) {
+    const double* ai = block + target[1];
+    const double* aj = block + target[2];
+    double sum = 0.0;
+    for (int r = 0; r < nr; ++r) sum += ai[r] * aj[r];
+    const int t = target[0];
+    if (t < 0) {
+      V[~t] = sum;
+    } else {
+      V[t] += sum;
     }
   }
   return target;

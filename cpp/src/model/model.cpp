@@ -639,12 +639,14 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
   data.loop_elimination.clear();
   data.loop_factor_start.assign(1, 0);
   data.loop_factor_rows.clear();
+  data.loop_factor_columns.clear();
   for (std::size_t k = 0; k < np; ++k) {
     data.loop_elimination.push_back(passive[static_cast<std::size_t>(order[k])]);
     std::vector<int>& rows = below[k];
     for (int& v : rows) v = position[static_cast<std::size_t>(v)];
     std::sort(rows.begin(), rows.end());
     data.loop_factor_rows.insert(data.loop_factor_rows.end(), rows.begin(), rows.end());
+    data.loop_factor_columns.insert(data.loop_factor_columns.end(), rows.size(), static_cast<int>(k));
     data.loop_factor_start.push_back(static_cast<int>(data.loop_factor_rows.size()));
   }
   // each loop's passive columns (elimination positions, increasing): N = A°^T A° is the sum over
@@ -721,10 +723,13 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
   for (int i = 0; i < model.num_loops(); ++i) {
     const int begin = data.loop_member_start[static_cast<std::size_t>(i)];
     const int end = data.loop_member_start[static_cast<std::size_t>(i) + 1];
+    const int rows = data.loop_blocks[static_cast<std::size_t>(i)].rows;
     for (int a = begin; a < end; ++a) {
       for (int b = a; b < end; ++b) {
         const int t = entry(data.loop_members[static_cast<std::size_t>(a)], data.loop_members[static_cast<std::size_t>(b)]);
         data.loop_normal_targets.push_back(reached[static_cast<std::size_t>(t)] ? t : ~t);
+        data.loop_normal_targets.push_back((a - begin) * rows);
+        data.loop_normal_targets.push_back((b - begin) * rows);
         reached[static_cast<std::size_t>(t)] = 1;
       }
     }
@@ -734,13 +739,17 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     if (!reached[static_cast<std::size_t>(t)]) data.loop_factor_clear.push_back(static_cast<int>(t));
   }
   data.loop_factor_updates.clear();
+  data.loop_factor_update_start.assign(1, 0);
   for (std::size_t k = 0; k < np; ++k) {
     const int begin = data.loop_factor_start[k], end = data.loop_factor_start[k + 1];
     for (int p = begin; p < end; ++p) {
       for (int r = p; r < end; ++r) {
         data.loop_factor_updates.push_back(entry(data.loop_factor_rows[static_cast<std::size_t>(p)], data.loop_factor_rows[static_cast<std::size_t>(r)]));
+        data.loop_factor_updates.push_back(p);
+        data.loop_factor_updates.push_back(r);
       }
     }
+    data.loop_factor_update_start.push_back(static_cast<int>(data.loop_factor_updates.size() / 3));
   }
 }
 

@@ -139,6 +139,7 @@ struct MechanismData {
   /// Structure of L in N = L D L^T: the rows (elimination positions, increasing) that column k may
   /// fill are loop_factor_rows[loop_factor_start[k] .. loop_factor_start[k + 1]).
   std::vector<int> loop_factor_start, loop_factor_rows;
+  std::vector<int> loop_factor_columns;  ///< the column k of each entry of loop_factor_rows
   /// The passive columns (elimination positions, increasing) each loop's rows involve:
   /// loop_members[loop_member_start[i] .. loop_member_start[i + 1]) for loop i.
   std::vector<int> loop_member_start, loop_members;
@@ -163,12 +164,14 @@ struct MechanismData {
   /// factorisation), then the entries of L's columns in loop_factor_rows' order (np + nnz(L)).
   Eigen::VectorXd loop_factor_values;
   Eigen::VectorXd loop_pivot_inverse;  ///< 1 / D, 0 where a pivot is not positive (np)
-  /// Symbolic factorisation (construction): the entry of loop_factor_values each product of two
-  /// of a loop's passive columns adds into (per loop, its column pairs a <= b in order; ~entry for
-  /// the entry's first product, which is stored instead), the entries no product reaches (fill:
-  /// cleared before the assembly) and the entry each step of the elimination updates (per column
-  /// k, its row pairs p <= r in order).
-  std::vector<int> loop_normal_targets, loop_factor_clear, loop_factor_updates;
+  /// Symbolic factorisation (construction), as flat lists of int triples:
+  /// - loop_normal_targets: per loop, its column pairs a <= b in order: the entry of
+  ///   loop_factor_values their product adds into (~entry for the entry's first product, which is
+  ///   stored instead), the offsets of columns a and b in the loop's block;
+  /// - loop_factor_updates: per column k of L (from loop_factor_update_start[k]), its entry pairs
+  ///   p <= r in order: the entry l_pk N_rk updates, p and r (indices of L's entries);
+  /// and the entries no product reaches (fill), cleared before the assembly.
+  std::vector<int> loop_normal_targets, loop_factor_updates, loop_factor_update_start, loop_factor_clear;
   /// Each named frame in its link's joint-aligned frame L (model.hpp): the loop equations place the
   /// closure frames with one product each.
   std::vector<Mat3> frame_rotation_in_link;
