@@ -320,11 +320,14 @@ void passive_transpose_actuated(const MechanismData& data, MechanismData::RowMaj
   }
 }
 
-/// out = A°^T y (or -A°^T y with `Negate`) over A°'s blocks (np).
+/// out = (A°^T A°)^-1 A°^T y (or its negative with `Negate`: the least-squares correction of
+/// A° x = -y) from the factors, A°^T y over A°'s blocks (a column's first product stored, the
+/// others added: data.loop_member_first; the columns in no loop are zero).
 template <bool Negate>
-void passive_transpose_apply(const MechanismData& data, const double* y, Eigen::VectorXd& out) noexcept {
+void normal_solve(const MechanismData& data, const double* y, Eigen::VectorXd& out) noexcept {
   double* o = out.data();
-  for (Eigen::Index i = 0; i < out.size(); ++i) o[i] = 0.0;
+  for (const int j : data.loop_loose_columns) o[j] = 0.0;
+  const char* first = data.loop_member_first.data();
   for (const auto& lb : data.loop_blocks) {
     const double* a = data.loop_passive_blocks.data() + lb.block;
     const int* members = data.loop_members.data() + lb.member;
@@ -332,9 +335,15 @@ void passive_transpose_apply(const MechanismData& data, const double* y, Eigen::
     for (int c = 0; c < lb.count; ++c, a += lb.rows) {
       double sum = 0.0;
       for (int r = 0; r < lb.rows; ++r) sum += a[r] * yl[r];
-      o[members[c]] += Negate ? -sum : sum;
+      if (Negate) sum = -sum;
+      if (first[lb.member + c]) {
+        o[members[c]] = sum;
+      } else {
+        o[members[c]] += sum;
+      }
     }
   }
+  ldl_solve(data, out);
 }
 
 /// Relative damping of the normal equations: keeps the solves bounded at a singular A° (Status::singular).
@@ -547,8 +556,7 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
       evaluate(model, data, trial, false);  // the residual at trial (the step needs it)
       placed_at_trial = true;
     }
-    passive_transpose_apply<true>(data, data.loop_residual.data(), data.loop_step);
-    ldl_solve(data, data.loop_step);
+    normal_solve<true>(data, data.loop_residual.data(), data.loop_step);
     const double biggest = data.loop_step.cwiseAbs().maxCoeff();
     if (!(biggest < 1e300)) {  // non-finite step: cannot assemble here
       if (chord) {
@@ -611,8 +619,7 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
     Eigen::VectorXd& offset = data.loop_prediction_offset;
     data.loop_prediction_offset_valid = data.loop_iterations == 0 && norm > 0.0 && !passive.empty();
     if (data.loop_prediction_offset_valid) {
-      passive_transpose_apply<true>(data, data.loop_residual.data(), offset);
-      ldl_solve(data, offset);
+      normal_solve<true>(data, data.loop_residual.data(), offset);
       for (std::size_t j = 0; j < passive.size(); ++j) raw(data.loop_elimination[j]) += offset(static_cast<Eigen::Index>(j));
     }
     data.loop_prediction_size = raw.cwiseAbs().maxCoeff();
@@ -651,8 +658,7 @@ void refine(MechanismData& data, const B& b, X&& x) noexcept {
     }
   }
   Eigen::VectorXd& step = data.loop_step;
-  passive_transpose_apply<false>(data, r.data(), step);
-  ldl_solve(data, step);
+  normal_solve<false>(data, r.data(), step);
   x += step;
 }
 
@@ -812,8 +818,7 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   // (the links are placed at q: by the solve's last evaluation, or by evaluate above)
   detail::forward_pass<true, false, false, false>(model, data);
   constraint_bias(model, data);
-  passive_transpose_apply<true>(data, data.loop_bias.data(), data.loop_step);
-  ldl_solve(data, data.loop_step);
+  normal_solve<true>(data, data.loop_bias.data(), data.loop_step);
   data.loop_refine_solution = data.loop_step;
   if (refine_solves) refine(data, data.loop_bias, data.loop_refine_solution);
   for (std::size_t j = 0; j < passive.size(); ++j) {
