@@ -185,23 +185,27 @@ class ReactionlessController {
 
  private:
   void build(const Eigen::VectorXd& q0, const Eigen::VectorXd& v0, const Eigen::VectorXd& q_guess);
-  /// K = A C at actuated positions (q_t, q_b) (loops solved into q_full_); v_act_: actuated
-  /// velocities for the loops' projection. Fills K_, Kb_. With `acceleration`, also the loops'
-  /// acceleration bias c (the feed-forward at t_n needs it; an RK4 stage that only needs K not).
+  /// The momentum matrix A and the loop projection C at actuated positions (q_t, q_b) (loops
+  /// solved into q_full_); v_act_: actuated velocities (its task entries: the task's rates). Fills
+  /// Kb_ and ht_ (task_momentum). With `acceleration`, also the loops' acceleration bias c (the
+  /// feed-forward at t_n needs it; an RK4 stage that only needs the rates not).
   Status evaluate(const Eigen::Ref<const Eigen::VectorXd>& q_t, const Eigen::VectorXd& q_b,
                   bool acceleration = true) noexcept;
   /// evaluate() at the same task positions with other balancing positions, for a closed
   /// mechanism whose loops the balancing joints do not move (no loop solve).
   Status rebalance(const Eigen::VectorXd& q_b) noexcept;
-  /// K_ = A C from data_'s momentum matrix and loop projection.
-  void momentum_projection() noexcept;
-  /// Factorise S K_b (cond, damping); then solve() applies the operator.
-  Status factorise(double& condition) noexcept;
+  /// From data_'s momentum matrix A (and C): Kb_ = S A C_b and ht_ = A C [v_t; 0], the momentum
+  /// of the task's motion with the balancing joints still (vt_full_, set by evaluate). K = A C is
+  /// never formed: its task columns enter only through such products.
+  void task_momentum() noexcept;
+  /// Factorise S K_b (damping when cond > max_condition); then solve() applies the operator.
+  /// `condition`: where the condition number is reported (null: only the decision is needed, and
+  /// a cheap bound settles it when it can).
+  Status factorise(double* condition) noexcept;
   void solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::VectorXd& x) noexcept;
   void project_null(const Eigen::VectorXd& z, Eigen::VectorXd& out) noexcept;
-  /// Balancing rates at the evaluated pose for task velocity v_t and target h.
-  Status rates(const Eigen::Ref<const Eigen::VectorXd>& v_t, const Vec6& h, const Eigen::VectorXd& q_b,
-               Eigen::VectorXd& v_b, double* condition) noexcept;
+  /// Balancing rates at the evaluated pose and task rates (ht_) for the target h.
+  Status rates(const Vec6& h, const Eigen::VectorXd& q_b, Eigen::VectorXd& v_b, double* condition) noexcept;
   Status limit_rate(Eigen::VectorXd& v_b) const noexcept;
   Status hold(Status why) noexcept;
   Status tick(const Eigen::Ref<const Eigen::VectorXd>& q_t, const Eigen::Ref<const Eigen::VectorXd>& v_t,
@@ -237,8 +241,11 @@ class ReactionlessController {
   ReactionlessCommand command_;
   // scratch (sized at construction)
   Eigen::VectorXd q_full_, q_act_, v_act_, a_act_, v_full_, a_full_;
-  Eigen::MatrixXd K_;   ///< 6 x na: A C
-  Eigen::MatrixXd Kb_;  ///< k x nb: S K_b
+  Eigen::VectorXd vt_full_;  ///< C [v_t; 0]: every coordinate's rate under the task alone
+  Eigen::VectorXd vt_act_;   ///< [v_t; 0] over the actuated coordinates
+  Eigen::VectorXd c_full_;   ///< scratch: C x of an actuated vector x
+  Vec6 ht_ = Vec6::Zero();   ///< A vt_full_: K_t v_t
+  Eigen::MatrixXd Kb_;       ///< k x nb: S K_b = S A C_b
   Eigen::VectorXd kb_work_, x_, z_, v_b_, a_b_, k1_, k2_, k3_, k4_, q_stage_, r_nb_;
   SmallVector r_, y_;
   Small gram_;
@@ -246,7 +253,7 @@ class ReactionlessController {
   Eigen::SelfAdjointEigenSolver<Small> eig_;
   Eigen::LLT<Small> llt_;
   Eigen::PartialPivLU<Small> lu_;
-  Eigen::PartialPivLU<Eigen::Matrix3d> lu3_;  ///< lu_ when S K_b is 3 x 3
+  Eigen::Matrix3d inv3_ = Eigen::Matrix3d::Identity();  ///< (S K_b)^-1 when it is 3 x 3
 };
 
 /// The reactionless controller followed by a computed-torque stage (computed_torque.hpp over the

@@ -7,7 +7,10 @@
 /// noexcept and allocation-free.
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "mechbal/model/data.hpp"
 #include "mechbal/model/model.hpp"
@@ -35,18 +38,38 @@ inline bool data_matches(const MechanismModel& model, const MechanismData& data)
          static_cast<int>(data.work.size()) == model.num_links();
 }
 
-/// True when every entry of x (a vector or a matrix) is finite (a NaN fails the comparison): one
-/// loop without branches, inlined where Eigen's allFinite (x - x compared with itself entry by
-/// entry) was left as a call in a big translation unit. The input checks and the algorithms'
-/// result checks (finite_result) share it.
+/// True when every entry of x (a vector or a matrix of doubles) is finite: inlined where Eigen's
+/// allFinite (x - x compared with itself entry by entry) was left as a call in a big translation
+/// unit. The input checks and the algorithms' result checks (finite_result) share it. An entry is
+/// infinite or NaN exactly when its exponent bits are all ones; adding 2^52 to those bits then
+/// carries into the sign bit, so one OR over the entries answers for all of them, in integer
+/// operations without a branch or a comparison per entry (vectorised over contiguous storage).
 template <typename Derived>
 inline bool all_finite(const Eigen::DenseBase<Derived>& x) noexcept {
-  constexpr double kMax = std::numeric_limits<double>::max();
+  static_assert(std::is_same<typename Derived::Scalar, double>::value, "all_finite: doubles only");
+  constexpr std::uint64_t kExponent = 0x7ff0000000000000ull, kUnit = 0x0010000000000000ull;
   const Derived& m = x.derived();
-  bool finite = true;
-  for (Eigen::Index j = 0; j < m.cols(); ++j)
-    for (Eigen::Index i = 0; i < m.rows(); ++i) finite &= std::abs(m.coeff(i, j)) <= kMax;
-  return finite;
+  std::uint64_t bad = 0;
+  if constexpr ((Eigen::internal::traits<Derived>::Flags & Eigen::DirectAccessBit) != 0) {
+    if (m.innerStride() == 1 && (m.cols() == 1 || m.rows() == 1 || m.outerStride() == m.rows())) {
+      const double* p = m.data();
+      for (Eigen::Index k = 0; k < m.size(); ++k) {
+        std::uint64_t b;
+        std::memcpy(&b, p + k, sizeof b);
+        bad |= (b & kExponent) + kUnit;
+      }
+      return (bad >> 63) == 0;
+    }
+  }
+  for (Eigen::Index j = 0; j < m.cols(); ++j) {
+    for (Eigen::Index i = 0; i < m.rows(); ++i) {
+      const double v = m.coeff(i, j);
+      std::uint64_t b;
+      std::memcpy(&b, &v, sizeof b);
+      bad |= (b & kExponent) + kUnit;
+    }
+  }
+  return (bad >> 63) == 0;
 }
 
 /// Sizes and finiteness of up to three state vectors (null = not used).
