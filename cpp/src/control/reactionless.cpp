@@ -212,6 +212,15 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
     }
   }
 
+  // the links a balancing joint moves: those of its coordinate (gear couplings included) and all
+  // their descendants (links are listed parents first)
+  subtree_.assign(static_cast<std::size_t>(m.num_links()), 0);
+  for (int l = 1; l < m.num_links(); ++l) {
+    const int c = m.coordinate(l);
+    const bool own = c >= 0 && std::find(balancing_coord_.begin(), balancing_coord_.end(), c) != balancing_coord_.end();
+    subtree_[static_cast<std::size_t>(l)] = own || subtree_[static_cast<std::size_t>(m.parent(l))] ? 1 : 0;
+  }
+
   rate_limit_.resize(nb_);
   lower_.resize(nb_);
   upper_.resize(nb_);
@@ -245,6 +254,7 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
   vt_full_ = Eigen::VectorXd::Zero(n_);
   c_full_ = Eigen::VectorXd::Zero(n_);
   vt_act_ = Eigen::VectorXd::Zero(na_);
+  Ab_ = Eigen::MatrixXd::Zero(6, nb_);
   Kb_ = Eigen::MatrixXd::Zero(k_, nb_);
   kb_work_ = Eigen::VectorXd::Zero(k_);
   for (Eigen::VectorXd* v : {&x_, &z_, &v_b_, &a_b_, &k1_, &k2_, &k3_, &k4_, &q_stage_, &r_nb_, &q_b_})
@@ -292,17 +302,15 @@ Status ReactionlessController::reset(const Eigen::Ref<const Eigen::VectorXd>& q0
     Eigen::VectorXd& q = q_full_;
     st = closed_motion(*model_, data_, q_act_, v_act_, a_act_, q, config_.loop_options);
     if (failed(st)) return st;
-    momentum_matrix(*model_, data_, q_full_);
     v_full_ = data_.closed_velocity;
   } else {
     q_full_ = q_act_;
-    st = momentum_matrix(*model_, data_, q_full_);
-    if (failed(st)) return st;
     v_full_ = v_act_;
   }
+  // (momentum() places the links: an open model's q_full_ was not placed yet)
+  if (momentum(*model_, data_, q_full_, v_full_) != Status::ok) return Status::out_of_range;
   Vec6 h;
-  h = momentum_times(data_.momentum_matrix, v_full_);
-  if (!h.allFinite()) return Status::out_of_range;
+  h << data_.shaking.linear_momentum, data_.shaking.angular_momentum;
   if (h.cwiseAbs().maxCoeff() > config_.max_momentum) return Status::out_of_range;
   target_ = h;
   target_rate_.setZero();
@@ -342,9 +350,6 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
     st = acceleration ? closed_motion(*model_, data_, q_act_, v_act_, a_act_, q_full_, config_.loop_options)
                       : closed_velocity_motion(*model_, data_, q_act_, v_act_, q_full_, config_.loop_options);
     if (failed(st)) return st;
-    // the solve left the links placed at its solution q_full_: no second placement
-    const Status sm = detail::momentum_matrix_placed(*model_, data_);
-    if (sm != Status::ok) return st | sm;
     if (balancing_in_loops_) {
       // C [v_t; 0]: the balancing joints' columns of C reach passive coordinates
       vt_act_ = v_act_;
@@ -358,27 +363,38 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
     }
   } else {
     q_full_ = q_act_;
-    st = momentum_matrix(*model_, data_, q_full_);
-    if (st != Status::ok) return st;
     vt_full_ = v_act_;  // an open model's coordinates are its actuated ones, in order
     for (const int c : balancing_coord_) vt_full_(c) = 0.0;
   }
-  task_momentum();
+  if (!balancing_in_loops_) return st | task_momentum(true);
+  // the solve left the links placed at its solution q_full_: no second placement
+  const Status sm = detail::momentum_matrix_placed(*model_, data_);
+  if (sm != Status::ok) return st | sm;
+  // K_b = A C_b (the balancing joints' columns of C reach passive coordinates), K_t v_t = A vt
+  const Eigen::MatrixXd& A = data_.momentum_matrix;
+  for (int j = 0; j < nb_; ++j) {
+    c_full_ = data_.loop_projection.col(balancing_[static_cast<std::size_t>(j)]);
+    Ab_.col(j) = momentum_times(A, c_full_);
+  }
+  for (int i = 0; i < k_; ++i) Kb_.row(i) = Ab_.row(rows_[static_cast<std::size_t>(i)]);
+  ht_ = momentum_times(A, vt_full_);
   return st;
 }
 
-void ReactionlessController::task_momentum() noexcept {
-  const Eigen::MatrixXd& A = data_.momentum_matrix;
-  if (closed_ && balancing_in_loops_) {
-    const Eigen::MatrixXd& C = data_.loop_projection;
-    for (int i = 0; i < k_; ++i)
-      for (int j = 0; j < nb_; ++j)
-        Kb_(i, j) = A.row(rows_[static_cast<std::size_t>(i)]).dot(C.col(balancing_[static_cast<std::size_t>(j)]));
-  } else {
-    for (int i = 0; i < k_; ++i)
-      for (int j = 0; j < nb_; ++j) Kb_(i, j) = A(rows_[static_cast<std::size_t>(i)], balancing_coord_[static_cast<std::size_t>(j)]);
-  }
-  ht_ = momentum_times(A, vt_full_);
+Status ReactionlessController::task_momentum(bool whole) noexcept {
+  // the task's motion alone (vt_full_) on the links placed at q_full_ (place() moves only the
+  // links whose joints moved: the balancing subtrees after rebalance(), none after a loop solve)
+  detail::joint_state<true, false>(*model_, data_, q_full_, vt_full_, vt_full_);
+  detail::place(*model_, data_);
+  // the links outside the balancing subtrees move alike whatever the balancing joints do: their
+  // velocities and momentum (rest_) are the last whole pass's when only those joints turned
+  detail::link_velocities(*model_, data_, whole ? nullptr : subtree_.data());
+  Vec6 inside;
+  detail::momentum_sums(*model_, data_, subtree_.data(), whole, inside, rest_);
+  ht_ = rest_ + inside;
+  detail::momentum_columns_placed(*model_, data_, subtree_.data(), balancing_coord_, Ab_);
+  for (int i = 0; i < k_; ++i) Kb_.row(i) = Ab_.row(rows_[static_cast<std::size_t>(i)]);
+  return detail::all_finite(ht_) && detail::all_finite(Ab_) ? Status::ok : Status::out_of_range;
 }
 
 Status ReactionlessController::rebalance(const Eigen::VectorXd& q_b) noexcept {
@@ -388,12 +404,9 @@ Status ReactionlessController::rebalance(const Eigen::VectorXd& q_b) noexcept {
     q_act_(balancing_[static_cast<std::size_t>(j)]) = q_b(j);
     q_full_(balancing_coord_[static_cast<std::size_t>(j)]) = q_b(j);
     // the loop solve's warm start follows (its tangent predictor needs q == closed_position)
-    data_.closed_position(balancing_coord_[static_cast<std::size_t>(j)]) = q_b(j);
+    if (closed_) data_.closed_position(balancing_coord_[static_cast<std::size_t>(j)]) = q_b(j);
   }
-  const Status st = momentum_matrix(*model_, data_, q_full_);
-  if (st != Status::ok) return st;
-  task_momentum();  // (vt_full_ is the last evaluate()'s: same task motion)
-  return Status::ok;
+  return task_momentum(false);  // (vt_full_ is the last evaluate()'s: same task motion)
 }
 
 Status ReactionlessController::factorise(double* reported) noexcept {
@@ -617,28 +630,26 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
     }
     // without balancing joints in the loops, c does not depend on their rates
     project_actuated(data_.loop_projection, v_act_, v_full_);
-    a_full_ = data_.loop_acceleration_bias;
+    // a = c + C [a_t; 0] (a_act_'s balancing entries are still zero)
+    project_actuated(data_.loop_projection, a_act_, a_full_);
+    a_full_ += data_.loop_acceleration_bias;
   } else {
     v_full_ = v_act_;
-    a_full_.setZero();
+    a_full_ = a_act_;
   }
-  // ---- feed-forward: S K_b a_b = S dh*/dt - S K_t a_t - S W(q, v, c)
+  // ---- feed-forward: S K_b a_b = S dh*/dt - S K_t a_t - S W(q, v, c) = S dh*/dt - S W'
+  // with W' = W(q, v, c + C [a_t; 0]) = W(q, v, c) + K_t a_t, the shaking wrench (the rate of
+  // momentum) of the motion with the balancing joints' accelerations still zero; the same pass
+  // gives the momentum h = A C v of the command.
   // the links are placed at q_full_ (evaluate(), or closed_motion just above, at the same q)
   if (const Status s = detail::shaking_wrench_placed(*model_, data_, q_full_, v_full_, a_full_); s != Status::ok)
     return hold(Status::out_of_range);
-  Vec6 W;
+  Vec6 W, h;
   W << data_.shaking.force, data_.shaking.moment;
-  // K_t a_t = A C [a_t; 0] (a_act_'s balancing entries are still zero)
-  const Eigen::MatrixXd& A = data_.momentum_matrix;  // at q_full_ (evaluate() or rebalance())
-  if (closed_) {
-    project_actuated(data_.loop_projection, a_act_, c_full_);
-  } else {
-    c_full_ = a_act_;
-  }
-  const Vec6 task_rate = momentum_times(A, c_full_);
+  h << data_.shaking.linear_momentum, data_.shaking.angular_momentum;
   for (int i = 0; i < k_; ++i) {
     const int row = rows_[static_cast<std::size_t>(i)];
-    kb_work_(i) = target_rate_(row) - W(row) - task_rate(row);
+    kb_work_(i) = target_rate_(row) - W(row);
   }
   solve(kb_work_, a_b_);  // same operator as the rates at t_n
   if (wide_ && (config_.home_gain > 0.0 || config_.limit_gain > 0.0)) {
@@ -665,19 +676,19 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
       st |= Status::saturated;
     }
   }
-  for (int j = 0; j < nb_; ++j) a_act_(balancing_[static_cast<std::size_t>(j)]) = a_b_(j);
-  if (closed_) {
-    project_actuated(data_.loop_projection, a_act_, c_full_);
-    a_full_ += c_full_;
-  } else {
-    c_full_ = a_act_;
-    a_full_ = a_act_;
+  // a += C_b a_b, and the predicted wrench W' + K_b a_b
+  Vec6 predicted = W;
+  for (int j = 0; j < nb_; ++j) {
+    const int b = balancing_[static_cast<std::size_t>(j)];
+    a_act_(b) = a_b_(j);
+    if (closed_) {
+      a_full_ += a_b_(j) * data_.loop_projection.col(b);
+    } else {
+      a_full_(b) += a_b_(j);
+    }
+    predicted += a_b_(j) * Ab_.col(j);
   }
-  // h = K v = A C v, and the predicted wrench W + K a = W + A C a
-  Vec6 h, predicted;
-  h = momentum_times(A, v_full_);
-  predicted = momentum_times(A, c_full_) + W;
-  if (!h.allFinite() || !predicted.allFinite()) return hold(Status::out_of_range);
+  if (!detail::all_finite(h) || !detail::all_finite(predicted)) return hold(Status::out_of_range);
 
   // the command at t_n (the stages below overwrite the model's data)
   command_.q = q_act_;
@@ -708,7 +719,7 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
     if (!failed(ss)) ss |= rates(target_ + (0.5 * dt_) * target_rate_, q_stage_, k2_, nullptr);
     q_stage_ = q_b_ + (0.5 * dt_) * k2_;
     if (!failed(ss))
-      ss |= closed_ && !balancing_in_loops_ ? rebalance(q_stage_) : evaluate(*q_half, q_stage_, false);
+      ss |= !balancing_in_loops_ ? rebalance(q_stage_) : evaluate(*q_half, q_stage_, false);
     if (!failed(ss)) ss |= rates(target_ + (0.5 * dt_) * target_rate_, q_stage_, k3_, nullptr);
     q_stage_ = q_b_ + dt_ * k3_;
     task_rates(*v_next);
@@ -751,7 +762,7 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
       command_.q_full = q_full_;
       command_.v_full = v_full_;
       command_.a_full = a_full_;
-      command_.momentum = momentum_times(data_.momentum_matrix, v_full_);
+      command_.momentum << data_.shaking.linear_momentum, data_.shaking.angular_momentum;
       command_.shaking_force = data_.shaking.force;
       command_.shaking_moment = data_.shaking.moment;
       next = q_b_;
@@ -761,7 +772,7 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
   }
   q_b_ = next;
   command_.status = st;
-  if (rk4 && closed_ && !balancing_in_loops_ && !failed(last_stage)) {
+  if (rk4 && !balancing_in_loops_ && !failed(last_stage)) {
     stage_cache_ = true;
     stage_cache_status_ = last_stage;
     stage_q_ = *q_next;

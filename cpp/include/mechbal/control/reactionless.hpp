@@ -194,10 +194,13 @@ class ReactionlessController {
   /// evaluate() at the same task positions with other balancing positions, for a closed
   /// mechanism whose loops the balancing joints do not move (no loop solve).
   Status rebalance(const Eigen::VectorXd& q_b) noexcept;
-  /// From data_'s momentum matrix A (and C): Kb_ = S A C_b and ht_ = A C [v_t; 0], the momentum
-  /// of the task's motion with the balancing joints still (vt_full_, set by evaluate). K = A C is
-  /// never formed: its task columns enter only through such products.
-  void task_momentum() noexcept;
+  /// When no balancing joint moves a loop: Ab_ = A_b (the balancing columns of the momentum
+  /// matrix, from the composites of the balancing subtrees alone) and ht_ = A vt_full_, the
+  /// momentum of the task's motion with the balancing joints still (vt_full_, set by evaluate),
+  /// at q_full_. `whole` false: only the balancing subtrees moved since the last whole one (the
+  /// other links' velocities and momentum rest_ are kept). The full A and K = A C are never formed:
+  /// K's task columns enter only through K_t v_t, and K_t a_t through the shaking wrench.
+  Status task_momentum(bool whole) noexcept;
   /// Factorise S K_b (damping when cond > max_condition); then solve() applies the operator.
   /// `condition`: where the condition number is reported (null: only the decision is needed, and
   /// a cheap bound settles it when it can).
@@ -233,7 +236,8 @@ class ReactionlessController {
   // RK4's last stage solved the loops at (q_t_next, v_t_next) with the momentum of the same loop
   // solution: when the next tick starts at exactly those task positions and rates (a sampled
   // trajectory), its t_n evaluation reuses them (the loop solve, C and c do not depend on the
-  // balancing joints when these move no loop frame): only A is recomputed (rebalance)
+  // balancing joints when these move no loop frame): only the balancing subtrees' momentum is
+  // recomputed (rebalance). Likewise for an open mechanism (no loops).
   bool stage_cache_ = false;
   Status stage_cache_status_ = Status::ok;
   Eigen::VectorXd stage_q_, stage_v_;
@@ -241,11 +245,14 @@ class ReactionlessController {
   ReactionlessCommand command_;
   // scratch (sized at construction)
   Eigen::VectorXd q_full_, q_act_, v_act_, a_act_, v_full_, a_full_;
+  std::vector<unsigned char> subtree_;  ///< per link: moved by a balancing joint (it or an ancestor)
   Eigen::VectorXd vt_full_;  ///< C [v_t; 0]: every coordinate's rate under the task alone
   Eigen::VectorXd vt_act_;   ///< [v_t; 0] over the actuated coordinates
   Eigen::VectorXd c_full_;   ///< scratch: C x of an actuated vector x
   Vec6 ht_ = Vec6::Zero();   ///< A vt_full_: K_t v_t
-  Eigen::MatrixXd Kb_;       ///< k x nb: S K_b = S A C_b
+  Vec6 rest_ = Vec6::Zero(); ///< the part of ht_ from the links outside subtree_
+  Eigen::MatrixXd Ab_;       ///< 6 x nb: K_b = A C_b
+  Eigen::MatrixXd Kb_;       ///< k x nb: S K_b
   Eigen::VectorXd kb_work_, x_, z_, v_b_, a_b_, k1_, k2_, k3_, k4_, q_stage_, r_nb_;
   SmallVector r_, y_;
   Small gram_;

@@ -294,11 +294,15 @@ MECHBAL_FLATTEN inline void backward_pass(const MechanismModel& model, Mechanism
 /// below it, so only the links marked stale by place() (LinkWork::composite_current: the
 /// ancestors of a link whose placement changed) are recomputed, each from its own bodies and its
 /// children in the same order as a full pass: bit for bit the same result.
-MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, MechanismData& data) noexcept {
+/// `only` (one flag per link, or null: all): recompute the flagged links alone, a set closed
+/// under descendants (the subtrees of some links: e.g. a controller's balancing joints, whose
+/// columns of the momentum matrix need nothing else); the others keep their state, stale or not.
+MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, MechanismData& data,
+                                               const unsigned char* only = nullptr) noexcept {
   const int nl = model.num_links();
   for (int l = 0; l < nl; ++l) {
     auto& W = data.work[static_cast<std::size_t>(l)];
-    if (W.composite_current) continue;
+    if (W.composite_current || (only && !only[l])) continue;
     W.momentum_current = false;  // its momentum-matrix column follows its composite
     const auto& c = model.link_constants(l);
     W.composite_mass = c.mass;
@@ -309,7 +313,7 @@ MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, Mech
     const int parent = model.parent(l);
     if (parent == 0) continue;
     auto& P = data.work[static_cast<std::size_t>(parent)];
-    if (P.composite_current) continue;
+    if (P.composite_current || (only && !only[parent])) continue;
     const auto& W = data.work[static_cast<std::size_t>(l)];
     // massless: m = 0 and a zero inertia (positive semi-definite with zero trace)
     if (W.composite_mass == 0.0 && W.composite_inertia.trace() == 0.0) continue;
@@ -337,7 +341,42 @@ MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, Mech
     P.composite_mass += m;
     P.composite_first_moment += mp_h;
   }
-  for (int l = 0; l < nl; ++l) data.work[static_cast<std::size_t>(l)].composite_current = true;
+  for (int l = 0; l < nl; ++l) {
+    if (!only || only[l]) data.work[static_cast<std::size_t>(l)].composite_current = true;
+  }
+}
+
+/// Angular velocity and origin velocity of the links in their L frames from the joints' rates
+/// (data.joint_velocity) and placements: the first part of forward_pass, with the same operations,
+/// for the momenta, which need nothing more. `only` (one flag per link, or null: all): update the
+/// flagged links alone, each after its parent, whose velocities must be current (from this pass
+/// or an earlier one at the same placements and rates).
+MECHBAL_FLATTEN inline void link_velocities(const MechanismModel& model, MechanismData& data,
+                                            const unsigned char* only = nullptr) noexcept {
+  data.work[0].w.setZero();
+  data.work[0].vel.setZero();
+  const int nl = model.num_links();
+  for (int l = 1; l < nl; ++l) {
+    if (only && !only[l]) continue;
+    const auto k = static_cast<std::size_t>(l);
+    const auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
+    auto& W = data.work[k];
+    const Vec3& p = W.translation;
+    const Mat3& R = W.rotation;
+    W.w.noalias() = R.transpose() * P.w;
+    W.vel.noalias() = R.transpose() * (P.vel + P.w.cross(p));
+    const double qd = data.joint_velocity[k];
+    switch (model.joint_type(l)) {
+      case JointType::revolute:
+        W.w.z() += qd;
+        break;
+      case JointType::prismatic:
+        W.vel.z() += qd;
+        break;
+      case JointType::fixed:
+        break;
+    }
+  }
 }
 
 /// World placement and motion of a named frame from placed links and a forward pass: origin
