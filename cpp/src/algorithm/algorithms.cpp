@@ -267,12 +267,13 @@ inline void add_column_term(const MechanismModel& model, const MechanismData::Li
 }  // namespace
 
 MECHBAL_FLATTEN void detail::momentum_sums(const MechanismModel& model, const MechanismData& data,
-                                           const unsigned char* mask, bool outside, Vec6& inside,
+                                           const LinkSubset& links, bool outside, Vec6& inside,
                                            Vec6& rest) noexcept {
   Vec3 P[2] = {Vec3::Zero(), Vec3::Zero()}, H[2] = {Vec3::Zero(), Vec3::Zero()};
-  for (int l = 1; l < model.num_links(); ++l) {
-    const int in = mask[l] ? 1 : 0;
-    if (!in && !outside) continue;
+  const int count = outside ? model.num_links() - 1 : static_cast<int>(links.links.size());
+  for (int i = 0; i < count; ++i) {
+    const int l = outside ? i + 1 : links.links[static_cast<std::size_t>(i)];
+    const int in = links.member[static_cast<std::size_t>(l)] ? 1 : 0;
     const auto& c = model.link_constants(l);
     const auto& W = data.work[static_cast<std::size_t>(l)];
     const Vec3 p_local = c.mass * W.vel + W.w.cross(c.first_moment);
@@ -286,12 +287,11 @@ MECHBAL_FLATTEN void detail::momentum_sums(const MechanismModel& model, const Me
 }
 
 MECHBAL_FLATTEN void detail::momentum_columns_placed(const MechanismModel& model, MechanismData& data,
-                                                     const unsigned char* mask, const std::vector<int>& coordinates,
+                                                     const LinkSubset& links, const std::vector<int>& coordinates,
                                                      Eigen::Ref<Eigen::MatrixXd> columns) noexcept {
-  detail::composite_inertias(model, data, mask);
+  detail::composite_inertias(model, data, &links);
   columns.setZero();
-  for (int l = 1; l < model.num_links(); ++l) {
-    if (!mask[l]) continue;
+  for (const int l : links.links) {
     const int c = model.coordinate(l);
     for (std::size_t j = 0; j < coordinates.size(); ++j) {
       if (coordinates[j] == c) add_column_term(model, data.work[static_cast<std::size_t>(l)], l, columns.col(static_cast<Eigen::Index>(j)));

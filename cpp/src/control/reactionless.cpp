@@ -214,11 +214,15 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
 
   // the links a balancing joint moves: those of its coordinate (gear couplings included) and all
   // their descendants (links are listed parents first)
-  subtree_.assign(static_cast<std::size_t>(m.num_links()), 0);
+  subtree_.member.assign(static_cast<std::size_t>(m.num_links()), 0);
+  subtree_.links.clear();
   for (int l = 1; l < m.num_links(); ++l) {
     const int c = m.coordinate(l);
     const bool own = c >= 0 && std::find(balancing_coord_.begin(), balancing_coord_.end(), c) != balancing_coord_.end();
-    subtree_[static_cast<std::size_t>(l)] = own || subtree_[static_cast<std::size_t>(m.parent(l))] ? 1 : 0;
+    if (own || subtree_.member[static_cast<std::size_t>(m.parent(l))]) {
+      subtree_.member[static_cast<std::size_t>(l)] = 1;
+      subtree_.links.push_back(l);
+    }
   }
 
   rate_limit_.resize(nb_);
@@ -382,17 +386,29 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
 }
 
 Status ReactionlessController::task_momentum(bool whole) noexcept {
-  // the task's motion alone (vt_full_) on the links placed at q_full_ (place() moves only the
-  // links whose joints moved: the balancing subtrees after rebalance(), none after a loop solve)
-  detail::joint_state<true, false>(*model_, data_, q_full_, vt_full_, vt_full_);
-  detail::place(*model_, data_);
-  // the links outside the balancing subtrees move alike whatever the balancing joints do: their
-  // velocities and momentum (rest_) are the last whole pass's when only those joints turned
-  detail::link_velocities(*model_, data_, whole ? nullptr : subtree_.data());
+  // the task's motion alone (vt_full_) on the links placed at q_full_. The links outside the
+  // balancing subtrees move alike whatever the balancing joints do: after rebalance() (`whole`
+  // false) their placements, velocities and momentum (rest_) are the last whole pass's, and only
+  // the subtrees are placed and moved again. A loop solve left every link placed at q_full_.
+  if (whole) {
+    detail::joint_state<true, false>(*model_, data_, q_full_, vt_full_, vt_full_);
+    if (!closed_) detail::place(*model_, data_);
+    detail::link_velocities(*model_, data_);
+  } else {
+    for (const int l : subtree_.links) {
+      const auto k = static_cast<std::size_t>(l);
+      const int c = model_->coordinate(l);
+      const double r = model_->coordinate_ratio(l);
+      data_.joint_position[k] = c < 0 ? 0.0 : r * q_full_(c) + model_->coordinate_offset(l);
+      data_.joint_velocity[k] = c < 0 ? 0.0 : r * vt_full_(c);
+    }
+    detail::place<true, detail::NoVisit, true>(*model_, data_, detail::NoVisit{}, &subtree_);
+    detail::link_velocities(*model_, data_, &subtree_);
+  }
   Vec6 inside;
-  detail::momentum_sums(*model_, data_, subtree_.data(), whole, inside, rest_);
+  detail::momentum_sums(*model_, data_, subtree_, whole, inside, rest_);
   ht_ = rest_ + inside;
-  detail::momentum_columns_placed(*model_, data_, subtree_.data(), balancing_coord_, Ab_);
+  detail::momentum_columns_placed(*model_, data_, subtree_, balancing_coord_, Ab_);
   for (int i = 0; i < k_; ++i) Kb_.row(i) = Ab_.row(rows_[static_cast<std::size_t>(i)]);
   return detail::all_finite(ht_) && detail::all_finite(Ab_) ? Status::ok : Status::out_of_range;
 }

@@ -54,6 +54,7 @@
 #include "mechbal/control/joint_controller.hpp"
 #include "mechbal/control/joint_limits.hpp"
 #include "mechbal/control/mechanism_dynamics.hpp"
+#include "mechbal/detail/link_subset.hpp"
 #include "mechbal/model/data.hpp"
 #include "mechbal/model/model.hpp"
 #include "mechbal/model/rigid_body.hpp"
@@ -245,7 +246,7 @@ class ReactionlessController {
   ReactionlessCommand command_;
   // scratch (sized at construction)
   Eigen::VectorXd q_full_, q_act_, v_act_, a_act_, v_full_, a_full_;
-  std::vector<unsigned char> subtree_;  ///< per link: moved by a balancing joint (it or an ancestor)
+  detail::LinkSubset subtree_;  ///< the links a balancing joint moves (it or an ancestor)
   Eigen::VectorXd vt_full_;  ///< C [v_t; 0]: every coordinate's rate under the task alone
   Eigen::VectorXd vt_act_;   ///< [v_t; 0] over the actuated coordinates
   Eigen::VectorXd c_full_;   ///< scratch: C x of an actuated vector x

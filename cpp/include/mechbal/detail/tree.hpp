@@ -11,7 +11,9 @@
 #include <cstring>
 #include <limits>
 #include <type_traits>
+#include <vector>
 
+#include "mechbal/detail/link_subset.hpp"
 #include "mechbal/model/data.hpp"
 #include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
@@ -123,10 +125,14 @@ struct NoVisit {
   void operator()(int, const MechanismData::LinkWork&) const noexcept {}
 };
 
-template <bool World = true, class Visit = NoVisit>
-MECHBAL_FLATTEN inline void place(const MechanismModel& model, MechanismData& data, Visit&& visit = Visit{}) noexcept {
-  const int nl = model.num_links();
-  for (int l = 1; l < nl; ++l) {
+/// With Subset, `only` (not null) restricts the pass to its links (their parents outside it keep
+/// their placements, in O too).
+template <bool World = true, class Visit = NoVisit, bool Subset = false>
+MECHBAL_FLATTEN inline void place(const MechanismModel& model, MechanismData& data, Visit&& visit = Visit{},
+                                  const LinkSubset* only = nullptr) noexcept {
+  const int count = Subset ? static_cast<int>(only->links.size()) : model.num_links() - 1;
+  for (int i = 0; i < count; ++i) {
+    const int l = Subset ? only->links[static_cast<std::size_t>(i)] : i + 1;
     const auto k = static_cast<std::size_t>(l);
     auto& w = data.work[k];
     const double qk = data.joint_position[k];
@@ -294,26 +300,29 @@ MECHBAL_FLATTEN inline void backward_pass(const MechanismModel& model, Mechanism
 /// below it, so only the links marked stale by place() (LinkWork::composite_current: the
 /// ancestors of a link whose placement changed) are recomputed, each from its own bodies and its
 /// children in the same order as a full pass: bit for bit the same result.
-/// `only` (one flag per link, or null: all): recompute the flagged links alone, a set closed
-/// under descendants (the subtrees of some links: e.g. a controller's balancing joints, whose
+/// `only` (or null: all): recompute its links alone (e.g. a controller's balancing subtrees, whose
 /// columns of the momentum matrix need nothing else); the others keep their state, stale or not.
 MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, MechanismData& data,
-                                               const unsigned char* only = nullptr) noexcept {
+                                               const LinkSubset* only = nullptr) noexcept {
   const int nl = model.num_links();
-  for (int l = 0; l < nl; ++l) {
+  const int count = only ? static_cast<int>(only->links.size()) : nl;
+  for (int i = 0; i < count; ++i) {
+    const int l = only ? only->links[static_cast<std::size_t>(i)] : i;
     auto& W = data.work[static_cast<std::size_t>(l)];
-    if (W.composite_current || (only && !only[l])) continue;
+    if (W.composite_current) continue;
     W.momentum_current = false;  // its momentum-matrix column follows its composite
     const auto& c = model.link_constants(l);
     W.composite_mass = c.mass;
     W.composite_first_moment = c.first_moment;
     W.composite_inertia = c.inertia_origin;
   }
-  for (int l = nl - 1; l >= 1; --l) {
+  for (int i = count - 1; i >= 0; --i) {
+    const int l = only ? only->links[static_cast<std::size_t>(i)] : i;
+    if (l == 0) continue;
     const int parent = model.parent(l);
     if (parent == 0) continue;
     auto& P = data.work[static_cast<std::size_t>(parent)];
-    if (P.composite_current || (only && !only[parent])) continue;
+    if (P.composite_current || (only && !only->member[static_cast<std::size_t>(parent)])) continue;
     const auto& W = data.work[static_cast<std::size_t>(l)];
     // massless: m = 0 and a zero inertia (positive semi-definite with zero trace)
     if (W.composite_mass == 0.0 && W.composite_inertia.trace() == 0.0) continue;
@@ -341,23 +350,23 @@ MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, Mech
     P.composite_mass += m;
     P.composite_first_moment += mp_h;
   }
-  for (int l = 0; l < nl; ++l) {
-    if (!only || only[l]) data.work[static_cast<std::size_t>(l)].composite_current = true;
+  for (int i = 0; i < count; ++i) {
+    data.work[static_cast<std::size_t>(only ? only->links[static_cast<std::size_t>(i)] : i)].composite_current = true;
   }
 }
 
 /// Angular velocity and origin velocity of the links in their L frames from the joints' rates
 /// (data.joint_velocity) and placements: the first part of forward_pass, with the same operations,
-/// for the momenta, which need nothing more. `only` (one flag per link, or null: all): update the
-/// flagged links alone, each after its parent, whose velocities must be current (from this pass
-/// or an earlier one at the same placements and rates).
+/// for the momenta, which need nothing more. `only` (or null: all): update its links alone, each
+/// after its parent, whose velocities must be current (from this pass or an earlier one at the
+/// same placements and rates).
 MECHBAL_FLATTEN inline void link_velocities(const MechanismModel& model, MechanismData& data,
-                                            const unsigned char* only = nullptr) noexcept {
+                                            const LinkSubset* only = nullptr) noexcept {
   data.work[0].w.setZero();
   data.work[0].vel.setZero();
-  const int nl = model.num_links();
-  for (int l = 1; l < nl; ++l) {
-    if (only && !only[l]) continue;
+  const int count = only ? static_cast<int>(only->links.size()) : model.num_links() - 1;
+  for (int i = 0; i < count; ++i) {
+    const int l = only ? only->links[static_cast<std::size_t>(i)] : i + 1;
     const auto k = static_cast<std::size_t>(l);
     const auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
     auto& W = data.work[k];
