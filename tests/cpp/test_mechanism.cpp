@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <iterator>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -17,6 +19,7 @@
 #include "mechbal/algorithm/regressor.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/control/kdl_chain.hpp"
+#include "mechbal/detail/tree.hpp"
 #include "test_support.hpp"
 
 using namespace mechbal;
@@ -459,4 +462,28 @@ TEST(Mechanism, ConstructionErrorsNameTheField) {
   d.joints[1].lower = 1.0;
   d.joints[1].upper = -1.0;
   EXPECT_THROW(MechanismModel{d}, std::invalid_argument);
+}
+
+// detail::all_finite (every input and result check) against Eigen's allFinite on the values at the
+// edges of the double range, in contiguous vectors and matrices and in strided blocks.
+TEST(Mechanism, AllFiniteAgreesWithEigenAtTheEdges) {
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
+  const double values[] = {0.0, -0.0, 1.0, -1.0, std::numeric_limits<double>::max(), -std::numeric_limits<double>::max(),
+                           std::numeric_limits<double>::min(), std::numeric_limits<double>::denorm_min(),
+                           -std::numeric_limits<double>::denorm_min(), 1e308, inf, -inf, nan, -nan};
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(std::size(values)) - 1);
+  for (int trial = 0; trial < 2000; ++trial) {
+    Eigen::MatrixXd m(5, 7);
+    for (Eigen::Index k = 0; k < m.size(); ++k) m.data()[k] = trial % 3 == 0 ? values[pick(rng) % 10] : values[pick(rng)];
+    EXPECT_EQ(detail::all_finite(m), m.allFinite());
+    const Eigen::VectorXd v = m.col(trial % 7);
+    EXPECT_EQ(detail::all_finite(v), v.allFinite());
+    const Eigen::Ref<const Eigen::VectorXd> r(v);
+    EXPECT_EQ(detail::all_finite(r), v.allFinite());
+    EXPECT_EQ(detail::all_finite(m.block(1, 2, 3, 4)), m.block(1, 2, 3, 4).allFinite());  // strided
+    EXPECT_EQ(detail::all_finite(m.row(trial % 5)), m.row(trial % 5).allFinite());
+    const Vec3 f = m.col(0).head<3>();
+    EXPECT_EQ(detail::all_finite(f), f.allFinite());
+  }
 }

@@ -242,6 +242,48 @@ TEST(Reactionless, BadInputHoldsTheCommand) {
 // balancing joints cancelling the three moment components: the commanded momentum stays on
 // target; with four balancing joints for the three moments (redundant) the null-space objective
 // pulls the balancing joints home without disturbing the cancellation.
+// A balancing joint that moves a loop: a planar five-bar whose second crank keeps the angular
+// momentum about z while the first follows its task. C's balancing column then reaches the
+// passive couplers (the controller's A C_b path, not the balancing-subtree one). The commanded
+// state's momentum, recomputed independently, stays on target; the second crank really turns.
+TEST(Reactionless, BalancingJointInsideALoop) {
+  const auto rod = [](const std::string& name, double mass, double length) {
+    return Body{name, "link", name, mass, Vec3(0.5 * length, 0.01, 0.0),
+                diag(1e-4, mass * length * length / 12.0, mass * length * length / 12.0)};
+  };
+  MechanismDescription d;
+  d.gravity = Vec3(0.0, -9.81, 0.0);
+  d.joints = {revolute("crank1", "base", at(0.0)), revolute("coupler1", "crank1", at(0.2)),
+              revolute("crank2", "base", at(0.3)), revolute("coupler2", "crank2", at(0.2))};
+  d.bodies = {rod("crank1", 0.8, 0.2), rod("coupler1", 1.2, 0.35), rod("crank2", 0.9, 0.2), rod("coupler2", 1.0, 0.35)};
+  d.frames = {Frame{"tip1", "coupler1", at(0.35)}, Frame{"tip2", "coupler2", at(0.35)}};
+  d.loops = {LoopConstraint{"tip", LoopType::point, "tip1", "tip2"}};
+  d.actuated = {"crank1", "crank2"};
+  const auto model = std::make_shared<const MechanismModel>(d);
+  // an assembly at the start: the tip where circles of radius 0.35 about both crank ends meet
+  const double q1 = 1.9, q2 = 1.3;
+  const Eigen::Vector2d A(0.2 * std::cos(q1), 0.2 * std::sin(q1)), B(0.3 + 0.2 * std::cos(q2), 0.2 * std::sin(q2));
+  const Eigen::Vector2d mid = 0.5 * (A + B), u = (B - A).normalized();
+  const double half = 0.5 * (B - A).norm(), up = std::sqrt(0.35 * 0.35 - half * half);
+  const Eigen::Vector2d P = mid + up * Eigen::Vector2d(-u(1), u(0));
+  Eigen::VectorXd guess(4);
+  guess << q1, std::atan2(P(1) - A(1), P(0) - A(0)) - q1, q2, std::atan2(P(1) - B(1), P(0) - B(0)) - q2;
+  for (auto integrator : {ReactionlessIntegrator::euler, ReactionlessIntegrator::rk4}) {
+    ReactionlessConfig c;
+    c.balancing_joints = {"crank2"};
+    c.cancel = moment_z;
+    c.integrator = integrator;
+    ReactionlessController ctrl(model, c, Eigen::Vector2d(q1, q2), Eigen::VectorXd(), guess);
+    Motion m{Eigen::VectorXd::Constant(1, q1), Eigen::VectorXd::Constant(1, 0.15), Eigen::VectorXd::Constant(1, 3.0)};
+    const RunResult r = run(ctrl, m, 1500);
+    EXPECT_EQ(r.status, Status::ok);
+    EXPECT_LT(r.momentum_error, 1e-10);
+    EXPECT_LT(r.predicted_moment, 1e-8);
+    EXPECT_GT(std::abs(ctrl.command().v(1)), 0.05);  // the balancing crank turns
+    EXPECT_GT(std::abs(ctrl.command().q(1) - q2), 1e-3);
+  }
+}
+
 TEST(Reactionless, RandomSpatialTreeAndRedundancy) {
   // Eigen's Quaterniond::UnitRandom draws from std::rand: seeded here (its default seed, 1) so
   // that the tree does not depend on which tests ran before in the same process

@@ -243,6 +243,62 @@ Status momentum_matrix(const MechanismModel& model, MechanismData& data, const C
   return detail::momentum_matrix_placed(model, data);
 }
 
+namespace {
+
+/// Link l's term of its coordinate's momentum-matrix column (linear; angular about O): the
+/// momentum of its subtree under a unit rate of its joint (times the gear ratio), from its
+/// composite and its pose in O.
+inline void add_column_term(const MechanismModel& model, const MechanismData::LinkWork& W, int l,
+                            Eigen::Ref<detail::Vec6> column) noexcept {
+  Vec3 P, L;  // momentum of the subtree under a unit joint rate, in L_l (L about its origin)
+  if (model.joint_type(l) == JointType::revolute) {
+    P = -detail::cross_ez(W.composite_first_moment);
+    L = W.composite_inertia.col(2);
+  } else {
+    P = Vec3(0.0, 0.0, W.composite_mass);
+    L = detail::cross_ez(W.composite_first_moment);
+  }
+  const double r = model.coordinate_ratio(l);
+  const Vec3 Pw = W.world_rotation * P;
+  column.head<3>() += r * Pw;
+  column.tail<3>() += r * (W.world_rotation * L + W.world_position.cross(Pw));
+}
+
+}  // namespace
+
+MECHBAL_FLATTEN void detail::momentum_sums(const MechanismModel& model, const MechanismData& data,
+                                           const LinkSubset& links, bool outside, Vec6& inside,
+                                           Vec6& rest) noexcept {
+  Vec3 P[2] = {Vec3::Zero(), Vec3::Zero()}, H[2] = {Vec3::Zero(), Vec3::Zero()};
+  const int count = outside ? model.num_links() - 1 : static_cast<int>(links.links.size());
+  for (int i = 0; i < count; ++i) {
+    const int l = outside ? i + 1 : links.links[static_cast<std::size_t>(i)];
+    const int in = links.member[static_cast<std::size_t>(l)] ? 1 : 0;
+    const auto& c = model.link_constants(l);
+    const auto& W = data.work[static_cast<std::size_t>(l)];
+    const Vec3 p_local = c.mass * W.vel + W.w.cross(c.first_moment);
+    const Vec3 h_local = c.inertia_origin * W.w + c.first_moment.cross(W.vel);
+    const Vec3 p_world = W.world_rotation * p_local;
+    P[in] += p_world;
+    H[in] += W.world_rotation * h_local + W.world_position.cross(p_world);
+  }
+  inside << P[1], H[1];
+  if (outside) rest << P[0], H[0];
+}
+
+MECHBAL_FLATTEN void detail::momentum_columns_placed(const MechanismModel& model, MechanismData& data,
+                                                     const LinkSubset& links, const std::vector<int>& coordinates,
+                                                     Eigen::Ref<Eigen::MatrixXd> columns) noexcept {
+  detail::composite_inertias(model, data, &links);
+  columns.setZero();
+  for (const int l : links.links) {
+    const int c = model.coordinate(l);
+    for (std::size_t j = 0; j < coordinates.size(); ++j) {
+      if (coordinates[j] == c) add_column_term(model, data.work[static_cast<std::size_t>(l)], l, columns.col(static_cast<Eigen::Index>(j)));
+    }
+  }
+}
+
 MECHBAL_FLATTEN Status detail::momentum_matrix_placed(const MechanismModel& model, MechanismData& data) noexcept {
   detail::composite_inertias(model, data);
   // Incremental: a link's term depends on its pose in O and its composite only, so a column is
@@ -262,19 +318,7 @@ MECHBAL_FLATTEN Status detail::momentum_matrix_placed(const MechanismModel& mode
   for (int l = 1; l < nl; ++l) {
     const int c = model.coordinate(l);
     if (c < 0 || !stale[static_cast<std::size_t>(c)]) continue;
-    const auto& W = data.work[static_cast<std::size_t>(l)];
-    Vec3 P, L;  // momentum of the subtree under a unit joint rate, in L_l (L about its origin)
-    if (model.joint_type(l) == JointType::revolute) {
-      P = -detail::cross_ez(W.composite_first_moment);
-      L = W.composite_inertia.col(2);
-    } else {
-      P = Vec3(0.0, 0.0, W.composite_mass);
-      L = detail::cross_ez(W.composite_first_moment);
-    }
-    const double r = model.coordinate_ratio(l);
-    const Vec3 Pw = W.world_rotation * P;
-    data.momentum_matrix.col(c).head<3>() += r * Pw;
-    data.momentum_matrix.col(c).tail<3>() += r * (W.world_rotation * L + W.world_position.cross(Pw));
+    add_column_term(model, data.work[static_cast<std::size_t>(l)], l, data.momentum_matrix.col(c));
   }
   for (int l = 1; l < nl; ++l) data.work[static_cast<std::size_t>(l)].momentum_current = true;
   std::fill(stale.begin(), stale.end(), static_cast<unsigned char>(0));

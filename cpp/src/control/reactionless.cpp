@@ -84,6 +84,23 @@ void extreme_eigenvalues(const Small& S, Solver& fallback, double& lmin, double&
   lmax = lambda(lambda.size() - 1);
 }
 
+/// A x for the 6 x n momentum matrix, column by column at fixed height (Eigen's dynamic
+/// matrix-vector product goes through a blocked kernel whose setup costs more at these sizes).
+Vec6 momentum_times(const Eigen::MatrixXd& A, const Eigen::VectorXd& x) noexcept {
+  Vec6 h = Vec6::Zero();
+  for (Eigen::Index c = 0; c < A.cols(); ++c) h += Eigen::Map<const Vec6>(A.data() + 6 * c) * x(c);
+  return h;
+}
+
+/// y = C x (the n x na loop projection), over x's nonzero entries.
+void project_actuated(const Eigen::MatrixXd& C, const Eigen::VectorXd& x, Eigen::VectorXd& y) noexcept {
+  y.setZero();
+  for (Eigen::Index i = 0; i < C.cols(); ++i) {
+    const double xi = x(i);
+    if (xi != 0.0) y += xi * C.col(i);
+  }
+}
+
 }  // namespace
 
 std::uint32_t momentum_component(const std::string& name) noexcept {
@@ -195,6 +212,19 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
     }
   }
 
+  // the links a balancing joint moves: those of its coordinate (gear couplings included) and all
+  // their descendants (links are listed parents first)
+  subtree_.member.assign(static_cast<std::size_t>(m.num_links()), 0);
+  subtree_.links.clear();
+  for (int l = 1; l < m.num_links(); ++l) {
+    const int c = m.coordinate(l);
+    const bool own = c >= 0 && std::find(balancing_coord_.begin(), balancing_coord_.end(), c) != balancing_coord_.end();
+    if (own || subtree_.member[static_cast<std::size_t>(m.parent(l))]) {
+      subtree_.member[static_cast<std::size_t>(l)] = 1;
+      subtree_.links.push_back(l);
+    }
+  }
+
   rate_limit_.resize(nb_);
   lower_.resize(nb_);
   upper_.resize(nb_);
@@ -225,7 +255,10 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
   a_act_ = Eigen::VectorXd::Zero(na_);
   v_full_ = Eigen::VectorXd::Zero(n_);
   a_full_ = Eigen::VectorXd::Zero(n_);
-  K_ = Eigen::MatrixXd::Zero(6, na_);
+  vt_full_ = Eigen::VectorXd::Zero(n_);
+  c_full_ = Eigen::VectorXd::Zero(n_);
+  vt_act_ = Eigen::VectorXd::Zero(na_);
+  Ab_ = Eigen::MatrixXd::Zero(6, nb_);
   Kb_ = Eigen::MatrixXd::Zero(k_, nb_);
   kb_work_ = Eigen::VectorXd::Zero(k_);
   for (Eigen::VectorXd* v : {&x_, &z_, &v_b_, &a_b_, &k1_, &k2_, &k3_, &k4_, &q_stage_, &r_nb_, &q_b_})
@@ -239,7 +272,7 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
   llt_.compute(gram_);
   if (square_) {
     lu_.compute(Small(Small::Identity(k_, k_)));
-    lu3_.compute(Eigen::Matrix3d::Identity());
+    inv3_.setIdentity();
   }
   command_.q = command_.v = command_.a = Eigen::VectorXd::Zero(na_);
   command_.q_full = command_.v_full = command_.a_full = Eigen::VectorXd::Zero(n_);
@@ -273,19 +306,15 @@ Status ReactionlessController::reset(const Eigen::Ref<const Eigen::VectorXd>& q0
     Eigen::VectorXd& q = q_full_;
     st = closed_motion(*model_, data_, q_act_, v_act_, a_act_, q, config_.loop_options);
     if (failed(st)) return st;
-    momentum_matrix(*model_, data_, q_full_);
-    momentum_projection();
     v_full_ = data_.closed_velocity;
   } else {
     q_full_ = q_act_;
-    st = momentum_matrix(*model_, data_, q_full_);
-    if (failed(st)) return st;
-    K_ = data_.momentum_matrix;
     v_full_ = v_act_;
   }
+  // (momentum() places the links: an open model's q_full_ was not placed yet)
+  if (momentum(*model_, data_, q_full_, v_full_) != Status::ok) return Status::out_of_range;
   Vec6 h;
-  h.noalias() = K_ * v_act_;
-  if (!h.allFinite()) return Status::out_of_range;
+  h << data_.shaking.linear_momentum, data_.shaking.angular_momentum;
   if (h.cwiseAbs().maxCoeff() > config_.max_momentum) return Status::out_of_range;
   target_ = h;
   target_rate_.setZero();
@@ -325,39 +354,63 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
     st = acceleration ? closed_motion(*model_, data_, q_act_, v_act_, a_act_, q_full_, config_.loop_options)
                       : closed_velocity_motion(*model_, data_, q_act_, v_act_, q_full_, config_.loop_options);
     if (failed(st)) return st;
-    // the solve left the links placed at its solution q_full_: no second placement
-    const Status sm = detail::momentum_matrix_placed(*model_, data_);
-    if (sm != Status::ok) return st | sm;
-    momentum_projection();
+    if (balancing_in_loops_) {
+      // C [v_t; 0]: the balancing joints' columns of C reach passive coordinates
+      vt_act_ = v_act_;
+      for (const int j : balancing_) vt_act_(j) = 0.0;
+      project_actuated(data_.loop_projection, vt_act_, vt_full_);
+    } else {
+      // the balancing joints move no loop: their columns of C are unit vectors, and the solve's
+      // C v_act is the task's motion plus the balancing rates on their own coordinates
+      vt_full_ = data_.closed_velocity;
+      for (const int c : balancing_coord_) vt_full_(c) = 0.0;
+    }
   } else {
     q_full_ = q_act_;
-    st = momentum_matrix(*model_, data_, q_full_);
-    if (st != Status::ok) return st;
-    K_ = data_.momentum_matrix;
+    vt_full_ = v_act_;  // an open model's coordinates are its actuated ones, in order
+    for (const int c : balancing_coord_) vt_full_(c) = 0.0;
   }
-  for (int i = 0; i < k_; ++i)
-    for (int j = 0; j < nb_; ++j) Kb_(i, j) = K_(rows_[static_cast<std::size_t>(i)], balancing_[static_cast<std::size_t>(j)]);
+  if (!balancing_in_loops_) return st | task_momentum(true);
+  // the solve left the links placed at its solution q_full_: no second placement
+  const Status sm = detail::momentum_matrix_placed(*model_, data_);
+  if (sm != Status::ok) return st | sm;
+  // K_b = A C_b (the balancing joints' columns of C reach passive coordinates), K_t v_t = A vt
+  const Eigen::MatrixXd& A = data_.momentum_matrix;
+  for (int j = 0; j < nb_; ++j) {
+    c_full_ = data_.loop_projection.col(balancing_[static_cast<std::size_t>(j)]);
+    Ab_.col(j) = momentum_times(A, c_full_);
+  }
+  for (int i = 0; i < k_; ++i) Kb_.row(i) = Ab_.row(rows_[static_cast<std::size_t>(i)]);
+  ht_ = momentum_times(A, vt_full_);
   return st;
 }
 
-void ReactionlessController::momentum_projection() noexcept {
-  // K = A C over C's nonzeros: the column of an actuated coordinate that moves no loop is the unit
-  // vector of that coordinate (K's column is A's); a loop-moving one (data_.loop_actuated_columns)
-  // adds its passive entries (a dense 6 x n x na product would go through Eigen's blocked GEMM,
-  // whose packing costs more than the product at these sizes)
-  const Eigen::MatrixXd& A = data_.momentum_matrix;
-  const Eigen::MatrixXd& C = data_.loop_projection;
-  const auto& actuated = model_->actuated_coordinates();
-  const auto& passive = model_->passive_coordinates();
-  for (int i = 0; i < na_; ++i) K_.col(i) = A.col(actuated[static_cast<std::size_t>(i)]);
-  for (const int t : data_.loop_actuated_columns) {
-    Vec6 k = K_.col(t);
-    for (const int j : passive) {
-      const double c = C(j, t);
-      if (c != 0.0) k += c * Vec6(A.col(j));
+Status ReactionlessController::task_momentum(bool whole) noexcept {
+  // the task's motion alone (vt_full_) on the links placed at q_full_. The links outside the
+  // balancing subtrees move alike whatever the balancing joints do: after rebalance() (`whole`
+  // false) their placements, velocities and momentum (rest_) are the last whole pass's, and only
+  // the subtrees are placed and moved again. A loop solve left every link placed at q_full_.
+  if (whole) {
+    detail::joint_state<true, false>(*model_, data_, q_full_, vt_full_, vt_full_);
+    if (!closed_) detail::place(*model_, data_);
+    detail::link_velocities(*model_, data_);
+  } else {
+    for (const int l : subtree_.links) {
+      const auto k = static_cast<std::size_t>(l);
+      const int c = model_->coordinate(l);
+      const double r = model_->coordinate_ratio(l);
+      data_.joint_position[k] = c < 0 ? 0.0 : r * q_full_(c) + model_->coordinate_offset(l);
+      data_.joint_velocity[k] = c < 0 ? 0.0 : r * vt_full_(c);
     }
-    K_.col(t) = k;
+    detail::place<true, detail::NoVisit, true>(*model_, data_, detail::NoVisit{}, &subtree_);
+    detail::link_velocities(*model_, data_, &subtree_);
   }
+  Vec6 inside;
+  detail::momentum_sums(*model_, data_, subtree_, whole, inside, rest_);
+  ht_ = rest_ + inside;
+  detail::momentum_columns_placed(*model_, data_, subtree_, balancing_coord_, Ab_);
+  for (int i = 0; i < k_; ++i) Kb_.row(i) = Ab_.row(rows_[static_cast<std::size_t>(i)]);
+  return detail::all_finite(ht_) && detail::all_finite(Ab_) ? Status::ok : Status::out_of_range;
 }
 
 Status ReactionlessController::rebalance(const Eigen::VectorXd& q_b) noexcept {
@@ -367,17 +420,14 @@ Status ReactionlessController::rebalance(const Eigen::VectorXd& q_b) noexcept {
     q_act_(balancing_[static_cast<std::size_t>(j)]) = q_b(j);
     q_full_(balancing_coord_[static_cast<std::size_t>(j)]) = q_b(j);
     // the loop solve's warm start follows (its tangent predictor needs q == closed_position)
-    data_.closed_position(balancing_coord_[static_cast<std::size_t>(j)]) = q_b(j);
+    if (closed_) data_.closed_position(balancing_coord_[static_cast<std::size_t>(j)]) = q_b(j);
   }
-  const Status st = momentum_matrix(*model_, data_, q_full_);
-  if (st != Status::ok) return st;
-  momentum_projection();
-  for (int i = 0; i < k_; ++i)
-    for (int j = 0; j < nb_; ++j) Kb_(i, j) = K_(rows_[static_cast<std::size_t>(i)], balancing_[static_cast<std::size_t>(j)]);
-  return Status::ok;
+  return task_momentum(false);  // (vt_full_ is the last evaluate()'s: same task motion)
 }
 
-Status ReactionlessController::factorise(double& condition) noexcept {
+Status ReactionlessController::factorise(double* reported) noexcept {
+  double ignored = 0.0;
+  double& condition = reported ? *reported : ignored;
   if (wide_) {
     gram_.noalias() = Kb_ * Kb_.transpose();
   } else {
@@ -391,7 +441,26 @@ Status ReactionlessController::factorise(double& condition) noexcept {
     return Status::singular | Status::out_of_range;
   }
   double lmin = 0.0, lmax = 0.0;
-  extreme_eigenvalues(gram_, eig_, lmin, lmax);
+  // Where the condition number is not reported (RK4's inner stages), a bound settles the damping
+  // decision when it can, without the eigenvalues. The Gram matrix G (2 x 2 or 3 x 3, positive
+  // semi-definite) has lmax <= tr G, and lmin >= det G / tr G (2 x 2) or 4 det G / (tr G)^2 (3 x 3:
+  // the two largest eigenvalues' product is at most (tr G / 2)^2). When that bound on lmax / lmin
+  // is within max_condition^2, so is the true ratio: no damping, as the eigenvalues would decide.
+  // Otherwise they are computed (the damping needs lmax).
+  const Eigen::Index g = gram_.rows();
+  bool bounded = false;
+  if (!reported && (g == 2 || g == 3)) {
+    const double tr = gram_.trace();
+    const double det = g == 2 ? gram_(0, 0) * gram_(1, 1) - gram_(0, 1) * gram_(1, 0)
+                              : Eigen::Matrix3d(gram_.topLeftCorner<3, 3>()).determinant();
+    const double low = g == 2 ? det / tr : 4.0 * det / (tr * tr);
+    bounded = tr > 0.0 && low > 0.0 && tr <= config_.max_condition * config_.max_condition * low;
+    if (bounded) {
+      lmax = tr;
+      lmin = low;
+    }
+  }
+  if (!bounded) extreme_eigenvalues(gram_, eig_, lmin, lmax);
   if (!(lmax > 0.0)) {  // S K_b = 0: the balancing joints cannot act on the cancelled components
     condition = huge;
     damped_ = true;
@@ -403,10 +472,11 @@ Status ReactionlessController::factorise(double& condition) noexcept {
   if (condition <= config_.max_condition) {
     damped_ = false;
     if (square_) {
-      // 3 x 3 (a wrist cancelling the moment) at fixed size: Eigen's dynamic LU dispatch costs
+      // 3 x 3 (a wrist cancelling the moment): the inverse from cofactors, accurate to cond eps
+      // like an LU at this condition (<= max_condition), where Eigen's dynamic LU dispatch costs
       // more than the factorisation itself
       if (k_ == 3) {
-        lu3_.compute(Eigen::Matrix3d(Kb_));
+        inv3_ = Eigen::Matrix3d(Kb_).inverse();
       } else {
         lu_.compute(Small(Kb_));
       }
@@ -428,7 +498,7 @@ void ReactionlessController::solve(const Eigen::Ref<const Eigen::VectorXd>& r, E
     x.noalias() = Kb_.transpose() * y_;
   } else if (square_ && !damped_) {
     if (k_ == 3) {
-      y_ = lu3_.solve(Eigen::Vector3d(r_));
+      y_ = inv3_ * Eigen::Vector3d(r_);
     } else {
       y_ = lu_.solve(r_);
     }
@@ -460,18 +530,14 @@ Status ReactionlessController::limit_rate(Eigen::VectorXd& v_b) const noexcept {
   return Status::ok;
 }
 
-Status ReactionlessController::rates(const Eigen::Ref<const Eigen::VectorXd>& v_t, const Vec6& h,
-                                     const Eigen::VectorXd& q_b, Eigen::VectorXd& v_b, double* condition) noexcept {
-  // r = S h* - S K_t v_t
+Status ReactionlessController::rates(const Vec6& h, const Eigen::VectorXd& q_b, Eigen::VectorXd& v_b,
+                                     double* condition) noexcept {
+  // r = S h* - S K_t v_t (ht_: the evaluation's, at these task rates)
   for (int i = 0; i < k_; ++i) {
     const int row = rows_[static_cast<std::size_t>(i)];
-    double s = h(row);
-    for (int j = 0; j < nt_; ++j) s -= K_(row, task_[static_cast<std::size_t>(j)]) * v_t(j);
-    kb_work_(i) = s;
+    kb_work_(i) = h(row) - ht_(row);
   }
-  double cond = 1.0;
-  Status st = factorise(cond);
-  if (condition) *condition = cond;
+  Status st = factorise(condition);
   solve(kb_work_, v_b);
   if (wide_ && (config_.home_gain > 0.0 || config_.limit_gain > 0.0)) {
     for (int j = 0; j < nb_; ++j) {
@@ -560,7 +626,7 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
   Status st = reuse ? stage_cache_status_ | rebalance(q_b_) : evaluate(q_t, q_b_);
   if (failed(st)) return hold(only(st, hard));
   double cond = 1.0;
-  st |= rates(v_t, target_, q_b_, k1_, &cond);
+  st |= rates(target_, q_b_, k1_, &cond);
   if (has(st, Status::out_of_range)) return hold(Status::out_of_range);
   const bool rate_saturated = has(st, Status::saturated);
   for (int i = 0; i < nt_; ++i) {
@@ -579,23 +645,27 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
       st |= only(s, Status::singular);
     }
     // without balancing joints in the loops, c does not depend on their rates
-    v_full_.noalias() = data_.loop_projection * v_act_;
-    a_full_ = data_.loop_acceleration_bias;
+    project_actuated(data_.loop_projection, v_act_, v_full_);
+    // a = c + C [a_t; 0] (a_act_'s balancing entries are still zero)
+    project_actuated(data_.loop_projection, a_act_, a_full_);
+    a_full_ += data_.loop_acceleration_bias;
   } else {
     v_full_ = v_act_;
-    a_full_.setZero();
+    a_full_ = a_act_;
   }
-  // ---- feed-forward: S K_b a_b = S dh*/dt - S K_t a_t - S W(q, v, c)
+  // ---- feed-forward: S K_b a_b = S dh*/dt - S K_t a_t - S W(q, v, c) = S dh*/dt - S W'
+  // with W' = W(q, v, c + C [a_t; 0]) = W(q, v, c) + K_t a_t, the shaking wrench (the rate of
+  // momentum) of the motion with the balancing joints' accelerations still zero; the same pass
+  // gives the momentum h = A C v of the command.
   // the links are placed at q_full_ (evaluate(), or closed_motion just above, at the same q)
   if (const Status s = detail::shaking_wrench_placed(*model_, data_, q_full_, v_full_, a_full_); s != Status::ok)
     return hold(Status::out_of_range);
-  Vec6 W;
+  Vec6 W, h;
   W << data_.shaking.force, data_.shaking.moment;
+  h << data_.shaking.linear_momentum, data_.shaking.angular_momentum;
   for (int i = 0; i < k_; ++i) {
     const int row = rows_[static_cast<std::size_t>(i)];
-    double s = target_rate_(row) - W(row);
-    for (int j = 0; j < nt_; ++j) s -= K_(row, task_[static_cast<std::size_t>(j)]) * a_t(j);
-    kb_work_(i) = s;
+    kb_work_(i) = target_rate_(row) - W(row);
   }
   solve(kb_work_, a_b_);  // same operator as the rates at t_n
   if (wide_ && (config_.home_gain > 0.0 || config_.limit_gain > 0.0)) {
@@ -622,14 +692,19 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
       st |= Status::saturated;
     }
   }
-  for (int j = 0; j < nb_; ++j) a_act_(balancing_[static_cast<std::size_t>(j)]) = a_b_(j);
-  if (closed_) a_full_.noalias() += data_.loop_projection * a_act_;
-  else a_full_ = a_act_;
-  Vec6 h, predicted;
-  h.noalias() = K_ * v_act_;
-  predicted.noalias() = K_ * a_act_;
-  predicted += W;
-  if (!h.allFinite() || !predicted.allFinite()) return hold(Status::out_of_range);
+  // a += C_b a_b, and the predicted wrench W' + K_b a_b
+  Vec6 predicted = W;
+  for (int j = 0; j < nb_; ++j) {
+    const int b = balancing_[static_cast<std::size_t>(j)];
+    a_act_(b) = a_b_(j);
+    if (closed_) {
+      a_full_ += a_b_(j) * data_.loop_projection.col(b);
+    } else {
+      a_full_(b) += a_b_(j);
+    }
+    predicted += a_b_(j) * Ab_.col(j);
+  }
+  if (!detail::all_finite(h) || !detail::all_finite(predicted)) return hold(Status::out_of_range);
 
   // the command at t_n (the stages below overwrite the model's data)
   command_.q = q_act_;
@@ -657,15 +732,15 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
     q_stage_ = q_b_ + (0.5 * dt_) * k1_;
     task_rates(*v_half);
     ss |= evaluate(*q_half, q_stage_, false);
-    if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k2_, nullptr);
+    if (!failed(ss)) ss |= rates(target_ + (0.5 * dt_) * target_rate_, q_stage_, k2_, nullptr);
     q_stage_ = q_b_ + (0.5 * dt_) * k2_;
     if (!failed(ss))
-      ss |= closed_ && !balancing_in_loops_ ? rebalance(q_stage_) : evaluate(*q_half, q_stage_, false);
-    if (!failed(ss)) ss |= rates(*v_half, target_ + (0.5 * dt_) * target_rate_, q_stage_, k3_, nullptr);
+      ss |= !balancing_in_loops_ ? rebalance(q_stage_) : evaluate(*q_half, q_stage_, false);
+    if (!failed(ss)) ss |= rates(target_ + (0.5 * dt_) * target_rate_, q_stage_, k3_, nullptr);
     q_stage_ = q_b_ + dt_ * k3_;
     task_rates(*v_next);
     if (!failed(ss)) ss |= last_stage = evaluate(*q_next, q_stage_);
-    if (!failed(ss)) ss |= rates(*v_next, target_ + dt_ * target_rate_, q_stage_, k4_, nullptr);
+    if (!failed(ss)) ss |= rates(target_ + dt_ * target_rate_, q_stage_, k4_, nullptr);
     task_rates(v_t);
     if (failed(ss)) {
       return hold(only(ss, hard));
@@ -703,7 +778,7 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
       command_.q_full = q_full_;
       command_.v_full = v_full_;
       command_.a_full = a_full_;
-      command_.momentum.noalias() = K_ * v_act_;
+      command_.momentum << data_.shaking.linear_momentum, data_.shaking.angular_momentum;
       command_.shaking_force = data_.shaking.force;
       command_.shaking_moment = data_.shaking.moment;
       next = q_b_;
@@ -713,7 +788,7 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
   }
   q_b_ = next;
   command_.status = st;
-  if (rk4 && closed_ && !balancing_in_loops_ && !failed(last_stage)) {
+  if (rk4 && !balancing_in_loops_ && !failed(last_stage)) {
     stage_cache_ = true;
     stage_cache_status_ = last_stage;
     stage_q_ = *q_next;

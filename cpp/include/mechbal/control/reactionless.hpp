@@ -54,6 +54,7 @@
 #include "mechbal/control/joint_controller.hpp"
 #include "mechbal/control/joint_limits.hpp"
 #include "mechbal/control/mechanism_dynamics.hpp"
+#include "mechbal/detail/link_subset.hpp"
 #include "mechbal/model/data.hpp"
 #include "mechbal/model/model.hpp"
 #include "mechbal/model/rigid_body.hpp"
@@ -185,23 +186,30 @@ class ReactionlessController {
 
  private:
   void build(const Eigen::VectorXd& q0, const Eigen::VectorXd& v0, const Eigen::VectorXd& q_guess);
-  /// K = A C at actuated positions (q_t, q_b) (loops solved into q_full_); v_act_: actuated
-  /// velocities for the loops' projection. Fills K_, Kb_. With `acceleration`, also the loops'
-  /// acceleration bias c (the feed-forward at t_n needs it; an RK4 stage that only needs K not).
+  /// The momentum matrix A and the loop projection C at actuated positions (q_t, q_b) (loops
+  /// solved into q_full_); v_act_: actuated velocities (its task entries: the task's rates). Fills
+  /// Kb_ and ht_ (task_momentum). With `acceleration`, also the loops' acceleration bias c (the
+  /// feed-forward at t_n needs it; an RK4 stage that only needs the rates not).
   Status evaluate(const Eigen::Ref<const Eigen::VectorXd>& q_t, const Eigen::VectorXd& q_b,
                   bool acceleration = true) noexcept;
   /// evaluate() at the same task positions with other balancing positions, for a closed
   /// mechanism whose loops the balancing joints do not move (no loop solve).
   Status rebalance(const Eigen::VectorXd& q_b) noexcept;
-  /// K_ = A C from data_'s momentum matrix and loop projection.
-  void momentum_projection() noexcept;
-  /// Factorise S K_b (cond, damping); then solve() applies the operator.
-  Status factorise(double& condition) noexcept;
+  /// When no balancing joint moves a loop: Ab_ = A_b (the balancing columns of the momentum
+  /// matrix, from the composites of the balancing subtrees alone) and ht_ = A vt_full_, the
+  /// momentum of the task's motion with the balancing joints still (vt_full_, set by evaluate),
+  /// at q_full_. `whole` false: only the balancing subtrees moved since the last whole one (the
+  /// other links' velocities and momentum rest_ are kept). The full A and K = A C are never formed:
+  /// K's task columns enter only through K_t v_t, and K_t a_t through the shaking wrench.
+  Status task_momentum(bool whole) noexcept;
+  /// Factorise S K_b (damping when cond > max_condition); then solve() applies the operator.
+  /// `condition`: where the condition number is reported (null: only the decision is needed, and
+  /// a cheap bound settles it when it can).
+  Status factorise(double* condition) noexcept;
   void solve(const Eigen::Ref<const Eigen::VectorXd>& r, Eigen::VectorXd& x) noexcept;
   void project_null(const Eigen::VectorXd& z, Eigen::VectorXd& out) noexcept;
-  /// Balancing rates at the evaluated pose for task velocity v_t and target h.
-  Status rates(const Eigen::Ref<const Eigen::VectorXd>& v_t, const Vec6& h, const Eigen::VectorXd& q_b,
-               Eigen::VectorXd& v_b, double* condition) noexcept;
+  /// Balancing rates at the evaluated pose and task rates (ht_) for the target h.
+  Status rates(const Vec6& h, const Eigen::VectorXd& q_b, Eigen::VectorXd& v_b, double* condition) noexcept;
   Status limit_rate(Eigen::VectorXd& v_b) const noexcept;
   Status hold(Status why) noexcept;
   Status tick(const Eigen::Ref<const Eigen::VectorXd>& q_t, const Eigen::Ref<const Eigen::VectorXd>& v_t,
@@ -229,7 +237,8 @@ class ReactionlessController {
   // RK4's last stage solved the loops at (q_t_next, v_t_next) with the momentum of the same loop
   // solution: when the next tick starts at exactly those task positions and rates (a sampled
   // trajectory), its t_n evaluation reuses them (the loop solve, C and c do not depend on the
-  // balancing joints when these move no loop frame): only A is recomputed (rebalance)
+  // balancing joints when these move no loop frame): only the balancing subtrees' momentum is
+  // recomputed (rebalance). Likewise for an open mechanism (no loops).
   bool stage_cache_ = false;
   Status stage_cache_status_ = Status::ok;
   Eigen::VectorXd stage_q_, stage_v_;
@@ -237,8 +246,14 @@ class ReactionlessController {
   ReactionlessCommand command_;
   // scratch (sized at construction)
   Eigen::VectorXd q_full_, q_act_, v_act_, a_act_, v_full_, a_full_;
-  Eigen::MatrixXd K_;   ///< 6 x na: A C
-  Eigen::MatrixXd Kb_;  ///< k x nb: S K_b
+  detail::LinkSubset subtree_;  ///< the links a balancing joint moves (it or an ancestor)
+  Eigen::VectorXd vt_full_;  ///< C [v_t; 0]: every coordinate's rate under the task alone
+  Eigen::VectorXd vt_act_;   ///< [v_t; 0] over the actuated coordinates
+  Eigen::VectorXd c_full_;   ///< scratch: C x of an actuated vector x
+  Vec6 ht_ = Vec6::Zero();   ///< A vt_full_: K_t v_t
+  Vec6 rest_ = Vec6::Zero(); ///< the part of ht_ from the links outside subtree_
+  Eigen::MatrixXd Ab_;       ///< 6 x nb: K_b = A C_b
+  Eigen::MatrixXd Kb_;       ///< k x nb: S K_b
   Eigen::VectorXd kb_work_, x_, z_, v_b_, a_b_, k1_, k2_, k3_, k4_, q_stage_, r_nb_;
   SmallVector r_, y_;
   Small gram_;
@@ -246,7 +261,7 @@ class ReactionlessController {
   Eigen::SelfAdjointEigenSolver<Small> eig_;
   Eigen::LLT<Small> llt_;
   Eigen::PartialPivLU<Small> lu_;
-  Eigen::PartialPivLU<Eigen::Matrix3d> lu3_;  ///< lu_ when S K_b is 3 x 3
+  Eigen::Matrix3d inv3_ = Eigen::Matrix3d::Identity();  ///< (S K_b)^-1 when it is 3 x 3
 };
 
 /// The reactionless controller followed by a computed-torque stage (computed_torque.hpp over the

@@ -6,15 +6,29 @@
 /// of every link) the public functions start with. The results are bit for bit those of the
 /// public functions at q. noexcept and allocation-free; no input checks (the caller's).
 #include <Eigen/Core>
+#include <vector>
 
+#include "mechbal/detail/link_subset.hpp"
 #include "mechbal/model/data.hpp"
 #include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
 namespace mechbal::detail {
 
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+
 /// momentum_matrix at the placed q.
 Status momentum_matrix_placed(const MechanismModel& model, MechanismData& data) noexcept;
+/// The momentum-matrix columns of `coordinates` (6 x coordinates.size(), written whole) at the
+/// placed q, from the composites of `links` alone: the links of those coordinates and all their
+/// descendants. The rest of the matrix and its bookkeeping are untouched.
+void momentum_columns_placed(const MechanismModel& model, MechanismData& data, const LinkSubset& links,
+                             const std::vector<int>& coordinates, Eigen::Ref<Eigen::MatrixXd> columns) noexcept;
+/// The momenta (linear; angular about O) of the placed links from their velocities in
+/// data.work (detail::link_velocities or a forward pass), summed over `links` into `inside` and,
+/// with `outside`, over the others into `rest` (untouched otherwise).
+void momentum_sums(const MechanismModel& model, const MechanismData& data, const LinkSubset& links, bool outside,
+                   Vec6& inside, Vec6& rest) noexcept;
 /// shaking_wrench(q, v, a) at the placed q (q: the coordinates the links are placed at).
 Status shaking_wrench_placed(const MechanismModel& model, MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,
                              const Eigen::Ref<const Eigen::VectorXd>& v,

@@ -7,8 +7,13 @@
 /// noexcept and allocation-free.
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
+#include <type_traits>
+#include <vector>
 
+#include "mechbal/detail/link_subset.hpp"
 #include "mechbal/model/data.hpp"
 #include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
@@ -35,18 +40,38 @@ inline bool data_matches(const MechanismModel& model, const MechanismData& data)
          static_cast<int>(data.work.size()) == model.num_links();
 }
 
-/// True when every entry of x (a vector or a matrix) is finite (a NaN fails the comparison): one
-/// loop without branches, inlined where Eigen's allFinite (x - x compared with itself entry by
-/// entry) was left as a call in a big translation unit. The input checks and the algorithms'
-/// result checks (finite_result) share it.
+/// True when every entry of x (a vector or a matrix of doubles) is finite: inlined where Eigen's
+/// allFinite (x - x compared with itself entry by entry) was left as a call in a big translation
+/// unit. The input checks and the algorithms' result checks (finite_result) share it. An entry is
+/// infinite or NaN exactly when its exponent bits are all ones; adding 2^52 to those bits then
+/// carries into the sign bit, so one OR over the entries answers for all of them, in integer
+/// operations without a branch or a comparison per entry (vectorised over contiguous storage).
 template <typename Derived>
 inline bool all_finite(const Eigen::DenseBase<Derived>& x) noexcept {
-  constexpr double kMax = std::numeric_limits<double>::max();
+  static_assert(std::is_same<typename Derived::Scalar, double>::value, "all_finite: doubles only");
+  constexpr std::uint64_t kExponent = 0x7ff0000000000000ull, kUnit = 0x0010000000000000ull;
   const Derived& m = x.derived();
-  bool finite = true;
-  for (Eigen::Index j = 0; j < m.cols(); ++j)
-    for (Eigen::Index i = 0; i < m.rows(); ++i) finite &= std::abs(m.coeff(i, j)) <= kMax;
-  return finite;
+  std::uint64_t bad = 0;
+  if constexpr ((Eigen::internal::traits<Derived>::Flags & Eigen::DirectAccessBit) != 0) {
+    if (m.innerStride() == 1 && (m.cols() == 1 || m.rows() == 1 || m.outerStride() == m.rows())) {
+      const double* p = m.data();
+      for (Eigen::Index k = 0; k < m.size(); ++k) {
+        std::uint64_t b;
+        std::memcpy(&b, p + k, sizeof b);
+        bad |= (b & kExponent) + kUnit;
+      }
+      return (bad >> 63) == 0;
+    }
+  }
+  for (Eigen::Index j = 0; j < m.cols(); ++j) {
+    for (Eigen::Index i = 0; i < m.rows(); ++i) {
+      const double v = m.coeff(i, j);
+      std::uint64_t b;
+      std::memcpy(&b, &v, sizeof b);
+      bad |= (b & kExponent) + kUnit;
+    }
+  }
+  return (bad >> 63) == 0;
 }
 
 /// Sizes and finiteness of up to three state vectors (null = not used).
@@ -100,10 +125,14 @@ struct NoVisit {
   void operator()(int, const MechanismData::LinkWork&) const noexcept {}
 };
 
-template <bool World = true, class Visit = NoVisit>
-MECHBAL_FLATTEN inline void place(const MechanismModel& model, MechanismData& data, Visit&& visit = Visit{}) noexcept {
-  const int nl = model.num_links();
-  for (int l = 1; l < nl; ++l) {
+/// With Subset, `only` (not null) restricts the pass to its links (their parents outside it keep
+/// their placements, in O too).
+template <bool World = true, class Visit = NoVisit, bool Subset = false>
+MECHBAL_FLATTEN inline void place(const MechanismModel& model, MechanismData& data, Visit&& visit = Visit{},
+                                  const LinkSubset* only = nullptr) noexcept {
+  const int count = Subset ? static_cast<int>(only->links.size()) : model.num_links() - 1;
+  for (int i = 0; i < count; ++i) {
+    const int l = Subset ? only->links[static_cast<std::size_t>(i)] : i + 1;
     const auto k = static_cast<std::size_t>(l);
     auto& w = data.work[k];
     const double qk = data.joint_position[k];
@@ -271,9 +300,14 @@ MECHBAL_FLATTEN inline void backward_pass(const MechanismModel& model, Mechanism
 /// below it, so only the links marked stale by place() (LinkWork::composite_current: the
 /// ancestors of a link whose placement changed) are recomputed, each from its own bodies and its
 /// children in the same order as a full pass: bit for bit the same result.
-MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, MechanismData& data) noexcept {
+/// `only` (or null: all): recompute its links alone (e.g. a controller's balancing subtrees, whose
+/// columns of the momentum matrix need nothing else); the others keep their state, stale or not.
+MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, MechanismData& data,
+                                               const LinkSubset* only = nullptr) noexcept {
   const int nl = model.num_links();
-  for (int l = 0; l < nl; ++l) {
+  const int count = only ? static_cast<int>(only->links.size()) : nl;
+  for (int i = 0; i < count; ++i) {
+    const int l = only ? only->links[static_cast<std::size_t>(i)] : i;
     auto& W = data.work[static_cast<std::size_t>(l)];
     if (W.composite_current) continue;
     W.momentum_current = false;  // its momentum-matrix column follows its composite
@@ -282,11 +316,13 @@ MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, Mech
     W.composite_first_moment = c.first_moment;
     W.composite_inertia = c.inertia_origin;
   }
-  for (int l = nl - 1; l >= 1; --l) {
+  for (int i = count - 1; i >= 0; --i) {
+    const int l = only ? only->links[static_cast<std::size_t>(i)] : i;
+    if (l == 0) continue;
     const int parent = model.parent(l);
     if (parent == 0) continue;
     auto& P = data.work[static_cast<std::size_t>(parent)];
-    if (P.composite_current) continue;
+    if (P.composite_current || (only && !only->member[static_cast<std::size_t>(parent)])) continue;
     const auto& W = data.work[static_cast<std::size_t>(l)];
     // massless: m = 0 and a zero inertia (positive semi-definite with zero trace)
     if (W.composite_mass == 0.0 && W.composite_inertia.trace() == 0.0) continue;
@@ -314,7 +350,42 @@ MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, Mech
     P.composite_mass += m;
     P.composite_first_moment += mp_h;
   }
-  for (int l = 0; l < nl; ++l) data.work[static_cast<std::size_t>(l)].composite_current = true;
+  for (int i = 0; i < count; ++i) {
+    data.work[static_cast<std::size_t>(only ? only->links[static_cast<std::size_t>(i)] : i)].composite_current = true;
+  }
+}
+
+/// Angular velocity and origin velocity of the links in their L frames from the joints' rates
+/// (data.joint_velocity) and placements: the first part of forward_pass, with the same operations,
+/// for the momenta, which need nothing more. `only` (or null: all): update its links alone, each
+/// after its parent, whose velocities must be current (from this pass or an earlier one at the
+/// same placements and rates).
+MECHBAL_FLATTEN inline void link_velocities(const MechanismModel& model, MechanismData& data,
+                                            const LinkSubset* only = nullptr) noexcept {
+  data.work[0].w.setZero();
+  data.work[0].vel.setZero();
+  const int count = only ? static_cast<int>(only->links.size()) : model.num_links() - 1;
+  for (int i = 0; i < count; ++i) {
+    const int l = only ? only->links[static_cast<std::size_t>(i)] : i + 1;
+    const auto k = static_cast<std::size_t>(l);
+    const auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
+    auto& W = data.work[k];
+    const Vec3& p = W.translation;
+    const Mat3& R = W.rotation;
+    W.w.noalias() = R.transpose() * P.w;
+    W.vel.noalias() = R.transpose() * (P.vel + P.w.cross(p));
+    const double qd = data.joint_velocity[k];
+    switch (model.joint_type(l)) {
+      case JointType::revolute:
+        W.w.z() += qd;
+        break;
+      case JointType::prismatic:
+        W.vel.z() += qd;
+        break;
+      case JointType::fixed:
+        break;
+    }
+  }
 }
 
 /// World placement and motion of a named frame from placed links and a forward pass: origin
