@@ -175,6 +175,17 @@ void constraint_bias(const MechanismModel& model, MechanismData& data) noexcept 
   for (int i = 0; i < model.num_loops(); ++i) {
     const int row = model.loop_row(i);
     const LoopType type = model.loop(i).type;
+    if (type == LoopType::point) {
+      // the origins' accelerations only, each in its link's axes, rotated once
+      const auto acceleration = [&](int frame) {
+        const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
+        const Vec3& p = data.frame_position_in_link[static_cast<std::size_t>(frame)];
+        const Vec3 local = W.acc + W.alpha.cross(p) + W.w.cross(W.w.cross(p));
+        return Vec3(W.world_rotation * local);
+      };
+      data.loop_bias.segment<3>(row) = acceleration(model.loop_frame_b(i)) - acceleration(model.loop_frame_a(i));
+      continue;
+    }
     const bool rotation = type == LoopType::planar_point || type == LoopType::axis;
     const bool planar = type == LoopType::planar_point;
     const detail::FrameMotion A = loop_frame_motion(model, data, model.loop_frame_a(i), rotation, planar);
@@ -781,34 +792,27 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   // the closure or when the actuators over-constrain the mechanism
   // (A v over A's nonzeros, the loops' blocks of A# and A°; the others are zero)
   // (the largest |entry| per column first: short, independent chains of max)
+  // (row by row over each loop's columns, the sums in registers; the passive velocities in the
+  // elimination order in data.loop_step, free until the bias solve below; A#'s are v#)
   Eigen::VectorXd& Av = data.loop_constraint_work;
+  double* const velocity = data.loop_step.data();
+  for (std::size_t j = 0; j < passive.size(); ++j) velocity[j] = data.closed_velocity(data.loop_elimination[j]);
   double biggest = 0.0;
   for (const auto& lb : data.loop_blocks) {
-    double* av = Av.data() + lb.row;
-    for (int k = 0; k < lb.rows; ++k) av[k] = 0.0;
-    const double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
-    const int* actuated_members = data.loop_actuated_members.data() + lb.actuated;
-    for (int t = 0; t < lb.actuated_count; ++t, b += lb.rows) {
-      const double vt = data.closed_velocity(
-          actuated[static_cast<std::size_t>(columns[static_cast<std::size_t>(actuated_members[t])])]);
-      double column_max = 0.0;
-      for (int k = 0; k < lb.rows; ++k) {
-        av[k] += b[k] * vt;
-        column_max = std::max(column_max, std::abs(b[k]));
-      }
-      biggest = std::max(biggest, column_max);
-    }
     const double* a = data.loop_passive_blocks.data() + lb.block;
+    const double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
     const int* members = data.loop_members.data() + lb.member;
-    for (int c = 0; c < lb.count; ++c, a += lb.rows) {
-      const double vi = data.closed_velocity(data.loop_elimination[static_cast<std::size_t>(members[c])]);
-      double column_max = 0.0;
-      for (int k = 0; k < lb.rows; ++k) {
-        av[k] += a[k] * vi;
-        column_max = std::max(column_max, std::abs(a[k]));
+    const int* actuated_members = data.loop_actuated_members.data() + lb.actuated;
+    for (int k = 0; k < lb.rows; ++k) {
+      double sum = 0.0;
+      for (int t = 0; t < lb.actuated_count; ++t) {
+        sum += b[t * lb.rows + k] * v_actuated(columns[static_cast<std::size_t>(actuated_members[t])]);
       }
-      biggest = std::max(biggest, column_max);
+      for (int c = 0; c < lb.count; ++c) sum += a[c * lb.rows + k] * velocity[members[c]];
+      Av(lb.row + k) = sum;
     }
+    for (int e = 0; e < lb.rows * lb.actuated_count; ++e) biggest = std::max(biggest, std::abs(b[e]));
+    for (int e = 0; e < lb.rows * lb.count; ++e) biggest = std::max(biggest, std::abs(a[e]));
   }
   const double scale = 1.0 + biggest * data.closed_velocity.cwiseAbs().maxCoeff();
   if (!(Av.cwiseAbs().maxCoeff() <= 1e-8 * scale)) status = Status::singular;
