@@ -255,20 +255,29 @@ void ldl_factor(MechanismData& data) noexcept {
   }
 }
 
-/// x = (L D L^T)^-1 x with the factors of ldl_factor: the triangular solves as one pass each over
-/// L's entries (column by column: an entry of column k reads x_k once every entry that updates
-/// x_k, in the columns before, is done; backwards, the reverse).
+/// x = (L D L^T)^-1 x with the factors of ldl_factor. Both triangular solves form each unknown
+/// as one sum (in registers, not through memory): forwards over the row's entries of L
+/// (loop_factor_row_*), backwards over the column's.
 void ldl_solve(const MechanismData& data, Eigen::Ref<Eigen::VectorXd> x) noexcept {
   const auto np = static_cast<int>(data.loop_elimination.size());
-  const auto nnz = static_cast<int>(data.loop_factor_rows.size());
   const double* const L = data.loop_factor_values.data() + np;  // (after the pivots)
   const int* rows = data.loop_factor_rows.data();
-  const int* columns = data.loop_factor_columns.data();
+  const int* start = data.loop_factor_start.data();
+  const int* row_start = data.loop_factor_row_start.data();
+  const int* row_entries = data.loop_factor_row_entries.data();
+  const int* row_columns = data.loop_factor_row_columns.data();
   const double* const inverse = data.loop_pivot_inverse.data();
   double* const v = x.data();
-  for (int p = 0; p < nnz; ++p) v[rows[p]] -= v[columns[p]] * L[p];
-  for (int k = 0; k < np; ++k) v[k] *= inverse[k];
-  for (int p = nnz - 1; p >= 0; --p) v[columns[p]] -= L[p] * v[rows[p]];
+  for (int i = 0; i < np; ++i) {
+    double sum = 0.0;
+    for (int e = row_start[i]; e < row_start[i + 1]; ++e) sum += L[row_entries[e]] * v[row_columns[e]];
+    v[i] -= sum;
+  }
+  for (int k = np - 1; k >= 0; --k) {
+    double sum = 0.0;
+    for (int p = start[k]; p < start[k + 1]; ++p) sum += L[p] * v[rows[p]];
+    v[k] = v[k] * inverse[k] - sum;
+  }
 }
 
 /// y += a x over W contiguous entries (rows of the row-major blocks: a handful of actuated columns,
@@ -284,17 +293,36 @@ template <int W>
 void ldl_solve_block_width(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
   const auto np = static_cast<int>(data.loop_elimination.size());
   const double* const L = data.loop_factor_values.data() + np;  // (after the pivots)
-  const auto nnz = static_cast<int>(data.loop_factor_rows.size());
   const int* rows = data.loop_factor_rows.data();
-  const int* columns = data.loop_factor_columns.data();
+  const int* start = data.loop_factor_start.data();
+  const int* row_start = data.loop_factor_row_start.data();
+  const int* row_entries = data.loop_factor_row_entries.data();
+  const int* row_columns = data.loop_factor_row_columns.data();
   const Eigen::Index w = W > 0 ? W : X.cols();
   double* x = X.data();
-  for (int p = 0; p < nnz; ++p) axpy<W>(x + rows[p] * w, -L[p], x + columns[p] * w, w);
-  for (int k = 0; k < np; ++k) {
-    const double inv = data.loop_pivot_inverse(k);
-    for (Eigen::Index j = 0; j < w; ++j) x[k * w + j] *= inv;
+  // (W > 0: the row's sums in registers, as ldl_solve; otherwise through the row itself)
+  for (int i = 0; i < np; ++i) {
+    double* xi = x + i * w;
+    if (W > 0) {
+      double sum[W > 0 ? W : 1] = {};
+      for (int e = row_start[i]; e < row_start[i + 1]; ++e) axpy<W>(sum, L[row_entries[e]], x + row_columns[e] * w, w);
+      for (Eigen::Index j = 0; j < w; ++j) xi[j] -= sum[j];
+    } else {
+      for (int e = row_start[i]; e < row_start[i + 1]; ++e) axpy<W>(xi, -L[row_entries[e]], x + row_columns[e] * w, w);
+    }
   }
-  for (int p = nnz - 1; p >= 0; --p) axpy<W>(x + columns[p] * w, -L[p], x + rows[p] * w, w);
+  for (int k = np - 1; k >= 0; --k) {
+    double* xk = x + k * w;
+    const double inv = data.loop_pivot_inverse(k);
+    if (W > 0) {
+      double sum[W > 0 ? W : 1] = {};
+      for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(sum, L[p], x + rows[p] * w, w);
+      for (Eigen::Index j = 0; j < w; ++j) xk[j] = xk[j] * inv - sum[j];
+    } else {
+      for (Eigen::Index j = 0; j < w; ++j) xk[j] *= inv;
+      for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(xk, -L[p], x + rows[p] * w, w);
+    }
+  }
 }
 
 /// X = (L D L^T)^-1 X for a block of right-hand sides (np x na, row-major): one pass over L for

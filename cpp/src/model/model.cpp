@@ -639,15 +639,29 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
   data.loop_elimination.clear();
   data.loop_factor_start.assign(1, 0);
   data.loop_factor_rows.clear();
-  data.loop_factor_columns.clear();
   for (std::size_t k = 0; k < np; ++k) {
     data.loop_elimination.push_back(passive[static_cast<std::size_t>(order[k])]);
     std::vector<int>& rows = below[k];
     for (int& v : rows) v = position[static_cast<std::size_t>(v)];
     std::sort(rows.begin(), rows.end());
     data.loop_factor_rows.insert(data.loop_factor_rows.end(), rows.begin(), rows.end());
-    data.loop_factor_columns.insert(data.loop_factor_columns.end(), rows.size(), static_cast<int>(k));
     data.loop_factor_start.push_back(static_cast<int>(data.loop_factor_rows.size()));
+  }
+  // L's entries row by row
+  data.loop_factor_row_start.assign(np + 1, 0);
+  data.loop_factor_row_entries.assign(data.loop_factor_rows.size(), 0);
+  data.loop_factor_row_columns.assign(data.loop_factor_rows.size(), 0);
+  for (const int r : data.loop_factor_rows) ++data.loop_factor_row_start[static_cast<std::size_t>(r) + 1];
+  for (std::size_t i = 0; i < np; ++i) data.loop_factor_row_start[i + 1] += data.loop_factor_row_start[i];
+  {
+    std::vector<int> fill(data.loop_factor_row_start.begin(), data.loop_factor_row_start.end() - 1);
+    for (std::size_t k = 0; k < np; ++k) {  // (columns in order: each row's entries by increasing column)
+      for (int p = data.loop_factor_start[k]; p < data.loop_factor_start[k + 1]; ++p) {
+        const int at = fill[static_cast<std::size_t>(data.loop_factor_rows[static_cast<std::size_t>(p)])]++;
+        data.loop_factor_row_entries[static_cast<std::size_t>(at)] = p;
+        data.loop_factor_row_columns[static_cast<std::size_t>(at)] = static_cast<int>(k);
+      }
+    }
   }
   // each loop's passive columns (elimination positions, increasing): N = A°^T A° is the sum over
   // the loops of their rows' small dense products

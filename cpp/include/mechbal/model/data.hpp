@@ -139,7 +139,10 @@ struct MechanismData {
   /// Structure of L in N = L D L^T: the rows (elimination positions, increasing) that column k may
   /// fill are loop_factor_rows[loop_factor_start[k] .. loop_factor_start[k + 1]).
   std::vector<int> loop_factor_start, loop_factor_rows;
-  std::vector<int> loop_factor_columns;  ///< the column k of each entry of loop_factor_rows
+  /// The same entries row by row (for the forward solve): row i's are loop_factor_row_entries
+  /// [loop_factor_row_start[i] .. loop_factor_row_start[i + 1]) (indices into L's entries), in
+  /// the columns loop_factor_row_columns (increasing).
+  std::vector<int> loop_factor_row_start, loop_factor_row_entries, loop_factor_row_columns;
   /// The passive columns (elimination positions, increasing) each loop's rows involve:
   /// loop_members[loop_member_start[i] .. loop_member_start[i + 1]) for loop i.
   std::vector<int> loop_member_start, loop_members;
