@@ -228,30 +228,38 @@ void evaluate(const MechanismModel& model, MechanismData& data, const Eigen::Ref
 /// N = L D L^T in place (data.loop_factor_values: N's pivots and lower triangle on L's structure,
 /// assembled by factor_passive), without pivoting: D in the first np entries, L's strict lower
 /// part (unit diagonal implied) after them, in loop_factor_rows' order. N is symmetric positive
-/// semi-definite (the normal matrix of A° plus a small damping, in the elimination order). The
-/// updates run down the list precomputed at construction (loop_factor_updates: which entry each
-/// product of a column's multipliers updates), so the numeric factorisation is straight loops over
-/// contiguous arrays. A pivot that is not positive (a singular A°) is kept as is and its component
-/// is zeroed by the solves, as Eigen's LDLT does (pseudo-inverse of D: loop_pivot_inverse, which
-/// the solves multiply by, holds 0 there).
+/// semi-definite (the normal matrix of A° plus a small damping, in the elimination order).
+/// Left-looking, column by column: each pivot and entry of L is its entry of N minus one sum of
+/// the products l_jk u_ik over the columns k before (u: the entries before scaling by the pivot,
+/// data.loop_factor_unscaled), summed in registers over the pairs listed at construction
+/// (loop_factor_updates), so the factorisation is straight loops over contiguous arrays. A pivot
+/// that is not positive (a singular A°) is kept as is and its component is zeroed by the solves,
+/// as Eigen's LDLT does (pseudo-inverse of D: loop_pivot_inverse, which the solves multiply by,
+/// holds 0 there).
 void ldl_factor(MechanismData& data) noexcept {
   double* const V = data.loop_factor_values.data();
   const auto np = static_cast<int>(data.loop_elimination.size());
   double* const L = V + np;
+  double* const U = data.loop_factor_unscaled.data();
   const int* start = data.loop_factor_start.data();
-  const int* update_start = data.loop_factor_update_start.data();
+  const int* sum_start = data.loop_factor_update_start.data();
+  const int* pairs = data.loop_factor_updates.data();
   double* const inverse = data.loop_pivot_inverse.data();
-  const int* update = data.loop_factor_updates.data();
-  for (int k = 0; k < np; ++k) {
-    const double d = V[k];
+  const auto reduced = [&](int entry, double value) {  // value - sum over the entry's pairs
+    double sum = 0.0;
+    for (int e = sum_start[entry]; e < sum_start[entry + 1]; ++e) sum += L[pairs[2 * e]] * U[pairs[2 * e + 1]];
+    return value - sum;
+  };
+  for (int j = 0; j < np; ++j) {
+    const double d = reduced(j, V[j]);
+    V[j] = d;
     const double inv = d > 0.0 ? 1.0 / d : 0.0;
-    inverse[k] = inv;
-    // N_rj -= l_jk N_rk over the column's pairs (l_jk = N_jk / d: 0 below a pivot that is not
-    // positive), then the column's entries become the multipliers
-    for (int u = update_start[k]; u < update_start[k + 1]; ++u, update += 3) {
-      V[update[0]] -= (L[update[1]] * inv) * L[update[2]];
+    inverse[j] = inv;
+    for (int q = start[j]; q < start[j + 1]; ++q) {
+      const double u = reduced(np + q, L[q]);
+      U[q] = u;
+      L[q] = u * inv;
     }
-    for (int p = start[k]; p < start[k + 1]; ++p) L[p] *= inv;
   }
 }
 

@@ -765,19 +765,29 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
   for (Eigen::Index t = 0; t < nvalues; ++t) {
     if (!reached[static_cast<std::size_t>(t)]) data.loop_factor_clear.push_back(static_cast<int>(t));
   }
-  data.loop_factor_updates.clear();
-  data.loop_factor_update_start.assign(1, 0);
-  for (std::size_t k = 0; k < np; ++k) {
-    const int begin = data.loop_factor_start[k], end = data.loop_factor_start[k + 1];
-    for (int p = begin; p < end; ++p) {
-      for (int r = p; r < end; ++r) {
-        data.loop_factor_updates.push_back(entry(data.loop_factor_rows[static_cast<std::size_t>(p)], data.loop_factor_rows[static_cast<std::size_t>(r)]));
-        data.loop_factor_updates.push_back(p);
-        data.loop_factor_updates.push_back(r);
+  // the factorisation's products l_jk u_ik (pairs of L's entries in column k: j's scaled, i's
+  // not), grouped by the entry (pivot or entry of L) they are subtracted from
+  {
+    std::vector<std::vector<int>> sums(static_cast<std::size_t>(nvalues));
+    for (std::size_t k = 0; k < np; ++k) {
+      const int begin = data.loop_factor_start[k], end = data.loop_factor_start[k + 1];
+      for (int p = begin; p < end; ++p) {
+        for (int r = p; r < end; ++r) {
+          auto& list = sums[static_cast<std::size_t>(entry(data.loop_factor_rows[static_cast<std::size_t>(p)],
+                                                          data.loop_factor_rows[static_cast<std::size_t>(r)]))];
+          list.push_back(p);
+          list.push_back(r);
+        }
       }
     }
-    data.loop_factor_update_start.push_back(static_cast<int>(data.loop_factor_updates.size() / 3));
+    data.loop_factor_updates.clear();
+    data.loop_factor_update_start.assign(1, 0);
+    for (const auto& list : sums) {
+      data.loop_factor_updates.insert(data.loop_factor_updates.end(), list.begin(), list.end());
+      data.loop_factor_update_start.push_back(static_cast<int>(data.loop_factor_updates.size() / 2));
+    }
   }
+  data.loop_factor_unscaled = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(data.loop_factor_rows.size()));
 }
 
 }  // namespace

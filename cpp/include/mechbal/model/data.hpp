@@ -171,14 +171,16 @@ struct MechanismData {
   /// factorisation), then the entries of L's columns in loop_factor_rows' order (np + nnz(L)).
   Eigen::VectorXd loop_factor_values;
   Eigen::VectorXd loop_pivot_inverse;  ///< 1 / D, 0 where a pivot is not positive (np)
-  /// Symbolic factorisation (construction), as flat lists of int triples:
-  /// - loop_normal_targets: per loop, its column pairs a <= b in order: the entry of
-  ///   loop_factor_values their product adds into (~entry for the entry's first product, which is
-  ///   stored instead), the offsets of columns a and b in the loop's block;
-  /// - loop_factor_updates: per column k of L (from loop_factor_update_start[k]), its entry pairs
-  ///   p <= r in order: the entry l_pk N_rk updates, p and r (indices of L's entries);
-  /// and the entries no product reaches (fill), cleared before the assembly.
+  /// Symbolic factorisation (construction), as flat lists:
+  /// - loop_normal_targets: per loop, its column pairs a <= b in order, three ints each: the entry
+  ///   of loop_factor_values their product adds into (~entry for the entry's first product, which
+  ///   is stored instead), the offsets of columns a and b in the loop's block;
+  /// - loop_factor_updates: per entry e of loop_factor_values (pivot or entry of L, from
+  ///   loop_factor_update_start[e]), the pairs (p, r) of L's entries in an earlier column whose
+  ///   products l_p u_r it is reduced by (l: scaled by the pivot, u: loop_factor_unscaled);
+  /// - loop_factor_clear: the entries no product of the assembly reaches (fill), cleared first.
   std::vector<int> loop_normal_targets, loop_factor_updates, loop_factor_update_start, loop_factor_clear;
+  Eigen::VectorXd loop_factor_unscaled;  ///< L's entries before the division by their pivot (nnz)
   /// Each named frame in its link's joint-aligned frame L (model.hpp): the loop equations place the
   /// closure frames with one product each.
   std::vector<Mat3> frame_rotation_in_link;
