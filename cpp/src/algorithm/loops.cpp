@@ -452,11 +452,8 @@ double factor_passive(MechanismData& data) noexcept {
   for (int i = 0; i < np; ++i) V[i] += kDamping * scale;
   ldl_factor(data);
   if (np == 0) return 1.0;
-  double dmax = 0.0, dmin = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < np; ++i) {
-    dmax = std::max(dmax, std::abs(V[i]));
-    dmin = std::min(dmin, std::abs(V[i]));
-  }
+  const auto D = data.loop_factor_values.head(np);
+  const double dmax = D.cwiseAbs().maxCoeff(), dmin = D.cwiseAbs().minCoeff();
   return dmax > 0.0 ? std::sqrt(std::max(0.0, dmin - kDamping * scale) / dmax) : 0.0;
 }
 
@@ -847,9 +844,10 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
       for (int c = 0; c < lb.count; ++c) sum += a[c * lb.rows + k] * velocity[members[c]];
       Av(lb.row + k) = sum;
     }
-    for (int e = 0; e < lb.rows * lb.actuated_count; ++e) biggest = std::max(biggest, std::abs(b[e]));
-    for (int e = 0; e < lb.rows * lb.count; ++e) biggest = std::max(biggest, std::abs(a[e]));
   }
+  // (over all the blocks at once: A's nonzeros, contiguous)
+  if (data.loop_actuated_blocks.size() > 0) biggest = data.loop_actuated_blocks.cwiseAbs().maxCoeff();
+  if (data.loop_passive_blocks.size() > 0) biggest = std::max(biggest, data.loop_passive_blocks.cwiseAbs().maxCoeff());
   const double scale = 1.0 + biggest * data.closed_velocity.cwiseAbs().maxCoeff();
   if (!(Av.cwiseAbs().maxCoeff() <= 1e-8 * scale)) status = Status::singular;
   if (!acceleration) return finite ? status : status | Status::singular;
