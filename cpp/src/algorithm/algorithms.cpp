@@ -266,13 +266,16 @@ inline void add_column_term(const MechanismModel& model, const MechanismData::Li
 
 }  // namespace
 
-MECHBAL_FLATTEN void detail::momentum_sums(const MechanismModel& model, const MechanismData& data,
-                                           const LinkSubset& links, bool outside, Vec6& inside,
-                                           Vec6& rest) noexcept {
+MECHBAL_FLATTEN void detail::velocity_momentum(const MechanismModel& model, MechanismData& data,
+                                               const LinkSubset& links, bool whole, Vec6& inside,
+                                               Vec6& rest) noexcept {
+  data.work[0].w.setZero();
+  data.work[0].vel.setZero();
   Vec3 P[2] = {Vec3::Zero(), Vec3::Zero()}, H[2] = {Vec3::Zero(), Vec3::Zero()};
-  const int count = outside ? model.num_links() - 1 : static_cast<int>(links.links.size());
+  const int count = whole ? model.num_links() - 1 : static_cast<int>(links.links.size());
   for (int i = 0; i < count; ++i) {
-    const int l = outside ? i + 1 : links.links[static_cast<std::size_t>(i)];
+    const int l = whole ? i + 1 : links.links[static_cast<std::size_t>(i)];
+    detail::set_link_velocity(model, data, l);
     const int in = links.member[static_cast<std::size_t>(l)] ? 1 : 0;
     const auto& c = model.link_constants(l);
     const auto& W = data.work[static_cast<std::size_t>(l)];
@@ -283,7 +286,7 @@ MECHBAL_FLATTEN void detail::momentum_sums(const MechanismModel& model, const Me
     H[in] += W.world_rotation * h_local + W.world_position.cross(p_world);
   }
   inside << P[1], H[1];
-  if (outside) rest << P[0], H[0];
+  if (whole) rest << P[0], H[0];
 }
 
 MECHBAL_FLATTEN void detail::momentum_columns_placed(const MechanismModel& model, MechanismData& data,

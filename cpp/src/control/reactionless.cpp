@@ -393,7 +393,6 @@ Status ReactionlessController::task_momentum(bool whole) noexcept {
   if (whole) {
     detail::joint_state<true, false>(*model_, data_, q_full_, vt_full_, vt_full_);
     if (!closed_) detail::place(*model_, data_);
-    detail::link_velocities(*model_, data_);
   } else {
     for (const int l : subtree_.links) {
       const auto k = static_cast<std::size_t>(l);
@@ -403,10 +402,9 @@ Status ReactionlessController::task_momentum(bool whole) noexcept {
       data_.joint_velocity[k] = c < 0 ? 0.0 : r * vt_full_(c);
     }
     detail::place<true, detail::NoVisit, true>(*model_, data_, detail::NoVisit{}, &subtree_);
-    detail::link_velocities(*model_, data_, &subtree_);
   }
   Vec6 inside;
-  detail::momentum_sums(*model_, data_, subtree_, whole, inside, rest_);
+  detail::velocity_momentum(*model_, data_, subtree_, whole, inside, rest_);
   ht_ = rest_ + inside;
   detail::momentum_columns_placed(*model_, data_, subtree_, balancing_coord_, Ab_);
   for (int i = 0; i < k_; ++i) Kb_.row(i) = Ab_.row(rows_[static_cast<std::size_t>(i)]);

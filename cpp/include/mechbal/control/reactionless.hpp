@@ -22,6 +22,16 @@
 ///
 /// and the predicted shaking wrench of the commanded motion is W(q, v, c) + K a#.
 ///
+/// Computation: K is never formed. When no balancing joint moves a loop's frame (or the mechanism
+/// is open), C's balancing columns are unit vectors: K_b = A_b, the momentum-matrix columns of the
+/// balancing joints, which need only the composite inertias of the subtrees those joints move, and
+/// K_t v_t = A C [v_t; 0] is the momentum of the task's motion with the balancing joints still (a
+/// velocity pass and the links' momenta). An RK4 stage that only turns the balancing joints (the
+/// third, and the next tick's first) places, moves and sums those subtrees again, nothing else.
+/// The feed-forward folds K_t a_t into one shaking-wrench pass, W(q, v, c + C [a_t; 0]) =
+/// W(q, v, c) + K_t a_t, which also gives h. With a balancing joint inside a loop, K_b = A C_b
+/// from the whole momentum matrix.
+///
 /// The balancing rates are integrated at the controller's rate (explicit Euler, or classical RK4
 /// with the task motion at t + dt/2 and t + dt). Each solve is a least-squares / minimum-norm
 /// solution of S K_b x = r: with n_b balancing joints and k cancelled components it is exact for

@@ -24,11 +24,13 @@ Status momentum_matrix_placed(const MechanismModel& model, MechanismData& data) 
 /// descendants. The rest of the matrix and its bookkeeping are untouched.
 void momentum_columns_placed(const MechanismModel& model, MechanismData& data, const LinkSubset& links,
                              const std::vector<int>& coordinates, Eigen::Ref<Eigen::MatrixXd> columns) noexcept;
-/// The momenta (linear; angular about O) of the placed links from their velocities in
-/// data.work (detail::link_velocities or a forward pass), summed over `links` into `inside` and,
-/// with `outside`, over the others into `rest` (untouched otherwise).
-void momentum_sums(const MechanismModel& model, const MechanismData& data, const LinkSubset& links, bool outside,
-                   Vec6& inside, Vec6& rest) noexcept;
+/// The velocities of the placed links from data.joint_velocity (into data.work, as a forward
+/// pass's) and their momenta (linear; angular about O), summed over `links` into `inside` and,
+/// with `whole`, over the others into `rest`. Without `whole`, only `links` are moved and summed
+/// (`rest` untouched): their parents outside must have current velocities (an earlier whole pass
+/// at the same placements and rates).
+void velocity_momentum(const MechanismModel& model, MechanismData& data, const LinkSubset& links, bool whole,
+                       Vec6& inside, Vec6& rest) noexcept;
 /// shaking_wrench(q, v, a) at the placed q (q: the coordinates the links are placed at).
 Status shaking_wrench_placed(const MechanismModel& model, MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,
                              const Eigen::Ref<const Eigen::VectorXd>& v,

@@ -355,36 +355,27 @@ MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, Mech
   }
 }
 
-/// Angular velocity and origin velocity of the links in their L frames from the joints' rates
-/// (data.joint_velocity) and placements: the first part of forward_pass, with the same operations,
-/// for the momenta, which need nothing more. `only` (or null: all): update its links alone, each
-/// after its parent, whose velocities must be current (from this pass or an earlier one at the
-/// same placements and rates).
-MECHBAL_FLATTEN inline void link_velocities(const MechanismModel& model, MechanismData& data,
-                                            const LinkSubset* only = nullptr) noexcept {
-  data.work[0].w.setZero();
-  data.work[0].vel.setZero();
-  const int count = only ? static_cast<int>(only->links.size()) : model.num_links() - 1;
-  for (int i = 0; i < count; ++i) {
-    const int l = only ? only->links[static_cast<std::size_t>(i)] : i + 1;
-    const auto k = static_cast<std::size_t>(l);
-    const auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
-    auto& W = data.work[k];
-    const Vec3& p = W.translation;
-    const Mat3& R = W.rotation;
-    W.w.noalias() = R.transpose() * P.w;
-    W.vel.noalias() = R.transpose() * (P.vel + P.w.cross(p));
-    const double qd = data.joint_velocity[k];
-    switch (model.joint_type(l)) {
-      case JointType::revolute:
-        W.w.z() += qd;
-        break;
-      case JointType::prismatic:
-        W.vel.z() += qd;
-        break;
-      case JointType::fixed:
-        break;
-    }
+/// Angular velocity and origin velocity of link l in its L frame from its joint's rate
+/// (data.joint_velocity), its placement and its parent's velocities: forward_pass's first part,
+/// with the same operations, for the momenta, which need nothing more.
+inline void set_link_velocity(const MechanismModel& model, MechanismData& data, int l) noexcept {
+  const auto k = static_cast<std::size_t>(l);
+  const auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
+  auto& W = data.work[k];
+  const Vec3& p = W.translation;
+  const Mat3& R = W.rotation;
+  W.w.noalias() = R.transpose() * P.w;
+  W.vel.noalias() = R.transpose() * (P.vel + P.w.cross(p));
+  const double qd = data.joint_velocity[k];
+  switch (model.joint_type(l)) {
+    case JointType::revolute:
+      W.w.z() += qd;
+      break;
+    case JointType::prismatic:
+      W.vel.z() += qd;
+      break;
+    case JointType::fixed:
+      break;
   }
 }
 
