@@ -1,11 +1,12 @@
 // The general reactionless controller's tick (control/reactionless.hpp), issue 21:
 //  - reactionless_wheel_{euler,rk4}: the reaction-wheel arm (tests/cpp/reaction_wheel_arm.hpp,
-//    cases/reaction-wheel-arm.toml), wheel cancelling the moment about z: pose, momentum matrix,
-//    the rate solve, the feed-forward, the predicted shaking wrench (and RK4's three stages).
+//    cases/reaction-wheel-arm.toml), wheel cancelling the moment about z: pose, the wheel's column
+//    and the task momentum, the rate solve, the feed-forward, the predicted shaking wrench (and
+//    RK4's three stages).
 //  - reactionless_paminsa_{euler,rk4}: PAMINSA as data on the general model (38 bodies, 9 loops,
-//    paminsa_general.hpp), the wrist joints balancing the moment: loop solve, projection,
-//    momentum matrix, controller and predicted shaking wrench of all bodies; the closed form of the
-//    same tick is paminsa_tick_{euler,rk4} (bench_controllers.cpp): ratio
+//    paminsa_general.hpp), the wrist joints balancing the moment: loop solve, projection, the
+//    wrist's columns and the task momentum, controller and predicted shaking wrench of all bodies;
+//    the closed form of the same tick is paminsa_tick_{euler,rk4} (bench_controllers.cpp): ratio
 //    reactionless_paminsa_general_over_closed_form_*.
 // Motions are periodic with period 2 pi s, sampled on the grid t_n = n 2 pi / kTicks (about 1 kHz),
 // so the cycled ticks never jump. Each case checks at setup that the controller keeps the

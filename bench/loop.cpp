@@ -16,8 +16,8 @@
 //     and wrist motion, the "measured" state the reference with a small tracking error;
 //   reactionless_general: the general reactionless tick (issue 21) on the same model: the
 //     ReactionlessController with the three wrist joints balancing the moment, RK4 (loop solve,
-//     projection, momentum matrix and the rate solve at four stages, feed-forward, predicted
-//     shaking wrench).
+//     projection, the balancing columns and the task momentum, the rate solve at four stages,
+//     feed-forward, predicted shaking wrench).
 //
 // Every tick is timed twice: wall clock (CLOCK_MONOTONIC) and the thread's CPU time
 // (CLOCK_THREAD_CPUTIME_ID). A tick whose wall time exceeds its CPU time by more than 2 us was
@@ -208,7 +208,7 @@ struct ReactionlessGeneralWorkload {
   static constexpr const char* name = "reactionless_general";
   static constexpr const char* description =
       "reactionless_general: ReactionlessController (RK4) on PAMINSA's general model, wrist "
-      "balancing the moment (loops, momentum matrix, rate solve x4, feed-forward, predicted wrench)";
+      "balancing the moment (loops, balancing columns and task momentum, rate solve x4, feed-forward, predicted wrench)";
   // the motion is 2 pi periodic: kInstants samples over one period (t_n = n 2 pi / kInstants, about
   // 1 ms apart), cycled forwards, so that each tick starts where the last one's RK4 stage ended
   static constexpr int kInstants = 6284;

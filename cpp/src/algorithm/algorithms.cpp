@@ -91,25 +91,30 @@ Vec3 mass_moment(const MechanismModel& model, const MechanismData& data) noexcep
 /// Momenta about O of all links, from a forward pass with velocities, and with Wrenches their
 /// rates: the sum of every link's Newton-Euler wrench (moment about its origin n_o, so about O:
 /// n_o + p x f). One sweep over the links for both (each sum in link order).
-template <bool Wrenches>
+/// Momenta = false: the wrenches only (data.shaking's momenta left as they were).
+template <bool Wrenches, bool Momenta = true>
 void sum_links(const MechanismModel& model, MechanismData& data) noexcept {
   Vec3 P = Vec3::Zero(), H = Vec3::Zero(), F = Vec3::Zero(), M = Vec3::Zero();
   for (int l = 1; l < model.num_links(); ++l) {
     const auto& c = model.link_constants(l);
     const auto& W = data.work[static_cast<std::size_t>(l)];
-    const Vec3 p_local = c.mass * W.vel + W.w.cross(c.first_moment);
-    const Vec3 h_local = c.inertia_origin * W.w + c.first_moment.cross(W.vel);
-    const Vec3 p_world = W.world_rotation * p_local;
-    P += p_world;
-    H += W.world_rotation * h_local + W.world_position.cross(p_world);
+    if (Momenta) {
+      const Vec3 p_local = c.mass * W.vel + W.w.cross(c.first_moment);
+      const Vec3 h_local = c.inertia_origin * W.w + c.first_moment.cross(W.vel);
+      const Vec3 p_world = W.world_rotation * p_local;
+      P += p_world;
+      H += W.world_rotation * h_local + W.world_position.cross(p_world);
+    }
     if (Wrenches) {
       const Vec3 f = W.world_rotation * W.force;
       F += f;
       M += W.world_rotation * W.moment + W.world_position.cross(f);
     }
   }
-  data.shaking.linear_momentum = P;
-  data.shaking.angular_momentum = H;
+  if (Momenta) {
+    data.shaking.linear_momentum = P;
+    data.shaking.angular_momentum = H;
+  }
   if (Wrenches) {
     data.shaking.force = F;
     data.shaking.moment = M;
@@ -337,9 +342,12 @@ Status shaking_wrench(const MechanismModel& model, MechanismData& data, const Co
 }
 
 Status detail::shaking_wrench_placed(const MechanismModel& model, MechanismData& data, const ConstVector& q,
-                                     const ConstVector& v, const ConstVector& a) noexcept {
+                                     const ConstVector& v, const ConstVector& a, bool momenta) noexcept {
   detail::joint_state<true, true>(model, data, q, v, a);  // the rates (the positions are q's already)
-  return shaking_wrench_of_placed(model, data);
+  if (momenta) return shaking_wrench_of_placed(model, data);
+  detail::forward_pass<true, true, false, true>(model, data);
+  sum_links<true, false>(model, data);
+  return finite_result(data.shaking.force, data.shaking.moment);
 }
 
 Status base_reaction(const MechanismModel& model, MechanismData& data, const ConstVector& q,

@@ -653,14 +653,15 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
   }
   // ---- feed-forward: S K_b a_b = S dh*/dt - S K_t a_t - S W(q, v, c) = S dh*/dt - S W'
   // with W' = W(q, v, c + C [a_t; 0]) = W(q, v, c) + K_t a_t, the shaking wrench (the rate of
-  // momentum) of the motion with the balancing joints' accelerations still zero; the same pass
-  // gives the momentum h = A C v of the command.
+  // momentum) of the motion with the balancing joints' accelerations still zero.
   // the links are placed at q_full_ (evaluate(), or closed_motion just above, at the same q)
-  if (const Status s = detail::shaking_wrench_placed(*model_, data_, q_full_, v_full_, a_full_); s != Status::ok)
+  if (const Status s = detail::shaking_wrench_placed(*model_, data_, q_full_, v_full_, a_full_, false); s != Status::ok)
     return hold(Status::out_of_range);
-  Vec6 W, h;
+  Vec6 W;
   W << data_.shaking.force, data_.shaking.moment;
-  h << data_.shaking.linear_momentum, data_.shaking.angular_momentum;
+  // the command's momentum h = K v = K_t v_t + K_b v_b
+  Vec6 h = ht_;
+  for (int j = 0; j < nb_; ++j) h += k1_(j) * Ab_.col(j);
   for (int i = 0; i < k_; ++i) {
     const int row = rows_[static_cast<std::size_t>(i)];
     kb_work_(i) = target_rate_(row) - W(row);

@@ -191,7 +191,8 @@ class ReactionlessController {
   const ReactionlessCommand& command() const noexcept { return command_; }
   /// Balancing joints' positions at the next tick (the state).
   const Eigen::VectorXd& balancing_state() const noexcept { return q_b_; }
-  /// The model's data at the last evaluation (kinematics of the last stage).
+  /// The model's data at the last evaluation (kinematics of the last stage; its momentum_matrix
+  /// is only filled when a balancing joint moves a loop: see "Computation" above).
   const MechanismData& data() const noexcept { return data_; }
 
  private:

@@ -32,8 +32,9 @@ void momentum_columns_placed(const MechanismModel& model, MechanismData& data, c
 void velocity_momentum(const MechanismModel& model, MechanismData& data, const LinkSubset& links, bool whole,
                        Vec6& inside, Vec6& rest) noexcept;
 /// shaking_wrench(q, v, a) at the placed q (q: the coordinates the links are placed at).
+/// `momenta` false: the force and moment only (data.shaking's momenta are left as they were).
 Status shaking_wrench_placed(const MechanismModel& model, MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,
-                             const Eigen::Ref<const Eigen::VectorXd>& v,
-                             const Eigen::Ref<const Eigen::VectorXd>& a) noexcept;
+                             const Eigen::Ref<const Eigen::VectorXd>& v, const Eigen::Ref<const Eigen::VectorXd>& a,
+                             bool momenta = true) noexcept;
 
 }  // namespace mechbal::detail
