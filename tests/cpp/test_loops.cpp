@@ -10,6 +10,7 @@
 #include <cmath>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "alloc_counter.hpp"
 #include "mechbal/algorithm/loops.hpp"
@@ -82,6 +83,25 @@ MechanismModel four_bar_with_arm() {
   return MechanismModel(d);
 }
 
+/// The planar_point four-bar on an actuated turntable (about x: it tilts the plane of the loop):
+/// the turntable is the two tip frames' common ancestor and moves them rigidly together, so the
+/// loop's rows do not depend on it (its column of A is zero, C's is a unit vector; the loop's
+/// columns stop below it: MechanismData::loop_path_stop).
+MechanismModel four_bar_on_turntable() {
+  MechanismDescription d;
+  d.gravity = Vec3(0.0, -9.81, 0.0);
+  Joint turn{"turn", JointType::revolute, "base", at(0, 0, 0.1)};
+  turn.axis = Vec3(1.0, 0.0, 0.0);
+  d.joints = {turn, Joint{"crank", JointType::revolute, "turn"}, Joint{"coupler", JointType::revolute, "crank", at(0.2, 0, 0)},
+              Joint{"rocker", JointType::revolute, "turn", at(0.45, 0, 0)}};
+  d.bodies = {rod("turn", "turn", 2.0, 0.45), rod("crank", "crank", 0.8, 0.2), rod("coupler", "coupler", 1.5, 0.5),
+              rod("rocker", "rocker", 1.1, 0.4)};
+  d.frames = {Frame{"coupler_tip", "coupler", at(0.5, 0, 0)}, Frame{"rocker_tip", "rocker", at(0.4, 0, 0)}};
+  d.loops = {LoopConstraint{"tip", LoopType::planar_point, "coupler_tip", "rocker_tip"}};
+  d.actuated = {"turn", "crank"};
+  return MechanismModel(d);
+}
+
 /// q near an assembly (the order of the coordinates is the joints', depth first)
 Eigen::VectorXd four_bar_guess() { return (Eigen::VectorXd(3) << 1.0, -0.6, 1.75).finished(); }
 Eigen::VectorXd five_bar_guess() { return (Eigen::VectorXd(4) << 2.0, -1.2, 1.1, 1.2).finished(); }
@@ -108,6 +128,8 @@ std::vector<Case> cases() {
     out.push_back(Case{name, four_bar(type), four_bar_guess(), (Eigen::VectorXd(1) << 1.0).finished()});
   }
   out.push_back(Case{"five_bar", five_bar(), five_bar_guess(), (Eigen::VectorXd(2) << 2.0, 1.1).finished()});
+  out.push_back(Case{"four_bar_on_turntable", four_bar_on_turntable(),
+                     (Eigen::VectorXd(4) << 0.3, 1.0, -0.6, 1.75).finished(), (Eigen::VectorXd(2) << 0.3, 1.0).finished()});
   {
     MechanismModel model = four_bar_with_arm();
     Eigen::VectorXd guess = Eigen::VectorXd::Zero(model.dof()), qa(model.num_actuated());
@@ -135,6 +157,35 @@ TEST(Loops, ClosureHoldsAfterTheSolve) {
       for (int i = 0; i < c.model.num_actuated(); ++i) {
         EXPECT_EQ(q(c.model.actuated_coordinates()[static_cast<std::size_t>(i)]), qa(i));
       }
+    }
+  }
+}
+
+TEST(Loops, JacobianMatchesFiniteDifferences) {
+  // A from the loops' path columns (zero above a planar_point loop's common ancestor) against
+  // central differences of the residual, near and away from the closure
+  for (const auto& c : cases()) {
+    const MechanismModel& model = c.model;
+    MechanismData data(model);
+    const Eigen::VectorXd q0 = solved(model, data, c.qa, c.guess);
+    for (const double away : {0.0, 0.05}) {
+      const Eigen::VectorXd q = q0 + Eigen::VectorXd::LinSpaced(model.dof(), away, -away);
+      ASSERT_EQ(loop_constraints(model, data, q), Status::ok) << c.name;
+      const Eigen::MatrixXd A = data.loop_jacobian;
+      const double h = 1e-6;
+      for (int k = 0; k < model.dof(); ++k) {
+        Eigen::VectorXd e = Eigen::VectorXd::Zero(model.dof());
+        e(k) = h;
+        ASSERT_EQ(loop_constraints(model, data, q + e), Status::ok);
+        const Eigen::VectorXd plus = data.loop_residual;
+        ASSERT_EQ(loop_constraints(model, data, q - e), Status::ok);
+        const Eigen::VectorXd column = (plus - data.loop_residual) / (2 * h);
+        EXPECT_LT((A.col(k) - column).cwiseAbs().maxCoeff(), 1e-8) << c.name << " coordinate " << k << " away " << away;
+      }
+    }
+    if (std::string(c.name) == "four_bar_on_turntable") {
+      EXPECT_EQ(data.loop_jacobian.col(0).cwiseAbs().maxCoeff(), 0.0);  // the turntable's
+      EXPECT_EQ(data.loop_actuated_columns, std::vector<int>{1});       // the crank only
     }
   }
 }

@@ -38,21 +38,37 @@ struct RowFunctional {
   Vec3 a = Vec3::Zero(), b = Vec3::Zero(), e = Vec3::Zero();
 };
 
-/// Adds the columns of the joints on the path from `link` to the root to the loop's rows:
+/// Calls f(c, r z, p_k, revolute) for the joints with a coordinate on the path from `link` up to
+/// (not including) the link `stop` (0: to the root): coordinate c, ratio r, axis z, origin p_k (O).
+template <class F>
+inline void for_each_loop_joint(const MechanismModel& model, const MechanismData& data, int link, int stop,
+                                F&& f) noexcept {
+  for (int k = link; k >= 1 && k != stop; k = model.parent(k)) {
+    const int c = model.coordinate(k);
+    if (c < 0) continue;
+    const auto& K = data.work[static_cast<std::size_t>(k)];
+    f(c, Vec3(model.coordinate_ratio(k) * K.world_rotation.col(2)), K.world_position,
+      model.joint_type(k) == JointType::revolute);
+  }
+}
+
+/// Adds the columns of the joints on the path from `link` towards the root (up to `stop`,
+/// data.loop_path_stop) to the loop's rows:
 /// joint k moves the frame's origin p by r z x (p - p_k) (revolute) or r z (prismatic) and turns
 /// it by r z (revolute); `side` -1 for frame A, +1 for frame B. Only the loop's own coordinates are
 /// touched (no dense 6 x n frame Jacobians).
-void add_path_columns(const MechanismModel& model, const MechanismData& data, int link, const Vec3& p, double side,
-                      const RowFunctional* f, int rows, int row0, Eigen::MatrixXd& jac, bool point) noexcept {
+void add_path_columns(const MechanismModel& model, const MechanismData& data, int link, int stop, const Vec3& p,
+                      double side, const RowFunctional* f, int rows, int row0, Eigen::MatrixXd& jac,
+                      bool point) noexcept {
   if (point) {  // a point loop's rows are d itself (a = e_k, b = e = 0): the columns are +-(z x (p - p_k)) or +-z
-    detail::for_each_path_joint(model, data, link, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
+    for_each_loop_joint(model, data, link, stop, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
       double* column = jac.data() + static_cast<Eigen::Index>(c) * jac.rows() + row0;
       const Vec3 rate = revolute ? Vec3(z.cross(p - pk)) : z;
       for (int r = 0; r < 3; ++r) column[r] += side * rate(r);
     });
     return;
   }
-  detail::for_each_path_joint(model, data, link, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
+  for_each_loop_joint(model, data, link, stop, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
     if (revolute) {
       const Vec3 lin = z.cross(p - pk);
       for (int r = 0; r < rows; ++r) {
@@ -113,8 +129,11 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
       }
     }
     if (jacobian) {
+      // (the columns above a planar_point loop's common ancestor are zero from construction: no
+      // loop type writes them in its rows)
+      const int stop = data.loop_path_stop[static_cast<std::size_t>(i)];
       for (const int frame : {fa, fb}) {
-        for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) {
+        for (int k = model.frame_link(frame); k >= 1 && k != stop; k = model.parent(k)) {
           const int c = model.coordinate(k);
           if (c < 0) continue;
           double* column = jac.data() + static_cast<Eigen::Index>(c) * jac.rows() + row;
@@ -123,8 +142,8 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
         }
       }
       const bool point = type == LoopType::point;
-      add_path_columns(model, data, model.frame_link(fa), A.position, -1.0, f, rows, row, jac, point);
-      add_path_columns(model, data, model.frame_link(fb), B.position, 1.0, f, rows, row, jac, point);
+      add_path_columns(model, data, model.frame_link(fa), stop, A.position, -1.0, f, rows, row, jac, point);
+      add_path_columns(model, data, model.frame_link(fb), stop, B.position, 1.0, f, rows, row, jac, point);
     }
   }
 }
@@ -156,6 +175,17 @@ void constraint_bias(const MechanismModel& model, MechanismData& data) noexcept 
   for (int i = 0; i < model.num_loops(); ++i) {
     const int row = model.loop_row(i);
     const LoopType type = model.loop(i).type;
+    if (type == LoopType::point) {
+      // the origins' accelerations only, each in its link's axes, rotated once
+      const auto acceleration = [&](int frame) {
+        const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
+        const Vec3& p = data.frame_position_in_link[static_cast<std::size_t>(frame)];
+        const Vec3 local = W.acc + W.alpha.cross(p) + W.w.cross(W.w.cross(p));
+        return Vec3(W.world_rotation * local);
+      };
+      data.loop_bias.segment<3>(row) = acceleration(model.loop_frame_b(i)) - acceleration(model.loop_frame_a(i));
+      continue;
+    }
     const bool rotation = type == LoopType::planar_point || type == LoopType::axis;
     const bool planar = type == LoopType::planar_point;
     const detail::FrameMotion A = loop_frame_motion(model, data, model.loop_frame_a(i), rotation, planar);
@@ -195,69 +225,66 @@ void evaluate(const MechanismModel& model, MechanismData& data, const Eigen::Ref
   constraint_rows(model, data, jacobian);
 }
 
-/// N = L D L^T in place, without pivoting, over the structure of data.loop_factor_rows (N is
-/// symmetric positive semi-definite: the normal matrix of A° plus a small damping; its rows and
-/// columns in the elimination order): L in N's strict lower triangle (unit diagonal implied, only
-/// the structural entries are read or written), D in `D`. Written out for the small, sparse
-/// systems of loop closures, where a dense LDLT (pivot search, blocked triangular solves) costs
-/// several times more. A pivot that is not positive (a singular A°) is kept as is and its
-/// component is zeroed by ldl_solve, as Eigen's LDLT does (pseudo-inverse of D).
+/// N = L D L^T in place (data.loop_factor_values: N's pivots and lower triangle on L's structure,
+/// assembled by factor_passive), without pivoting: D in the first np entries, L's strict lower
+/// part (unit diagonal implied) after them, in loop_factor_rows' order. N is symmetric positive
+/// semi-definite (the normal matrix of A° plus a small damping, in the elimination order).
+/// Left-looking, column by column: each pivot and entry of L is its entry of N minus one sum of
+/// the products l_jk u_ik over the columns k before (u: the entries before scaling by the pivot,
+/// data.loop_factor_unscaled), summed in registers over the pairs listed at construction
+/// (loop_factor_updates), so the factorisation is straight loops over contiguous arrays. A pivot
+/// that is not positive (a singular A°) is kept as is and its component is zeroed by the solves,
+/// as Eigen's LDLT does (pseudo-inverse of D: loop_pivot_inverse, which the solves multiply by,
+/// holds 0 there).
 void ldl_factor(MechanismData& data) noexcept {
-  Eigen::MatrixXd& N = data.loop_normal;
-  Eigen::VectorXd& D = data.loop_normal_pivots;
-  const int* rows = data.loop_factor_rows.data();
-  const Eigen::Index n = N.rows();
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double d = N(k, k);
-    D(k) = d;
-    const int begin = data.loop_factor_start[static_cast<std::size_t>(k)];
-    const int end = data.loop_factor_start[static_cast<std::size_t>(k) + 1];
-    double* lk = N.data() + k * n;
-    if (!(d > 0.0)) {
-      for (int p = begin; p < end; ++p) lk[rows[p]] = 0.0;
-      continue;
-    }
-    // the column's multipliers l_jk = N_jk / d, divided once (kept aside while the unscaled column
-    // updates the rest; a column with more structural entries than the buffer divides twice)
-    constexpr int kBuffer = 32;
-    double scaled[kBuffer];
-    const bool buffered = end - begin <= kBuffer;
-    for (int p = begin; p < end; ++p) {
-      const int j = rows[p];
-      const double f = lk[j] / d;
-      if (buffered) scaled[p - begin] = f;
-      if (f == 0.0) continue;
-      double* nj = N.data() + j * n;
-      for (int r = p; r < end; ++r) nj[rows[r]] -= f * lk[rows[r]];
-    }
-    if (buffered) {
-      for (int p = begin; p < end; ++p) lk[rows[p]] = scaled[p - begin];
-    } else {
-      for (int p = begin; p < end; ++p) lk[rows[p]] /= d;
+  double* const V = data.loop_factor_values.data();
+  const auto np = static_cast<int>(data.loop_elimination.size());
+  double* const L = V + np;
+  double* const U = data.loop_factor_unscaled.data();
+  const int* start = data.loop_factor_start.data();
+  const int* sum_start = data.loop_factor_update_start.data();
+  const int* pairs = data.loop_factor_updates.data();
+  double* const inverse = data.loop_pivot_inverse.data();
+  const auto reduced = [&](int entry, double value) {  // value - sum over the entry's pairs
+    double sum = 0.0;
+    for (int e = sum_start[entry]; e < sum_start[entry + 1]; ++e) sum += L[pairs[2 * e]] * U[pairs[2 * e + 1]];
+    return value - sum;
+  };
+  for (int j = 0; j < np; ++j) {
+    const double d = reduced(j, V[j]);
+    V[j] = d;
+    const double inv = d > 0.0 ? 1.0 / d : 0.0;
+    inverse[j] = inv;
+    for (int q = start[j]; q < start[j + 1]; ++q) {
+      const double u = reduced(np + q, L[q]);
+      U[q] = u;
+      L[q] = u * inv;
     }
   }
 }
 
-/// x = (L D L^T)^-1 x with the factors of ldl_factor.
+/// x = (L D L^T)^-1 x with the factors of ldl_factor. Both triangular solves form each unknown
+/// as one sum (in registers, not through memory): forwards over the row's entries of L
+/// (loop_factor_row_*), backwards over the column's.
 void ldl_solve(const MechanismData& data, Eigen::Ref<Eigen::VectorXd> x) noexcept {
-  const Eigen::MatrixXd& L = data.loop_normal;
-  const Eigen::VectorXd& D = data.loop_normal_pivots;
+  const auto np = static_cast<int>(data.loop_elimination.size());
+  const double* const L = data.loop_factor_values.data() + np;  // (after the pivots)
   const int* rows = data.loop_factor_rows.data();
   const int* start = data.loop_factor_start.data();
-  const Eigen::Index n = L.rows();
+  const int* row_start = data.loop_factor_row_start.data();
+  const int* row_entries = data.loop_factor_row_entries.data();
+  const int* row_columns = data.loop_factor_row_columns.data();
+  const double* const inverse = data.loop_pivot_inverse.data();
   double* const v = x.data();
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double xk = v[k];
-    if (xk == 0.0) continue;
-    const double* l = L.data() + k * n;
-    for (int p = start[k]; p < start[k + 1]; ++p) v[rows[p]] -= xk * l[rows[p]];
-  }
-  for (Eigen::Index k = 0; k < n; ++k) v[k] = D(k) > 0.0 ? v[k] / D(k) : 0.0;
-  for (Eigen::Index k = n - 1; k >= 0; --k) {
-    const double* l = L.data() + k * n;
+  for (int i = 0; i < np; ++i) {
     double sum = 0.0;
-    for (int p = start[k]; p < start[k + 1]; ++p) sum += l[rows[p]] * v[rows[p]];
-    v[k] -= sum;
+    for (int e = row_start[i]; e < row_start[i + 1]; ++e) sum += L[row_entries[e]] * v[row_columns[e]];
+    v[i] -= sum;
+  }
+  for (int k = np - 1; k >= 0; --k) {
+    double sum = 0.0;
+    for (int p = start[k]; p < start[k + 1]; ++p) sum += L[p] * v[rows[p]];
+    v[k] = v[k] * inverse[k] - sum;
   }
 }
 
@@ -272,23 +299,37 @@ inline void axpy(double* y, double a, const double* x, Eigen::Index n) noexcept 
 /// ldl_solve_block with w = W columns (0: X.cols()), unrolled for the usual one to four.
 template <int W>
 void ldl_solve_block_width(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
-  const Eigen::MatrixXd& L = data.loop_normal;
-  const Eigen::VectorXd& D = data.loop_normal_pivots;
+  const auto np = static_cast<int>(data.loop_elimination.size());
+  const double* const L = data.loop_factor_values.data() + np;  // (after the pivots)
   const int* rows = data.loop_factor_rows.data();
   const int* start = data.loop_factor_start.data();
-  const Eigen::Index n = L.rows(), w = W > 0 ? W : X.cols();
+  const int* row_start = data.loop_factor_row_start.data();
+  const int* row_entries = data.loop_factor_row_entries.data();
+  const int* row_columns = data.loop_factor_row_columns.data();
+  const Eigen::Index w = W > 0 ? W : X.cols();
   double* x = X.data();
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double* l = L.data() + k * n;
-    for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(x + rows[p] * w, -l[rows[p]], x + k * w, w);
+  // (W > 0: the row's sums in registers, as ldl_solve; otherwise through the row itself)
+  for (int i = 0; i < np; ++i) {
+    double* xi = x + i * w;
+    if (W > 0) {
+      double sum[W > 0 ? W : 1] = {};
+      for (int e = row_start[i]; e < row_start[i + 1]; ++e) axpy<W>(sum, L[row_entries[e]], x + row_columns[e] * w, w);
+      for (Eigen::Index j = 0; j < w; ++j) xi[j] -= sum[j];
+    } else {
+      for (int e = row_start[i]; e < row_start[i + 1]; ++e) axpy<W>(xi, -L[row_entries[e]], x + row_columns[e] * w, w);
+    }
   }
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double inv = D(k) > 0.0 ? 1.0 / D(k) : 0.0;
-    for (Eigen::Index j = 0; j < w; ++j) x[k * w + j] *= inv;
-  }
-  for (Eigen::Index k = n - 1; k >= 0; --k) {
-    const double* l = L.data() + k * n;
-    for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(x + k * w, -l[rows[p]], x + rows[p] * w, w);
+  for (int k = np - 1; k >= 0; --k) {
+    double* xk = x + k * w;
+    const double inv = data.loop_pivot_inverse(k);
+    if (W > 0) {
+      double sum[W > 0 ? W : 1] = {};
+      for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(sum, L[p], x + rows[p] * w, w);
+      for (Eigen::Index j = 0; j < w; ++j) xk[j] = xk[j] * inv - sum[j];
+    } else {
+      for (Eigen::Index j = 0; j < w; ++j) xk[j] *= inv;
+      for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(xk, -L[p], x + rows[p] * w, w);
+    }
   }
 }
 
@@ -304,105 +345,116 @@ void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X
   }
 }
 
-/// X = -A°^T B (np x w, row-major; B m x w row-major) over A°'s structural nonzeros, w = W (0: B's).
-template <int W>
-void passive_transpose_times(const MechanismData& data, const MechanismData::RowMajorMatrix& B,
-                             MechanismData::RowMajorMatrix& X) noexcept {
-  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
-  const Eigen::Index w = W > 0 ? W : B.cols();
+/// X = -A°^T A# (np x w, row-major) over the loops' blocks of A° and A# (data.loop_blocks: the
+/// products of each loop's passive and actuated columns over its rows).
+void passive_transpose_actuated(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
+  const Eigen::Index w = X.cols();
   X.setZero();
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-    const double* a = Ap.data() + i * Ap.rows();
-    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-    for (int p = 0; p < data.loop_passive_count(i); ++p) {
-      const int r = rows[p];
-      axpy<W>(X.data() + i * w, -a[r], B.data() + r * w, w);
+  for (const auto& lb : data.loop_blocks) {
+    if (lb.actuated_count == 0) continue;
+    const double* a = data.loop_passive_blocks.data() + lb.block;
+    const int* members = data.loop_members.data() + lb.member;
+    const int* actuated = data.loop_actuated_members.data() + lb.actuated;
+    for (int c = 0; c < lb.count; ++c, a += lb.rows) {
+      double* x = X.data() + members[c] * w;
+      const double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
+      for (int t = 0; t < lb.actuated_count; ++t, b += lb.rows) {
+        double sum = 0.0;
+        for (int r = 0; r < lb.rows; ++r) sum += a[r] * b[r];
+        x[actuated[t]] -= sum;
+      }
     }
   }
+}
+
+/// out = (A°^T A°)^-1 A°^T y (or its negative with `Negate`: the least-squares correction of
+/// A° x = -y) from the factors, A°^T y over A°'s blocks (a column's first product stored, the
+/// others added: data.loop_member_first; the columns in no loop are zero).
+template <bool Negate>
+void normal_solve(const MechanismData& data, const double* y, Eigen::VectorXd& out) noexcept {
+  double* o = out.data();
+  for (const int j : data.loop_loose_columns) o[j] = 0.0;
+  const char* first = data.loop_member_first.data();
+  for (const auto& lb : data.loop_blocks) {
+    const double* a = data.loop_passive_blocks.data() + lb.block;
+    const int* members = data.loop_members.data() + lb.member;
+    const double* yl = y + lb.row;
+    for (int c = 0; c < lb.count; ++c, a += lb.rows) {
+      double sum = 0.0;
+      for (int r = 0; r < lb.rows; ++r) sum += a[r] * yl[r];
+      if (Negate) sum = -sum;
+      if (first[lb.member + c]) {
+        o[members[c]] = sum;
+      } else {
+        o[members[c]] += sum;
+      }
+    }
+  }
+  ldl_solve(data, out);
 }
 
 /// Relative damping of the normal equations: keeps the solves bounded at a singular A° (Status::singular).
 constexpr double kDamping = 1e-16;
 
-/// N(j, i) += A°(rows of one loop, j) . A°(those rows, i) over the loop's passive columns
-/// (`members`, increasing: j >= i, the lower triangle, L's structure); R = rows (0: `rows`).
+/// One loop's block of A° from A (its rows, R of them (0: `rows`), of its passive columns), then
+/// N += the products of its columns (column pairs a <= b in order, into the entries `target`
+/// lists, ~entry for an entry's first product: symbolic factorisation).
 template <int R>
-void add_loop_products(const Eigen::MatrixXd& Ap, Eigen::MatrixXd& N, int r0, int rows, const int* members,
-                       int count) noexcept {
-  const Eigen::Index m = Ap.rows();
-  const int nr = R > 0 ? R : rows;
-  for (int a = 0; a < count; ++a) {
-    const Eigen::Index i = members[a];
-    const double* ai = Ap.data() + i * m + r0;
-    double* ni = N.data() + i * N.rows();
-    for (int b = a; b < count; ++b) {
-      const double* aj = Ap.data() + members[b] * m + r0;
-      double sum = 0.0;
-      for (int r = 0; r < nr; ++r) sum += ai[r] * aj[r];
-      ni[members[b]] += sum;
+const int* add_loop_products(const MechanismData& data, const MechanismData::LoopBlockInfo& lb, double* block,
+                             double* V, const int* target) noexcept {
+  const int nr = R > 0 ? R : lb.rows;
+  const int count = lb.count;
+  const int* members = data.loop_members.data() + lb.member;
+  const Eigen::Index m = data.loop_jacobian.rows();
+  for (int c = 0; c < count; ++c) {
+    const double* from = data.loop_jacobian.data() +
+                         static_cast<Eigen::Index>(data.loop_elimination[static_cast<std::size_t>(members[c])]) * m + lb.row;
+    for (int r = 0; r < nr; ++r) block[c * nr + r] = from[r];
+  }
+  const int* const end = target + 3 * (count * (count + 1) / 2);
+  for (; target != end; target += 3) {
+    const double* ai = block + target[1];
+    const double* aj = block + target[2];
+    double sum = 0.0;
+    for (int r = 0; r < nr; ++r) sum += ai[r] * aj[r];
+    const int t = target[0];
+    if (t < 0) {
+      V[~t] = sum;
+    } else {
+      V[t] += sum;
     }
   }
+  return target;
 }
 
 /// N = A°^T A° + damping from data.loop_jacobian, factorised; returns the rcond estimate of A°.
 double factor_passive(MechanismData& data) noexcept {
-  const auto& order = data.loop_elimination;
-  const auto np = static_cast<Eigen::Index>(order.size());
-  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
-  const auto m = static_cast<int>(Ap.rows());
-  // A°'s columns in the elimination order, over the rows each can be nonzero in (the rows of the
-  // loops whose frames it moves, fixed at construction: data.loop_passive_rows); the other
-  // entries of A° stay zero
-  for (Eigen::Index j = 0; j < np; ++j) {
-    const double* from = data.loop_jacobian.data() + static_cast<Eigen::Index>(order[static_cast<std::size_t>(j)]) * m;
-    double* to = data.loop_passive_jacobian.data() + j * m;
-    const int* rows = data.loop_passive_rows.data() + j * data.loop_passive_rows.rows();
-    for (int p = 0; p < data.loop_passive_count(j); ++p) to[rows[p]] = from[rows[p]];
-  }
-  // N = A°^T A° on the structure of L (which holds N's): the sum over the loops of the products
-  // of their own columns over their own rows (2 to 6 rows, a handful of columns each)
-  Eigen::MatrixXd& N = data.loop_normal;
-  for (Eigen::Index i = 0; i < np; ++i) {
-    N(i, i) = 0.0;
-    const int end = data.loop_factor_start[static_cast<std::size_t>(i) + 1];
-    for (int p = data.loop_factor_start[static_cast<std::size_t>(i)]; p < end; ++p) {
-      N(data.loop_factor_rows[static_cast<std::size_t>(p)], i) = 0.0;
-    }
-  }
-  const int nloops = static_cast<int>(data.loop_member_start.size()) - 1;
-  for (int l = 0; l < nloops; ++l) {
-    const int r0 = data.loop_row_start[static_cast<std::size_t>(l)];
-    const int rows = data.loop_row_start[static_cast<std::size_t>(l) + 1] - r0;
-    const int* members = data.loop_members.data() + data.loop_member_start[static_cast<std::size_t>(l)];
-    const int count = data.loop_member_start[static_cast<std::size_t>(l) + 1] - data.loop_member_start[static_cast<std::size_t>(l)];
+  const auto np = static_cast<int>(data.loop_elimination.size());
+  // A°'s blocks from A (each loop's rows of its passive columns; A°'s other entries are zero),
+  // then N = A°^T A° on the structure of L: the sum over the loops of the products of their own
+  // columns over their own rows (2 to 6 rows, a handful of columns each)
+  double* const V = data.loop_factor_values.data();
+  for (const int t : data.loop_factor_clear) V[t] = 0.0;
+  const int* target = data.loop_normal_targets.data();
+  for (const auto& lb : data.loop_blocks) {
+    double* block = data.loop_passive_blocks.data() + lb.block;
     // (the loop types' row counts unrolled: 2 planar_point, 3 point, 5 axis, 6 weld)
-    switch (rows) {
-      case 2: add_loop_products<2>(Ap, N, r0, rows, members, count); break;
-      case 3: add_loop_products<3>(Ap, N, r0, rows, members, count); break;
-      case 5: add_loop_products<5>(Ap, N, r0, rows, members, count); break;
-      case 6: add_loop_products<6>(Ap, N, r0, rows, members, count); break;
-      default: add_loop_products<0>(Ap, N, r0, rows, members, count); break;
+    switch (lb.rows) {
+      case 2: target = add_loop_products<2>(data, lb, block, V, target); break;
+      case 3: target = add_loop_products<3>(data, lb, block, V, target); break;
+      case 5: target = add_loop_products<5>(data, lb, block, V, target); break;
+      case 6: target = add_loop_products<6>(data, lb, block, V, target); break;
+      default: target = add_loop_products<0>(data, lb, block, V, target); break;
     }
   }
   double scale = 1.0;
-  for (Eigen::Index i = 0; i < np; ++i) scale = std::max(scale, N(i, i));
-  for (Eigen::Index i = 0; i < np; ++i) N(i, i) += kDamping * scale;
+  for (int i = 0; i < np; ++i) scale = std::max(scale, V[i]);
+  for (int i = 0; i < np; ++i) V[i] += kDamping * scale;
   ldl_factor(data);
-  const Eigen::VectorXd& D = data.loop_normal_pivots;
   if (np == 0) return 1.0;
+  const auto D = data.loop_factor_values.head(np);
   const double dmax = D.cwiseAbs().maxCoeff(), dmin = D.cwiseAbs().minCoeff();
   return dmax > 0.0 ? std::sqrt(std::max(0.0, dmin - kDamping * scale) / dmax) : 0.0;
-}
-
-/// (A°^T y)_i: column i of A° (elimination order) against y, over the rows holding the column's
-/// nonzeros (data.loop_passive_rows, from factor_passive).
-double column_dot(const MechanismData& data, Eigen::Index i, const double* y) noexcept {
-  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
-  const double* a = Ap.data() + i * Ap.rows();
-  double sum = 0.0;
-  const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-  for (int p = 0; p < data.loop_passive_count(i); ++p) sum += a[rows[p]] * y[rows[p]];
-  return sum;
 }
 
 Status check(const MechanismModel& model, MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,
@@ -548,10 +600,7 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
       evaluate(model, data, trial, false);  // the residual at trial (the step needs it)
       placed_at_trial = true;
     }
-    for (Eigen::Index i = 0; i < data.loop_step.size(); ++i) {
-      data.loop_step(i) = -column_dot(data, i, data.loop_residual.data());
-    }
-    ldl_solve(data, data.loop_step);
+    normal_solve<true>(data, data.loop_residual.data(), data.loop_step);
     const double biggest = data.loop_step.cwiseAbs().maxCoeff();
     if (!(biggest < 1e300)) {  // non-finite step: cannot assemble here
       if (chord) {
@@ -614,8 +663,7 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
     Eigen::VectorXd& offset = data.loop_prediction_offset;
     data.loop_prediction_offset_valid = data.loop_iterations == 0 && norm > 0.0 && !passive.empty();
     if (data.loop_prediction_offset_valid) {
-      for (Eigen::Index i = 0; i < offset.size(); ++i) offset(i) = -column_dot(data, i, data.loop_residual.data());
-      ldl_solve(data, offset);
+      normal_solve<true>(data, data.loop_residual.data(), offset);
       for (std::size_t j = 0; j < passive.size(); ++j) raw(data.loop_elimination[j]) += offset(static_cast<Eigen::Index>(j));
     }
     data.loop_prediction_size = raw.cwiseAbs().maxCoeff();
@@ -643,18 +691,18 @@ namespace {
 /// machine's internal spring forces of thousands of newtons multiply C's error: Orthoglide).
 template <typename B, typename X>
 void refine(MechanismData& data, const B& b, X&& x) noexcept {
-  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
   Eigen::VectorXd& r = data.loop_constraint_work;
   r = -b;
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-    const double xi = x(i);
-    const double* a = Ap.data() + i * Ap.rows();
-    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-    for (int p = 0; p < data.loop_passive_count(i); ++p) r(rows[p]) -= a[rows[p]] * xi;
+  for (const auto& lb : data.loop_blocks) {
+    const double* a = data.loop_passive_blocks.data() + lb.block;
+    const int* members = data.loop_members.data() + lb.member;
+    for (int c = 0; c < lb.count; ++c, a += lb.rows) {
+      const double xi = x(members[c]);
+      for (int k = 0; k < lb.rows; ++k) r(lb.row + k) -= a[k] * xi;
+    }
   }
   Eigen::VectorXd& step = data.loop_step;
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) step(i) = column_dot(data, i, r.data());
-  ldl_solve(data, step);
+  normal_solve<false>(data, r.data(), step);
   x += step;
 }
 
@@ -719,46 +767,46 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   if (data.loop_rcond < options.singular_rcond) status = Status::singular;
   // C: passive rows -(A°^T A°)^-1 A°^T A#
   // (only the columns of the actuated coordinates that move a loop: C's others are unit vectors)
+  // (A#'s blocks: each loop's rows of the actuated columns that move it)
   const auto& columns = data.loop_actuated_columns;
-  for (std::size_t t = 0; t < columns.size(); ++t) {
-    data.loop_actuated_jacobian.col(static_cast<Eigen::Index>(t)) =
-        data.loop_jacobian.col(actuated[static_cast<std::size_t>(columns[t])]);
+  const Eigen::Index m = data.loop_jacobian.rows();
+  for (const auto& lb : data.loop_blocks) {
+    double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
+    const int* members = data.loop_actuated_members.data() + lb.actuated;
+    for (int t = 0; t < lb.actuated_count; ++t, b += lb.rows) {
+      const int coordinate = actuated[static_cast<std::size_t>(columns[static_cast<std::size_t>(members[t])])];
+      const double* from = data.loop_jacobian.data() + static_cast<Eigen::Index>(coordinate) * m + lb.row;
+      for (int r = 0; r < lb.rows; ++r) b[r] = from[r];
+    }
   }
-  const Eigen::MatrixXd& Ap = data.loop_passive_jacobian;
-  // X = -A°^T A# (each column of A° over its nonzero rows), solved for all columns at once, then
-  // one step of iterative refinement (see refine): R = -A# - A° X, X += (A°^T A°)^-1 A°^T R
+  // X = -A°^T A# (over the loops' blocks), solved for all columns at once, then one step of
+  // iterative refinement (see refine): R = -A# - A° X, X += (A°^T A°)^-1 A°^T R
   MechanismData::RowMajorMatrix& X = data.loop_solution;
-  MechanismData::RowMajorMatrix& R = data.loop_block_residual;
-  MechanismData::RowMajorMatrix& S = data.loop_block_step;
-  const MechanismData::RowMajorMatrix& Aa = data.loop_actuated_jacobian;
   const Eigen::Index w = X.cols();
-  const auto column = [&](Eigen::Index i) { return Ap.data() + i * Ap.rows(); };
-  switch (w) {
-    case 1: passive_transpose_times<1>(data, Aa, X); break;
-    case 2: passive_transpose_times<2>(data, Aa, X); break;
-    case 3: passive_transpose_times<3>(data, Aa, X); break;
-    case 4: passive_transpose_times<4>(data, Aa, X); break;
-    default: passive_transpose_times<0>(data, Aa, X); break;
-  }
+  passive_transpose_actuated(data, X);
   ldl_solve_block(data, X);
   const bool refine_solves = data.loop_rcond < options.refine_rcond;
   if (refine_solves) {
-    R = -Aa;
+    MechanismData::RowMajorMatrix& R = data.loop_block_residual;
+    MechanismData::RowMajorMatrix& S = data.loop_block_step;
+    for (std::size_t t = 0; t < columns.size(); ++t) {
+      R.col(static_cast<Eigen::Index>(t)) = -data.loop_jacobian.col(actuated[static_cast<std::size_t>(columns[t])]);
+    }
     S.setZero();
-    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-      const double* a = column(i);
-      const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-      for (int p = 0; p < data.loop_passive_count(i); ++p) {
-        const int r = rows[p];
-        axpy(R.data() + r * w, -a[r], X.data() + i * w, w);
+    for (const auto& lb : data.loop_blocks) {
+      const double* a = data.loop_passive_blocks.data() + lb.block;
+      const int* members = data.loop_members.data() + lb.member;
+      for (int c = 0; c < lb.count; ++c, a += lb.rows) {
+        const double* x = X.data() + members[c] * w;
+        for (int k = 0; k < lb.rows; ++k) axpy(R.data() + (lb.row + k) * w, -a[k], x, w);
       }
     }
-    for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-      const double* a = column(i);
-      const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-      for (int p = 0; p < data.loop_passive_count(i); ++p) {
-        const int r = rows[p];
-        axpy(S.data() + i * w, a[r], R.data() + r * w, w);
+    for (const auto& lb : data.loop_blocks) {
+      const double* a = data.loop_passive_blocks.data() + lb.block;
+      const int* members = data.loop_members.data() + lb.member;
+      for (int c = 0; c < lb.count; ++c, a += lb.rows) {
+        double* si = S.data() + members[c] * w;
+        for (int k = 0; k < lb.rows; ++k) axpy(si, a[k], R.data() + (lb.row + k) * w, w);
       }
     }
     ldl_solve_block(data, S);
@@ -775,31 +823,31 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   apply_projection(model, data, v_actuated, data.closed_velocity);
   // the loops must accept the actuated velocities (A v = 0); they do not at a serial singularity of
   // the closure or when the actuators over-constrain the mechanism
-  // (A v over A's nonzeros: A°'s in each column's rows, A#'s loop columns; the others are zero)
+  // (A v over A's nonzeros, the loops' blocks of A# and A°; the others are zero)
   // (the largest |entry| per column first: short, independent chains of max)
+  // (row by row over each loop's columns, the sums in registers; the passive velocities in the
+  // elimination order in data.loop_step, free until the bias solve below; A#'s are v#)
   Eigen::VectorXd& Av = data.loop_constraint_work;
+  double* const velocity = data.loop_step.data();
+  for (std::size_t j = 0; j < passive.size(); ++j) velocity[j] = data.closed_velocity(data.loop_elimination[j]);
   double biggest = 0.0;
-  for (Eigen::Index r = 0; r < Aa.rows(); ++r) {
-    double sum = 0.0, row_max = 0.0;
-    for (Eigen::Index t = 0; t < w; ++t) {
-      const double a = Aa(r, t);
-      sum += a * data.closed_velocity(actuated[static_cast<std::size_t>(columns[static_cast<std::size_t>(t)])]);
-      row_max = std::max(row_max, std::abs(a));
+  for (const auto& lb : data.loop_blocks) {
+    const double* a = data.loop_passive_blocks.data() + lb.block;
+    const double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
+    const int* members = data.loop_members.data() + lb.member;
+    const int* actuated_members = data.loop_actuated_members.data() + lb.actuated;
+    for (int k = 0; k < lb.rows; ++k) {
+      double sum = 0.0;
+      for (int t = 0; t < lb.actuated_count; ++t) {
+        sum += b[t * lb.rows + k] * v_actuated(columns[static_cast<std::size_t>(actuated_members[t])]);
+      }
+      for (int c = 0; c < lb.count; ++c) sum += a[c * lb.rows + k] * velocity[members[c]];
+      Av(lb.row + k) = sum;
     }
-    Av(r) = sum;
-    biggest = std::max(biggest, row_max);
   }
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) {
-    const double* a = column(i);
-    const double vi = data.closed_velocity(data.loop_elimination[static_cast<std::size_t>(i)]);
-    const int* rows = data.loop_passive_rows.data() + i * data.loop_passive_rows.rows();
-    double column_max = 0.0;
-    for (int p = 0; p < data.loop_passive_count(i); ++p) {
-      Av(rows[p]) += a[rows[p]] * vi;
-      column_max = std::max(column_max, std::abs(a[rows[p]]));
-    }
-    biggest = std::max(biggest, column_max);
-  }
+  // (over all the blocks at once: A's nonzeros, contiguous)
+  if (data.loop_actuated_blocks.size() > 0) biggest = data.loop_actuated_blocks.cwiseAbs().maxCoeff();
+  if (data.loop_passive_blocks.size() > 0) biggest = std::max(biggest, data.loop_passive_blocks.cwiseAbs().maxCoeff());
   const double scale = 1.0 + biggest * data.closed_velocity.cwiseAbs().maxCoeff();
   if (!(Av.cwiseAbs().maxCoeff() <= 1e-8 * scale)) status = Status::singular;
   if (!acceleration) return finite ? status : status | Status::singular;
@@ -808,8 +856,7 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   // (the links are placed at q: by the solve's last evaluation, or by evaluate above)
   detail::forward_pass<true, false, false, false>(model, data);
   constraint_bias(model, data);
-  for (Eigen::Index i = 0; i < Ap.cols(); ++i) data.loop_step(i) = -column_dot(data, i, data.loop_bias.data());
-  ldl_solve(data, data.loop_step);
+  normal_solve<true>(data, data.loop_bias.data(), data.loop_step);
   data.loop_refine_solution = data.loop_step;
   if (refine_solves) refine(data, data.loop_bias, data.loop_refine_solution);
   for (std::size_t j = 0; j < passive.size(); ++j) {

@@ -548,6 +548,26 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     data.frame_rotation_in_link.push_back(aligned_t * model.frame(f).placement.linear());
     data.frame_position_in_link.push_back(aligned_t * model.frame(f).placement.translation());
   }
+  // where each loop's walks from its frames' links towards the root stop (loop_path_stop): at the
+  // root, or for a planar_point loop at the two frames' deepest common ancestor, whose joint and
+  // those above it move both frames rigidly together and leave its rows (x_A . (p_B - p_A))
+  // unchanged: their columns are zero (computed, they cancel to round-off)
+  data.loop_path_stop.assign(static_cast<std::size_t>(model.num_loops()), 0);
+  for (int i = 0; i < model.num_loops(); ++i) {
+    if (model.loop(i).type != LoopType::planar_point) continue;
+    std::vector<char> above_a(static_cast<std::size_t>(model.num_links()), 0);
+    for (int k = model.frame_link(model.loop_frame_a(i)); k >= 1; k = model.parent(k)) above_a[static_cast<std::size_t>(k)] = 1;
+    int k = model.frame_link(model.loop_frame_b(i));
+    while (k >= 1 && !above_a[static_cast<std::size_t>(k)]) k = model.parent(k);
+    data.loop_path_stop[static_cast<std::size_t>(i)] = std::max(k, 0);
+  }
+  const auto path = [&](int i, int frame) {  // the links whose joints can move loop i's rows
+    std::vector<int> links;
+    for (int k = model.frame_link(frame); k >= 1 && k != data.loop_path_stop[static_cast<std::size_t>(i)]; k = model.parent(k)) {
+      links.push_back(k);
+    }
+    return links;
+  };
   const auto& passive = model.passive_coordinates();
   const auto np = passive.size();
   std::vector<int> slot(static_cast<std::size_t>(model.dof()), -1);  // coordinate -> passive index
@@ -559,7 +579,7 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
   for (int i = 0; i < model.num_loops(); ++i) {
     members.clear();
     for (int frame : {model.loop_frame_a(i), model.loop_frame_b(i)}) {
-      for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) {
+      for (int k : path(i, frame)) {
         const int c = model.coordinate(k);
         if (c >= 0 && slot[static_cast<std::size_t>(c)] >= 0) members.push_back(slot[static_cast<std::size_t>(c)]);
       }
@@ -578,14 +598,13 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     bool in_loop = false;
     for (int l = 0; l < model.num_loops() && !in_loop; ++l) {
       for (int frame : {model.loop_frame_a(l), model.loop_frame_b(l)}) {
-        for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) in_loop = in_loop || model.coordinate(k) == actuated[i];
+        for (int k : path(l, frame)) in_loop = in_loop || model.coordinate(k) == actuated[i];
       }
     }
     if (in_loop) data.loop_actuated_columns.push_back(static_cast<int>(i));
   }
   const auto nla = static_cast<Eigen::Index>(data.loop_actuated_columns.size());
   const Eigen::Index m = model.num_constraints();
-  data.loop_actuated_jacobian = MechanismData::RowMajorMatrix::Zero(m, nla);
   data.loop_block_residual = MechanismData::RowMajorMatrix::Zero(m, nla);
   data.loop_block_step = MechanismData::RowMajorMatrix::Zero(static_cast<Eigen::Index>(np), nla);
   data.loop_solution = MechanismData::RowMajorMatrix::Zero(static_cast<Eigen::Index>(np), nla);
@@ -628,6 +647,22 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     data.loop_factor_rows.insert(data.loop_factor_rows.end(), rows.begin(), rows.end());
     data.loop_factor_start.push_back(static_cast<int>(data.loop_factor_rows.size()));
   }
+  // L's entries row by row
+  data.loop_factor_row_start.assign(np + 1, 0);
+  data.loop_factor_row_entries.assign(data.loop_factor_rows.size(), 0);
+  data.loop_factor_row_columns.assign(data.loop_factor_rows.size(), 0);
+  for (const int r : data.loop_factor_rows) ++data.loop_factor_row_start[static_cast<std::size_t>(r) + 1];
+  for (std::size_t i = 0; i < np; ++i) data.loop_factor_row_start[i + 1] += data.loop_factor_row_start[i];
+  {
+    std::vector<int> fill(data.loop_factor_row_start.begin(), data.loop_factor_row_start.end() - 1);
+    for (std::size_t k = 0; k < np; ++k) {  // (columns in order: each row's entries by increasing column)
+      for (int p = data.loop_factor_start[k]; p < data.loop_factor_start[k + 1]; ++p) {
+        const int at = fill[static_cast<std::size_t>(data.loop_factor_rows[static_cast<std::size_t>(p)])]++;
+        data.loop_factor_row_entries[static_cast<std::size_t>(at)] = p;
+        data.loop_factor_row_columns[static_cast<std::size_t>(at)] = static_cast<int>(k);
+      }
+    }
+  }
   // each loop's passive columns (elimination positions, increasing): N = A°^T A° is the sum over
   // the loops of their rows' small dense products
   data.loop_member_start.assign(1, 0);
@@ -638,7 +673,7 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
   for (int i = 0; i < model.num_loops(); ++i) {
     std::vector<int> own;
     for (int frame : {model.loop_frame_a(i), model.loop_frame_b(i)}) {
-      for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) {
+      for (int k : path(i, frame)) {
         const int c = model.coordinate(k);
         if (c >= 0 && slot[static_cast<std::size_t>(c)] >= 0)
           own.push_back(position[static_cast<std::size_t>(slot[static_cast<std::size_t>(c)])]);
@@ -649,31 +684,110 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     data.loop_members.insert(data.loop_members.end(), own.begin(), own.end());
     data.loop_member_start.push_back(static_cast<int>(data.loop_members.size()));
   }
-  // the rows of A° each passive column can be nonzero in (elimination order): the rows of the
-  // loops whose frames it moves; the factorisation reads A° over these only
-  data.loop_passive_rows.setZero(m, static_cast<Eigen::Index>(np));
-  data.loop_passive_count.setZero(static_cast<Eigen::Index>(np));
-  data.loop_passive_first.setZero(static_cast<Eigen::Index>(np));
-  data.loop_passive_last.setConstant(static_cast<Eigen::Index>(np), -1);
-  for (std::size_t k = 0; k < np; ++k) {
-    const int coordinate = data.loop_elimination[k];
-    const auto j = static_cast<Eigen::Index>(k);
-    int count = 0;
-    for (int i = 0; i < model.num_loops(); ++i) {
+  // each loop's slice of A (loop_blocks): its rows over its passive columns (A°'s structural
+  // nonzeros: a passive column is nonzero in the rows of the loops whose joints it moves) and over
+  // the actuated columns that move it (A#'s)
+  data.loop_blocks.clear();
+  data.loop_actuated_members.clear();
+  int passive_size = 0, actuated_size = 0;
+  for (int i = 0; i < model.num_loops(); ++i) {
+    const auto li = static_cast<std::size_t>(i);
+    MechanismData::LoopBlockInfo info;
+    info.row = data.loop_row_start[li];
+    info.rows = data.loop_row_start[li + 1] - info.row;
+    info.member = data.loop_member_start[li];
+    info.count = data.loop_member_start[li + 1] - info.member;
+    info.block = passive_size;
+    passive_size += info.rows * info.count;
+    info.actuated = static_cast<int>(data.loop_actuated_members.size());
+    for (std::size_t t = 0; t < data.loop_actuated_columns.size(); ++t) {
+      const int coordinate = actuated[static_cast<std::size_t>(data.loop_actuated_columns[t])];
       bool moves = false;
       for (int frame : {model.loop_frame_a(i), model.loop_frame_b(i)}) {
-        for (int l = model.frame_link(frame); l >= 1; l = model.parent(l)) moves = moves || model.coordinate(l) == coordinate;
+        for (int k : path(i, frame)) moves = moves || model.coordinate(k) == coordinate;
       }
-      if (!moves) continue;
-      const int end = i + 1 < model.num_loops() ? model.loop_row(i + 1) : model.num_constraints();
-      for (int r = model.loop_row(i); r < end; ++r) data.loop_passive_rows(count++, j) = r;
+      if (moves) data.loop_actuated_members.push_back(static_cast<int>(t));
     }
-    data.loop_passive_count(j) = count;
-    if (count > 0) {
-      data.loop_passive_first(j) = data.loop_passive_rows(0, j);
-      data.loop_passive_last(j) = data.loop_passive_rows(count - 1, j);
+    info.actuated_count = static_cast<int>(data.loop_actuated_members.size()) - info.actuated;
+    info.actuated_block = actuated_size;
+    actuated_size += info.rows * info.actuated_count;
+    data.loop_blocks.push_back(info);
+  }
+  data.loop_member_first.assign(data.loop_members.size(), 0);
+  data.loop_loose_columns.clear();
+  {
+    std::vector<char> seen(np, 0);
+    for (std::size_t e = 0; e < data.loop_members.size(); ++e) {
+      const auto j = static_cast<std::size_t>(data.loop_members[e]);
+      data.loop_member_first[e] = seen[j] ? 0 : 1;
+      seen[j] = 1;
+    }
+    for (std::size_t j = 0; j < np; ++j) {
+      if (!seen[j]) data.loop_loose_columns.push_back(static_cast<int>(j));
     }
   }
+  data.loop_passive_blocks = Eigen::VectorXd::Zero(passive_size);
+  data.loop_actuated_blocks = Eigen::VectorXd::Zero(actuated_size);
+  // the numeric LDL^T as straight lists: N's (and L's) entries in loop_factor_values (the np
+  // pivots, then L's entries in loop_factor_rows' order); where each loop's products of its
+  // columns add into N, and where each column's elimination updates the columns after it
+  const auto entry = [&](int column, int row) {  // (row, column) of N's lower triangle
+    if (row == column) return column;
+    const auto first = data.loop_factor_rows.begin() + data.loop_factor_start[static_cast<std::size_t>(column)];
+    const auto last = data.loop_factor_rows.begin() + data.loop_factor_start[static_cast<std::size_t>(column) + 1];
+    const auto at = std::lower_bound(first, last, row);
+    if (at == last || *at != row) throw std::logic_error("loop factor structure: missing fill entry");
+    return static_cast<int>(np) + static_cast<int>(at - data.loop_factor_rows.begin());
+  };
+  const auto nvalues = static_cast<Eigen::Index>(np + data.loop_factor_rows.size());
+  data.loop_factor_values = Eigen::VectorXd::Zero(nvalues);
+  data.loop_factor_values.head(static_cast<Eigen::Index>(np)).setOnes();  // N = I until the first factorisation
+  data.loop_pivot_inverse = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(np));
+  // (an entry's first product is stored, ~target, the others added: N needs no clearing but of
+  // the entries no product reaches, fill, loop_factor_clear)
+  data.loop_normal_targets.clear();
+  std::vector<char> reached(static_cast<std::size_t>(nvalues), 0);
+  for (int i = 0; i < model.num_loops(); ++i) {
+    const int begin = data.loop_member_start[static_cast<std::size_t>(i)];
+    const int end = data.loop_member_start[static_cast<std::size_t>(i) + 1];
+    const int rows = data.loop_blocks[static_cast<std::size_t>(i)].rows;
+    for (int a = begin; a < end; ++a) {
+      for (int b = a; b < end; ++b) {
+        const int t = entry(data.loop_members[static_cast<std::size_t>(a)], data.loop_members[static_cast<std::size_t>(b)]);
+        data.loop_normal_targets.push_back(reached[static_cast<std::size_t>(t)] ? t : ~t);
+        data.loop_normal_targets.push_back((a - begin) * rows);
+        data.loop_normal_targets.push_back((b - begin) * rows);
+        reached[static_cast<std::size_t>(t)] = 1;
+      }
+    }
+  }
+  data.loop_factor_clear.clear();
+  for (Eigen::Index t = 0; t < nvalues; ++t) {
+    if (!reached[static_cast<std::size_t>(t)]) data.loop_factor_clear.push_back(static_cast<int>(t));
+  }
+  // the factorisation's products l_jk u_ik (pairs of L's entries in column k: j's scaled, i's
+  // not), grouped by the entry (pivot or entry of L) they are subtracted from
+  {
+    std::vector<std::vector<int>> sums(static_cast<std::size_t>(nvalues));
+    for (std::size_t k = 0; k < np; ++k) {
+      const int begin = data.loop_factor_start[k], end = data.loop_factor_start[k + 1];
+      for (int p = begin; p < end; ++p) {
+        for (int r = p; r < end; ++r) {
+          auto& list = sums[static_cast<std::size_t>(entry(data.loop_factor_rows[static_cast<std::size_t>(p)],
+                                                          data.loop_factor_rows[static_cast<std::size_t>(r)]))];
+          list.push_back(p);
+          list.push_back(r);
+        }
+      }
+    }
+    data.loop_factor_updates.clear();
+    data.loop_factor_update_start.assign(1, 0);
+    for (const auto& list : sums) {
+      data.loop_factor_updates.insert(data.loop_factor_updates.end(), list.begin(), list.end());
+      data.loop_factor_update_start.push_back(static_cast<int>(data.loop_factor_updates.size() / 2));
+    }
+  }
+  data.loop_factor_unscaled = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(data.loop_factor_rows.size()));
 }
 
 }  // namespace
@@ -748,18 +862,10 @@ MechanismData::MechanismData(const MechanismModel& model)
   actuated_gravity = Eigen::VectorXd::Zero(na);
   actuated_static_torque = Eigen::VectorXd::Zero(na);
   actuated_acceleration = Eigen::VectorXd::Zero(na);
-  loop_passive_jacobian = Eigen::MatrixXd::Zero(m, np);
-  loop_actuated_jacobian = RowMajorMatrix::Zero(m, na);
   loop_block_residual = RowMajorMatrix::Zero(m, na);
   loop_block_step = RowMajorMatrix::Zero(np, na);
   loop_constraint_work = Eigen::VectorXd::Zero(m);
   loop_refine_solution = Eigen::VectorXd::Zero(np);
-  loop_normal = Eigen::MatrixXd::Identity(np, np);
-  loop_passive_first = Eigen::VectorXi::Zero(np);
-  loop_passive_last = Eigen::VectorXi::Zero(np);
-  loop_passive_rows = Eigen::MatrixXi::Zero(m, np);
-  loop_passive_count = Eigen::VectorXi::Zero(np);
-  loop_normal_pivots = Eigen::VectorXd::Ones(np);
   loop_step = Eigen::VectorXd::Zero(np);
   loop_trial = Eigen::VectorXd::Zero(dof);
   loop_solution = RowMajorMatrix::Zero(np, na);

@@ -122,21 +122,15 @@ struct MechanismData {
   Eigen::VectorXd actuated_acceleration;   ///< a# of the forward dynamics (na)
   Eigen::MatrixXd reduced_mass_matrix;     ///< C^T M C (na x na)
   // scratch of the loop algorithms
-  Eigen::MatrixXd loop_passive_jacobian;   ///< A° (m x np)
   using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   /// The actuated coordinates (indices into model.actuated_coordinates()) that move a loop frame,
   /// fixed at construction: only their columns of C need a solve (the others are unit vectors)
   std::vector<int> loop_actuated_columns;
-  RowMajorMatrix loop_actuated_jacobian;   ///< A#'s loop_actuated_columns (m x nla), row-major: the solves run over all columns at once
-  RowMajorMatrix loop_block_residual;      ///< m x nla
+  RowMajorMatrix loop_block_residual;      ///< m x nla (the refinement's -A# - A° X over loop_actuated_columns)
   RowMajorMatrix loop_block_step;          ///< np x nla
   Eigen::VectorXd loop_constraint_work;    ///< m
   Eigen::VectorXd loop_refine_solution;    ///< np
   Eigen::LDLT<Eigen::MatrixXd> reduced_ldlt;  ///< of C^T M C (na x na)
-  Eigen::MatrixXd loop_normal;             ///< A°^T A° + damping (np x np)
-  Eigen::VectorXi loop_passive_first, loop_passive_last;  ///< rows of A° holding each column's nonzeros (np)
-  Eigen::MatrixXi loop_passive_rows;  ///< m x np: column j lists the rows of A°'s nonzeros in column j
-  Eigen::VectorXi loop_passive_count; ///< np: how many (the rest of loop_passive_rows' column is unused)
   /// The passive coordinates in the elimination order of N = A°^T A° (a minimum-degree ordering of
   /// the loops' structure, fixed at construction: PAMINSA's legs before the platform they share, so
   /// that the factor keeps the legs' blocks apart); A°'s columns, the Newton step and the solution
@@ -145,15 +139,52 @@ struct MechanismData {
   /// Structure of L in N = L D L^T: the rows (elimination positions, increasing) that column k may
   /// fill are loop_factor_rows[loop_factor_start[k] .. loop_factor_start[k + 1]).
   std::vector<int> loop_factor_start, loop_factor_rows;
+  /// The same entries row by row (for the forward solve): row i's are loop_factor_row_entries
+  /// [loop_factor_row_start[i] .. loop_factor_row_start[i + 1]) (indices into L's entries), in
+  /// the columns loop_factor_row_columns (increasing).
+  std::vector<int> loop_factor_row_start, loop_factor_row_entries, loop_factor_row_columns;
   /// The passive columns (elimination positions, increasing) each loop's rows involve:
   /// loop_members[loop_member_start[i] .. loop_member_start[i + 1]) for loop i.
   std::vector<int> loop_member_start, loop_members;
   std::vector<int> loop_row_start;  ///< loop i's rows: loop_row_start[i] .. loop_row_start[i + 1]
+  /// Loop i's Jacobian columns are those of the joints from its frames' links up to (not
+  /// including) the link loop_path_stop[i]: 0 (the root), or for a planar_point loop the frames'
+  /// deepest common ancestor (the joints from it up move both frames together: zero columns).
+  std::vector<int> loop_path_stop;
+  /// Each loop's slice of A, fixed at construction: its rows (row .. row + rows), its passive
+  /// columns (loop_members[member .. member + count]: elimination positions, increasing) with
+  /// their block of A° (loop_passive_blocks from `block`: rows x count, column-major; A°'s
+  /// structural nonzeros), and the columns of A# that move it (loop_actuated_members[actuated ..
+  /// actuated + actuated_count]: indices into loop_actuated_columns) with their block
+  /// (loop_actuated_blocks from `actuated_block`, the same layout).
+  struct LoopBlockInfo {
+    int row = 0, rows = 0, member = 0, count = 0, block = 0, actuated = 0, actuated_count = 0, actuated_block = 0;
+  };
+  std::vector<LoopBlockInfo> loop_blocks;
+  std::vector<int> loop_actuated_members;
+  /// Per entry of loop_members: 1 where the column appears for the first time (in loop order);
+  /// the passive columns in no loop (A°'s zero columns).
+  std::vector<char> loop_member_first;
+  std::vector<int> loop_loose_columns;
+  Eigen::VectorXd loop_passive_blocks, loop_actuated_blocks;
+  /// N = A°^T A° + damping, then its factors N = L D L^T: the np pivots (D after the
+  /// factorisation), then the entries of L's columns in loop_factor_rows' order (np + nnz(L)).
+  Eigen::VectorXd loop_factor_values;
+  Eigen::VectorXd loop_pivot_inverse;  ///< 1 / D, 0 where a pivot is not positive (np)
+  /// Symbolic factorisation (construction), as flat lists:
+  /// - loop_normal_targets: per loop, its column pairs a <= b in order, three ints each: the entry
+  ///   of loop_factor_values their product adds into (~entry for the entry's first product, which
+  ///   is stored instead), the offsets of columns a and b in the loop's block;
+  /// - loop_factor_updates: per entry e of loop_factor_values (pivot or entry of L, from
+  ///   loop_factor_update_start[e]), the pairs (p, r) of L's entries in an earlier column whose
+  ///   products l_p u_r it is reduced by (l: scaled by the pivot, u: loop_factor_unscaled);
+  /// - loop_factor_clear: the entries no product of the assembly reaches (fill), cleared first.
+  std::vector<int> loop_normal_targets, loop_factor_updates, loop_factor_update_start, loop_factor_clear;
+  Eigen::VectorXd loop_factor_unscaled;  ///< L's entries before the division by their pivot (nnz)
   /// Each named frame in its link's joint-aligned frame L (model.hpp): the loop equations place the
   /// closure frames with one product each.
   std::vector<Mat3> frame_rotation_in_link;
   std::vector<Vec3> frame_position_in_link;
-  Eigen::VectorXd loop_normal_pivots;      ///< D of N = L D L^T (L in loop_normal's lower triangle) (np)
   Eigen::VectorXd loop_step, loop_trial;   ///< np, n
   RowMajorMatrix loop_solution;            ///< np x nla (elimination order)
   Eigen::MatrixXd loop_reduced_work;       ///< n x na
