@@ -91,6 +91,15 @@ Vec3 mass_moment(const MechanismModel& model, const MechanismData& data) noexcep
 /// Momenta about O of all links, from a forward pass with velocities, and with Wrenches their
 /// rates: the sum of every link's Newton-Euler wrench (moment about its origin n_o, so about O:
 /// n_o + p x f). One sweep over the links for both (each sum in link order).
+/// Link l's momentum (linear, angular about O) from its velocities in L_l, added to P and H.
+inline void add_link_momentum(const MechanismModel::LinkConstants& c, const MechanismData::LinkWork& W, Vec3& P, Vec3& H) noexcept {
+  const Vec3 p_local = c.mass * W.vel + W.w.cross(c.first_moment);
+  const Vec3 h_local = c.inertia_origin * W.w + c.first_moment.cross(W.vel);
+  const Vec3 p_world = W.world_rotation * p_local;
+  P += p_world;
+  H += W.world_rotation * h_local + W.world_position.cross(p_world);
+}
+
 /// Momenta = false: the wrenches only (data.shaking's momenta left as they were).
 template <bool Wrenches, bool Momenta = true>
 void sum_links(const MechanismModel& model, MechanismData& data) noexcept {
@@ -98,13 +107,7 @@ void sum_links(const MechanismModel& model, MechanismData& data) noexcept {
   for (int l = 1; l < model.num_links(); ++l) {
     const auto& c = model.link_constants(l);
     const auto& W = data.work[static_cast<std::size_t>(l)];
-    if (Momenta) {
-      const Vec3 p_local = c.mass * W.vel + W.w.cross(c.first_moment);
-      const Vec3 h_local = c.inertia_origin * W.w + c.first_moment.cross(W.vel);
-      const Vec3 p_world = W.world_rotation * p_local;
-      P += p_world;
-      H += W.world_rotation * h_local + W.world_position.cross(p_world);
-    }
+    if (Momenta) add_link_momentum(c, W, P, H);
     if (Wrenches) {
       const Vec3 f = W.world_rotation * W.force;
       F += f;
@@ -282,13 +285,7 @@ MECHBAL_FLATTEN void detail::velocity_momentum(const MechanismModel& model, Mech
     const int l = whole ? i + 1 : links.links[static_cast<std::size_t>(i)];
     detail::set_link_velocity(model, data, l);
     const int in = links.member[static_cast<std::size_t>(l)] ? 1 : 0;
-    const auto& c = model.link_constants(l);
-    const auto& W = data.work[static_cast<std::size_t>(l)];
-    const Vec3 p_local = c.mass * W.vel + W.w.cross(c.first_moment);
-    const Vec3 h_local = c.inertia_origin * W.w + c.first_moment.cross(W.vel);
-    const Vec3 p_world = W.world_rotation * p_local;
-    P[in] += p_world;
-    H[in] += W.world_rotation * h_local + W.world_position.cross(p_world);
+    add_link_momentum(model.link_constants(l), data.work[static_cast<std::size_t>(l)], P[in], H[in]);
   }
   inside << P[1], H[1];
   if (whole) rest << P[0], H[0];

@@ -394,13 +394,7 @@ Status ReactionlessController::task_momentum(bool whole) noexcept {
     detail::joint_state<true, false>(*model_, data_, q_full_, vt_full_, vt_full_);
     if (!closed_) detail::place(*model_, data_);
   } else {
-    for (const int l : subtree_.links) {
-      const auto k = static_cast<std::size_t>(l);
-      const int c = model_->coordinate(l);
-      const double r = model_->coordinate_ratio(l);
-      data_.joint_position[k] = c < 0 ? 0.0 : r * q_full_(c) + model_->coordinate_offset(l);
-      data_.joint_velocity[k] = c < 0 ? 0.0 : r * vt_full_(c);
-    }
+    detail::joint_state<true, false, true>(*model_, data_, q_full_, vt_full_, vt_full_, &subtree_);
     detail::place<true, detail::NoVisit, true>(*model_, data_, detail::NoVisit{}, &subtree_);
   }
   Vec6 inside;

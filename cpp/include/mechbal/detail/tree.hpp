@@ -89,13 +89,15 @@ inline Status check_state(const MechanismModel& model, const MechanismData& data
 }
 
 /// Joint position, velocity, acceleration of every link from the independent coordinates.
-template <bool Velocity, bool Acceleration>
+/// With Subset, `only` (not null) restricts it to its links (as place).
+template <bool Velocity, bool Acceleration, bool Subset = false>
 inline void joint_state(const MechanismModel& model, MechanismData& data,
                         const Eigen::Ref<const Eigen::VectorXd>& q,
                         const Eigen::Ref<const Eigen::VectorXd>& v,
-                        const Eigen::Ref<const Eigen::VectorXd>& a) noexcept {
-  const int nl = model.num_links();
-  for (int l = 1; l < nl; ++l) {
+                        const Eigen::Ref<const Eigen::VectorXd>& a, const LinkSubset* only = nullptr) noexcept {
+  const int count = Subset ? static_cast<int>(only->links.size()) : model.num_links() - 1;
+  for (int i = 0; i < count; ++i) {
+    const int l = Subset ? only->links[static_cast<std::size_t>(i)] : i + 1;
     const auto k = static_cast<std::size_t>(l);
     const int c = model.coordinate(l);
     if (c < 0) {
