@@ -3,7 +3,10 @@
 
 #include <cmath>
 
+#include "../../bench/paminsa_general.hpp"
 #include "alloc_counter.hpp"
+#include "mechbal/algorithm/loops.hpp"
+#include "paminsa_motion.hpp"
 #include "mechbal/papers/arm2dof/arm2dof.hpp"
 #include "mechbal/control/computed_torque.hpp"
 #include "mechbal/control/decoupled_control.hpp"
@@ -111,5 +114,22 @@ TEST(Allocations, RejectionAndSingularPathsAllocateNothing) {
     EXPECT_EQ(pc.tick(fast, fast, fast), Status::out_of_range);
     EXPECT_EQ(pc.tick(far, far, far), Status::singular);
   }
+  EXPECT_EQ(scope.count(), 0u);
+}
+
+// The general PAMINSA tick (closed_shaking_wrench: position solve, projection, shaking wrench of
+// the closed motion), at 1 kHz and after jumps of 50 ms (Newton iterates): no allocation.
+TEST(Allocations, ClosedShakingWrenchAllocatesNothing) {
+  const PaminsaModel closed(PaminsaParameters{});
+  const MechanismModel model(bench::paminsa_description(closed));
+  MechanismData data(model);
+  Eigen::VectorXd q = bench::initial_guess(closed, model, test::platform_at(0.0), test::wrist_at(0.0));
+  std::vector<bench::ActuatedState> in;
+  for (int k = 0; k < 60; ++k) {
+    const double t = k < 30 ? 1e-3 * k : 0.05 * k;
+    in.push_back(bench::actuated(closed, model, test::platform_at(t), test::wrist_at(t)));
+  }
+  test::AllocationScope scope;
+  for (const auto& s : in) EXPECT_EQ(closed_shaking_wrench(model, data, s.q, s.v, s.a, q), Status::ok);
   EXPECT_EQ(scope.count(), 0u);
 }

@@ -12,8 +12,14 @@
 #include <string>
 #include <vector>
 
+#include <random>
+
+#include "../../bench/paminsa_general.hpp"
 #include "alloc_counter.hpp"
 #include "mechbal/algorithm/loops.hpp"
+#include "mechbal/algorithm/shaking_wrench.hpp"
+#include "paminsa_motion.hpp"
+#include "test_support.hpp"
 
 using namespace mechbal;
 
@@ -380,8 +386,109 @@ TEST(Loops, TicksAllocateNothing) {
       EXPECT_EQ(closed_forward_dynamics(model, data, qa, va, tau, q), Status::ok) << c.name;
       EXPECT_EQ(closed_motion(model, data, qa, va, aa, q, refined), Status::ok) << c.name;
       EXPECT_EQ(closed_velocity_motion(model, data, qa, va, q), Status::ok) << c.name;
+      EXPECT_EQ(closed_shaking_wrench(model, data, qa, va, aa, q), Status::ok) << c.name;
     }
     EXPECT_EQ(scope.count(), 0u) << c.name;
+  }
+}
+
+namespace {
+
+/// |x - y| relative to max(1, |y|)
+double relative(const Vec3& x, const Vec3& y) { return (x - y).norm() / std::max(1.0, y.norm()); }
+
+/// closed_shaking_wrench against closed_motion + shaking_wrench, each on its own data from the
+/// same warm start, over `ticks` ticks of the motion `at(k, qa, va, aa)`: the same q to the last
+/// bit (the same solve), the same momenta and wrench to round-off; returns the largest
+/// relative difference of the four.
+template <class Motion>
+double fused_against_separate(const MechanismModel& model, const Eigen::VectorXd& guess, int ticks, Motion&& at) {
+  MechanismData fused(model), separate(model);
+  const int na = model.num_actuated();
+  Eigen::VectorXd q_fused = guess, q_separate = guess, qa(na), va(na), aa(na);
+  double worst = 0.0;
+  for (int k = 0; k < ticks; ++k) {
+    at(k, qa, va, aa);
+    EXPECT_EQ(closed_shaking_wrench(model, fused, qa, va, aa, q_fused), Status::ok) << "tick " << k;
+    EXPECT_EQ(closed_motion(model, separate, qa, va, aa, q_separate), Status::ok) << "tick " << k;
+    EXPECT_EQ(shaking_wrench(model, separate, separate.closed_position, separate.closed_velocity,
+                             separate.closed_acceleration),
+              Status::ok);
+    EXPECT_TRUE((q_fused.array() == q_separate.array()).all()) << "tick " << k;
+    EXPECT_TRUE((fused.closed_acceleration.array() == separate.closed_acceleration.array()).all()) << "tick " << k;
+    const ShakingWrench &f = fused.shaking, &s = separate.shaking;
+    // (an assertion that can fail: the wrench is not zero)
+    EXPECT_GT(s.force.norm() + s.moment.norm(), 1e-3) << "tick " << k;
+    worst = std::max({worst, relative(f.force, s.force), relative(f.moment, s.moment),
+                      relative(f.linear_momentum, s.linear_momentum),
+                      relative(f.angular_momentum, s.angular_momentum)});
+  }
+  return worst;
+}
+
+/// four_bar_with_arm with random bodies (test_support.hpp) and its wrist link massless (the
+/// tool, below it, carries mass: the accelerations pass through a link the sums skip).
+MechanismModel random_four_bar_with_arm(std::mt19937& rng) {
+  MechanismDescription d = four_bar_with_arm().description();
+  std::vector<Body> bodies;
+  for (const Body& b : d.bodies) {
+    if (b.link == "wrist") continue;
+    const RigidBody r = test::random_body(rng);
+    std::uniform_real_distribution<double> u(-0.1, 0.1);
+    Body out = b;
+    out.mass = r.mass;
+    out.com = Vec3(u(rng), u(rng), u(rng));
+    out.inertia = r.inertia_body;
+    bodies.push_back(out);
+  }
+  d.bodies = bodies;
+  return MechanismModel(d);
+}
+
+}  // namespace
+
+TEST(Loops, ClosedShakingWrenchIsClosedMotionThenShakingWrench) {
+  // every test mechanism (point, planar_point and axis loops, two actuators, a turntable, an arm
+  // and a slide outside the loop), and the arm with random bodies and a massless link
+  std::mt19937 rng(7);
+  std::vector<Case> all = cases();
+  {
+    MechanismModel model = random_four_bar_with_arm(rng);
+    EXPECT_FALSE(model.has_inertia(model.link_index("wrist")));
+    EXPECT_EQ(static_cast<int>(model.inertial_links().size()), model.num_links() - 2);
+    all.push_back(Case{"random_four_bar_with_arm", std::move(model), all.back().guess, all.back().qa});
+  }
+  for (const auto& c : all) {
+    const double worst = fused_against_separate(c.model, c.guess, 40, [&](int k, Eigen::VectorXd& qa, Eigen::VectorXd& va,
+                                                                          Eigen::VectorXd& aa) {
+      const double t = 1e-3 * k;
+      for (Eigen::Index i = 0; i < qa.size(); ++i) {
+        const double w = 2.0 + 0.7 * static_cast<double>(i);
+        qa(i) = c.qa(i) + 0.3 * std::sin(w * t);
+        va(i) = 0.3 * w * std::cos(w * t) + 0.5;
+        aa(i) = -0.3 * w * w * std::sin(w * t) - 1.0;
+      }
+    });
+    EXPECT_LT(worst, 1e-12) << c.name;
+  }
+}
+
+TEST(Loops, ClosedShakingWrenchOnPaminsa) {
+  // PAMINSA as a general model (31 moving links, 9 loops, massless stages): along the bench's
+  // motion at 1 kHz, and with jumps of 20 ms (Newton iterates)
+  const PaminsaModel closed{PaminsaParameters{}};
+  const MechanismModel model(bench::paminsa_description(closed));
+  EXPECT_LT(static_cast<int>(model.inertial_links().size()), model.num_links() - 1);  // massless links
+  const Eigen::VectorXd guess = bench::initial_guess(closed, model, test::platform_at(0.0), test::wrist_at(0.0));
+  for (const double dt : {1e-3, 2e-2}) {
+    const double worst = fused_against_separate(model, guess, 30, [&](int k, Eigen::VectorXd& qa, Eigen::VectorXd& va,
+                                                                      Eigen::VectorXd& aa) {
+      const bench::ActuatedState s = bench::actuated(closed, model, test::platform_at(k * dt), test::wrist_at(k * dt));
+      qa = s.q;
+      va = s.v;
+      aa = s.a;
+    });
+    EXPECT_LT(worst, 1e-12) << "dt " << dt;
   }
 }
 

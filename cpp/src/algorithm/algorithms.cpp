@@ -104,7 +104,8 @@ inline void add_link_momentum(const MechanismModel::LinkConstants& c, const Mech
 template <bool Wrenches, bool Momenta = true>
 void sum_links(const MechanismModel& model, MechanismData& data) noexcept {
   Vec3 P = Vec3::Zero(), H = Vec3::Zero(), F = Vec3::Zero(), M = Vec3::Zero();
-  for (int l = 1; l < model.num_links(); ++l) {
+  // (the links with mass or inertia only: the others' terms are zeros)
+  for (const int l : model.inertial_links()) {
     const auto& c = model.link_constants(l);
     const auto& W = data.work[static_cast<std::size_t>(l)];
     if (Momenta) add_link_momentum(c, W, P, H);

@@ -10,6 +10,7 @@
 
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
+#include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/detail/tree.hpp"
 
 namespace mechbal {
@@ -852,7 +853,16 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   if (!(Av.cwiseAbs().maxCoeff() <= 1e-8 * scale)) status = Status::singular;
   if (!acceleration) return finite ? status : status | Status::singular;
   // gamma at (q, v), then c = [0; -(A°^T A°)^-1 A°^T gamma]
-  detail::joint_state<true, false>(model, data, q, data.closed_velocity, data.closed_velocity);
+  // (the joints' rates only: their positions are q's already, from the last evaluation; the
+  // velocity pass below reads no joint acceleration)
+  {
+    const double* v = data.closed_velocity.data();
+    const int nl = model.num_links();
+    for (int l = 1; l < nl; ++l) {
+      const int c = model.coordinate(l);
+      data.joint_velocity[static_cast<std::size_t>(l)] = c < 0 ? 0.0 : model.coordinate_ratio(l) * v[c];
+    }
+  }
   // (the links are placed at q: by the solve's last evaluation, or by evaluate above)
   detail::forward_pass<true, false, false, false>(model, data);
   constraint_bias(model, data);
@@ -884,6 +894,96 @@ Status closed_motion(const MechanismModel& model, MechanismData& data, const Con
   status |= project(model, data, q, v_actuated, options, true);
   data.closed_acceleration = data.loop_acceleration_bias;
   apply_projection(model, data, a_actuated, data.closed_acceleration, true);
+  return status;
+}
+
+namespace {
+
+/// The shaking wrench of the closed motion, after project (closed model: the links placed at q in
+/// O, the joints' rates those of closed_velocity, and every link's velocities and its accelerations
+/// at a = 0 from the bias pass). The wrench is linear in a: the rates of the momenta are those at
+/// a = 0 plus A(q) a, so the bias pass's motion needs only a's part added, propagated down the
+/// tree with no velocity terms (the acceleration field of a alone: alpha_a, acc_a, in
+/// data.loop_acceleration_field); each link's Newton-Euler wrench and momentum are then formed
+/// from the totals and summed about O in the same sweep. work[].alpha and acc end as the total
+/// accelerations and data.joint_acceleration as a's (as shaking_wrench leaves them); work[].force
+/// and moment are not written. Equal to shaking_wrench at (q, v, a) to round-off.
+MECHBAL_FLATTEN void closed_wrench_of_projected(const MechanismModel& model, MechanismData& data) noexcept {
+  const double* a = data.closed_acceleration.data();
+  Vec3* field = data.loop_acceleration_field.data();
+  field[0].setZero();
+  field[1].setZero();
+  Vec3 P = Vec3::Zero(), H = Vec3::Zero(), F = Vec3::Zero(), M = Vec3::Zero();
+  const int nl = model.num_links();
+  for (int l = 1; l < nl; ++l) {
+    const auto k = static_cast<std::size_t>(l);
+    auto& W = data.work[k];
+    const auto parent = static_cast<std::size_t>(model.parent(l));
+    const Vec3& parent_angular = field[2 * parent];
+    const Vec3& parent_linear = field[2 * parent + 1];
+    Vec3 angular, linear;
+    angular.noalias() = W.rotation.transpose() * parent_angular;
+    linear.noalias() = W.rotation.transpose() * (parent_linear + parent_angular.cross(W.translation));
+    const int c = model.coordinate(l);
+    const double qdd = c >= 0 ? model.coordinate_ratio(l) * a[c] : 0.0;
+    data.joint_acceleration[k] = qdd;
+    switch (model.joint_type(l)) {
+      case JointType::revolute:
+        angular.z() += qdd;
+        break;
+      case JointType::prismatic:
+        linear.z() += qdd;
+        break;
+      case JointType::fixed:
+        break;
+    }
+    field[2 * k] = angular;
+    field[2 * k + 1] = linear;
+    W.alpha += angular;
+    W.acc += linear;
+    if (!model.has_inertia(l)) continue;  // adds nothing to the sums
+    const auto& cst = model.link_constants(l);
+    const Vec3& h = cst.first_moment;
+    const Vec3 Iw = cst.inertia_origin * W.w;
+    const Vec3 force = cst.mass * W.acc + W.alpha.cross(h) + W.w.cross(W.w.cross(h));
+    Vec3 moment;
+    moment.noalias() = cst.inertia_origin * W.alpha;
+    moment += h.cross(W.acc) + W.w.cross(Iw);
+    const Vec3 p_local = cst.mass * W.vel + W.w.cross(h);
+    const Vec3 h_local = Iw + h.cross(W.vel);
+    const Mat3& R = W.world_rotation;
+    const Vec3& o = W.world_position;
+    const Vec3 f = R * force, p = R * p_local;
+    F += f;
+    M += R * moment + o.cross(f);
+    P += p;
+    H += R * h_local + o.cross(p);
+  }
+  data.shaking.linear_momentum = P;
+  data.shaking.angular_momentum = H;
+  data.shaking.force = F;
+  data.shaking.moment = M;
+}
+
+}  // namespace
+
+Status closed_shaking_wrench(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                             const ConstVector& v_actuated, const ConstVector& a_actuated,
+                             Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
+  Status status = closed_motion(model, data, q_actuated, v_actuated, a_actuated, q, options);
+  if (has(status, Status::solver_error) || has(status, Status::bad_size) || has(status, Status::non_finite_input) ||
+      has(status, Status::out_of_range)) {
+    return status;
+  }
+  if (!model.is_closed()) {  // no bias pass to build on (project does none for an open model)
+    return status | shaking_wrench(model, data, data.closed_position, data.closed_velocity, data.closed_acceleration);
+  }
+  closed_wrench_of_projected(model, data);
+  const ShakingWrench& w = data.shaking;
+  if (!detail::all_finite(w.linear_momentum) || !detail::all_finite(w.angular_momentum) ||
+      !detail::all_finite(w.force) || !detail::all_finite(w.moment)) {
+    status |= Status::out_of_range;
+  }
   return status;
 }
 

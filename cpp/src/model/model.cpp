@@ -361,6 +361,15 @@ MechanismModel::MechanismModel(MechanismDescription d) {
     c.first_moment += m * com;
     c.inertia_origin += I + m * (com.squaredNorm() * Mat3::Identity() - com * com.transpose());
   }
+  has_inertia_.assign(nl, 0);
+  inertial_links_.clear();
+  for (std::size_t l = 1; l < nl; ++l) {
+    const LinkConstants& c = constants_[l];
+    if (c.mass != 0.0 || !c.first_moment.isZero(0.0) || !c.inertia_origin.isZero(0.0)) {
+      has_inertia_[l] = 1;
+      inertial_links_.push_back(static_cast<int>(l));
+    }
+  }
 
   // ---- springs ----
   std::map<std::string, std::size_t> spring_names;
@@ -874,6 +883,7 @@ MechanismData::MechanismData(const MechanismModel& model)
   loop_prediction_error_old = Eigen::VectorXd::Zero(dof);
   loop_prediction_offset = Eigen::VectorXd::Zero(np);
   loop_prediction_origin = Eigen::VectorXd::Constant(dof, std::numeric_limits<double>::quiet_NaN());
+  if (model.is_closed()) loop_acceleration_field.assign(2 * nl, Vec3::Zero());
   loop_factor_structure(model, *this);
 }
 

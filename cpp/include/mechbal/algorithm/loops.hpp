@@ -72,6 +72,17 @@ Status closed_motion(const MechanismModel& model, MechanismData& data, const Con
                      const ConstVector& v_actuated, const ConstVector& a_actuated, Eigen::Ref<Eigen::VectorXd> q,
                      const LoopSolveOptions& options = {}) noexcept;
 
+/// closed_motion and the shaking wrench of its motion (data.shaking: momenta about O and their
+/// rates, as shaking_wrench(model, data, data.closed_position, data.closed_velocity,
+/// data.closed_acceleration) gives them, to round-off), in one: the wrench is linear in the
+/// accelerations, so the projection's pass over the links' velocities (which gamma needs) also
+/// gives the momenta and the rates at a = 0, and one pass of the accelerations' own part, with no
+/// velocity terms, completes them (not a second Newton-Euler pass over the whole motion).
+/// Status as closed_motion's, plus Status::out_of_range for a non-finite wrench.
+Status closed_shaking_wrench(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                             const ConstVector& v_actuated, const ConstVector& a_actuated,
+                             Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options = {}) noexcept;
+
 /// closed_motion up to the velocities: positions solved (q in/out), data.loop_projection (C),
 /// data.closed_position and data.closed_velocity = C v#, without the acceleration level (no
 /// gamma, no c: the pass over the links' velocities and its solve are skipped). For callers that

@@ -199,6 +199,10 @@ struct MechanismData {
   int loop_prediction_depth = 0;
   Eigen::VectorXd loop_prediction_offset;  ///< np: a Newton step from the last solution, when it took none
   bool loop_prediction_offset_valid = false;
+  /// closed_shaking_wrench's field of the accelerations' actuated-and-passive part (loops.cpp):
+  /// per link, the angular then the origin acceleration (in L_i) that a alone gives, with no
+  /// velocity (2 per link; a closed model only).
+  std::vector<Vec3> loop_acceleration_field;
 
   // ---- internal buffers (per link, in the joint-aligned frames L_i of model.hpp) ----
   // Field order: what one pass touches sits together (the placement, relative and in O, then the

@@ -237,6 +237,12 @@ class MechanismModel {
     Mat3 aligned;          ///< A_i: F_i -> L_i rotation with A_i e_z = axis (identity when fixed)
   };
   const LinkConstants& link_constants(int link) const noexcept { return constants_[static_cast<std::size_t>(link)]; }
+  /// The moving links (1 .. num_links - 1, in order) that carry mass or inertia: a link without
+  /// either (a massless intermediate link: a prismatic stage, a gimbal's first axis) adds nothing
+  /// to a momentum or a wrench sum, which then visit these only.
+  const std::vector<int>& inertial_links() const noexcept { return inertial_links_; }
+  /// Whether link `link` carries mass or inertia (inertial_links' membership).
+  bool has_inertia(int link) const noexcept { return has_inertia_[static_cast<std::size_t>(link)] != 0; }
 
  private:
   MechanismDescription description_;
@@ -254,6 +260,8 @@ class MechanismModel {
   Eigen::VectorXd lower_, upper_, velocity_limit_, effort_limit_;
   std::vector<Body> bodies_;
   std::vector<int> body_link_;
+  std::vector<int> inertial_links_;
+  std::vector<unsigned char> has_inertia_;
   std::vector<Frame> frames_;
   std::vector<int> frame_link_;
   std::vector<LinkConstants, detail::LargeBufferAllocator<LinkConstants>> constants_;
