@@ -297,9 +297,11 @@ inline void axpy(double* y, double a, const double* x, Eigen::Index n) noexcept 
   for (Eigen::Index j = 0; j < count; ++j) y[j] += a * x[j];
 }
 
-/// ldl_solve_block with w = W columns (0: X.cols()), unrolled for the usual one to four.
-template <int W>
-void ldl_solve_block_width(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
+/// ldl_solve_block with w = W columns (0: X.cols()), unrolled for the usual one to four; with
+/// Extra (W > 0), the vector y (np) is solved in the same pass over L (its sums beside X's).
+template <int W, bool Extra = false>
+void ldl_solve_block_width(const MechanismData& data, MechanismData::RowMajorMatrix& X, double* y = nullptr) noexcept {
+  static_assert(W > 0 || !Extra, "the extra right-hand side needs a fixed width");
   const auto np = static_cast<int>(data.loop_elimination.size());
   const double* const L = data.loop_factor_values.data() + np;  // (after the pivots)
   const int* rows = data.loop_factor_rows.data();
@@ -314,8 +316,14 @@ void ldl_solve_block_width(const MechanismData& data, MechanismData::RowMajorMat
     double* xi = x + i * w;
     if (W > 0) {
       double sum[W > 0 ? W : 1] = {};
-      for (int e = row_start[i]; e < row_start[i + 1]; ++e) axpy<W>(sum, L[row_entries[e]], x + row_columns[e] * w, w);
+      double extra = 0.0;
+      for (int e = row_start[i]; e < row_start[i + 1]; ++e) {
+        const double l = L[row_entries[e]];
+        axpy<W>(sum, l, x + row_columns[e] * w, w);
+        if (Extra) extra += l * y[row_columns[e]];
+      }
       for (Eigen::Index j = 0; j < w; ++j) xi[j] -= sum[j];
+      if (Extra) y[i] -= extra;
     } else {
       for (int e = row_start[i]; e < row_start[i + 1]; ++e) axpy<W>(xi, -L[row_entries[e]], x + row_columns[e] * w, w);
     }
@@ -325,8 +333,13 @@ void ldl_solve_block_width(const MechanismData& data, MechanismData::RowMajorMat
     const double inv = data.loop_pivot_inverse(k);
     if (W > 0) {
       double sum[W > 0 ? W : 1] = {};
-      for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(sum, L[p], x + rows[p] * w, w);
+      double extra = 0.0;
+      for (int p = start[k]; p < start[k + 1]; ++p) {
+        axpy<W>(sum, L[p], x + rows[p] * w, w);
+        if (Extra) extra += L[p] * y[rows[p]];
+      }
       for (Eigen::Index j = 0; j < w; ++j) xk[j] = xk[j] * inv - sum[j];
+      if (Extra) y[k] = y[k] * inv - extra;
     } else {
       for (Eigen::Index j = 0; j < w; ++j) xk[j] *= inv;
       for (int p = start[k]; p < start[k + 1]; ++p) axpy<W>(xk, -L[p], x + rows[p] * w, w);
@@ -335,8 +348,18 @@ void ldl_solve_block_width(const MechanismData& data, MechanismData::RowMajorMat
 }
 
 /// X = (L D L^T)^-1 X for a block of right-hand sides (np x na, row-major): one pass over L for
-/// all of them (the columns of C).
-void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
+/// all of them (the columns of C); and y = (L D L^T)^-1 y when `y` is given (in the same pass for
+/// up to three columns of X).
+void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X,
+                     Eigen::VectorXd* y = nullptr) noexcept {
+  if (y) {
+    switch (X.cols()) {
+      case 1: return ldl_solve_block_width<1, true>(data, X, y->data());
+      case 2: return ldl_solve_block_width<2, true>(data, X, y->data());
+      case 3: return ldl_solve_block_width<3, true>(data, X, y->data());
+      default: ldl_solve(data, *y); break;
+    }
+  }
   switch (X.cols()) {
     case 1: return ldl_solve_block_width<1>(data, X);
     case 2: return ldl_solve_block_width<2>(data, X);
@@ -372,7 +395,7 @@ void passive_transpose_actuated(const MechanismData& data, MechanismData::RowMaj
 /// A° x = -y) from the factors, A°^T y over A°'s blocks (a column's first product stored, the
 /// others added: data.loop_member_first; the columns in no loop are zero).
 template <bool Negate>
-void normal_solve(const MechanismData& data, const double* y, Eigen::VectorXd& out) noexcept {
+void normal_rhs(const MechanismData& data, const double* y, Eigen::VectorXd& out) noexcept {
   double* o = out.data();
   for (const int j : data.loop_loose_columns) o[j] = 0.0;
   const char* first = data.loop_member_first.data();
@@ -391,7 +414,24 @@ void normal_solve(const MechanismData& data, const double* y, Eigen::VectorXd& o
       }
     }
   }
+}
+
+template <bool Negate>
+void normal_solve(const MechanismData& data, const double* y, Eigen::VectorXd& out) noexcept {
+  normal_rhs<Negate>(data, y, out);
   ldl_solve(data, out);
+}
+
+/// The warm start's last step once data.loop_prediction_offset is solved: the recorded prediction
+/// error moves to the estimated exact solution (solve_positions).
+void finish_prediction_offset(const MechanismModel& model, MechanismData& data) noexcept {
+  const auto& passive = model.passive_coordinates();
+  Eigen::VectorXd& raw = data.loop_prediction_error;
+  for (std::size_t j = 0; j < passive.size(); ++j) {
+    raw(data.loop_elimination[j]) += data.loop_prediction_offset(static_cast<Eigen::Index>(j));
+  }
+  data.loop_prediction_size = raw.cwiseAbs().maxCoeff();
+  data.loop_prediction_offset_pending = false;
 }
 
 /// Relative damping of the normal equations: keeps the solves bounded at a singular A° (Status::singular).
@@ -487,8 +527,16 @@ Status loop_constraints(const MechanismModel& model, MechanismData& data, const 
 namespace {
 
 /// solve_loop_positions after its input checks (the closed_* functions check once).
+/// `defer_offset`: the warm start's Newton step from the solution (data.loop_prediction_offset,
+/// for the next tick) is left as its right-hand side, data.loop_prediction_offset_pending set:
+/// project, which always follows, solves it in its pass over the factors for C.
 Status solve_positions(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
-                       Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
+                       Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options,
+                       bool defer_offset = false) noexcept {
+  if (data.loop_prediction_offset_pending) {  // (not reached: project follows every deferral)
+    ldl_solve(data, data.loop_prediction_offset);
+    finish_prediction_offset(model, data);
+  }
   const auto& actuated = model.actuated_coordinates();
   const auto& passive = model.passive_coordinates();
   Eigen::VectorXd& trial = data.loop_trial;
@@ -663,11 +711,15 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
     // estimates the exact solution, which the error and the next prediction then start from
     Eigen::VectorXd& offset = data.loop_prediction_offset;
     data.loop_prediction_offset_valid = data.loop_iterations == 0 && norm > 0.0 && !passive.empty();
-    if (data.loop_prediction_offset_valid) {
+    if (data.loop_prediction_offset_valid && defer_offset) {
+      normal_rhs<true>(data, data.loop_residual.data(), offset);
+      data.loop_prediction_offset_pending = true;  // project solves it and finishes the record
+    } else if (data.loop_prediction_offset_valid) {
       normal_solve<true>(data, data.loop_residual.data(), offset);
-      for (std::size_t j = 0; j < passive.size(); ++j) raw(data.loop_elimination[j]) += offset(static_cast<Eigen::Index>(j));
+      finish_prediction_offset(model, data);
+    } else {
+      data.loop_prediction_size = raw.cwiseAbs().maxCoeff();
     }
-    data.loop_prediction_size = raw.cwiseAbs().maxCoeff();
     data.loop_prediction_origin = trial;
     data.loop_prediction_step_old = data.loop_prediction_step;
     data.loop_prediction_step = s;
@@ -785,7 +837,12 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   MechanismData::RowMajorMatrix& X = data.loop_solution;
   const Eigen::Index w = X.cols();
   passive_transpose_actuated(data, X);
-  ldl_solve_block(data, X);
+  if (data.loop_prediction_offset_pending) {  // (solve_positions' deferred step, at the same factors)
+    ldl_solve_block(data, X, &data.loop_prediction_offset);
+    finish_prediction_offset(model, data);
+  } else {
+    ldl_solve_block(data, X);
+  }
   const bool refine_solves = data.loop_rcond < options.refine_rcond;
   if (refine_solves) {
     MechanismData::RowMajorMatrix& R = data.loop_block_residual;
@@ -888,7 +945,7 @@ Status closed_motion(const MechanismModel& model, MechanismData& data, const Con
                      const ConstVector& v_actuated, const ConstVector& a_actuated, Eigen::Ref<Eigen::VectorXd> q,
                      const LoopSolveOptions& options) noexcept {
   if (Status s = check(model, data, q, &q_actuated, &v_actuated, &a_actuated); s != Status::ok) return s;
-  Status status = solve_positions(model, data, q_actuated, q, options);
+  Status status = solve_positions(model, data, q_actuated, q, options, true);
   if (has(status, Status::solver_error)) return status;
   data.closed_position = q;
   status |= project(model, data, q, v_actuated, options, true);
@@ -991,7 +1048,7 @@ Status closed_velocity_motion(const MechanismModel& model, MechanismData& data, 
                               const ConstVector& v_actuated, Eigen::Ref<Eigen::VectorXd> q,
                               const LoopSolveOptions& options) noexcept {
   if (Status s = check(model, data, q, &q_actuated, &v_actuated); s != Status::ok) return s;
-  Status status = solve_positions(model, data, q_actuated, q, options);
+  Status status = solve_positions(model, data, q_actuated, q, options, true);
   if (has(status, Status::solver_error)) return status;
   data.closed_position = q;
   return status | project(model, data, q, v_actuated, options, true, false);
@@ -1013,7 +1070,7 @@ Status closed_inverse_dynamics(const MechanismModel& model, MechanismData& data,
 Status closed_mass_matrix(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
                           Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
   if (Status s = check(model, data, q, &q_actuated); s != Status::ok) return s;
-  Status status = solve_positions(model, data, q_actuated, q, options);
+  Status status = solve_positions(model, data, q_actuated, q, options, true);
   if (has(status, Status::solver_error)) return status;
   data.closed_position = q;
   data.actuated_force.setZero();  // v# = 0 for the projection only
@@ -1033,7 +1090,7 @@ Status closed_forward_dynamics(const MechanismModel& model, MechanismData& data,
                                const ConstVector& v_actuated, const ConstVector& tau_actuated,
                                Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
   if (Status s = check(model, data, q, &q_actuated, &v_actuated, &tau_actuated); s != Status::ok) return s;
-  Status status = solve_positions(model, data, q_actuated, q, options);
+  Status status = solve_positions(model, data, q_actuated, q, options, true);
   if (has(status, Status::solver_error)) return status;
   data.closed_position = q;
   status |= project(model, data, q, v_actuated, options, true);

@@ -199,6 +199,9 @@ struct MechanismData {
   int loop_prediction_depth = 0;
   Eigen::VectorXd loop_prediction_offset;  ///< np: a Newton step from the last solution, when it took none
   bool loop_prediction_offset_valid = false;
+  /// loop_prediction_offset holds the step's right-hand side, not the step yet (loops.cpp: solved
+  /// with C's columns by the projection that follows the solve)
+  bool loop_prediction_offset_pending = false;
   /// closed_shaking_wrench's field of the accelerations' actuated-and-passive part (loops.cpp):
   /// per link, the angular then the origin acceleration (in L_i) that a alone gives, with no
   /// velocity (2 per link; a closed model only).
