@@ -17,7 +17,10 @@
 #include "../../bench/paminsa_general.hpp"
 #include "alloc_counter.hpp"
 #include "mechbal/algorithm/loops.hpp"
+#include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/detail/placed.hpp"
+#include "mechbal/detail/tree.hpp"
 #include "paminsa_motion.hpp"
 #include "test_support.hpp"
 
@@ -358,6 +361,95 @@ TEST(Loops, VelocityMotionIsClosedMotionWithoutAccelerations) {
       velocity.loop_acceleration_bias = full.loop_acceleration_bias;
     }
   }
+}
+
+TEST(Loops, AccelerationBiasFromAMomentumPassIsClosedMotions) {
+  // closed_velocity_motion, then a momentum pass with the links' accelerations at a = 0
+  // (velocity_momentum, as a controller's) and detail::loop_acceleration_bias_placed: the same c
+  // as closed_motion's own bias pass, refined or not
+  LoopSolveOptions refined;
+  refined.refine_rcond = 1.0;
+  for (const LoopSolveOptions& options : {LoopSolveOptions{}, refined}) {
+    for (const auto& c : cases()) {
+      const MechanismModel& model = c.model;
+      MechanismData full(model), split(model);
+      const int na = model.num_actuated();
+      Eigen::VectorXd q_full = c.guess, q_split = c.guess, qa = c.qa, va(na), aa = Eigen::VectorXd::Zero(na);
+      detail::LinkSubset none;
+      none.member.assign(static_cast<std::size_t>(model.num_links()), 0);
+      detail::Vec6 inside, rest;
+      for (int k = 0; k < 10; ++k) {
+        qa.setConstant(0.3 * std::sin(0.05 * k));
+        qa += c.qa;
+        va.setConstant(0.5 * std::cos(0.05 * k));
+        ASSERT_EQ(closed_motion(model, full, qa, va, aa, q_full, options), Status::ok) << c.name;
+        ASSERT_EQ(closed_velocity_motion(model, split, qa, va, q_split, options), Status::ok) << c.name;
+        detail::joint_state<true, false>(model, split, q_split, split.closed_velocity, split.closed_velocity);
+        detail::velocity_momentum(model, split, none, true, inside, rest, true);
+        ASSERT_EQ(detail::loop_acceleration_bias_placed(model, split, options), Status::ok) << c.name;
+        const double scale = 1.0 + full.loop_acceleration_bias.cwiseAbs().maxCoeff();
+        EXPECT_LT((split.loop_acceleration_bias - full.loop_acceleration_bias).cwiseAbs().maxCoeff(), 1e-13 * scale)
+            << c.name << " tick " << k;
+        EXPECT_GT(full.loop_acceleration_bias.cwiseAbs().maxCoeff(), 0.0) << c.name;  // not trivially zero
+        // and the momentum of the pass is the mechanism's
+        ASSERT_EQ(momentum(model, full, q_full, full.closed_velocity), Status::ok);
+        const detail::Vec6 h = inside + rest;
+        EXPECT_LT((h.head<3>() - full.shaking.linear_momentum).cwiseAbs().maxCoeff(), 1e-12) << c.name;
+        EXPECT_LT((h.tail<3>() - full.shaking.angular_momentum).cwiseAbs().maxCoeff(), 1e-12) << c.name;
+      }
+    }
+  }
+}
+
+TEST(Loops, ActuatorsOutsideTheLoopsLeaveTheWarmStartAlone) {
+  // The four-bar carrying an actuated arm and slide, which move no loop frame: a tick that moves
+  // them too solves the loop from the same warm start (history included) as one that does not,
+  // so the loop's coordinates come out the same to the last bit, and the warm start keeps
+  // closing the loop at its prediction. Also when they are moved between the solves in q and in
+  // data.closed_position (what a reactionless controller does when it turns its balancing joints
+  // at a pose whose loops are solved)
+  const MechanismModel model = four_bar_with_arm();
+  MechanismData still(model), moving(model);
+  const int na = model.num_actuated();
+  Eigen::VectorXd guess = Eigen::VectorXd::Zero(model.dof()), qa(na), va(na), aa = Eigen::VectorXd::Zero(na);
+  const std::map<std::string, double> near{{"crank", 1.0}, {"coupler", -0.6}, {"rocker", 1.75},
+                                           {"wrist", 0.5}, {"tool", -0.8}, {"slide", 0.05}};
+  for (int c = 0; c < model.dof(); ++c) guess(c) = near.at(model.coordinate_name(c));
+  Eigen::VectorXd q_still = guess, q_moving = guess;
+  int crank = -1;
+  for (int i = 0; i < na; ++i) {
+    if (model.coordinate_name(model.actuated_coordinates()[static_cast<std::size_t>(i)]) == "crank") crank = i;
+  }
+  ASSERT_GE(crank, 0);
+  int closed_at_prediction = 0;
+  const int ticks = 200;
+  for (int k = 0; k < ticks; ++k) {
+    const double t = 1e-3 * k;
+    for (int i = 0; i < na; ++i) {
+      const int c = model.actuated_coordinates()[static_cast<std::size_t>(i)];
+      qa(i) = guess(c);
+      va(i) = 0.0;
+    }
+    qa(crank) = 1.0 + 0.4 * std::sin(2.0 * t);
+    va(crank) = 0.8 * std::cos(2.0 * t);
+    ASSERT_EQ(closed_motion(model, still, qa, va, aa, q_still), Status::ok) << k;
+    for (int i = 0; i < na; ++i) {  // the arm and the slide wander
+      if (i == crank) continue;
+      qa(i) += 0.3 * std::sin(7.0 * t + i);
+      va(i) = 2.1 * std::cos(7.0 * t + i);
+    }
+    ASSERT_EQ(closed_motion(model, moving, qa, va, aa, q_moving), Status::ok) << k;
+    for (int i = 0; i < na; ++i) {
+      if (i == crank) continue;
+      const int c = model.actuated_coordinates()[static_cast<std::size_t>(i)];
+      q_moving(c) += 0.01;
+      moving.closed_position(c) = q_moving(c);
+    }
+    for (const int c : model.passive_coordinates()) EXPECT_EQ(q_moving(c), q_still(c)) << "tick " << k;
+    EXPECT_EQ(moving.loop_iterations, still.loop_iterations) << "tick " << k;
+    if (k >= 10 && moving.loop_iterations == 0) ++closed_at_prediction;
+  }
+  EXPECT_GT(closed_at_prediction, (ticks - 10) / 2);
 }
 
 TEST(Loops, TicksAllocateNothing) {

@@ -275,21 +275,39 @@ inline void add_column_term(const MechanismModel& model, const MechanismData::Li
 
 }  // namespace
 
-MECHBAL_FLATTEN void detail::velocity_momentum(const MechanismModel& model, MechanismData& data,
-                                               const LinkSubset& links, bool whole, Vec6& inside,
-                                               Vec6& rest) noexcept {
+namespace {
+
+template <bool Accelerations>
+MECHBAL_FLATTEN void velocity_momentum_pass(const MechanismModel& model, MechanismData& data,
+                                            const detail::LinkSubset& links, bool whole, detail::Vec6& inside,
+                                            detail::Vec6& rest) noexcept {
   data.work[0].w.setZero();
   data.work[0].vel.setZero();
+  if (Accelerations) {
+    data.work[0].acc.setZero();
+    data.work[0].alpha.setZero();
+  }
   Vec3 P[2] = {Vec3::Zero(), Vec3::Zero()}, H[2] = {Vec3::Zero(), Vec3::Zero()};
   const int count = whole ? model.num_links() - 1 : static_cast<int>(links.links.size());
   for (int i = 0; i < count; ++i) {
     const int l = whole ? i + 1 : links.links[static_cast<std::size_t>(i)];
-    detail::set_link_velocity(model, data, l);
+    detail::forward_link<true, false, false, true, Accelerations>(model, data, l);
     const int in = links.member[static_cast<std::size_t>(l)] ? 1 : 0;
     add_link_momentum(model.link_constants(l), data.work[static_cast<std::size_t>(l)], P[in], H[in]);
   }
   inside << P[1], H[1];
   if (whole) rest << P[0], H[0];
+}
+
+}  // namespace
+
+void detail::velocity_momentum(const MechanismModel& model, MechanismData& data, const LinkSubset& links,
+                               bool whole, Vec6& inside, Vec6& rest, bool accelerations) noexcept {
+  if (accelerations && whole) {
+    velocity_momentum_pass<true>(model, data, links, whole, inside, rest);
+  } else {
+    velocity_momentum_pass<false>(model, data, links, whole, inside, rest);
+  }
 }
 
 MECHBAL_FLATTEN void detail::momentum_columns_placed(const MechanismModel& model, MechanismData& data,

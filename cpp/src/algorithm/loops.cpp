@@ -11,6 +11,7 @@
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/detail/placed.hpp"
 #include "mechbal/detail/tree.hpp"
 
 namespace mechbal {
@@ -550,13 +551,20 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
   // exceed options.max_step.
   const bool tangent = model.is_closed() && q == data.closed_position;
   double vv = 0.0, dv = 0.0;
-  bool moved = false;  // the actuators moved since q (a solve at the same q# from its solution returns it)
   for (std::size_t i = 0; i < actuated.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
-    const double step = q_actuated(k) - q(actuated[i]), rate = data.closed_velocity(actuated[i]);
-    moved = moved || step != 0.0;
-    if (tangent) trial.noalias() += data.loop_projection.col(k) * step;
+    if (tangent) trial.noalias() += data.loop_projection.col(k) * (q_actuated(k) - q(actuated[i]));
     trial(actuated[i]) = q_actuated(k);
+  }
+  // the path parameter and the history over the loops' own coordinates: the actuated coordinates
+  // that move no loop (a wrist carried by a parallel mechanism) change neither the solution nor c,
+  // which is quadratic in the loops' rates alone, so their moves keep the warm start's history
+  bool moved = false;  // the loops' actuators moved since q (a solve at the same q# from its solution returns it)
+  for (const int i : data.loop_actuated_columns) {
+    const auto k = static_cast<Eigen::Index>(i);
+    const int c = actuated[static_cast<std::size_t>(i)];
+    const double step = q_actuated(k) - q(c), rate = data.closed_velocity(c);
+    moved = moved || step != 0.0;
     vv += rate * rate;
     dv += step * rate;
   }
@@ -570,7 +578,14 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
   Eigen::VectorXd& older = data.loop_prediction_error_old;
   double s = 0.0;
   bool record = false;
-  const bool history = tangent && q == data.loop_prediction_origin;
+  bool history = tangent;  // q is the solution the last error was recorded at, in the loops' coordinates
+  for (std::size_t j = 0; j < passive.size() && history; ++j) {
+    history = q(passive[j]) == data.loop_prediction_origin(passive[j]);
+  }
+  for (std::size_t t = 0; t < data.loop_actuated_columns.size() && history; ++t) {
+    const int c = actuated[static_cast<std::size_t>(data.loop_actuated_columns[t])];
+    history = q(c) == data.loop_prediction_origin(c);
+  }
   if (tangent && vv > 0.0) {
     s = dv / vv;
     trial.noalias() += (0.5 * s * s) * data.loop_acceleration_bias;  // zero on the actuated rows
@@ -607,9 +622,8 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
     for (std::size_t i = 0; i < actuated.size(); ++i) trial(actuated[i]) = q_actuated(static_cast<Eigen::Index>(i));
     record = false;
   }
-  if (!record && data.loop_prediction_origin.size() > 0) {
-    data.loop_prediction_origin(0) = std::numeric_limits<double>::quiet_NaN();
-  }
+  // (forgotten whole: the history compares the loops' coordinates only)
+  if (!record) data.loop_prediction_origin.setConstant(std::numeric_limits<double>::quiet_NaN());
   data.loop_iterations = 0;
   if (!model.is_closed()) {
     data.loop_residual_norm = 0.0;
@@ -700,7 +714,7 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
   }
   data.loop_rcond = passive.empty() ? 1.0 : factor_passive(data);
   if (!(norm <= options.tolerance)) {
-    if (data.loop_prediction_origin.size() > 0) data.loop_prediction_origin(0) = std::numeric_limits<double>::quiet_NaN();
+    data.loop_prediction_origin.setConstant(std::numeric_limits<double>::quiet_NaN());
     return Status::solver_error;
   }
   q = trial;
@@ -795,6 +809,21 @@ void apply_projection_transpose(const MechanismModel& model, const MechanismData
     }
     out(columns[static_cast<std::size_t>(t)]) += sum;
   }
+}
+
+/// c = [0; -(A°^T A°)^-1 A°^T gamma] into data.loop_acceleration_bias (its passive rows; the
+/// actuated ones stay zero) from gamma = dA/dt v, the loops' bias from the link accelerations at
+/// a = 0 in data.work, with the factorisation of A° at the placed q; false when c is not finite.
+bool acceleration_bias(const MechanismModel& model, MechanismData& data, bool refine_solves) noexcept {
+  constraint_bias(model, data);
+  normal_solve<true>(data, data.loop_bias.data(), data.loop_step);
+  data.loop_refine_solution = data.loop_step;
+  if (refine_solves) refine(data, data.loop_bias, data.loop_refine_solution);
+  const auto& passive = model.passive_coordinates();
+  for (std::size_t j = 0; j < passive.size(); ++j) {
+    data.loop_acceleration_bias(data.loop_elimination[j]) = data.loop_refine_solution(static_cast<Eigen::Index>(j));
+  }
+  return detail::all_finite(data.loop_acceleration_bias);
 }
 
 /// loop_projection at q (checked); `solved`: q is where solve_loop_positions just converged, so
@@ -909,7 +938,7 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   const double scale = 1.0 + biggest * data.closed_velocity.cwiseAbs().maxCoeff();
   if (!(Av.cwiseAbs().maxCoeff() <= 1e-8 * scale)) status = Status::singular;
   if (!acceleration) return finite ? status : status | Status::singular;
-  // gamma at (q, v), then c = [0; -(A°^T A°)^-1 A°^T gamma]
+  // gamma at (q, v), then c
   // (the joints' rates only: their positions are q's already, from the last evaluation; the
   // velocity pass below reads no joint acceleration)
   {
@@ -922,14 +951,7 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   }
   // (the links are placed at q: by the solve's last evaluation, or by evaluate above)
   detail::forward_pass<true, false, false, false>(model, data);
-  constraint_bias(model, data);
-  normal_solve<true>(data, data.loop_bias.data(), data.loop_step);
-  data.loop_refine_solution = data.loop_step;
-  if (refine_solves) refine(data, data.loop_bias, data.loop_refine_solution);
-  for (std::size_t j = 0; j < passive.size(); ++j) {
-    data.loop_acceleration_bias(data.loop_elimination[j]) = data.loop_refine_solution(static_cast<Eigen::Index>(j));
-  }
-  if (!finite || !data.loop_acceleration_bias.allFinite()) return status | Status::singular;
+  if (!acceleration_bias(model, data, refine_solves) || !finite) return status | Status::singular;
   return status;
 }
 
@@ -1052,6 +1074,12 @@ Status closed_velocity_motion(const MechanismModel& model, MechanismData& data, 
   if (has(status, Status::solver_error)) return status;
   data.closed_position = q;
   return status | project(model, data, q, v_actuated, options, true, false);
+}
+
+Status detail::loop_acceleration_bias_placed(const MechanismModel& model, MechanismData& data,
+                                             const LoopSolveOptions& options) noexcept {
+  if (!model.is_closed()) return Status::ok;
+  return acceleration_bias(model, data, data.loop_rcond < options.refine_rcond) ? Status::ok : Status::singular;
 }
 
 Status closed_inverse_dynamics(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,

@@ -351,8 +351,10 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
   Status st = Status::ok;
   if (closed_) {
     // positions (warm-started from the last solve), C and c (c with the current velocity guess)
-    st = acceleration ? closed_motion(*model_, data_, q_act_, v_act_, a_act_, q_full_, config_.loop_options)
-                      : closed_velocity_motion(*model_, data_, q_act_, v_act_, q_full_, config_.loop_options);
+    // (without balancing joints in the loops, c comes from task_momentum's pass below)
+    st = acceleration && balancing_in_loops_
+             ? closed_motion(*model_, data_, q_act_, v_act_, a_act_, q_full_, config_.loop_options)
+             : closed_velocity_motion(*model_, data_, q_act_, v_act_, q_full_, config_.loop_options);
     if (failed(st)) return st;
     if (balancing_in_loops_) {
       // C [v_t; 0]: the balancing joints' columns of C reach passive coordinates
@@ -370,7 +372,7 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
     vt_full_ = v_act_;  // an open model's coordinates are its actuated ones, in order
     for (const int c : balancing_coord_) vt_full_(c) = 0.0;
   }
-  if (!balancing_in_loops_) return st | task_momentum(true);
+  if (!balancing_in_loops_) return st | task_momentum(true, closed_);
   // the solve left the links placed at its solution q_full_: no second placement
   const Status sm = detail::momentum_matrix_placed(*model_, data_);
   if (sm != Status::ok) return st | sm;
@@ -385,7 +387,7 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
   return st;
 }
 
-Status ReactionlessController::task_momentum(bool whole) noexcept {
+Status ReactionlessController::task_momentum(bool whole, bool bias) noexcept {
   // the task's motion alone (vt_full_) on the links placed at q_full_. The links outside the
   // balancing subtrees move alike whatever the balancing joints do: after rebalance() (`whole`
   // false) their placements, velocities and momentum (rest_) are the last whole pass's, and only
@@ -398,11 +400,15 @@ Status ReactionlessController::task_momentum(bool whole) noexcept {
     detail::place<true, detail::NoVisit, true>(*model_, data_, detail::NoVisit{}, &subtree_);
   }
   Vec6 inside;
-  detail::velocity_momentum(*model_, data_, subtree_, whole, inside, rest_);
+  detail::velocity_momentum(*model_, data_, subtree_, whole, inside, rest_, bias && whole);
+  // c from the links on the loops' paths, which the balancing joints do not move: their
+  // velocities and accelerations are those of the whole motion
+  Status st = Status::ok;
+  if (bias && whole) st = detail::loop_acceleration_bias_placed(*model_, data_, config_.loop_options);
   ht_ = rest_ + inside;
   detail::momentum_columns_placed(*model_, data_, subtree_, balancing_coord_, Ab_);
   for (int i = 0; i < k_; ++i) Kb_.row(i) = Ab_.row(rows_[static_cast<std::size_t>(i)]);
-  return detail::all_finite(ht_) && detail::all_finite(Ab_) ? Status::ok : Status::out_of_range;
+  return detail::all_finite(ht_) && detail::all_finite(Ab_) ? st : Status::out_of_range;
 }
 
 Status ReactionlessController::rebalance(const Eigen::VectorXd& q_b) noexcept {

@@ -200,7 +200,11 @@ class ReactionlessController {
   /// The momentum matrix A and the loop projection C at actuated positions (q_t, q_b) (loops
   /// solved into q_full_); v_act_: actuated velocities (its task entries: the task's rates). Fills
   /// Kb_ and ht_ (task_momentum). With `acceleration`, also the loops' acceleration bias c (the
-  /// feed-forward at t_n needs it; an RK4 stage that only needs the rates not).
+  /// feed-forward at t_n needs it; an RK4 stage that only needs the rates not). When no balancing
+  /// joint moves a loop, c is computed at every evaluation whatever `acceleration` says: the
+  /// momentum pass gives the link accelerations it needs for the velocity products alone, and
+  /// the next loop solve's warm start predicts from it (from t_n + dt/2 to t_n + dt, a stale c
+  /// costs a Newton step).
   Status evaluate(const Eigen::Ref<const Eigen::VectorXd>& q_t, const Eigen::VectorXd& q_b,
                   bool acceleration = true) noexcept;
   /// evaluate() at the same task positions with other balancing positions, for a closed
@@ -212,7 +216,9 @@ class ReactionlessController {
   /// at q_full_. `whole` false: only the balancing subtrees moved since the last whole one (the
   /// other links' velocities and momentum rest_ are kept). The full A and K = A C are never formed:
   /// K's task columns enter only through K_t v_t, and K_t a_t through the shaking wrench.
-  Status task_momentum(bool whole) noexcept;
+  /// `bias` (with `whole`): the same pass also gives the links' accelerations at a = 0, and from
+  /// them the loops' acceleration bias c (after a velocity-level loop solve at q_full_).
+  Status task_momentum(bool whole, bool bias = false) noexcept;
   /// Factorise S K_b (damping when cond > max_condition); then solve() applies the operator.
   /// `condition`: where the condition number is reported (null: only the decision is needed, and
   /// a cheap bound settles it when it can).

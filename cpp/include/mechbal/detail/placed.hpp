@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mechbal/detail/link_subset.hpp"
+#include "mechbal/algorithm/loops.hpp"
 #include "mechbal/model/data.hpp"
 #include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
@@ -28,9 +29,20 @@ void momentum_columns_placed(const MechanismModel& model, MechanismData& data, c
 /// pass's) and their momenta (linear; angular about O), summed over `links` into `inside` and,
 /// with `whole`, over the others into `rest`. Without `whole`, only `links` are moved and summed
 /// (`rest` untouched): their parents outside must have current velocities (an earlier whole pass
-/// at the same placements and rates).
+/// at the same placements and rates). With `accelerations` (and `whole`), also every link's
+/// accelerations at a = 0 (work[].acc and alpha: the velocity products alone, as a
+/// forward_pass<true, false, false, false>), which loop_acceleration_bias_placed needs.
 void velocity_momentum(const MechanismModel& model, MechanismData& data, const LinkSubset& links, bool whole,
-                       Vec6& inside, Vec6& rest) noexcept;
+                       Vec6& inside, Vec6& rest, bool accelerations = false) noexcept;
+/// The loops' acceleration bias c (data.loop_acceleration_bias: a = C a# + c) at the placed q
+/// from the link accelerations at a = 0 that a pass with velocities left in data.work (at least
+/// on the links of the loops' paths: forward_pass<true, false, false, false> or
+/// velocity_momentum with `accelerations`), with the velocity projection computed at the same q
+/// (closed_velocity_motion just before: its factorisation of A° is reused). What closed_motion
+/// computes after closed_velocity_motion's work. Status::singular when c is not finite; nothing
+/// for an open model (c = 0).
+Status loop_acceleration_bias_placed(const MechanismModel& model, MechanismData& data,
+                                     const LoopSolveOptions& options) noexcept;
 /// shaking_wrench(q, v, a) at the placed q (q: the coordinates the links are placed at).
 /// `momenta` false: the force and moment only (data.shaking's momenta are left as they were).
 Status shaking_wrench_placed(const MechanismModel& model, MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,

@@ -197,6 +197,70 @@ inline Mat3 rotate_symmetric(const Mat3& R, const Mat3& S) noexcept {
   return out;
 }
 
+/// One link's step of the forward pass (see forward_pass) from its parent's motion: velocity,
+/// acceleration in its own L frame and, when Forces, its net wrench. Rates = false: the velocities
+/// alone (w and, with OriginVelocity, vel), acc and alpha left as they were (the momenta need
+/// nothing more).
+template <bool Velocity, bool Acceleration, bool Forces, bool OriginVelocity = true, bool Rates = true>
+inline void forward_link(const MechanismModel& model, MechanismData& data, int l) noexcept {
+  const auto k = static_cast<std::size_t>(l);
+  const auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
+  auto& W = data.work[k];
+  const Vec3& p = W.translation;
+  const Mat3& R = W.rotation;
+  if (Rates) {
+    Vec3 a_lin = P.acc;
+    if (Velocity || Acceleration) a_lin += P.alpha.cross(p);
+    if (Velocity) a_lin += P.w.cross(P.w.cross(p));
+    W.acc.noalias() = R.transpose() * a_lin;
+  }
+  if (Velocity) {
+    W.w.noalias() = R.transpose() * P.w;
+    if (OriginVelocity) W.vel.noalias() = R.transpose() * (P.vel + P.w.cross(p));
+  } else {
+    W.w.setZero();
+    W.vel.setZero();
+  }
+  if (Rates) {
+    if (Velocity || Acceleration) {
+      W.alpha.noalias() = R.transpose() * P.alpha;
+    } else {
+      W.alpha.setZero();
+    }
+  }
+  const double qd = Velocity ? data.joint_velocity[k] : 0.0;
+  const double qdd = Acceleration ? data.joint_acceleration[k] : 0.0;
+  switch (model.joint_type(l)) {
+    case JointType::revolute:
+      if (Velocity) {
+        if (Rates) W.alpha += cross_ez(W.w) * qd;
+        W.w.z() += qd;
+      }
+      if (Acceleration) W.alpha.z() += qdd;
+      break;
+    case JointType::prismatic:
+      if (Velocity) {
+        if (Rates) W.acc += cross_ez(W.w) * (2.0 * qd);
+        if (OriginVelocity) W.vel.z() += qd;
+      }
+      if (Acceleration) W.acc.z() += qdd;
+      break;
+    case JointType::fixed:
+      break;
+  }
+  if (Forces) {
+    const auto& c = model.link_constants(l);
+    const Vec3& h = c.first_moment;
+    W.force = c.mass * W.acc + W.alpha.cross(h);
+    W.moment.noalias() = c.inertia_origin * W.alpha;
+    W.moment += h.cross(W.acc);
+    if (Velocity) {
+      W.force += W.w.cross(W.w.cross(h));
+      W.moment += W.w.cross(c.inertia_origin * W.w);
+    }
+  }
+}
+
 /// Forward pass: velocity, acceleration of every link in its own L frame and, when Forces, the
 /// net wrench each link needs (force, moment about its origin). Gravity enters as an upward
 /// acceleration -g of the base (Luh et al.), so with Gravity the wrenches include the weights.
@@ -215,60 +279,7 @@ MECHBAL_FLATTEN inline void forward_pass(const MechanismModel& model, MechanismD
     base.acc.setZero();
   }
   const int nl = model.num_links();
-  for (int l = 1; l < nl; ++l) {
-    const auto k = static_cast<std::size_t>(l);
-    const auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
-    auto& W = data.work[k];
-    const Vec3& p = W.translation;
-    const Mat3& R = W.rotation;
-    Vec3 a_lin = P.acc;
-    if (Velocity || Acceleration) a_lin += P.alpha.cross(p);
-    if (Velocity) a_lin += P.w.cross(P.w.cross(p));
-    W.acc.noalias() = R.transpose() * a_lin;
-    if (Velocity) {
-      W.w.noalias() = R.transpose() * P.w;
-      if (OriginVelocity) W.vel.noalias() = R.transpose() * (P.vel + P.w.cross(p));
-    } else {
-      W.w.setZero();
-      W.vel.setZero();
-    }
-    if (Velocity || Acceleration) {
-      W.alpha.noalias() = R.transpose() * P.alpha;
-    } else {
-      W.alpha.setZero();
-    }
-    const double qd = Velocity ? data.joint_velocity[k] : 0.0;
-    const double qdd = Acceleration ? data.joint_acceleration[k] : 0.0;
-    switch (model.joint_type(l)) {
-      case JointType::revolute:
-        if (Velocity) {
-          W.alpha += cross_ez(W.w) * qd;
-          W.w.z() += qd;
-        }
-        if (Acceleration) W.alpha.z() += qdd;
-        break;
-      case JointType::prismatic:
-        if (Velocity) {
-          W.acc += cross_ez(W.w) * (2.0 * qd);
-          if (OriginVelocity) W.vel.z() += qd;
-        }
-        if (Acceleration) W.acc.z() += qdd;
-        break;
-      case JointType::fixed:
-        break;
-    }
-    if (Forces) {
-      const auto& c = model.link_constants(l);
-      const Vec3& h = c.first_moment;
-      W.force = c.mass * W.acc + W.alpha.cross(h);
-      W.moment.noalias() = c.inertia_origin * W.alpha;
-      W.moment += h.cross(W.acc);
-      if (Velocity) {
-        W.force += W.w.cross(W.w.cross(h));
-        W.moment += W.w.cross(c.inertia_origin * W.w);
-      }
-    }
-  }
+  for (int l = 1; l < nl; ++l) forward_link<Velocity, Acceleration, Forces, OriginVelocity>(model, data, l);
 }
 
 /// Backward pass: wrench transmitted by each joint (accumulated into work[l].force/moment; the
@@ -359,26 +370,9 @@ MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, Mech
 
 /// Angular velocity and origin velocity of link l in its L frame from its joint's rate
 /// (data.joint_velocity), its placement and its parent's velocities: forward_pass's first part,
-/// with the same operations, for the momenta, which need nothing more.
+/// for the momenta, which need nothing more.
 inline void set_link_velocity(const MechanismModel& model, MechanismData& data, int l) noexcept {
-  const auto k = static_cast<std::size_t>(l);
-  const auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
-  auto& W = data.work[k];
-  const Vec3& p = W.translation;
-  const Mat3& R = W.rotation;
-  W.w.noalias() = R.transpose() * P.w;
-  W.vel.noalias() = R.transpose() * (P.vel + P.w.cross(p));
-  const double qd = data.joint_velocity[k];
-  switch (model.joint_type(l)) {
-    case JointType::revolute:
-      W.w.z() += qd;
-      break;
-    case JointType::prismatic:
-      W.vel.z() += qd;
-      break;
-    case JointType::fixed:
-      break;
-  }
+  forward_link<true, false, false, true, false>(model, data, l);
 }
 
 /// World placement and motion of a named frame from placed links and a forward pass: origin
