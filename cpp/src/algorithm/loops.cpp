@@ -372,51 +372,79 @@ void ldl_solve_block(const MechanismData& data, MechanismData::RowMajorMatrix& X
 
 /// X = -A°^T A# (np x w, row-major) over the loops' blocks of A° and A# (data.loop_blocks: the
 /// products of each loop's passive and actuated columns over its rows).
-void passive_transpose_actuated(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
+/// One loop's part of passive_transpose_actuated, R rows (0: lb.rows; unrolled as block_velocity).
+template <int R>
+inline void add_block_products(const MechanismData& data, const MechanismData::LoopBlockInfo& lb,
+                               MechanismData::RowMajorMatrix& X) noexcept {
+  const int nr = R > 0 ? R : lb.rows;
   const Eigen::Index w = X.cols();
+  const double* a = data.loop_passive_blocks.data() + lb.block;
+  const int* members = data.loop_members.data() + lb.member;
+  const int* actuated = data.loop_actuated_members.data() + lb.actuated;
+  for (int c = 0; c < lb.count; ++c, a += nr) {
+    double* x = X.data() + members[c] * w;
+    const double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
+    for (int t = 0; t < lb.actuated_count; ++t, b += nr) {
+      double sum = 0.0;
+      for (int r = 0; r < nr; ++r) sum += a[r] * b[r];
+      x[actuated[t]] -= sum;
+    }
+  }
+}
+
+void passive_transpose_actuated(const MechanismData& data, MechanismData::RowMajorMatrix& X) noexcept {
   X.setZero();
   for (const auto& lb : data.loop_blocks) {
     if (lb.actuated_count == 0) continue;
-    const double* a = data.loop_passive_blocks.data() + lb.block;
-    const int* members = data.loop_members.data() + lb.member;
-    const int* actuated = data.loop_actuated_members.data() + lb.actuated;
-    for (int c = 0; c < lb.count; ++c, a += lb.rows) {
-      double* x = X.data() + members[c] * w;
-      const double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
-      for (int t = 0; t < lb.actuated_count; ++t, b += lb.rows) {
-        double sum = 0.0;
-        for (int r = 0; r < lb.rows; ++r) sum += a[r] * b[r];
-        x[actuated[t]] -= sum;
-      }
+    switch (lb.rows) {
+      case 2: add_block_products<2>(data, lb, X); break;
+      case 3: add_block_products<3>(data, lb, X); break;
+      case 5: add_block_products<5>(data, lb, X); break;
+      case 6: add_block_products<6>(data, lb, X); break;
+      default: add_block_products<0>(data, lb, X); break;
+    }
+  }
+}
+
+/// One loop's part of normal_rhs: o[members[c]] += (or -=) column c of its block . y's rows, R
+/// rows (0: lb.rows), unrolled for the loop types' 2, 3, 5 and 6.
+template <int R, bool Negate>
+inline void add_block_transpose(const MechanismData& data, const MechanismData::LoopBlockInfo& lb, const double* y,
+                                double* o) noexcept {
+  const int nr = R > 0 ? R : lb.rows;
+  const double* a = data.loop_passive_blocks.data() + lb.block;
+  const int* members = data.loop_members.data() + lb.member;
+  const double* yl = y + lb.row;
+  for (int c = 0; c < lb.count; ++c, a += nr) {
+    double sum = 0.0;
+    for (int r = 0; r < nr; ++r) sum += a[r] * yl[r];
+    if (Negate) {
+      o[members[c]] -= sum;
+    } else {
+      o[members[c]] += sum;
+    }
+  }
+}
+
+/// out = A°^T y (or its negative with `Negate`) over A°'s blocks, summed from zero loop by loop
+/// (the columns in no loop are zero).
+template <bool Negate>
+void normal_rhs(const MechanismData& data, const double* y, Eigen::VectorXd& out) noexcept {
+  out.setZero();  // (the columns in no loop stay zero; the others are sums from zero)
+  double* o = out.data();
+  for (const auto& lb : data.loop_blocks) {
+    switch (lb.rows) {
+      case 2: add_block_transpose<2, Negate>(data, lb, y, o); break;
+      case 3: add_block_transpose<3, Negate>(data, lb, y, o); break;
+      case 5: add_block_transpose<5, Negate>(data, lb, y, o); break;
+      case 6: add_block_transpose<6, Negate>(data, lb, y, o); break;
+      default: add_block_transpose<0, Negate>(data, lb, y, o); break;
     }
   }
 }
 
 /// out = (A°^T A°)^-1 A°^T y (or its negative with `Negate`: the least-squares correction of
-/// A° x = -y) from the factors, A°^T y over A°'s blocks (a column's first product stored, the
-/// others added: data.loop_member_first; the columns in no loop are zero).
-template <bool Negate>
-void normal_rhs(const MechanismData& data, const double* y, Eigen::VectorXd& out) noexcept {
-  double* o = out.data();
-  for (const int j : data.loop_loose_columns) o[j] = 0.0;
-  const char* first = data.loop_member_first.data();
-  for (const auto& lb : data.loop_blocks) {
-    const double* a = data.loop_passive_blocks.data() + lb.block;
-    const int* members = data.loop_members.data() + lb.member;
-    const double* yl = y + lb.row;
-    for (int c = 0; c < lb.count; ++c, a += lb.rows) {
-      double sum = 0.0;
-      for (int r = 0; r < lb.rows; ++r) sum += a[r] * yl[r];
-      if (Negate) sum = -sum;
-      if (first[lb.member + c]) {
-        o[members[c]] = sum;
-      } else {
-        o[members[c]] += sum;
-      }
-    }
-  }
-}
-
+/// A° x = -y) from the factors.
 template <bool Negate>
 void normal_solve(const MechanismData& data, const double* y, Eigen::VectorXd& out) noexcept {
   normal_rhs<Negate>(data, y, out);
@@ -826,6 +854,42 @@ bool acceleration_bias(const MechanismModel& model, MechanismData& data, bool re
   return detail::all_finite(data.loop_acceleration_bias);
 }
 
+/// One loop's rows of A v (into out, at the loop's rows): its block of A# times v# (over the
+/// actuated columns that move it), then its block of A° times the passive velocities (`velocity`,
+/// elimination order), each row summed in that order; R rows (0: lb.rows), unrolled for the loop
+/// types' 2, 3, 5 and 6 (the row's sums in registers, the columns' entries contiguous).
+template <int R>
+inline void block_velocity(const MechanismData& data, const MechanismData::LoopBlockInfo& lb,
+                           const ConstVector& v_actuated, const double* velocity, double* out) noexcept {
+  const int nr = R > 0 ? R : lb.rows;
+  const double* a = data.loop_passive_blocks.data() + lb.block;
+  const double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
+  const int* members = data.loop_members.data() + lb.member;
+  const int* actuated_members = data.loop_actuated_members.data() + lb.actuated;
+  const auto& columns = data.loop_actuated_columns;
+  if (R == 0) {
+    for (int k = 0; k < nr; ++k) {
+      double sum = 0.0;
+      for (int t = 0; t < lb.actuated_count; ++t) {
+        sum += b[t * nr + k] * v_actuated(columns[static_cast<std::size_t>(actuated_members[t])]);
+      }
+      for (int c = 0; c < lb.count; ++c) sum += a[c * nr + k] * velocity[members[c]];
+      out[lb.row + k] = sum;
+    }
+    return;
+  }
+  double sum[R > 0 ? R : 1] = {};
+  for (int t = 0; t < lb.actuated_count; ++t, b += nr) {
+    const double x = v_actuated(columns[static_cast<std::size_t>(actuated_members[t])]);
+    for (int k = 0; k < nr; ++k) sum[k] += b[k] * x;
+  }
+  for (int c = 0; c < lb.count; ++c, a += nr) {
+    const double x = velocity[members[c]];
+    for (int k = 0; k < nr; ++k) sum[k] += a[k] * x;
+  }
+  for (int k = 0; k < nr; ++k) out[lb.row + k] = sum[k];
+}
+
 /// loop_projection at q (checked); `solved`: q is where solve_loop_positions just converged, so
 /// data.loop_jacobian, the factorisation of A° and data.loop_rcond are already those of q (its last
 /// evaluation) and are not recomputed.
@@ -919,17 +983,12 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
   for (std::size_t j = 0; j < passive.size(); ++j) velocity[j] = data.closed_velocity(data.loop_elimination[j]);
   double biggest = 0.0;
   for (const auto& lb : data.loop_blocks) {
-    const double* a = data.loop_passive_blocks.data() + lb.block;
-    const double* b = data.loop_actuated_blocks.data() + lb.actuated_block;
-    const int* members = data.loop_members.data() + lb.member;
-    const int* actuated_members = data.loop_actuated_members.data() + lb.actuated;
-    for (int k = 0; k < lb.rows; ++k) {
-      double sum = 0.0;
-      for (int t = 0; t < lb.actuated_count; ++t) {
-        sum += b[t * lb.rows + k] * v_actuated(columns[static_cast<std::size_t>(actuated_members[t])]);
-      }
-      for (int c = 0; c < lb.count; ++c) sum += a[c * lb.rows + k] * velocity[members[c]];
-      Av(lb.row + k) = sum;
+    switch (lb.rows) {  // (the loop types' row counts unrolled, as factor_passive)
+      case 2: block_velocity<2>(data, lb, v_actuated, velocity, Av.data()); break;
+      case 3: block_velocity<3>(data, lb, v_actuated, velocity, Av.data()); break;
+      case 5: block_velocity<5>(data, lb, v_actuated, velocity, Av.data()); break;
+      case 6: block_velocity<6>(data, lb, v_actuated, velocity, Av.data()); break;
+      default: block_velocity<0>(data, lb, v_actuated, velocity, Av.data()); break;
     }
   }
   // (over all the blocks at once: A's nonzeros, contiguous)

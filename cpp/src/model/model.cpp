@@ -722,19 +722,6 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     actuated_size += info.rows * info.actuated_count;
     data.loop_blocks.push_back(info);
   }
-  data.loop_member_first.assign(data.loop_members.size(), 0);
-  data.loop_loose_columns.clear();
-  {
-    std::vector<char> seen(np, 0);
-    for (std::size_t e = 0; e < data.loop_members.size(); ++e) {
-      const auto j = static_cast<std::size_t>(data.loop_members[e]);
-      data.loop_member_first[e] = seen[j] ? 0 : 1;
-      seen[j] = 1;
-    }
-    for (std::size_t j = 0; j < np; ++j) {
-      if (!seen[j]) data.loop_loose_columns.push_back(static_cast<int>(j));
-    }
-  }
   data.loop_passive_blocks = Eigen::VectorXd::Zero(passive_size);
   data.loop_actuated_blocks = Eigen::VectorXd::Zero(actuated_size);
   // the numeric LDL^T as straight lists: N's (and L's) entries in loop_factor_values (the np

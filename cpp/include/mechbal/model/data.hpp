@@ -162,10 +162,6 @@ struct MechanismData {
   };
   std::vector<LoopBlockInfo> loop_blocks;
   std::vector<int> loop_actuated_members;
-  /// Per entry of loop_members: 1 where the column appears for the first time (in loop order);
-  /// the passive columns in no loop (A°'s zero columns).
-  std::vector<char> loop_member_first;
-  std::vector<int> loop_loose_columns;
   Eigen::VectorXd loop_passive_blocks, loop_actuated_blocks;
   /// N = A°^T A° + damping, then its factors N = L D L^T: the np pivots (D after the
   /// factorisation), then the entries of L's columns in loop_factor_rows' order (np + nnz(L)).
