@@ -40,48 +40,6 @@ struct RowFunctional {
   Vec3 a = Vec3::Zero(), b = Vec3::Zero(), e = Vec3::Zero();
 };
 
-/// Calls f(c, r z, p_k, revolute) for the joints with a coordinate on the path from `link` up to
-/// (not including) the link `stop` (0: to the root): coordinate c, ratio r, axis z, origin p_k (O).
-template <class F>
-inline void for_each_loop_joint(const MechanismModel& model, const MechanismData& data, int link, int stop,
-                                F&& f) noexcept {
-  for (int k = link; k >= 1 && k != stop; k = model.parent(k)) {
-    const int c = model.coordinate(k);
-    if (c < 0) continue;
-    const auto& K = data.work[static_cast<std::size_t>(k)];
-    f(c, Vec3(model.coordinate_ratio(k) * K.world_rotation.col(2)), K.world_position,
-      model.joint_type(k) == JointType::revolute);
-  }
-}
-
-/// Adds the columns of the joints on the path from `link` towards the root (up to `stop`,
-/// data.loop_path_stop) to the loop's rows:
-/// joint k moves the frame's origin p by r z x (p - p_k) (revolute) or r z (prismatic) and turns
-/// it by r z (revolute); `side` -1 for frame A, +1 for frame B. Only the loop's own coordinates are
-/// touched (no dense 6 x n frame Jacobians).
-void add_path_columns(const MechanismModel& model, const MechanismData& data, int link, int stop, const Vec3& p,
-                      double side, const RowFunctional* f, int rows, int row0, Eigen::MatrixXd& jac,
-                      bool point) noexcept {
-  if (point) {  // a point loop's rows are d itself (a = e_k, b = e = 0): the columns are +-(z x (p - p_k)) or +-z
-    for_each_loop_joint(model, data, link, stop, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
-      double* column = jac.data() + static_cast<Eigen::Index>(c) * jac.rows() + row0;
-      const Vec3 rate = revolute ? Vec3(z.cross(p - pk)) : z;
-      for (int r = 0; r < 3; ++r) column[r] += side * rate(r);
-    });
-    return;
-  }
-  for_each_loop_joint(model, data, link, stop, [&](int c, const Vec3& z, const Vec3& pk, bool revolute) {
-    if (revolute) {
-      const Vec3 lin = z.cross(p - pk);
-      for (int r = 0; r < rows; ++r) {
-        jac(row0 + r, c) += side * f[r].a.dot(lin) + (side < 0.0 ? f[r].b : f[r].e).dot(z);
-      }
-    } else {
-      for (int r = 0; r < rows; ++r) jac(row0 + r, c) += side * f[r].a.dot(z);
-    }
-  });
-}
-
 /// Residual (and Jacobian) of every loop, from placed links (world poses computed).
 void constraint_rows(const MechanismModel& model, MechanismData& data, bool jacobian) noexcept {
   // (A's entries outside the loops' path columns are zero from construction and never written:
@@ -132,20 +90,43 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
     }
     if (jacobian) {
       // (the columns above a planar_point loop's common ancestor are zero from construction: no
-      // loop type writes them in its rows)
-      const int stop = data.loop_path_stop[static_cast<std::size_t>(i)];
-      for (const int frame : {fa, fb}) {
-        for (int k = model.frame_link(frame); k >= 1 && k != stop; k = model.parent(k)) {
-          const int c = model.coordinate(k);
-          if (c < 0) continue;
-          double* column = jac.data() + static_cast<Eigen::Index>(c) * jac.rows() + row;
-          column[0] = column[1] = 0.0;  // every loop type has at least 2 rows
-          for (int r = 2; r < rows; ++r) column[r] = 0.0;
-        }
+      // loop type writes them in its rows; its paths stop below it, data.loop_path_stop)
+      // joint k moves a frame's origin p by r z x (p - p_k) (revolute) or r z (prismatic) and turns
+      // it by r z (revolute): -1 times that for frame A, +1 for B; a joint on both paths (a common
+      // ancestor) moves d = p_B - p_A by r z x d (revolute) or not at all (prismatic). Only the
+      // loop's own columns are touched (no dense 6 x n frame Jacobians).
+      const auto* const begin = data.loop_path_joints.data() + data.loop_path_joint_start[static_cast<std::size_t>(i)];
+      const auto* const end = data.loop_path_joints.data() + data.loop_path_joint_start[static_cast<std::size_t>(i) + 1];
+      const Eigen::Index m = jac.rows();
+      for (const auto* e = begin; e != end; ++e) {  // (a coordinate may drive several links: gears)
+        double* column = jac.data() + static_cast<Eigen::Index>(e->coordinate) * m + row;
+        for (int r = 0; r < rows; ++r) column[r] = 0.0;
       }
       const bool point = type == LoopType::point;
-      add_path_columns(model, data, model.frame_link(fa), stop, A.position, -1.0, f, rows, row, jac, point);
-      add_path_columns(model, data, model.frame_link(fb), stop, B.position, 1.0, f, rows, row, jac, point);
+      for (const auto* e = begin; e != end; ++e) {
+        const auto& K = data.work[static_cast<std::size_t>(e->link)];
+        const Vec3 z = model.coordinate_ratio(e->link) * K.world_rotation.col(2);
+        const bool revolute = model.joint_type(e->link) == JointType::revolute;
+        const bool on_a = (e->sides & 1) != 0, on_b = (e->sides & 2) != 0;
+        Vec3 lin;
+        if (revolute) {
+          lin = z.cross(on_a ? (on_b ? Vec3(B.position - A.position) : Vec3(K.world_position - A.position))
+                             : Vec3(B.position - K.world_position));
+        } else {
+          lin = on_a ? (on_b ? Vec3::Zero() : Vec3(-z)) : z;
+        }
+        double* column = jac.data() + static_cast<Eigen::Index>(e->coordinate) * m + row;
+        if (point) {  // a point loop's rows are d itself (a = e_k, b = e = 0)
+          for (int r = 0; r < 3; ++r) column[r] += lin(r);
+          continue;
+        }
+        for (int r = 0; r < rows; ++r) {
+          double value = f[r].a.dot(lin);
+          if (revolute && on_a) value += f[r].b.dot(z);
+          if (revolute && on_b) value += f[r].e.dot(z);
+          column[r] += value;
+        }
+      }
     }
   }
 }

@@ -577,6 +577,27 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     }
     return links;
   };
+  data.loop_path_joints.clear();
+  data.loop_path_joint_start.assign(1, 0);
+  for (int i = 0; i < model.num_loops(); ++i) {
+    const auto first = data.loop_path_joints.size();
+    for (int side = 0; side < 2; ++side) {
+      for (int k : path(i, side == 0 ? model.loop_frame_a(i) : model.loop_frame_b(i))) {
+        const int c = model.coordinate(k);
+        if (c < 0) continue;
+        const auto bit = static_cast<unsigned char>(side == 0 ? 1 : 2);
+        bool listed = false;
+        for (auto e = first; e < data.loop_path_joints.size(); ++e) {
+          if (data.loop_path_joints[e].link == k) {
+            data.loop_path_joints[e].sides = static_cast<unsigned char>(data.loop_path_joints[e].sides | bit);
+            listed = true;
+          }
+        }
+        if (!listed) data.loop_path_joints.push_back({k, c, bit});
+      }
+    }
+    data.loop_path_joint_start.push_back(static_cast<int>(data.loop_path_joints.size()));
+  }
   const auto& passive = model.passive_coordinates();
   const auto np = passive.size();
   std::vector<int> slot(static_cast<std::size_t>(model.dof()), -1);  // coordinate -> passive index

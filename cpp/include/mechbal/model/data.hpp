@@ -151,6 +151,16 @@ struct MechanismData {
   /// including) the link loop_path_stop[i]: 0 (the root), or for a planar_point loop the frames'
   /// deepest common ancestor (the joints from it up move both frames together: zero columns).
   std::vector<int> loop_path_stop;
+  /// Those joints (with a coordinate) listed per loop, each once: loop i's are
+  /// loop_path_joints[loop_path_joint_start[i] .. loop_path_joint_start[i + 1]), frame A's path
+  /// first, with the paths they are on (bit 1: A's, bit 2: B's; a common ancestor's on both), so
+  /// that the loop's columns come from a list instead of two walks up the tree per evaluation.
+  struct LoopPathJoint {
+    int link = 0, coordinate = 0;
+    unsigned char sides = 0;
+  };
+  std::vector<LoopPathJoint> loop_path_joints;
+  std::vector<int> loop_path_joint_start;
   /// Each loop's slice of A, fixed at construction: its rows (row .. row + rows), its passive
   /// columns (loop_members[member .. member + count]: elimination positions, increasing) with
   /// their block of A° (loop_passive_blocks from `block`: rows x count, column-major; A°'s
