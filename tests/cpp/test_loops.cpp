@@ -96,7 +96,7 @@ MechanismModel four_bar_with_arm() {
 /// the turntable is the two tip frames' common ancestor and moves them rigidly together, so the
 /// loop's rows do not depend on it (its column of A is zero, C's is a unit vector; the loop's
 /// columns stop below it: MechanismData::loop_path_stop).
-MechanismModel four_bar_on_turntable() {
+MechanismModel four_bar_on_turntable(LoopType type = LoopType::planar_point) {
   MechanismDescription d;
   d.gravity = Vec3(0.0, -9.81, 0.0);
   Joint turn{"turn", JointType::revolute, "base", at(0, 0, 0.1)};
@@ -106,7 +106,7 @@ MechanismModel four_bar_on_turntable() {
   d.bodies = {rod("turn", "turn", 2.0, 0.45), rod("crank", "crank", 0.8, 0.2), rod("coupler", "coupler", 1.5, 0.5),
               rod("rocker", "rocker", 1.1, 0.4)};
   d.frames = {Frame{"coupler_tip", "coupler", at(0.5, 0, 0)}, Frame{"rocker_tip", "rocker", at(0.4, 0, 0)}};
-  d.loops = {LoopConstraint{"tip", LoopType::planar_point, "coupler_tip", "rocker_tip"}};
+  d.loops = {LoopConstraint{"tip", type, "coupler_tip", "rocker_tip"}};
   d.actuated = {"turn", "crank"};
   return MechanismModel(d);
 }
@@ -195,6 +195,35 @@ TEST(Loops, JacobianMatchesFiniteDifferences) {
     if (std::string(c.name) == "four_bar_on_turntable") {
       EXPECT_EQ(data.loop_jacobian.col(0).cwiseAbs().maxCoeff(), 0.0);  // the turntable's
       EXPECT_EQ(data.loop_actuated_columns, std::vector<int>{1});       // the crank only
+    }
+  }
+}
+
+TEST(Loops, CommonAncestorColumnsMatchFiniteDifferences) {
+  // point and axis loops walk both frames' paths to the root: the turntable is on both (one entry
+  // of MechanismData::loop_path_joints, moving d by z x d and turning both frames alike); its column
+  // and the others against central differences, away from the closure (where d != 0)
+  for (const LoopType type : {LoopType::point, LoopType::axis}) {
+    const MechanismModel model = four_bar_on_turntable(type);
+    MechanismData data(model);
+    const Eigen::VectorXd guess = (Eigen::VectorXd(4) << 0.3, 1.0, -0.6, 1.75).finished();
+    const Eigen::VectorXd q0 = solved(model, data, (Eigen::VectorXd(2) << 0.3, 1.0).finished(), guess);
+    int both = 0;
+    for (const auto& e : data.loop_path_joints) both += e.sides == 3 ? 1 : 0;
+    EXPECT_EQ(both, 1);  // the turntable
+    const Eigen::VectorXd q = q0 + Eigen::VectorXd::LinSpaced(model.dof(), 0.07, -0.05);
+    ASSERT_EQ(loop_constraints(model, data, q), Status::ok);
+    const Eigen::MatrixXd A = data.loop_jacobian;
+    EXPECT_GT(A.col(0).cwiseAbs().maxCoeff(), 1e-3);  // d != 0 away from the closure
+    const double h = 1e-6;
+    for (int k = 0; k < model.dof(); ++k) {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(model.dof());
+      e(k) = h;
+      ASSERT_EQ(loop_constraints(model, data, q + e), Status::ok);
+      const Eigen::VectorXd plus = data.loop_residual;
+      ASSERT_EQ(loop_constraints(model, data, q - e), Status::ok);
+      const Eigen::VectorXd column = (plus - data.loop_residual) / (2 * h);
+      EXPECT_LT((A.col(k) - column).cwiseAbs().maxCoeff(), 1e-8) << static_cast<int>(type) << " coordinate " << k;
     }
   }
 }
