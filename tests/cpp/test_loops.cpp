@@ -592,6 +592,15 @@ TEST(Loops, ClosedShakingWrenchIsClosedMotionThenShakingWrench) {
     });
     EXPECT_LT(worst, 1e-12) << c.name;
   }
+  // an open model (every coordinate actuated): shaking_wrench itself, the same to the last bit
+  const MechanismModel open(test::random_chain(rng, "RRPR"));
+  const double worst = fused_against_separate(open, Eigen::VectorXd::Zero(open.dof()), 5,
+                                              [&](int k, Eigen::VectorXd& qa, Eigen::VectorXd& va, Eigen::VectorXd& aa) {
+                                                qa.setConstant(0.1 * k);
+                                                va.setConstant(1.0 - 0.1 * k);
+                                                aa.setConstant(2.0);
+                                              });
+  EXPECT_EQ(worst, 0.0);
 }
 
 TEST(Loops, ClosedShakingWrenchOnPaminsa) {
