@@ -92,9 +92,12 @@ Vec3 mass_moment(const MechanismModel& model, const MechanismData& data) noexcep
 /// rates: the sum of every link's Newton-Euler wrench (moment about its origin n_o, so about O:
 /// n_o + p x f). One sweep over the links for both (each sum in link order).
 /// Link l's momentum (linear, angular about O) from its velocities in L_l, added to P and H.
-inline void add_link_momentum(const MechanismModel::LinkConstants& c, const MechanismData::LinkWork& W, Vec3& P, Vec3& H) noexcept {
-  const Vec3 p_local = c.mass * W.vel + W.w.cross(c.first_moment);
-  const Vec3 h_local = c.inertia_origin * W.w + c.first_moment.cross(W.vel);
+/// (w, vel: the link's velocities in L_l; passed apart from W so that a pass that has just
+/// computed them hands them over in registers: detail::forward_link)
+inline void add_link_momentum(const MechanismModel::LinkConstants& c, const MechanismData::LinkWork& W, const Vec3& w,
+                              const Vec3& vel, Vec3& P, Vec3& H) noexcept {
+  const Vec3 p_local = c.mass * vel + w.cross(c.first_moment);
+  const Vec3 h_local = c.inertia_origin * w + c.first_moment.cross(vel);
   const Vec3 p_world = W.world_rotation * p_local;
   P += p_world;
   H += W.world_rotation * h_local + W.world_position.cross(p_world);
@@ -108,7 +111,7 @@ void sum_links(const MechanismModel& model, MechanismData& data) noexcept {
   for (const int l : model.inertial_links()) {
     const auto& c = model.link_constants(l);
     const auto& W = data.work[static_cast<std::size_t>(l)];
-    if (Momenta) add_link_momentum(c, W, P, H);
+    if (Momenta) add_link_momentum(c, W, W.w, W.vel, P, H);
     if (Wrenches) {
       const Vec3 f = W.world_rotation * W.force;
       F += f;
@@ -289,11 +292,13 @@ MECHBAL_FLATTEN void velocity_momentum_pass(const MechanismModel& model, Mechani
   }
   Vec3 P[2] = {Vec3::Zero(), Vec3::Zero()}, H[2] = {Vec3::Zero(), Vec3::Zero()};
   const int count = whole ? model.num_links() - 1 : static_cast<int>(links.links.size());
+  detail::LinkMotion m{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  int last = whole ? 0 : -1;  // (a subset's first link reads its parent's motion from data.work)
   for (int i = 0; i < count; ++i) {
     const int l = whole ? i + 1 : links.links[static_cast<std::size_t>(i)];
-    detail::forward_link<true, false, false, true, Accelerations>(model, data, l);
+    detail::forward_link<true, false, false, true, Accelerations>(model, data, l, m, last);
     const int in = links.member[static_cast<std::size_t>(l)] ? 1 : 0;
-    add_link_momentum(model.link_constants(l), data.work[static_cast<std::size_t>(l)], P[in], H[in]);
+    add_link_momentum(model.link_constants(l), data.work[static_cast<std::size_t>(l)], m.w, m.vel, P[in], H[in]);
   }
   inside << P[1], H[1];
   if (whole) rest << P[0], H[0];

@@ -257,6 +257,7 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
   a_full_ = Eigen::VectorXd::Zero(n_);
   vt_full_ = Eigen::VectorXd::Zero(n_);
   c_full_ = Eigen::VectorXd::Zero(n_);
+  bias_now_ = bias_before_ = bias_earlier_ = Eigen::VectorXd::Zero(n_);
   vt_act_ = Eigen::VectorXd::Zero(na_);
   Ab_ = Eigen::MatrixXd::Zero(6, nb_);
   Kb_ = Eigen::MatrixXd::Zero(k_, nb_);
@@ -372,7 +373,7 @@ Status ReactionlessController::evaluate(const Eigen::Ref<const Eigen::VectorXd>&
     vt_full_ = v_act_;  // an open model's coordinates are its actuated ones, in order
     for (const int c : balancing_coord_) vt_full_(c) = 0.0;
   }
-  if (!balancing_in_loops_) return st | task_momentum(true, closed_);
+  if (!balancing_in_loops_) return st | task_momentum(true, closed_ && (acceleration || bias_count_ < 3));
   // the solve left the links placed at its solution q_full_: no second placement
   const Status sm = detail::momentum_matrix_placed(*model_, data_);
   if (sm != Status::ok) return st | sm;
@@ -623,6 +624,12 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
   stage_cache_ = false;
   Status st = reuse ? stage_cache_status_ | rebalance(q_b_) : evaluate(q_t, q_b_);
   if (failed(st)) return hold(only(st, hard));
+  if (closed_ && !balancing_in_loops_) {  // c at t_n, and at the starts of the ticks before it
+    bias_count_ = reuse ? std::min(bias_count_ + 1, 3) : 1;
+    bias_earlier_.swap(bias_before_);
+    bias_before_.swap(bias_now_);
+    bias_now_ = data_.loop_acceleration_bias;
+  }
   double cond = 1.0;
   st |= rates(target_, q_b_, k1_, &cond);
   if (has(st, Status::out_of_range)) return hold(Status::out_of_range);
@@ -738,6 +745,11 @@ Status ReactionlessController::tick(const Eigen::Ref<const Eigen::VectorXd>& q_t
     if (!failed(ss)) ss |= rates(target_ + (0.5 * dt_) * target_rate_, q_stage_, k3_, nullptr);
     q_stage_ = q_b_ + dt_ * k3_;
     task_rates(*v_next);
+    if (closed_ && !balancing_in_loops_ && bias_count_ >= 3) {
+      // c at t_n + dt/2 for the t_n + dt solve's warm start (the stage above computed none): the
+      // parabola through c at t_n - 2 dt, t_n - dt, t_n
+      data_.loop_acceleration_bias = 1.875 * bias_now_ - 1.25 * bias_before_ + 0.375 * bias_earlier_;
+    }
     if (!failed(ss)) ss |= last_stage = evaluate(*q_next, q_stage_);
     if (!failed(ss)) ss |= rates(target_ + dt_ * target_rate_, q_stage_, k4_, nullptr);
     task_rates(v_t);

@@ -197,66 +197,93 @@ inline Mat3 rotate_symmetric(const Mat3& R, const Mat3& S) noexcept {
   return out;
 }
 
+/// The motion a link hands to its children in the forward pass (in its own L frame).
+struct LinkMotion {
+  Vec3 w, vel, acc, alpha;
+};
+
 /// One link's step of the forward pass (see forward_pass) from its parent's motion: velocity,
 /// acceleration in its own L frame and, when Forces, its net wrench. Rates = false: the velocities
 /// alone (w and, with OriginVelocity, vel), acc and alpha left as they were (the momenta need
 /// nothing more).
+/// `m` and `last`: the motion of the link stepped just before and its index (-1: none). When it
+/// is l's parent (along a chain: most links), its motion is taken from `m`, in registers, not read
+/// back from data.work, where it was just written: a load that straddles the parts of a vector
+/// stored separately (z after x and y) waits for the stores to retire instead of forwarding
+/// from them, which cost the passes a fifth of their time. On return `m` is l's motion and
+/// `last` = l.
 template <bool Velocity, bool Acceleration, bool Forces, bool OriginVelocity = true, bool Rates = true>
-inline void forward_link(const MechanismModel& model, MechanismData& data, int l) noexcept {
+inline void forward_link(const MechanismModel& model, MechanismData& data, int l, LinkMotion& m, int& last) noexcept {
   const auto k = static_cast<std::size_t>(l);
-  const auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
+  const int parent = model.parent(l);
+  if (parent != last) {
+    const auto& P = data.work[static_cast<std::size_t>(parent)];
+    if (Velocity) {
+      m.w = P.w;
+      if (OriginVelocity) m.vel = P.vel;
+    }
+    if (Rates) {
+      m.acc = P.acc;
+      m.alpha = P.alpha;
+    }
+  }
   auto& W = data.work[k];
   const Vec3& p = W.translation;
   const Mat3& R = W.rotation;
+  Vec3 w = Vec3::Zero(), vel = Vec3::Zero(), acc = Vec3::Zero(), alpha = Vec3::Zero();
   if (Rates) {
-    Vec3 a_lin = P.acc;
-    if (Velocity || Acceleration) a_lin += P.alpha.cross(p);
-    if (Velocity) a_lin += P.w.cross(P.w.cross(p));
-    W.acc.noalias() = R.transpose() * a_lin;
+    Vec3 a_lin = m.acc;
+    if (Velocity || Acceleration) a_lin += m.alpha.cross(p);
+    if (Velocity) a_lin += m.w.cross(m.w.cross(p));
+    acc.noalias() = R.transpose() * a_lin;
   }
   if (Velocity) {
-    W.w.noalias() = R.transpose() * P.w;
-    if (OriginVelocity) W.vel.noalias() = R.transpose() * (P.vel + P.w.cross(p));
-  } else {
-    W.w.setZero();
-    W.vel.setZero();
+    w.noalias() = R.transpose() * m.w;
+    if (OriginVelocity) vel.noalias() = R.transpose() * (m.vel + m.w.cross(p));
   }
-  if (Rates) {
-    if (Velocity || Acceleration) {
-      W.alpha.noalias() = R.transpose() * P.alpha;
-    } else {
-      W.alpha.setZero();
-    }
-  }
+  if (Rates && (Velocity || Acceleration)) alpha.noalias() = R.transpose() * m.alpha;
   const double qd = Velocity ? data.joint_velocity[k] : 0.0;
   const double qdd = Acceleration ? data.joint_acceleration[k] : 0.0;
   switch (model.joint_type(l)) {
     case JointType::revolute:
       if (Velocity) {
-        if (Rates) W.alpha += cross_ez(W.w) * qd;
-        W.w.z() += qd;
+        if (Rates) alpha += cross_ez(w) * qd;
+        w.z() += qd;
       }
-      if (Acceleration) W.alpha.z() += qdd;
+      if (Acceleration) alpha.z() += qdd;
       break;
     case JointType::prismatic:
       if (Velocity) {
-        if (Rates) W.acc += cross_ez(W.w) * (2.0 * qd);
-        if (OriginVelocity) W.vel.z() += qd;
+        if (Rates) acc += cross_ez(w) * (2.0 * qd);
+        if (OriginVelocity) vel.z() += qd;
       }
-      if (Acceleration) W.acc.z() += qdd;
+      if (Acceleration) acc.z() += qdd;
       break;
     case JointType::fixed:
       break;
   }
+  W.w = w;
+  if (OriginVelocity || !Velocity) W.vel = vel;
+  if (Rates) {
+    W.acc = acc;
+    W.alpha = alpha;
+  }
+  m.w = w;
+  m.vel = vel;
+  if (Rates) {
+    m.acc = acc;
+    m.alpha = alpha;
+  }
+  last = l;
   if (Forces) {
     const auto& c = model.link_constants(l);
     const Vec3& h = c.first_moment;
-    W.force = c.mass * W.acc + W.alpha.cross(h);
-    W.moment.noalias() = c.inertia_origin * W.alpha;
-    W.moment += h.cross(W.acc);
+    W.force = c.mass * acc + alpha.cross(h);
+    W.moment.noalias() = c.inertia_origin * alpha;
+    W.moment += h.cross(acc);
     if (Velocity) {
-      W.force += W.w.cross(W.w.cross(h));
-      W.moment += W.w.cross(c.inertia_origin * W.w);
+      W.force += w.cross(w.cross(h));
+      W.moment += w.cross(c.inertia_origin * w);
     }
   }
 }
@@ -278,8 +305,10 @@ MECHBAL_FLATTEN inline void forward_pass(const MechanismModel& model, MechanismD
   } else {
     base.acc.setZero();
   }
+  LinkMotion m{base.w, base.vel, base.acc, base.alpha};
+  int last = 0;
   const int nl = model.num_links();
-  for (int l = 1; l < nl; ++l) forward_link<Velocity, Acceleration, Forces, OriginVelocity>(model, data, l);
+  for (int l = 1; l < nl; ++l) forward_link<Velocity, Acceleration, Forces, OriginVelocity>(model, data, l, m, last);
 }
 
 /// Backward pass: wrench transmitted by each joint (accumulated into work[l].force/moment; the
@@ -366,13 +395,6 @@ MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, Mech
   for (int i = 0; i < count; ++i) {
     data.work[static_cast<std::size_t>(only ? only->links[static_cast<std::size_t>(i)] : i)].composite_current = true;
   }
-}
-
-/// Angular velocity and origin velocity of link l in its L frame from its joint's rate
-/// (data.joint_velocity), its placement and its parent's velocities: forward_pass's first part,
-/// for the momenta, which need nothing more.
-inline void set_link_velocity(const MechanismModel& model, MechanismData& data, int l) noexcept {
-  forward_link<true, false, false, true, false>(model, data, l);
 }
 
 /// World placement and motion of a named frame from placed links and a forward pass: origin
