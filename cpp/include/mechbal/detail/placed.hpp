@@ -9,10 +9,13 @@
 #include <vector>
 
 #include "mechbal/detail/link_subset.hpp"
-#include "mechbal/algorithm/loops.hpp"
 #include "mechbal/model/data.hpp"
 #include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
+
+namespace mechbal {
+struct LoopSolveOptions;  // algorithm/loops.hpp (not included: detail/ sits below the algorithms)
+}  // namespace mechbal
 
 namespace mechbal::detail {
 
