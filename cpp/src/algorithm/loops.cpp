@@ -1119,9 +1119,9 @@ Status closed_velocity_motion(const MechanismModel& model, MechanismData& data, 
 }
 
 Status detail::loop_acceleration_bias_placed(const MechanismModel& model, MechanismData& data,
-                                             const LoopSolveOptions& options) noexcept {
+                                             double refine_rcond) noexcept {
   if (!model.is_closed()) return Status::ok;
-  return acceleration_bias(model, data, data.loop_rcond < options.refine_rcond) ? Status::ok : Status::singular;
+  return acceleration_bias(model, data, data.loop_rcond < refine_rcond) ? Status::ok : Status::singular;
 }
 
 Status closed_inverse_dynamics(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,

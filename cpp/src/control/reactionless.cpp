@@ -405,7 +405,7 @@ Status ReactionlessController::task_momentum(bool whole, bool bias) noexcept {
   // c from the links on the loops' paths, which the balancing joints do not move: their
   // velocities and accelerations are those of the whole motion
   Status st = Status::ok;
-  if (bias && whole) st = detail::loop_acceleration_bias_placed(*model_, data_, config_.loop_options);
+  if (bias && whole) st = detail::loop_acceleration_bias_placed(*model_, data_, config_.loop_options.refine_rcond);
   ht_ = rest_ + inside;
   detail::momentum_columns_placed(*model_, data_, subtree_, balancing_coord_, Ab_);
   for (int i = 0; i < k_; ++i) Kb_.row(i) = Ab_.row(rows_[static_cast<std::size_t>(i)]);

@@ -30,7 +30,12 @@
 /// third, and the next tick's first) places, moves and sums those subtrees again, nothing else.
 /// The feed-forward folds K_t a_t into one shaking-wrench pass, W(q, v, c + C [a_t; 0]) =
 /// W(q, v, c) + K_t a_t, which also gives h. With a balancing joint inside a loop, K_b = A C_b
-/// from the whole momentum matrix.
+/// from the whole momentum matrix. On a closed mechanism, RK4's loop solves at t + dt/2 and
+/// t + dt start from the last solution followed along the closure to second order (algorithm/
+/// loops.hpp), which needs the loops' acceleration bias c where the step starts: the t + dt solve
+/// gets c at t + dt/2 extrapolated from c at the last three ticks' starts (consecutive ticks of
+/// a sampled trajectory), and the solves then close the loops at their predictions, with no
+/// Newton step.
 ///
 /// The balancing rates are integrated at the controller's rate (explicit Euler, or classical RK4
 /// with the task motion at t + dt/2 and t + dt). Each solve is a least-squares / minimum-norm
@@ -201,10 +206,10 @@ class ReactionlessController {
   /// solved into q_full_); v_act_: actuated velocities (its task entries: the task's rates). Fills
   /// Kb_ and ht_ (task_momentum). With `acceleration`, also the loops' acceleration bias c (the
   /// feed-forward at t_n needs it; an RK4 stage that only needs the rates not). When no balancing
-  /// joint moves a loop, c is computed at every evaluation whatever `acceleration` says: the
-  /// momentum pass gives the link accelerations it needs for the velocity products alone, and
-  /// the next loop solve's warm start predicts from it (from t_n + dt/2 to t_n + dt, a stale c
-  /// costs a Newton step).
+  /// joint moves a loop, c comes from the momentum pass (the link accelerations of the velocity
+  /// products alone, then the loops' bias and one solve), and without `acceleration` too until
+  /// bias_count_ reaches 3: the next loop solve's warm start predicts from it (from t_n + dt/2 to
+  /// t_n + dt, a stale c costs a Newton step); from then on tick() extrapolates it instead.
   Status evaluate(const Eigen::Ref<const Eigen::VectorXd>& q_t, const Eigen::VectorXd& q_b,
                   bool acceleration = true) noexcept;
   /// evaluate() at the same task positions with other balancing positions, for a closed

@@ -42,10 +42,9 @@ void velocity_momentum(const MechanismModel& model, MechanismData& data, const L
 /// on the links of the loops' paths: forward_pass<true, false, false, false> or
 /// velocity_momentum with `accelerations`), with the velocity projection computed at the same q
 /// (closed_velocity_motion just before: its factorisation of A° is reused). What closed_motion
-/// computes after closed_velocity_motion's work. Status::singular when c is not finite; nothing
-/// for an open model (c = 0).
-Status loop_acceleration_bias_placed(const MechanismModel& model, MechanismData& data,
-                                     const LoopSolveOptions& options) noexcept;
+/// computes after closed_velocity_motion's work, with the same refinement (the solve's options'
+/// refine_rcond). Status::singular when c is not finite; nothing for an open model (c = 0).
+Status loop_acceleration_bias_placed(const MechanismModel& model, MechanismData& data, double refine_rcond) noexcept;
 /// shaking_wrench(q, v, a) at the placed q (q: the coordinates the links are placed at).
 /// `momenta` false: the force and moment only (data.shaking's momenta are left as they were).
 Status shaking_wrench_placed(const MechanismModel& model, MechanismData& data, const Eigen::Ref<const Eigen::VectorXd>& q,
