@@ -13,10 +13,6 @@
 #include "mechbal/model/model.hpp"
 #include "mechbal/status.hpp"
 
-namespace mechbal {
-struct LoopSolveOptions;  // algorithm/loops.hpp (not included: detail/ sits below the algorithms)
-}  // namespace mechbal
-
 namespace mechbal::detail {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
