@@ -297,6 +297,7 @@ MECHBAL_FLATTEN void velocity_momentum_pass(const MechanismModel& model, Mechani
   for (int i = 0; i < count; ++i) {
     const int l = whole ? i + 1 : links.links[static_cast<std::size_t>(i)];
     detail::forward_link<true, false, false, true, Accelerations>(model, data, l, m, last);
+    if (!model.has_inertia(l)) continue;  // adds nothing to the momenta
     const int in = links.member[static_cast<std::size_t>(l)] ? 1 : 0;
     add_link_momentum(model.link_constants(l), data.work[static_cast<std::size_t>(l)], m.w, m.vel, P[in], H[in]);
   }
