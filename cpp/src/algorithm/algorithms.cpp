@@ -88,20 +88,11 @@ Vec3 mass_moment(const MechanismModel& model, const MechanismData& data) noexcep
   return mc;
 }
 
+using detail::add_link_momentum;
+
 /// Momenta about O of all links, from a forward pass with velocities, and with Wrenches their
 /// rates: the sum of every link's Newton-Euler wrench (moment about its origin n_o, so about O:
 /// n_o + p x f). One sweep over the links for both (each sum in link order).
-/// Link l's momentum (linear, angular about O) from its velocities in L_l, added to P and H.
-/// (w, vel: the link's velocities in L_l; passed apart from W so that a pass that has just
-/// computed them hands them over in registers: detail::forward_link)
-inline void add_link_momentum(const MechanismModel::LinkConstants& c, const MechanismData::LinkWork& W, const Vec3& w,
-                              const Vec3& vel, Vec3& P, Vec3& H) noexcept {
-  const Vec3 p_local = c.mass * vel + w.cross(c.first_moment);
-  const Vec3 h_local = c.inertia_origin * w + c.first_moment.cross(vel);
-  const Vec3 p_world = W.world_rotation * p_local;
-  P += p_world;
-  H += W.world_rotation * h_local + W.world_position.cross(p_world);
-}
 
 /// Momenta = false: the wrenches only (data.shaking's momenta left as they were).
 template <bool Wrenches, bool Momenta = true>

@@ -1064,21 +1064,12 @@ MECHBAL_FLATTEN void closed_wrench_of_projected(const MechanismModel& model, Mec
     W.acc += linear;
     if (!model.has_inertia(l)) continue;  // adds nothing to the sums
     const auto& cst = model.link_constants(l);
-    const Vec3& h = cst.first_moment;
-    const Vec3 Iw = cst.inertia_origin * W.w;
-    const Vec3 force = cst.mass * W.acc + W.alpha.cross(h) + W.w.cross(W.w.cross(h));
-    Vec3 moment;
-    moment.noalias() = cst.inertia_origin * W.alpha;
-    moment += h.cross(W.acc) + W.w.cross(Iw);
-    const Vec3 p_local = cst.mass * W.vel + W.w.cross(h);
-    const Vec3 h_local = Iw + h.cross(W.vel);
-    const Mat3& R = W.world_rotation;
-    const Vec3& o = W.world_position;
-    const Vec3 f = R * force, p = R * p_local;
+    Vec3 force, moment;
+    detail::link_wrench(cst, W.w, W.alpha, W.acc, force, moment);
+    const Vec3 f = W.world_rotation * force;
     F += f;
-    M += R * moment + o.cross(f);
-    P += p;
-    H += R * h_local + o.cross(p);
+    M += W.world_rotation * moment + W.world_position.cross(f);
+    detail::add_link_momentum(cst, W, W.w, W.vel, P, H);
   }
   data.shaking.linear_momentum = P;
   data.shaking.angular_momentum = H;

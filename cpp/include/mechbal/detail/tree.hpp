@@ -197,6 +197,34 @@ inline Mat3 rotate_symmetric(const Mat3& R, const Mat3& S) noexcept {
   return out;
 }
 
+/// Link l's Newton-Euler wrench (force, moment about its origin, in L_l) from its motion in L_l:
+/// f = m acc + alpha x h + w x (w x h), n = I alpha + h x acc + w x (I w) (h = m c, I about the
+/// origin). Velocity = false: the terms in w are left out (w = 0).
+template <bool Velocity = true>
+inline void link_wrench(const MechanismModel::LinkConstants& c, const Vec3& w, const Vec3& alpha, const Vec3& acc,
+                        Vec3& force, Vec3& moment) noexcept {
+  const Vec3& h = c.first_moment;
+  force = c.mass * acc + alpha.cross(h);
+  moment.noalias() = c.inertia_origin * alpha;
+  moment += h.cross(acc);
+  if (Velocity) {
+    force += w.cross(w.cross(h));
+    moment += w.cross(c.inertia_origin * w);
+  }
+}
+
+/// Link l's momentum (linear, angular about O) from its velocities in L_l, added to P and H.
+/// (w, vel: the link's velocities in L_l; passed apart from W so that a pass that has just
+/// computed them hands them over in registers: forward_link)
+inline void add_link_momentum(const MechanismModel::LinkConstants& c, const MechanismData::LinkWork& W, const Vec3& w,
+                              const Vec3& vel, Vec3& P, Vec3& H) noexcept {
+  const Vec3 p_local = c.mass * vel + w.cross(c.first_moment);
+  const Vec3 h_local = c.inertia_origin * w + c.first_moment.cross(vel);
+  const Vec3 p_world = W.world_rotation * p_local;
+  P += p_world;
+  H += W.world_rotation * h_local + W.world_position.cross(p_world);
+}
+
 /// The motion a link hands to its children in the forward pass (in its own L frame).
 struct LinkMotion {
   Vec3 w, vel, acc, alpha;
@@ -275,17 +303,7 @@ inline void forward_link(const MechanismModel& model, MechanismData& data, int l
     m.alpha = alpha;
   }
   last = l;
-  if (Forces) {
-    const auto& c = model.link_constants(l);
-    const Vec3& h = c.first_moment;
-    W.force = c.mass * acc + alpha.cross(h);
-    W.moment.noalias() = c.inertia_origin * alpha;
-    W.moment += h.cross(acc);
-    if (Velocity) {
-      W.force += w.cross(w.cross(h));
-      W.moment += w.cross(c.inertia_origin * w);
-    }
-  }
+  if (Forces) link_wrench<Velocity>(model.link_constants(l), w, alpha, acc, W.force, W.moment);
 }
 
 /// Forward pass: velocity, acceleration of every link in its own L frame and, when Forces, the
