@@ -560,11 +560,25 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
   // exceed options.max_step.
   const bool tangent = model.is_closed() && q == data.closed_position;
   double vv = 0.0, dv = 0.0;
-  for (std::size_t i = 0; i < actuated.size(); ++i) {
-    const auto k = static_cast<Eigen::Index>(i);
-    if (tangent) trial.noalias() += data.loop_projection.col(k) * (q_actuated(k) - q(actuated[i]));
-    trial(actuated[i]) = q_actuated(k);
+  if (tangent) {
+    // (C d over C's structure: its passive rows are data.loop_solution's over the actuated
+    // columns that move a loop, its other passive entries zero; its actuated rows are d itself,
+    // which q_actuated replaces below)
+    const auto& columns = data.loop_actuated_columns;
+    const MechanismData::RowMajorMatrix& X = data.loop_solution;
+    const Eigen::Index w = X.cols();
+    double* const step = data.loop_vector_work.data();  // (n >= nla entries, free until the Newton steps)
+    for (Eigen::Index t = 0; t < w; ++t) {
+      const int c = columns[static_cast<std::size_t>(t)];
+      step[t] = q_actuated(c) - q(actuated[static_cast<std::size_t>(c)]);
+    }
+    for (std::size_t j = 0; j < passive.size(); ++j) {
+      const double* x = X.data() + static_cast<Eigen::Index>(j) * w;
+      double& p = trial(data.loop_elimination[j]);
+      for (Eigen::Index t = 0; t < w; ++t) p += x[t] * step[t];
+    }
   }
+  for (std::size_t i = 0; i < actuated.size(); ++i) trial(actuated[i]) = q_actuated(static_cast<Eigen::Index>(i));
   // the path parameter and the history over the loops' own coordinates: the actuated coordinates
   // that move no loop (a wrist carried by a parallel mechanism) change neither the solution nor c,
   // which is quadratic in the loops' rates alone, so their moves keep the warm start's history
