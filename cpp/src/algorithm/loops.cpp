@@ -43,7 +43,7 @@ struct RowFunctional {
 /// Residual (and Jacobian) of every loop, from placed links (world poses computed).
 void constraint_rows(const MechanismModel& model, MechanismData& data, bool jacobian) noexcept {
   // (A's entries outside the loops' path columns are zero from construction and never written:
-  // only the columns each loop's rows accumulate into are cleared, not the whole m x n matrix)
+  // each loop's rows are set in its path columns alone, not the whole m x n matrix cleared)
   Eigen::MatrixXd& jac = data.loop_jacobian;
   for (int i = 0; i < model.num_loops(); ++i) {
     const int row = model.loop_row(i), fa = model.loop_frame_a(i), fb = model.loop_frame_b(i);
@@ -98,18 +98,15 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
       const auto* const begin = data.loop_path_joints.data() + data.loop_path_joint_start[static_cast<std::size_t>(i)];
       const auto* const end = data.loop_path_joints.data() + data.loop_path_joint_start[static_cast<std::size_t>(i) + 1];
       const Eigen::Index m = jac.rows();
-      for (const auto* e = begin; e != end; ++e) {  // (a coordinate may drive several links: gears)
-        double* column = jac.data() + static_cast<Eigen::Index>(e->coordinate) * m + row;
-        for (int r = 0; r < rows; ++r) column[r] = 0.0;
-      }
+      // (a coordinate may drive several links, gears: its first joint in the list sets the
+      // column's rows, the others add to them)
       const bool point = type == LoopType::point;
       for (const auto* e = begin; e != end; ++e) {
         const auto& K = data.work[static_cast<std::size_t>(e->link)];
-        const Vec3 z = model.coordinate_ratio(e->link) * K.world_rotation.col(2);
-        const bool revolute = model.joint_type(e->link) == JointType::revolute;
+        const Vec3 z = e->ratio * K.world_rotation.col(2);
         const bool on_a = (e->sides & 1) != 0, on_b = (e->sides & 2) != 0;
         Vec3 lin;
-        if (revolute) {
+        if (e->revolute) {
           lin = z.cross(on_a ? (on_b ? Vec3(B.position - A.position) : Vec3(K.world_position - A.position))
                              : Vec3(B.position - K.world_position));
         } else {
@@ -117,14 +114,18 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
         }
         double* column = jac.data() + static_cast<Eigen::Index>(e->coordinate) * m + row;
         if (point) {  // a point loop's rows are d itself (a = e_k, b = e = 0)
-          for (int r = 0; r < 3; ++r) column[r] += lin(r);
+          if (e->first) {
+            for (int r = 0; r < 3; ++r) column[r] = lin(r);
+          } else {
+            for (int r = 0; r < 3; ++r) column[r] += lin(r);
+          }
           continue;
         }
         for (int r = 0; r < rows; ++r) {
           double value = f[r].a.dot(lin);
-          if (revolute && on_a) value += f[r].b.dot(z);
-          if (revolute && on_b) value += f[r].e.dot(z);
-          column[r] += value;
+          if (e->revolute && on_a) value += f[r].b.dot(z);
+          if (e->revolute && on_b) value += f[r].e.dot(z);
+          column[r] = e->first ? value : column[r] + value;
         }
       }
     }

@@ -590,20 +590,25 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
   data.loop_path_joints.clear();
   data.loop_path_joint_start.assign(1, 0);
   for (int i = 0; i < model.num_loops(); ++i) {
-    const auto first = data.loop_path_joints.size();
+    const auto first_index = data.loop_path_joints.size();
     for (int side = 0; side < 2; ++side) {
       for (int k : path(i, side == 0 ? model.loop_frame_a(i) : model.loop_frame_b(i))) {
         const int c = model.coordinate(k);
         if (c < 0) continue;
         const auto bit = static_cast<unsigned char>(side == 0 ? 1 : 2);
         bool listed = false;
-        for (auto e = first; e < data.loop_path_joints.size(); ++e) {
+        for (auto e = first_index; e < data.loop_path_joints.size(); ++e) {
           if (data.loop_path_joints[e].link == k) {
             data.loop_path_joints[e].sides = static_cast<unsigned char>(data.loop_path_joints[e].sides | bit);
             listed = true;
           }
         }
-        if (!listed) data.loop_path_joints.push_back({k, c, bit});
+        if (!listed) {
+          bool first = true;  // (a coordinate may drive several links: gears)
+          for (auto e = first_index; e < data.loop_path_joints.size(); ++e) first = first && data.loop_path_joints[e].coordinate != c;
+          data.loop_path_joints.push_back(
+              {k, c, bit, first, model.joint_type(k) == JointType::revolute, model.coordinate_ratio(k)});
+        }
       }
     }
     data.loop_path_joint_start.push_back(static_cast<int>(data.loop_path_joints.size()));

@@ -155,9 +155,13 @@ struct MechanismData {
   /// loop_path_joints[loop_path_joint_start[i] .. loop_path_joint_start[i + 1]), frame A's path
   /// first, with the paths they are on (bit 1: A's, bit 2: B's; a common ancestor's on both), so
   /// that the loop's columns come from a list instead of two walks up the tree per evaluation.
+  /// (`first`: the first of the loop's joints on its coordinate, which sets the column's rows
+  /// instead of adding to them; the joint's type and coordinate ratio copied from the model)
   struct LoopPathJoint {
     int link = 0, coordinate = 0;
     unsigned char sides = 0;
+    bool first = true, revolute = true;
+    double ratio = 1.0;
   };
   std::vector<LoopPathJoint> loop_path_joints;
   std::vector<int> loop_path_joint_start;
