@@ -1090,6 +1090,9 @@ MECHBAL_FLATTEN void closed_wrench_of_projected(const MechanismModel& model, Mec
   for (int l = 1; l < nl; ++l) {
     const auto k = static_cast<std::size_t>(l);
     auto& W = data.work[k];
+    // (the link's motion in locals for the sums below: read back from W right after its totals
+    // are stored, 16-byte loads straddle those stores and wait for them to retire)
+    Vec3 w, vel, alpha, acc;
     if (!in_bias_pass[k]) {
       // outside the bias pass (no loop frame at or below it; its parent's motion is whole by now,
       // inside the pass or not): its whole motion in one forward step, which its children
@@ -1097,6 +1100,10 @@ MECHBAL_FLATTEN void closed_wrench_of_projected(const MechanismModel& model, Mec
       const int c = model.coordinate(l);
       data.joint_acceleration[k] = c >= 0 ? model.coordinate_ratio(l) * a[c] : 0.0;
       detail::forward_link<true, true, false>(model, data, l, motion, stepped);
+      w = motion.w;
+      vel = motion.vel;
+      alpha = motion.alpha;
+      acc = motion.acc;
     } else {
       const auto parent = static_cast<std::size_t>(model.parent(l));
       const Vec3& parent_angular = field[2 * parent];
@@ -1119,17 +1126,21 @@ MECHBAL_FLATTEN void closed_wrench_of_projected(const MechanismModel& model, Mec
       }
       field[2 * k] = angular;
       field[2 * k + 1] = linear;
-      W.alpha += angular;
-      W.acc += linear;
+      w = W.w;
+      vel = W.vel;
+      alpha = W.alpha + angular;
+      acc = W.acc + linear;
+      W.alpha = alpha;
+      W.acc = acc;
     }
     if (!model.has_inertia(l)) continue;  // adds nothing to the sums
     const auto& cst = model.link_constants(l);
     Vec3 force, moment;
-    detail::link_wrench(cst, W.w, W.alpha, W.acc, force, moment);
+    detail::link_wrench(cst, w, alpha, acc, force, moment);
     const Vec3 f = W.world_rotation * force;
     F += f;
     M += W.world_rotation * moment + W.world_position.cross(f);
-    detail::add_link_momentum(cst, W, W.w, W.vel, P, H);
+    detail::add_link_momentum(cst, W, w, vel, P, H);
   }
   data.shaking.linear_momentum = P;
   data.shaking.angular_momentum = H;
