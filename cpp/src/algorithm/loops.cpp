@@ -811,11 +811,25 @@ void apply_projection(const MechanismModel& model, const MechanismData& data, co
   const auto& columns = data.loop_actuated_columns;
   const MechanismData::RowMajorMatrix& X = data.loop_solution;
   const Eigen::Index w = X.cols();
-  for (std::size_t j = 0; j < data.loop_elimination.size(); ++j) {
-    const double* row = X.data() + static_cast<Eigen::Index>(j) * w;
+  constexpr Eigen::Index kHeld = 8;  // (x over C's solved columns held in registers, up to 8 of them)
+  if (w > kHeld) {
+    for (std::size_t j = 0; j < data.loop_elimination.size(); ++j) {
+      const double* row = X.data() + static_cast<Eigen::Index>(j) * w;
+      double sum = 0.0;
+      for (Eigen::Index t = 0; t < w; ++t) sum += row[t] * x(columns[static_cast<std::size_t>(t)]);
+      y(data.loop_elimination[j]) += sum;
+    }
+    return;
+  }
+  double held[kHeld];
+  for (Eigen::Index t = 0; t < w; ++t) held[t] = x(columns[static_cast<std::size_t>(t)]);
+  double* const out = y.data();
+  const int* const elimination = data.loop_elimination.data();
+  const double* row = X.data();
+  for (std::size_t j = 0; j < data.loop_elimination.size(); ++j, row += w) {
     double sum = 0.0;
-    for (Eigen::Index t = 0; t < w; ++t) sum += row[t] * x(columns[static_cast<std::size_t>(t)]);
-    y(data.loop_elimination[j]) += sum;
+    for (Eigen::Index t = 0; t < w; ++t) sum += row[t] * held[t];
+    out[elimination[j]] += sum;
   }
 }
 
@@ -976,12 +990,12 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
     ldl_solve_block(data, S);
     X += S;
   }
-  bool finite = true;  // C's other entries are 0 and 1
+  // (C's other entries are 0 and 1)
+  const bool finite = detail::all_finite(Eigen::Map<const Eigen::VectorXd>(X.data(), X.size()));
   for (std::size_t j = 0; j < passive.size(); ++j) {
     const double* x = X.data() + static_cast<Eigen::Index>(j) * w;
     for (Eigen::Index t = 0; t < w; ++t) {
       data.loop_projection(data.loop_elimination[j], columns[static_cast<std::size_t>(t)]) = x[t];
-      finite = finite && std::abs(x[t]) <= std::numeric_limits<double>::max();
     }
   }
   apply_projection(model, data, v_actuated, data.closed_velocity);
@@ -1048,8 +1062,7 @@ Status motion(const MechanismModel& model, MechanismData& data, const ConstVecto
   if (Status s = check(model, data, q, &q_actuated, &v_actuated, &a_actuated); s != Status::ok) return s;
   Status status = solve_positions(model, data, q_actuated, q, options, true);
   if (has(status, Status::solver_error)) return status;
-  data.closed_position = q;
-  status |= project(model, data, q, v_actuated, options, true, true, bias_links_only);
+  status |= project(model, data, q, v_actuated, options, true, true, bias_links_only);  // (closed_position = q)
   data.closed_acceleration = data.loop_acceleration_bias;
   apply_projection(model, data, a_actuated, data.closed_acceleration, true);
   return status;
