@@ -681,6 +681,41 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
       }
     }
   }
+  // then by height in the elimination tree (a column's parent: the first row below its pivot),
+  // ties in the minimum-degree order: any order that eliminates each column after all its
+  // descendants in that tree has the same fill and the same L, permuted. Independent branches
+  // (PAMINSA's three legs) then alternate column by column, so that the chains of dependent
+  // pivots of the factorisation and of the triangular solves (each pivot a division or a long
+  // sum) interleave instead of running one after the other
+  {
+    std::vector<int> height(np, 0);
+    for (std::size_t k = 0; k < np; ++k) {
+      int parent = -1;
+      for (const int v : below[k]) {
+        const int at = position[static_cast<std::size_t>(v)];
+        if (parent < 0 || at < parent) parent = at;
+      }
+      if (parent >= 0) {
+        height[static_cast<std::size_t>(parent)] =
+            std::max(height[static_cast<std::size_t>(parent)], height[k] + 1);
+      }
+    }
+    std::vector<int> steps(np);
+    for (std::size_t k = 0; k < np; ++k) steps[k] = static_cast<int>(k);
+    std::stable_sort(steps.begin(), steps.end(), [&](int a, int b) {
+      return height[static_cast<std::size_t>(a)] < height[static_cast<std::size_t>(b)];
+    });
+    std::vector<int> scheduled(np);
+    std::vector<std::vector<int>> scheduled_below(np);
+    for (std::size_t k = 0; k < np; ++k) {
+      const auto from = static_cast<std::size_t>(steps[k]);
+      scheduled[k] = order[from];
+      scheduled_below[k] = std::move(below[from]);
+      position[static_cast<std::size_t>(order[from])] = static_cast<int>(k);
+    }
+    order = std::move(scheduled);
+    below = std::move(scheduled_below);
+  }
   data.loop_elimination.clear();
   data.loop_factor_start.assign(1, 0);
   data.loop_factor_rows.clear();
