@@ -133,11 +133,11 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
 }
 
 /// detail::frame_motion from the frames' placements in their links (data.frame_*_in_link, as
-/// frame_pose), the rotation only when the loop's bias needs it (a point loop does not).
-/// (the position and velocity only with `translation`: of the loop types only planar_point's
-/// bias reads them)
+/// frame_pose), the rotation only when the loop's bias needs it, for the axis and weld loops'
+/// bias: the origin's acceleration and the angular motion (not the origin's position and velocity,
+/// which only planar_point's reads: planar_bias).
 detail::FrameMotion loop_frame_motion(const MechanismModel& model, const MechanismData& data, int frame,
-                                      bool rotation, bool translation) noexcept {
+                                      bool rotation) noexcept {
   const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
   const auto f = static_cast<std::size_t>(frame);
   const Mat3& R = W.world_rotation;
@@ -146,12 +146,59 @@ detail::FrameMotion loop_frame_motion(const MechanismModel& model, const Mechani
   if (rotation) m.rotation.noalias() = R * data.frame_rotation_in_link[f];
   m.angular_velocity.noalias() = R * W.w;
   m.angular_acceleration.noalias() = R * W.alpha;
-  if (translation) {
-    m.position = W.world_position + r;
-    m.velocity = R * W.vel + m.angular_velocity.cross(r);
-  }
   m.acceleration = R * W.acc + m.angular_acceleration.cross(r) + m.angular_velocity.cross(m.angular_velocity.cross(r));
   return m;
+}
+
+/// 3-vectors as three scalars, for gamma's short products: written as Eigen expressions, each
+/// cross product went through a stack temporary stored as scalars and read back by the next sum
+/// as a 16-byte packet straddling two of those stores, which the store buffer cannot forward (a
+/// third of constraint_bias's time sat on such loads). These stay in registers.
+struct P3 {
+  double x, y, z;
+};
+inline P3 p3(const Vec3& v) noexcept { return {v.x(), v.y(), v.z()}; }
+inline P3 operator+(const P3& a, const P3& b) noexcept { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline P3 operator-(const P3& a, const P3& b) noexcept { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline P3 cross(const P3& a, const P3& b) noexcept {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double dot(const P3& a, const P3& b) noexcept { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline P3 rotate(const Mat3& R, const P3& v) noexcept {
+  return {R(0, 0) * v.x + R(0, 1) * v.y + R(0, 2) * v.z, R(1, 0) * v.x + R(1, 1) * v.y + R(1, 2) * v.z,
+          R(2, 0) * v.x + R(2, 1) * v.y + R(2, 2) * v.z};
+}
+
+/// A planar_point loop's rows of gamma: x_k . d has the second derivative
+/// xdd . d + 2 xd . dd + x . ddd (x_k of frame A, d = p_B - p_A), in O (as loop_frame_motion).
+void planar_bias(const MechanismModel& model, MechanismData& data, int i, int row) noexcept {
+  struct Motion {
+    P3 position, velocity, acceleration, angular_velocity, angular_acceleration;
+  };
+  const auto motion = [&](int frame) {
+    const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
+    const Mat3& R = W.world_rotation;
+    const P3 r = rotate(R, p3(data.frame_position_in_link[static_cast<std::size_t>(frame)]));
+    Motion m;
+    m.angular_velocity = rotate(R, p3(W.w));
+    m.angular_acceleration = rotate(R, p3(W.alpha));
+    m.position = p3(W.world_position) + r;
+    m.velocity = rotate(R, p3(W.vel)) + cross(m.angular_velocity, r);
+    m.acceleration = rotate(R, p3(W.acc)) + cross(m.angular_acceleration, r) +
+                     cross(m.angular_velocity, cross(m.angular_velocity, r));
+    return m;
+  };
+  const int fa = model.loop_frame_a(i);
+  const Motion A = motion(fa), B = motion(model.loop_frame_b(i));
+  const P3 d = B.position - A.position, dd = B.velocity - A.velocity, ddd = B.acceleration - A.acceleration;
+  const Mat3& RA = data.work[static_cast<std::size_t>(model.frame_link(fa))].world_rotation;
+  const Mat3& F = data.frame_rotation_in_link[static_cast<std::size_t>(fa)];
+  for (int k = 0; k < 2; ++k) {
+    const P3 x = rotate(RA, P3{F(0, k), F(1, k), F(2, k)});
+    const P3 xd = cross(A.angular_velocity, x);
+    const P3 xdd = cross(A.angular_acceleration, x) + cross(A.angular_velocity, xd);
+    data.loop_bias(row + k) = dot(xdd, d) + 2.0 * dot(xd, dd) + dot(x, ddd);
+  }
 }
 
 /// gamma = dA/dt v from a forward pass with velocities (accelerations at a = 0).
@@ -160,31 +207,27 @@ void constraint_bias(const MechanismModel& model, MechanismData& data) noexcept 
     const int row = model.loop_row(i);
     const LoopType type = model.loop(i).type;
     if (type == LoopType::point) {
-      // the origins' accelerations only, each in its link's axes, rotated once
+      // the origins' accelerations only, each in its link's axes, rotated once:
+      // R (acc + alpha x p + w x (w x p)) (in scalars: P3)
       const auto acceleration = [&](int frame) {
         const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
-        const Vec3& p = data.frame_position_in_link[static_cast<std::size_t>(frame)];
-        const Vec3 local = W.acc + W.alpha.cross(p) + W.w.cross(W.w.cross(p));
-        return Vec3(W.world_rotation * local);
+        const P3 p = p3(data.frame_position_in_link[static_cast<std::size_t>(frame)]), w = p3(W.w);
+        return rotate(W.world_rotation, p3(W.acc) + cross(p3(W.alpha), p) + cross(w, cross(w, p)));
       };
-      data.loop_bias.segment<3>(row) = acceleration(model.loop_frame_b(i)) - acceleration(model.loop_frame_a(i));
+      const P3 ddd = acceleration(model.loop_frame_b(i)) - acceleration(model.loop_frame_a(i));
+      data.loop_bias(row) = ddd.x;
+      data.loop_bias(row + 1) = ddd.y;
+      data.loop_bias(row + 2) = ddd.z;
       continue;
     }
-    const bool rotation = type == LoopType::planar_point || type == LoopType::axis;
-    const bool planar = type == LoopType::planar_point;
-    const detail::FrameMotion A = loop_frame_motion(model, data, model.loop_frame_a(i), rotation, planar);
-    const detail::FrameMotion B = loop_frame_motion(model, data, model.loop_frame_b(i), type == LoopType::axis, planar);
+    if (type == LoopType::planar_point) {
+      planar_bias(model, data, i, row);
+      continue;
+    }
+    const bool axis = type == LoopType::axis;
+    const detail::FrameMotion A = loop_frame_motion(model, data, model.loop_frame_a(i), axis);
+    const detail::FrameMotion B = loop_frame_motion(model, data, model.loop_frame_b(i), axis);
     const Vec3 ddd = B.acceleration - A.acceleration;
-    if (planar) {
-      const Vec3 d = B.position - A.position, dd = B.velocity - A.velocity;
-      for (int k = 0; k < 2; ++k) {
-        const Vec3 x = A.rotation.col(k);
-        const Vec3 xd = A.angular_velocity.cross(x);
-        const Vec3 xdd = A.angular_acceleration.cross(x) + A.angular_velocity.cross(xd);
-        data.loop_bias(row + k) = xdd.dot(d) + 2.0 * xd.dot(dd) + x.dot(ddd);
-      }
-      continue;
-    }
     data.loop_bias.segment<3>(row) = ddd;
     if (type == LoopType::axis) {
       const Vec3 z = A.rotation.col(2);
