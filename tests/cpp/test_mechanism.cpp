@@ -3,6 +3,7 @@
 // its own invariants on random trees, and the real-time contract (no allocation, statuses).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <iterator>
 #include <limits>
@@ -26,9 +27,23 @@ using namespace mechbal;
 
 namespace {
 
+/// A random rotation among the 24 that permute the axes with signs (exact zeros and ones).
+Mat3 random_axis_permutation(std::mt19937& rng) {
+  int order[3] = {0, 1, 2};
+  std::shuffle(std::begin(order), std::end(order), rng);
+  Mat3 R = Mat3::Zero();
+  for (int c = 0; c < 3; ++c) R(order[c], c) = std::bernoulli_distribution(0.5)(rng) ? 1.0 : -1.0;
+  if (R.determinant() < 0.0) R.col(2) = -R.col(2);
+  return R;
+}
+
 /// A random tree: each joint's parent is a random earlier link; types from `types` (R, P, F);
 /// 1-3 bodies per link; a gear coupling on the last joint when `gear`; a frame on every link.
-MechanismModel random_tree(std::mt19937& rng, const std::string& types, bool gear = false) {
+/// `aligned`: the joints' placements turn the axes into one another (random_axis_permutation)
+/// and their axes are +-x, +-y or +-z, as in models drawn at right angles, or (half of them) the
+/// placement does not turn and the axis is z.
+MechanismDescription random_tree_description(std::mt19937& rng, const std::string& types, bool gear = false,
+                                             bool aligned = false) {
   MechanismDescription d;
   std::uniform_real_distribution<double> u(-0.3, 0.3);
   std::vector<std::string> links{d.root_name};
@@ -39,6 +54,14 @@ MechanismModel random_tree(std::mt19937& rng, const std::string& types, bool gea
     j.parent = links[std::uniform_int_distribution<std::size_t>(0, links.size() - 1)(rng)];
     j.placement = test::random_pose(rng);
     j.axis = Vec3(u(rng), u(rng), u(rng)).normalized();
+    if (aligned && std::bernoulli_distribution(0.5)(rng)) {  // (the other half: in line with the parent, along z)
+      j.placement.linear() = random_axis_permutation(rng);
+      j.axis = (std::bernoulli_distribution(0.5)(rng) ? 1.0 : -1.0) *
+               Vec3::Unit(std::uniform_int_distribution<int>(0, 2)(rng));
+    } else if (aligned) {
+      j.placement.linear().setIdentity();
+      j.axis = Vec3::UnitZ();
+    }
     d.joints.push_back(j);
     const int nb = 1 + static_cast<int>(std::uniform_int_distribution<int>(0, 2)(rng));
     for (int b = 0; b < nb; ++b) {
@@ -50,7 +73,11 @@ MechanismModel random_tree(std::mt19937& rng, const std::string& types, bool gea
     links.push_back(j.name);
   }
   if (gear) test::gear_last_joint(d);
-  return MechanismModel(d);
+  return d;
+}
+
+MechanismModel random_tree(std::mt19937& rng, const std::string& types, bool gear = false) {
+  return MechanismModel(random_tree_description(rng, types, gear));
 }
 
 using test::rel;
@@ -102,6 +129,58 @@ TEST(Mechanism, ShakingWrenchEqualsTheSumOverBodies) {
     EXPECT_LT(rel(data.shaking.linear_momentum, per_body.linear_momentum), 1e-12);
     EXPECT_LT(rel(data.shaking.angular_momentum, per_body.angular_momentum), 1e-12);
   }
+}
+
+// Links whose constant rotation permutes the axes (exact zeros and ones) take shortcuts in every
+// pass (MechanismModel::local_rotation: products with R's zeros left out). Their results must be
+// those of the general products: the same tree with each placement turned by 1e-13 rad (no exact
+// zeros left: every link general, a different mechanism by 1e-13) agrees to 1e-11 in every
+// algorithm that places links, runs a forward or a backward pass or accumulates composites.
+TEST(Mechanism, AxisAlignedLinksAgreeWithTheGeneralProducts) {
+  std::mt19937 rng(29);
+  using K = MechanismModel::LocalRotation;
+  int seen[5] = {0, 0, 0, 0, 0};
+  for (int trial = 0; trial < 12; ++trial) {
+    const MechanismDescription d = random_tree_description(rng, trial % 2 == 0 ? "RRPFRRPR" : "RFRRPRRF", trial % 3 == 0, true);
+    MechanismDescription turned = d;
+    for (Joint& j : turned.joints) j.placement.linear() = j.placement.linear() * Eigen::AngleAxisd(1e-13, Vec3(0.6, 0.0, 0.8)).toRotationMatrix();
+    const MechanismModel model(d), general(turned);
+    for (int l = 1; l < model.num_links(); ++l) {
+      ASSERT_NE(model.local_rotation(l), K::general) << "link " << l;
+      ASSERT_EQ(general.local_rotation(l), K::general) << "link " << l;
+      ++seen[static_cast<int>(model.local_rotation(l))];
+    }
+    MechanismData data(model), other(general);
+    const int n = model.dof();
+    const Eigen::VectorXd q = test::random_vector(rng, n, 2.0), v = test::random_vector(rng, n, 1.0),
+                          a = test::random_vector(rng, n, 1.0);
+    ASSERT_EQ(inverse_dynamics(model, data, q, v, a), Status::ok);
+    ASSERT_EQ(inverse_dynamics(general, other, q, v, a), Status::ok);
+    EXPECT_LT(rel(data.joint_torque, other.joint_torque), 1e-11);
+    ASSERT_EQ(mass_matrix(model, data, q), Status::ok);
+    ASSERT_EQ(mass_matrix(general, other, q), Status::ok);
+    EXPECT_LT(rel(data.mass_matrix, other.mass_matrix), 1e-11);
+    ASSERT_EQ(shaking_wrench(model, data, q, v, a), Status::ok);
+    ASSERT_EQ(shaking_wrench(general, other, q, v, a), Status::ok);
+    EXPECT_LT(rel(data.shaking.force, other.shaking.force), 1e-11);
+    EXPECT_LT(rel(data.shaking.moment, other.shaking.moment), 1e-11);
+    EXPECT_LT(rel(data.shaking.angular_momentum, other.shaking.angular_momentum), 1e-11);
+    ASSERT_EQ(base_reaction(model, data, q, v, a), Status::ok);
+    ASSERT_EQ(base_reaction(general, other, q, v, a), Status::ok);
+    EXPECT_LT(rel(data.base_reaction.moment, other.base_reaction.moment), 1e-11);
+    ASSERT_EQ(momentum_matrix(model, data, q), Status::ok);
+    ASSERT_EQ(momentum_matrix(general, other, q), Status::ok);
+    EXPECT_LT(rel(data.momentum_matrix, other.momentum_matrix), 1e-11);
+    for (int f = 0; f < model.num_frames(); ++f) {
+      ASSERT_EQ(frame_placement(model, data, q, f), Status::ok);
+      ASSERT_EQ(frame_placement(general, other, q, f), Status::ok);
+      const auto fs = static_cast<std::size_t>(f);
+      EXPECT_LT((data.frame_placements[fs].matrix() - other.frame_placements[fs].matrix()).cwiseAbs().maxCoeff(), 1e-11)
+          << f;
+    }
+  }
+  // every shortcut taken: the links along x, y, z and the identity (prismatic and fixed joints)
+  for (const K kind : {K::along_x, K::along_y, K::along_z, K::identity}) EXPECT_GT(seen[static_cast<int>(kind)], 0);
 }
 
 // A chain long enough that its per-link buffers take the large-buffer path (2 MiB and more:

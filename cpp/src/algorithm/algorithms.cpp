@@ -541,12 +541,15 @@ Status mass_matrix(const MechanismModel& model, MechanismData& data, const Const
     if (W.composite_mass == 0.0 && W.composite_inertia.trace() == 0.0) continue;
     const Mat3& R = W.rotation;
     const Vec3& t = W.translation;
-    for (int l = i; l < end; ++l) {
-      auto& C = data.work[static_cast<std::size_t>(l)];
-      const Vec3 P = R * C.force;
-      C.moment = R * C.moment + t.cross(P);
-      C.force = P;
-    }
+    detail::with_local_rotation(model.local_rotation(i), [&](auto kind) {
+      constexpr auto K = decltype(kind)::value;
+      for (int l = i; l < end; ++l) {
+        auto& C = data.work[static_cast<std::size_t>(l)];
+        const Vec3 P = detail::to_parent<K>(R, C.force);
+        C.moment = detail::to_parent<K>(R, C.moment) + t.cross(P);
+        C.force = P;
+      }
+    });
   }
   return ok ? Status::ok : Status::out_of_range;
 }

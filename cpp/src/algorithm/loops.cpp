@@ -1165,8 +1165,11 @@ MECHBAL_FLATTEN void closed_wrench_of_projected(const MechanismModel& model, Mec
       const Vec3& parent_angular = field[2 * parent];
       const Vec3& parent_linear = field[2 * parent + 1];
       Vec3 angular, linear;
-      angular.noalias() = W.rotation.transpose() * parent_angular;
-      linear.noalias() = W.rotation.transpose() * (parent_linear + parent_angular.cross(W.translation));
+      detail::with_local_rotation(model.local_rotation(l), [&](auto kind) {
+        constexpr auto K = decltype(kind)::value;
+        angular = detail::to_child<K>(W.rotation, parent_angular);
+        linear = detail::to_child<K>(W.rotation, Vec3(parent_linear + parent_angular.cross(W.translation)));
+      });
       const int c = model.coordinate(l);
       const double qdd = c >= 0 ? model.coordinate_ratio(l) * a[c] : 0.0;
       data.joint_acceleration[k] = qdd;

@@ -56,7 +56,10 @@ void validate_shared_fields(std::uint32_t cancel, double rate_hz, double damping
 /// 6 x 6): Eigen's closed forms for 1 x 1 to 3 x 3 (computeDirect: a few hundred flops where the
 /// iterative tridiagonal QR costs about 500 ns at 3 x 3), the iterative solver `fallback` for
 /// larger matrices and whenever the closed form finds the matrix ill-conditioned (lmin < 1e-6
-/// lmax), where its absolute error of a few eps lmax would matter to the condition number.
+/// lmax), where its absolute error (up to ~sqrt(eps) lmax near a double root: see
+/// closed_form3_error) would matter to the condition number. The controllers call it through
+/// gram_extremes, which needs it only for Gram matrices above 3 x 3 or from more than
+/// max_minor_side columns.
 template <typename Small, typename Solver>
 void extreme_eigenvalues(const Small& S, Solver& fallback, double& lmin, double& lmax) noexcept {
   const Eigen::Index n = S.rows();
@@ -84,6 +87,176 @@ void extreme_eigenvalues(const Small& S, Solver& fallback, double& lmin, double&
   lmax = lambda(lambda.size() - 1);
 }
 
+/// Unit roundoff of double (u = eps / 2).
+constexpr double unit = std::numeric_limits<double>::epsilon() / 2.0;
+
+/// The closed forms' error bounds, relative to lmax, on any eigenvalue they give.
+/// 2 x 2 (Eigen's computeDirect: shift by the mean, scale, lambda = mean +- sqrt(...)): lmax is a
+/// sum of non-negative terms, a few roundings: 8 eps covers it. 3 x 3 (the trigonometric method on
+/// the shifted and scaled matrix B, max |B_ij| = 1): the characteristic polynomial's coefficients
+/// carry absolute errors of a few eps (B's entries are at most 1), and every step is well
+/// conditioned except theta = atan2(sqrt(q), b) / 3 where two roots meet (q -> 0): there an error
+/// e_q ~ 5 eps in q moves sqrt(q), hence theta, by up to sqrt(e_q) / (3 rho^(3/2)), and with
+/// rho^2 = |B|_F^2 / 6 >= 1/6 and the roots 2 rho cos(theta + 2 pi j / 3) (rho <= 1.23) each
+/// root by at most 2 rho sqrt(e_q) / (3 rho^(3/2)) <= 1.3 sqrt(5 eps) = 2.9 sqrt(eps) in B's units,
+/// the scale being at most lmax. 8 sqrt(eps) lmax (1.2e-7 lmax) bounds every root with margin.
+/// This absolute error is why the closed form's lmin cannot settle a decision at max_condition =
+/// 1e4 (lmin = 1e-8 lmax there).
+constexpr double closed_form2_error = 8.0 * std::numeric_limits<double>::epsilon();
+constexpr double closed_form3_error = 8.0 * 1.4901161193847656e-08;  // 8 sqrt(eps)
+/// Eigen's iterative solver (Householder tridiagonalisation, implicit QR): backward stable, each
+/// eigenvalue within a small multiple of eps lmax of the computed Gram matrix's.
+constexpr double iterative_error = 16.0 * std::numeric_limits<double>::epsilon();
+/// The largest matrix side whose minors are summed (Cauchy-Binet): C(8, 3) = 56 determinants.
+constexpr int max_minor_side = 8;
+
+/// e_{g-1} and e_g (the elementary symmetric functions) of the eigenvalues of the g x g Gram
+/// matrix W W^T (W: g x n, g = 2 or 3, g <= n) from W's minors, each with a bound on its rounding
+/// error: by Cauchy-Binet, e_j is the sum of the squares of W's j x j minors. A minor's rounding
+/// error is relative to the sum of its products' magnitudes (2 x 2: 2u (|ad| + |bc|); 3 x 3 by
+/// cofactors: 5u times its permanent of |W|; taken 3u and 6u), not to the Gram matrix's norm, so
+/// e_g = det(W W^T) keeps its relative accuracy where det(W W^T) from the Gram matrix itself loses
+/// it: for a square 3 x 3 W with singular values s1 >= s2 >= s3 the relative error of det W is
+/// about u s1^2 / (s2 s3), that of det(W^T W) computed from W^T W u s1^4 / (s2 s3)^2.
+/// (For g = 2, e_{g-1} = e_1 is not needed and left 0.)
+struct GramInvariants {
+  double low = 0.0, low_error = 0.0;  ///< e_{g-1}
+  double top = 0.0, top_error = 0.0;  ///< e_g
+};
+
+template <class At>
+GramInvariants gram_invariants(const At& w, int g, int n) noexcept {
+  GramInvariants e;
+  int low_terms = 0, top_terms = 0;
+  const auto add = [](double& sum, double& error, double m, double bound) {
+    sum += m * m;
+    error += (2.0 * std::abs(m) + bound) * bound;
+  };
+  if (g == 2) {
+    for (int a = 0; a < n; ++a)
+      for (int b = a + 1; b < n; ++b) {
+        const double p = w(0, a) * w(1, b), q = w(0, b) * w(1, a);
+        add(e.top, e.top_error, p - q, 3.0 * unit * (std::abs(p) + std::abs(q)));
+        ++top_terms;
+      }
+  } else {
+    for (int a = 0; a < n; ++a)
+      for (int b = a + 1; b < n; ++b)
+        for (int r = 0; r < 3; ++r)
+          for (int s = r + 1; s < 3; ++s) {
+            const double p = w(r, a) * w(s, b), q = w(r, b) * w(s, a);
+            add(e.low, e.low_error, p - q, 3.0 * unit * (std::abs(p) + std::abs(q)));
+            ++low_terms;
+          }
+    for (int a = 0; a < n; ++a)
+      for (int b = a + 1; b < n; ++b)
+        for (int c = b + 1; c < n; ++c) {
+          // along row 0, with rows 1 and 2's 2 x 2 minors
+          const double bc = w(1, b) * w(2, c) - w(1, c) * w(2, b);
+          const double ac = w(1, a) * w(2, c) - w(1, c) * w(2, a);
+          const double ab = w(1, a) * w(2, b) - w(1, b) * w(2, a);
+          const double pbc = std::abs(w(1, b) * w(2, c)) + std::abs(w(1, c) * w(2, b));
+          const double pac = std::abs(w(1, a) * w(2, c)) + std::abs(w(1, c) * w(2, a));
+          const double pab = std::abs(w(1, a) * w(2, b)) + std::abs(w(1, b) * w(2, a));
+          const double det = w(0, a) * bc - w(0, b) * ac + w(0, c) * ab;
+          const double perm = std::abs(w(0, a)) * pbc + std::abs(w(0, b)) * pac + std::abs(w(0, c)) * pab;
+          add(e.top, e.top_error, det, 6.0 * unit * perm);
+          ++top_terms;
+        }
+  }
+  // the squares' and the sum's own roundings
+  e.low_error += (low_terms + 2) * unit * e.low;
+  e.top_error += (top_terms + 2) * unit * e.top;
+  return e;
+}
+
+/// The smallest and largest eigenvalues of the Gram matrix G = W W^T (W: g x n through `w`, G
+/// computed from it by the caller), accurate enough for the damping decision at max_condition
+/// (lmin against lmax / max_condition^2) and, when `reported`, for the reported condition
+/// sqrt(lmax / lmin) (to 1e-6 relative on lmin, or as accurately as the iterative solver), without
+/// iterating where an interval on lmin settles both. Returns whether the iterative solver ran.
+///
+/// g = 2, 3 and n <= max_minor_side: lmax from the closed form (relative error d = the closed
+/// form's bound: the largest root is never the one lost to cancellation). Then lmin:
+/// - g = 2: lmin = e_2 / lmax (det G = lmin lmax), relative error ~ that of e_2 plus d.
+/// - g = 3, closed-form lmin >= lmax / 4: the closed form (absolute error <= d lmax).
+/// - g = 3 otherwise, by deflation: r = lmid lmin = e_3 / lmax, s = lmid + lmin = (e_2 - r) /
+///   lmax (no cancellation: r / (e_2 - r) <= lmin / lmax < 1/4), lmid = (s + sqrt(s^2 - 4r)) / 2
+///   (>= s / 2), lmin = r / lmid. Relative errors of e_2, e_3 and lmax (small: lmax is either
+///   well apart from lmid, or lmid is well apart from lmin and s^2 - 4r does not cancel) carry
+///   over; where lmid and lmin meet, s^2 - 4r cancels and the square root turns an error e into
+///   sqrt(e), so the bounds are propagated at run time, absolute, step by step, with lmin <=
+///   sqrt(lmid lmin) and lmin <= s / 2 as further upper bounds.
+/// The interval [lo, hi] on the true lmin settles the decision unless it overlaps lmax /
+/// max_condition^2 widened by d; for a reported condition, the interval must also be within 1e-6
+/// relative of lmin or narrower than the iterative solver's error. Otherwise (and for g > 3, or
+/// n > max_minor_side) the iterative solver decides (extreme_eigenvalues).
+template <class At, typename Small, typename Solver>
+bool gram_extremes(const At& w, int g, int n, const Small& G, double max_condition, bool reported, Solver& fallback,
+                   double& lmin, double& lmax) noexcept {
+  if (!(g == 2 || g == 3) || n > max_minor_side) {
+    extreme_eigenvalues(G, fallback, lmin, lmax);
+    return g > 3 || !(lmax > 0.0 && lmin >= 1e-6 * lmax);
+  }
+  double l0 = 0.0, d = 0.0;
+  if (g == 2) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> direct;
+    direct.computeDirect(Eigen::Matrix2d(G.template topLeftCorner<2, 2>()), Eigen::EigenvaluesOnly);
+    l0 = direct.eigenvalues()(0);
+    lmax = direct.eigenvalues()(1);
+    d = closed_form2_error;
+  } else {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> direct;
+    direct.computeDirect(Eigen::Matrix3d(G.template topLeftCorner<3, 3>()), Eigen::EigenvaluesOnly);
+    l0 = direct.eigenvalues()(0);
+    lmax = direct.eigenvalues()(2);
+    d = closed_form3_error;
+  }
+  if (!(lmax > 0.0 && lmax <= huge)) {  // G = 0 (or not finite: the caller checked)
+    lmin = l0;
+    return false;
+  }
+  const GramInvariants e = gram_invariants(w, g, n);
+  double lo = 0.0, hi = 0.0;
+  if (g == 2) {
+    lmin = e.top / lmax;
+    const double err = e.top_error / lmax + lmin * (d + 2.0 * unit);
+    lo = lmin - err;
+    hi = lmin + err;
+  } else if (l0 >= 0.25 * lmax) {
+    lmin = l0;
+    lo = lmin - d * lmax;
+    hi = lmin + d * lmax;
+  } else {
+    const double r = e.top / lmax;
+    const double er = e.top_error / lmax + r * (d + 2.0 * unit);
+    const double s = std::max(e.low - r, 0.0) / lmax;
+    const double es = (e.low_error + er) / lmax + s * (d + 3.0 * unit);
+    const double disc = s * s - 4.0 * r;
+    const double ed = (2.0 * s + es) * es + 4.0 * er + 4.0 * unit * (s * s + 4.0 * r);
+    const double root = std::sqrt(std::max(disc, 0.0));
+    const double eroot = root > 0.0 ? std::min(std::sqrt(ed), ed / root) : std::sqrt(ed);
+    const double mid = 0.5 * (s + root);
+    const double emid = 0.5 * (es + eroot) + unit * mid;
+    lmin = mid > 0.0 ? r / mid : 0.0;
+    hi = std::min(0.5 * (s + es), std::sqrt(r + er));
+    if (mid > emid) hi = std::min(hi, (r + er) / (mid - emid));
+    lo = (r - er) / (mid + emid);
+    hi *= 1.0 + 4.0 * unit;
+    lo *= 1.0 - 4.0 * unit;
+  }
+  lo = std::max(lo, 0.0);
+  const double threshold = lmax / (max_condition * max_condition);  // damped iff lmin < threshold
+  bool settled = hi < threshold * (1.0 - d) || lo > threshold * (1.0 + d);
+  if (settled && reported) settled = hi - lo <= 2e-6 * lmin || 0.5 * (hi - lo) <= iterative_error * lmax;
+  if (settled) return false;
+  fallback.compute(G, Eigen::EigenvaluesOnly);
+  const auto& lambda = fallback.eigenvalues();  // ascending
+  lmax = lambda(lambda.size() - 1);
+  lmin = std::min(std::max(lambda(0), lo), hi);  // the true lmin is in [lo, hi]
+  return true;
+}
+
 /// A x for the 6 x n momentum matrix, column by column at fixed height (Eigen's dynamic
 /// matrix-vector product goes through a blocked kernel whose setup costs more at these sizes).
 Vec6 momentum_times(const Eigen::MatrixXd& A, const Eigen::VectorXd& x) noexcept {
@@ -102,6 +275,29 @@ void project_actuated(const Eigen::MatrixXd& C, const Eigen::VectorXd& x, Eigen:
 }
 
 }  // namespace
+
+namespace detail {
+
+GramExtremes gram_extremes(const Eigen::MatrixXd& K, double max_condition, bool reported) {
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+  if (K.rows() < 1 || K.cols() < 1 || K.rows() > 6 || K.cols() > 6 || !K.allFinite())
+    fail("gram_extremes: K must be finite, 1 to 6 rows and columns");
+  const bool wide = K.rows() < K.cols();
+  const Small G = wide ? Small(K * K.transpose()) : Small(K.transpose() * K);
+  const int g = static_cast<int>(G.rows()), n = static_cast<int>(wide ? K.cols() : K.rows());
+  Eigen::SelfAdjointEigenSolver<Small> fallback(g);
+  GramExtremes out;
+  if (wide) {
+    out.iterated = mechbal::gram_extremes([&](int i, int j) { return K(i, j); }, g, n, G, max_condition, reported,
+                                          fallback, out.lmin, out.lmax);
+  } else {
+    out.iterated = mechbal::gram_extremes([&](int i, int j) { return K(j, i); }, g, n, G, max_condition, reported,
+                                          fallback, out.lmin, out.lmax);
+  }
+  return out;
+}
+
+}  // namespace detail
 
 std::uint32_t momentum_component(const std::string& name) noexcept {
   if (name == "moment") return cancel_moment;
@@ -445,13 +641,16 @@ Status ReactionlessController::factorise(double* reported) noexcept {
   // semi-definite) has lmax <= tr G, and lmin >= det G / tr G (2 x 2) or 4 det G / (tr G)^2 (3 x 3:
   // the two largest eigenvalues' product is at most (tr G / 2)^2). When that bound on lmax / lmin
   // is within max_condition^2, so is the true ratio: no damping, as the eigenvalues would decide.
-  // Otherwise they are computed (the damping needs lmax).
+  // Otherwise they are computed (the damping needs lmax): gram_extremes, which settles the
+  // decision near a singularity too without the iterative solver.
   const Eigen::Index g = gram_.rows();
   bool bounded = false;
   if (!reported && (g == 2 || g == 3)) {
+    // det G less its rounding error's bound: the products' magnitudes are at most tr^g (|G_ij|
+    // <= sqrt(G_ii G_jj) <= tr), 2 products of 2 roundings at 2 x 2, 6 products of 5 at 3 x 3
     const double tr = gram_.trace();
-    const double det = g == 2 ? gram_(0, 0) * gram_(1, 1) - gram_(0, 1) * gram_(1, 0)
-                              : Eigen::Matrix3d(gram_.topLeftCorner<3, 3>()).determinant();
+    const double det = g == 2 ? gram_(0, 0) * gram_(1, 1) - gram_(0, 1) * gram_(1, 0) - 4.0 * unit * tr * tr
+                              : Eigen::Matrix3d(gram_.topLeftCorner<3, 3>()).determinant() - 30.0 * unit * tr * tr * tr;
     const double low = g == 2 ? det / tr : 4.0 * det / (tr * tr);
     bounded = tr > 0.0 && low > 0.0 && tr <= config_.max_condition * config_.max_condition * low;
     if (bounded) {
@@ -459,7 +658,18 @@ Status ReactionlessController::factorise(double* reported) noexcept {
       lmin = low;
     }
   }
-  if (!bounded) extreme_eigenvalues(gram_, eig_, lmin, lmax);
+  if (!bounded) {
+    // the Gram matrix's eigenvalues, from K_b's minors and the closed forms where these settle
+    // the decision (and the reported condition): near a singularity too, without iterating
+    const int n = static_cast<int>(wide_ ? Kb_.cols() : Kb_.rows());
+    if (wide_) {
+      gram_extremes([this](int i, int j) { return Kb_(i, j); }, static_cast<int>(g), n, gram_, config_.max_condition,
+                    reported != nullptr, eig_, lmin, lmax);
+    } else {
+      gram_extremes([this](int i, int j) { return Kb_(j, i); }, static_cast<int>(g), n, gram_, config_.max_condition,
+                    reported != nullptr, eig_, lmin, lmax);
+    }
+  }
   if (!(lmax > 0.0)) {  // S K_b = 0: the balancing joints cannot act on the cancelled components
     condition = huge;
     damped_ = true;
@@ -917,7 +1127,8 @@ Status ReactionlessTaskController::factorise(MinNorm& f, const Eigen::MatrixXd& 
   if (rank == 0) return Status::ok;  // nothing can move these rows (an empty null space): x = 0
   if (rank == rows) {
     double lmin = 0.0, lmax = 0.0;
-    extreme_eigenvalues(f.gram, f.eig, lmin, lmax);
+    gram_extremes([&M](int i, int j) { return M(i, j); }, static_cast<int>(rows), static_cast<int>(M.cols()), f.gram,
+                  config_.max_condition, false, f.eig, lmin, lmax);
     if (!(lmax > 0.0)) return Status::singular;
     Status st = Status::ok;
     const double cond = lmin > 0.0 ? std::sqrt(lmax / lmin) : huge;

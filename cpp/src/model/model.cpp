@@ -361,6 +361,18 @@ MechanismModel::MechanismModel(MechanismDescription d) {
     c.first_moment += m * com;
     c.inertia_origin += I + m * (com.squaredNorm() * Mat3::Identity() - com * com.transpose());
   }
+  local_rotation_.assign(nl, LocalRotation::general);
+  for (std::size_t l = 1; l < nl; ++l) {
+    const Mat3& C = constants_[l].rotation;
+    if (!C.unaryExpr([](double x) { return x == 0.0 || x == 1.0 || x == -1.0 ? 0.0 : 1.0; }).isZero(0.0)) continue;
+    if (type_[l] != JointType::revolute && C == Mat3::Identity()) {
+      local_rotation_[l] = LocalRotation::identity;
+      continue;
+    }
+    Eigen::Index axis = 0;  // the row of C e_z's one nonzero entry
+    C.col(2).cwiseAbs().maxCoeff(&axis);
+    local_rotation_[l] = axis == 0 ? LocalRotation::along_x : axis == 1 ? LocalRotation::along_y : LocalRotation::along_z;
+  }
   has_inertia_.assign(nl, 0);
   inertial_links_.clear();
   for (std::size_t l = 1; l < nl; ++l) {

@@ -33,6 +33,87 @@ namespace mechbal::detail {
 /// w x e_z without the multiplications by zero.
 inline Vec3 cross_ez(const Vec3& w) noexcept { return Vec3(w.y(), -w.x(), 0.0); }
 
+using LocalRotation = MechanismModel::LocalRotation;
+
+/// R^T v and R v for a link's rotation R relative to its parent (LinkWork::rotation) as it acts
+/// (K: model.local_rotation): the identity costs nothing; along an axis k of the parent's frame,
+/// R e_z = +-e_k and R's first two columns lie in the other two rows (i, j), so four
+/// multiplications and one sign instead of nine. The products left out are those with R's exact
+/// zeros, so the results are R^T v and R v.
+template <LocalRotation K>
+struct AxisRows {  // k, and the other two rows i < j
+  static constexpr int k = K == LocalRotation::along_x ? 0 : K == LocalRotation::along_y ? 1 : 2;
+  static constexpr int i = k == 0 ? 1 : 0;
+  static constexpr int j = k == 2 ? 1 : 2;
+};
+
+template <LocalRotation K>
+inline Vec3 to_child(const Mat3& R, const Vec3& v) noexcept {
+  if constexpr (K == LocalRotation::identity) {
+    return v;
+  } else if constexpr (K == LocalRotation::general) {
+    return R.transpose() * v;
+  } else {
+    using A = AxisRows<K>;
+    return Vec3(R(A::i, 0) * v(A::i) + R(A::j, 0) * v(A::j), R(A::i, 1) * v(A::i) + R(A::j, 1) * v(A::j),
+                R(A::k, 2) * v(A::k));
+  }
+}
+
+template <LocalRotation K>
+inline Vec3 to_parent(const Mat3& R, const Vec3& v) noexcept {
+  if constexpr (K == LocalRotation::identity) {
+    return v;
+  } else if constexpr (K == LocalRotation::general) {
+    return R * v;
+  } else {
+    using A = AxisRows<K>;
+    Vec3 out;
+    out(A::i) = R(A::i, 0) * v.x() + R(A::i, 1) * v.y();
+    out(A::j) = R(A::j, 0) * v.x() + R(A::j, 1) * v.y();
+    out(A::k) = R(A::k, 2) * v.z();
+    return out;
+  }
+}
+
+/// P R for a rotation P (a parent's in O) and a link's R, as to_child.
+template <LocalRotation K>
+inline void times_local(const Mat3& P, const Mat3& R, Mat3& out) noexcept {
+  if constexpr (K == LocalRotation::identity) {
+    out = P;
+  } else if constexpr (K == LocalRotation::general) {
+    out.noalias() = P * R;
+  } else {
+    using A = AxisRows<K>;
+    out.col(0) = R(A::i, 0) * P.col(A::i) + R(A::j, 0) * P.col(A::j);
+    out.col(1) = R(A::i, 1) * P.col(A::i) + R(A::j, 1) * P.col(A::j);
+    out.col(2) = R(A::k, 2) * P.col(A::k);
+  }
+}
+
+/// f(std::integral_constant<LocalRotation, K>{}) with K = `kind`: one branch per link, then code
+/// specialised for its rotation.
+template <typename F>
+inline void with_local_rotation(LocalRotation kind, F&& f) noexcept {
+  switch (kind) {
+    case LocalRotation::along_x:
+      f(std::integral_constant<LocalRotation, LocalRotation::along_x>{});
+      break;
+    case LocalRotation::along_y:
+      f(std::integral_constant<LocalRotation, LocalRotation::along_y>{});
+      break;
+    case LocalRotation::along_z:
+      f(std::integral_constant<LocalRotation, LocalRotation::along_z>{});
+      break;
+    case LocalRotation::identity:
+      f(std::integral_constant<LocalRotation, LocalRotation::identity>{});
+      break;
+    case LocalRotation::general:
+      f(std::integral_constant<LocalRotation, LocalRotation::general>{});
+      break;
+  }
+}
+
 inline bool data_matches(const MechanismModel& model, const MechanismData& data) noexcept {
   return data.dof == model.dof() && data.num_links == model.num_links() &&
          data.num_bodies == model.num_bodies() && data.num_frames == model.num_frames() &&
@@ -172,7 +253,9 @@ MECHBAL_FLATTEN inline void place(const MechanismModel& model, MechanismData& da
       const auto& p = data.work[static_cast<std::size_t>(model.parent(l))];
       w.world_moved = local || w.world_stale || p.world_moved;
       if (w.world_moved) {
-        w.world_rotation.noalias() = p.world_rotation * w.rotation;
+        with_local_rotation(model.local_rotation(l), [&](auto kind) {
+          times_local<decltype(kind)::value>(p.world_rotation, w.rotation, w.world_rotation);
+        });
         w.world_position = p.world_position + p.world_rotation * w.translation;
         w.world_stale = false;
         w.momentum_current = false;
@@ -240,8 +323,9 @@ struct LinkMotion {
 /// stored separately (z after x and y) waits for the stores to retire instead of forwarding
 /// from them, which cost the passes a fifth of their time. On return `m` is l's motion and
 /// `last` = l.
-template <bool Velocity, bool Acceleration, bool Forces, bool OriginVelocity = true, bool Rates = true>
-inline void forward_link(const MechanismModel& model, MechanismData& data, int l, LinkMotion& m, int& last) noexcept {
+/// (forward_link for a link whose rotation acts as K)
+template <LocalRotation K, bool Velocity, bool Acceleration, bool Forces, bool OriginVelocity, bool Rates>
+inline void forward_link_as(const MechanismModel& model, MechanismData& data, int l, LinkMotion& m, int& last) noexcept {
   const auto k = static_cast<std::size_t>(l);
   const int parent = model.parent(l);
   if (parent != last) {
@@ -263,13 +347,13 @@ inline void forward_link(const MechanismModel& model, MechanismData& data, int l
     Vec3 a_lin = m.acc;
     if (Velocity || Acceleration) a_lin += m.alpha.cross(p);
     if (Velocity) a_lin += m.w.cross(m.w.cross(p));
-    acc.noalias() = R.transpose() * a_lin;
+    acc = to_child<K>(R, a_lin);
   }
   if (Velocity) {
-    w.noalias() = R.transpose() * m.w;
-    if (OriginVelocity) vel.noalias() = R.transpose() * (m.vel + m.w.cross(p));
+    w = to_child<K>(R, m.w);
+    if (OriginVelocity) vel = to_child<K>(R, Vec3(m.vel + m.w.cross(p)));
   }
-  if (Rates && (Velocity || Acceleration)) alpha.noalias() = R.transpose() * m.alpha;
+  if (Rates && (Velocity || Acceleration)) alpha = to_child<K>(R, m.alpha);
   const double qd = Velocity ? data.joint_velocity[k] : 0.0;
   const double qdd = Acceleration ? data.joint_acceleration[k] : 0.0;
   switch (model.joint_type(l)) {
@@ -304,6 +388,14 @@ inline void forward_link(const MechanismModel& model, MechanismData& data, int l
   }
   last = l;
   if (Forces) link_wrench<Velocity>(model.link_constants(l), w, alpha, acc, W.force, W.moment);
+}
+
+template <bool Velocity, bool Acceleration, bool Forces, bool OriginVelocity = true, bool Rates = true>
+inline void forward_link(const MechanismModel& model, MechanismData& data, int l, LinkMotion& m, int& last) noexcept {
+  with_local_rotation(model.local_rotation(l), [&](auto kind) {
+    forward_link_as<decltype(kind)::value, Velocity, Acceleration, Forces, OriginVelocity, Rates>(model, data, l, m,
+                                                                                                 last);
+  });
 }
 
 /// Forward pass: velocity, acceleration of every link in its own L frame and, when Forces, the
@@ -345,9 +437,12 @@ MECHBAL_FLATTEN inline void backward_pass(const MechanismModel& model, Mechanism
       tau(c) += model.coordinate_ratio(l) * t;
     }
     auto& P = data.work[static_cast<std::size_t>(model.parent(l))];
-    const Vec3 f = W.rotation * W.force;
-    P.force += f;
-    P.moment += W.rotation * W.moment + W.translation.cross(f);
+    with_local_rotation(model.local_rotation(l), [&](auto kind) {
+      constexpr LocalRotation K = decltype(kind)::value;
+      const Vec3 f = to_parent<K>(W.rotation, W.force);
+      P.force += f;
+      P.moment += to_parent<K>(W.rotation, W.moment) + W.translation.cross(f);
+    });
   }
 }
 
@@ -390,8 +485,17 @@ MECHBAL_FLATTEN inline void composite_inertias(const MechanismModel& model, Mech
     // on the six distinct entries of the symmetric result.
     const double m = W.composite_mass;
     const Vec3& p = W.translation;
-    const Vec3 h = W.rotation * W.composite_first_moment;
-    const Mat3 I = rotate_symmetric(W.rotation, W.composite_inertia);
+    Vec3 h;
+    Mat3 I;
+    with_local_rotation(model.local_rotation(l), [&](auto kind) {
+      constexpr LocalRotation K = decltype(kind)::value;
+      h = to_parent<K>(W.rotation, W.composite_first_moment);
+      if constexpr (K == LocalRotation::identity) {
+        I = W.composite_inertia;
+      } else {
+        I = rotate_symmetric(W.rotation, W.composite_inertia);
+      }
+    });
     const double diagonal = m * p.squaredNorm() + 2.0 * p.dot(h);
     const Vec3 mp_h = m * p + h;  // m p_r p_c + h_r p_c + p_r h_c = (m p + h)_r p_c + p_r h_c
     Mat3& C = P.composite_inertia;

@@ -243,6 +243,14 @@ class MechanismModel {
   const std::vector<int>& inertial_links() const noexcept { return inertial_links_; }
   /// Whether link `link` carries mass or inertia (inertial_links' membership).
   bool has_inertia(int link) const noexcept { return has_inertia_[static_cast<std::size_t>(link)] != 0; }
+  /// How link `link`'s rotation R relative to its parent acts (the passes' products with it):
+  /// identity when R is the identity (a prismatic or fixed joint whose constant rotation is exactly
+  /// the identity); along_x, along_y, along_z when its constant rotation is a signed permutation
+  /// (exact zeros and ones: frames at right angles, links along parallel axes, a pantograph's)
+  /// that takes the joint's axis to the parent's x, y or z axis, so that R's third column has one
+  /// nonzero entry, in that row, and its first two columns none there; general otherwise.
+  enum class LocalRotation : unsigned char { general, along_x, along_y, along_z, identity };
+  LocalRotation local_rotation(int link) const noexcept { return local_rotation_[static_cast<std::size_t>(link)]; }
 
  private:
   MechanismDescription description_;
@@ -262,6 +270,7 @@ class MechanismModel {
   std::vector<int> body_link_;
   std::vector<int> inertial_links_;
   std::vector<unsigned char> has_inertia_;
+  std::vector<LocalRotation> local_rotation_;
   std::vector<Frame> frames_;
   std::vector<int> frame_link_;
   std::vector<LinkConstants, detail::LargeBufferAllocator<LinkConstants>> constants_;
