@@ -945,27 +945,12 @@ inline void block_velocity(const MechanismData& data, const MechanismData::LoopB
   for (int k = 0; k < nr; ++k) out[lb.row + k] = sum[k];
 }
 
-/// forward_pass<true, false, false, false> over data.loop_bias_links alone (the loop frames' links
-/// and their ancestors: the motion gamma reads).
-MECHBAL_FLATTEN void bias_pass(const MechanismModel& model, MechanismData& data) noexcept {
-  auto& base = data.work[0];
-  base.w.setZero();
-  base.alpha.setZero();
-  base.vel.setZero();
-  base.acc.setZero();
-  detail::LinkMotion m{base.w, base.vel, base.acc, base.alpha};
-  int last = 0;
-  for (const int l : data.loop_bias_links) detail::forward_link<true, false, false>(model, data, l, m, last);
-}
-
 /// loop_projection at q (checked); `solved`: q is where solve_loop_positions just converged, so
 /// data.loop_jacobian, the factorisation of A° and data.loop_rcond are already those of q (its last
-/// evaluation) and are not recomputed. `bias_links_only`: the velocity pass for gamma covers the
-/// loop frames' links and their ancestors alone (data.loop_bias_links); the other links' motion
-/// is left as it was (closed_wrench_of_projected computes it whole).
+/// evaluation) and are not recomputed.
 Status project(const MechanismModel& model, MechanismData& data, const ConstVector& q,
                const ConstVector& v_actuated, const LoopSolveOptions& options, bool solved,
-               bool acceleration = true, bool bias_links_only = false) noexcept {
+               bool acceleration = true) noexcept {
   const auto& actuated = model.actuated_coordinates();
   const auto& passive = model.passive_coordinates();
   Status status = Status::ok;
@@ -1079,11 +1064,7 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
     }
   }
   // (the links are placed at q: by the solve's last evaluation, or by evaluate above)
-  if (bias_links_only && data.loop_bias_links.size() + 1 < static_cast<std::size_t>(model.num_links())) {
-    bias_pass(model, data);  // gamma reads the loop frames' links' motion alone
-  } else {
-    detail::forward_pass<true, false, false, false>(model, data);
-  }
+  detail::forward_pass<true, false, false, false>(model, data);
   if (!acceleration_bias(model, data, refine_solves) || !finite) return status | Status::singular;
   return status;
 }
@@ -1096,41 +1077,27 @@ Status loop_projection(const MechanismModel& model, MechanismData& data, const C
   return project(model, data, q, v_actuated, options, false);
 }
 
-namespace {
-
-/// closed_motion; `bias_links_only` as project's (closed_shaking_wrench completes the motion).
-Status motion(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
-              const ConstVector& v_actuated, const ConstVector& a_actuated, Eigen::Ref<Eigen::VectorXd> q,
-              const LoopSolveOptions& options, bool bias_links_only) noexcept {
+Status closed_motion(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
+                     const ConstVector& v_actuated, const ConstVector& a_actuated, Eigen::Ref<Eigen::VectorXd> q,
+                     const LoopSolveOptions& options) noexcept {
   if (Status s = check(model, data, q, &q_actuated, &v_actuated, &a_actuated); s != Status::ok) return s;
   Status status = solve_positions(model, data, q_actuated, q, options, true);
   if (has(status, Status::solver_error)) return status;
-  status |= project(model, data, q, v_actuated, options, true, true, bias_links_only);  // (closed_position = q)
+  status |= project(model, data, q, v_actuated, options, true);  // (closed_position = q)
   data.closed_acceleration = data.loop_acceleration_bias;
   apply_projection(model, data, a_actuated, data.closed_acceleration, true);
   return status;
 }
 
-}  // namespace
-
-Status closed_motion(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
-                     const ConstVector& v_actuated, const ConstVector& a_actuated, Eigen::Ref<Eigen::VectorXd> q,
-                     const LoopSolveOptions& options) noexcept {
-  return motion(model, data, q_actuated, v_actuated, a_actuated, q, options, false);
-}
-
 namespace {
 
-/// The shaking wrench of the closed motion, after project with bias_links_only (closed model: the
-/// links placed at q in O, the joints' rates those of closed_velocity, and the velocities and
-/// accelerations at a = 0 of the links in the bias pass, data.loop_bias_links). The wrench is
-/// linear in a: the rates of the momenta are those at a = 0 plus A(q) a, so the bias pass's motion
-/// needs only a's part added, propagated down the tree with no velocity terms (the acceleration
-/// field of a alone: alpha_a, acc_a, in data.loop_acceleration_field); the links outside that pass
-/// (those with no loop frame at or below them: a wrist carried by a parallel mechanism) take their
-/// whole motion, velocities and total accelerations, in one forward step each. Each link's
-/// Newton-Euler wrench and momentum are then formed from the totals and summed about O in the same
-/// sweep. work[].alpha and acc end as the total
+/// The shaking wrench of the closed motion, after project (closed model: the links placed at q in
+/// O, the joints' rates those of closed_velocity, and every link's velocities and its accelerations
+/// at a = 0 from the bias pass). The wrench is linear in a: the rates of the momenta are those at
+/// a = 0 plus A(q) a, so the bias pass's motion needs only a's part added, propagated down the
+/// tree with no velocity terms (the acceleration field of a alone: alpha_a, acc_a, in
+/// data.loop_acceleration_field); each link's Newton-Euler wrench and momentum are then formed
+/// from the totals and summed about O in the same sweep. work[].alpha and acc end as the total
 /// accelerations and data.joint_acceleration as a's (as shaking_wrench leaves them); work[].force
 /// and moment are not written. Equal to shaking_wrench at (q, v, a) to round-off.
 MECHBAL_FLATTEN void closed_wrench_of_projected(const MechanismModel& model, MechanismData& data) noexcept {
@@ -1140,58 +1107,38 @@ MECHBAL_FLATTEN void closed_wrench_of_projected(const MechanismModel& model, Mec
   field[1].setZero();
   Vec3 P = Vec3::Zero(), H = Vec3::Zero(), F = Vec3::Zero(), M = Vec3::Zero();
   const int nl = model.num_links();
-  const unsigned char* in_bias_pass = data.loop_bias_member.data();
-  detail::LinkMotion motion{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};  // (of `stepped`)
-  int stepped = -1;
   for (int l = 1; l < nl; ++l) {
     const auto k = static_cast<std::size_t>(l);
     auto& W = data.work[k];
+    const auto parent = static_cast<std::size_t>(model.parent(l));
+    const Vec3& parent_angular = field[2 * parent];
+    const Vec3& parent_linear = field[2 * parent + 1];
+    Vec3 angular, linear;
+    detail::with_local_rotation(model.local_rotation(l), [&](auto kind) {
+      constexpr auto K = decltype(kind)::value;
+      angular = detail::to_child<K>(W.rotation, parent_angular);
+      linear = detail::to_child<K>(W.rotation, Vec3(parent_linear + parent_angular.cross(W.translation)));
+    });
+    const int c = model.coordinate(l);
+    const double qdd = c >= 0 ? model.coordinate_ratio(l) * a[c] : 0.0;
+    data.joint_acceleration[k] = qdd;
+    switch (model.joint_type(l)) {
+      case JointType::revolute:
+        angular.z() += qdd;
+        break;
+      case JointType::prismatic:
+        linear.z() += qdd;
+        break;
+      case JointType::fixed:
+        break;
+    }
+    field[2 * k] = angular;
+    field[2 * k + 1] = linear;
     // (the link's motion in locals for the sums below: read back from W right after its totals
     // are stored, 16-byte loads straddle those stores and wait for them to retire)
-    Vec3 w, vel, alpha, acc;
-    if (!in_bias_pass[k]) {
-      // outside the bias pass (no loop frame at or below it; its parent's motion is whole by now,
-      // inside the pass or not): its whole motion in one forward step, which its children
-      // (outside too) take over, with no field of a
-      const int c = model.coordinate(l);
-      data.joint_acceleration[k] = c >= 0 ? model.coordinate_ratio(l) * a[c] : 0.0;
-      detail::forward_link<true, true, false>(model, data, l, motion, stepped);
-      w = motion.w;
-      vel = motion.vel;
-      alpha = motion.alpha;
-      acc = motion.acc;
-    } else {
-      const auto parent = static_cast<std::size_t>(model.parent(l));
-      const Vec3& parent_angular = field[2 * parent];
-      const Vec3& parent_linear = field[2 * parent + 1];
-      Vec3 angular, linear;
-      detail::with_local_rotation(model.local_rotation(l), [&](auto kind) {
-        constexpr auto K = decltype(kind)::value;
-        angular = detail::to_child<K>(W.rotation, parent_angular);
-        linear = detail::to_child<K>(W.rotation, Vec3(parent_linear + parent_angular.cross(W.translation)));
-      });
-      const int c = model.coordinate(l);
-      const double qdd = c >= 0 ? model.coordinate_ratio(l) * a[c] : 0.0;
-      data.joint_acceleration[k] = qdd;
-      switch (model.joint_type(l)) {
-        case JointType::revolute:
-          angular.z() += qdd;
-          break;
-        case JointType::prismatic:
-          linear.z() += qdd;
-          break;
-        case JointType::fixed:
-          break;
-      }
-      field[2 * k] = angular;
-      field[2 * k + 1] = linear;
-      w = W.w;
-      vel = W.vel;
-      alpha = W.alpha + angular;
-      acc = W.acc + linear;
-      W.alpha = alpha;
-      W.acc = acc;
-    }
+    const Vec3 w = W.w, vel = W.vel, alpha = W.alpha + angular, acc = W.acc + linear;
+    W.alpha = alpha;
+    W.acc = acc;
     if (!model.has_inertia(l)) continue;  // adds nothing to the sums
     const auto& cst = model.link_constants(l);
     Vec3 force, moment;
@@ -1212,7 +1159,7 @@ MECHBAL_FLATTEN void closed_wrench_of_projected(const MechanismModel& model, Mec
 Status closed_shaking_wrench(const MechanismModel& model, MechanismData& data, const ConstVector& q_actuated,
                              const ConstVector& v_actuated, const ConstVector& a_actuated,
                              Eigen::Ref<Eigen::VectorXd> q, const LoopSolveOptions& options) noexcept {
-  Status status = motion(model, data, q_actuated, v_actuated, a_actuated, q, options, true);
+  Status status = closed_motion(model, data, q_actuated, v_actuated, a_actuated, q, options);
   if (has(status, Status::solver_error) || has(status, Status::bad_size) || has(status, Status::non_finite_input) ||
       has(status, Status::out_of_range)) {
     return status;

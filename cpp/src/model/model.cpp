@@ -589,16 +589,6 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
     }
     return links;
   };
-  data.loop_bias_member.assign(static_cast<std::size_t>(model.num_links()), 0);
-  for (int i = 0; i < model.num_loops(); ++i) {
-    for (int frame : {model.loop_frame_a(i), model.loop_frame_b(i)}) {
-      for (int k = model.frame_link(frame); k >= 1; k = model.parent(k)) data.loop_bias_member[static_cast<std::size_t>(k)] = 1;
-    }
-  }
-  data.loop_bias_links.clear();
-  for (int k = 1; k < model.num_links(); ++k) {
-    if (data.loop_bias_member[static_cast<std::size_t>(k)]) data.loop_bias_links.push_back(k);
-  }
   data.loop_path_joints.clear();
   data.loop_path_joint_start.assign(1, 0);
   for (int i = 0; i < model.num_loops(); ++i) {

@@ -216,11 +216,6 @@ struct MechanismData {
   /// per link, the angular then the origin acceleration (in L_i) that a alone gives, with no
   /// velocity (2 per link; a closed model only).
   std::vector<Vec3> loop_acceleration_field;
-  /// The links whose motion gamma needs: each loop frame's link and its ancestors (tree order,
-  /// the base excluded), and per link whether it is one of them. closed_shaking_wrench's velocity
-  /// pass covers these alone; its wrench pass moves the others (a wrist on a parallel mechanism).
-  std::vector<int> loop_bias_links;
-  std::vector<unsigned char> loop_bias_member;
 
   // ---- internal buffers (per link, in the joint-aligned frames L_i of model.hpp) ----
   // Field order: what one pass touches sits together (the placement, relative and in O, then the
