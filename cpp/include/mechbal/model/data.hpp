@@ -133,8 +133,9 @@ struct MechanismData {
   Eigen::LDLT<Eigen::MatrixXd> reduced_ldlt;  ///< of C^T M C (na x na)
   /// The passive coordinates in the elimination order of N = A°^T A° (a minimum-degree ordering of
   /// the loops' structure, fixed at construction: PAMINSA's legs before the platform they share, so
-  /// that the factor keeps the legs' blocks apart); A°'s columns, the Newton step and the solution
-  /// rows are in this order.
+  /// that the factor keeps the legs' blocks apart; then sorted by height in the elimination tree,
+  /// the same fill, so that the legs' columns alternate); A°'s columns, the Newton step and the
+  /// solution rows are in this order.
   std::vector<int> loop_elimination;
   /// Structure of L in N = L D L^T: the rows (elimination positions, increasing) that column k may
   /// fill are loop_factor_rows[loop_factor_start[k] .. loop_factor_start[k + 1]).
