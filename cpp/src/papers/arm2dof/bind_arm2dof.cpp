@@ -91,6 +91,22 @@ py::dict log_to_dict(const ClosedLoopLog& log) {
   return d;
 }
 
+/// simulate_closed_loop from the Python arguments (q0, v0 and the options checked first), the GIL
+/// released while it runs; the log as a dict. `desired`: a RestToRestTrajectory or a SampledMotion.
+template <typename Desired>
+py::dict run_closed_loop(ForwardDynamics& plant, JointController& controller, const Desired& desired,
+                         const Array& q0_arg, const Array& qd0_arg, double dt, double duration,
+                         const std::string& sampling) {
+  const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "v0", -1);
+  const ClosedLoopOptions opt = closed_loop_options(dt, duration, sampling);
+  ClosedLoopLog log;
+  {
+    py::gil_scoped_release release;
+    log = simulate_closed_loop(plant, controller, desired, q0, qd0, opt);
+  }
+  return log_to_dict(log);
+}
+
 void bind_arm2dof(py::module_& m) {
   py::class_<Arm2DofParameters>(m, "Arm2DofParameters",
                                 "Bare 2R arm of Arakelian et al. 2011, Fig. 1 (defaults: Sec. 4)")
@@ -215,14 +231,7 @@ void bind_arm2dof(py::module_& m) {
       [](ForwardDynamics& plant, JointController& controller, const RestToRestTrajectory& desired,
          const Array& q0_arg, const Array& qd0_arg, double dt, double duration,
          const std::string& sampling) {
-        const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "v0", -1);
-        const ClosedLoopOptions opt = closed_loop_options(dt, duration, sampling);
-        ClosedLoopLog log;
-        {
-          py::gil_scoped_release release;
-          log = simulate_closed_loop(plant, controller, desired, q0, qd0, opt);
-        }
-        return log_to_dict(log);
+        return run_closed_loop(plant, controller, desired, q0_arg, qd0_arg, dt, duration, sampling);
       },
       py::arg("plant"), py::arg("controller"), py::arg("desired"), py::arg("q0"), py::arg("v0"),
       py::arg("dt") = 1e-3, py::arg("duration") = 1.0, py::arg("sampling") = "zero_order_hold",
@@ -245,14 +254,7 @@ void bind_arm2dof(py::module_& m) {
         desired.q = Eigen::Map<const RowMajor>(q_des.data(), J, n);
         desired.qd = Eigen::Map<const RowMajor>(qd_des.data(), J, n);
         desired.qdd = Eigen::Map<const RowMajor>(qdd_des.data(), J, n);
-        const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "v0", -1);
-        const ClosedLoopOptions opt = closed_loop_options(dt, duration, sampling);
-        ClosedLoopLog log;
-        {
-          py::gil_scoped_release release;
-          log = simulate_closed_loop(plant, controller, desired, q0, qd0, opt);
-        }
-        return log_to_dict(log);
+        return run_closed_loop(plant, controller, desired, q0_arg, qd0_arg, dt, duration, sampling);
       },
       py::arg("plant"), py::arg("controller"), py::arg("q_des"), py::arg("v_des"),
       py::arg("a_des"), py::arg("q0"), py::arg("v0"), py::arg("dt") = 1e-3,
