@@ -422,10 +422,7 @@ void bind_mechanism(py::module_& m) {
          int max_iterations, double tolerance, double singular_rcond, bool dynamics) {
         const auto na = static_cast<py::ssize_t>(mo.num_actuated());
         const auto n = static_cast<py::ssize_t>(mo.dof());
-        require_shape(qa, "q_actuated", {-1, na});
-        const auto N = qa.shape(0);
-        require_shape(va, "v_actuated", {N, na});
-        require_shape(aa, "a_actuated", {N, na});
+        const auto N = batch_rows(na, {{qa, "q_actuated"}, {va, "v_actuated"}, {aa, "a_actuated"}});
         require_shape(q0, "q_guess", {n});
         if (max_iterations < 1 || max_iterations > 1000) {
           throw py::value_error("max_iterations must be in 1..1000, got " + std::to_string(max_iterations));

@@ -96,11 +96,9 @@ std::vector<std::string> names_of(const ReactionlessController& c, const std::ve
 py::dict run(ReactionlessController& c, const Array& q, const Array& v, const Array& a) {
   const auto nt = static_cast<py::ssize_t>(c.num_task());
   const std::string context = "the controller has " + std::to_string(nt) + " task joints";
-  require_shape(q, "q_task", {-1, nt}, context.c_str());
-  const auto rows = q.shape(0);
+  const auto rows = batch_rows(nt, {{q, "q_task"}}, context.c_str());
   const py::ssize_t steps = half_step_ticks(rows, "q_task"), N = steps + 1;
-  require_shape(v, "v_task", {rows, nt}, context.c_str());
-  require_shape(a, "a_task", {rows, nt}, context.c_str());
+  require_rows(rows, nt, {{v, "v_task"}, {a, "a_task"}}, context.c_str());
   const auto na = static_cast<py::ssize_t>(c.num_actuated()), n = static_cast<py::ssize_t>(c.model().dof());
   OutArray Q = make_array({N, na}), V = make_array({N, na}), A = make_array({N, na});
   OutArray QF = make_array({N, n}), VF = make_array({N, n}), AF = make_array({N, n});

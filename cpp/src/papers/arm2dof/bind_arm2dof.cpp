@@ -44,10 +44,7 @@ using CVec = Eigen::Map<const Eigen::VectorXd>;
 template <class F>
 py::dict batch3(const Array& a, const char* na, const Array& b, const char* nb, const Array& c,
                 const char* nc, const char* out_name, F&& f) {
-  require_shape(a, na, {-1, 2});
-  const auto N = a.shape(0);
-  require_shape(b, nb, {N, 2});
-  require_shape(c, nc, {N, 2});
+  const auto N = batch_rows(2, {{a, na}, {b, nb}, {c, nc}});
   OutArray out = make_array({N, 2});
   auto per_instant = make_status_array(N);
   Status status = Status::ok;
@@ -245,10 +242,8 @@ void bind_arm2dof(py::module_& m) {
          const Array& qd_des, const Array& qdd_des, const Array& q0_arg, const Array& qd0_arg,
          double dt, double duration, const std::string& sampling) {
         const auto n = static_cast<py::ssize_t>(plant.dof());
-        require_shape(q_des, "q_des", {-1, n}, "one row every dt/2, one value per joint");
-        const auto J = q_des.shape(0);
-        require_shape(qd_des, "v_des", {J, n});
-        require_shape(qdd_des, "a_des", {J, n});
+        const auto J = batch_rows(n, {{q_des, "q_des"}}, "one row every dt/2, one value per joint");
+        require_rows(J, n, {{qd_des, "v_des"}, {qdd_des, "a_des"}});
         using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
         SampledMotion desired;
         desired.q = Eigen::Map<const RowMajor>(q_des.data(), J, n);
