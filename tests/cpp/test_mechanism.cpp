@@ -21,6 +21,7 @@
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/control/kdl_chain.hpp"
 #include "mechbal/detail/tree.hpp"
+#include "every_algorithm.hpp"
 #include "test_support.hpp"
 
 using namespace mechbal;
@@ -444,29 +445,7 @@ TEST(Mechanism, AlgorithmsAllocateNothing) {
   const int n = model.dof();
   const Eigen::VectorXd q = test::random_vector(rng, n, 2.0), v = test::random_vector(rng, n, 1.0),
                         a = test::random_vector(rng, n, 1.0);
-  // the quadratic results are sized by their first call (data.hpp): once, before the loop
-  data.reserve_mass_matrix();
-  torque_regressor(model, data, q, v, a);
-  gravity_regressor(model, data, q);
-  test::AllocationScope scope;
-  for (int k = 0; k < 3; ++k) {
-    EXPECT_EQ(forward_kinematics(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(center_of_mass(model, data, q), Status::ok);
-    EXPECT_EQ(momentum(model, data, q, v), Status::ok);
-    EXPECT_EQ(momentum_matrix(model, data, q), Status::ok);
-    EXPECT_EQ(shaking_wrench(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(base_reaction(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(inverse_dynamics(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(gravity_torque(model, data, q), Status::ok);
-    EXPECT_EQ(bias_torque(model, data, q, v), Status::ok);
-    EXPECT_EQ(mass_matrix(model, data, q), Status::ok);
-    EXPECT_EQ(frame_jacobian(model, data, q, 0), Status::ok);
-    EXPECT_EQ(frame_placement(model, data, q, 1), Status::ok);
-    EXPECT_EQ(torque_regressor(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(gravity_regressor(model, data, q), Status::ok);
-    EXPECT_EQ(momentum_regressor(model, data, q, v), Status::ok);
-  }
-  EXPECT_EQ(scope.count(), 0u);
+  EXPECT_EQ(test::allocations_of_every_algorithm(model, data, q, v, a, 1), 0u);
 }
 
 // frame_placement (one frame from the link placements) is the frame forward_kinematics places,
