@@ -18,6 +18,7 @@
 #include "mechbal/algorithm/regressor.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/io/urdf.hpp"
+#include "urdf_error.hpp"
 
 using namespace mechbal;
 
@@ -59,14 +60,7 @@ std::string replaced(std::string text, const std::string& from, const std::strin
   return text;
 }
 
-std::string error_of(const std::string& xml) {
-  try {
-    model_from_urdf_string(xml);
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using test::urdf_error_of;
 
 }  // namespace
 
@@ -146,26 +140,26 @@ TEST(Urdf, AlgorithmsAllocateNothing) {
 }
 
 TEST(Urdf, ErrorsNameTheElement) {
-  std::string e = error_of(replaced(kTree, "type=\"prismatic\"", "type=\"floating\""));
+  std::string e = urdf_error_of(replaced(kTree, "type=\"prismatic\"", "type=\"floating\""));
   EXPECT_NE(e.find("URDF joint 'j3'"), std::string::npos) << e;
   EXPECT_NE(e.find("floating"), std::string::npos) << e;
 
-  e = error_of(replaced(kTree, "<parent link=\"l3\"/>", "<parent link=\"l33\"/>"));
+  e = urdf_error_of(replaced(kTree, "<parent link=\"l3\"/>", "<parent link=\"l33\"/>"));
   EXPECT_NE(e.find("l33"), std::string::npos) << e;
   EXPECT_NE(e.find("j5"), std::string::npos) << e;
   EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 
-  e = error_of(replaced(kTree, "<mass value=\"0.5\"/>", "<mass value=\"-0.5\"/>"));
+  e = urdf_error_of(replaced(kTree, "<mass value=\"0.5\"/>", "<mass value=\"-0.5\"/>"));
   EXPECT_NE(e.find("URDF link 'l3' inertial.mass"), std::string::npos) << e;
   EXPECT_NE(e.find("-0.5"), std::string::npos) << e;
 
-  e = error_of(replaced(kTree, "ixx=\"0.005\"", "ixx=\"0.5\""));  // triangle inequality
+  e = urdf_error_of(replaced(kTree, "ixx=\"0.005\"", "ixx=\"0.5\""));  // triangle inequality
   EXPECT_NE(e.find("URDF link 'l3' inertial.inertia"), std::string::npos) << e;
 
-  e = error_of(replaced(kTree, "<mimic joint=\"j1\"", "<mimic joint=\"jj1\""));
+  e = urdf_error_of(replaced(kTree, "<mimic joint=\"j1\"", "<mimic joint=\"jj1\""));
   EXPECT_NE(e.find("URDF joint 'j5': mimic joint 'jj1' does not exist"), std::string::npos) << e;
 
-  e = error_of("<robot name=\"x\"><link name=\"a\"></robot>");
+  e = urdf_error_of("<robot name=\"x\"><link name=\"a\"></robot>");
   EXPECT_EQ(e.rfind("URDF: ", 0), 0u) << e;
 
   try {
