@@ -46,15 +46,10 @@ Mat3 random_axis_permutation(std::mt19937& rng) {
 MechanismDescription random_tree_description(std::mt19937& rng, const std::string& types, bool gear = false,
                                              bool aligned = false) {
   MechanismDescription d;
-  std::uniform_real_distribution<double> u(-0.3, 0.3);
   std::vector<std::string> links{d.root_name};
   for (std::size_t i = 0; i < types.size(); ++i) {
-    Joint j;
-    j.name = "j" + std::to_string(i + 1);
-    j.type = types[i] == 'P' ? JointType::prismatic : types[i] == 'F' ? JointType::fixed : JointType::revolute;
-    j.parent = links[std::uniform_int_distribution<std::size_t>(0, links.size() - 1)(rng)];
-    j.placement = test::random_pose(rng);
-    j.axis = Vec3(u(rng), u(rng), u(rng)).normalized();
+    const std::string parent = links[std::uniform_int_distribution<std::size_t>(0, links.size() - 1)(rng)];
+    Joint j = test::random_joint(rng, "j" + std::to_string(i + 1), types[i], parent);
     if (aligned && std::bernoulli_distribution(0.5)(rng)) {  // (the other half: in line with the parent, along z)
       j.placement.linear() = random_axis_permutation(rng);
       j.axis = (std::bernoulli_distribution(0.5)(rng) ? 1.0 : -1.0) *
@@ -65,11 +60,7 @@ MechanismDescription random_tree_description(std::mt19937& rng, const std::strin
     }
     d.joints.push_back(j);
     const int nb = 1 + static_cast<int>(std::uniform_int_distribution<int>(0, 2)(rng));
-    for (int b = 0; b < nb; ++b) {
-      const RigidBody rb = test::random_body(rng);
-      d.bodies.push_back(Body{j.name + "_b" + std::to_string(b), "link", j.name, rb.mass,
-                              Vec3(u(rng), u(rng), u(rng)), rb.inertia_body});
-    }
+    for (int b = 0; b < nb; ++b) d.bodies.push_back(test::random_link_body(rng, j.name + "_b" + std::to_string(b), j.name));
     d.frames.push_back(Frame{j.name + "_tool", j.name, test::random_pose(rng)});
     links.push_back(j.name);
   }
