@@ -96,20 +96,28 @@ def _cmd_run(args) -> int:
     return 0
 
 
-def _run_mujoco(args, out: Path) -> int:
+def _in_mujoco(args, out: Path, run, wrote: str) -> int:
+    """`run(tmp)` (a command that drives MuJoCo) into the staged folder that becomes ``out``, its
+    tables printed after it (unless -q), then "wrote {out}/{wrote}"."""
     from mechbal.output import staged_output
-    from mechbal.verify import run_cosimulation
 
     buffer = io.StringIO()
     try:
         with contextlib.redirect_stdout(buffer), staged_output(out) as tmp:
-            run_cosimulation(args.case, tmp)
+            run(tmp)
     except ImportError as exc:  # the optional 'mujoco' extra is missing: the message names it
         raise UserError(str(exc)) from None
     if not args.quiet:
         sys.stdout.write(buffer.getvalue())
-        print(f"wrote {out}/summary.json, base_reaction.png (MuJoCo beside mechbal) and the files beside them")
+        print(f"wrote {out}/{wrote}")
     return 0
+
+
+def _run_mujoco(args, out: Path) -> int:
+    from mechbal.verify import run_cosimulation
+
+    return _in_mujoco(args, out, lambda tmp: run_cosimulation(args.case, tmp),
+                      "summary.json, base_reaction.png (MuJoCo beside mechbal) and the files beside them")
 
 
 def _cmd_balance(args) -> int:
@@ -219,21 +227,14 @@ def _cmd_export(args) -> int:
 
 
 def _cmd_verify(args) -> int:
-    from mechbal.output import check_output_dir, staged_output
+    from mechbal.output import check_output_dir
     from mechbal.verify import run_verify
 
     out = Path(args.out)
     check_output_dir(out)
-    buffer = io.StringIO()
-    try:
-        with contextlib.redirect_stdout(buffer), staged_output(out) as tmp:
-            run_verify(args.case, tmp, simulate=not args.no_simulation, method=args.method)
-    except ImportError as exc:  # the optional 'mujoco' extra is missing: the message names it
-        raise UserError(str(exc)) from None
-    if not args.quiet:
-        sys.stdout.write(buffer.getvalue())
-        print(f"wrote {out}/summary.json and the plots beside it")
-    return 0
+    return _in_mujoco(args, out, lambda tmp: run_verify(args.case, tmp, simulate=not args.no_simulation,
+                                                        method=args.method),
+                      "summary.json and the plots beside it")
 
 
 # ---- parser and main --------------------------------------------------------------------------
