@@ -175,6 +175,43 @@ TEST(Mechanism, AxisAlignedLinksAgreeWithTheGeneralProducts) {
   for (const K kind : {K::along_x, K::along_y, K::along_z, K::identity}) EXPECT_GT(seen[static_cast<int>(kind)], 0);
 }
 
+// The shortcuts themselves, against the dense products they stand for, on rotations of each kind
+// (R = C R_z(q), C a signed permutation taking z to the axis k; the identity), to round-off.
+TEST(Mechanism, RotationShortcutsAreTheDenseProducts) {
+  std::mt19937 rng(31);
+  using K = MechanismModel::LocalRotation;
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto check = [&](auto kind, const Mat3& R) {
+    constexpr K k = decltype(kind)::value;
+    const Vec3 v(u(rng), u(rng), u(rng));
+    Mat3 S = Mat3::Random();
+    S = (S * S.transpose()).eval();
+    S = (0.5 * (S + S.transpose())).eval();  // (exactly symmetric, as a composite inertia)
+    const Mat3 P = Eigen::Quaterniond::UnitRandom().toRotationMatrix();
+    Mat3 PR;
+    detail::times_local<k>(P, R, PR);
+    const double tol = 4.0 * std::numeric_limits<double>::epsilon();
+    EXPECT_LT((detail::to_child<k>(R, v) - R.transpose() * v).cwiseAbs().maxCoeff(), tol);
+    EXPECT_LT((detail::to_parent<k>(R, v) - R * v).cwiseAbs().maxCoeff(), tol);
+    EXPECT_LT((PR - P * R).cwiseAbs().maxCoeff(), tol);
+    const Mat3 rotated = detail::rotate_symmetric_as<k>(R, S);
+    EXPECT_LT((rotated - R * S * R.transpose()).cwiseAbs().maxCoeff(), tol * S.norm());
+    EXPECT_EQ(rotated, rotated.transpose());  // exactly symmetric, as rotate_symmetric's
+  };
+  for (int trial = 0; trial < 50; ++trial) {
+    Mat3 C = random_axis_permutation(rng);
+    const double q = 3.0 * u(rng);
+    const Mat3 R = C * Eigen::AngleAxisd(q, Vec3::UnitZ()).toRotationMatrix();
+    Eigen::Index axis = 0;
+    C.col(2).cwiseAbs().maxCoeff(&axis);
+    if (axis == 0) check(std::integral_constant<K, K::along_x>{}, R);
+    if (axis == 1) check(std::integral_constant<K, K::along_y>{}, R);
+    if (axis == 2) check(std::integral_constant<K, K::along_z>{}, R);
+    check(std::integral_constant<K, K::general>{}, Mat3(Eigen::Quaterniond::UnitRandom().toRotationMatrix()));
+  }
+  check(std::integral_constant<K, K::identity>{}, Mat3::Identity());
+}
+
 // A chain long enough that its per-link buffers take the large-buffer path (2 MiB and more:
 // 2 MiB-aligned, marked for huge pages): the buffers are aligned, and the centre of mass summed
 // while the links are placed equals the body-by-body sum over forward kinematics' body states.
