@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bench_registry.hpp"
+#include "bench_support.hpp"
 #include "mechbal/papers/paminsa/paminsa.hpp"
 #include "mechbal/papers/paminsa/reactionless_wrist.hpp"
 #include "paminsa_motion.hpp"
@@ -23,11 +24,6 @@ constexpr double kDt = 1e-3;  // 1 kHz
 constexpr int kTicks = 1024;  // a precomputed stretch of trajectory, cycled through (power of 2)
 
 const Vec3 kWristStart(M_PI / 2, M_PI / 2, M_PI / 2);  // away from the z-x-z gimbal lock
-
-[[noreturn]] void fail(const char* what, double value) {
-  std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
-  std::abort();
-}
 
 // ---------------------------------------------------------------------------- wrist alone
 struct WristInputs {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bench_registry.hpp"
+#include "bench_support.hpp"
 #include "disc_arms.hpp"
 #include "mechbal/algorithm/mass_matrix.hpp"
 #include "mechbal/control/computed_torque.hpp"
@@ -26,11 +27,6 @@
 
 namespace mechbal::bench {
 namespace {
-
-[[noreturn]] void fail(const char* what, double value) {
-  std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
-  std::abort();
-}
 
 MechanismModel disc_arm_6() {
   std::vector<test::Disc> discs;

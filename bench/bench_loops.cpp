@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bench_registry.hpp"
+#include "bench_support.hpp"
 #include "mechbal/algorithm/loops.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/papers/paminsa/paminsa.hpp"
@@ -30,22 +31,6 @@ using test::wrist_at;
 constexpr double kDt = 1e-3;
 constexpr int kTicks = 1024;
 
-[[noreturn]] void fail(const char* what, double value) {
-  std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
-  std::abort();
-}
-
-/// 0, 1, ..., kTicks - 1, kTicks - 2, ..., 1, 0, 1, ...: consecutive instants stay neighbours.
-struct PingPong {
-  int k = 0, step = 1;
-  std::size_t next() noexcept {
-    const int out = k;
-    if (k + step < 0 || k + step >= kTicks) step = -step;
-    k += step;
-    return static_cast<std::size_t>(out);
-  }
-};
-
 // ---------------------------------------------------------------------------- PAMINSA general
 struct PaminsaGeneralCase {
   PaminsaModel closed{PaminsaParameters{}};
@@ -53,7 +38,7 @@ struct PaminsaGeneralCase {
   MechanismData data{model};
   std::vector<ActuatedState> in;
   Eigen::VectorXd q;
-  PingPong order;
+  PingPong<kTicks> order;
   Status status = Status::ok;
 };
 
@@ -122,7 +107,7 @@ struct FourBarCase {
   MechanismData data{model};
   std::vector<ActuatedState> in;
   Eigen::VectorXd q = (Eigen::VectorXd(3) << 1.0, -0.6, 1.75).finished();
-  PingPong order;
+  PingPong<kTicks> order;
   Status status = Status::ok;
 };
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "bench_registry.hpp"
+#include "bench_support.hpp"
 #include "mechbal/control/reactionless.hpp"
 #include "paminsa_general.hpp"
 #include "paminsa_motion.hpp"
@@ -28,11 +29,6 @@ namespace {
 
 constexpr int kTicks = 6284;  // t wraps at 2 pi: every motion below is 2 pi periodic
 const double kDt = 2.0 * M_PI / kTicks;
-
-[[noreturn]] void fail(const char* what, double value) {
-  std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
-  std::abort();
-}
 
 struct TaskSample {
   Eigen::VectorXd q, v, a, qh, vh, qn, vn;

@@ -26,6 +26,7 @@
 
 #include "bench_registry.hpp"
 #include "bench_reactionless_panda.hpp"
+#include "bench_support.hpp"
 #include "bench_urdf.hpp"
 #include "mechbal/control/reactionless.hpp"
 
@@ -33,11 +34,6 @@ namespace mechbal::bench {
 namespace {
 
 using namespace panda_reactionless;
-
-[[noreturn]] void fail(const char* what, double value) {
-  std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
-  std::abort();
-}
 
 struct MechCase {
   std::unique_ptr<ReactionlessTaskController> ctrl;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bench_registry.hpp"
+#include "bench_support.hpp"
 #include "mechbal/algorithm/loops.hpp"
 #include "mechbal/control/reactionless.hpp"
 #include "mechbal/model/data.hpp"
@@ -27,11 +28,6 @@ namespace {
 
 constexpr int kTicks = 6284;
 const double kDt = 2.0 * M_PI / kTicks;
-
-[[noreturn]] void fail(const char* what, double value) {
-  std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
-  std::abort();
-}
 
 /// The wheel arm as a Pinocchio model (three RZ joints).
 pinocchio::Model wheel_arm_pinocchio(const MechanismModel& m) {
@@ -199,21 +195,6 @@ namespace {
 constexpr double kDt = 1e-3;
 constexpr int kTicks = 1024;
 
-[[noreturn]] void fail(const char* what, double value) {
-  std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
-  std::abort();
-}
-
-struct PingPong {
-  int k = 0, step = 1;
-  std::size_t next() noexcept {
-    const int out = k;
-    if (k + step < 0 || k + step >= kTicks) step = -step;
-    k += step;
-    return static_cast<std::size_t>(out);
-  }
-};
-
 /// The crank's state and torque along a swing; the torque holds the crank against gravity with a
 /// periodic excess, so that the accelerations are of the order of the bench's other motions.
 struct Instant {
@@ -238,7 +219,7 @@ struct MechCase {
   MechanismData data{model};
   std::vector<Instant> in = crank_instants();
   Eigen::VectorXd q = kStart;
-  PingPong order;
+  PingPong<kTicks> order;
   Status status = Status::ok;
 };
 
@@ -283,7 +264,7 @@ struct PinCase {
   ConstraintDatas constraint_data;
   pinocchio::ProximalSettings settings{1e-12, 1e-12, 3};
   std::vector<Eigen::VectorXd> q, v, tau;  // full state of each instant (from mechbal's solve)
-  PingPong order;
+  PingPong<kTicks> order;
 };
 
 Tick mechbal_case() {

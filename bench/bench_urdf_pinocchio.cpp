@@ -24,6 +24,7 @@
 #include <pinocchio/multibody.hpp>
 
 #include "bench_reactionless_panda.hpp"
+#include "bench_support.hpp"
 #include "bench_urdf.hpp"
 #include "bench_urdf_pinocchio.hpp"
 #include "mechbal/algorithm/inverse_dynamics.hpp"
@@ -132,11 +133,6 @@ Tick momentum_rate_case(const char* robot) {
 // file comment there says what is compared).
 namespace panda_reactionless {
 namespace {
-
-[[noreturn]] void fail(const char* what, double value) {
-  std::fprintf(stderr, "mechbal-bench: %s (%g)\n", what, value);
-  std::abort();
-}
 
 /// ReactionlessTaskController's tick (control/reactionless.cpp) over Pinocchio's kinematics: the
 /// rates (J^+, N, S A N, their factorisations) and the acceleration feed-forward (J'v and

@@ -172,6 +172,30 @@ inline void require_shape(const Array& a, const char* name,
   }
 }
 
+/// An array argument and the name its errors give.
+struct NamedArray {
+  const Array& array;
+  const char* name;
+};
+
+/// Each argument real numbers of shape (rows, cols) (rows < 0: any), checked in order: the
+/// ValueError of the first that is not names it (require_shape, with `context`).
+inline void require_rows(pybind11::ssize_t rows, pybind11::ssize_t cols, std::initializer_list<NamedArray> args,
+                         const char* context = nullptr) {
+  for (const NamedArray& a : args) require_shape(a.array, a.name, {rows, cols}, context);
+}
+
+/// The arguments of a batch over N instants, each (N, cols): the first sets N (any number of
+/// rows), the others must have as many. Returns N; checks and messages as require_shape's.
+inline pybind11::ssize_t batch_rows(pybind11::ssize_t cols, std::initializer_list<NamedArray> args,
+                                    const char* context = nullptr) {
+  const NamedArray& first = *args.begin();
+  require_shape(first.array, first.name, {-1, cols}, context);
+  const pybind11::ssize_t N = first.array.shape(0);
+  for (auto it = args.begin() + 1; it != args.end(); ++it) require_shape(it->array, it->name, {N, cols}, context);
+  return N;
+}
+
 /// ValueError naming `name` when any value is NaN or infinite (functions with no status).
 inline void require_finite(const Array& a, const char* name) {
   const double* p = a.data();

@@ -17,10 +17,7 @@ template <typename Dynamics>
 pybind11::dict batch_inverse_dynamics(Dynamics& d, const Array& q, const Array& qd,
                                       const Array& qdd) {
   const auto n = static_cast<pybind11::ssize_t>(d.dof());
-  require_shape(q, "q", {-1, n});
-  const auto N = q.shape(0);
-  require_shape(qd, "v", {N, n});
-  require_shape(qdd, "a", {N, n});
+  const auto N = batch_rows(n, {{q, "q"}, {qd, "v"}, {qdd, "a"}});
   OutArray tau = make_array({N, n}), F = make_array({N, 3}), M = make_array({N, 3});
   auto per_instant = make_status_array(N);
   using CVec = Eigen::Map<const Eigen::VectorXd>;

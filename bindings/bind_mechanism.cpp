@@ -49,12 +49,6 @@ Eigen::Isometry3d to_isometry(const Eigen::Matrix4d& T, const char* field) {
 /// Row k of a C-contiguous (N, n) array (valid for n = 0 too).
 const double* row(const Array& a, py::ssize_t k) { return a.data() + k * a.shape(1); }
 
-/// Rows (N) of a batch argument that must be (N, dof); N taken from the first argument.
-py::ssize_t batch_rows(const MechanismModel& model, const Array& a, const char* name, py::ssize_t N = -1) {
-  require_shape(a, name, {N, static_cast<py::ssize_t>(model.dof())});
-  return a.shape(0);
-}
-
 /// Runs `fn(k, data) -> Status` for each instant, then `write(k, data, ok)`; instants whose result
 /// is not finite are flagged out_of_range and written as NaN (write gets ok = false).
 template <typename Fn, typename Finite, typename Write>
@@ -109,9 +103,7 @@ bool finite_wrench(const MechanismData& d) {
 }
 
 py::dict kinematics_batch(const MechanismModel& model, const Array& q, const Array& v, const Array& a) {
-  const auto N = batch_rows(model, q, "q");
-  batch_rows(model, v, "v", N);
-  batch_rows(model, a, "a", N);
+  const auto N = batch_rows(model.dof(), {{q, "q"}, {v, "v"}, {a, "a"}});
   const py::ssize_t B = model.num_bodies(), L = model.num_links(), F = model.num_frames();
   Array com = make_array({N, B, 3}), com_v = make_array({N, B, 3}), com_a = make_array({N, B, 3}),
         rot = make_array({N, B, 3, 3}), w = make_array({N, B, 3}), al = make_array({N, B, 3}),
@@ -422,10 +414,7 @@ void bind_mechanism(py::module_& m) {
          int max_iterations, double tolerance, double singular_rcond, bool dynamics) {
         const auto na = static_cast<py::ssize_t>(mo.num_actuated());
         const auto n = static_cast<py::ssize_t>(mo.dof());
-        require_shape(qa, "q_actuated", {-1, na});
-        const auto N = qa.shape(0);
-        require_shape(va, "v_actuated", {N, na});
-        require_shape(aa, "a_actuated", {N, na});
+        const auto N = batch_rows(na, {{qa, "q_actuated"}, {va, "v_actuated"}, {aa, "a_actuated"}});
         require_shape(q0, "q_guess", {n});
         if (max_iterations < 1 || max_iterations > 1000) {
           throw py::value_error("max_iterations must be in 1..1000, got " + std::to_string(max_iterations));
@@ -563,9 +552,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_inverse_dynamics",
       [](const MechanismModel& mo, const Array& q, const Array& v, const Array& a) {
-        const auto N = batch_rows(mo, q, "q");
-        batch_rows(mo, v, "v", N);
-        batch_rows(mo, a, "a", N);
+        const auto N = batch_rows(mo.dof(), {{q, "q"}, {v, "v"}, {a, "a"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         return matrix_batch(mo, N, n, 1, true, "joint_torque", &MechanismData::joint_torque,
                             [&](py::ssize_t k, MechanismData& d) {
@@ -578,7 +565,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_gravity_torque",
       [](const MechanismModel& mo, const Array& q) {
-        const auto N = batch_rows(mo, q, "q");
+        const auto N = batch_rows(mo.dof(), {{q, "q"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         return matrix_batch(mo, N, n, 1, true, "gravity_torque", &MechanismData::gravity_torque,
                             [&](py::ssize_t k, MechanismData& d) {
@@ -590,7 +577,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_static_torque",
       [](const MechanismModel& mo, const Array& q) {
-        const auto N = batch_rows(mo, q, "q");
+        const auto N = batch_rows(mo.dof(), {{q, "q"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         return matrix_batch(mo, N, n, 1, true, "static_torque", &MechanismData::static_torque,
                             [&](py::ssize_t k, MechanismData& d) {
@@ -602,7 +589,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_springs",
       [](const MechanismModel& mo, const Array& q) {
-        const auto N = batch_rows(mo, q, "q");
+        const auto N = batch_rows(mo.dof(), {{q, "q"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         const py::ssize_t S = mo.num_springs();
         Array length = make_array({N, S}), tension = make_array({N, S}), torque = make_array({N, n}),
@@ -643,8 +630,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_bias_torque",
       [](const MechanismModel& mo, const Array& q, const Array& v) {
-        const auto N = batch_rows(mo, q, "q");
-        batch_rows(mo, v, "v", N);
+        const auto N = batch_rows(mo.dof(), {{q, "q"}, {v, "v"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         return matrix_batch(mo, N, n, 1, true, "bias_torque", &MechanismData::bias_torque,
                             [&](py::ssize_t k, MechanismData& d) {
@@ -656,7 +642,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_mass_matrix",
       [](const MechanismModel& mo, const Array& q) {
-        const auto N = batch_rows(mo, q, "q");
+        const auto N = batch_rows(mo.dof(), {{q, "q"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         return matrix_batch(mo, N, n, n, false, "mass_matrix", &MechanismData::mass_matrix,
                             [&](py::ssize_t k, MechanismData& d) {
@@ -668,7 +654,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_momentum_matrix",
       [](const MechanismModel& mo, const Array& q) {
-        const auto N = batch_rows(mo, q, "q");
+        const auto N = batch_rows(mo.dof(), {{q, "q"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         return matrix_batch(mo, N, 6, n, false, "momentum_matrix", &MechanismData::momentum_matrix,
                             [&](py::ssize_t k, MechanismData& d) {
@@ -682,7 +668,7 @@ void bind_mechanism(py::module_& m) {
       [](const MechanismModel& mo, const Array& q, const std::string& frame) {
         const int f = mo.frame_index(frame);
         if (f < 0) throw py::value_error("frame: no frame named '" + frame + "'");
-        const auto N = batch_rows(mo, q, "q");
+        const auto N = batch_rows(mo.dof(), {{q, "q"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         return matrix_batch(mo, N, 6, n, false, "jacobian", &MechanismData::frame_jacobian,
                             [&](py::ssize_t k, MechanismData& d) {
@@ -694,9 +680,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_torque_regressor",
       [](const MechanismModel& mo, const Array& q, const Array& v, const Array& a) {
-        const auto N = batch_rows(mo, q, "q");
-        batch_rows(mo, v, "v", N);
-        batch_rows(mo, a, "a", N);
+        const auto N = batch_rows(mo.dof(), {{q, "q"}, {v, "v"}, {a, "a"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         return matrix_batch(mo, N, n, 10 * mo.num_bodies(), false, "regressor",
                             &MechanismData::torque_regressor, [&](py::ssize_t k, MechanismData& d) {
@@ -709,7 +693,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_gravity_regressor",
       [](const MechanismModel& mo, const Array& q) {
-        const auto N = batch_rows(mo, q, "q");
+        const auto N = batch_rows(mo.dof(), {{q, "q"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         return matrix_batch(mo, N, n, 10 * mo.num_bodies(), false, "regressor",
                             &MechanismData::gravity_regressor, [&](py::ssize_t k, MechanismData& d) {
@@ -721,8 +705,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_momentum_regressor",
       [](const MechanismModel& mo, const Array& q, const Array& v) {
-        const auto N = batch_rows(mo, q, "q");
-        batch_rows(mo, v, "v", N);
+        const auto N = batch_rows(mo.dof(), {{q, "q"}, {v, "v"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         return matrix_batch(mo, N, 6, 10 * mo.num_bodies(), false, "regressor",
                             &MechanismData::momentum_regressor, [&](py::ssize_t k, MechanismData& d) {
@@ -734,7 +717,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_center_of_mass",
       [](const MechanismModel& mo, const Array& q) {
-        const auto N = batch_rows(mo, q, "q");
+        const auto N = batch_rows(mo.dof(), {{q, "q"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         Array com = make_array({N, 3});
         auto status = run_batch(
@@ -751,8 +734,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_momentum",
       [](const MechanismModel& mo, const Array& q, const Array& v) {
-        const auto N = batch_rows(mo, q, "q");
-        batch_rows(mo, v, "v", N);
+        const auto N = batch_rows(mo.dof(), {{q, "q"}, {v, "v"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         Array P = make_array({N, 3}), H = make_array({N, 3});
         auto status = run_batch(
@@ -776,9 +758,7 @@ void bind_mechanism(py::module_& m) {
   m.def(
       "mechanism_shaking_wrench",
       [](const MechanismModel& mo, const Array& q, const Array& v, const Array& a, bool with_gravity) {
-        const auto N = batch_rows(mo, q, "q");
-        batch_rows(mo, v, "v", N);
-        batch_rows(mo, a, "a", N);
+        const auto N = batch_rows(mo.dof(), {{q, "q"}, {v, "v"}, {a, "a"}});
         const auto n = static_cast<Eigen::Index>(mo.dof());
         const py::ssize_t NR = with_gravity ? N : 0;  // the reactions' arrays: only when asked for
         Array F = make_array({N, 3}), M = make_array({N, 3}), P = make_array({N, 3}), H = make_array({N, 3}),

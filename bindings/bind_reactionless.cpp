@@ -25,18 +25,11 @@ namespace mechbal::pyb {
 
 namespace {
 
-std::uint32_t cancel_mask(const std::vector<std::string>& cancel) {
+/// The factory's cancel table and messages (ValueError), but for the empty list's, which this
+/// binding has always worded without the colon.
+std::uint32_t cancel_of(const std::vector<std::string>& cancel) {
   if (cancel.empty()) throw py::value_error("cancel must name at least one momentum component");
-  std::uint32_t mask = 0;
-  for (std::size_t i = 0; i < cancel.size(); ++i) {
-    const std::uint32_t m = momentum_component(cancel[i]);
-    if (m == 0)
-      throw py::value_error("cancel[" + std::to_string(i) + "]: '" + cancel[i] +
-                            "' is not a momentum component (moment, force, both, moment_x, moment_y, "
-                            "moment_z, force_x, force_y, force_z)");
-    mask |= m;
-  }
-  return mask;
+  return cancel_mask(cancel, "cancel");
 }
 
 ReactionlessIntegrator integrator_of(const std::string& name) {
@@ -52,7 +45,7 @@ ReactionlessConfig make_config(const std::vector<std::string>& balancing, const 
                                double max_task_acceleration) {
   ReactionlessConfig c;
   c.balancing_joints = balancing;
-  c.cancel = cancel_mask(cancel);
+  c.cancel = cancel_of(cancel);
   c.integrator = integrator_of(integrator);
   c.rate_hz = rate_hz;
   c.damping = damping;
@@ -96,11 +89,9 @@ std::vector<std::string> names_of(const ReactionlessController& c, const std::ve
 py::dict run(ReactionlessController& c, const Array& q, const Array& v, const Array& a) {
   const auto nt = static_cast<py::ssize_t>(c.num_task());
   const std::string context = "the controller has " + std::to_string(nt) + " task joints";
-  require_shape(q, "q_task", {-1, nt}, context.c_str());
-  const auto rows = q.shape(0);
+  const auto rows = batch_rows(nt, {{q, "q_task"}}, context.c_str());
   const py::ssize_t steps = half_step_ticks(rows, "q_task"), N = steps + 1;
-  require_shape(v, "v_task", {rows, nt}, context.c_str());
-  require_shape(a, "a_task", {rows, nt}, context.c_str());
+  require_rows(rows, nt, {{v, "v_task"}, {a, "a_task"}}, context.c_str());
   const auto na = static_cast<py::ssize_t>(c.num_actuated()), n = static_cast<py::ssize_t>(c.model().dof());
   OutArray Q = make_array({N, na}), V = make_array({N, na}), A = make_array({N, na});
   OutArray QF = make_array({N, n}), VF = make_array({N, n}), AF = make_array({N, n});
@@ -160,7 +151,7 @@ void bind_task_controller(py::module_& m) {
              c.null_space = null_space;
              c.frame = frame;
              c.task_rows = task_rows_mask(task_rows, "task_rows");  // the factory's table and messages
-             c.cancel = cancel_mask(cancel);
+             c.cancel = cancel_of(cancel);
              c.integrator = integrator_of(integrator);
              c.rate_hz = rate_hz;
              c.damping = damping;

@@ -199,12 +199,7 @@ pybind11::dict controller_run(Controller& c, const Array& q, const Array& qd, co
                               const Array& qd_des, const Array& qdd_des) {
   const auto n = static_cast<pybind11::ssize_t>(c.dof());
   const std::string context = "the controller has " + std::to_string(n) + " joints";
-  require_shape(q, "q", {-1, n}, context.c_str());
-  const auto N = q.shape(0);
-  require_shape(qd, "v", {N, n}, context.c_str());
-  require_shape(q_des, "q_des", {N, n}, context.c_str());
-  require_shape(qd_des, "v_des", {N, n}, context.c_str());
-  require_shape(qdd_des, "a_des", {N, n}, context.c_str());
+  const auto N = batch_rows(n, {{q, "q"}, {qd, "v"}, {q_des, "q_des"}, {qd_des, "v_des"}, {qdd_des, "a_des"}}, context.c_str());
   OutArray tau = make_array({N, n});
   auto status = make_status_array(N);
   using CMap = Eigen::Map<const Eigen::VectorXd>;

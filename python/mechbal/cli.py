@@ -96,20 +96,28 @@ def _cmd_run(args) -> int:
     return 0
 
 
-def _run_mujoco(args, out: Path) -> int:
+def _in_mujoco(args, out: Path, run, wrote: str) -> int:
+    """`run(tmp)` (a command that drives MuJoCo) into the staged folder that becomes ``out``, its
+    tables printed after it (unless -q), then "wrote {out}/{wrote}"."""
     from mechbal.output import staged_output
-    from mechbal.verify import run_cosimulation
 
     buffer = io.StringIO()
     try:
         with contextlib.redirect_stdout(buffer), staged_output(out) as tmp:
-            run_cosimulation(args.case, tmp)
+            run(tmp)
     except ImportError as exc:  # the optional 'mujoco' extra is missing: the message names it
         raise UserError(str(exc)) from None
     if not args.quiet:
         sys.stdout.write(buffer.getvalue())
-        print(f"wrote {out}/summary.json, base_reaction.png (MuJoCo beside mechbal) and the files beside them")
+        print(f"wrote {out}/{wrote}")
     return 0
+
+
+def _run_mujoco(args, out: Path) -> int:
+    from mechbal.verify import run_cosimulation
+
+    return _in_mujoco(args, out, lambda tmp: run_cosimulation(args.case, tmp),
+                      "summary.json, base_reaction.png (MuJoCo beside mechbal) and the files beside them")
 
 
 def _cmd_balance(args) -> int:
@@ -219,21 +227,14 @@ def _cmd_export(args) -> int:
 
 
 def _cmd_verify(args) -> int:
-    from mechbal.output import check_output_dir, staged_output
+    from mechbal.output import check_output_dir
     from mechbal.verify import run_verify
 
     out = Path(args.out)
     check_output_dir(out)
-    buffer = io.StringIO()
-    try:
-        with contextlib.redirect_stdout(buffer), staged_output(out) as tmp:
-            run_verify(args.case, tmp, simulate=not args.no_simulation, method=args.method)
-    except ImportError as exc:  # the optional 'mujoco' extra is missing: the message names it
-        raise UserError(str(exc)) from None
-    if not args.quiet:
-        sys.stdout.write(buffer.getvalue())
-        print(f"wrote {out}/summary.json and the plots beside it")
-    return 0
+    return _in_mujoco(args, out, lambda tmp: run_verify(args.case, tmp, simulate=not args.no_simulation,
+                                                        method=args.method),
+                      "summary.json and the plots beside it")
 
 
 # ---- parser and main --------------------------------------------------------------------------
@@ -254,6 +255,29 @@ def _urdf_flags(s) -> None:
                         "kinematics only (every mass and torque is then zero)")
 
 
+#: the balancing methods of `mechbal balance --method` and `mechbal verify --method`
+_METHODS = ("static", "force", "moment", "springs", "rms")
+_QUIET = dict(action="store_true", help="no progress bar and no tables: only warnings and errors (on stderr)")
+_FORCE = dict(action="store_true",
+              help="run values outside the plausible ranges (a joint travel beyond 1e3 rad or m, "
+                   "a gravity beyond 1e3 m/s^2, a mass beyond 1e6 kg), which are refused otherwise")
+
+
+def _out_folder(s, default: str) -> None:
+    s.add_argument("--out", default=default, metavar="DIR", help=f"output folder (default: {default})")
+
+
+def _last_flags(s, func, *, force: bool = False, urdf: bool = False) -> None:
+    """The flags every command ends with (-q; --force and the URDF flags where they apply), then
+    the function that runs it."""
+    s.add_argument("-q", "--quiet", **_QUIET)
+    if force:
+        s.add_argument("--force", **_FORCE)
+    if urdf:
+        _urdf_flags(s)
+    s.set_defaults(func=func)
+
+
 def build_parser() -> argparse.ArgumentParser:
     from mechbal import __version__
 
@@ -269,15 +293,10 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     s = sub.add_parser("cases", help="list the built-in case studies")
     s.set_defaults(func=_cmd_cases)
-    force = dict(action="store_true",
-                 help="run values outside the plausible ranges (a joint travel beyond 1e3 rad or m, "
-                      "a gravity beyond 1e3 m/s^2, a mass beyond 1e6 kg), which are refused otherwise")
     s = sub.add_parser("sweeps", help="list the built-in sweep files (mechbal sweep CASE --spec NAME)",
                        description="List the built-in sweep files: name, kind and title. Run one with "
                                    "'mechbal sweep CASE --spec NAME --out DIR'.")
     s.set_defaults(func=_cmd_sweeps)
-    quiet = dict(action="store_true",
-                 help="no progress bar and no tables: only warnings and errors (on stderr)")
     s = sub.add_parser("run", help="run a case study (built-in name or TOML file)",
                        description="Run a case study and write DIR/summary.json, PNG plots and "
                                    "DIR/bodies_<variant>.npz for every simulated variant. DIR "
@@ -285,7 +304,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "it and moved into place when complete, replacing a previous "
                                    "run.")
     s.add_argument("case", help="built-in case name (see 'mechbal cases') or path to a TOML or URDF file")
-    s.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    _out_folder(s, "out")
     s.add_argument("--duration", type=float, metavar="S",
                    help="URDF files: duration of the default trajectory [s] (default: 2)")
     s.add_argument("--samples", type=int, metavar="N",
@@ -298,10 +317,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--animate", action="store_true",
                    help="also write DIR/animation_<variant>.gif: the mechanism moving, with the "
                         "shaking force and moment drawn at its base")
-    s.add_argument("-q", "--quiet", **quiet)
-    s.add_argument("--force", **force)
-    _urdf_flags(s)
-    s.set_defaults(func=_cmd_run)
+    _last_flags(s, _cmd_run, force=True, urdf=True)
     s = sub.add_parser("balance", help="balance a mechanism by a method (static, force, moment, springs, rms)",
                        description="Size counterweights (static: gravity torque zero over the "
                                    "workspace; force: centre of mass stationary; rms: least RMS or "
@@ -311,19 +327,16 @@ def build_parser() -> argparse.ArgumentParser:
                                    "mechanism (balanced.toml, and balanced.urdf for trees). DIR "
                                    "receives a whole run or nothing.")
     s.add_argument("case", help="built-in case name, a TOML case file, or a URDF file (with --design)")
-    s.add_argument("--method", choices=("static", "force", "moment", "springs", "rms"), default=None,
+    s.add_argument("--method", choices=_METHODS, default=None,
                    help="balancing method (default: balance.method of the case)")
     s.add_argument("--design", metavar="FILE", default=None,
                    help="a TOML file with a [balance] table (and optionally a [trajectory]) that "
                         "replaces the case's (required for a URDF)")
-    s.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")
+    _out_folder(s, "out")
     s.add_argument("--allow-partial", action="store_true",
                    help=f"exit 0 when the requested balance is not reached (default: exit "
                         f"{EXIT_PARTIAL_BALANCE}; the results are written either way)")
-    s.add_argument("-q", "--quiet", **quiet)
-    s.add_argument("--force", **force)
-    _urdf_flags(s)
-    s.set_defaults(func=_cmd_balance)
+    _last_flags(s, _cmd_balance, force=True, urdf=True)
     s = sub.add_parser("export", help="write a case's mechanism as MJCF (MuJoCo) or URDF",
                        description="Write the mechanism of a case (built-in name, TOML or URDF file) "
                                    "as MJCF (any mechanism: loops, gears, springs; the assembled pose "
@@ -333,8 +346,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--format", choices=("mjcf", "urdf"), default=None,
                    help="file format (default: urdf for an --out ending in .urdf, mjcf otherwise)")
     s.add_argument("--out", required=True, metavar="FILE", help="the file to write")
-    s.add_argument("-q", "--quiet", **quiet)
-    s.set_defaults(func=_cmd_export)
+    _last_flags(s, _cmd_export)
     s = sub.add_parser("verify", help="check a case's predictions (balanced and not) in MuJoCo",
                        description="Export the case's mechanism and its balanced variant to MuJoCo and "
                                    "compare mechbal's predicted shaking force, shaking moment and "
@@ -342,36 +354,30 @@ def build_parser() -> argparse.ArgumentParser:
                                    "and a 1 kHz computed-torque simulation): DIR/summary.json, a "
                                    "table and plots. Needs the 'mujoco' extra.")
     s.add_argument("case", help="built-in case name or path to a TOML case file")
-    s.add_argument("--out", default="out/verify", metavar="DIR", help="output folder (default: out/verify)")
-    s.add_argument("--method", choices=("static", "force", "moment", "springs", "rms"), default=None,
+    _out_folder(s, "out/verify")
+    s.add_argument("--method", choices=_METHODS, default=None,
                    help="balancing method of the balanced variant (default: balance.method of the case)")
     s.add_argument("--no-simulation", action="store_true",
                    help="only the inverse dynamics on the trajectory (no forward simulation)")
-    s.add_argument("-q", "--quiet", **quiet)
-    s.set_defaults(func=_cmd_verify)
+    _last_flags(s, _cmd_verify)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")
-    s.add_argument("--out", default="out/demo", metavar="DIR", help="output folder (default: out/demo)")
-    s.add_argument("-q", "--quiet", **quiet)
-    s.add_argument("--force", **force)
-    s.set_defaults(func=_cmd_demo)
+    _out_folder(s, "out/demo")
+    _last_flags(s, _cmd_demo, force=True)
     s = sub.add_parser("sweep", help="sensitivity, tolerance Monte Carlo or grid over a case",
                        description="Run the [sweep] of a sweep file (or built-in sweep name) over a case: "
                                    "DIR/results.parquet (one row per evaluation), summary.json and plots. "
                                    "The same seeded sweep gives the same table on every backend.")
     s.add_argument("case", help="built-in case name or path to a TOML or URDF file")
     s.add_argument("--spec", required=True, metavar="SWEEP", help="sweep file (TOML with [sweep]) or built-in sweep name")
-    s.add_argument("--out", default="out/sweep", metavar="DIR", help="output folder (default: out/sweep)")
+    _out_folder(s, "out/sweep")
     s.add_argument("--backend", choices=("auto", "serial", "processes", "dask"), default="auto",
                    help="auto (default): serial unless the sweep would take more than a few seconds "
                         "in one process, then every local core; serial; processes: every local core; "
                         "dask: a cluster (--scheduler)")
     s.add_argument("--workers", type=int, metavar="N", help="processes: number of local processes (default: all cores)")
     s.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 (implies --backend dask)")
-    s.add_argument("-q", "--quiet", **quiet)
-    s.add_argument("--force", **force)
-    _urdf_flags(s)
-    s.set_defaults(func=_cmd_sweep)
+    _last_flags(s, _cmd_sweep, force=True, urdf=True)
     s = sub.add_parser("init", help="print a commented case template: mechbal init serial > my.toml",
                        description="Print a commented case file to standard output, to edit and "
                                    "run with 'mechbal run my.toml'.")

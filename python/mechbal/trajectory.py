@@ -108,6 +108,22 @@ def _vector(name: str, value: ArrayLike) -> np.ndarray:
     return a
 
 
+def _samples(times: ArrayLike, values: ArrayLike, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """``times`` (K,) strictly increasing, K >= 2, and ``values`` (K, dof) (a 1-D array: one
+    coordinate) named ``name`` in the ValueError, as ViaPoints and Sampled take them."""
+    t = _vector("times", times)
+    p = _vector(name, values)
+    if t.ndim != 1 or t.size < 2:
+        raise ValueError(f"times must be a 1-D array of at least 2 times, got shape {t.shape}")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("times must be strictly increasing")
+    if p.ndim == 1:
+        p = p[:, None]
+    if p.ndim != 2 or p.shape[0] != t.size:
+        raise ValueError(f"{name} must have shape ({t.size}, dof), got {np.shape(values)}")
+    return t, p
+
+
 def _finite_motion(what: str, single: bool, q: FloatArray, v: FloatArray, a: FloatArray) -> Motion:
     """The motion, or ValueError when finite input overflowed into a non-finite value."""
     for name, x in (("q", q), ("v", v), ("a", a)):
@@ -119,7 +135,21 @@ def _finite_motion(what: str, single: bool, q: FloatArray, v: FloatArray, a: Flo
     return Motion(q, v, a)
 
 
-class RestToRest:
+class _FromZero:
+    """A motion that starts at t = 0: it ends at its duration."""
+
+    @property
+    def duration(self) -> float:
+        """Motion time [s]."""
+        raise NotImplementedError
+
+    @property
+    def end_time(self) -> float:
+        """Time the motion ends [s] (= ``duration``: it starts at t = 0)."""
+        return self.duration
+
+
+class RestToRest(_FromZero):
     """Rest-to-rest motion from ``start`` to ``end`` in ``duration`` seconds along a time law
     (the C++ ``RestToRestTrajectory``; Arakelian, Le Baron & Mottu 2011, eqs 10-13):
     ``q(t) = start + (end - start) s(t / duration)``.
@@ -155,11 +185,6 @@ class RestToRest:
         return float(self.core.duration)
 
     @property
-    def end_time(self) -> float:
-        """Time the motion ends [s] (= ``duration``: it starts at t = 0)."""
-        return self.duration
-
-    @property
     def law(self) -> str:
         """``"quintic"`` or ``"cubic"``."""
         return str(self.core.law.name)
@@ -190,7 +215,7 @@ def minimum_energy_cubic(start: ArrayLike, end: ArrayLike, duration: float) -> R
     return RestToRest(start, end, duration, "cubic")
 
 
-class ConstantSpeed:
+class ConstantSpeed(_FromZero):
     """Steady motion at constant speed: ``q(t) = start + speed t``, ``qd = speed``, ``qdd = 0``
     for ``0 <= t <= duration`` (a crank turning at so many rpm). Outside ``[0, duration]`` it holds
     its first or last point at rest, as every trajectory here does.
@@ -241,11 +266,6 @@ class ConstantSpeed:
     @property
     def duration(self) -> float:
         """Motion time [s]."""
-        return self._duration
-
-    @property
-    def end_time(self) -> float:
-        """Time the motion ends [s] (= ``duration``)."""
         return self._duration
 
     @property
@@ -306,16 +326,7 @@ class ViaPoints(_OverTimes):
 
     def __init__(self, times: ArrayLike, points: ArrayLike, velocities: ArrayLike | None = None,
                  accelerations: ArrayLike | None = None):
-        t = _vector("times", times)
-        p = _vector("points", points)
-        if t.ndim != 1 or t.size < 2:
-            raise ValueError(f"times must be a 1-D array of at least 2 times, got shape {t.shape}")
-        if np.any(np.diff(t) <= 0):
-            raise ValueError("times must be strictly increasing")
-        if p.ndim == 1:
-            p = p[:, None]
-        if p.ndim != 2 or p.shape[0] != t.size:
-            raise ValueError(f"points must have shape ({t.size}, dof), got {np.shape(points)}")
+        t, p = _samples(times, points, "points")
         h = np.diff(t)[:, None]
         if velocities is None:
             with np.errstate(all="ignore"):  # an overflow is reported below
@@ -385,16 +396,7 @@ class Sampled(_OverTimes):
     def __init__(self, times: ArrayLike, positions: ArrayLike, bc_type: str = "clamped"):
         from scipy.interpolate import CubicSpline
 
-        t = _vector("times", times)
-        p = _vector("positions", positions)
-        if t.ndim != 1 or t.size < 2:
-            raise ValueError(f"times must be a 1-D array of at least 2 times, got shape {t.shape}")
-        if np.any(np.diff(t) <= 0):
-            raise ValueError("times must be strictly increasing")
-        if p.ndim == 1:
-            p = p[:, None]
-        if p.ndim != 2 or p.shape[0] != t.size:
-            raise ValueError(f"positions must have shape ({t.size}, dof), got {np.shape(positions)}")
+        t, p = _samples(times, positions, "positions")
         self._t = t
         overflow = False
         with np.errstate(all="ignore"):  # an overflow is reported here, not as a RuntimeWarning

@@ -21,6 +21,7 @@
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/control/kdl_chain.hpp"
 #include "mechbal/detail/tree.hpp"
+#include "every_algorithm.hpp"
 #include "test_support.hpp"
 
 using namespace mechbal;
@@ -45,15 +46,10 @@ Mat3 random_axis_permutation(std::mt19937& rng) {
 MechanismDescription random_tree_description(std::mt19937& rng, const std::string& types, bool gear = false,
                                              bool aligned = false) {
   MechanismDescription d;
-  std::uniform_real_distribution<double> u(-0.3, 0.3);
   std::vector<std::string> links{d.root_name};
   for (std::size_t i = 0; i < types.size(); ++i) {
-    Joint j;
-    j.name = "j" + std::to_string(i + 1);
-    j.type = types[i] == 'P' ? JointType::prismatic : types[i] == 'F' ? JointType::fixed : JointType::revolute;
-    j.parent = links[std::uniform_int_distribution<std::size_t>(0, links.size() - 1)(rng)];
-    j.placement = test::random_pose(rng);
-    j.axis = Vec3(u(rng), u(rng), u(rng)).normalized();
+    const std::string parent = links[std::uniform_int_distribution<std::size_t>(0, links.size() - 1)(rng)];
+    Joint j = test::random_joint(rng, "j" + std::to_string(i + 1), types[i], parent);
     if (aligned && std::bernoulli_distribution(0.5)(rng)) {  // (the other half: in line with the parent, along z)
       j.placement.linear() = random_axis_permutation(rng);
       j.axis = (std::bernoulli_distribution(0.5)(rng) ? 1.0 : -1.0) *
@@ -64,11 +60,7 @@ MechanismDescription random_tree_description(std::mt19937& rng, const std::strin
     }
     d.joints.push_back(j);
     const int nb = 1 + static_cast<int>(std::uniform_int_distribution<int>(0, 2)(rng));
-    for (int b = 0; b < nb; ++b) {
-      const RigidBody rb = test::random_body(rng);
-      d.bodies.push_back(Body{j.name + "_b" + std::to_string(b), "link", j.name, rb.mass,
-                              Vec3(u(rng), u(rng), u(rng)), rb.inertia_body});
-    }
+    for (int b = 0; b < nb; ++b) d.bodies.push_back(test::random_link_body(rng, j.name + "_b" + std::to_string(b), j.name));
     d.frames.push_back(Frame{j.name + "_tool", j.name, test::random_pose(rng)});
     links.push_back(j.name);
   }
@@ -481,29 +473,7 @@ TEST(Mechanism, AlgorithmsAllocateNothing) {
   const int n = model.dof();
   const Eigen::VectorXd q = test::random_vector(rng, n, 2.0), v = test::random_vector(rng, n, 1.0),
                         a = test::random_vector(rng, n, 1.0);
-  // the quadratic results are sized by their first call (data.hpp): once, before the loop
-  data.reserve_mass_matrix();
-  torque_regressor(model, data, q, v, a);
-  gravity_regressor(model, data, q);
-  test::AllocationScope scope;
-  for (int k = 0; k < 3; ++k) {
-    EXPECT_EQ(forward_kinematics(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(center_of_mass(model, data, q), Status::ok);
-    EXPECT_EQ(momentum(model, data, q, v), Status::ok);
-    EXPECT_EQ(momentum_matrix(model, data, q), Status::ok);
-    EXPECT_EQ(shaking_wrench(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(base_reaction(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(inverse_dynamics(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(gravity_torque(model, data, q), Status::ok);
-    EXPECT_EQ(bias_torque(model, data, q, v), Status::ok);
-    EXPECT_EQ(mass_matrix(model, data, q), Status::ok);
-    EXPECT_EQ(frame_jacobian(model, data, q, 0), Status::ok);
-    EXPECT_EQ(frame_placement(model, data, q, 1), Status::ok);
-    EXPECT_EQ(torque_regressor(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(gravity_regressor(model, data, q), Status::ok);
-    EXPECT_EQ(momentum_regressor(model, data, q, v), Status::ok);
-  }
-  EXPECT_EQ(scope.count(), 0u);
+  EXPECT_EQ(test::allocations_of_every_algorithm(model, data, q, v, a, 1), 0u);
 }
 
 // frame_placement (one frame from the link placements) is the frame forward_kinematics places,

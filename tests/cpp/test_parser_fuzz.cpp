@@ -18,6 +18,7 @@
 #include "mechbal/algorithm/mass_matrix.hpp"
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/io/urdf.hpp"
+#include "urdf_error.hpp"
 #include "mechbal/model/data.hpp"
 #include "mechbal/model/rigid_body.hpp"
 
@@ -91,14 +92,7 @@ std::string mutate(std::mt19937& rng, std::string doc) {
   return doc;
 }
 
-std::string error_of(const std::string& xml) {
-  try {
-    model_from_urdf_string(xml);
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using test::urdf_error_of;
 
 }  // namespace
 
@@ -123,24 +117,24 @@ TEST(ParserFuzz, DeepNestingIsAnErrorNotACrash) {
     for (int i = 0; i < depth; ++i) xml += "<a>";
     for (int i = 0; i < depth; ++i) xml += "</a>";
     xml += "</robot>";
-    const std::string e = error_of(xml);
+    const std::string e = urdf_error_of(xml);
     EXPECT_NE(e.find("nest more than 64 deep"), std::string::npos) << e.substr(0, 200);
   }
   std::string ok = "<robot name=\"r\"><link name=\"base\"/>";
   for (int i = 0; i < 60; ++i) ok += "<a>";
   for (int i = 0; i < 60; ++i) ok += "</a>";
-  EXPECT_EQ(error_of(ok + "</robot>"), "no error");
+  EXPECT_EQ(urdf_error_of(ok + "</robot>"), "no error");
 }
 
 TEST(ParserFuzz, JointCyclesAreRefusedNamingTheJoints) {
   const std::string links = "<link name=\"base\"/><link name=\"a\"/><link name=\"b\"/>";
-  std::string e = error_of("<robot name=\"r\">" + links +
+  std::string e = urdf_error_of("<robot name=\"r\">" + links +
                            "<joint name=\"j0\" type=\"fixed\"><parent link=\"base\"/><child link=\"a\"/></joint>"
                            "<joint name=\"j1\" type=\"fixed\"><parent link=\"a\"/><child link=\"b\"/></joint>"
                            "<joint name=\"j2\" type=\"fixed\"><parent link=\"b\"/><child link=\"a\"/></joint></robot>");
   EXPECT_NE(e.find("'j0'"), std::string::npos) << e;
   EXPECT_NE(e.find("'j2'"), std::string::npos) << e;
-  e = error_of("<robot name=\"r\">" + links +
+  e = urdf_error_of("<robot name=\"r\">" + links +
                "<joint name=\"j1\" type=\"fixed\"><parent link=\"a\"/><child link=\"b\"/></joint>"
                "<joint name=\"j2\" type=\"fixed\"><parent link=\"b\"/><child link=\"a\"/></joint></robot>");
   EXPECT_NE(e.find("cycle"), std::string::npos) << e;
@@ -152,7 +146,7 @@ TEST(ParserFuzz, NumbersAreStrict) {
   for (const char* bad : {"nan", "inf", "-inf", "abc", "1e999", "", "1.0.0", "0x", "2kg"}) {
     std::string xml = kSeed;
     xml.replace(xml.find("<mass value=\"1\"/>"), 17, std::string("<mass value=\"") + bad + "\"/>");
-    const std::string e = error_of(xml);
+    const std::string e = urdf_error_of(xml);
     EXPECT_NE(e.find("URDF link 'l2' <mass value="), std::string::npos) << bad << ": " << e;
   }
 }

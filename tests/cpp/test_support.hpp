@@ -53,24 +53,39 @@ inline Eigen::Isometry3d random_pose(std::mt19937& rng, double scale = 0.4) {
   return T;
 }
 
+/// A joint of the random mechanisms: type 'P' prismatic, 'F' fixed, else revolute; a random
+/// placement in its parent (random_pose) and a random unit axis. Draws in this order: the
+/// placement, then the axis.
+inline Joint random_joint(std::mt19937& rng, const std::string& name, char type, const std::string& parent) {
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  Joint j;
+  j.name = name;
+  j.type = type == 'P' ? JointType::prismatic : type == 'F' ? JointType::fixed : JointType::revolute;
+  j.parent = parent;
+  j.placement = random_pose(rng);
+  j.axis = Vec3(u(rng), u(rng), u(rng)).normalized();
+  return j;
+}
+
+/// A body of kind "link" named `name` on `link`: random mass and inertia (random_body), then a
+/// random centre of mass within 0.3 m of the link frame's origin.
+inline Body random_link_body(std::mt19937& rng, const std::string& name, const std::string& link) {
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  const RigidBody b = random_body(rng);
+  const Vec3 com(u(rng), u(rng), u(rng));
+  return Body{name, "link", link, b.mass, com, b.inertia_body};
+}
+
 /// A random serial chain in the general format, one body per link (kind "link", named after its
 /// joint); `types` pattern: 'R' revolute, 'P' prismatic. A random base pose is folded into the
 /// first joint's placement; gravity (0, 0, -9.81).
 inline MechanismDescription random_chain(std::mt19937& rng, const char* types) {
   MechanismDescription d;
-  std::uniform_real_distribution<double> u(-0.3, 0.3);
   std::string parent = d.root_name;
   for (int i = 0; types[i]; ++i) {
-    Joint j;
-    j.name = "j" + std::to_string(i + 1);
-    j.type = types[i] == 'P' ? JointType::prismatic : JointType::revolute;
-    j.parent = parent;
-    j.placement = random_pose(rng);
-    j.axis = Vec3(u(rng), u(rng), u(rng)).normalized();
-    const RigidBody link = random_body(rng);
-    const Vec3 com(u(rng), u(rng), u(rng));
+    const Joint j = random_joint(rng, "j" + std::to_string(i + 1), types[i] == 'P' ? 'P' : 'R', parent);
     d.joints.push_back(j);
-    d.bodies.push_back(Body{j.name, "link", j.name, link.mass, com, link.inertia_body});
+    d.bodies.push_back(random_link_body(rng, j.name, j.name));
     parent = j.name;
   }
   d.gravity = Vec3(0.0, 0.0, -9.81);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "alloc_counter.hpp"
+#include "every_algorithm.hpp"
 #include "mechbal/algorithm/center_of_mass.hpp"
 #include "mechbal/algorithm/inverse_dynamics.hpp"
 #include "mechbal/algorithm/jacobian.hpp"
@@ -17,6 +18,7 @@
 #include "mechbal/algorithm/regressor.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
 #include "mechbal/io/urdf.hpp"
+#include "urdf_error.hpp"
 
 using namespace mechbal;
 
@@ -58,14 +60,7 @@ std::string replaced(std::string text, const std::string& from, const std::strin
   return text;
 }
 
-std::string error_of(const std::string& xml) {
-  try {
-    model_from_urdf_string(xml);
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using test::urdf_error_of;
 
 }  // namespace
 
@@ -140,53 +135,31 @@ TEST(Urdf, AlgorithmsAllocateNothing) {
   MechanismData data(model);
   const Eigen::Vector3d q(0.3, -0.7, 0.1), v(1.0, -0.5, 0.2), a(-0.4, 2.0, 0.3);
   const int tool = model.frame_index("tool");
-  // the quadratic results (mass matrix, torque and gravity regressors) are sized by their first
-  // call (data.hpp): once before the loop, as a real-time user does at set-up
-  data.reserve_mass_matrix();
-  torque_regressor(model, data, q, v, a);
-  gravity_regressor(model, data, q);
-  test::AllocationScope scope;
-  for (int k = 0; k < 3; ++k) {
-    EXPECT_EQ(forward_kinematics(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(center_of_mass(model, data, q), Status::ok);
-    EXPECT_EQ(momentum(model, data, q, v), Status::ok);
-    EXPECT_EQ(momentum_matrix(model, data, q), Status::ok);
-    EXPECT_EQ(shaking_wrench(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(base_reaction(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(inverse_dynamics(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(gravity_torque(model, data, q), Status::ok);
-    EXPECT_EQ(bias_torque(model, data, q, v), Status::ok);
-    EXPECT_EQ(mass_matrix(model, data, q), Status::ok);
-    EXPECT_EQ(frame_jacobian(model, data, q, tool), Status::ok);
-    EXPECT_EQ(torque_regressor(model, data, q, v, a), Status::ok);
-    EXPECT_EQ(gravity_regressor(model, data, q), Status::ok);
-    EXPECT_EQ(momentum_regressor(model, data, q, v), Status::ok);
-  }
-  EXPECT_EQ(scope.count(), 0u);
+  EXPECT_EQ(test::allocations_of_every_algorithm(model, data, q, v, a, tool), 0u);
   EXPECT_TRUE(data.joint_torque.allFinite());
 }
 
 TEST(Urdf, ErrorsNameTheElement) {
-  std::string e = error_of(replaced(kTree, "type=\"prismatic\"", "type=\"floating\""));
+  std::string e = urdf_error_of(replaced(kTree, "type=\"prismatic\"", "type=\"floating\""));
   EXPECT_NE(e.find("URDF joint 'j3'"), std::string::npos) << e;
   EXPECT_NE(e.find("floating"), std::string::npos) << e;
 
-  e = error_of(replaced(kTree, "<parent link=\"l3\"/>", "<parent link=\"l33\"/>"));
+  e = urdf_error_of(replaced(kTree, "<parent link=\"l3\"/>", "<parent link=\"l33\"/>"));
   EXPECT_NE(e.find("l33"), std::string::npos) << e;
   EXPECT_NE(e.find("j5"), std::string::npos) << e;
   EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 
-  e = error_of(replaced(kTree, "<mass value=\"0.5\"/>", "<mass value=\"-0.5\"/>"));
+  e = urdf_error_of(replaced(kTree, "<mass value=\"0.5\"/>", "<mass value=\"-0.5\"/>"));
   EXPECT_NE(e.find("URDF link 'l3' inertial.mass"), std::string::npos) << e;
   EXPECT_NE(e.find("-0.5"), std::string::npos) << e;
 
-  e = error_of(replaced(kTree, "ixx=\"0.005\"", "ixx=\"0.5\""));  // triangle inequality
+  e = urdf_error_of(replaced(kTree, "ixx=\"0.005\"", "ixx=\"0.5\""));  // triangle inequality
   EXPECT_NE(e.find("URDF link 'l3' inertial.inertia"), std::string::npos) << e;
 
-  e = error_of(replaced(kTree, "<mimic joint=\"j1\"", "<mimic joint=\"jj1\""));
+  e = urdf_error_of(replaced(kTree, "<mimic joint=\"j1\"", "<mimic joint=\"jj1\""));
   EXPECT_NE(e.find("URDF joint 'j5': mimic joint 'jj1' does not exist"), std::string::npos) << e;
 
-  e = error_of("<robot name=\"x\"><link name=\"a\"></robot>");
+  e = urdf_error_of("<robot name=\"x\"><link name=\"a\"></robot>");
   EXPECT_EQ(e.rfind("URDF: ", 0), 0u) << e;
 
   try {

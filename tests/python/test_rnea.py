@@ -8,7 +8,8 @@ import mechbal
 from conftest import chain_from_specs, random_chain_specs
 
 pin = pytest.importorskip("pinocchio")
-from test_pinocchio import pin_model  # noqa: E402  (same Pinocchio model builder as the KDL test)
+from test_pinocchio import (  # noqa: E402  (the same chains and checks as the KDL test)
+    assert_chain_dynamics_match_pinocchio, random_chain_and_pinocchio)
 
 
 def _rel(a, b):
@@ -19,38 +20,8 @@ def _rel(a, b):
                                         ("RRRRRRR", 25), ("RRPRRRP", 26)])
 def test_rnea_matches_pinocchio(types, seed):
     rng = np.random.default_rng(seed)
-    specs = random_chain_specs(rng, types)
-    base = np.eye(4)
-    base[:3, :3], _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    if np.linalg.det(base[:3, :3]) < 0:
-        base[:3, 0] *= -1
-    base[:3, 3] = rng.uniform(-0.2, 0.2, 3)
-    gravity = np.array([0.3, -0.2, -9.81])
-    model = chain_from_specs(specs, gravity, base)
-    pm = pin_model(specs, gravity, base)
-    pd = pm.createData()
-    rne = mechbal.MechanismDynamics(model)
-    n = len(types)
-    N = 15
-    q, qd, qdd = (rng.uniform(-2, 2, (N, n)), rng.uniform(-1.5, 1.5, (N, n)),
-                  rng.uniform(-3, 3, (N, n)))
-    out = rne.inverse_dynamics(q, qd, qdd)
-    assert out.ok
-    for k in range(N):
-        tau_pin = pin.rnea(pm, pd, q[k], qd[k], qdd[k])
-        assert _rel(out.joint_torque[k], tau_pin) < 1e-9, (k, out.joint_torque[k], tau_pin)
-        pin.forwardKinematics(pm, pd, q[k])
-        f_world = pd.oMi[1].act(pd.f[1])
-        assert _rel(out.support_force[k], f_world.linear) < 1e-9
-        assert _rel(out.support_moment[k], f_world.angular) < 1e-9
-        M_pin = pin.crba(pm, pd, q[k])
-        M_pin = np.triu(M_pin) + np.triu(M_pin, 1).T
-        assert _rel(rne.mass_matrix(q[k]), M_pin) < 1e-9
-        g_pin = pin.computeGeneralizedGravity(pm, pd, q[k])
-        assert _rel(rne.gravity(q[k]), g_pin) < 1e-9
-        b_pin = pin.nle(pm, pd, q[k], qd[k])
-        assert _rel(rne.bias(q[k], qd[k]), b_pin) < 1e-9
-        assert _rel(rne.coriolis(q[k], qd[k]), b_pin - g_pin) < 1e-9
+    model, pm = random_chain_and_pinocchio(rng, types, rotate_base=True)
+    assert_chain_dynamics_match_pinocchio(mechbal.MechanismDynamics(model), pm, rng, N=15)
 
 
 def test_rnea_bad_input_names_the_argument():

@@ -28,17 +28,10 @@ Status ComputedTorque::step(const Eigen::Ref<const Eigen::VectorXd>& q,
                             const Eigen::Ref<const Eigen::VectorXd>& qd_des,
                             const Eigen::Ref<const Eigen::VectorXd>& qdd_des,
                             Eigen::Ref<Eigen::VectorXd> tau) noexcept {
-  if (q.size() != n_ || qd.size() != n_ || q_des.size() != n_ || qd_des.size() != n_ ||
-      qdd_des.size() != n_ || tau.size() != n_)
-    return Status::bad_size;
-  if (!q.allFinite() || !qd.allFinite() || !q_des.allFinite() || !qd_des.allFinite() ||
-      !qdd_des.allFinite()) {
-    tau = last_;
-    return Status::non_finite_input;
-  }
-  if (!within(range_, q, qd, q_des, qd_des, qdd_des)) {
-    tau = last_;
-    return Status::out_of_range;
+  const Status input = detail::check_tick_input(range_, n_, q, qd, q_des, qd_des, qdd_des, tau.size());
+  if (input != Status::ok) {
+    if (input != Status::bad_size) tau = last_;
+    return input;
   }
   // eq 4: v = qdd_d + Kp e + Kd edot (diagonal gains); computed into raw_ first so that v_ keeps
   // the last good value if the model fails.

@@ -41,17 +41,10 @@ Status DecoupledJointController::step(const Eigen::Ref<const Eigen::VectorXd>& q
                                       const Eigen::Ref<const Eigen::VectorXd>& qdd_des,
                                       Eigen::Ref<Eigen::VectorXd> tau) noexcept {
   const Eigen::Index n = k_.size();
-  if (q.size() != n || qd.size() != n || q_des.size() != n || qd_des.size() != n ||
-      qdd_des.size() != n || tau.size() != n)
-    return Status::bad_size;
-  if (!q.allFinite() || !qd.allFinite() || !q_des.allFinite() || !qd_des.allFinite() ||
-      !qdd_des.allFinite()) {
-    tau = last_;
-    return Status::non_finite_input;
-  }
-  if (!within(range_, q, qd, q_des, qd_des, qdd_des)) {
-    tau = last_;
-    return Status::out_of_range;
+  const Status input = detail::check_tick_input(range_, n, q, qd, q_des, qd_des, qdd_des, tau.size());
+  if (input != Status::ok) {
+    if (input != Status::bad_size) tau = last_;
+    return input;
   }
   // eqs 15, 26, 36 with the computed-torque outer loop: tau_i = k_i (qdd_d + Kp e + Kd e').
   raw_ = k_.cwiseProduct(qdd_des + kp_.cwiseProduct(q_des - q) + kd_.cwiseProduct(qd_des - qd));

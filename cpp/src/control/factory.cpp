@@ -101,21 +101,6 @@ T rename_errors(Fn fn) {
   }
 }
 
-std::uint32_t cancel_mask(const std::vector<std::string>& cancel) {
-  if (cancel.empty()) fail("cancel", "must name at least one momentum component");
-  std::uint32_t mask = 0;
-  for (std::size_t i = 0; i < cancel.size(); ++i) {
-    const std::uint32_t m = momentum_component(cancel[i]);
-    if (m == 0) {
-      fail("cancel[" + std::to_string(i) + "]", "'" + cancel[i] +
-                                                    "' is not a momentum component (moment, force, both, moment_x, "
-                                                    "moment_y, moment_z, force_x, force_y, force_z)");
-    }
-    mask |= m;
-  }
-  return mask;
-}
-
 ReactionlessIntegrator integrator_of(const std::string& name) {
   if (name == "euler") return ReactionlessIntegrator::euler;
   if (name == "rk4") return ReactionlessIntegrator::rk4;
@@ -123,6 +108,21 @@ ReactionlessIntegrator integrator_of(const std::string& name) {
 }
 
 }  // namespace
+
+std::uint32_t cancel_mask(const std::vector<std::string>& cancel, const std::string& field) {
+  if (cancel.empty()) throw std::invalid_argument(field + ": must name at least one momentum component");
+  std::uint32_t mask = 0;
+  for (std::size_t i = 0; i < cancel.size(); ++i) {
+    const std::uint32_t m = momentum_component(cancel[i]);
+    if (m == 0) {
+      throw std::invalid_argument(field + "[" + std::to_string(i) + "]: '" + cancel[i] +
+                                  "' is not a momentum component (moment, force, both, moment_x, "
+                                  "moment_y, moment_z, force_x, force_y, force_z)");
+    }
+    mask |= m;
+  }
+  return mask;
+}
 
 std::uint32_t task_rows_mask(const std::vector<std::string>& rows, const std::string& field) {
   static const std::pair<const char*, std::uint32_t> names[] = {

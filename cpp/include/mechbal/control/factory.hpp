@@ -44,6 +44,12 @@ ReactionlessConfig reactionless_config(const ControlConfig& control);
 /// The TaskSpaceConfig of a `[control]` table of kind reactionless with a task_frame.
 TaskSpaceConfig task_space_config(const ControlConfig& control);
 
+/// The cancel mask (MomentumComponent bits) of momentum component names: "moment", "force",
+/// "both", "moment_x|y|z", "force_x|y|z" (at least one; momentum_component). Throws
+/// std::invalid_argument naming `field` (the `[control]` table's, or "cancel" for a caller's own
+/// argument) and the entry: every reader of cancel gives the same message.
+std::uint32_t cancel_mask(const std::vector<std::string>& cancel, const std::string& field = "control.cancel");
+
 /// The TaskSpaceConfig::task_rows mask (MomentumComponent bits of [v; w]) of twist component names:
 /// "all", "linear", "angular", "v_x", "v_y", "v_z", "w_x", "w_y", "w_z" (at least one). Throws
 /// std::invalid_argument naming `field` (the `[control]` table's, or "task_rows" for a caller's

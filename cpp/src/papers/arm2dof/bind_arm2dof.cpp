@@ -44,10 +44,7 @@ using CVec = Eigen::Map<const Eigen::VectorXd>;
 template <class F>
 py::dict batch3(const Array& a, const char* na, const Array& b, const char* nb, const Array& c,
                 const char* nc, const char* out_name, F&& f) {
-  require_shape(a, na, {-1, 2});
-  const auto N = a.shape(0);
-  require_shape(b, nb, {N, 2});
-  require_shape(c, nc, {N, 2});
+  const auto N = batch_rows(2, {{a, na}, {b, nb}, {c, nc}});
   OutArray out = make_array({N, 2});
   auto per_instant = make_status_array(N);
   Status status = Status::ok;
@@ -89,6 +86,22 @@ py::dict log_to_dict(const ClosedLoopLog& log) {
   d["saturated_ticks"] = log.saturated_ticks;
   d["steps_completed"] = log.steps_completed;
   return d;
+}
+
+/// simulate_closed_loop from the Python arguments (q0, v0 and the options checked first), the GIL
+/// released while it runs; the log as a dict. `desired`: a RestToRestTrajectory or a SampledMotion.
+template <typename Desired>
+py::dict run_closed_loop(ForwardDynamics& plant, JointController& controller, const Desired& desired,
+                         const Array& q0_arg, const Array& qd0_arg, double dt, double duration,
+                         const std::string& sampling) {
+  const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "v0", -1);
+  const ClosedLoopOptions opt = closed_loop_options(dt, duration, sampling);
+  ClosedLoopLog log;
+  {
+    py::gil_scoped_release release;
+    log = simulate_closed_loop(plant, controller, desired, q0, qd0, opt);
+  }
+  return log_to_dict(log);
 }
 
 void bind_arm2dof(py::module_& m) {
@@ -215,14 +228,7 @@ void bind_arm2dof(py::module_& m) {
       [](ForwardDynamics& plant, JointController& controller, const RestToRestTrajectory& desired,
          const Array& q0_arg, const Array& qd0_arg, double dt, double duration,
          const std::string& sampling) {
-        const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "v0", -1);
-        const ClosedLoopOptions opt = closed_loop_options(dt, duration, sampling);
-        ClosedLoopLog log;
-        {
-          py::gil_scoped_release release;
-          log = simulate_closed_loop(plant, controller, desired, q0, qd0, opt);
-        }
-        return log_to_dict(log);
+        return run_closed_loop(plant, controller, desired, q0_arg, qd0_arg, dt, duration, sampling);
       },
       py::arg("plant"), py::arg("controller"), py::arg("desired"), py::arg("q0"), py::arg("v0"),
       py::arg("dt") = 1e-3, py::arg("duration") = 1.0, py::arg("sampling") = "zero_order_hold",
@@ -236,23 +242,14 @@ void bind_arm2dof(py::module_& m) {
          const Array& qd_des, const Array& qdd_des, const Array& q0_arg, const Array& qd0_arg,
          double dt, double duration, const std::string& sampling) {
         const auto n = static_cast<py::ssize_t>(plant.dof());
-        require_shape(q_des, "q_des", {-1, n}, "one row every dt/2, one value per joint");
-        const auto J = q_des.shape(0);
-        require_shape(qd_des, "v_des", {J, n});
-        require_shape(qdd_des, "a_des", {J, n});
+        const auto J = batch_rows(n, {{q_des, "q_des"}}, "one row every dt/2, one value per joint");
+        require_rows(J, n, {{qd_des, "v_des"}, {qdd_des, "a_des"}});
         using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
         SampledMotion desired;
         desired.q = Eigen::Map<const RowMajor>(q_des.data(), J, n);
         desired.qd = Eigen::Map<const RowMajor>(qd_des.data(), J, n);
         desired.qdd = Eigen::Map<const RowMajor>(qdd_des.data(), J, n);
-        const Eigen::VectorXd q0 = vector_arg(q0_arg, "q0", -1), qd0 = vector_arg(qd0_arg, "v0", -1);
-        const ClosedLoopOptions opt = closed_loop_options(dt, duration, sampling);
-        ClosedLoopLog log;
-        {
-          py::gil_scoped_release release;
-          log = simulate_closed_loop(plant, controller, desired, q0, qd0, opt);
-        }
-        return log_to_dict(log);
+        return run_closed_loop(plant, controller, desired, q0_arg, qd0_arg, dt, duration, sampling);
       },
       py::arg("plant"), py::arg("controller"), py::arg("q_des"), py::arg("v_des"),
       py::arg("a_des"), py::arg("q0"), py::arg("v0"), py::arg("dt") = 1e-3,

@@ -67,9 +67,7 @@ void bind_five_bar(py::module_& m) {
       .def(
           "evaluate",
           [](FiveBarDynamics& f, const Array& q, const Array& qd) {
-            require_shape(q, "q", {-1, 2});
-            const auto N = q.shape(0);
-            require_shape(qd, "v", {N, 2});
+            const auto N = batch_rows(2, {{q, "q"}, {qd, "v"}});
             OutArray M = make_array({N, 2, 2}), v = make_array({N, 2}), g = make_array({N, 2}),
                      rc = make_array({N});
             py::array_t<bool> ok(N);
@@ -106,10 +104,7 @@ void bind_five_bar(py::module_& m) {
       .def(
           "inverse_dynamics",
           [](FiveBarDynamics& f, const Array& q, const Array& qd, const Array& qdd) {
-            require_shape(q, "q", {-1, 2});
-            const auto N = q.shape(0);
-            require_shape(qd, "v", {N, 2});
-            require_shape(qdd, "a", {N, 2});
+            const auto N = batch_rows(2, {{q, "q"}, {qd, "v"}, {qdd, "a"}});
             OutArray tau = make_array({N, 2});
             auto per_instant = make_status_array(N);
             Status status = Status::ok;
@@ -133,10 +128,7 @@ void bind_five_bar(py::module_& m) {
       .def(
           "motion",
           [](FiveBarDynamics& f, const Array& q, const Array& qd, const Array& qdd) {
-            require_shape(q, "q", {-1, 2});
-            const auto N = q.shape(0);
-            require_shape(qd, "v", {N, 2});
-            require_shape(qdd, "a", {N, 2});
+            const auto N = batch_rows(2, {{q, "q"}, {qd, "v"}, {qdd, "a"}});
             OutArray ang = make_array({N, 4}), rate = make_array({N, 4}), acc = make_array({N, 4}),
                      P = make_array({N, 2}), vP = make_array({N, 2}), aP = make_array({N, 2});
             auto per_instant = make_status_array(N);

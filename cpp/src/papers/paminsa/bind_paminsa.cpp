@@ -224,11 +224,7 @@ void bind_paminsa(py::module_& m) {
           "run",
           [](ReactionlessWrist& w, const Array& D, const Array& Dd, const Array& Dh,
              const Array& Dn) {
-            require_shape(D, "D", {-1, 3});
-            const auto N = D.shape(0);
-            require_shape(Dd, "D_dot", {N, 3});
-            require_shape(Dh, "D_half", {N, 3});
-            require_shape(Dn, "D_next", {N, 3});
+            const auto N = batch_rows(3, {{D, "D"}, {Dd, "D_dot"}, {Dh, "D_half"}, {Dn, "D_next"}});
             OutArray q = make_array({N, 3}), qd = make_array({N, 3}), qdd = make_array({N, 3}),
                      cond = make_array({N});
             auto status = make_status_array(N);
@@ -420,13 +416,7 @@ void bind_paminsa(py::module_& m) {
   m.def("paminsa_kinematics",
         [](const PaminsaModel& mo, const Array& P, const Array& Pd, const Array& Pdd,
            const Array& q, const Array& qd, const Array& qdd) {
-          require_shape(P, "P", {-1, 3});
-          const auto N = P.shape(0);
-          require_shape(Pd, "Pd", {N, 3});
-          require_shape(Pdd, "Pdd", {N, 3});
-          require_shape(q, "q", {N, 3});
-          require_shape(qd, "v", {N, 3});
-          require_shape(qdd, "a", {N, 3});
+          const auto N = batch_rows(3, {{P, "P"}, {Pd, "Pd"}, {Pdd, "Pdd"}, {q, "q"}, {qd, "v"}, {qdd, "a"}});
           BatchArrays out(N);
           const Status s = paminsa_kinematics_batch(mo, static_cast<std::size_t>(N), P.data(),
                                                     Pd.data(), Pdd.data(), q.data(), qd.data(),
@@ -442,11 +432,9 @@ void bind_paminsa(py::module_& m) {
         [](const PaminsaModel& mo, const ReactionlessWristConfig& c, const Array& q0_arg,
            const Array& P, const Array& Pd, const Array& Pdd) {
           const Vec3 q0 = fixed_vector<3>(q0_arg, "initial_wrist_angles");
-          require_shape(P, "P_half", {-1, 3});
-          const auto J = P.shape(0);
+          const auto J = batch_rows(3, {{P, "P_half"}});
           const auto steps = half_step_ticks(J, "P_half", 1);
-          require_shape(Pd, "Pd_half", {J, 3});
-          require_shape(Pdd, "Pdd_half", {J, 3});
+          require_rows(J, 3, {{Pd, "Pd_half"}, {Pdd, "Pdd_half"}});
           BatchArrays out(steps + 1);
           const Status s = paminsa_reactionless_run(mo, c, q0, static_cast<std::size_t>(steps),
                                                     P.data(), Pd.data(), Pdd.data(), out.view());

@@ -20,6 +20,27 @@ void check_positive_vector(const Eigen::VectorXd& v, const char* field, Eigen::I
 void check_torque_limit(const Eigen::VectorXd& limit, const char* field, Eigen::Index n,
                         Eigen::VectorXd& out);
 
+/// Real time: the checks a joint controller's tick starts with, in this order: a size other than
+/// n (tau_size is the output's) gives Status::bad_size, a NaN or infinite input
+/// Status::non_finite_input, an input outside `range` Status::out_of_range; Status::ok otherwise.
+/// The caller holds its last command on the last two (and leaves tau untouched on bad_size).
+inline Status check_tick_input(const JointInputRange& range, Eigen::Index n,
+                               const Eigen::Ref<const Eigen::VectorXd>& q,
+                               const Eigen::Ref<const Eigen::VectorXd>& qd,
+                               const Eigen::Ref<const Eigen::VectorXd>& q_des,
+                               const Eigen::Ref<const Eigen::VectorXd>& qd_des,
+                               const Eigen::Ref<const Eigen::VectorXd>& qdd_des,
+                               Eigen::Index tau_size) noexcept {
+  if (q.size() != n || qd.size() != n || q_des.size() != n || qd_des.size() != n ||
+      qdd_des.size() != n || tau_size != n)
+    return Status::bad_size;
+  if (!q.allFinite() || !qd.allFinite() || !q_des.allFinite() || !qd_des.allFinite() ||
+      !qdd_des.allFinite())
+    return Status::non_finite_input;
+  if (!within(range, q, qd, q_des, qd_des, qdd_des)) return Status::out_of_range;
+  return Status::ok;
+}
+
 /// Clips x(i) to [-limit(i), limit(i)] for the first n entries (limits may be +infinity).
 /// Returns Status::saturated when any entry was clipped, Status::ok otherwise. noexcept, no
 /// allocation.
