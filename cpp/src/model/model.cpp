@@ -373,6 +373,8 @@ MechanismModel::MechanismModel(MechanismDescription d) {
     C.col(2).cwiseAbs().maxCoeff(&axis);
     local_rotation_[l] = axis == 0 ? LocalRotation::along_x : axis == 1 ? LocalRotation::along_y : LocalRotation::along_z;
   }
+  has_aligned_links_ = std::any_of(local_rotation_.begin() + 1, local_rotation_.end(),
+                                   [](LocalRotation r) { return r != LocalRotation::general; });
   has_inertia_.assign(nl, 0);
   inertial_links_.clear();
   for (std::size_t l = 1; l < nl; ++l) {

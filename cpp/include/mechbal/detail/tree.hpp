@@ -210,9 +210,11 @@ struct NoVisit {
 
 /// With Subset, `only` (not null) restricts the pass to its links (their parents outside it keep
 /// their placements, in O too).
-template <bool World = true, class Visit = NoVisit, bool Subset = false>
-MECHBAL_FLATTEN inline void place(const MechanismModel& model, MechanismData& data, Visit&& visit = Visit{},
-                                  const LinkSubset* only = nullptr) noexcept {
+/// (place with Shortcuts: the rotations in O through times_local's shortcuts, one branch per link;
+/// without, dense products throughout: a model with no axis-aligned link does not pay the branch)
+template <bool Shortcuts, bool World, class Visit, bool Subset>
+MECHBAL_FLATTEN inline void place_as(const MechanismModel& model, MechanismData& data, Visit& visit,
+                                     const LinkSubset* only) noexcept {
   const int count = Subset ? static_cast<int>(only->links.size()) : model.num_links() - 1;
   for (int i = 0; i < count; ++i) {
     const int l = Subset ? only->links[static_cast<std::size_t>(i)] : i + 1;
@@ -253,9 +255,13 @@ MECHBAL_FLATTEN inline void place(const MechanismModel& model, MechanismData& da
       const auto& p = data.work[static_cast<std::size_t>(model.parent(l))];
       w.world_moved = local || w.world_stale || p.world_moved;
       if (w.world_moved) {
-        with_local_rotation(model.local_rotation(l), [&](auto kind) {
-          times_local<decltype(kind)::value>(p.world_rotation, w.rotation, w.world_rotation);
-        });
+        if constexpr (Shortcuts) {
+          with_local_rotation(model.local_rotation(l), [&](auto kind) {
+            times_local<decltype(kind)::value>(p.world_rotation, w.rotation, w.world_rotation);
+          });
+        } else {
+          w.world_rotation.noalias() = p.world_rotation * w.rotation;
+        }
         w.world_position = p.world_position + p.world_rotation * w.translation;
         w.world_stale = false;
         w.momentum_current = false;
@@ -264,6 +270,16 @@ MECHBAL_FLATTEN inline void place(const MechanismModel& model, MechanismData& da
       w.world_stale = true;  // world_* no longer that of rotation / translation
     }
     visit(l, static_cast<const MechanismData::LinkWork&>(w));
+  }
+}
+
+template <bool World = true, class Visit = NoVisit, bool Subset = false>
+inline void place(const MechanismModel& model, MechanismData& data, Visit&& visit = Visit{},
+                  const LinkSubset* only = nullptr) noexcept {
+  if (model.has_aligned_links()) {
+    place_as<true, World, Visit, Subset>(model, data, visit, only);
+  } else {
+    place_as<false, World, Visit, Subset>(model, data, visit, only);
   }
 }
 
@@ -454,7 +470,14 @@ MECHBAL_FLATTEN inline void forward_pass(const MechanismModel& model, MechanismD
   LinkMotion m{base.w, base.vel, base.acc, base.alpha};
   int last = 0;
   const int nl = model.num_links();
-  for (int l = 1; l < nl; ++l) forward_link<Velocity, Acceleration, Forces, OriginVelocity>(model, data, l, m, last);
+  if (model.has_aligned_links()) {
+    for (int l = 1; l < nl; ++l) forward_link<Velocity, Acceleration, Forces, OriginVelocity>(model, data, l, m, last);
+  } else {  // (no branch per link to a shortcut no link takes)
+    for (int l = 1; l < nl; ++l) {
+      forward_link_as<LocalRotation::general, Velocity, Acceleration, Forces, OriginVelocity, true>(model, data, l, m,
+                                                                                                   last);
+    }
+  }
 }
 
 /// Backward pass: wrench transmitted by each joint (accumulated into work[l].force/moment; the

@@ -251,6 +251,9 @@ class MechanismModel {
   /// nonzero entry, in that row, and its first two columns none there; general otherwise.
   enum class LocalRotation : unsigned char { general, along_x, along_y, along_z, identity };
   LocalRotation local_rotation(int link) const noexcept { return local_rotation_[static_cast<std::size_t>(link)]; }
+  /// Whether any link's rotation is other than general (the passes then branch per link to the
+  /// shortcuts; a model without one runs the dense products straight through).
+  bool has_aligned_links() const noexcept { return has_aligned_links_; }
 
  private:
   MechanismDescription description_;
@@ -271,6 +274,7 @@ class MechanismModel {
   std::vector<int> inertial_links_;
   std::vector<unsigned char> has_inertia_;
   std::vector<LocalRotation> local_rotation_;
+  bool has_aligned_links_ = false;
   std::vector<Frame> frames_;
   std::vector<int> frame_link_;
   std::vector<LinkConstants, detail::LargeBufferAllocator<LinkConstants>> constants_;
