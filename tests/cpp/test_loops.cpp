@@ -231,6 +231,39 @@ TEST(Loops, CommonAncestorColumnsMatchFiniteDifferences) {
   }
 }
 
+TEST(Loops, GearedJointsOnOneLoopAddTheirColumns) {
+  // a knuckle between the coupler and its tip turns with the rocker (a gear, mimic ratio 0.5): the
+  // rocker's coordinate drives a joint on each of the loop's paths, so its column is the sum of
+  // both joints' (the first listed sets the column's rows, the second adds to them)
+  for (const LoopType type : {LoopType::point, LoopType::axis, LoopType::planar_point}) {
+    MechanismDescription d;
+    d.gravity = Vec3(0.0, -9.81, 0.0);
+    Joint knuckle{"knuckle", JointType::revolute, "coupler", at(0.4, 0, 0)};
+    knuckle.mimic_joint = "rocker";
+    knuckle.mimic_ratio = 0.5;
+    d.joints = {Joint{"crank", JointType::revolute, "base"}, Joint{"coupler", JointType::revolute, "crank", at(0.2, 0, 0)},
+                knuckle, Joint{"rocker", JointType::revolute, "base", at(0.45, 0, 0)}};
+    d.bodies = {rod("crank", "crank", 0.8, 0.2), rod("coupler", "coupler", 1.5, 0.4), rod("knuckle", "knuckle", 0.3, 0.1),
+                rod("rocker", "rocker", 1.1, 0.4)};
+    d.frames = {Frame{"coupler_tip", "knuckle", at(0.1, 0, 0)}, Frame{"rocker_tip", "rocker", at(0.4, 0, 0)}};
+    d.loops = {LoopConstraint{"tip", type, "coupler_tip", "rocker_tip"}};
+    d.actuated = {"crank"};
+    const MechanismModel model(d);
+    MechanismData data(model);
+    int repeated = 0;  // the joints listed after another on the same coordinate
+    for (const auto& e : data.loop_path_joints) repeated += e.first ? 0 : 1;
+    EXPECT_EQ(repeated, 1) << static_cast<int>(type);
+    const Eigen::VectorXd q = (Eigen::VectorXd(3) << 0.9, -0.5, 1.6).finished();
+    ASSERT_EQ(loop_constraints(model, data, q), Status::ok);
+    const Eigen::MatrixXd A = data.loop_jacobian;
+    const Eigen::MatrixXd fd = residual_differences(model, data, q);
+    EXPECT_GT(A.cwiseAbs().maxCoeff(), 1e-2);
+    for (int k = 0; k < model.dof(); ++k) {
+      EXPECT_LT((A.col(k) - fd.col(k)).cwiseAbs().maxCoeff(), 1e-8) << static_cast<int>(type) << " coordinate " << k;
+    }
+  }
+}
+
 TEST(Loops, CouplingMatrixAndBiasMatchFiniteDifferences) {
   for (const auto& c : cases()) {
     const MechanismModel& model = c.model;

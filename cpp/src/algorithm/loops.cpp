@@ -43,7 +43,7 @@ struct RowFunctional {
 /// Residual (and Jacobian) of every loop, from placed links (world poses computed).
 void constraint_rows(const MechanismModel& model, MechanismData& data, bool jacobian) noexcept {
   // (A's entries outside the loops' path columns are zero from construction and never written:
-  // only the columns each loop's rows accumulate into are cleared, not the whole m x n matrix)
+  // each loop's rows are set in its path columns alone, not the whole m x n matrix cleared)
   Eigen::MatrixXd& jac = data.loop_jacobian;
   for (int i = 0; i < model.num_loops(); ++i) {
     const int row = model.loop_row(i), fa = model.loop_frame_a(i), fb = model.loop_frame_b(i);
@@ -98,18 +98,15 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
       const auto* const begin = data.loop_path_joints.data() + data.loop_path_joint_start[static_cast<std::size_t>(i)];
       const auto* const end = data.loop_path_joints.data() + data.loop_path_joint_start[static_cast<std::size_t>(i) + 1];
       const Eigen::Index m = jac.rows();
-      for (const auto* e = begin; e != end; ++e) {  // (a coordinate may drive several links: gears)
-        double* column = jac.data() + static_cast<Eigen::Index>(e->coordinate) * m + row;
-        for (int r = 0; r < rows; ++r) column[r] = 0.0;
-      }
+      // (a coordinate may drive several links, gears: its first joint in the list sets the
+      // column's rows, the others add to them)
       const bool point = type == LoopType::point;
       for (const auto* e = begin; e != end; ++e) {
         const auto& K = data.work[static_cast<std::size_t>(e->link)];
-        const Vec3 z = model.coordinate_ratio(e->link) * K.world_rotation.col(2);
-        const bool revolute = model.joint_type(e->link) == JointType::revolute;
+        const Vec3 z = e->ratio * K.world_rotation.col(2);
         const bool on_a = (e->sides & 1) != 0, on_b = (e->sides & 2) != 0;
         Vec3 lin;
-        if (revolute) {
+        if (e->revolute) {
           lin = z.cross(on_a ? (on_b ? Vec3(B.position - A.position) : Vec3(K.world_position - A.position))
                              : Vec3(B.position - K.world_position));
         } else {
@@ -117,14 +114,18 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
         }
         double* column = jac.data() + static_cast<Eigen::Index>(e->coordinate) * m + row;
         if (point) {  // a point loop's rows are d itself (a = e_k, b = e = 0)
-          for (int r = 0; r < 3; ++r) column[r] += lin(r);
+          if (e->first) {
+            for (int r = 0; r < 3; ++r) column[r] = lin(r);
+          } else {
+            for (int r = 0; r < 3; ++r) column[r] += lin(r);
+          }
           continue;
         }
         for (int r = 0; r < rows; ++r) {
           double value = f[r].a.dot(lin);
-          if (revolute && on_a) value += f[r].b.dot(z);
-          if (revolute && on_b) value += f[r].e.dot(z);
-          column[r] += value;
+          if (e->revolute && on_a) value += f[r].b.dot(z);
+          if (e->revolute && on_b) value += f[r].e.dot(z);
+          column[r] = e->first ? value : column[r] + value;
         }
       }
     }
@@ -132,11 +133,11 @@ void constraint_rows(const MechanismModel& model, MechanismData& data, bool jaco
 }
 
 /// detail::frame_motion from the frames' placements in their links (data.frame_*_in_link, as
-/// frame_pose), the rotation only when the loop's bias needs it (a point loop does not).
-/// (the position and velocity only with `translation`: of the loop types only planar_point's
-/// bias reads them)
+/// frame_pose), the rotation only when the loop's bias needs it, for the axis and weld loops'
+/// bias: the origin's acceleration and the angular motion (not the origin's position and velocity,
+/// which only planar_point's reads: planar_bias).
 detail::FrameMotion loop_frame_motion(const MechanismModel& model, const MechanismData& data, int frame,
-                                      bool rotation, bool translation) noexcept {
+                                      bool rotation) noexcept {
   const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
   const auto f = static_cast<std::size_t>(frame);
   const Mat3& R = W.world_rotation;
@@ -145,12 +146,59 @@ detail::FrameMotion loop_frame_motion(const MechanismModel& model, const Mechani
   if (rotation) m.rotation.noalias() = R * data.frame_rotation_in_link[f];
   m.angular_velocity.noalias() = R * W.w;
   m.angular_acceleration.noalias() = R * W.alpha;
-  if (translation) {
-    m.position = W.world_position + r;
-    m.velocity = R * W.vel + m.angular_velocity.cross(r);
-  }
   m.acceleration = R * W.acc + m.angular_acceleration.cross(r) + m.angular_velocity.cross(m.angular_velocity.cross(r));
   return m;
+}
+
+/// 3-vectors as three scalars, for gamma's short products: written as Eigen expressions, each
+/// cross product went through a stack temporary stored as scalars and read back by the next sum
+/// as a 16-byte packet straddling two of those stores, which the store buffer cannot forward (a
+/// third of constraint_bias's time sat on such loads). These stay in registers.
+struct P3 {
+  double x, y, z;
+};
+inline P3 p3(const Vec3& v) noexcept { return {v.x(), v.y(), v.z()}; }
+inline P3 operator+(const P3& a, const P3& b) noexcept { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline P3 operator-(const P3& a, const P3& b) noexcept { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline P3 cross(const P3& a, const P3& b) noexcept {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double dot(const P3& a, const P3& b) noexcept { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline P3 rotate(const Mat3& R, const P3& v) noexcept {
+  return {R(0, 0) * v.x + R(0, 1) * v.y + R(0, 2) * v.z, R(1, 0) * v.x + R(1, 1) * v.y + R(1, 2) * v.z,
+          R(2, 0) * v.x + R(2, 1) * v.y + R(2, 2) * v.z};
+}
+
+/// A planar_point loop's rows of gamma: x_k . d has the second derivative
+/// xdd . d + 2 xd . dd + x . ddd (x_k of frame A, d = p_B - p_A), in O (as loop_frame_motion).
+void planar_bias(const MechanismModel& model, MechanismData& data, int i, int row) noexcept {
+  struct Motion {
+    P3 position, velocity, acceleration, angular_velocity, angular_acceleration;
+  };
+  const auto motion = [&](int frame) {
+    const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
+    const Mat3& R = W.world_rotation;
+    const P3 r = rotate(R, p3(data.frame_position_in_link[static_cast<std::size_t>(frame)]));
+    Motion m;
+    m.angular_velocity = rotate(R, p3(W.w));
+    m.angular_acceleration = rotate(R, p3(W.alpha));
+    m.position = p3(W.world_position) + r;
+    m.velocity = rotate(R, p3(W.vel)) + cross(m.angular_velocity, r);
+    m.acceleration = rotate(R, p3(W.acc)) + cross(m.angular_acceleration, r) +
+                     cross(m.angular_velocity, cross(m.angular_velocity, r));
+    return m;
+  };
+  const int fa = model.loop_frame_a(i);
+  const Motion A = motion(fa), B = motion(model.loop_frame_b(i));
+  const P3 d = B.position - A.position, dd = B.velocity - A.velocity, ddd = B.acceleration - A.acceleration;
+  const Mat3& RA = data.work[static_cast<std::size_t>(model.frame_link(fa))].world_rotation;
+  const Mat3& F = data.frame_rotation_in_link[static_cast<std::size_t>(fa)];
+  for (int k = 0; k < 2; ++k) {
+    const P3 x = rotate(RA, P3{F(0, k), F(1, k), F(2, k)});
+    const P3 xd = cross(A.angular_velocity, x);
+    const P3 xdd = cross(A.angular_acceleration, x) + cross(A.angular_velocity, xd);
+    data.loop_bias(row + k) = dot(xdd, d) + 2.0 * dot(xd, dd) + dot(x, ddd);
+  }
 }
 
 /// gamma = dA/dt v from a forward pass with velocities (accelerations at a = 0).
@@ -159,31 +207,27 @@ void constraint_bias(const MechanismModel& model, MechanismData& data) noexcept 
     const int row = model.loop_row(i);
     const LoopType type = model.loop(i).type;
     if (type == LoopType::point) {
-      // the origins' accelerations only, each in its link's axes, rotated once
+      // the origins' accelerations only, each in its link's axes, rotated once:
+      // R (acc + alpha x p + w x (w x p)) (in scalars: P3)
       const auto acceleration = [&](int frame) {
         const auto& W = data.work[static_cast<std::size_t>(model.frame_link(frame))];
-        const Vec3& p = data.frame_position_in_link[static_cast<std::size_t>(frame)];
-        const Vec3 local = W.acc + W.alpha.cross(p) + W.w.cross(W.w.cross(p));
-        return Vec3(W.world_rotation * local);
+        const P3 p = p3(data.frame_position_in_link[static_cast<std::size_t>(frame)]), w = p3(W.w);
+        return rotate(W.world_rotation, p3(W.acc) + cross(p3(W.alpha), p) + cross(w, cross(w, p)));
       };
-      data.loop_bias.segment<3>(row) = acceleration(model.loop_frame_b(i)) - acceleration(model.loop_frame_a(i));
+      const P3 ddd = acceleration(model.loop_frame_b(i)) - acceleration(model.loop_frame_a(i));
+      data.loop_bias(row) = ddd.x;
+      data.loop_bias(row + 1) = ddd.y;
+      data.loop_bias(row + 2) = ddd.z;
       continue;
     }
-    const bool rotation = type == LoopType::planar_point || type == LoopType::axis;
-    const bool planar = type == LoopType::planar_point;
-    const detail::FrameMotion A = loop_frame_motion(model, data, model.loop_frame_a(i), rotation, planar);
-    const detail::FrameMotion B = loop_frame_motion(model, data, model.loop_frame_b(i), type == LoopType::axis, planar);
+    if (type == LoopType::planar_point) {
+      planar_bias(model, data, i, row);
+      continue;
+    }
+    const bool axis = type == LoopType::axis;
+    const detail::FrameMotion A = loop_frame_motion(model, data, model.loop_frame_a(i), axis);
+    const detail::FrameMotion B = loop_frame_motion(model, data, model.loop_frame_b(i), axis);
     const Vec3 ddd = B.acceleration - A.acceleration;
-    if (planar) {
-      const Vec3 d = B.position - A.position, dd = B.velocity - A.velocity;
-      for (int k = 0; k < 2; ++k) {
-        const Vec3 x = A.rotation.col(k);
-        const Vec3 xd = A.angular_velocity.cross(x);
-        const Vec3 xdd = A.angular_acceleration.cross(x) + A.angular_velocity.cross(xd);
-        data.loop_bias(row + k) = xdd.dot(d) + 2.0 * xd.dot(dd) + x.dot(ddd);
-      }
-      continue;
-    }
     data.loop_bias.segment<3>(row) = ddd;
     if (type == LoopType::axis) {
       const Vec3 z = A.rotation.col(2);
@@ -560,11 +604,25 @@ Status solve_positions(const MechanismModel& model, MechanismData& data, const C
   // exceed options.max_step.
   const bool tangent = model.is_closed() && q == data.closed_position;
   double vv = 0.0, dv = 0.0;
-  for (std::size_t i = 0; i < actuated.size(); ++i) {
-    const auto k = static_cast<Eigen::Index>(i);
-    if (tangent) trial.noalias() += data.loop_projection.col(k) * (q_actuated(k) - q(actuated[i]));
-    trial(actuated[i]) = q_actuated(k);
+  if (tangent) {
+    // (C d over C's structure: its passive rows are data.loop_solution's over the actuated
+    // columns that move a loop, its other passive entries zero; its actuated rows are d itself,
+    // which q_actuated replaces below)
+    const auto& columns = data.loop_actuated_columns;
+    const MechanismData::RowMajorMatrix& X = data.loop_solution;
+    const Eigen::Index w = X.cols();
+    double* const step = data.loop_vector_work.data();  // (n >= nla entries, free until the Newton steps)
+    for (Eigen::Index t = 0; t < w; ++t) {
+      const int c = columns[static_cast<std::size_t>(t)];
+      step[t] = q_actuated(c) - q(actuated[static_cast<std::size_t>(c)]);
+    }
+    for (std::size_t j = 0; j < passive.size(); ++j) {
+      const double* x = X.data() + static_cast<Eigen::Index>(j) * w;
+      double& p = trial(data.loop_elimination[j]);
+      for (Eigen::Index t = 0; t < w; ++t) p += x[t] * step[t];
+    }
   }
+  for (std::size_t i = 0; i < actuated.size(); ++i) trial(actuated[i]) = q_actuated(static_cast<Eigen::Index>(i));
   // the path parameter and the history over the loops' own coordinates: the actuated coordinates
   // that move no loop (a wrist carried by a parallel mechanism) change neither the solution nor c,
   // which is quadratic in the loops' rates alone, so their moves keep the warm start's history
@@ -796,11 +854,25 @@ void apply_projection(const MechanismModel& model, const MechanismData& data, co
   const auto& columns = data.loop_actuated_columns;
   const MechanismData::RowMajorMatrix& X = data.loop_solution;
   const Eigen::Index w = X.cols();
-  for (std::size_t j = 0; j < data.loop_elimination.size(); ++j) {
-    const double* row = X.data() + static_cast<Eigen::Index>(j) * w;
+  constexpr Eigen::Index kHeld = 8;  // (x over C's solved columns held in registers, up to 8 of them)
+  if (w > kHeld) {
+    for (std::size_t j = 0; j < data.loop_elimination.size(); ++j) {
+      const double* row = X.data() + static_cast<Eigen::Index>(j) * w;
+      double sum = 0.0;
+      for (Eigen::Index t = 0; t < w; ++t) sum += row[t] * x(columns[static_cast<std::size_t>(t)]);
+      y(data.loop_elimination[j]) += sum;
+    }
+    return;
+  }
+  double held[kHeld];
+  for (Eigen::Index t = 0; t < w; ++t) held[t] = x(columns[static_cast<std::size_t>(t)]);
+  double* const out = y.data();
+  const int* const elimination = data.loop_elimination.data();
+  const double* row = X.data();
+  for (std::size_t j = 0; j < data.loop_elimination.size(); ++j, row += w) {
     double sum = 0.0;
-    for (Eigen::Index t = 0; t < w; ++t) sum += row[t] * x(columns[static_cast<std::size_t>(t)]);
-    y(data.loop_elimination[j]) += sum;
+    for (Eigen::Index t = 0; t < w; ++t) sum += row[t] * held[t];
+    out[elimination[j]] += sum;
   }
 }
 
@@ -946,12 +1018,12 @@ Status project(const MechanismModel& model, MechanismData& data, const ConstVect
     ldl_solve_block(data, S);
     X += S;
   }
-  bool finite = true;  // C's other entries are 0 and 1
+  // (C's other entries are 0 and 1)
+  const bool finite = detail::all_finite(Eigen::Map<const Eigen::VectorXd>(X.data(), X.size()));
   for (std::size_t j = 0; j < passive.size(); ++j) {
     const double* x = X.data() + static_cast<Eigen::Index>(j) * w;
     for (Eigen::Index t = 0; t < w; ++t) {
       data.loop_projection(data.loop_elimination[j], columns[static_cast<std::size_t>(t)]) = x[t];
-      finite = finite && std::abs(x[t]) <= std::numeric_limits<double>::max();
     }
   }
   apply_projection(model, data, v_actuated, data.closed_velocity);
@@ -1011,8 +1083,7 @@ Status closed_motion(const MechanismModel& model, MechanismData& data, const Con
   if (Status s = check(model, data, q, &q_actuated, &v_actuated, &a_actuated); s != Status::ok) return s;
   Status status = solve_positions(model, data, q_actuated, q, options, true);
   if (has(status, Status::solver_error)) return status;
-  data.closed_position = q;
-  status |= project(model, data, q, v_actuated, options, true);
+  status |= project(model, data, q, v_actuated, options, true);  // (closed_position = q)
   data.closed_acceleration = data.loop_acceleration_bias;
   apply_projection(model, data, a_actuated, data.closed_acceleration, true);
   return status;
@@ -1063,16 +1134,19 @@ MECHBAL_FLATTEN void closed_wrench_of_projected(const MechanismModel& model, Mec
     }
     field[2 * k] = angular;
     field[2 * k + 1] = linear;
-    W.alpha += angular;
-    W.acc += linear;
+    // (the link's motion in locals for the sums below: read back from W right after its totals
+    // are stored, 16-byte loads straddle those stores and wait for them to retire)
+    const Vec3 w = W.w, vel = W.vel, alpha = W.alpha + angular, acc = W.acc + linear;
+    W.alpha = alpha;
+    W.acc = acc;
     if (!model.has_inertia(l)) continue;  // adds nothing to the sums
     const auto& cst = model.link_constants(l);
     Vec3 force, moment;
-    detail::link_wrench(cst, W.w, W.alpha, W.acc, force, moment);
+    detail::link_wrench(cst, w, alpha, acc, force, moment);
     const Vec3 f = W.world_rotation * force;
     F += f;
     M += W.world_rotation * moment + W.world_position.cross(f);
-    detail::add_link_momentum(cst, W, W.w, W.vel, P, H);
+    detail::add_link_momentum(cst, W, w, vel, P, H);
   }
   data.shaking.linear_momentum = P;
   data.shaking.angular_momentum = H;

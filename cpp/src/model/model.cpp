@@ -594,20 +594,25 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
   data.loop_path_joints.clear();
   data.loop_path_joint_start.assign(1, 0);
   for (int i = 0; i < model.num_loops(); ++i) {
-    const auto first = data.loop_path_joints.size();
+    const auto first_index = data.loop_path_joints.size();
     for (int side = 0; side < 2; ++side) {
       for (int k : path(i, side == 0 ? model.loop_frame_a(i) : model.loop_frame_b(i))) {
         const int c = model.coordinate(k);
         if (c < 0) continue;
         const auto bit = static_cast<unsigned char>(side == 0 ? 1 : 2);
         bool listed = false;
-        for (auto e = first; e < data.loop_path_joints.size(); ++e) {
+        for (auto e = first_index; e < data.loop_path_joints.size(); ++e) {
           if (data.loop_path_joints[e].link == k) {
             data.loop_path_joints[e].sides = static_cast<unsigned char>(data.loop_path_joints[e].sides | bit);
             listed = true;
           }
         }
-        if (!listed) data.loop_path_joints.push_back({k, c, bit});
+        if (!listed) {
+          bool first = true;  // (a coordinate may drive several links: gears)
+          for (auto e = first_index; e < data.loop_path_joints.size(); ++e) first = first && data.loop_path_joints[e].coordinate != c;
+          data.loop_path_joints.push_back(
+              {k, c, bit, first, model.joint_type(k) == JointType::revolute, model.coordinate_ratio(k)});
+        }
       }
     }
     data.loop_path_joint_start.push_back(static_cast<int>(data.loop_path_joints.size()));
@@ -679,6 +684,41 @@ void loop_factor_structure(const MechanismModel& model, MechanismData& data) {
         if (w != v && !eliminated[w] && adjacent[best][w]) adjacent[v][w] = 1;
       }
     }
+  }
+  // then by height in the elimination tree (a column's parent: the first row below its pivot),
+  // ties in the minimum-degree order: any order that eliminates each column after all its
+  // descendants in that tree has the same fill and the same L, permuted. Independent branches
+  // (PAMINSA's three legs) then alternate column by column, so that the chains of dependent
+  // pivots of the factorisation and of the triangular solves (each pivot a division or a long
+  // sum) interleave instead of running one after the other
+  {
+    std::vector<int> height(np, 0);
+    for (std::size_t k = 0; k < np; ++k) {
+      int parent = -1;
+      for (const int v : below[k]) {
+        const int at = position[static_cast<std::size_t>(v)];
+        if (parent < 0 || at < parent) parent = at;
+      }
+      if (parent >= 0) {
+        height[static_cast<std::size_t>(parent)] =
+            std::max(height[static_cast<std::size_t>(parent)], height[k] + 1);
+      }
+    }
+    std::vector<int> steps(np);
+    for (std::size_t k = 0; k < np; ++k) steps[k] = static_cast<int>(k);
+    std::stable_sort(steps.begin(), steps.end(), [&](int a, int b) {
+      return height[static_cast<std::size_t>(a)] < height[static_cast<std::size_t>(b)];
+    });
+    std::vector<int> scheduled(np);
+    std::vector<std::vector<int>> scheduled_below(np);
+    for (std::size_t k = 0; k < np; ++k) {
+      const auto from = static_cast<std::size_t>(steps[k]);
+      scheduled[k] = order[from];
+      scheduled_below[k] = std::move(below[from]);
+      position[static_cast<std::size_t>(order[from])] = static_cast<int>(k);
+    }
+    order = std::move(scheduled);
+    below = std::move(scheduled_below);
   }
   data.loop_elimination.clear();
   data.loop_factor_start.assign(1, 0);

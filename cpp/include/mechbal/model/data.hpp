@@ -133,8 +133,9 @@ struct MechanismData {
   Eigen::LDLT<Eigen::MatrixXd> reduced_ldlt;  ///< of C^T M C (na x na)
   /// The passive coordinates in the elimination order of N = A°^T A° (a minimum-degree ordering of
   /// the loops' structure, fixed at construction: PAMINSA's legs before the platform they share, so
-  /// that the factor keeps the legs' blocks apart); A°'s columns, the Newton step and the solution
-  /// rows are in this order.
+  /// that the factor keeps the legs' blocks apart; then sorted by height in the elimination tree,
+  /// the same fill, so that the legs' columns alternate); A°'s columns, the Newton step and the
+  /// solution rows are in this order.
   std::vector<int> loop_elimination;
   /// Structure of L in N = L D L^T: the rows (elimination positions, increasing) that column k may
   /// fill are loop_factor_rows[loop_factor_start[k] .. loop_factor_start[k + 1]).
@@ -155,9 +156,13 @@ struct MechanismData {
   /// loop_path_joints[loop_path_joint_start[i] .. loop_path_joint_start[i + 1]), frame A's path
   /// first, with the paths they are on (bit 1: A's, bit 2: B's; a common ancestor's on both), so
   /// that the loop's columns come from a list instead of two walks up the tree per evaluation.
+  /// (`first`: the first of the loop's joints on its coordinate, which sets the column's rows
+  /// instead of adding to them; the joint's type and coordinate ratio copied from the model)
   struct LoopPathJoint {
     int link = 0, coordinate = 0;
     unsigned char sides = 0;
+    bool first = true, revolute = true;
+    double ratio = 1.0;
   };
   std::vector<LoopPathJoint> loop_path_joints;
   std::vector<int> loop_path_joint_start;
