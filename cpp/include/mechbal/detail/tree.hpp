@@ -109,6 +109,7 @@ inline void with_local_rotation(LocalRotation kind, F&& f) noexcept {
       f(std::integral_constant<LocalRotation, LocalRotation::identity>{});
       break;
     case LocalRotation::general:
+    default:  // (every value is listed: this tells the compiler that f always runs)
       f(std::integral_constant<LocalRotation, LocalRotation::general>{});
       break;
   }
