@@ -216,6 +216,15 @@ bool gram_extremes(const At& w, int g, int n, const Small& G, double max_conditi
     lmin = l0;
     return false;
   }
+  // the usual, well-conditioned case: the closed form's lmin, within d lmax, settles the decision
+  // (and, for a reported condition, is accurate to 1e-6 relative) without K's minors, whose
+  // C(n, 3) determinants cost a wide K (a 7-joint arm's) more than the rest of the solve
+  const double threshold = lmax / (max_condition * max_condition);  // damped iff lmin < threshold
+  if ((l0 - d * lmax > threshold * (1.0 + d) && (!reported || d * lmax <= 1e-6 * l0)) ||
+      (!reported && l0 + d * lmax < threshold * (1.0 - d))) {
+    lmin = l0;
+    return false;
+  }
   const GramInvariants e = gram_invariants(w, g, n);
   double lo = 0.0, hi = 0.0;
   if (g == 2) {
@@ -246,7 +255,6 @@ bool gram_extremes(const At& w, int g, int n, const Small& G, double max_conditi
     lo *= 1.0 - 4.0 * unit;
   }
   lo = std::max(lo, 0.0);
-  const double threshold = lmax / (max_condition * max_condition);  // damped iff lmin < threshold
   bool settled = hi < threshold * (1.0 - d) || lo > threshold * (1.0 + d);
   if (settled && reported) settled = hi - lo <= 2e-6 * lmin || 0.5 * (hi - lo) <= iterative_error * lmax;
   if (settled) return false;
