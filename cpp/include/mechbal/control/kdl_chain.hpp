@@ -20,7 +20,7 @@
 
 namespace mechbal {
 
-class KdlChainDynamics final : public SupportWrenchDynamics<KdlChainDynamics> {
+class KdlChainDynamics final : public InverseDynamics {
  public:
   /// From the general model when it is a serial chain: joint k moves link k + 1 whose parent is
   /// link k, every joint revolute or prismatic with its own coordinate (no fixed joint, no gear
@@ -35,8 +35,13 @@ class KdlChainDynamics final : public SupportWrenchDynamics<KdlChainDynamics> {
 
   int dof() const noexcept override { return dof_; }
 
-  /// InverseDynamics interface: joint torques only (SupportWrenchDynamics).
-  using SupportWrenchDynamics<KdlChainDynamics>::inverse_dynamics;
+  /// InverseDynamics interface: joint torques only.
+  Status inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
+                          const Eigen::Ref<const Eigen::VectorXd>& qd,
+                          const Eigen::Ref<const Eigen::VectorXd>& qdd,
+                          Eigen::Ref<Eigen::VectorXd> tau) noexcept override {
+    return inverse_dynamics(q, qd, qdd, tau, nullptr, nullptr);
+  }
 
   /// tau = M(q) qdd + C(q, qd) qd + G(q). When `support_force`/`support_moment` are non-null
   /// they receive the wrench the base exerts on the chain (moment about the base origin).
