@@ -175,6 +175,52 @@ TEST(Mechanism, AxisAlignedLinksAgreeWithTheGeneralProducts) {
   for (const K kind : {K::along_x, K::along_y, K::along_z, K::identity}) EXPECT_GT(seen[static_cast<int>(kind)], 0);
 }
 
+// Right angles as a URDF gives them: rpy angles of +-pi/2 leave cos(pi/2) = 6e-17 where the zeros
+// belong. Such a rotation is taken as the signed permutation it stands for (the model's joint
+// placements, before fixed joints are folded): the tree built from rotations recomposed from their Euler angles (as a parser does)
+// is bit for bit the tree built from the exact permutations, in its kinds and in every result. A
+// real angle of 1e-14 rad is not rounding: that tree stays general.
+TEST(Mechanism, RightAnglesWithinRoundingAreExact) {
+  std::mt19937 rng(31);
+  using K = MechanismModel::LocalRotation;
+  int rounded = 0;  // placements whose recomposed rotation is not exactly the permutation
+  for (int trial = 0; trial < 8; ++trial) {
+    const MechanismDescription d = random_tree_description(rng, trial % 2 == 0 ? "RRPFRRPR" : "RFRRPRRF", trial % 3 == 0, true);
+    MechanismDescription parsed = d, turned = d;
+    for (std::size_t i = 0; i < d.joints.size(); ++i) {
+      const Mat3 R = d.joints[i].placement.linear();
+      const Vec3 e = R.eulerAngles(2, 1, 0);  // multiples of pi/2, rounded
+      const Mat3 Rp = (Eigen::AngleAxisd(e(0), Vec3::UnitZ()) * Eigen::AngleAxisd(e(1), Vec3::UnitY()) *
+                       Eigen::AngleAxisd(e(2), Vec3::UnitX())).toRotationMatrix();
+      ASSERT_LT((Rp - R).cwiseAbs().maxCoeff(), 1e-15);
+      rounded += Rp != R;
+      parsed.joints[i].placement.linear() = Rp;
+      turned.joints[i].placement.linear() = R * Eigen::AngleAxisd(1e-14, Vec3(0.0, 0.6, 0.8)).toRotationMatrix();
+    }
+    const MechanismModel exact(d), model(parsed), general(turned);
+    for (int l = 1; l < model.num_links(); ++l) {
+      ASSERT_EQ(model.local_rotation(l), exact.local_rotation(l)) << "link " << l;
+      ASSERT_NE(model.local_rotation(l), K::general) << "link " << l;
+      ASSERT_TRUE(model.placement(l).matrix() == exact.placement(l).matrix()) << "link " << l;
+      ASSERT_TRUE(model.link_constants(l).rotation == exact.link_constants(l).rotation) << "link " << l;
+      if (d.joints[static_cast<std::size_t>(l - 1)].placement.linear() != Mat3::Identity()) {
+        EXPECT_EQ(general.local_rotation(l), K::general) << "link " << l;
+      }
+    }
+    MechanismData a(exact), b(model);
+    const int n = model.dof();
+    const Eigen::VectorXd q = test::random_vector(rng, n, 2.0), v = test::random_vector(rng, n, 1.0),
+                          acc = test::random_vector(rng, n, 1.0);
+    ASSERT_EQ(inverse_dynamics(exact, a, q, v, acc), Status::ok);
+    ASSERT_EQ(inverse_dynamics(model, b, q, v, acc), Status::ok);
+    EXPECT_TRUE(a.joint_torque == b.joint_torque);
+    ASSERT_EQ(mass_matrix(exact, a, q), Status::ok);
+    ASSERT_EQ(mass_matrix(model, b, q), Status::ok);
+    EXPECT_TRUE(a.mass_matrix == b.mass_matrix);
+  }
+  EXPECT_GT(rounded, 10);  // (the recomposition rounds: the test is not of exact input)
+}
+
 // The shortcuts themselves, against the dense products they stand for, on rotations of each kind
 // (R = C R_z(q), C a signed permutation taking z to the axis k; the identity), to round-off.
 TEST(Mechanism, RotationShortcutsAreTheDenseProducts) {

@@ -40,6 +40,22 @@ void check_placement(const Eigen::Isometry3d& T, const std::string& field) {
   }
 }
 
+/// A rotation within rounding of a signed permutation is that permutation: rpy angles of +-pi/2
+/// (URDF's usual way to turn a frame at a right angle) leave cos(pi/2) = 6e-17 where the zeros
+/// belong, and 1 - 1e-16 for the ones. When every entry is within 4 ulp of 0, 1 or -1, each is set
+/// to it (an orthonormal R then becomes an exact signed permutation: it has one entry near +-1 per
+/// row and column). The model moves by at most 1e-15, toward the rotation meant, and its links
+/// take the passes' shortcuts for frames at right angles (MechanismModel::local_rotation).
+void snap_right_angles(Eigen::Isometry3d& T) {
+  constexpr double kSnap = 4.0 * std::numeric_limits<double>::epsilon();
+  const Mat3 R = T.linear();
+  for (Eigen::Index i = 0; i < 9; ++i) {
+    const double x = std::abs(R.data()[i]);
+    if (!(x <= kSnap || std::abs(x - 1.0) <= kSnap)) return;
+  }
+  T.linear() = R.unaryExpr([](double x) { return std::abs(x) <= kSnap ? 0.0 : x > 0.0 ? 1.0 : -1.0; });
+}
+
 /// A rotation A with A e_z = axis (axis unit): the joint-aligned frame of a link.
 Mat3 aligned_with_z(const Vec3& axis) {
   Vec3 seed = Vec3::UnitX();
@@ -120,6 +136,7 @@ MechanismModel::MechanismModel(MechanismDescription d) {
     }
     if (j.parent == j.name) throw std::invalid_argument(joint_field(i, j, "parent") + " is the joint itself");
     check_placement(j.placement, joint_field(i, j, "placement"));
+    snap_right_angles(j.placement);
     if (j.type != JointType::fixed) {
       const double scale = j.axis.cwiseAbs().maxCoeff();
       if (!j.axis.allFinite() || !(scale > 0.0)) {

@@ -246,7 +246,8 @@ class MechanismModel {
   /// How link `link`'s rotation R relative to its parent acts (the passes' products with it):
   /// identity when R is the identity (a prismatic or fixed joint whose constant rotation is exactly
   /// the identity); along_x, along_y, along_z when its constant rotation is a signed permutation
-  /// (exact zeros and ones: frames at right angles, links along parallel axes, a pantograph's)
+  /// (exact zeros and ones: frames at right angles, links along parallel axes, a pantograph's;
+  /// a joint placement within 4 ulp of one, as rpy angles of +-pi/2 give, is taken as exact)
   /// that takes the joint's axis to the parent's x, y or z axis, so that R's third column has one
   /// nonzero entry, in that row, and its first two columns none there; general otherwise.
   enum class LocalRotation : unsigned char { general, along_x, along_y, along_z, identity };
