@@ -11,6 +11,9 @@
 
 namespace mechbal {
 
+// The one definition of the base's vtable and typeinfo (declared extern in the header).
+template class SupportWrenchDynamics<KdlChainDynamics>;
+
 namespace {
 
 [[noreturn]] void not_a_chain(const std::string& why) {

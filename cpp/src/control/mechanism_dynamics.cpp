@@ -10,6 +10,9 @@
 
 namespace mechbal {
 
+// The one definition of the base's vtable and typeinfo (declared extern in the header).
+template class SupportWrenchDynamics<MechanismDynamics>;
+
 MechanismDynamics::MechanismDynamics(MechanismModel model, const Eigen::VectorXd& q_guess)
     : MechanismDynamics(std::make_shared<const MechanismModel>(std::move(model)), q_guess) {}
 

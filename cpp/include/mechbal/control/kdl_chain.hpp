@@ -20,7 +20,11 @@
 
 namespace mechbal {
 
-class KdlChainDynamics final : public InverseDynamics {
+class KdlChainDynamics;
+/// Instantiated in kdl_chain.cpp only (its vtable and typeinfo: see SupportWrenchDynamics).
+extern template class SupportWrenchDynamics<KdlChainDynamics>;
+
+class KdlChainDynamics final : public SupportWrenchDynamics<KdlChainDynamics> {
  public:
   /// From the general model when it is a serial chain: joint k moves link k + 1 whose parent is
   /// link k, every joint revolute or prismatic with its own coordinate (no fixed joint, no gear
@@ -35,13 +39,8 @@ class KdlChainDynamics final : public InverseDynamics {
 
   int dof() const noexcept override { return dof_; }
 
-  /// InverseDynamics interface: joint torques only.
-  Status inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
-                          const Eigen::Ref<const Eigen::VectorXd>& qd,
-                          const Eigen::Ref<const Eigen::VectorXd>& qdd,
-                          Eigen::Ref<Eigen::VectorXd> tau) noexcept override {
-    return inverse_dynamics(q, qd, qdd, tau, nullptr, nullptr);
-  }
+  /// InverseDynamics interface: joint torques only (SupportWrenchDynamics).
+  using SupportWrenchDynamics<KdlChainDynamics>::inverse_dynamics;
 
   /// tau = M(q) qdd + C(q, qd) qd + G(q). When `support_force`/`support_moment` are non-null
   /// they receive the wrench the base exerts on the chain (moment about the base origin).

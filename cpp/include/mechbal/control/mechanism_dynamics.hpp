@@ -25,7 +25,11 @@
 
 namespace mechbal {
 
-class MechanismDynamics : public InverseDynamics, public ForwardDynamics {
+class MechanismDynamics;
+/// Instantiated in mechanism_dynamics.cpp only (its vtable and typeinfo: see SupportWrenchDynamics).
+extern template class SupportWrenchDynamics<MechanismDynamics>;
+
+class MechanismDynamics : public SupportWrenchDynamics<MechanismDynamics>, public ForwardDynamics {
  public:
   /// `q_guess` (model.dof() values, default zeros): the full coordinates near the assembly the
   /// loops start from (the assembly mode). Throws std::invalid_argument when an open mechanism has
@@ -46,13 +50,9 @@ class MechanismDynamics : public InverseDynamics, public ForwardDynamics {
   /// tau# = M#(q#) a# + b#(q#, v#) (gravity and springs included). Sizes must equal dof() (Status::bad_size),
   /// input finite (Status::non_finite_input), tau untouched otherwise; a closed mechanism that
   /// cannot be assembled gives Status::solver_error (tau untouched); near a parallel singularity
-  /// Status::singular with the computed tau.
-  Status inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
-                          const Eigen::Ref<const Eigen::VectorXd>& qd,
-                          const Eigen::Ref<const Eigen::VectorXd>& qdd,
-                          Eigen::Ref<Eigen::VectorXd> tau) noexcept override {
-    return inverse_dynamics(q, qd, qdd, tau, nullptr, nullptr);
-  }
+  /// Status::singular with the computed tau. The InverseDynamics call (SupportWrenchDynamics) is
+  /// this one without the wrench.
+  using SupportWrenchDynamics<MechanismDynamics>::inverse_dynamics;
   /// As above; `support_force`/`support_moment` (when non-null) receive the wrench the base exerts
   /// on the moving links (moment about O, gravity included; bodies fixed to the base excluded).
   Status inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& q,
