@@ -1,10 +1,10 @@
 // The reactionless controllers' damping decision and reported condition (detail::gram_extremes,
-// control/reactionless.hpp) against accurate singular values: K's own, from a long double Jacobi
-// SVD (cond K = sqrt(lmax / lmin) of its Gram matrix). Near-singular Gram matrices of every shape
-// the controllers meet (2 x 2 and 3 x 3, square, wide and tall K), conditions 1e2 to 1e9 with one
-// small singular value, two (clustered or not), the two largest clustered, conditions right at
-// max_condition, and exactly singular K of rank 0, 1 and 2. Also Eigen's 3 x 3 closed form against
-// the error bound the decision relies on.
+// control/detail/gram_extremes.hpp) against accurate singular values: K's own, from a long double
+// Jacobi SVD (cond K = sqrt(lmax / lmin) of its Gram matrix). Near-singular Gram matrices of every
+// shape the controllers meet (2 x 2 and 3 x 3, square, wide and tall K), conditions 1e2 to 1e9
+// with one small singular value, two (clustered or not), the two largest clustered, conditions
+// right at max_condition, and exactly singular K of rank 0, 1 and 2. Also Eigen's 3 x 3 closed
+// form against the error bound the decision relies on.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "mechbal/control/reactionless.hpp"
+#include "mechbal/control/detail/gram_extremes.hpp"
 
 using namespace mechbal;
 

@@ -10,6 +10,7 @@
 #include "mechbal/algorithm/kinematics.hpp"
 #include "mechbal/algorithm/momentum.hpp"
 #include "mechbal/algorithm/shaking_wrench.hpp"
+#include "mechbal/control/detail/gram_extremes.hpp"
 #include "mechbal/detail/placed.hpp"
 #include "mechbal/detail/tree.hpp"
 

@@ -458,20 +458,4 @@ class ReactionlessTaskController {
   Status status_ = Status::ok;
 };
 
-namespace detail {
-
-/// The extreme eigenvalues of a reactionless solve's Gram matrix (K K^T when K has fewer rows
-/// than columns, else K^T K) as the controllers compute them for the damping decision at
-/// max_condition (damped iff lmax / lmin > max_condition^2) and, when `reported`, for the
-/// reported condition sqrt(lmax / lmin); `iterated`: Eigen's iterative eigensolver was needed
-/// (otherwise the closed forms and K's minors settled both). For tests (it allocates):
-/// std::invalid_argument when K is not finite or has more than 6 rows or columns.
-struct GramExtremes {
-  double lmin = 0.0, lmax = 0.0;
-  bool iterated = false;
-};
-GramExtremes gram_extremes(const Eigen::MatrixXd& K, double max_condition, bool reported);
-
-}  // namespace detail
-
 }  // namespace mechbal
