@@ -193,26 +193,14 @@ inline void joint_state(const MechanismModel& model, MechanismData& data,
   }
 }
 
-/// Link placements relative to their parents and, with World, in O (L frames). The passes that
-/// work in the links' own frames only (inverse dynamics, gravity, bias, mass matrix) skip World:
-/// work[].world_* are then left as they were (and marked stale). `visit(l, work[l])` runs on each
-/// link right after it is placed (in tree order, links 1..n-1), while its data is in cache: an
-/// algorithm that needs one more quantity per placed link folds it into this pass instead of
-/// sweeping the links again.
-/// Incremental: a link whose joint position is the one its placement was last computed at
-/// (LinkWork::placed_at) keeps its rotation and translation, and its pose in O when neither it
-/// nor its parent moved since that pose was computed: an algorithm called at the q the links are
-/// already placed at (shaking_wrench after closed_motion, the momentum matrix at a pose where
-/// only a few joints moved) pays for the moved links only. The skipped values are exactly those
-/// that would be recomputed (same inputs, same operations), so results are bit for bit the same.
+/// The visit that does nothing (place's default).
 struct NoVisit {
   void operator()(int, const MechanismData::LinkWork&) const noexcept {}
 };
 
-/// With Subset, `only` (not null) restricts the pass to its links (their parents outside it keep
-/// their placements, in O too).
-/// (place with Shortcuts: the rotations in O through times_local's shortcuts, one branch per link;
-/// without, dense products throughout: a model with no axis-aligned link does not pay the branch)
+/// place's pass. With Shortcuts: the rotations in O through times_local's shortcuts, one branch
+/// per link; without, dense products throughout (a model with no axis-aligned link does not pay
+/// the branch).
 template <bool Shortcuts, bool World, class Visit, bool Subset>
 MECHBAL_FLATTEN inline void place_as(const MechanismModel& model, MechanismData& data, Visit& visit,
                                      const LinkSubset* only) noexcept {
@@ -274,6 +262,20 @@ MECHBAL_FLATTEN inline void place_as(const MechanismModel& model, MechanismData&
   }
 }
 
+/// Link placements relative to their parents and, with World, in O (L frames). The passes that
+/// work in the links' own frames only (inverse dynamics, gravity, bias, mass matrix) skip World:
+/// work[].world_* are then left as they were (and marked stale). `visit(l, work[l])` runs on each
+/// link right after it is placed (in tree order, links 1..n-1), while its data is in cache: an
+/// algorithm that needs one more quantity per placed link folds it into this pass instead of
+/// sweeping the links again.
+/// Incremental: a link whose joint position is the one its placement was last computed at
+/// (LinkWork::placed_at) keeps its rotation and translation, and its pose in O when neither it
+/// nor its parent moved since that pose was computed: an algorithm called at the q the links are
+/// already placed at (shaking_wrench after closed_motion, the momentum matrix at a pose where
+/// only a few joints moved) pays for the moved links only. The skipped values are exactly those
+/// that would be recomputed (same inputs, same operations), so results are bit for bit the same.
+/// With Subset, `only` (not null) restricts the pass to its links (their parents outside it keep
+/// their placements, in O too).
 template <bool World = true, class Visit = NoVisit, bool Subset = false>
 inline void place(const MechanismModel& model, MechanismData& data, Visit&& visit = Visit{},
                   const LinkSubset* only = nullptr) noexcept {
