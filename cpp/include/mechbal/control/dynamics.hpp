@@ -12,7 +12,7 @@ namespace mechbal {
 
 class InverseDynamics {
  public:
-  virtual ~InverseDynamics() = default;
+  virtual ~InverseDynamics();  // (defined in the library: its vtable's one home, interfaces.cpp)
   virtual int dof() const noexcept = 0;
   /// Real-time: noexcept, allocation-free. Sizes must equal dof() (else Status::bad_size and tau
   /// untouched); non-finite input gives Status::non_finite_input and tau untouched.
@@ -53,7 +53,7 @@ class SupportWrenchDynamics : public InverseDynamics {
 /// Forward-dynamics interface of a plant for closed-loop simulation: qdd = M^-1 (tau - C qd - G).
 class ForwardDynamics {
  public:
-  virtual ~ForwardDynamics() = default;
+  virtual ~ForwardDynamics();  // (defined in the library: its vtable's one home, interfaces.cpp)
   virtual int dof() const noexcept = 0;
   /// Real-time: noexcept, allocation-free; sizes must equal dof() (else bad_size, qdd untouched);
   /// non-finite input -> non_finite_input, qdd untouched; singular mass matrix -> singular.

@@ -11,7 +11,7 @@ namespace mechbal {
 
 class JointController {
  public:
-  virtual ~JointController() = default;
+  virtual ~JointController();  // (defined in the library: its vtable's one home, interfaces.cpp)
   virtual int dof() const noexcept = 0;
   /// One control tick: the command tau tracking (q_des, qd_des, qdd_des) from the measured
   /// (q, qd). Real-time: noexcept, allocation-free, bounded; bad input gives a status and the held
