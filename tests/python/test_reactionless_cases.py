@@ -25,6 +25,7 @@ from mechbal import control
 from mechbal.cases import run_case
 from mechbal.config import CASES_DIR, ConfigError, case_path, load_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
+from generated_text import text_differences
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -87,7 +88,8 @@ def _variant_case(tmp_path: Path, integrator: str, theta0: float | None) -> Path
 def test_the_shipped_paminsa_reactionless_case_is_its_generator():
     from mechbal.papers.paminsa import paminsa_case_toml
 
-    assert case_path("paminsa-reactionless").read_text() == paminsa_case_toml("paminsa", reactionless=True), \
+    assert text_differences(case_path("paminsa-reactionless").read_text(),
+                            paminsa_case_toml("paminsa", reactionless=True)) == [], \
         "regenerate paminsa-reactionless.toml"
 
 
@@ -142,7 +144,7 @@ def panda_run(tmp_path_factory):
 def test_the_shipped_panda_case_is_its_generator_and_its_urdf():
     from mechbal.cases.panda import panda_case_toml, urdf_path
 
-    assert (CASES_DIR / "panda-reactionless.toml").read_text() == panda_case_toml(), \
+    assert text_differences((CASES_DIR / "panda-reactionless.toml").read_text(), panda_case_toml()) == [], \
         "regenerate panda-reactionless.toml"
     a = mechbal.Mechanism.from_urdf(urdf_path())
     b = mechbal.Mechanism.from_toml(CASES_DIR / "panda-reactionless.toml")
