@@ -61,6 +61,12 @@ class GeneratedCode:
     frame_names: list[str]
     input_hash: str           # sha256 of the model's constants as the generator read them
     operations: dict[str, int] = field(default_factory=dict)  # arithmetic operations per function
+    actuated: list[int] = field(default_factory=list)  # closed mechanisms: indices of q# in q
+    passive: list[int] = field(default_factory=list)   # and of the passive coordinates
+
+    @property
+    def closed(self) -> bool:
+        return bool(self.passive)
 
     def write(self, directory: str | Path) -> Path:
         """Write ``<name>.hpp`` into `directory` (created if missing); returns its path."""
@@ -102,9 +108,6 @@ def generate(mechanism, *, name: str | None = None, frames: list[str] | None = N
     frame of the model). Raises `CodegenError` for a model with loop closures (not generated
     yet) or with more than `max_joints` joints (the unrolled code would be too large)."""
     model = mechanism.model
-    if model.is_closed:
-        raise CodegenError(f"mechanism {mechanism.name!r} has {model.num_constraints} loop-closure "
-                           "equations: closed loops are not generated yet (open trees only)")
     links = model.num_links - 1
     if links > max_joints:
         raise CodegenError(f"mechanism {mechanism.name!r} has {links} joints, more than the "
@@ -123,11 +126,12 @@ def generate(mechanism, *, name: str | None = None, frames: list[str] | None = N
     bodies: list[str] = []
     operations: dict[str, int] = {}
 
-    def function(signature: str, doc: str, build, inputs=("q",)) -> None:
+    def function(signature: str, doc: str, build, inputs=("q",), sizes=None) -> None:
         g = Graph()
-        syms = {k: [g.input(f"{k}{i}") for i in range(n)] for k in inputs}
+        sizes = sizes or {}
+        syms = {k: [g.input(f"{k}{i}") for i in range(sizes.get(k, n))] for k in inputs}
         outputs = build(g, syms)
-        names = {f"{k}{i}": f"{k}[{i}]" for k in inputs for i in range(n)}
+        names = {f"{k}{i}": f"{k}[{i}]" for k in inputs for i in range(sizes.get(k, n))}
         lines, ops = function_body(g, outputs, names)
         params = [x.strip().split()[-1].lstrip("*") for x in signature.split("(", 1)[1].rstrip(")").split(",")]
         unused = [x for x in params if not any(f"{x}[" in line for line in lines)]
@@ -195,6 +199,34 @@ def generate(mechanism, *, name: str | None = None, frames: list[str] | None = N
              "Placements in O of the frames listed above: R column-major (9 per frame), p (3 per frame).",
              frame_outputs)
 
+    closed = bool(tc.loops)
+    if closed:
+        na, npas = len(tc.actuated), len(tc.passive)
+
+        def residual_outputs(g, s):
+            phi = _tree.loop_residual(g, tc, s["q"])
+            return [(f"phi[{i}]", x) for i, x in enumerate(phi)]
+
+        def newton_outputs(g, s):
+            new, _ = _tree.newton_step(g, tc, s["q"])
+            return [(f"q_next[{k}]", x) for k, x in zip(tc.passive, new)]
+
+        def projection_outputs(g, s):
+            spare = [g.input(f"w{i}") for i in range(n)]
+            v, a = _tree.closed_projection(g, tc, s["q"], s["v_actuated"], s["a_actuated"], spare)
+            return [(f"v[{k}]", v[k]) for k in range(n)] + [(f"a[{k}]", a[k]) for k in range(n)]
+
+        function("void loop_residual(const double* q, double* phi)",
+                 "Phi(q): the loop-closure equations (num_equations values).", residual_outputs)
+        function("void newton_step(const double* q, double* q_next)",
+                 "One Gauss-Newton step of the passive coordinates on Phi(q) = 0 (writes only the passive "
+                 "entries of q_next, which may be q).", newton_outputs)
+        function("void closed_projection(const double* q, const double* v_actuated, const double* a_actuated, "
+                 "double* v, double* a)",
+                 "At a closed q: v = C v#, a = C a# + c over every coordinate (the coupling-matrix method).",
+                 projection_outputs, ("q", "v_actuated", "a_actuated"),
+                 {"v_actuated": na, "a_actuated": na})
+
     from mechbal._core import __version__ as library_version
     coordinate_lines = "\n".join(f"//   q[{i}] = {c}" for i, c in enumerate(tc.coordinate_names))
     frame_lines = "\n".join(f"//   {k}: {f}" for k, f in enumerate(frame_names)) or "//   (none)"
@@ -220,11 +252,78 @@ constexpr int dof = {n};
 constexpr int num_frames = {len(frame_names)};
 
 {chr(10).join(bodies)}
-{eigen}
+{_closed_driver(tc) if closed else ""}{eigen}
 }}  // namespace {ident}
 }}  // namespace mechbal_generated
 """
-    return GeneratedCode(ident, header, n, list(tc.coordinate_names), frame_names, digest, operations)
+    return GeneratedCode(ident, header, n, list(tc.coordinate_names), frame_names, digest, operations,
+                         list(tc.actuated) if closed else [], list(tc.passive) if closed else [])
+
+
+def _closed_driver(tc) -> str:
+    """The loop solve and the closed mechanism's tick, over the generated functions."""
+    na, npas = len(tc.actuated), len(tc.passive)
+    g = Graph()
+    m = len(_tree.loop_residual(g, tc, [g.input(f"q{i}") for i in range(tc.dof)]))
+    act = ", ".join(str(k) for k in tc.actuated)
+    pas = ", ".join(str(k) for k in tc.passive)
+    return f"""constexpr int num_actuated = {na};
+constexpr int num_passive = {npas};
+constexpr int num_equations = {m};
+constexpr int actuated_index[num_actuated] = {{{act}}};
+constexpr int passive_index[num_passive] = {{{pas}}};
+
+/// Status of closed_motion: ok; loops_not_closed (no solution within max_iterations Newton steps
+/// from the warm start: q, v, a are left unchanged); non_finite (a non-finite input or result).
+enum ClosedStatus : int {{ ok = 0, loops_not_closed = 1, non_finite = 2 }};
+
+/// The closed mechanism's motion from its actuated coordinates: q (in: warm start of the passive
+/// coordinates; out: the solution, actuated entries replaced) closes the loops to `tolerance`
+/// (max |Phi|) by at most `max_iterations` Gauss-Newton steps, then v = C v#, a = C a# + c.
+inline int closed_motion(const double* q_actuated, const double* v_actuated, const double* a_actuated,
+                         double* q, double* v, double* a, int max_iterations = 20,
+                         double tolerance = 1e-13) noexcept {{
+  double work[dof];
+  for (int i = 0; i < dof; ++i) work[i] = q[i];
+  for (int i = 0; i < num_actuated; ++i) work[actuated_index[i]] = q_actuated[i];
+  for (int iteration = 0;; ++iteration) {{
+    double phi[num_equations];
+    loop_residual(work, phi);
+    double largest = 0.0;
+    bool finite = true;
+    for (int i = 0; i < num_equations; ++i) {{
+      finite = finite && std::isfinite(phi[i]);
+      largest = std::fabs(phi[i]) > largest ? std::fabs(phi[i]) : largest;
+    }}
+    if (finite && largest <= tolerance) break;
+    if (!finite && iteration == 0) return non_finite;
+    if (iteration == max_iterations || !finite) return loops_not_closed;
+    newton_step(work, work);
+  }}
+  double v_out[dof], a_out[dof];
+  closed_projection(work, v_actuated, a_actuated, v_out, a_out);
+  for (int i = 0; i < dof; ++i) {{
+    if (!std::isfinite(v_out[i]) || !std::isfinite(a_out[i])) return non_finite;
+  }}
+  for (int i = 0; i < dof; ++i) {{
+    q[i] = work[i];
+    v[i] = v_out[i];
+    a[i] = a_out[i];
+  }}
+  return ok;
+}}
+
+/// closed_motion, then the shaking wrench of that motion (force dP/dt, moment dH_O/dt about O).
+inline int closed_shaking_wrench(const double* q_actuated, const double* v_actuated, const double* a_actuated,
+                                 double* q, double* force, double* moment, int max_iterations = 20,
+                                 double tolerance = 1e-13) noexcept {{
+  double v[dof], a[dof];
+  const int status = closed_motion(q_actuated, v_actuated, a_actuated, q, v, a, max_iterations, tolerance);
+  if (status == ok) shaking_wrench(q, v, a, force, moment);
+  return status;
+}}
+
+"""
 
 
 def _comment(text: str) -> str:
@@ -287,7 +386,11 @@ void mb_base_reaction(const double* q, const double* v, const double* a, double*
 void mb_center_of_mass(const double* q, double* c) {{ g::center_of_mass(q, c); }}
 void mb_momentum_matrix(const double* q, double* A) {{ g::momentum_matrix(q, A); }}
 void mb_frame_placements(const double* q, double* R, double* p) {{ g::frame_placements(q, R, p); }}
-}}
+{closed}}}
+"""
+
+_SHIM_CLOSED = """int mb_closed_motion(const double* qa, const double* va, const double* aa, double* q, double* v, double* a, int it, double tol) {{ return g::closed_motion(qa, va, aa, q, v, a, it, tol); }}
+int mb_closed_shaking_wrench(const double* qa, const double* va, const double* aa, double* q, double* f, double* m, int it, double tol) {{ return g::closed_shaking_wrench(qa, va, aa, q, f, m, it, tol); }}
 """
 
 #: flags of `build` (part of the cache key)
@@ -319,6 +422,11 @@ class GeneratedModule:
             f = getattr(self._lib, f"mb_{fname}")
             f.argtypes = [d] * nargs
             f.restype = None
+        if code.closed:
+            for fname in ("closed_motion", "closed_shaking_wrench"):
+                f = getattr(self._lib, f"mb_{fname}")
+                f.argtypes = [d] * 6 + [ctypes.c_int, ctypes.c_double]
+                f.restype = ctypes.c_int
 
     def _vec(self, x, name: str) -> np.ndarray:
         arr = np.ascontiguousarray(x, dtype=float)
@@ -372,6 +480,39 @@ class GeneratedModule:
         self._lib.mb_momentum_matrix(self._ptr(q), self._ptr(A))
         return np.ascontiguousarray(A)
 
+    def _actuated(self, x, name: str) -> np.ndarray:
+        arr = np.ascontiguousarray(x, dtype=float)
+        if arr.shape != (len(self.code.actuated),):
+            raise ValueError(f"{name} must have shape ({len(self.code.actuated)},), got {arr.shape}")
+        return arr
+
+    def closed_motion(self, q_actuated, v_actuated, a_actuated, q_guess, *, max_iterations: int = 20,
+                      tolerance: float = 1e-13) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """(q, v, a, status) of a closed mechanism from its actuated coordinates, the loops closed
+        from the warm start `q_guess` (status 0 ok, 1 the loops did not close, 2 non-finite)."""
+        if not self.code.closed:
+            raise ValueError(f"{self.code.name!r} has no loop closures: closed_motion does not apply")
+        qa, va, aa = (self._actuated(x, n) for x, n in ((q_actuated, "q_actuated"), (v_actuated, "v_actuated"),
+                                                          (a_actuated, "a_actuated")))
+        q = np.array(self._vec(q_guess, "q_guess"))
+        v, a = np.zeros(self.dof), np.zeros(self.dof)
+        status = self._lib.mb_closed_motion(self._ptr(qa), self._ptr(va), self._ptr(aa), self._ptr(q),
+                                            self._ptr(v), self._ptr(a), int(max_iterations), float(tolerance))
+        return q, v, a, int(status)
+
+    def closed_shaking_wrench(self, q_actuated, v_actuated, a_actuated, q_guess, *, max_iterations: int = 20,
+                              tolerance: float = 1e-13) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """(force, moment, q, status): the shaking wrench of the closed mechanism's motion."""
+        if not self.code.closed:
+            raise ValueError(f"{self.code.name!r} has no loop closures: closed_shaking_wrench does not apply")
+        qa, va, aa = (self._actuated(x, n) for x, n in ((q_actuated, "q_actuated"), (v_actuated, "v_actuated"),
+                                                          (a_actuated, "a_actuated")))
+        q = np.array(self._vec(q_guess, "q_guess"))
+        f, m = np.zeros(3), np.zeros(3)
+        status = self._lib.mb_closed_shaking_wrench(self._ptr(qa), self._ptr(va), self._ptr(aa), self._ptr(q),
+                                                    self._ptr(f), self._ptr(m), int(max_iterations), float(tolerance))
+        return f, m, q, int(status)
+
     def frame_placement(self, q, frame: str) -> np.ndarray:
         """4x4 placement of a generated frame in O."""
         if frame not in self.frame_names:
@@ -409,7 +550,8 @@ def build(mechanism_or_code, *, cache_dir: str | Path | None = None, **generate_
             header = Path(tmp) / f"{code.name}.hpp"
             header.write_text(code.header)
             shim = Path(tmp) / "shim.cpp"
-            shim.write_text(_SHIM.format(header=header.name, ident=code.name))
+            shim.write_text(_SHIM.format(header=header.name, ident=code.name,
+                                         closed=_SHIM_CLOSED if code.closed else ""))
             out = Path(tmp) / library.name
             result = subprocess.run([cxx, *BUILD_FLAGS, str(shim), "-o", str(out)],
                                     capture_output=True, text=True)

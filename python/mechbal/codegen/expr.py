@@ -242,3 +242,131 @@ def matmul(g: Graph, a, b):
 
 def transpose(m):
     return [[m[j][i] for j in range(3)] for i in range(3)]
+
+
+def directional_derivative(g: Graph, values: list, seeds: dict[int, Value]) -> list:
+    """Forward-mode derivative of `values` along the input directions `seeds` (input node id ->
+    the derivative of that input, a graph value): d/ds of each value, as graph values. One pass
+    over the nodes the values depend on; derivatives that vanish structurally fold to 0.0."""
+    top = 1 + max((x.id for x in values if isinstance(x, Sym)), default=-1)
+    d: dict[int, Value] = {}
+    for k in range(top):
+        node = g.nodes[k]
+        op = node[0]
+        if op == "in":
+            d[k] = seeds.get(k, 0.0)
+            continue
+        args = node[1:]
+        da = [d[x.id] if isinstance(x, Sym) else 0.0 for x in args]
+        if all(is_const(z) and z == 0.0 for z in da):
+            d[k] = 0.0
+            continue
+        me = Sym(g, k)
+        if op == "add":
+            d[k] = g.add(da[0], da[1])
+        elif op == "sub":
+            d[k] = g.sub(da[0], da[1])
+        elif op == "mul":
+            d[k] = g.add(g.mul(args[0], da[1]), g.mul(args[1], da[0]))
+        elif op == "div":
+            d[k] = g.div(g.sub(da[0], g.mul(me, da[1])), args[1])
+        elif op == "neg":
+            d[k] = g.neg(da[0])
+        elif op == "sin":
+            d[k] = g.mul(g.cos(args[0]), da[0])
+        elif op == "cos":
+            d[k] = g.neg(g.mul(g.sin(args[0]), da[0]))
+        elif op == "sqrt":
+            d[k] = g.div(g.mul(0.5, da[0]), me)
+        else:  # pragma: no cover - every operation is listed above
+            raise ValueError(f"no derivative for {op}")
+    return [d[x.id] if isinstance(x, Sym) else 0.0 for x in values]
+
+
+def _zero(x: Value) -> bool:
+    return is_const(x) and x == 0.0
+
+
+def ldlt_factor(g: Graph, N: list[list[Value]], order: list[int] | None = None):
+    """Unrolled LDL^T of symmetric positive definite N (n x n graph values) in the elimination
+    `order` (default: a minimum-degree order of N's structural nonzeros): (L, 1/D, order). Products
+    with structural zeros fold away, so only the fill the order creates is computed."""
+    n = len(N)
+    if order is None:
+        order = minimum_degree_order(N)
+    P = [[N[order[i]][order[j]] for j in range(n)] for i in range(n)]
+    L: list[list[Value]] = [[0.0] * n for _ in range(n)]
+    D: list[Value] = [0.0] * n
+    inv: list[Value] = [0.0] * n
+    for j in range(n):
+        s = P[j][j]
+        for k in range(j):
+            if not _zero(L[j][k]):
+                s = g.sub(s, g.mul(g.mul(L[j][k], L[j][k]), D[k]))
+        D[j] = s
+        inv[j] = g.div(1.0, s)
+        for i in range(j + 1, n):
+            t = P[i][j]
+            for k in range(j):
+                if not _zero(L[i][k]) and not _zero(L[j][k]):
+                    t = g.sub(t, g.mul(g.mul(L[i][k], L[j][k]), D[k]))
+            L[i][j] = g.mul(t, inv[j])
+    return L, inv, order
+
+
+def ldlt_apply(g: Graph, factor, b: list[Value]) -> list[Value]:
+    """x with N x = b, from `ldlt_factor`'s result."""
+    L, inv, order = factor
+    n = len(order)
+    y = [b[order[i]] for i in range(n)]
+    for i in range(n):
+        for k in range(i):
+            if not _zero(L[i][k]):
+                y[i] = g.sub(y[i], g.mul(L[i][k], y[k]))
+    y = [g.mul(y[i], inv[i]) for i in range(n)]
+    for i in range(n - 1, -1, -1):
+        for k in range(i + 1, n):
+            if not _zero(L[k][i]):
+                y[i] = g.sub(y[i], g.mul(L[k][i], y[k]))
+    x: list[Value] = [0.0] * n
+    for i in range(n):
+        x[order[i]] = y[i]
+    return x
+
+
+def substitute(g: Graph, values: list, mapping: dict[int, Value]) -> list:
+    """`values` with the input nodes of `mapping` (node id -> value) replaced, rebuilt through the
+    graph (nodes that do not depend on them stay the same nodes)."""
+    top = 1 + max((x.id for x in values if isinstance(x, Sym)), default=-1)
+    new: dict[int, Value] = {}
+    for k in range(top):
+        node = g.nodes[k]
+        op = node[0]
+        if op == "in":
+            new[k] = mapping.get(k, Sym(g, k))
+            continue
+        args = [new[x.id] if isinstance(x, Sym) else x for x in node[1:]]
+        if all(isinstance(a, Sym) and isinstance(o, Sym) and a.id == o.id or (not isinstance(a, Sym) and not isinstance(o, Sym))
+               for a, o in zip(args, node[1:])):
+            new[k] = Sym(g, k)
+            continue
+        new[k] = getattr(g, op)(*args)
+    return [new[x.id] if isinstance(x, Sym) else x for x in values]
+
+
+def minimum_degree_order(N: list[list[Value]]) -> list[int]:
+    """A greedy minimum-degree elimination order of the structural nonzeros of symmetric N."""
+    n = len(N)
+    adj = {i: {j for j in range(n) if j != i and not (is_const(N[i][j]) and N[i][j] == 0.0)} for i in range(n)}
+    order: list[int] = []
+    remaining = set(range(n))
+    while remaining:
+        i = min(remaining, key=lambda k: (len(adj[k]), k))
+        order.append(i)
+        nbrs = adj[i]
+        for a in nbrs:
+            adj[a] |= nbrs - {a}
+            adj[a].discard(i)
+        remaining.discard(i)
+        del adj[i]
+    return order

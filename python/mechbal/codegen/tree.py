@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .expr import Graph, Value, cross, dot, matmul, mattvec, matvec, transpose, vadd, vscale, vsub
+from .expr import (Graph, Value, cross, directional_derivative, dot, ldlt_apply, ldlt_factor, matmul, mattvec,
+                   matvec, substitute, transpose, vadd, vscale, vsub)
 
 _RIGHT_ANGLE_ULP = 4.0
 
@@ -83,6 +84,9 @@ class TreeConstants:
     gravity: np.ndarray
     frames: dict[str, tuple[int, np.ndarray]]  # name -> (link, 4x4 placement in the link frame)
     springs: list  # (link_a, anchor_a, link_b, anchor_b, K_eq, T0 = count preload / k - K_eq L0)
+    loops: list = field(default_factory=list)      # (type name, frame_a, frame_b)
+    actuated: list = field(default_factory=list)   # coordinates of q# (every one without loops)
+    passive: list = field(default_factory=list)    # the others, solved by the closures
 
 
 def tree_constants(mechanism) -> TreeConstants:
@@ -131,8 +135,10 @@ def tree_constants(mechanism) -> TreeConstants:
         T0 = s.count * s.preload / k - K_eq * s.free_length
         springs.append((index[s.link_a], np.asarray(s.anchor_a, float), index[s.link_b],
                         np.asarray(s.anchor_b, float), K_eq, T0))
+    loops = [(lc.type.name, lc.frame_a, lc.frame_b) for lc in description.loops]
     return TreeConstants(mechanism.name if hasattr(mechanism, "name") else "mechanism", model.dof,
-                         coordinates, links, np.asarray(model.gravity, dtype=float), frames, springs)
+                         coordinates, links, np.asarray(model.gravity, dtype=float), frames, springs,
+                         loops, list(model.actuated_coordinates), list(model.passive_coordinates))
 
 
 # ---- kinematics ---------------------------------------------------------------------------------
@@ -425,3 +431,90 @@ def base_reaction(g: Graph, tree: TreeConstants, q, v, a):
     force = vsub(g, F, [mass * x for x in grav])
     torque = vsub(g, M, cross(g, moment, grav))
     return force, torque
+
+
+# ---- closed loops --------------------------------------------------------------------------------
+def loop_residual(g: Graph, tree: TreeConstants, q) -> list:
+    """Phi(q), the closure equations of every loop (algorithm/loops.hpp), with d = p_B - p_A:
+    point d (3); planar_point [x_A . d, y_A . d] (2); axis d and [z_A . x_B, z_A . y_B] (5);
+    weld d and the skew part of R_B R_A^T (6: the same manifold as the library's rotation
+    vector near the closure, hence the same solution, velocities and accelerations)."""
+    kin = Kinematics(g, tree, q)
+    phi: list = []
+    for kind, frame_a, frame_b in tree.loops:
+        Ra, pa = _frame(g, kin, tree, frame_a)
+        Rb, pb = _frame(g, kin, tree, frame_b)
+        d = vsub(g, pb, pa)
+        col = lambda R, k: [R[0][k], R[1][k], R[2][k]]  # noqa: E731
+        if kind == "point":
+            phi += d
+        elif kind == "planar_point":
+            phi += [dot(g, col(Ra, 0), d), dot(g, col(Ra, 1), d)]
+        elif kind == "axis":
+            phi += d + [dot(g, col(Ra, 2), col(Rb, 0)), dot(g, col(Ra, 2), col(Rb, 1))]
+        elif kind == "weld":
+            R = matmul(g, Rb, transpose(Ra))
+            phi += d + [g.mul(0.5, g.sub(R[2][1], R[1][2])), g.mul(0.5, g.sub(R[0][2], R[2][0])),
+                        g.mul(0.5, g.sub(R[1][0], R[0][1]))]
+        else:  # pragma: no cover - the model knows no other type
+            raise ValueError(f"loop type {kind!r}")
+    return phi
+
+
+def _frame(g: Graph, kin: Kinematics, tree: TreeConstants, frame: str):
+    link, P = tree.frames[frame]
+    Rl, pl = kin.world(link)
+    R = matmul(g, Rl, [[float(x) for x in row] for row in P[:3, :3]])
+    p = vadd(g, pl, matvec(g, Rl, [float(x) for x in P[:3, 3]]))
+    return R, p
+
+
+def _passive_columns(g: Graph, tree: TreeConstants, q, phi):
+    """A° = dPhi/dq° column by column, its normal matrix A°^T A° and that matrix's LDL^T."""
+    columns = [directional_derivative(g, phi, {q[p].id: 1.0}) for p in tree.passive]
+    n = len(columns)
+    N: list[list[Value]] = [[0.0] * n for _ in range(n)]
+    for i in range(n):
+        for j in range(i, n):
+            N[i][j] = N[j][i] = dot(g, columns[i], columns[j])
+    return columns, ldlt_factor(g, N)
+
+
+def newton_step(g: Graph, tree: TreeConstants, q):
+    """One Gauss-Newton step of the passive coordinates on Phi(q) = 0 (the normal equations of
+    A°, as the library): the new passive values and |Phi(q)|^2 before the step."""
+    phi = loop_residual(g, tree, q)
+    columns, factor = _passive_columns(g, tree, q, phi)
+    delta = ldlt_apply(g, factor, [g.neg(dot(g, c, phi)) for c in columns])
+    norm2 = dot(g, phi, phi)
+    return [g.add(q[p], delta[i]) for i, p in enumerate(tree.passive)], norm2
+
+
+def closed_projection(g: Graph, tree: TreeConstants, q, v_actuated, a_actuated, w):
+    """At a closed q: v = C v#, a = C a# + c (full dof), from A°, A#, gamma = dA/dt v. `w` are
+    spare inputs (one per coordinate) through which gamma is derived with v held constant."""
+    phi = loop_residual(g, tree, q)
+    columns, factor = _passive_columns(g, tree, q, phi)
+    act = tree.actuated
+
+    def solve(b):
+        return ldlt_apply(g, factor, [g.neg(dot(g, c, b)) for c in columns])
+
+    Aa_v = directional_derivative(g, phi, {q[k].id: v_actuated[i] for i, k in enumerate(act)})
+    v_passive = solve(Aa_v)
+    v: list[Value] = [0.0] * tree.dof
+    for i, k in enumerate(act):
+        v[k] = v_actuated[i]
+    for i, k in enumerate(tree.passive):
+        v[k] = v_passive[i]
+    seeds = {q[k].id: w[k] for k in range(tree.dof)}
+    gamma_w = directional_derivative(g, directional_derivative(g, phi, seeds), seeds)
+    gamma = substitute(g, gamma_w, {w[k].id: v[k] for k in range(tree.dof)})
+    Aa_a = directional_derivative(g, phi, {q[k].id: a_actuated[i] for i, k in enumerate(act)})
+    a_passive = solve([g.add(x, y) for x, y in zip(Aa_a, gamma)])
+    a: list[Value] = [0.0] * tree.dof
+    for i, k in enumerate(act):
+        a[k] = a_actuated[i]
+    for i, k in enumerate(tree.passive):
+        a[k] = a_passive[i]
+    return v, a
