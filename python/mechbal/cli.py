@@ -371,8 +371,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "matrix, gravity torque, shaking wrench, base reaction, centre of "
                                    "mass, momentum matrix and frame placements as straight-line C++17 "
                                    "with its constants folded (no heap, no exceptions; needs only "
-                                   "<cmath>, Eigen for the optional overloads). Open trees: a case "
-                                   "with loop closures is refused.")
+                                   "<cmath>, Eigen for the optional overloads); with loop closures, "
+                                   "the loop solve and the closed tick (closed_shaking_wrench).")
     s.add_argument("case", help="built-in case name or path to a TOML or URDF file")
     s.add_argument("--out", required=True, metavar="DIR", help="the folder to write the header into")
     s.add_argument("--name", default=None,

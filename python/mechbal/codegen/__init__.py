@@ -5,8 +5,8 @@ inertias, gear ratios, springs) and writes straight-line code for that mechanism
 folded, structural zeros pruned, sines and cosines shared, common subexpressions shared as the
 expressions are built (`mechbal.codegen.expr`). The header needs nothing but ``<cmath>`` (the
 Eigen overloads need ``<Eigen/Core>`` and can be left out with ``MECHBAL_GENERATED_NO_EIGEN``):
-no heap, no exceptions, no virtual calls, no branches on the state. It provides, for an open tree
-(revolute, prismatic and fixed joints, gear couplings, springs):
+no heap, no exceptions, no virtual calls. It provides, for the model's tree (revolute, prismatic
+and fixed joints, gear couplings, springs):
 
 * ``inverse_dynamics(q, v, a, tau)``: tau = M a + C v + G + K (springs included, as the library);
 * ``gravity_torque(q, tau)``, ``mass_matrix(q, M)``, ``center_of_mass(q, c)``;
@@ -14,7 +14,9 @@ no heap, no exceptions, no virtual calls, no branches on the state. It provides,
 * ``momentum_matrix(q, A)``: [P; H_O] = A v (6 x dof, column-major);
 * ``frame_placements(q, R, p)``: every named frame in O (R column-major, 9 per frame).
 
-Closed loops are not generated yet: `generate` refuses a model with loop closures. `build`
+With loop closures it adds the loop solve and the closed mechanism's tick: ``loop_residual``,
+``newton_step``, ``closed_projection`` (v = C v#, a = C a# + c), ``closed_motion`` and
+``closed_shaking_wrench`` (bounded Newton from a warm start, with a status). `build`
 compiles the header into a small shared library with the installed C++ compiler (cached by the
 hash of the generated code) and returns a `GeneratedModule` whose methods mirror `Mechanism`'s,
 for a Python harness that wants the fast path.
@@ -105,8 +107,8 @@ def generate(mechanism, *, name: str | None = None, frames: list[str] | None = N
     """Generate the C++ header of `mechanism` (a `mechbal.Mechanism`).
 
     `frames`: the named frames whose placements ``frame_placements`` computes (default: every
-    frame of the model). Raises `CodegenError` for a model with loop closures (not generated
-    yet) or with more than `max_joints` joints (the unrolled code would be too large)."""
+    frame of the model). Raises `CodegenError` for a model with more than `max_joints` joints
+    (the unrolled code would be too large)."""
     model = mechanism.model
     links = model.num_links - 1
     if links > max_joints:
