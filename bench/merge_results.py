@@ -157,6 +157,14 @@ def main(argv=None):
         for alg in URDF_ALGORITHMS:
             ratios[f"pinocchio_over_mechbal_{alg}_{robot}"] = ratio(
                 cases, f"{alg}_{robot}_pinocchio", f"{alg}_{robot}_mechbal")
+    # generated code for one robot (mechbal codegen, bench_generated.cpp): the general model's time
+    # and Pinocchio's over the generated code's, same robot, same run
+    for robot in URDF_ROBOTS:
+        for alg in URDF_ALGORITHMS:
+            ratios[f"mechbal_over_generated_{alg}_{robot}"] = ratio(
+                cases, f"{alg}_{robot}_mechbal", f"{alg}_{robot}_generated")
+            ratios[f"pinocchio_over_generated_{alg}_{robot}"] = ratio(
+                cases, f"{alg}_{robot}_pinocchio", f"{alg}_{robot}_generated")
     if py:
         ratios["numpy_over_mechbal_batch"] = py["batch"]["numpy_over_mechbal"]
         # the same work on both sides (numpy computes the chain's motion from q, v, a too): since
@@ -213,6 +221,11 @@ def main(argv=None):
         for alg in URDF_ALGORITHMS:
             key = f"pinocchio_over_mechbal_{alg}_{robot}"
             targets[f"{key} >= 1"] = check(ratios[key], lambda v: v >= 1.0)
+    for robot in URDF_ROBOTS:  # code generation: >= 2x the general model on id and mass
+        for alg in ("id", "mass"):
+            key = f"mechbal_over_generated_{alg}_{robot}"
+            if ratios.get(key) is not None:
+                targets[f"{key} >= 2"] = check(ratios[key], lambda v: v >= 2.0)
     from merge_loops import loop_results  # closed loops on the general model (bench_loops.cpp)
 
     loop_ratios, loop_targets, loop_notes = loop_results(cases, ratio, median, check)

@@ -44,6 +44,11 @@ def speed_results(cases, ratio, median, check, loops_extra, interleaved):
                         ("reactionless_paminsa_general_over_closed_form_rk4",
                          ratio(cases, "reactionless_paminsa_rk4", "paminsa_tick_rk4"))):
         targets[f"{name} <= 2"] = check(value, lambda v: v <= 2.0)
+    # the generated closed tick of the same model over the closed form (code generation: <= 1)
+    value = ratio(cases, "paminsa_generated_wrench", "paminsa_wrench")
+    if value is not None:
+        ratios["paminsa_generated_over_closed_form"] = value
+        targets["paminsa_generated_over_closed_form <= 1"] = check(value, lambda v: v <= 1.0)
 
     # issue 21's bench: the general reactionless tick beside the same controller over Pinocchio
     for robot in ("wheel", "panda"):

@@ -226,6 +226,25 @@ def _cmd_export(args) -> int:
     return 0
 
 
+def _cmd_codegen(args) -> int:
+    from mechbal.codegen import CodegenError, generate
+
+    mech, _, _ = _export_mechanism(args.case)
+    try:
+        code = generate(mech, name=args.name, frames=args.frames)
+    except CodegenError as exc:
+        raise UserError(str(exc)) from None
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out: '{out}' is a file: give a folder")
+    path = code.write(out)
+    if not args.quiet:
+        total = sum(code.operations.values())
+        print(f"wrote {path} ({mech!r}: {code.dof} coordinates, {len(code.frame_names)} frames, "
+              f"{total} operations in {len(code.operations)} functions)")
+    return 0
+
+
 def _cmd_verify(args) -> int:
     from mechbal.output import check_output_dir
     from mechbal.verify import run_verify
@@ -347,6 +366,20 @@ def build_parser() -> argparse.ArgumentParser:
                    help="file format (default: urdf for an --out ending in .urdf, mjcf otherwise)")
     s.add_argument("--out", required=True, metavar="FILE", help="the file to write")
     _last_flags(s, _cmd_export)
+    s = sub.add_parser("codegen", help="write a C++ header specialised to one mechanism",
+                       description="Generate DIR/<name>.hpp: the mechanism's inverse dynamics, mass "
+                                   "matrix, gravity torque, shaking wrench, base reaction, centre of "
+                                   "mass, momentum matrix and frame placements as straight-line C++17 "
+                                   "with its constants folded (no heap, no exceptions; needs only "
+                                   "<cmath>, Eigen for the optional overloads); with loop closures, "
+                                   "the loop solve and the closed tick (closed_shaking_wrench).")
+    s.add_argument("case", help="built-in case name or path to a TOML or URDF file")
+    s.add_argument("--out", required=True, metavar="DIR", help="the folder to write the header into")
+    s.add_argument("--name", default=None,
+                   help="C++ namespace mechbal_generated::NAME and file name (default: the mechanism's)")
+    s.add_argument("--frames", nargs="+", default=None, metavar="FRAME",
+                   help="the frames whose placements frame_placements computes (default: all)")
+    _last_flags(s, _cmd_codegen)
     s = sub.add_parser("verify", help="check a case's predictions (balanced and not) in MuJoCo",
                        description="Export the case's mechanism and its balanced variant to MuJoCo and "
                                    "compare mechbal's predicted shaking force, shaking moment and "

@@ -1,0 +1,568 @@
+"""Code generation for one mechanism: a self-contained C++17 header specialised to one model.
+
+`generate(mechanism)` walks the model with its constants known (placements, axes, masses,
+inertias, gear ratios, springs) and writes straight-line code for that mechanism only: constants
+folded, structural zeros pruned, sines and cosines shared, common subexpressions shared as the
+expressions are built (`mechbal.codegen.expr`). The header needs nothing but ``<cmath>`` (the
+Eigen overloads need ``<Eigen/Core>`` and can be left out with ``MECHBAL_GENERATED_NO_EIGEN``):
+no heap, no exceptions, no virtual calls. It provides, for the model's tree (revolute, prismatic
+and fixed joints, gear couplings, springs):
+
+* ``inverse_dynamics(q, v, a, tau)``: tau = M a + C v + G + K (springs included, as the library);
+* ``gravity_torque(q, tau)``, ``mass_matrix(q, M)``, ``center_of_mass(q, c)``;
+* ``shaking_wrench(q, v, a, F, M)``: the momentum rates about O; ``base_reaction(...)``;
+* ``momentum_matrix(q, A)``: [P; H_O] = A v (6 x dof, column-major);
+* ``frame_placements(q, R, p)``: every named frame in O (R column-major, 9 per frame).
+
+With loop closures it adds the loop solve and the closed mechanism's tick: ``loop_residual``,
+``newton_step``, ``closed_projection`` (v = C v#, a = C a# + c), ``closed_motion`` and
+``closed_shaking_wrench`` (bounded Newton from a warm start, with a status). `build`
+compiles the header into a small shared library with the installed C++ compiler (cached by the
+hash of the generated code) and returns a `GeneratedModule` whose methods mirror `Mechanism`'s,
+for a Python harness that wants the fast path.
+
+Regenerating the same model gives byte-identical output; the header names the model, the
+generator's version and a hash of the input.
+"""
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .emit import function_body
+from .expr import Graph
+from . import tree as _tree
+
+#: bumped when the generated code changes for the same input
+GENERATOR_VERSION = 1
+#: the largest tree generated unrolled (the code grows with the square of the depth)
+MAX_JOINTS = 64
+
+
+class CodegenError(ValueError):
+    """A mechanism that cannot be generated, or a build that failed; the message says why."""
+
+
+@dataclass(frozen=True)
+class GeneratedCode:
+    """A generated header and what it provides."""
+
+    name: str                 # the C++ namespace: mechbal_generated::<name>
+    header: str               # the whole header text
+    dof: int
+    coordinate_names: list[str]
+    frame_names: list[str]
+    input_hash: str           # sha256 of the model's constants as the generator read them
+    operations: dict[str, int] = field(default_factory=dict)  # arithmetic operations per function
+    actuated: list[int] = field(default_factory=list)  # closed mechanisms: indices of q# in q
+    passive: list[int] = field(default_factory=list)   # and of the passive coordinates
+
+    @property
+    def closed(self) -> bool:
+        return bool(self.passive)
+
+    def write(self, directory: str | Path) -> Path:
+        """Write ``<name>.hpp`` into `directory` (created if missing); returns its path."""
+        out = Path(directory)
+        out.mkdir(parents=True, exist_ok=True)
+        path = out / f"{self.name}.hpp"
+        path.write_text(self.header)
+        return path
+
+
+def _identifier(name: str) -> str:
+    ident = re.sub(r"[^A-Za-z0-9_]", "_", name)
+    if not ident or ident[0].isdigit():
+        ident = "m_" + ident
+    return ident
+
+
+def _input_text(tc: _tree.TreeConstants) -> str:
+    """A canonical text of every constant the generator reads (the input hash is over it)."""
+    def arr(x) -> str:
+        return ",".join(repr(float(v)) for v in np.asarray(x, dtype=float).ravel())
+    lines = [f"dof {tc.dof}", "coordinates " + ",".join(tc.coordinate_names), "gravity " + arr(tc.gravity)]
+    for link in tc.links:
+        lines.append(f"link {link.name} {link.parent} {link.kind} {arr(link.R0)} {arr(link.p0)} "
+                     f"{arr(link.axis)} {link.coordinate} {link.ratio!r} {link.offset!r} {link.mass!r} "
+                     f"{arr(link.first_moment)} {arr(link.inertia_origin)} {link.moves}")
+    for name, (link, P) in tc.frames.items():
+        lines.append(f"frame {name} {link} {arr(P)}")
+    for la, aa, lb, ab, k, t0 in tc.springs:
+        lines.append(f"spring {la} {arr(aa)} {lb} {arr(ab)} {k!r} {t0!r}")
+    return "\n".join(lines) + "\n"
+
+
+def generate(mechanism, *, name: str | None = None, frames: list[str] | None = None,
+             max_joints: int = MAX_JOINTS) -> GeneratedCode:
+    """Generate the C++ header of `mechanism` (a `mechbal.Mechanism`).
+
+    `frames`: the named frames whose placements ``frame_placements`` computes (default: every
+    frame of the model). Raises `CodegenError` for a model with more than `max_joints` joints
+    (the unrolled code would be too large)."""
+    model = mechanism.model
+    links = model.num_links - 1
+    if links > max_joints:
+        raise CodegenError(f"mechanism {mechanism.name!r} has {links} joints, more than the "
+                           f"generation limit max_joints = {max_joints}")
+    tc = _tree.tree_constants(mechanism)
+    frame_names = list(tc.frames) if frames is None else list(frames)
+    for f in frame_names:
+        if f not in tc.frames:
+            raise CodegenError(f"frames: {f!r} is not a frame of {mechanism.name!r} "
+                               f"(frames: {', '.join(tc.frames)})")
+    ident = _identifier(name or mechanism.name)
+    input_text = _input_text(tc) + "frames " + ",".join(frame_names) + "\n"
+    digest = hashlib.sha256(input_text.encode()).hexdigest()
+    n = tc.dof
+
+    bodies: list[str] = []
+    operations: dict[str, int] = {}
+
+    def function(signature: str, doc: str, build, inputs=("q",), sizes=None) -> None:
+        g = Graph()
+        sizes = sizes or {}
+        syms = {k: [g.input(f"{k}{i}") for i in range(sizes.get(k, n))] for k in inputs}
+        outputs = build(g, syms)
+        names = {f"{k}{i}": f"{k}[{i}]" for k in inputs for i in range(sizes.get(k, n))}
+        lines, ops = function_body(g, outputs, names)
+        params = [x.strip().split()[-1].lstrip("*") for x in signature.split("(", 1)[1].rstrip(")").split(",")]
+        unused = [x for x in params if not any(f"{x}[" in line for line in lines)]
+        lines = [f"  static_cast<void>({x});" for x in unused] + lines
+        fname = signature.split("(")[0].split()[-1]
+        operations[fname] = ops
+        bodies.append(f"/// {doc}\ninline {signature} noexcept {{\n" + "\n".join(lines) + "\n}\n")
+
+    def id_outputs(g, s):
+        tau, _ = _tree.newton_euler(g, tc, s["q"], s["v"], s["a"], gravity=True, springs=True)
+        return [(f"tau[{i}]", tau[i]) for i in range(n)]
+
+    def gravity_outputs(g, s):
+        zero = [0.0] * n
+        tau, _ = _tree.newton_euler(g, tc, s["q"], zero, zero, gravity=True, springs=False)
+        return [(f"tau[{i}]", tau[i]) for i in range(n)]
+
+    def mass_outputs(g, s):
+        M = _tree.mass_matrix(g, tc, s["q"])
+        return [(f"M[{c * n + r}]", M[r][c]) for c in range(n) for r in range(n)]
+
+    def wrench_outputs(g, s):
+        F, M = _tree.shaking_wrench(g, tc, s["q"], s["v"], s["a"])
+        return [(f"force[{i}]", F[i]) for i in range(3)] + [(f"moment[{i}]", M[i]) for i in range(3)]
+
+    def reaction_outputs(g, s):
+        F, M = _tree.base_reaction(g, tc, s["q"], s["v"], s["a"])
+        return [(f"force[{i}]", F[i]) for i in range(3)] + [(f"moment[{i}]", M[i]) for i in range(3)]
+
+    def com_outputs(g, s):
+        c = _tree.center_of_mass(g, tc, s["q"])
+        return [(f"com[{i}]", c[i]) for i in range(3)]
+
+    def momentum_outputs(g, s):
+        A = _tree.momentum_matrix(g, tc, s["q"])
+        return [(f"A[{c * 6 + r}]", A[r][c]) for c in range(n) for r in range(6)]
+
+    def frame_outputs(g, s):
+        out = []
+        for k, f in enumerate(frame_names):
+            R, p = _tree.frame_placement(g, tc, s["q"], f)
+            out += [(f"R[{9 * k + 3 * c + r}]", R[r][c]) for c in range(3) for r in range(3)]
+            out += [(f"p[{3 * k + i}]", p[i]) for i in range(3)]
+        return out
+
+    qva = ("q", "v", "a")
+    function("void inverse_dynamics(const double* q, const double* v, const double* a, double* tau)",
+             "tau = M(q) a + C(q, v) v + G(q) + K(q) [N m or N], gear couplings projected.",
+             id_outputs, qva)
+    function("void gravity_torque(const double* q, double* tau)", "G(q) [N m or N], gravity alone.",
+             gravity_outputs)
+    function("void mass_matrix(const double* q, double* M)", "M(q), dof x dof, column-major.",
+             mass_outputs)
+    function("void shaking_wrench(const double* q, const double* v, const double* a, double* force, "
+             "double* moment)", "Shaking force dP/dt [N] and moment dH_O/dt [N m] about O.",
+             wrench_outputs, qva)
+    function("void base_reaction(const double* q, const double* v, const double* a, double* force, "
+             "double* moment)", "Wrench the base exerts on the moving links, gravity included (about O).",
+             reaction_outputs, qva)
+    function("void center_of_mass(const double* q, double* com)", "Centre of mass of all bodies in O [m].",
+             com_outputs)
+    function("void momentum_matrix(const double* q, double* A)",
+             "A(q), 6 x dof column-major, linear rows first: [P; H_O] = A v.", momentum_outputs)
+    function("void frame_placements(const double* q, double* R, double* p)",
+             "Placements in O of the frames listed above: R column-major (9 per frame), p (3 per frame).",
+             frame_outputs)
+
+    closed = bool(tc.loops)
+    if closed:
+        na, npas = len(tc.actuated), len(tc.passive)
+
+        def residual_outputs(g, s):
+            phi = _tree.loop_residual(g, tc, s["q"])
+            return [(f"phi[{i}]", x) for i, x in enumerate(phi)]
+
+        def newton_outputs(g, s):
+            new, _ = _tree.newton_step(g, tc, s["q"])
+            return [(f"q_next[{k}]", x) for k, x in zip(tc.passive, new)]
+
+        def projection_outputs(g, s):
+            spare = [g.input(f"w{i}") for i in range(n)]
+            v, a = _tree.closed_projection(g, tc, s["q"], s["v_actuated"], s["a_actuated"], spare)
+            return [(f"v[{k}]", v[k]) for k in range(n)] + [(f"a[{k}]", a[k]) for k in range(n)]
+
+        function("void loop_residual(const double* q, double* phi)",
+                 "Phi(q): the loop-closure equations (num_equations values).", residual_outputs)
+        function("void newton_step(const double* q, double* q_next)",
+                 "One Gauss-Newton step of the passive coordinates on Phi(q) = 0 (writes only the passive "
+                 "entries of q_next, which may be q).", newton_outputs)
+        function("void closed_projection(const double* q, const double* v_actuated, const double* a_actuated, "
+                 "double* v, double* a)",
+                 "At a closed q: v = C v#, a = C a# + c over every coordinate (the coupling-matrix method).",
+                 projection_outputs, ("q", "v_actuated", "a_actuated"),
+                 {"v_actuated": na, "a_actuated": na})
+
+    from mechbal._core import __version__ as library_version
+    coordinate_lines = "\n".join(f"//   q[{i}] = {c}" for i, c in enumerate(tc.coordinate_names))
+    frame_lines = "\n".join(f"//   {k}: {f}" for k, f in enumerate(frame_names)) or "//   (none)"
+    eigen = _eigen_overloads(n, len(frame_names))
+    header = f"""// Generated by mechbal {library_version} (mechbal.codegen, generator {GENERATOR_VERSION}) for the
+// mechanism {_comment(mechanism.name)}; do not edit, regenerate: `mechbal codegen`.
+// Input hash (sha256 of the constants the generator read): {digest}
+// Coordinates:
+{coordinate_lines}
+// Frames of frame_placements:
+{frame_lines}
+// Everything is noexcept, allocation-free and branch-free; arrays are the caller's.
+#pragma once
+#include <cmath>
+#ifndef MECHBAL_GENERATED_NO_EIGEN
+#include <Eigen/Core>
+#endif
+
+namespace mechbal_generated {{
+namespace {ident} {{
+
+constexpr int dof = {n};
+constexpr int num_frames = {len(frame_names)};
+
+{chr(10).join(bodies)}
+{_closed_driver(tc) if closed else ""}{eigen}
+}}  // namespace {ident}
+}}  // namespace mechbal_generated
+"""
+    return GeneratedCode(ident, header, n, list(tc.coordinate_names), frame_names, digest, operations,
+                         list(tc.actuated) if closed else [], list(tc.passive) if closed else [])
+
+
+def _closed_driver(tc) -> str:
+    """The loop solve and the closed mechanism's tick, over the generated functions."""
+    na, npas = len(tc.actuated), len(tc.passive)
+    g = Graph()
+    m = len(_tree.loop_residual(g, tc, [g.input(f"q{i}") for i in range(tc.dof)]))
+    act = ", ".join(str(k) for k in tc.actuated)
+    pas = ", ".join(str(k) for k in tc.passive)
+    return f"""constexpr int num_actuated = {na};
+constexpr int num_passive = {npas};
+constexpr int num_equations = {m};
+constexpr int actuated_index[num_actuated] = {{{act}}};
+constexpr int passive_index[num_passive] = {{{pas}}};
+
+/// Status of closed_motion: ok; loops_not_closed (no solution within max_iterations Newton steps
+/// from the warm start: q, v, a are left unchanged); non_finite (a non-finite input or result).
+enum ClosedStatus : int {{ ok = 0, loops_not_closed = 1, non_finite = 2 }};
+
+/// The closed mechanism's motion from its actuated coordinates: q (in: warm start of the passive
+/// coordinates; out: the solution, actuated entries replaced) closes the loops to `tolerance`
+/// (max |Phi|) by at most `max_iterations` Gauss-Newton steps, then v = C v#, a = C a# + c.
+inline int closed_motion(const double* q_actuated, const double* v_actuated, const double* a_actuated,
+                         double* q, double* v, double* a, int max_iterations = 20,
+                         double tolerance = 1e-13) noexcept {{
+  double work[dof];
+  for (int i = 0; i < dof; ++i) work[i] = q[i];
+  for (int i = 0; i < num_actuated; ++i) work[actuated_index[i]] = q_actuated[i];
+  for (int iteration = 0;; ++iteration) {{
+    double phi[num_equations];
+    loop_residual(work, phi);
+    double largest = 0.0;
+    bool finite = true;
+    for (int i = 0; i < num_equations; ++i) {{
+      finite = finite && std::isfinite(phi[i]);
+      largest = std::fabs(phi[i]) > largest ? std::fabs(phi[i]) : largest;
+    }}
+    if (finite && largest <= tolerance) break;
+    if (!finite && iteration == 0) return non_finite;
+    if (iteration == max_iterations || !finite) return loops_not_closed;
+    newton_step(work, work);
+  }}
+  double v_out[dof], a_out[dof];
+  closed_projection(work, v_actuated, a_actuated, v_out, a_out);
+  for (int i = 0; i < dof; ++i) {{
+    if (!std::isfinite(v_out[i]) || !std::isfinite(a_out[i])) return non_finite;
+  }}
+  for (int i = 0; i < dof; ++i) {{
+    q[i] = work[i];
+    v[i] = v_out[i];
+    a[i] = a_out[i];
+  }}
+  return ok;
+}}
+
+/// closed_motion, then the shaking wrench of that motion (force dP/dt, moment dH_O/dt about O).
+inline int closed_shaking_wrench(const double* q_actuated, const double* v_actuated, const double* a_actuated,
+                                 double* q, double* force, double* moment, int max_iterations = 20,
+                                 double tolerance = 1e-13) noexcept {{
+  double v[dof], a[dof];
+  const int status = closed_motion(q_actuated, v_actuated, a_actuated, q, v, a, max_iterations, tolerance);
+  if (status == ok) shaking_wrench(q, v, a, force, moment);
+  return status;
+}}
+
+"""
+
+
+def _comment(text: str) -> str:
+    """A name made safe for a one-line C++ comment (printable ASCII, quoted)."""
+    return '"' + "".join(c if 32 <= ord(c) < 127 and c != "\\" else "?" for c in text) + '"'
+
+
+def _eigen_overloads(n: int, frames: int) -> str:
+    return f"""#ifndef MECHBAL_GENERATED_NO_EIGEN
+using Vector = Eigen::Matrix<double, dof, 1>;
+using Matrix = Eigen::Matrix<double, dof, dof>;
+using Vector3 = Eigen::Matrix<double, 3, 1>;
+inline Vector inverse_dynamics(const Vector& q, const Vector& v, const Vector& a) noexcept {{
+  Vector tau;
+  inverse_dynamics(q.data(), v.data(), a.data(), tau.data());
+  return tau;
+}}
+inline Vector gravity_torque(const Vector& q) noexcept {{
+  Vector tau;
+  gravity_torque(q.data(), tau.data());
+  return tau;
+}}
+inline Matrix mass_matrix(const Vector& q) noexcept {{
+  Matrix M;
+  mass_matrix(q.data(), M.data());
+  return M;
+}}
+inline Eigen::Matrix<double, 6, dof> momentum_matrix(const Vector& q) noexcept {{
+  Eigen::Matrix<double, 6, dof> A;
+  momentum_matrix(q.data(), A.data());
+  return A;
+}}
+inline Vector3 center_of_mass(const Vector& q) noexcept {{
+  Vector3 c;
+  center_of_mass(q.data(), c.data());
+  return c;
+}}
+#endif  // MECHBAL_GENERATED_NO_EIGEN
+"""
+
+
+# ---- building and loading -----------------------------------------------------------------------
+def _cache_dir() -> Path:
+    base = os.environ.get("MECHBAL_CACHE") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "mechbal")
+    return Path(base) / "codegen"
+
+
+_SHIM = """#define MECHBAL_GENERATED_NO_EIGEN
+#include "{header}"
+namespace g = mechbal_generated::{ident};
+extern "C" {{
+int mb_dof() {{ return g::dof; }}
+int mb_num_frames() {{ return g::num_frames; }}
+void mb_inverse_dynamics(const double* q, const double* v, const double* a, double* tau) {{ g::inverse_dynamics(q, v, a, tau); }}
+void mb_gravity_torque(const double* q, double* tau) {{ g::gravity_torque(q, tau); }}
+void mb_mass_matrix(const double* q, double* M) {{ g::mass_matrix(q, M); }}
+void mb_shaking_wrench(const double* q, const double* v, const double* a, double* f, double* m) {{ g::shaking_wrench(q, v, a, f, m); }}
+void mb_base_reaction(const double* q, const double* v, const double* a, double* f, double* m) {{ g::base_reaction(q, v, a, f, m); }}
+void mb_center_of_mass(const double* q, double* c) {{ g::center_of_mass(q, c); }}
+void mb_momentum_matrix(const double* q, double* A) {{ g::momentum_matrix(q, A); }}
+void mb_frame_placements(const double* q, double* R, double* p) {{ g::frame_placements(q, R, p); }}
+{closed}}}
+"""
+
+_SHIM_CLOSED = """int mb_closed_motion(const double* qa, const double* va, const double* aa, double* q, double* v, double* a, int it, double tol) {{ return g::closed_motion(qa, va, aa, q, v, a, it, tol); }}
+int mb_closed_shaking_wrench(const double* qa, const double* va, const double* aa, double* q, double* f, double* m, int it, double tol) {{ return g::closed_shaking_wrench(qa, va, aa, q, f, m, it, tol); }}
+"""
+
+#: flags of `build` (part of the cache key)
+BUILD_FLAGS = ("-std=c++17", "-O2", "-fPIC", "-shared", "-fno-exceptions", "-fno-rtti")
+
+
+def compiler() -> str | None:
+    """The C++ compiler `build` uses: $CXX, else c++ or g++ on PATH (None when there is none)."""
+    cxx = os.environ.get("CXX")
+    if cxx:
+        return shutil.which(cxx) or (cxx if os.path.isfile(cxx) else None)
+    return shutil.which("c++") or shutil.which("g++") or shutil.which("clang++")
+
+
+class GeneratedModule:
+    """The generated functions of one mechanism, compiled and loaded (ctypes). Single samples:
+    1-D arrays in, arrays out, as `mechbal.Mechanism`'s methods."""
+
+    def __init__(self, code: GeneratedCode, library: Path):
+        self.code = code
+        self.path = library
+        self._lib = ctypes.CDLL(str(library))
+        self.dof = int(self._lib.mb_dof())
+        self.frame_names = list(code.frame_names)
+        d = ctypes.POINTER(ctypes.c_double)
+        for fname, nargs in (("inverse_dynamics", 4), ("gravity_torque", 2), ("mass_matrix", 2),
+                             ("shaking_wrench", 5), ("base_reaction", 5), ("center_of_mass", 2),
+                             ("momentum_matrix", 2), ("frame_placements", 3)):
+            f = getattr(self._lib, f"mb_{fname}")
+            f.argtypes = [d] * nargs
+            f.restype = None
+        if code.closed:
+            for fname in ("closed_motion", "closed_shaking_wrench"):
+                f = getattr(self._lib, f"mb_{fname}")
+                f.argtypes = [d] * 6 + [ctypes.c_int, ctypes.c_double]
+                f.restype = ctypes.c_int
+
+    def _vec(self, x, name: str) -> np.ndarray:
+        arr = np.ascontiguousarray(x, dtype=float)
+        if arr.shape != (self.dof,):
+            raise ValueError(f"{name} must have shape ({self.dof},), got {arr.shape}")
+        return arr
+
+    @staticmethod
+    def _ptr(a: np.ndarray):
+        return a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+    def inverse_dynamics(self, q, v, a) -> np.ndarray:
+        q, v, a = self._vec(q, "q"), self._vec(v, "v"), self._vec(a, "a")
+        tau = np.empty(self.dof)
+        self._lib.mb_inverse_dynamics(self._ptr(q), self._ptr(v), self._ptr(a), self._ptr(tau))
+        return tau
+
+    def gravity_torque(self, q) -> np.ndarray:
+        q = self._vec(q, "q")
+        tau = np.empty(self.dof)
+        self._lib.mb_gravity_torque(self._ptr(q), self._ptr(tau))
+        return tau
+
+    def mass_matrix(self, q) -> np.ndarray:
+        q = self._vec(q, "q")
+        M = np.empty((self.dof, self.dof), order="F")
+        self._lib.mb_mass_matrix(self._ptr(q), self._ptr(M))
+        return np.ascontiguousarray(M)
+
+    def shaking_wrench(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
+        q, v, a = self._vec(q, "q"), self._vec(v, "v"), self._vec(a, "a")
+        f, m = np.empty(3), np.empty(3)
+        self._lib.mb_shaking_wrench(self._ptr(q), self._ptr(v), self._ptr(a), self._ptr(f), self._ptr(m))
+        return f, m
+
+    def base_reaction(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
+        q, v, a = self._vec(q, "q"), self._vec(v, "v"), self._vec(a, "a")
+        f, m = np.empty(3), np.empty(3)
+        self._lib.mb_base_reaction(self._ptr(q), self._ptr(v), self._ptr(a), self._ptr(f), self._ptr(m))
+        return f, m
+
+    def center_of_mass(self, q) -> np.ndarray:
+        q = self._vec(q, "q")
+        c = np.empty(3)
+        self._lib.mb_center_of_mass(self._ptr(q), self._ptr(c))
+        return c
+
+    def momentum_matrix(self, q) -> np.ndarray:
+        q = self._vec(q, "q")
+        A = np.empty((6, self.dof), order="F")
+        self._lib.mb_momentum_matrix(self._ptr(q), self._ptr(A))
+        return np.ascontiguousarray(A)
+
+    def _actuated(self, x, name: str) -> np.ndarray:
+        arr = np.ascontiguousarray(x, dtype=float)
+        if arr.shape != (len(self.code.actuated),):
+            raise ValueError(f"{name} must have shape ({len(self.code.actuated)},), got {arr.shape}")
+        return arr
+
+    def closed_motion(self, q_actuated, v_actuated, a_actuated, q_guess, *, max_iterations: int = 20,
+                      tolerance: float = 1e-13) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """(q, v, a, status) of a closed mechanism from its actuated coordinates, the loops closed
+        from the warm start `q_guess` (status 0 ok, 1 the loops did not close, 2 non-finite)."""
+        if not self.code.closed:
+            raise ValueError(f"{self.code.name!r} has no loop closures: closed_motion does not apply")
+        qa, va, aa = (self._actuated(x, n) for x, n in ((q_actuated, "q_actuated"), (v_actuated, "v_actuated"),
+                                                          (a_actuated, "a_actuated")))
+        q = np.array(self._vec(q_guess, "q_guess"))
+        v, a = np.zeros(self.dof), np.zeros(self.dof)
+        status = self._lib.mb_closed_motion(self._ptr(qa), self._ptr(va), self._ptr(aa), self._ptr(q),
+                                            self._ptr(v), self._ptr(a), int(max_iterations), float(tolerance))
+        return q, v, a, int(status)
+
+    def closed_shaking_wrench(self, q_actuated, v_actuated, a_actuated, q_guess, *, max_iterations: int = 20,
+                              tolerance: float = 1e-13) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """(force, moment, q, status): the shaking wrench of the closed mechanism's motion."""
+        if not self.code.closed:
+            raise ValueError(f"{self.code.name!r} has no loop closures: closed_shaking_wrench does not apply")
+        qa, va, aa = (self._actuated(x, n) for x, n in ((q_actuated, "q_actuated"), (v_actuated, "v_actuated"),
+                                                          (a_actuated, "a_actuated")))
+        q = np.array(self._vec(q_guess, "q_guess"))
+        f, m = np.zeros(3), np.zeros(3)
+        status = self._lib.mb_closed_shaking_wrench(self._ptr(qa), self._ptr(va), self._ptr(aa), self._ptr(q),
+                                                    self._ptr(f), self._ptr(m), int(max_iterations), float(tolerance))
+        return f, m, q, int(status)
+
+    def frame_placement(self, q, frame: str) -> np.ndarray:
+        """4x4 placement of a generated frame in O."""
+        if frame not in self.frame_names:
+            raise ValueError(f"frame {frame!r} was not generated (frames: {', '.join(self.frame_names)})")
+        q = self._vec(q, "q")
+        k = len(self.frame_names)
+        R, p = np.empty(9 * max(k, 1)), np.empty(3 * max(k, 1))
+        self._lib.mb_frame_placements(self._ptr(q), self._ptr(R), self._ptr(p))
+        i = self.frame_names.index(frame)
+        T = np.eye(4)
+        T[:3, :3] = R[9 * i:9 * i + 9].reshape(3, 3, order="F")
+        T[:3, 3] = p[3 * i:3 * i + 3]
+        return T
+
+
+def build(mechanism_or_code, *, cache_dir: str | Path | None = None, **generate_options) -> GeneratedModule:
+    """Generate (unless given a `GeneratedCode`), compile with the installed C++ compiler and load.
+
+    The library is cached under `cache_dir` (default ``$MECHBAL_CACHE/codegen`` or
+    ``~/.cache/mechbal/codegen``) by the hash of the generated code and the compiler flags, so a
+    second call with the same model loads it without compiling. Raises `CodegenError` when no
+    compiler is installed or the compile fails (its diagnostics in the message)."""
+    code = mechanism_or_code if isinstance(mechanism_or_code, GeneratedCode) else \
+        generate(mechanism_or_code, **generate_options)
+    cxx = compiler()
+    if cxx is None:
+        raise CodegenError("mechbal.codegen.build needs a C++17 compiler: none found (set CXX, or "
+                           "install g++: apt-get install g++); generate() and the header need none")
+    key = hashlib.sha256((code.header + "\0" + " ".join(BUILD_FLAGS)).encode()).hexdigest()[:24]
+    directory = Path(cache_dir) if cache_dir is not None else _cache_dir()
+    library = directory / f"{code.name}-{key}.so"
+    if not library.exists():
+        directory.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=directory) as tmp:
+            header = Path(tmp) / f"{code.name}.hpp"
+            header.write_text(code.header)
+            shim = Path(tmp) / "shim.cpp"
+            shim.write_text(_SHIM.format(header=header.name, ident=code.name,
+                                         closed=_SHIM_CLOSED if code.closed else ""))
+            out = Path(tmp) / library.name
+            result = subprocess.run([cxx, *BUILD_FLAGS, str(shim), "-o", str(out)],
+                                    capture_output=True, text=True)
+            if result.returncode != 0:
+                raise CodegenError(f"compiling the generated code of {code.name!r} failed "
+                                   f"({cxx}):\n{result.stderr.strip()[-4000:]}")
+            os.replace(out, library)  # atomic: a concurrent build finds a whole file or none
+    return GeneratedModule(code, library)
+
+
+__all__ = ["BUILD_FLAGS", "CodegenError", "GENERATOR_VERSION", "GeneratedCode", "GeneratedModule",
+           "MAX_JOINTS", "build", "compiler", "generate"]
