@@ -245,6 +245,23 @@ def _cmd_codegen(args) -> int:
     return 0
 
 
+def _cmd_view(args) -> int:
+    from mechbal.view import ViewError, case_variants, write_html
+
+    if args.samples < 2:
+        raise UserError(f"--samples: {args.samples}: give at least 2")
+    try:
+        variants = case_variants(args.case, samples=args.samples, compare=args.compare)
+        path = write_html(args.out, variants, title=f"mechbal: {Path(str(args.case)).stem}")
+    except ViewError as exc:
+        raise UserError(str(exc)) from None
+    if not args.quiet:
+        size = path.stat().st_size / 1e6
+        print(f"wrote {path} ({size:.1f} MB; {len(variants)} variant(s), {len(variants[0].t)} instants): "
+              f"open it in a browser (no network needed)")
+    return 0
+
+
 def _cmd_verify(args) -> int:
     from mechbal.output import check_output_dir
     from mechbal.verify import run_verify
@@ -380,6 +397,20 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--frames", nargs="+", default=None, metavar="FRAME",
                    help="the frames whose placements frame_placements computes (default: all)")
     _last_flags(s, _cmd_codegen)
+    s = sub.add_parser("view", help="write an interactive 3-D view of a case (one HTML file)",
+                       description="Write FILE: a self-contained HTML page (WebGL, viewable offline) "
+                                   "of the case's mechanism moving along its trajectory: links, bodies "
+                                   "as inertia ellipsoids (counterweights red, discs blue), springs, "
+                                   "the centre of mass path, and the shaking force and moment as arrows "
+                                   "at O, with play/pause and a time slider. Needs the 'view' extra.")
+    s.add_argument("case", help="built-in case name or path to a TOML or URDF file")
+    s.add_argument("--out", required=True, metavar="FILE", help="the HTML file to write")
+    s.add_argument("--samples", type=int, default=201, metavar="N",
+                   help="instants of the trajectory shown (default: 201)")
+    s.add_argument("--compare", action="store_true",
+                   help="also show the mechanism without its counterweights and discs, side by side "
+                        "and in step, arrows on one scale")
+    _last_flags(s, _cmd_view)
     s = sub.add_parser("verify", help="check a case's predictions (balanced and not) in MuJoCo",
                        description="Export the case's mechanism and its balanced variant to MuJoCo and "
                                    "compare mechbal's predicted shaking force, shaking moment and "
