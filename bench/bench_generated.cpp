@@ -4,7 +4,8 @@
 // and of Talos (talos_reduced), read from the same URDF files. The headers are generated at build
 // time by mechbal_add_generated (cmake/MechbalGenerated.cmake).
 //  - paminsa_generated_wrench: the generated closed tick of PAMINSA's general model (position solve
-//    warm-started from the last tick, v = C v#, a = C a# + c, shaking wrench), on the trajectory and
+//    from the last tick's solution moved to second order (closed_tick), v = C v#, a = C a# + c,
+//    shaking wrench), on the trajectory and
 //    model of paminsa_general_wrench (bench_loops.cpp), checked at setup against the closed form:
 //    ratio paminsa_generated_over_closed_form.
 #include <algorithm>
@@ -83,6 +84,7 @@ struct PaminsaGeneratedCase {
   double q[gp::dof];
   double q0[gp::dof];
   double force[3], moment[3];
+  gp::ClosedState state;
   PingPong<1024> order;
   int status = 0;
 };
@@ -114,9 +116,10 @@ Tick paminsa_generated_case() {
     if (!(rel < 1e-9)) fail("generated PAMINSA != closed form (relative)", rel);
   }
   std::copy(s->q0, s->q0 + gp::dof, s->q);
+  std::copy(s->q0, s->q0 + gp::dof, s->state.q);
   return [s] {
     const ActuatedState& a = s->in[s->order.next()];
-    s->status = gp::closed_shaking_wrench(a.q.data(), a.v.data(), a.a.data(), s->q, s->force, s->moment);
+    s->status = gp::closed_tick(s->state, a.q.data(), a.v.data(), a.a.data(), s->force, s->moment);
     benchmark::DoNotOptimize(s->status);
     benchmark::DoNotOptimize(s->force);
     benchmark::DoNotOptimize(s->moment);

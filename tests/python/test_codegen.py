@@ -200,7 +200,10 @@ _CLOSED_CALLS = """double qa[g::num_actuated], va[g::num_actuated], aa[g::num_ac
   for (int i = 0; i < g::num_actuated; ++i) { qa[i] = q[g::actuated_index[i]]; va[i] = 0.1; aa[i] = 0.2; }
   double qc[g::dof];
   for (int i = 0; i < g::dof; ++i) qc[i] = q[i];
-  const int status = g::closed_shaking_wrench(qa, va, aa, qc, f, m);
+  int status = g::closed_shaking_wrench(qa, va, aa, qc, f, m);
+  g::ClosedState state;
+  for (int i = 0; i < g::dof; ++i) state.q[i] = q[i];
+  status += 10 * g::closed_tick(state, qa, va, aa, f, m);
   std::printf("closed status %d\\n", status);"""
 
 
@@ -304,8 +307,19 @@ def test_generated_closed_tick_is_exact_to_a_40_digit_evaluation(tmp_path):
         assert _rel(ours[:n], ref[:n]) < 1e-13 and _rel(ours[n:2 * n], ref[n:2 * n]) < 1e-13
         assert _rel(ours[2 * n:2 * n + 3], ref[2 * n:2 * n + 3]) < 1e-13
         assert _rel(ours[2 * n + 3:], ref[2 * n + 3:]) < 1e-13
-    # tick to tick along the whole motion, each warm-started from the last
+    # closed_tick along the motion, forward then backward (its warm start moves the last solution
+    # by the time step the actuated motion implies, so a motion run backwards predicts as well)
+    order = np.r_[np.arange(len(Qa)), np.arange(len(Qa) - 1, -1, -1)]
+    F, M, Q, status = module.closed_ticks(Qa[order], Va[order], Aa[order], _closed_case("paminsa")[2])
+    assert np.all(status == 0)
     q = np.asarray(_closed_case("paminsa")[2])
+    for j in range(0, len(order), 37):
+        k = order[j]
+        cm = mech.closed_motion(Qa[k], Va[k], Aa[k], q_guess=Q[j])
+        sw = mech.shaking_wrench(cm.q, cm.v, cm.a)
+        assert _rel(Q[j], cm.q) < 1e-12 and _rel(F[j], sw.shaking_force) < 2e-12
+        assert _rel(M[j], sw.shaking_moment) < 2e-12
+    # tick to tick along the whole motion, each warm-started from the last
     worst = 0.0
     for k in range(len(Qa)):
         F, M, q_next, status = module.closed_shaking_wrench(Qa[k], Va[k], Aa[k], q)

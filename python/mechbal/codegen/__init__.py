@@ -325,6 +325,58 @@ inline int closed_shaking_wrench(const double* q_actuated, const double* v_actua
   return status;
 }}
 
+/// What a tick keeps of the last one, for the warm start: the solved q, v, a and the actuated
+/// coordinates and rates they were solved for. `valid` is false before the first good tick.
+struct ClosedState {{
+  double q[dof];
+  double v[dof];
+  double a[dof];
+  double q_actuated[num_actuated];
+  double v_actuated[num_actuated];
+  bool valid = false;
+}};
+
+/// A tick along a motion: the loops are closed from the last tick's solution moved to the new
+/// actuated coordinates to second order (q + v s + a s^2 / 2, with s the time step that the
+/// actuated displacement and rates imply, so that a motion run backwards or at another rate
+/// predicts as well), then as closed_motion; `state` is updated on success. Before the first
+/// good tick, `state.q` is the warm start (set it, with state.valid = false).
+inline int closed_tick(ClosedState& state, const double* q_actuated, const double* v_actuated,
+                       const double* a_actuated, double* force, double* moment, int max_iterations = 20,
+                       double tolerance = 1e-13) noexcept {{
+  double q[dof], v[dof], a[dof];
+  for (int i = 0; i < dof; ++i) q[i] = state.q[i];
+  if (state.valid) {{
+    double num = 0.0, den = 0.0;
+    for (int i = 0; i < num_actuated; ++i) {{
+      const double rate = 0.5 * (v_actuated[i] + state.v_actuated[i]);
+      num += (q_actuated[i] - state.q_actuated[i]) * rate;
+      den += rate * rate;
+    }}
+    const double s = den > 0.0 ? num / den : 0.0;
+    if (std::isfinite(s)) {{
+      for (int i = 0; i < num_passive; ++i) {{
+        const int k = passive_index[i];
+        q[k] = state.q[k] + s * (state.v[k] + 0.5 * s * state.a[k]);
+      }}
+    }}
+  }}
+  const int status = closed_motion(q_actuated, v_actuated, a_actuated, q, v, a, max_iterations, tolerance);
+  if (status != ok) return status;
+  shaking_wrench(q, v, a, force, moment);
+  for (int i = 0; i < dof; ++i) {{
+    state.q[i] = q[i];
+    state.v[i] = v[i];
+    state.a[i] = a[i];
+  }}
+  for (int i = 0; i < num_actuated; ++i) {{
+    state.q_actuated[i] = q_actuated[i];
+    state.v_actuated[i] = v_actuated[i];
+  }}
+  state.valid = true;
+  return ok;
+}}
+
 """
 
 
@@ -375,6 +427,7 @@ def _cache_dir() -> Path:
 
 
 _SHIM = """#define MECHBAL_GENERATED_NO_EIGEN
+#include <new>
 #include "{header}"
 namespace g = mechbal_generated::{ident};
 extern "C" {{
@@ -393,6 +446,14 @@ void mb_frame_placements(const double* q, double* R, double* p) {{ g::frame_plac
 
 _SHIM_CLOSED = """int mb_closed_motion(const double* qa, const double* va, const double* aa, double* q, double* v, double* a, int it, double tol) {{ return g::closed_motion(qa, va, aa, q, v, a, it, tol); }}
 int mb_closed_shaking_wrench(const double* qa, const double* va, const double* aa, double* q, double* f, double* m, int it, double tol) {{ return g::closed_shaking_wrench(qa, va, aa, q, f, m, it, tol); }}
+int mb_closed_state_size() {{ return static_cast<int>(sizeof(g::ClosedState)); }}
+void mb_closed_state_init(void* state, const double* q) {{ auto* s = new (state) g::ClosedState(); for (int i = 0; i < g::dof; ++i) s->q[i] = q[i]; }}
+int mb_closed_tick(void* state, const double* qa, const double* va, const double* aa, double* f, double* m, double* q_out) {{
+  auto* s = static_cast<g::ClosedState*>(state);
+  const int status = g::closed_tick(*s, qa, va, aa, f, m);
+  for (int i = 0; i < g::dof; ++i) q_out[i] = s->q[i];
+  return status;
+}}
 """
 
 #: flags of `build` (part of the cache key)
@@ -429,6 +490,10 @@ class GeneratedModule:
                 f = getattr(self._lib, f"mb_{fname}")
                 f.argtypes = [d] * 6 + [ctypes.c_int, ctypes.c_double]
                 f.restype = ctypes.c_int
+            self._lib.mb_closed_state_size.restype = ctypes.c_int
+            self._lib.mb_closed_state_init.argtypes = [ctypes.c_void_p, d]
+            self._lib.mb_closed_tick.argtypes = [ctypes.c_void_p] + [d] * 6
+            self._lib.mb_closed_tick.restype = ctypes.c_int
 
     def _vec(self, x, name: str) -> np.ndarray:
         arr = np.ascontiguousarray(x, dtype=float)
@@ -514,6 +579,27 @@ class GeneratedModule:
         status = self._lib.mb_closed_shaking_wrench(self._ptr(qa), self._ptr(va), self._ptr(aa), self._ptr(q),
                                                     self._ptr(f), self._ptr(m), int(max_iterations), float(tolerance))
         return f, m, q, int(status)
+
+    def closed_ticks(self, q_actuated, v_actuated, a_actuated, q_guess):
+        """Run `closed_tick` along a motion ((N, na) arrays, in the order given), its state kept
+        from tick to tick: (force (N, 3), moment (N, 3), q (N, dof), status (N,))."""
+        if not self.code.closed:
+            raise ValueError(f"{self.code.name!r} has no loop closures: closed_ticks does not apply")
+        Qa, Va, Aa = (np.ascontiguousarray(x, dtype=float) for x in (q_actuated, v_actuated, a_actuated))
+        state = ctypes.create_string_buffer(int(self._lib.mb_closed_state_size()) + 64)
+        address = (ctypes.addressof(state) + 63) // 64 * 64
+        guess = np.array(self._vec(q_guess, "q_guess"))
+        self._lib.mb_closed_state_init(ctypes.c_void_p(address), self._ptr(guess))
+        n = len(Qa)
+        F, M, Q, status = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, self.dof)), np.zeros(n, dtype=int)
+        f, m, q = np.zeros(3), np.zeros(3), np.zeros(self.dof)
+        for k in range(n):
+            qa, va, aa = (self._actuated(x[k], name) for x, name in ((Qa, "q_actuated"), (Va, "v_actuated"),
+                                                                     (Aa, "a_actuated")))
+            status[k] = self._lib.mb_closed_tick(ctypes.c_void_p(address), self._ptr(qa), self._ptr(va),
+                                                 self._ptr(aa), self._ptr(f), self._ptr(m), self._ptr(q))
+            F[k], M[k], Q[k] = f, m, q
+        return F, M, Q, status
 
     def frame_placement(self, q, frame: str) -> np.ndarray:
         """4x4 placement of a generated frame in O."""
