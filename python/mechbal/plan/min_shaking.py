@@ -1,0 +1,551 @@
+"""Motions that minimise shaking: ``min_shaking(mech, start, end, duration, ...)``.
+
+A rest-to-rest (or given boundary velocities) motion of the actuated joints of any mechanism
+(serial, tree, closed loop) from ``start`` to ``end`` in ``duration`` that minimises the RMS or
+the peak of the shaking force or of the shaking moment (about ``moment_point``, default O), or a
+weighted sum of the mean squares of shaking force, shaking moment and actuator torque, subject to
+the joints' position, velocity, acceleration and torque limits.
+
+* Parameterisation: a clamped quintic B-spline per actuated joint (`mechbal.plan.spline`), the
+  boundary positions and velocities held exactly (and zero accelerations with ``smooth_ends``); the quintic law is one
+  point of it, the warm start.
+* Gradients: the shaking wrench and the torques are linear in the accelerations and quadratic in
+  the rates; their partial derivatives come from the model (`mechbal.plan.model`), chained through
+  the spline basis.
+* Solver: scipy's SLSQP. RMS objectives are integrated by Gauss-Legendre quadrature on each knot
+  span; peaks by an epigraph variable; limits are imposed at the quadrature nodes, then checked
+  on a grid ten times finer than the output samples, and every violation found there is added
+  as a constraint and the problem solved again.
+* Infeasible requests (a duration too short for the torque, velocity or acceleration limits) are
+  refused before the long run with `PlanInfeasible`, whose message gives the shortest duration
+  the planner found feasible.
+
+Layer: methods (docs/architecture.md).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+import numpy as np
+
+from mechbal.mechanism import Mechanism
+from mechbal.plan.model import ActuatedModel, Evaluation
+from mechbal.plan.spline import SplineBasis, SplineTrajectory
+
+OBJECTIVES = ("force_rms", "force_peak", "moment_rms", "moment_peak")
+#: relative tolerance of a limit on the check grid (rounding of the solver's constraints)
+LIMIT_TOLERANCE = 1e-9
+#: nodes of the Gauss-Legendre quadrature per knot span
+NODES_PER_SPAN = 8
+
+
+class PlanInfeasible(ValueError):
+    """No motion within the limits exists for this request (the message says what would make it
+    feasible: ``shortest_duration`` [s], or None where none was found)."""
+
+    def __init__(self, message: str, shortest_duration: float | None = None, field: str = "duration"):
+        super().__init__(message)
+        self.shortest_duration = shortest_duration
+        self.field = field
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Limits of the actuated joints (inf where none): positions [rad or m], velocity [rad/s or
+    m/s], acceleration [rad/s^2 or m/s^2], torque [N m or N]."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    torque: np.ndarray
+
+    def active_kinds(self) -> list[str]:
+        out = []
+        if np.any(np.isfinite(self.lower)) or np.any(np.isfinite(self.upper)):
+            out.append("position")
+        for k in ("velocity", "acceleration", "torque"):
+            if np.any(np.isfinite(getattr(self, k))):
+                out.append(k)
+        return out
+
+
+@dataclass
+class PlanResult:
+    """A planned motion and what it achieved.
+
+    ``trajectory``: the motion of the actuated joints (`SplineTrajectory`); ``quintic``: the
+    quintic with the same boundary conditions (the warm start and the reference); ``objective``:
+    the name (``force_rms``, ..., or ``weighted``); ``value`` and ``quintic_value``: the objective
+    of each ([N] or [N m]; a weighted objective: the weighted sum of mean squares), on the same
+    time grid; ``reduction``: ``1 - value / quintic_value``; ``active_limits``: the limits the
+    plan touches (kind, joint, time, value, limit); ``ok`` and ``message`` from the solver;
+    ``limits``: the limits held; ``checked_samples``: the size of the grid the limits were checked
+    on."""
+
+    trajectory: SplineTrajectory
+    quintic: Any
+    objective: str
+    weights: dict[str, float]
+    moment_point: np.ndarray
+    value: float
+    quintic_value: float
+    reduction: float
+    active_limits: list[dict[str, Any]]
+    limits: Limits
+    ok: bool
+    message: str
+    iterations: int
+    checked_samples: int
+    metrics: dict[str, dict[str, float]] = field(default_factory=dict)
+
+    def summary(self, names: list[str]) -> dict[str, Any]:
+        """What summary.json says about the plan (``plan``)."""
+        return {"objective": self.objective, "weights": self.weights,
+                "moment_point": self.moment_point.tolist(), "value": self.value,
+                "quintic_value": self.quintic_value, "reduction": self.reduction,
+                "ok": self.ok, "message": self.message, "iterations": self.iterations,
+                "control_points": int(self.trajectory.basis.count),
+                "active_limits": [{**a, "joint": names[a["joint"]]} for a in self.active_limits],
+                "limits_checked_on": self.checked_samples, "metrics": self.metrics}
+
+
+def quintic_with_velocities(start, end, duration, v0, v1):
+    """The quintic polynomial with the given boundary positions and velocities and zero boundary
+    accelerations (`mechbal.trajectory.ViaPoints` with two points)."""
+    from mechbal.trajectory import ViaPoints
+
+    return ViaPoints([0.0, duration], np.vstack([start, end]), velocities=np.vstack([v0, v1]))
+
+
+def model_limits(mech: Mechanism, acceleration_limit=None, torque_limit=None,
+                 velocity_limit=None) -> Limits:
+    """The actuated joints' limits: the model's (URDF ``<limit>``, the case's ``limits``), with
+    the given acceleration, velocity and torque limits (one per actuated joint) where tighter."""
+    na = len(mech.actuated_names)
+    idx = list(mech.model.actuated_coordinates) if mech.is_closed else list(range(mech.dof))
+    pick = lambda xs: np.asarray(xs, float)[idx]  # noqa: E731
+    lower, upper = pick(mech.model.lower_limits), pick(mech.model.upper_limits)
+    vel, tau = pick(mech.model.velocity_limits), pick(mech.model.effort_limits)
+    acc = np.full(na, np.inf)
+    for name, given, base in (("acceleration_limit", acceleration_limit, acc),
+                              ("torque_limit", torque_limit, tau),
+                              ("velocity_limit", velocity_limit, vel)):
+        if given is None:
+            continue
+        g = np.broadcast_to(np.asarray(given, float), (na,)).copy()
+        if np.any(~(g > 0)):
+            raise ValueError(f"{name} must be > 0 (one per actuated joint), got {g.tolist()}")
+        base[:] = np.minimum(base, g)
+    return Limits(lower, upper, vel, acc, tau)
+
+
+class _Problem:
+    """The optimisation problem over the free control points (and the epigraph variable)."""
+
+    def __init__(self, am: ActuatedModel, basis: SplineBasis, boundary: np.ndarray, objective: str,
+                 weights: Mapping[str, float], limits: Limits, nodes: np.ndarray, node_weights: np.ndarray):
+        self.am, self.basis, self.boundary = am, basis, boundary
+        self.objective, self.weights, self.limits = objective, dict(weights), limits
+        self.na = am.na
+        self.nf = basis.free_count
+        self.peak = objective.endswith("_peak")
+        self.need_torque = bool(np.any(np.isfinite(limits.torque)) or self.weights.get("torque", 0.0))
+        self.set_nodes(nodes, node_weights)
+        self.constraint_times = np.array(nodes)
+        self._cache: tuple[bytes, Evaluation] | None = None
+        self.scale = 1.0
+
+    def set_nodes(self, nodes, node_weights):
+        self.nodes, self.node_weights = np.asarray(nodes), np.asarray(node_weights)
+        B = self.basis.matrices(self.nodes)
+        self.Z = [b @ self.basis.free_map for b in B]        # (N, nf) each
+        self.R = [b @ self.basis.boundary_map @ self.boundary for b in B]  # (N, na)
+
+    # ---- motion of the free points -------------------------------------------------------------
+    def motion(self, z: np.ndarray, which: str = "nodes"):
+        Z, R = (self.Z, self.R) if which == "nodes" else (self.Zc, self.Rc)
+        Zm = z[: self.na * self.nf].reshape(self.nf, self.na)
+        return [Zk @ Zm + Rk for Zk, Rk in zip(Z, R)]
+
+    def evaluate(self, z: np.ndarray) -> Evaluation:
+        key = z.tobytes()
+        if self._cache is None or self._cache[0] != key:
+            q, v, a = self.motion(z)
+            self._cache = (key, self.am.evaluate(q, v, a, torque=self.need_torque, partials=True))
+        return self._cache[1]
+
+    def _chain(self, dq, dv, da):
+        """d(quantity)/dz (N, k, na * nf) from the partials (N, k, na)."""
+        out = (np.einsum("ikj,il->iklj", dq, self.Z[0]) + np.einsum("ikj,il->iklj", dv, self.Z[1])
+               + np.einsum("ikj,il->iklj", da, self.Z[2]))
+        return out.reshape(dq.shape[0], dq.shape[1], -1)
+
+    def _squares(self, ev: Evaluation):
+        """Per node: the weighted sum of squares that the objective integrates, and its partials
+        with respect to the actuated q, v, a (N, na)."""
+        W = ev.wrench
+        w = np.zeros(6)
+        if self.objective in ("force_rms", "force_peak"):
+            w[:3] = 1.0
+        elif self.objective in ("moment_rms", "moment_peak"):
+            w[3:] = 1.0
+        else:
+            w[:3], w[3:] = self.weights.get("force", 0.0), self.weights.get("moment", 0.0)
+        s = np.sum(w * W ** 2, axis=1)
+        gq = 2.0 * np.einsum("ik,k,ikj->ij", W, w, ev.dq)
+        gv = 2.0 * np.einsum("ik,k,ikj->ij", W, w, ev.dv)
+        ga = 2.0 * np.einsum("ik,k,ikj->ij", W, w, ev.da)
+        wt = self.weights.get("torque", 0.0) if self.objective == "weighted" else 0.0
+        if wt:
+            T = ev.torque
+            s = s + wt * np.sum(T ** 2, axis=1)
+            gq = gq + 2.0 * wt * np.einsum("ik,ikj->ij", T, ev.torque_dq)
+            gv = gv + 2.0 * wt * np.einsum("ik,ikj->ij", T, ev.torque_dv)
+            ga = ga + 2.0 * wt * np.einsum("ik,ikj->ij", T, ev.torque_da)
+        return s, gq, gv, ga
+
+    def _dz(self, gq, gv, ga):
+        """sum over nodes of g (N, na) chained: (N, nf * na) rows."""
+        return (np.einsum("ij,il->ilj", gq, self.Z[0]) + np.einsum("ij,il->ilj", gv, self.Z[1])
+                + np.einsum("ij,il->ilj", ga, self.Z[2])).reshape(gq.shape[0], -1)
+
+    def value(self, z: np.ndarray) -> float:
+        """The objective (mean square or peak square) of the motion, unscaled."""
+        s, *_ = self._squares(self.evaluate(z))
+        if self.peak:
+            return float(np.max(s))
+        return float(np.sum(self.node_weights * s) / self.basis.duration)
+
+    # ---- scipy callbacks -----------------------------------------------------------------------
+    def fun(self, x: np.ndarray):
+        if self.peak:
+            g = np.zeros_like(x)
+            g[-1] = 1.0
+            return float(x[-1]), g
+        s, gq, gv, ga = self._squares(self.evaluate(x))
+        J = np.sum(self.node_weights * s) / self.basis.duration
+        G = self.node_weights @ self._dz(gq, gv, ga) / self.basis.duration
+        return float(J / self.scale), G / self.scale
+
+    def peak_constraint(self, x: np.ndarray):
+        s, gq, gv, ga = self._squares(self.evaluate(x))
+        c = x[-1] - s / self.scale
+        J = np.zeros((s.size, x.size))
+        J[:, :-1] = -self._dz(gq, gv, ga) / self.scale
+        J[:, -1] = 1.0
+        return c, J
+
+    def set_constraint_times(self, times: np.ndarray):
+        self.constraint_times = np.unique(np.asarray(times, float))
+        B = self.basis.matrices(self.constraint_times)
+        self.Zc = [b @ self.basis.free_map for b in B]
+        self.Rc = [b @ self.basis.boundary_map @ self.boundary for b in B]
+
+    def linear_constraints(self):
+        """(A, lo, hi) of the position, velocity and acceleration limits at the constraint
+        times, in the free points (rows scaled by the limit)."""
+        rows, lo, hi = [], [], []
+        L = self.limits
+        for k, (lower, upper) in enumerate(((L.lower, L.upper), (-L.velocity, L.velocity),
+                                            (-L.acceleration, L.acceleration))):
+            for j in range(self.na):
+                if not (np.isfinite(lower[j]) or np.isfinite(upper[j])):
+                    continue
+                A = np.zeros((len(self.constraint_times), self.nf, self.na))
+                A[:, :, j] = self.Zc[k]
+                rows.append(A.reshape(len(self.constraint_times), -1))
+                lo.append(lower[j] - self.Rc[k][:, j])
+                hi.append(upper[j] - self.Rc[k][:, j])
+        if not rows:
+            return None
+        return np.vstack(rows), np.concatenate(lo), np.concatenate(hi)
+
+    def torque_constraint(self, x: np.ndarray):
+        """1 -+ tau / tau_max >= 0 at the constraint times (joints with a torque limit)."""
+        z = x[: self.na * self.nf]
+        q, v, a = self.motion(z, "constraints")
+        ev = self.am.evaluate(q, v, a, torque=True, partials=True)
+        lim = self.limits.torque
+        js = [j for j in range(self.na) if np.isfinite(lim[j])]
+        c, J = [], []
+        dT = (np.einsum("ikj,il->iklj", ev.torque_dq, self.Zc[0]) + np.einsum("ikj,il->iklj", ev.torque_dv, self.Zc[1])
+              + np.einsum("ikj,il->iklj", ev.torque_da, self.Zc[2])).reshape(len(q), self.na, -1)
+        for j in js:
+            for sign in (1.0, -1.0):
+                c.append(1.0 - sign * ev.torque[:, j] / lim[j])
+                Jj = np.zeros((len(q), x.size))
+                Jj[:, : self.na * self.nf] = -sign * dT[:, j, :] / lim[j]
+                J.append(Jj)
+        return np.concatenate(c), np.vstack(J)
+
+
+def _gauss_nodes(knots: np.ndarray, per_span: int) -> tuple[np.ndarray, np.ndarray]:
+    x, w = np.polynomial.legendre.leggauss(per_span)
+    spans = np.unique(knots)
+    nodes, weights = [], []
+    for a, b in zip(spans[:-1], spans[1:]):
+        nodes.append(0.5 * (b - a) * x + 0.5 * (a + b))
+        weights.append(0.5 * (b - a) * w)
+    return np.concatenate(nodes), np.concatenate(weights)
+
+
+def _vector(name: str, value, n: int) -> np.ndarray:
+    a = np.asarray(value, float).reshape(-1)
+    if a.size == 1 and n > 1:
+        a = np.full(n, float(a[0]))
+    if a.shape != (n,) or not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must have {n} finite values (one per actuated joint), got {np.asarray(value).tolist()}")
+    return a
+
+
+def _violations(am: ActuatedModel, traj, limits: Limits, t: np.ndarray, torque: bool):
+    """Relative excess over each limit on the grid ``t``: list of (kind, joint, time, value, limit,
+    excess) and the torque (or None)."""
+    q, v, a = traj.evaluate(t)
+    tau = am.full(q, v, a, torque=True)[3] if torque else None
+    out = []
+    for kind, x, lo, hi in (("position", q, limits.lower, limits.upper),
+                            ("velocity", v, -limits.velocity, limits.velocity),
+                            ("acceleration", a, -limits.acceleration, limits.acceleration),
+                            ("torque", tau, -limits.torque, limits.torque)):
+        if x is None:
+            continue
+        for j in range(x.shape[1]):
+            for bound, sign in ((hi[j], 1.0), (lo[j], -1.0)):
+                if not np.isfinite(bound):
+                    continue
+                excess = sign * (x[:, j] - bound)
+                k = int(np.argmax(excess))
+                scale = max(abs(bound), 1e-12)
+                out.append((kind, j, float(t[k]), float(x[k, j]), float(bound), float(excess[k] / scale),
+                            excess / scale))
+    return out, tau
+
+
+def min_shaking(mech: Mechanism, start, end, duration: float, *, objective: str = "force_rms",
+                weights: Mapping[str, float] | None = None, moment_point=(0.0, 0.0, 0.0),
+                start_velocity=None, end_velocity=None, acceleration_limit=None, torque_limit=None,
+                velocity_limit=None, smooth_ends: bool = False, control_points: int = 14,
+                samples: int = 501, q_guess=None,
+                max_iterations: int = 200, feasibility_search: bool = True) -> PlanResult:
+    """Plan the motion of ``mech``'s actuated joints from ``start`` to ``end`` (rad or m, one per
+    actuated joint) in ``duration`` [s] that minimises shaking (module docstring).
+
+    Args:
+        objective: ``"force_rms" | "force_peak" | "moment_rms" | "moment_peak"``; ignored when
+            ``weights`` is given.
+        weights: ``{"force": w1, "moment": w2, "torque": w3}``: minimise
+            ``w1 mean|F|^2 + w2 mean|M_p|^2 + w3 mean|tau|^2`` (SI units; objective ``weighted``).
+        moment_point: the point p of the shaking moment ``M_p = M_O - p x F`` [m], in O.
+        start_velocity, end_velocity: boundary velocities (default zero: rest to rest).
+        acceleration_limit, torque_limit, velocity_limit: limits per actuated joint (or one
+            number for all) besides the model's (the tighter wins).
+        smooth_ends: also hold zero accelerations at both ends (no step in the actuator
+            torques at the start and the end; by default the accelerations there are free).
+        control_points: control points per joint of the quintic B-spline (>= 7).
+        samples: the output grid (``samples`` instants over ``[0, duration]``); the limits are
+            checked on a grid ten times finer.
+        q_guess: a closed mechanism's assembly at the start (default: `mechbal.assembly.assemble`).
+
+    Raises `PlanInfeasible` when no motion within the limits is found, with the shortest duration
+    the planner found feasible in its message; ValueError on bad arguments."""
+    from scipy.optimize import Bounds, LinearConstraint, NonlinearConstraint, minimize
+
+    na = len(mech.actuated_names)
+    if weights is not None:
+        bad = set(weights) - {"force", "moment", "torque"}
+        if bad:
+            raise ValueError(f"weights: unknown key {sorted(bad)} (known: force, moment, torque)")
+        weights = {k: float(v) for k, v in weights.items()}
+        if any(not (v >= 0 and np.isfinite(v)) for v in weights.values()) or not any(weights.values()):
+            raise ValueError(f"weights must be finite, >= 0 and not all zero, got {weights}")
+        objective = "weighted"
+    elif objective not in OBJECTIVES:
+        raise ValueError(f"objective must be one of {', '.join(OBJECTIVES)}, got {objective!r}")
+    if not (np.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be a finite number of seconds > 0, got {duration!r}")
+    q0, q1 = _vector("start", start, na), _vector("end", end, na)
+    v0 = np.zeros(na) if start_velocity is None else _vector("start_velocity", start_velocity, na)
+    v1 = np.zeros(na) if end_velocity is None else _vector("end_velocity", end_velocity, na)
+    limits = model_limits(mech, acceleration_limit, torque_limit, velocity_limit)
+    for name, x in (("start", q0), ("end", q1)):
+        out = (x < limits.lower) | (x > limits.upper)
+        if np.any(out):
+            j = int(np.argmax(out))
+            raise PlanInfeasible(f"{name} of {mech.actuated_names[j]} = {x[j]:g} is outside its position "
+                                 f"limits [{limits.lower[j]:g}, {limits.upper[j]:g}]", None, name)
+    for name, x in (("start_velocity", v0), ("end_velocity", v1)):
+        out = np.abs(x) > limits.velocity
+        if np.any(out):
+            j = int(np.argmax(out))
+            raise PlanInfeasible(f"{name} of {mech.actuated_names[j]} = {x[j]:g} exceeds its velocity "
+                                 f"limit {limits.velocity[j]:g}", None, name)
+    if mech.is_closed and q_guess is None:
+        from mechbal.assembly import assemble
+
+        q_guess = assemble(mech, q0).q
+    am = ActuatedModel(mech, q_guess=q_guess, moment_point=moment_point)
+    common = dict(objective=objective, weights=weights or {}, control_points=control_points,
+                  samples=samples, max_iterations=max_iterations, smooth_ends=smooth_ends)
+    result = _solve(am, q0, q1, v0, v1, float(duration), limits, **common)
+    if result.ok or not feasibility_search:
+        return result
+    if not _is_limited(result):
+        return result
+    # infeasible: the shortest duration the planner can hold the limits in (bisection)
+    lo, hi = float(duration), 2.0 * float(duration)
+    for _ in range(12):
+        if _solve(am, q0, q1, v0, v1, hi, limits, feasibility_only=True, **common).ok:
+            break
+        lo, hi = hi, 2.0 * hi
+    else:
+        raise PlanInfeasible(f"duration {duration:g} s is too short for the limits, and no duration up to "
+                             f"{hi:g} s holds them: {result.message}", None)
+    while hi - lo > 0.005 * hi:
+        mid = 0.5 * (lo + hi)
+        if _solve(am, q0, q1, v0, v1, mid, limits, feasibility_only=True, **common).ok:
+            hi = mid
+        else:
+            lo = mid
+    raise PlanInfeasible(f"duration {duration:g} s is too short for the limits ({result.message}); the "
+                         f"shortest feasible duration found is {hi:.4g} s", hi)
+
+
+def _is_limited(result: PlanResult) -> bool:
+    return result.message.startswith("limits exceeded")
+
+
+def _solve(am: ActuatedModel, q0, q1, v0, v1, T: float, limits: Limits, *, objective: str,
+           weights: dict, control_points: int, samples: int, max_iterations: int, smooth_ends: bool,
+           feasibility_only: bool = False) -> PlanResult:
+    from scipy.optimize import LinearConstraint, NonlinearConstraint, minimize
+
+    na = am.na
+    basis = SplineBasis.make(T, int(control_points), 3 if smooth_ends else 2)
+    boundary = (np.vstack([q0, v0, np.zeros(na), q1, v1, np.zeros(na)]) if smooth_ends
+                else np.vstack([q0, v0, q1, v1]))
+    quintic = quintic_with_velocities(q0, q1, T, v0, v1)
+    nodes, node_weights = _gauss_nodes(basis.knots, NODES_PER_SPAN)
+    # warm start: the quintic, exactly a spline of this basis
+    fit_t = np.linspace(0.0, T, 4 * control_points)
+    z0 = basis.fit(fit_t, quintic.evaluate(fit_t).q, boundary)
+    prob = _Problem(am, basis, boundary, objective, weights, limits, nodes, node_weights)
+    x0 = z0.reshape(-1)
+    quintic_value = prob.value(x0)
+    prob.scale = quintic_value if quintic_value > 0 else 1.0
+    if prob.peak:
+        x0 = np.concatenate([x0, [1.0 + 1e-6]])
+    check_t = np.linspace(0.0, T, 10 * (int(samples) - 1) + 1)
+    constraint_t = np.unique(np.concatenate([nodes, np.linspace(0.0, T, 4 * control_points)]))
+    torque = bool(np.any(np.isfinite(limits.torque)))
+    x = x0
+    res = None
+    message, iterations = "", 0
+    for _round in range(6):
+        prob.set_constraint_times(constraint_t)
+        cons = []
+        lin = prob.linear_constraints()
+        if lin is not None:
+            A, lo, hi = lin
+            A = np.hstack([A, np.zeros((A.shape[0], x.size - A.shape[1]))])
+            cons.append(LinearConstraint(A, lo, hi))
+        if torque:
+            cons.append({"type": "ineq", "fun": lambda x: prob.torque_constraint(x)[0],
+                         "jac": lambda x: prob.torque_constraint(x)[1]})
+        if prob.peak:
+            cons.append({"type": "ineq", "fun": lambda x: prob.peak_constraint(x)[0],
+                         "jac": lambda x: prob.peak_constraint(x)[1]})
+        if feasibility_only:
+            fun = lambda x: (0.0, np.zeros_like(x))  # noqa: E731
+        else:
+            fun = prob.fun
+        res = minimize(fun, x, jac=True, method="SLSQP", constraints=_as_dicts(cons),
+                       options={"maxiter": max_iterations, "ftol": 1e-12})
+        x = res.x
+        iterations += int(res.nit)
+        message = str(res.message)
+        traj = SplineTrajectory(basis, basis.control_points(x[: na * basis.free_count].reshape(basis.free_count, na),
+                                                            boundary))
+        found, _ = _violations(am, traj, limits, check_t, torque)
+        over = [v for v in found if v[5] > LIMIT_TOLERANCE]
+        if not over:
+            break
+        # add the worst instants of each violated limit, then solve again from here
+        extra = []
+        for v in over:
+            ex = v[6]
+            k = np.argsort(ex)[-8:]
+            extra.append(check_t[k[ex[k] > 0]])
+        constraint_t = np.concatenate([constraint_t, *extra])
+    found, _ = _violations(am, traj, limits, check_t, torque)
+    over = [v for v in found if v[5] > LIMIT_TOLERANCE]
+    ok = bool(res is not None and res.success and not over)
+    if over:
+        worst = max(over, key=lambda v: v[5])
+        message = (f"limits exceeded: {worst[0]} of joint {worst[1]} reaches {worst[3]:.6g} against "
+                   f"{worst[4]:.6g} at t = {worst[2]:.4g} s (solver: {message})")
+    active = [dict(kind=v[0], joint=v[1], time=v[2], value=v[3], limit=v[4])
+              for v in found if v[5] > -1e-4]
+    metrics: dict[str, dict[str, float]] = {}
+    if feasibility_only:
+        value = float("nan")
+    else:
+        planned = _metrics(am, traj, check_t, prob)
+        reference = _metrics(am, quintic, check_t, prob)
+        value, quintic_value = planned.pop("objective"), reference.pop("objective")
+        metrics = {"planned": planned, "quintic": reference}
+    return PlanResult(trajectory=traj, quintic=quintic, objective=objective, weights=weights,
+                      moment_point=am.moment_point, value=value, quintic_value=quintic_value,
+                      reduction=1.0 - value / quintic_value if quintic_value > 0 else 0.0,
+                      active_limits=active, limits=limits, ok=ok, message=message,
+                      iterations=iterations, checked_samples=len(check_t), metrics=metrics)
+
+
+def _metrics(am: ActuatedModel, traj, t: np.ndarray, prob: "_Problem") -> dict[str, float]:
+    """RMS and peak |F|, |M_p| and the objective of a motion on the grid ``t`` (RMS by the
+    trapezoid rule over [0, T])."""
+    q, v, a = traj.evaluate(t)
+    ev = am.evaluate(q, v, a, torque=prob.need_torque)
+    w = _trapezoid(t) / (t[-1] - t[0])
+    F2 = np.sum(ev.wrench[:, :3] ** 2, axis=1)
+    M2 = np.sum(ev.wrench[:, 3:] ** 2, axis=1)
+    out = {"rms_shaking_force": float(np.sqrt(w @ F2)), "peak_shaking_force": float(np.sqrt(F2.max())),
+           "rms_shaking_moment": float(np.sqrt(w @ M2)), "peak_shaking_moment": float(np.sqrt(M2.max()))}
+    if ev.torque is not None:
+        T2 = np.sum(ev.torque ** 2, axis=1)
+        out["rms_torque"] = float(np.sqrt(w @ T2))
+    if prob.objective == "weighted":
+        wt = prob.weights
+        out["objective"] = (wt.get("force", 0.0) * float(w @ F2) + wt.get("moment", 0.0) * float(w @ M2)
+                            + wt.get("torque", 0.0) * (out.get("rms_torque", 0.0) ** 2))
+    else:
+        quantity, stat = prob.objective.split("_")
+        out["objective"] = out[f"{stat}_shaking_{quantity}"]
+    return out
+
+
+def _trapezoid(t: np.ndarray) -> np.ndarray:
+    w = np.zeros_like(t)
+    d = np.diff(t)
+    w[:-1] += 0.5 * d
+    w[1:] += 0.5 * d
+    return w
+
+
+def _as_dicts(cons):
+    from scipy.optimize import LinearConstraint
+
+    out = []
+    for c in cons:
+        if isinstance(c, LinearConstraint):
+            A, lo, hi = c.A, c.lb, c.ub
+            for sel, sign, bound in ((np.isfinite(hi), -1.0, hi), (np.isfinite(lo), 1.0, lo)):
+                if np.any(sel):
+                    As, bs = A[sel], bound[sel]
+                    out.append({"type": "ineq", "fun": (lambda x, As=As, bs=bs, s=sign: s * (As @ x - bs)),
+                                "jac": (lambda x, As=As, s=sign: s * As)})
+        else:
+            out.append(c)
+    return out
