@@ -36,6 +36,10 @@ from mechbal.plan.spline import SplineBasis, SplineTrajectory
 OBJECTIVES = ("force_rms", "force_peak", "moment_rms", "moment_peak")
 #: relative tolerance of a limit on the check grid (rounding of the solver's constraints)
 LIMIT_TOLERANCE = 1e-9
+#: BFGS stops where |gradient| of the objective (scaled to 1 at the quintic) is below this
+GRADIENT_TOLERANCE = 1e-9
+#: and accepts a stop on "precision loss" (a flat optimum, rounding of the partials) below this
+ACCEPTED_GRADIENT = 1e-6
 #: nodes of the Gauss-Legendre quadrature per knot span
 NODES_PER_SPAN = 8
 
@@ -229,6 +233,35 @@ class _Problem:
         G = self.node_weights @ self._dz(gq, gv, ga) / self.basis.duration
         return float(J / self.scale), G / self.scale
 
+    def _weights6(self) -> np.ndarray:
+        w = np.zeros(6)
+        if self.objective in ("force_rms", "force_peak"):
+            w[:3] = 1.0
+        elif self.objective in ("moment_rms", "moment_peak"):
+            w[3:] = 1.0
+        else:
+            w[:3], w[3:] = self.weights.get("force", 0.0), self.weights.get("moment", 0.0)
+        return w
+
+    def residuals(self, x: np.ndarray) -> np.ndarray:
+        """r with sum r^2 = the mean-square objective / scale (least squares form)."""
+        ev = self.evaluate(x)
+        c = np.sqrt(self.node_weights / self.basis.duration / self.scale)[:, None]
+        r = [c * np.sqrt(self._weights6()) * ev.wrench]
+        wt = self.weights.get("torque", 0.0) if self.objective == "weighted" else 0.0
+        if wt:
+            r.append(c * np.sqrt(wt) * ev.torque)
+        return np.concatenate(r, axis=1).reshape(-1)
+
+    def residual_jacobian(self, x: np.ndarray) -> np.ndarray:
+        ev = self.evaluate(x)
+        c = np.sqrt(self.node_weights / self.basis.duration / self.scale)[:, None, None]
+        J = [c * np.sqrt(self._weights6())[None, :, None] * self._chain(ev.dq, ev.dv, ev.da)]
+        wt = self.weights.get("torque", 0.0) if self.objective == "weighted" else 0.0
+        if wt:
+            J.append(c * np.sqrt(wt) * self._chain(ev.torque_dq, ev.torque_dv, ev.torque_da))
+        return np.concatenate(J, axis=1).reshape(-1, x.size)
+
     def peak_constraint(self, x: np.ndarray):
         s, gq, gv, ga = self._squares(self.evaluate(x))
         c = x[-1] - s / self.scale
@@ -329,7 +362,7 @@ def min_shaking(mech: Mechanism, start, end, duration: float, *, objective: str 
                 start_velocity=None, end_velocity=None, acceleration_limit=None, torque_limit=None,
                 velocity_limit=None, smooth_ends: bool = False, control_points: int = 14,
                 samples: int = 501, q_guess=None,
-                max_iterations: int = 200, feasibility_search: bool = True) -> PlanResult:
+                max_iterations: int = 2000, feasibility_search: bool = True) -> PlanResult:
     """Plan the motion of ``mech``'s actuated joints from ``start`` to ``end`` (rad or m, one per
     actuated joint) in ``duration`` [s] that minimises shaking (module docstring).
 
@@ -443,7 +476,23 @@ def _solve(am: ActuatedModel, q0, q1, v0, v1, T: float, limits: Limits, *, objec
     x = x0
     res = None
     message, iterations = "", 0
-    for _round in range(6):
+    traj_of = lambda x: SplineTrajectory(  # noqa: E731
+        basis, basis.control_points(x[: na * basis.free_count].reshape(basis.free_count, na), boundary))
+    rounds = 6
+    if not prob.peak and not feasibility_only:
+        # without its limits first (BFGS: the exact gradient, cheap iterations); the limits
+        # after, by SLSQP from there, where the motion touches them
+        first = minimize(prob.fun, x0, jac=True, method="BFGS",
+                         options={"maxiter": max_iterations, "gtol": GRADIENT_TOLERANCE})
+        x, iterations, message = first.x, int(first.nit), str(first.message)
+        traj = traj_of(x)
+        found, _ = _violations(am, traj, limits, check_t, torque)
+        if not any(v[5] > LIMIT_TOLERANCE for v in found):
+            rounds = 0
+            res = first
+            # BFGS stops on "precision loss" at a flat optimum: converged if the gradient is nil
+            res.success = bool(first.success or np.linalg.norm(first.jac, np.inf) <= ACCEPTED_GRADIENT)
+    for _round in range(rounds):
         prob.set_constraint_times(constraint_t)
         cons = []
         lin = prob.linear_constraints()
@@ -466,8 +515,7 @@ def _solve(am: ActuatedModel, q0, q1, v0, v1, T: float, limits: Limits, *, objec
         x = res.x
         iterations += int(res.nit)
         message = str(res.message)
-        traj = SplineTrajectory(basis, basis.control_points(x[: na * basis.free_count].reshape(basis.free_count, na),
-                                                            boundary))
+        traj = traj_of(x)
         found, _ = _violations(am, traj, limits, check_t, torque)
         over = [v for v in found if v[5] > LIMIT_TOLERANCE]
         if not over:

@@ -88,36 +88,41 @@ class ActuatedModel:
 
     def evaluate(self, qa, va, aa, *, torque: bool = False, partials: bool = False) -> Evaluation:
         qa, va, aa = (np.atleast_2d(np.asarray(x, float)) for x in (qa, va, aa))
-        W, tau, (q, v, a) = self._eval(qa, va, aa, torque)
-        out = Evaluation(W, tau, q, v, a)
         if not partials:
-            return out
+            W, tau, (q, v, a) = self._eval(qa, va, aa, torque)
+            return Evaluation(W, tau, q, v, a)
         N, na = qa.shape
-        zeros = np.zeros_like(va)
-        dq = np.empty((N, 6, na)); dv = np.empty((N, 6, na)); da = np.empty((N, 6, na))
-        tq = tv = ta = None
+        # every instant with its 1 + 5 na variants, consecutive (one batched call of the model;
+        # a closed mechanism's loop solve warm-starts each row from the one before, all nearby):
+        # 0: the motion; 1 + j: (q, 0, e_j); 1 + na + j: (q, v +- e_j, 0); 1 + 3 na + j: (q +- h e_j, v, a)
+        K = 1 + 5 * na
+        h = Q_STEP * np.maximum(1.0, np.max(np.abs(qa), axis=0))
+        E = np.eye(na)
+        Q = np.repeat(qa[:, None, :], K, axis=1)
+        V = np.zeros((N, K, na))
+        A = np.zeros((N, K, na))
+        V[:, 0], A[:, 0] = va, aa
+        A[:, 1:1 + na] = E
+        V[:, 1 + na:1 + 2 * na] = va[:, None, :] + E
+        V[:, 1 + 2 * na:1 + 3 * na] = va[:, None, :] - E
+        Q[:, 1 + 3 * na:1 + 4 * na] += h * E
+        Q[:, 1 + 4 * na:] -= h * E
+        V[:, 1 + 3 * na:], A[:, 1 + 3 * na:] = va[:, None, :], aa[:, None, :]
+        W, tau, (q, v, a) = self._eval(Q.reshape(-1, na), V.reshape(-1, na), A.reshape(-1, na), torque)
+        W = W.reshape(N, K, 6)
+        out = Evaluation(W[:, 0], None, q.reshape(N, K, -1)[:, 0], v.reshape(N, K, -1)[:, 0],
+                         a.reshape(N, K, -1)[:, 0])
+        # accelerations: W(q, 0, e_j) = A C e_j (no velocity term at v = 0)
+        out.da = np.moveaxis(W[:, 1:1 + na], 1, 2)
+        # rates: polarisation of the quadratic term
+        out.dv = np.moveaxis(0.5 * (W[:, 1 + na:1 + 2 * na] - W[:, 1 + 2 * na:1 + 3 * na]), 1, 2)
+        # positions: central differences of the model
+        out.dq = np.moveaxis((W[:, 1 + 3 * na:1 + 4 * na] - W[:, 1 + 4 * na:]) / (2.0 * h[:, None]), 1, 2)
         if torque:
-            tq = np.empty((N, na, na)); tv = np.empty((N, na, na)); ta = np.empty((N, na, na))
-            _, tau0, _ = self._eval(qa, zeros, zeros, True)
-        for j in range(na):
-            e = np.zeros(na)
-            e[j] = 1.0
-            # accelerations: W(q, 0, e_j) = A C e_j (no velocity term at v = 0)
-            Wa, ta_j, _ = self._eval(qa, zeros, zeros + e, torque)
-            da[:, :, j] = Wa
-            # rates: polarisation of the quadratic term
-            Wp, tp, _ = self._eval(qa, va + e, zeros, torque)
-            Wm, tm, _ = self._eval(qa, va - e, zeros, torque)
-            dv[:, :, j] = 0.5 * (Wp - Wm)
-            # positions: central differences of the model
-            h = Q_STEP * max(1.0, float(np.max(np.abs(qa[:, j]))))
-            Wqp, tqp, _ = self._eval(qa + h * e, va, aa, torque)
-            Wqm, tqm, _ = self._eval(qa - h * e, va, aa, torque)
-            dq[:, :, j] = (Wqp - Wqm) / (2.0 * h)
-            if torque:
-                ta[:, :, j] = ta_j - tau0
-                tv[:, :, j] = 0.5 * (tp - tm)
-                tq[:, :, j] = (tqp - tqm) / (2.0 * h)
-        out.dq, out.dv, out.da = dq, dv, da
-        out.torque_dq, out.torque_dv, out.torque_da = tq, tv, ta
+            T = tau.reshape(N, K, na)
+            out.torque = T[:, 0]
+            gravity = self._eval(qa, np.zeros_like(va), np.zeros_like(aa), True)[1]
+            out.torque_da = np.moveaxis(T[:, 1:1 + na] - gravity[:, None, :], 1, 2)
+            out.torque_dv = np.moveaxis(0.5 * (T[:, 1 + na:1 + 2 * na] - T[:, 1 + 2 * na:1 + 3 * na]), 1, 2)
+            out.torque_dq = np.moveaxis((T[:, 1 + 3 * na:1 + 4 * na] - T[:, 1 + 4 * na:]) / (2.0 * h[:, None]), 1, 2)
         return out
