@@ -11,9 +11,9 @@ Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 
-from mechbal.plan.com import ComLawResult, com_law
+from mechbal.plan.com import PROFILES, ComLawNotApplicable, ComLawResult, SampledMotion, com_law
 from mechbal.plan.min_shaking import OBJECTIVES, Limits, PlanInfeasible, PlanResult, min_shaking
 from mechbal.plan.spline import SplineTrajectory
 
 __all__ = ["min_shaking", "com_law", "PlanResult", "ComLawResult", "PlanInfeasible", "Limits",
-           "SplineTrajectory", "OBJECTIVES"]
+           "SplineTrajectory", "OBJECTIVES", "PROFILES", "ComLawNotApplicable", "SampledMotion"]

@@ -30,7 +30,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from mechbal.mechanism import Mechanism
-from mechbal.plan.model import ActuatedModel, Evaluation
+from mechbal.plan.model import ActuatedModel, Evaluation, LoopFailure
 from mechbal.plan.spline import SplineBasis, SplineTrajectory
 
 OBJECTIVES = ("force_rms", "force_peak", "moment_rms", "moment_peak")
@@ -228,7 +228,11 @@ class _Problem:
             g = np.zeros_like(x)
             g[-1] = 1.0
             return float(x[-1]), g
-        s, gq, gv, ga = self._squares(self.evaluate(x))
+        try:
+            ev = self.evaluate(x)
+        except LoopFailure:   # a trial step out of the workspace: the line search steps back
+            return np.inf, np.zeros_like(x)
+        s, gq, gv, ga = self._squares(ev)
         J = np.sum(self.node_weights * s) / self.basis.duration
         G = self.node_weights @ self._dz(gq, gv, ga) / self.basis.duration
         return float(J / self.scale), G / self.scale
