@@ -149,7 +149,11 @@ def com_law(mech: Mechanism, start, end, duration: float, *, profile: str = "ban
     q = ref.q.copy()
     err = np.inf
     for _ in range(max_iterations):
-        c, J = com_and_jacobian(q)
+        try:
+            c, J = com_and_jacobian(q)
+        except LoopFailure:
+            err = np.inf
+            break
         r = target - c
         err = float(np.max(np.linalg.norm(r, axis=1)))
         if err <= tolerance * max(1.0, float(np.linalg.norm(c1 - c0))):
@@ -157,10 +161,11 @@ def com_law(mech: Mechanism, start, end, duration: float, *, profile: str = "ban
         dq = np.einsum("ijk,ik->ij", np.linalg.pinv(J[:, :, S]), r)
         q[:, S] += dq
     if not err <= 1e-9:
+        where = "the loops cannot be assembled on the way" if not np.isfinite(err) else f"it stays {err:.3g} m away"
         raise ComLawNotApplicable(
             f"the centre of mass cannot follow the straight line from {np.round(c0, 6).tolist()} to "
-            f"{np.round(c1, 6).tolist()} m (it stays {err:.3g} m away): the joints that move it do not "
-            "reach it")
+            f"{np.round(c1, 6).tolist()} m ({where}): the {len(S)} joint(s) that move it do not "
+            "reach every point of it")
     # rates and accelerations: J v = c*', J a = c*'' - Jdot v (J restricted to S; the others: quintic)
     c, J = com_and_jacobian(q)
     v, a = ref.v.copy(), ref.a.copy()
