@@ -40,6 +40,9 @@ LIMIT_TOLERANCE = 1e-9
 GRADIENT_TOLERANCE = 1e-9
 #: and accepts a stop on "precision loss" (a flat optimum, rounding of the partials) below this
 ACCEPTED_GRADIENT = 1e-6
+#: what the objective and the constraints say of a trial step where the loops cannot be assembled
+#: (the line searches step back)
+OUT_OF_WORKSPACE = 1e12
 #: nodes of the Gauss-Legendre quadrature per knot span
 NODES_PER_SPAN = 8
 
@@ -231,7 +234,7 @@ class _Problem:
         try:
             ev = self.evaluate(x)
         except LoopFailure:   # a trial step out of the workspace: the line search steps back
-            return np.inf, np.zeros_like(x)
+            return OUT_OF_WORKSPACE, np.zeros_like(x)
         s, gq, gv, ga = self._squares(ev)
         J = np.sum(self.node_weights * s) / self.basis.duration
         G = self.node_weights @ self._dz(gq, gv, ga) / self.basis.duration
@@ -267,7 +270,11 @@ class _Problem:
         return np.concatenate(J, axis=1).reshape(-1, x.size)
 
     def peak_constraint(self, x: np.ndarray):
-        s, gq, gv, ga = self._squares(self.evaluate(x))
+        try:
+            ev = self.evaluate(x)
+        except LoopFailure:
+            return np.full(len(self.nodes), -OUT_OF_WORKSPACE), np.zeros((len(self.nodes), x.size))
+        s, gq, gv, ga = self._squares(ev)
         c = x[-1] - s / self.scale
         J = np.zeros((s.size, x.size))
         J[:, :-1] = -self._dz(gq, gv, ga) / self.scale
@@ -303,9 +310,13 @@ class _Problem:
         """1 -+ tau / tau_max >= 0 at the constraint times (joints with a torque limit)."""
         z = x[: self.na * self.nf]
         q, v, a = self.motion(z, "constraints")
-        ev = self.am.evaluate(q, v, a, torque=True, partials=True)
         lim = self.limits.torque
         js = [j for j in range(self.na) if np.isfinite(lim[j])]
+        try:
+            ev = self.am.evaluate(q, v, a, torque=True, partials=True)
+        except LoopFailure:
+            m = 2 * len(js) * len(q)
+            return np.full(m, -OUT_OF_WORKSPACE), np.zeros((m, x.size))
         c, J = [], []
         dT = (np.einsum("ikj,il->iklj", ev.torque_dq, self.Zc[0]) + np.einsum("ikj,il->iklj", ev.torque_dv, self.Zc[1])
               + np.einsum("ikj,il->iklj", ev.torque_da, self.Zc[2])).reshape(len(q), self.na, -1)
@@ -424,30 +435,65 @@ def min_shaking(mech: Mechanism, start, end, duration: float, *, objective: str 
 
         q_guess = assemble(mech, q0).q
     am = ActuatedModel(mech, q_guess=q_guess, moment_point=moment_point)
+    with _single_threaded_blas():
+        return _plan(am, q0, q1, v0, v1, float(duration), limits, objective=objective, weights=weights,
+                     control_points=control_points, samples=samples, max_iterations=max_iterations,
+                     smooth_ends=smooth_ends, feasibility_search=feasibility_search)
+
+
+def _single_threaded_blas():
+    """BLAS on one thread while planning: the solver's matrices are small, and a threaded BLAS
+    spinning on a loaded machine makes each iteration ten times slower (threadpoolctl where it is
+    installed; nothing otherwise)."""
+    import contextlib
+
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        return contextlib.nullcontext()
+    return threadpool_limits(1, user_api="blas")
+
+
+def _plan(am, q0, q1, v0, v1, duration, limits, *, objective, weights, control_points, samples,
+          max_iterations, smooth_ends, feasibility_search) -> PlanResult:
     common = dict(objective=objective, weights=weights or {}, control_points=control_points,
                   samples=samples, max_iterations=max_iterations, smooth_ends=smooth_ends)
-    result = _solve(am, q0, q1, v0, v1, float(duration), limits, **common)
-    if result.ok or not feasibility_search:
-        return result
-    if not _is_limited(result):
-        return result
-    # infeasible: the shortest duration the planner can hold the limits in (bisection)
+    if feasibility_search and limits.active_kinds():
+        # feasible at all? (before the long run: a motion within the limits, no objective)
+        first = _solve(am, q0, q1, v0, v1, float(duration), limits, feasibility_only=True, **common)
+        if not first.ok and _is_limited(first):
+            shortest = _shortest_duration(am, q0, q1, v0, v1, duration, limits, common)
+            raise PlanInfeasible(_shortest_duration_message(duration, first, shortest), shortest)
+    return _solve(am, q0, q1, v0, v1, float(duration), limits, **common)
+
+
+def _shortest_duration(am, q0, q1, v0, v1, duration, limits, common) -> float | None:
+    """The shortest duration (to 0.5 %) at which the planner finds a motion within the limits
+    (bisection over durations, doubling first), or None up to 4096 times ``duration``."""
+    feasible = lambda T: _solve(am, q0, q1, v0, v1, T, limits, feasibility_only=True, **common).ok  # noqa: E731
     lo, hi = float(duration), 2.0 * float(duration)
     for _ in range(12):
-        if _solve(am, q0, q1, v0, v1, hi, limits, feasibility_only=True, **common).ok:
+        if feasible(hi):
             break
         lo, hi = hi, 2.0 * hi
     else:
-        raise PlanInfeasible(f"duration {duration:g} s is too short for the limits, and no duration up to "
-                             f"{hi:g} s holds them: {result.message}", None)
+        return None
     while hi - lo > 0.005 * hi:
         mid = 0.5 * (lo + hi)
-        if _solve(am, q0, q1, v0, v1, mid, limits, feasibility_only=True, **common).ok:
+        if feasible(mid):
             hi = mid
         else:
             lo = mid
-    raise PlanInfeasible(f"duration {duration:g} s is too short for the limits ({result.message}); the "
-                         f"shortest feasible duration found is {hi:.4g} s", hi)
+    return hi
+
+
+def _shortest_duration_message(duration: float, first: PlanResult, shortest: float | None) -> str:
+    why = first.message.removeprefix("limits exceeded: ").split(" (solver:")[0]
+    if shortest is None:
+        return (f"duration {duration:g} s is too short for the limits ({why}), and no duration up to "
+                f"{4096 * duration:g} s holds them")
+    return (f"duration {duration:g} s is too short for the limits ({why}); the shortest feasible "
+            f"duration found is {shortest:.4g} s")
 
 
 def _is_limited(result: PlanResult) -> bool:
