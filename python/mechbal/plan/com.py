@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechbal.mechanism import Mechanism
-from mechbal.plan.model import ActuatedModel
+from mechbal.plan.model import ActuatedModel, LoopFailure
 
 PROFILES = ("bang_bang", "cubic", "minimum_jerk")
 

@@ -34,8 +34,11 @@ from mechbal.plan.model import ActuatedModel, Evaluation, LoopFailure
 from mechbal.plan.spline import SplineBasis, SplineTrajectory
 
 OBJECTIVES = ("force_rms", "force_peak", "moment_rms", "moment_peak")
-#: relative tolerance of a limit on the check grid (rounding of the solver's constraints)
-LIMIT_TOLERANCE = 1e-9
+#: the solver holds each limit tightened by this much (relative), so that it holds between the
+#: instants it was imposed at too; the plan is then checked against the limit itself
+LIMIT_MARGIN = 1e-5
+#: relative excess over a limit on the check grid that counts as exceeding it (none)
+LIMIT_TOLERANCE = 0.0
 #: BFGS stops where |gradient| of the objective (scaled to 1 at the quintic) is below this
 GRADIENT_TOLERANCE = 1e-9
 #: and accepts a stop on "precision loss" (a flat optimum, rounding of the partials) below this
@@ -67,6 +70,19 @@ class Limits:
     velocity: np.ndarray
     acceleration: np.ndarray
     torque: np.ndarray
+
+    def shrunk(self, margin: float) -> "Limits":
+        """The limits tightened by ``margin`` (relative; positions: of the range where bounded on
+        both sides, else of the bound's size)."""
+        both = np.isfinite(self.lower) & np.isfinite(self.upper)
+        span = np.where(both, self.upper - self.lower, 0.0)
+        lower, upper = self.lower.copy(), self.upper.copy()
+        fin = np.isfinite(lower)
+        lower[fin] += margin * np.where(both, span, np.abs(lower))[fin]
+        fin = np.isfinite(upper)
+        upper[fin] -= margin * np.where(both, span, np.abs(upper))[fin]
+        k = 1.0 - margin
+        return Limits(lower, upper, k * self.velocity, k * self.acceleration, k * self.torque)
 
     def active_kinds(self) -> list[str]:
         out = []
@@ -349,15 +365,21 @@ def _vector(name: str, value, n: int) -> np.ndarray:
 
 
 def _violations(am: ActuatedModel, traj, limits: Limits, t: np.ndarray, torque: bool):
-    """Relative excess over each limit on the grid ``t``: list of (kind, joint, time, value, limit,
-    excess) and the torque (or None)."""
-    q, v, a = traj.evaluate(t)
-    tau = am.full(q, v, a, torque=True)[3] if torque else None
+    """Relative excess over each limit: list of (kind, joint, time, value, limit, largest excess,
+    excess along the grid, the grid) and the torque (or None). The torques are checked on the
+    grid ``t``; positions, velocities and accelerations (the spline alone, cheap) on a grid ten
+    times finer."""
+    fine = np.linspace(t[0], t[-1], 10 * (len(t) - 1) + 1)
+    q, v, a = traj.evaluate(fine)
+    tau = None
+    if torque:
+        qt, vt, at = traj.evaluate(t)
+        tau = am.full(qt, vt, at, torque=True)[3]
     out = []
-    for kind, x, lo, hi in (("position", q, limits.lower, limits.upper),
-                            ("velocity", v, -limits.velocity, limits.velocity),
-                            ("acceleration", a, -limits.acceleration, limits.acceleration),
-                            ("torque", tau, -limits.torque, limits.torque)):
+    for kind, x, lo, hi, grid in (("position", q, limits.lower, limits.upper, fine),
+                                  ("velocity", v, -limits.velocity, limits.velocity, fine),
+                                  ("acceleration", a, -limits.acceleration, limits.acceleration, fine),
+                                  ("torque", tau, -limits.torque, limits.torque, t)):
         if x is None:
             continue
         for j in range(x.shape[1]):
@@ -367,8 +389,8 @@ def _violations(am: ActuatedModel, traj, limits: Limits, t: np.ndarray, torque: 
                 excess = sign * (x[:, j] - bound)
                 k = int(np.argmax(excess))
                 scale = max(abs(bound), 1e-12)
-                out.append((kind, j, float(t[k]), float(x[k, j]), float(bound), float(excess[k] / scale),
-                            excess / scale))
+                out.append((kind, j, float(grid[k]), float(x[k, j]), float(bound), float(excess[k] / scale),
+                            excess / scale, grid))
     return out, tau
 
 
@@ -514,7 +536,7 @@ def _solve(am: ActuatedModel, q0, q1, v0, v1, T: float, limits: Limits, *, objec
     # warm start: the quintic, exactly a spline of this basis
     fit_t = np.linspace(0.0, T, 4 * control_points)
     z0 = basis.fit(fit_t, quintic.evaluate(fit_t).q, boundary)
-    prob = _Problem(am, basis, boundary, objective, weights, limits, nodes, node_weights)
+    prob = _Problem(am, basis, boundary, objective, weights, limits.shrunk(LIMIT_MARGIN), nodes, node_weights)
     x0 = z0.reshape(-1)
     quintic_value = prob.value(x0)
     prob.scale = quintic_value if quintic_value > 0 else 1.0
@@ -573,9 +595,9 @@ def _solve(am: ActuatedModel, q0, q1, v0, v1, T: float, limits: Limits, *, objec
         # add the worst instants of each violated limit, then solve again from here
         extra = []
         for v in over:
-            ex = v[6]
+            ex, grid = v[6], v[7]
             k = np.argsort(ex)[-8:]
-            extra.append(check_t[k[ex[k] > 0]])
+            extra.append(grid[k[ex[k] > 0]])
         constraint_t = np.concatenate([constraint_t, *extra])
     found, _ = _violations(am, traj, limits, check_t, torque)
     over = [v for v in found if v[5] > LIMIT_TOLERANCE]
