@@ -176,7 +176,7 @@ class _Problem:
         self.peak = objective.endswith("_peak")
         self.need_torque = bool(np.any(np.isfinite(limits.torque)) or self.weights.get("torque", 0.0))
         self.set_nodes(nodes, node_weights)
-        self.constraint_times = np.array(nodes)
+        self.watched: dict[tuple[str, int, float], np.ndarray] = {}
         self._cache: tuple[bytes, Evaluation] | None = None
         self.scale = 1.0
 
@@ -187,10 +187,9 @@ class _Problem:
         self.R = [b @ self.basis.boundary_map @ self.boundary for b in B]  # (N, na)
 
     # ---- motion of the free points -------------------------------------------------------------
-    def motion(self, z: np.ndarray, which: str = "nodes"):
-        Z, R = (self.Z, self.R) if which == "nodes" else (self.Zc, self.Rc)
+    def motion(self, z: np.ndarray):
         Zm = z[: self.na * self.nf].reshape(self.nf, self.na)
-        return [Zk @ Zm + Rk for Zk, Rk in zip(Z, R)]
+        return [Zk @ Zm + Rk for Zk, Rk in zip(self.Z, self.R)]
 
     def evaluate(self, z: np.ndarray) -> Evaluation:
         key = z.tobytes()
@@ -297,51 +296,58 @@ class _Problem:
         J[:, -1] = 1.0
         return c, J
 
-    def set_constraint_times(self, times: np.ndarray):
-        self.constraint_times = np.unique(np.asarray(times, float))
-        B = self.basis.matrices(self.constraint_times)
-        self.Zc = [b @ self.basis.free_map for b in B]
-        self.Rc = [b @ self.basis.boundary_map @ self.boundary for b in B]
+    # ---- the limits, imposed where the motion comes near them (an active set, refined) --------
+    def watch(self, kind: str, joint: int, side: float, times: np.ndarray) -> None:
+        """Impose the ``side`` (+1 upper, -1 lower) limit of ``kind`` on ``joint`` at ``times`` too."""
+        key = (kind, int(joint), float(side))
+        old = self.watched.get(key, np.zeros(0))
+        self.watched[key] = np.unique(np.concatenate([old, np.asarray(times, float)]))
 
-    def linear_constraints(self):
-        """(A, lo, hi) of the position, velocity and acceleration limits at the constraint
-        times, in the free points (rows scaled by the limit)."""
-        rows, lo, hi = [], [], []
+    def linear_constraints(self, size: int) -> list[dict]:
+        """SLSQP constraints ``b - A x >= 0`` of the watched position, velocity and acceleration
+        limits (linear in the free points; scaled by the limit)."""
+        out = []
         L = self.limits
-        for k, (lower, upper) in enumerate(((L.lower, L.upper), (-L.velocity, L.velocity),
-                                            (-L.acceleration, L.acceleration))):
-            for j in range(self.na):
-                if not (np.isfinite(lower[j]) or np.isfinite(upper[j])):
-                    continue
-                A = np.zeros((len(self.constraint_times), self.nf, self.na))
-                A[:, :, j] = self.Zc[k]
-                rows.append(A.reshape(len(self.constraint_times), -1))
-                lo.append(lower[j] - self.Rc[k][:, j])
-                hi.append(upper[j] - self.Rc[k][:, j])
-        if not rows:
-            return None
-        return np.vstack(rows), np.concatenate(lo), np.concatenate(hi)
+        bounds = {"position": (L.lower, L.upper), "velocity": (-L.velocity, L.velocity),
+                  "acceleration": (-L.acceleration, L.acceleration)}
+        order = {"position": 0, "velocity": 1, "acceleration": 2}
+        for (kind, j, side), times in self.watched.items():
+            if kind == "torque":
+                continue
+            Bk = self.basis.matrices(times)[order[kind]]
+            Z = Bk @ self.basis.free_map
+            R = (Bk @ self.basis.boundary_map @ self.boundary)[:, j]
+            bound = bounds[kind][1 if side > 0 else 0][j]
+            scale = max(abs(bound), 1e-12)
+            A = np.zeros((len(times), size))
+            A[:, j: self.na * self.nf: self.na] = side * Z / scale
+            b = side * (bound - R) / scale
+            out.append({"type": "ineq", "fun": (lambda x, A=A, b=b: b - A @ x), "jac": (lambda x, A=A: -A)})
+        return out
 
     def torque_constraint(self, x: np.ndarray):
-        """1 -+ tau / tau_max >= 0 at the constraint times (joints with a torque limit)."""
-        z = x[: self.na * self.nf]
-        q, v, a = self.motion(z, "constraints")
+        """1 -+ tau / tau_max >= 0 at the watched instants of each joint's torque limits."""
+        keys = [k for k in self.watched if k[0] == "torque"]
+        times = np.unique(np.concatenate([self.watched[k] for k in keys]))
+        B = self.basis.matrices(times)
+        Z = [b @ self.basis.free_map for b in B]
+        Zm = x[: self.na * self.nf].reshape(self.nf, self.na)
+        q, v, a = [Zk @ Zm + b @ self.basis.boundary_map @ self.boundary for Zk, b in zip(Z, B)]
         lim = self.limits.torque
-        js = [j for j in range(self.na) if np.isfinite(lim[j])]
+        m = sum(len(self.watched[k]) for k in keys)
         try:
             ev = self.am.evaluate(q, v, a, torque=True, partials=True)
         except LoopFailure:
-            m = 2 * len(js) * len(q)
             return np.full(m, -OUT_OF_WORKSPACE), np.zeros((m, x.size))
+        dT = (np.einsum("ikj,il->iklj", ev.torque_dq, Z[0]) + np.einsum("ikj,il->iklj", ev.torque_dv, Z[1])
+              + np.einsum("ikj,il->iklj", ev.torque_da, Z[2])).reshape(len(q), self.na, -1)
         c, J = [], []
-        dT = (np.einsum("ikj,il->iklj", ev.torque_dq, self.Zc[0]) + np.einsum("ikj,il->iklj", ev.torque_dv, self.Zc[1])
-              + np.einsum("ikj,il->iklj", ev.torque_da, self.Zc[2])).reshape(len(q), self.na, -1)
-        for j in js:
-            for sign in (1.0, -1.0):
-                c.append(1.0 - sign * ev.torque[:, j] / lim[j])
-                Jj = np.zeros((len(q), x.size))
-                Jj[:, : self.na * self.nf] = -sign * dT[:, j, :] / lim[j]
-                J.append(Jj)
+        for (_, j, side) in keys:
+            rows = np.searchsorted(times, self.watched[("torque", j, side)])
+            c.append(1.0 - side * ev.torque[rows, j] / lim[j])
+            Jj = np.zeros((len(rows), x.size))
+            Jj[:, : self.na * self.nf] = -side * dT[rows, j, :] / lim[j]
+            J.append(Jj)
         return np.concatenate(c), np.vstack(J)
 
 
@@ -390,7 +396,7 @@ def _violations(am: ActuatedModel, traj, limits: Limits, t: np.ndarray, torque: 
                 k = int(np.argmax(excess))
                 scale = max(abs(bound), 1e-12)
                 out.append((kind, j, float(grid[k]), float(x[k, j]), float(bound), float(excess[k] / scale),
-                            excess / scale, grid))
+                            excess / scale, grid, sign))
     return out, tau
 
 
@@ -421,8 +427,6 @@ def min_shaking(mech: Mechanism, start, end, duration: float, *, objective: str 
 
     Raises `PlanInfeasible` when no motion within the limits is found, with the shortest duration
     the planner found feasible in its message; ValueError on bad arguments."""
-    from scipy.optimize import Bounds, LinearConstraint, NonlinearConstraint, minimize
-
     na = len(mech.actuated_names)
     if weights is not None:
         bad = set(weights) - {"force", "moment", "torque"}
@@ -525,7 +529,7 @@ def _is_limited(result: PlanResult) -> bool:
 def _solve(am: ActuatedModel, q0, q1, v0, v1, T: float, limits: Limits, *, objective: str,
            weights: dict, control_points: int, samples: int, max_iterations: int, smooth_ends: bool,
            feasibility_only: bool = False) -> PlanResult:
-    from scipy.optimize import LinearConstraint, NonlinearConstraint, minimize
+    from scipy.optimize import minimize
 
     na = am.na
     basis = SplineBasis.make(T, int(control_points), 3 if smooth_ends else 2)
@@ -543,14 +547,14 @@ def _solve(am: ActuatedModel, q0, q1, v0, v1, T: float, limits: Limits, *, objec
     if prob.peak:
         x0 = np.concatenate([x0, [1.0 + 1e-6]])
     check_t = np.linspace(0.0, T, 10 * (int(samples) - 1) + 1)
-    constraint_t = np.unique(np.concatenate([nodes, np.linspace(0.0, T, 4 * control_points)]))
     torque = bool(np.any(np.isfinite(limits.torque)))
     x = x0
     res = None
     message, iterations = "", 0
     traj_of = lambda x: SplineTrajectory(  # noqa: E731
         basis, basis.control_points(x[: na * basis.free_count].reshape(basis.free_count, na), boundary))
-    rounds = 6
+    traj = traj_of(x)
+    rounds = 8
     if not prob.peak and not feasibility_only:
         # without its limits first (BFGS: the exact gradient, cheap iterations); the limits
         # after, by SLSQP from there, where the motion touches them
@@ -564,15 +568,15 @@ def _solve(am: ActuatedModel, q0, q1, v0, v1, T: float, limits: Limits, *, objec
             res = first
             # BFGS stops on "precision loss" at a flat optimum: converged if the gradient is nil
             res.success = bool(first.success or np.linalg.norm(first.jac, np.inf) <= ACCEPTED_GRADIENT)
+        else:
+            # the quintic's near-limit instants too: SLSQP's path from here stays within them
+            _watch(prob, _violations(am, traj_of(x0), limits, check_t, torque)[0])
+    elif rounds:
+        found, _ = _violations(am, traj, limits, check_t, torque)
     for _round in range(rounds):
-        prob.set_constraint_times(constraint_t)
-        cons = []
-        lin = prob.linear_constraints()
-        if lin is not None:
-            A, lo, hi = lin
-            A = np.hstack([A, np.zeros((A.shape[0], x.size - A.shape[1]))])
-            cons.append(LinearConstraint(A, lo, hi))
-        if torque:
+        _watch(prob, found)
+        cons = prob.linear_constraints(x.size)
+        if any(k[0] == "torque" for k in prob.watched):
             cons.append({"type": "ineq", "fun": lambda x: prob.torque_constraint(x)[0],
                          "jac": lambda x: prob.torque_constraint(x)[1]})
         if prob.peak:
@@ -582,23 +586,15 @@ def _solve(am: ActuatedModel, q0, q1, v0, v1, T: float, limits: Limits, *, objec
             fun = lambda x: (0.0, np.zeros_like(x))  # noqa: E731
         else:
             fun = prob.fun
-        res = minimize(fun, x, jac=True, method="SLSQP", constraints=_as_dicts(cons),
+        res = minimize(fun, x, jac=True, method="SLSQP", constraints=cons,
                        options={"maxiter": max_iterations, "ftol": 1e-12})
         x = res.x
         iterations += int(res.nit)
         message = str(res.message)
         traj = traj_of(x)
         found, _ = _violations(am, traj, limits, check_t, torque)
-        over = [v for v in found if v[5] > LIMIT_TOLERANCE]
-        if not over:
+        if not any(v[5] > LIMIT_TOLERANCE for v in found):
             break
-        # add the worst instants of each violated limit, then solve again from here
-        extra = []
-        for v in over:
-            ex, grid = v[6], v[7]
-            k = np.argsort(ex)[-8:]
-            extra.append(grid[k[ex[k] > 0]])
-        constraint_t = np.concatenate([constraint_t, *extra])
     found, _ = _violations(am, traj, limits, check_t, torque)
     over = [v for v in found if v[5] > LIMIT_TOLERANCE]
     ok = bool(res is not None and res.success and not over)
@@ -621,6 +617,27 @@ def _solve(am: ActuatedModel, q0, q1, v0, v1, T: float, limits: Limits, *, objec
                       reduction=1.0 - value / quintic_value if quintic_value > 0 else 0.0,
                       active_limits=active, limits=limits, ok=ok, message=message,
                       iterations=iterations, checked_samples=len(check_t), metrics=metrics)
+
+
+#: a limit is watched (imposed) at the instants where the motion comes within this fraction of it
+NEAR_LIMIT = 0.05
+#: at most this many instants per limit and round (the local maxima first)
+WATCH_PER_ROUND = 24
+
+
+def _watch(prob: "_Problem", found) -> None:
+    """Watch each limit at the instants where the motion comes near it: its local maxima within
+    `NEAR_LIMIT` of the limit, and a few instants spread over the stretches near it."""
+    for kind, j, _, _, _, _, excess, grid, side in found:
+        near = excess > -NEAR_LIMIT
+        if not np.any(near):
+            continue
+        inner = np.r_[False, (excess[1:-1] >= excess[:-2]) & (excess[1:-1] >= excess[2:]), False]
+        peaks = np.flatnonzero(near & (inner | (np.arange(len(excess)) == 0) | (np.arange(len(excess)) == len(excess) - 1)))
+        peaks = peaks[np.argsort(excess[peaks])[::-1][:WATCH_PER_ROUND]]
+        spread = np.flatnonzero(near)
+        spread = spread[np.linspace(0, len(spread) - 1, min(len(spread), WATCH_PER_ROUND)).astype(int)]
+        prob.watch(kind, j, side, grid[np.union1d(peaks, spread)])
 
 
 def _metrics(am: ActuatedModel, traj, t: np.ndarray, prob: "_Problem") -> dict[str, float]:
@@ -652,20 +669,3 @@ def _trapezoid(t: np.ndarray) -> np.ndarray:
     w[:-1] += 0.5 * d
     w[1:] += 0.5 * d
     return w
-
-
-def _as_dicts(cons):
-    from scipy.optimize import LinearConstraint
-
-    out = []
-    for c in cons:
-        if isinstance(c, LinearConstraint):
-            A, lo, hi = c.A, c.lb, c.ub
-            for sel, sign, bound in ((np.isfinite(hi), -1.0, hi), (np.isfinite(lo), 1.0, lo)):
-                if np.any(sel):
-                    As, bs = A[sel], bound[sel]
-                    out.append({"type": "ineq", "fun": (lambda x, As=As, bs=bs, s=sign: s * (As @ x - bs)),
-                                "jac": (lambda x, As=As, s=sign: s * As)})
-        else:
-            out.append(c)
-    return out
