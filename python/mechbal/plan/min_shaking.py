@@ -47,7 +47,7 @@ ACCEPTED_GRADIENT = 1e-6
 #: (the line searches step back)
 OUT_OF_WORKSPACE = 1e12
 #: nodes of the Gauss-Legendre quadrature per knot span
-NODES_PER_SPAN = 8
+NODES_PER_SPAN = 6
 
 
 class PlanInfeasible(ValueError):
