@@ -415,9 +415,13 @@ def min_shaking(mech: Mechanism, start, end, duration: float, *, objective: str 
         weights: ``{"force": w1, "moment": w2, "torque": w3}``: minimise
             ``w1 mean|F|^2 + w2 mean|M_p|^2 + w3 mean|tau|^2`` (SI units; objective ``weighted``).
         moment_point: the point p of the shaking moment ``M_p = M_O - p x F`` [m], in O.
-        start_velocity, end_velocity: boundary velocities (default zero: rest to rest).
-        acceleration_limit, torque_limit, velocity_limit: limits per actuated joint (or one
-            number for all) besides the model's (the tighter wins).
+        start_velocity: velocities at the start (default zero: from rest).
+        end_velocity: velocities at the end (default zero: to rest).
+        acceleration_limit: |acceleration| limit per actuated joint (or one number for all).
+        torque_limit: |torque| limit per actuated joint (or one number for all), besides the
+            model's effort limits (the tighter wins).
+        velocity_limit: |velocity| limit per actuated joint, besides the model's (the tighter
+            wins).
         smooth_ends: also hold zero accelerations at both ends (no step in the actuator
             torques at the start and the end; by default the accelerations there are free).
         control_points: control points per joint of the quintic B-spline (>= 7).
