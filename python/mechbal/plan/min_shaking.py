@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from mechbal.mechanism import Mechanism
 from mechbal.plan.model import ActuatedModel, Evaluation, LoopFailure
@@ -400,12 +401,14 @@ def _violations(am: ActuatedModel, traj, limits: Limits, t: np.ndarray, torque: 
     return out, tau
 
 
-def min_shaking(mech: Mechanism, start, end, duration: float, *, objective: str = "force_rms",
-                weights: Mapping[str, float] | None = None, moment_point=(0.0, 0.0, 0.0),
-                start_velocity=None, end_velocity=None, acceleration_limit=None, torque_limit=None,
-                velocity_limit=None, smooth_ends: bool = False, control_points: int = 14,
-                samples: int = 501, q_guess=None,
-                max_iterations: int = 2000, feasibility_search: bool = True) -> PlanResult:
+def min_shaking(mech: Mechanism, start: ArrayLike, end: ArrayLike, duration: float, *,
+                objective: str = "force_rms", weights: Mapping[str, float] | None = None,
+                moment_point: ArrayLike = (0.0, 0.0, 0.0), start_velocity: ArrayLike | None = None,
+                end_velocity: ArrayLike | None = None, acceleration_limit: ArrayLike | None = None,
+                torque_limit: ArrayLike | None = None, velocity_limit: ArrayLike | None = None,
+                smooth_ends: bool = False, control_points: int = 14, samples: int = 501,
+                q_guess: ArrayLike | None = None, max_iterations: int = 2000,
+                feasibility_search: bool = True) -> PlanResult:
     """Plan the motion of ``mech``'s actuated joints from ``start`` to ``end`` (rad or m, one per
     actuated joint) in ``duration`` [s] that minimises shaking (module docstring).
 
