@@ -18,45 +18,53 @@ unbalanced one, so the shaking force is too, for every motion.
 Run: python docs/examples/min_shaking_paminsa.py
 """
 import tomllib
+from typing import Any
 
 import numpy as np
 
 import mechbal
 from mechbal.assembly import assemble
 from mechbal.config import load_case
-from mechbal.papers.paminsa import paminsa_case_toml, paminsa_mechanism, parameters_from_config
+from mechbal.papers.paminsa import paminsa_case_toml
 from mechbal.plan import com_law, min_shaking
 from mechbal.plan.model import ActuatedModel
 from mechbal.schema import validate_case
 
 BUDGET = 10.0   # kg of counterweights (the complete balance needs 23.5 kg)
 
-params = parameters_from_config(validate_case(load_case("paminsa"), warn=False))
-unbalanced = paminsa_mechanism(params, balanced=False)
-full = paminsa_mechanism(params, balanced=True)
+case = validate_case(tomllib.loads(paminsa_case_toml("paminsa", balanced=False)), warn=False)
+unbalanced = mechbal.Mechanism.from_spec(case.spec, name="paminsa (unbalanced)")
+balanced_case = validate_case(load_case("paminsa-linkage"), warn=False)   # the same, balanced
+full = mechbal.Mechanism.from_spec(balanced_case.spec, name="paminsa (balanced)")
 full_mass = sum(b.mass for b in full.bodies if b.kind == "counterweight")
 s = BUDGET / full_mass
 bodies = [mechbal.Body(b.name, b.link, b.mass * (s if b.kind == "counterweight" else 1.0), b.com, b.inertia, b.kind)
           for b in full.bodies]
 partial = full.with_bodies(bodies, replace=True)
 
-case = validate_case(tomllib.loads(paminsa_case_toml("paminsa", balanced=False)), warn=False)
 tr = case.trajectory
 t = np.linspace(0.0, tr.duration, tr.samples)
 
 
-def metrics(mech, motion):
+def rms(x: np.ndarray) -> float:
+    return float(np.sqrt(np.trapezoid(np.sum(x ** 2, axis=1), t) / tr.duration))
+
+
+def peak(x: np.ndarray) -> float:
+    return float(np.max(np.linalg.norm(x, axis=1)))
+
+
+def metrics(mech: mechbal.Mechanism, motion: Any) -> list[float]:
     qg = assemble(mech, np.asarray(tr.start), initial_guess=tr.initial_guess).q
     am = ActuatedModel(mech, q_guess=qg)
     ev = am.evaluate(*motion.evaluate(t), torque=True)
-    rms = lambda x: float(np.sqrt(np.trapezoid(np.sum(x ** 2, axis=1), t) / tr.duration))  # noqa: E731
-    peak = lambda x: float(np.max(np.linalg.norm(x, axis=1)))  # noqa: E731
+    assert ev.torque is not None
     legs = ev.torque[:, [mech.actuated_names.index(n) for n in ("leg1_slider", "leg1_guide", "leg3_guide")]]
     return [rms(ev.wrench[:, :3]), peak(ev.wrench[:, :3]), rms(ev.wrench[:, 3:]), peak(ev.wrench[:, 3:]),
             float(np.max(np.abs(legs[:, 0]))), float(np.max(np.abs(legs[:, 1:])))]
 
 
-rows = []
+rows: list[tuple[str, float, list[float]]] = []
 for label, mech, added in (("no counterweight", unbalanced, 0.0), (f"counterweights, {BUDGET:g} kg", partial, BUDGET)):
     qg = assemble(mech, np.asarray(tr.start), initial_guess=tr.initial_guess).q
     plan = min_shaking(mech, tr.start, tr.end, tr.duration, q_guess=qg, samples=tr.samples)

@@ -20,6 +20,7 @@ Layer: methods (docs/architecture.md).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -40,16 +41,16 @@ class Evaluation:
     with respect to the actuated positions, rates and accelerations; full ``q, v, a`` (N, dof)."""
 
     wrench: np.ndarray
-    torque: np.ndarray | None
+    torque: Any            # (N, na), or None where not asked
     q: np.ndarray
     v: np.ndarray
     a: np.ndarray
-    dq: np.ndarray | None = None
-    dv: np.ndarray | None = None
-    da: np.ndarray | None = None
-    torque_dq: np.ndarray | None = None
-    torque_dv: np.ndarray | None = None
-    torque_da: np.ndarray | None = None
+    dq: Any = None         # the partials (N, 6, na): None where not asked
+    dv: Any = None
+    da: Any = None
+    torque_dq: Any = None  # (N, na, na): None where not asked
+    torque_dv: Any = None
+    torque_da: Any = None
 
 
 class ActuatedModel:
