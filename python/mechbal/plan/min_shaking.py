@@ -7,15 +7,18 @@ weighted sum of the mean squares of shaking force, shaking moment and actuator t
 the joints' position, velocity, acceleration and torque limits.
 
 * Parameterisation: a clamped quintic B-spline per actuated joint (`mechbal.plan.spline`), the
-  boundary positions and velocities held exactly (and zero accelerations with ``smooth_ends``); the quintic law is one
-  point of it, the warm start.
+  boundary positions and velocities held exactly (and zero accelerations with ``smooth_ends``);
+  the quintic law is one point of it, the warm start.
 * Gradients: the shaking wrench and the torques are linear in the accelerations and quadratic in
   the rates; their partial derivatives come from the model (`mechbal.plan.model`), chained through
   the spline basis.
-* Solver: scipy's SLSQP. RMS objectives are integrated by Gauss-Legendre quadrature on each knot
-  span; peaks by an epigraph variable; limits are imposed at the quadrature nodes, then checked
-  on a grid ten times finer than the output samples, and every violation found there is added
-  as a constraint and the problem solved again.
+* Solvers (scipy): RMS objectives, integrated by Gauss-Legendre quadrature on each knot span,
+  by BFGS without the limits first; where that motion exceeds a limit, SLSQP from there with the
+  limits imposed where the motion comes near them (an active set: local maxima within 5 % of a
+  limit), each tightened by `LIMIT_MARGIN`; peaks by SLSQP with an epigraph variable. The
+  torques are checked on a grid ten times finer than the output samples, positions, velocities
+  and accelerations on one a hundred times finer; every violation found there is watched too and
+  the problem solved again.
 * Infeasible requests (a duration too short for the torque, velocity or acceleration limits) are
   refused before the long run with `PlanInfeasible`, whose message gives the shortest duration
   the planner found feasible.
