@@ -210,7 +210,8 @@ RUN_MECHANISM: dict[str, Schema] = {
                    "quintic_value ([N] or [N m]: RMS or peak; weighted: the weighted sum of mean squares), "
                    "reduction (1 - value / quintic_value), ok, message, iterations, control_points, "
                    "active_limits (kind, joint, time [s], value, limit), limits_checked_on (instants), "
-                   "metrics (RMS and peak shaking force [N] and moment [N m] of planned and quintic), "
+                   "metrics (rms_ and peak_shaking_force [N] and _shaking_moment [N m] of the norm, "
+                   "rms_joint_torque [N m] of the norm over the actuated joints, of planned and quintic), "
                    "com_law (the centre-of-mass law's profile, joints and the same metrics, or "
                    "not_applicable: why)."),
     "passive": detail("[control] kind = passive: rate_hz, integrator, q0, v0, initial_energy [J], "

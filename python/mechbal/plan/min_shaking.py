@@ -662,11 +662,11 @@ def _metrics(am: ActuatedModel, traj, t: np.ndarray, prob: "_Problem") -> dict[s
            "rms_shaking_moment": float(np.sqrt(w @ M2)), "peak_shaking_moment": float(np.sqrt(M2.max()))}
     if ev.torque is not None:
         T2 = np.sum(ev.torque ** 2, axis=1)
-        out["rms_torque"] = float(np.sqrt(w @ T2))
+        out["rms_joint_torque"] = float(np.sqrt(w @ T2))
     if prob.objective == "weighted":
         wt = prob.weights
         out["objective"] = (wt.get("force", 0.0) * float(w @ F2) + wt.get("moment", 0.0) * float(w @ M2)
-                            + wt.get("torque", 0.0) * (out.get("rms_torque", 0.0) ** 2))
+                            + wt.get("torque", 0.0) * (out.get("rms_joint_torque", 0.0) ** 2))
     else:
         quantity, stat = prob.objective.split("_")
         out["objective"] = out[f"{stat}_shaking_{quantity}"]
