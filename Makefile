@@ -233,6 +233,7 @@ bench: install $(VENV)/.stamp-apt-test $(BENCH_BUILD)/build.ninja
 	$(BENCH_BUILD)/bench/mechbal-loop --seconds $(LOOP_GENERAL_SECONDS) --rate 1000 --rt --spin-us $(LOOP_SPIN_US) \
 	  --workload reactionless_general --json $(BENCH_RUN)/loop_reactionless_general.json
 	$(PY) bench/bench_python.py --out $(BENCH_RUN)/python.json
+	$(PY) bench/bench_plan.py --out bench/results/plan.json
 	$(PY) bench/merge_results.py --gbench $(BENCH_RUN)/gbench.json --tail $(BENCH_RUN)/tail.json \
 	  --loop $(BENCH_RUN)/loop.json --loop-paminsa $(BENCH_RUN)/loop_paminsa.json --python $(BENCH_RUN)/python.json \
 	  --loop-extra paminsa_general=$(BENCH_RUN)/loop_paminsa_general.json \

@@ -265,6 +265,10 @@ def trajectory_from_config(table: Any, dof: int, field: str = "trajectory"):
     from mechbal.trajectory import ConstantSpeed
 
     tr = table if isinstance(table, ChainTrajectory) else validate_table(ChainTrajectory, table, field)
+    if tr.law == "min_shaking":
+        raise ConfigError(f"{field}.law", "'min_shaking' is a planned motion: `mechbal run` plans it "
+                                          "(mechbal.plan.min_shaking); this command needs a fixed law "
+                                          "(quintic, cubic, constant_speed)", tr.law)
     keys = ("start", "speed", "rpm") if tr.law == "constant_speed" else ("start", "end")
     for key in keys:
         v = getattr(tr, key)

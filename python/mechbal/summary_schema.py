@@ -206,6 +206,14 @@ RUN_MECHANISM: dict[str, Schema] = {
     "loops": detail("Loop solve along the trajectory: min_rcond, singular_instants, "
                     "max_closure_residual [m], max_newton_iterations."),
     "control": _CONTROL,
+    "plan": detail("law = min_shaking (mechbal.plan): objective, weights, moment_point [m], value and "
+                   "quintic_value ([N] or [N m]: RMS or peak; weighted: the weighted sum of mean squares), "
+                   "reduction (1 - value / quintic_value), ok, message, iterations, control_points, "
+                   "active_limits (kind, joint, time [s], value, limit), limits_checked_on (instants), "
+                   "metrics (rms_ and peak_shaking_force [N] and _shaking_moment [N m] of the norm, "
+                   "rms_joint_torque [N m] of the norm over the actuated joints, of planned and quintic), "
+                   "com_law (the centre-of-mass law's profile, joints and the same metrics, or "
+                   "not_applicable: why)."),
     "passive": detail("[control] kind = passive: rate_hz, integrator, q0, v0, initial_energy [J], "
                       "max_energy_drift [J], kinetic_energy_swing [J], relative_energy_drift, "
                       "energy (definition), final_q, final_v."),

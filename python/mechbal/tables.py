@@ -382,9 +382,38 @@ class Mechanism(Table):
     springs: Annotated[list[MechanismSpring], Field(max_length=MAX_BODIES)] = []
 
 
-#: the time laws of ``[trajectory]``: rest-to-rest (quintic, minimum-energy cubic) or a steady
-#: rotation at constant speed
-TrajectoryLaw = Literal["quintic", "cubic", "constant_speed"]
+#: the time laws of ``[trajectory]``: rest-to-rest (quintic, minimum-energy cubic), a steady
+#: rotation at constant speed, or a motion planned to minimise shaking (`mechbal.plan`)
+TrajectoryLaw = Literal["quintic", "cubic", "constant_speed", "min_shaking"]
+#: what ``law = "min_shaking"`` minimises (`mechbal.plan.OBJECTIVES`)
+PlanObjective = Literal["force_rms", "force_peak", "moment_rms", "moment_peak"]
+#: the keys that only ``law = "min_shaking"`` takes
+PLAN_KEYS = ("objective", "weights", "moment_point", "start_velocity", "end_velocity", "acceleration_limit",
+             "torque_limit", "control_points", "smooth_ends", "com_profile")
+
+
+class PlanWeights(Table):
+    """``[trajectory] weights``: minimise ``force mean|F|^2 + moment mean|M|^2 + torque
+    mean|tau|^2`` (SI units), instead of one ``objective``."""
+    force: NonNeg = 0.0
+    moment: NonNeg = 0.0
+    torque: NonNeg = 0.0
+
+    @model_validator(mode="after")
+    def _some(self):
+        if not (self.force or self.moment or self.torque):
+            raise _custom("needs a weight > 0 (force, moment or torque)", value=self.model_dump())
+        return self
+
+
+def _positive_values(value: Any) -> Any:
+    for i, x in enumerate(value):
+        if not x > 0:
+            raise _custom("must be > 0", f"[{i}]", x)
+    return value
+
+
+PositiveJointValues = Annotated[JointValues, AfterValidator(_positive_values)]
 def _check_speeds(value: Any) -> Any:
     """A speed or rpm: a number, or a list of 1 .. MAX_JOINTS numbers (finite, within MAX_ABS)."""
     entries = [("", value)]
@@ -438,9 +467,39 @@ class ChainTrajectory(Table):
     branch: Optional[Literal["open", "crossed"]] = Field(
         None, description="closed mechanisms whose loops are four-bar-like (four parallel pivots): the "
                           "assembly at start; default open unless a full initial_guess picks it")
+    objective: Optional[PlanObjective] = Field(
+        None, description="min_shaking: what to minimise (default force_rms); or weights")
+    weights: Optional[PlanWeights] = Field(
+        None, description="min_shaking: weights of the mean squares of shaking force, shaking moment "
+                          "and actuator torque; or objective")
+    moment_point: Optional[Vec3] = Field(
+        None, description="min_shaking: the point the shaking moment is taken about, m in O (default O)")
+    start_velocity: Optional[JointValues] = Field(
+        None, description="min_shaking: velocities at the start (default 0: from rest), rad/s or m/s")
+    end_velocity: Optional[JointValues] = Field(
+        None, description="min_shaking: velocities at the end (default 0: to rest), rad/s or m/s")
+    acceleration_limit: Optional[PositiveJointValues] = Field(
+        None, description="min_shaking: |acceleration| limit per actuated joint, rad/s^2 or m/s^2")
+    torque_limit: Optional[PositiveJointValues] = Field(
+        None, description="min_shaking: |torque| limit per actuated joint besides the joints' effort "
+                          "limits, N m or N")
+    control_points: Optional[Annotated[int, Field(ge=7, le=200, strict=True)]] = Field(
+        None, description="min_shaking: control points per joint of the quintic B-spline (default 14)")
+    smooth_ends: Optional[bool] = Field(
+        None, description="min_shaking: also hold zero accelerations at both ends (default false)")
+    com_profile: Optional[Literal["bang_bang", "cubic", "minimum_jerk", "none"]] = Field(
+        None, description="min_shaking: the profile of the centre-of-mass law reported beside the plan "
+                          "(default bang_bang; none: not computed)")
 
     @model_validator(mode="after")
     def _law_keys(self):
+        if self.law != "min_shaking":
+            for key in PLAN_KEYS:
+                if getattr(self, key) is not None:
+                    raise _custom(f"is for law = 'min_shaking' (law is '{self.law}')", f".{key}",
+                                  getattr(self, key))
+        elif self.objective is not None and self.weights is not None:
+            raise _custom("give objective or weights, not both", ".weights", self.weights.model_dump())
         if self.law == "constant_speed":
             for key in ("end",):
                 if getattr(self, key) is not None:

@@ -147,6 +147,17 @@ def _trajectory_motion(mech, tt, law=None, field="trajectory"):
     if law is not None:
         table = {**table, "law": law}
     table = {k: v for k, v in table.items() if k != "initial_guess"}
+    if table.get("law") == "min_shaking":
+        # a planned motion (mechbal.plan: `mechbal run` plans it): balance over the quintic
+        # between the same ends, and say so
+        import warnings
+
+        from mechbal.errors import ConfigWarning
+        from mechbal.tables import PLAN_KEYS
+
+        warnings.warn(f"{field}.law: 'min_shaking' is planned by `mechbal run`; balancing samples the "
+                      "quintic between the same start and end", ConfigWarning, stacklevel=2)
+        table = {**{k: v for k, v in table.items() if k not in PLAN_KEYS}, "law": "quintic"}
     traj, t = trajectory_from_config(table, n, field)
     return t, traj.evaluate_batch(t), table
 

@@ -67,6 +67,8 @@ def motion_summary(tr, traj) -> dict:
 def run(config, out: Path) -> dict:
     case = validate_case(config, warn=False)
     mech = Mechanism.from_spec(case.spec, name=case.case.name)
+    if case.trajectory.law == "min_shaking":
+        return run_min_shaking(mech, case, out)
     traj, t = trajectory_from_config(case.trajectory, len(mech.actuated_names))
     assembly = start_assembly(mech, case.trajectory, traj)
     q_guess = None if assembly is None else assembly.q
@@ -77,6 +79,41 @@ def run(config, out: Path) -> dict:
     return run_mechanism(mech, traj, t, out, name=case.case.name, kind=case.case.kind,
                          title=case.case.title or case.case.name, q_guess=q_guess,
                          summary_extra=motion_summary(case.trajectory, traj), assembly=assembly)
+
+
+def run_min_shaking(mech: Mechanism, case, out: Path) -> dict:
+    """``law = "min_shaking"`` (`mechbal.plan`): plan the motion, then the run every mechanism
+    gets along it, with motion.npz, the plot of the quintic against the planned motion and
+    summary.json's ``plan`` (objective, value of both, reduction, active limits, the
+    centre-of-mass law)."""
+    from mechbal.plan.case import com_law_of_table, plan_from_table, write_plan_outputs
+
+    tr = case.trajectory
+    if case.control is not None:
+        raise ConfigError("control", "is not run along a planned motion (law = 'min_shaking'): plan "
+                                     "first, then control the motion.npz it writes", has_value=False)
+    q_guess = None
+    assembly = None
+    if mech.is_closed:
+        from mechbal.assembly import assemble
+
+        assembly = assemble(mech, np.asarray(tr.start, float), branch=tr.branch, initial_guess=tr.initial_guess)
+        q_guess = assembly.q
+    result = plan_from_table(mech, tr, q_guess)
+    t = np.linspace(0.0, float(tr.duration), tr.samples)
+    com, why_not = com_law_of_table(mech, tr, t, q_guess)
+    summary = run_mechanism(mech, result.trajectory, t, out, name=case.case.name, kind=case.case.kind,
+                            title=case.case.title or case.case.name, q_guess=q_guess, assembly=assembly)
+    q, v, a, _, _ = mechanism_motion(mech, result.trajectory, t, q_guess)
+    summary["plan"] = write_plan_outputs(mech, result, com, why_not, t, q, v, a, out,
+                                         title=case.case.title or case.case.name, q_guess=q_guess)
+    summary["files"] += ["motion.npz", "plan_shaking_wrench.png"]
+    write_summary(out / "summary.json", summary)
+    print(report.table([[result.objective, result.quintic_value, result.value, f"{100 * result.reduction:.1f} %"]],
+                       ["objective", "quintic", "min_shaking", "reduction"]))
+    if not result.ok:
+        print(f"plan: not converged ({result.message})")
+    return summary
 
 
 def _drawing(mech: Mechanism, motion) -> dict:
