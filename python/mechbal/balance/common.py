@@ -446,11 +446,24 @@ class LinearProblem:
     C: np.ndarray | None = None
     v: np.ndarray | None = None
 
+    def __post_init__(self):
+        # the rows once reduced to their triangular factor (|A x + b|^2 = |R x + c|^2 + rest): the
+        # solves of a front then never touch the N rows again
+        if self.A.shape[0] > self.A.shape[1]:
+            Q, R = np.linalg.qr(self.A)
+            c = Q.T @ self.b
+            self._compressed = (R, c, max(float(self.b @ self.b) - float(c @ c), 0.0))
+        else:
+            self._compressed = (self.A, self.b, 0.0)
+
     def solve(self, *, mass_budget: float | None = None, residual_target: float | None = None,
               certified: bool | None = None) -> LinearSolution:
-        return solve_mass_moments(self.A, self.b, self.slots, mass_budget=mass_budget, L=self.L, what=self.what,
+        """The design of `solve_mass_moments` for this budget and residual target."""
+        R, c, rest = self._compressed
+        return solve_mass_moments(R, c, self.slots, mass_budget=mass_budget, L=self.L, what=self.what,
                                   components=self.components, objective=self.objective,
-                                  residual_target=residual_target, certified=certified)
+                                  residual_target=residual_target, certified=certified,
+                                  rows=self.A.shape[0], rest=rest, full=(self.A, self.b))
 
     def result(self, sol: LinearSolution) -> BalanceResult[CounterweightDesign]:
         design_out, placed = design_from_solution(sol.x, self.slots, sol.active_bounds)
@@ -808,7 +821,8 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
                        what: str = "the balancing condition",
                        components: Sequence[str] | None = None, objective: Any = None,
                        residual_target: float | None = None,
-                       certified: bool | None = None) -> LinearSolution:
+                       certified: bool | None = None, rows: int | None = None, rest: float = 0.0,
+                       full: tuple[np.ndarray, np.ndarray] | None = None) -> LinearSolution:
     """The two stages of the module docstring for ``A x + b = 0`` (rows: every sample and
     component; x: (m, h_user) per slot). The least squares is over the design's free variables
     (a fixed mass is not an unknown; a slot with a direction has one moment along it).
@@ -821,7 +835,9 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
     residual, or within the target). ``certified``: solve it with the conic solver (the
     ``optimal`` extra) and keep its certificate in ``certificate``; None: when the extra is
     installed (otherwise the mass objective by polyhedral cuts and SLSQP, without certificate;
-    another objective or a target then needs the extra)."""
+    another objective or a target then needs the extra). ``rows``, ``rest``, ``full``: ``A``, ``b``
+    are a compressed form of the ``full`` rows (their triangular factor: `LinearProblem`), whose RMS
+    is ``sqrt((|A x + b|^2 + rest) / rows)``."""
     A = np.asarray(A, float)
     b = np.asarray(b, float).reshape(-1)
     if A.shape[0] == 0:
@@ -832,8 +848,9 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
     Ay = A @ dsg.P
     by = A @ dsg.xc + b
     ny = Ay.shape[1]
-    before = float(np.sqrt(np.mean(b ** 2)))
-    rms = lambda y: float(np.sqrt(np.mean((Ay @ y + by) ** 2)))  # noqa: E731
+    nrows = A.shape[0] if rows is None else int(rows)
+    before = float(np.sqrt((b @ b + rest) / nrows))
+    rms = lambda y: float(np.sqrt((np.sum((Ay @ y + by) ** 2) + rest) / nrows))  # noqa: E731
     if ny:
         U, sv, Vt = np.linalg.svd(Ay, full_matrices=False)
         rank = int(np.sum(sv > RANK_RTOL * sv[0])) if sv[0] > 0 else 0
@@ -865,7 +882,8 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
             obj = optimal.Objective("inertia", W=Wg, constant=obj.constant)
         if obj.kind == "torque" and obj.rows is not None:
             obj = optimal.Objective("torque", rows=(obj.rows[0] @ E, obj.rows[1]))
-        conv = optimal.solve(dsg, Ay, by, Z, mscale, objective=obj, residual_target=residual_target, y0=y0)
+        conv = optimal.solve(dsg, Ay, by, Z, mscale, objective=obj, residual_target=residual_target, y0=y0,
+                             rows=nrows, rest=rest)
         # y as solved, on the least-residual set: the bounds are met to the solver's feasibility
         # tolerance (``bound_violation``, relative to the mass scale), as the cuts below meet them to
         # CONE_RTOL, rather than projected onto them at the cost of the residual
@@ -920,7 +938,8 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
     x0 = E @ dsg.x(y0)
     unconstrained = unconstrained_design(x0, slots)
     if ls > EXACT_RTOL * scale:
-        left = uncancelled(Ay @ y0 + by, components, EXACT_RTOL * scale)
+        left = uncancelled((Ay @ y0 + by) if full is None else (full[0] @ E @ dsg.x(y0) + full[1]),
+                           components, EXACT_RTOL * scale)
         limited.append(f"impossible: rank {rank} of {ny} unknowns and a least-squares residual of "
                        f"{ls:.6g} (RMS; {100 * ls / scale:.3g} % of the unbalanced {before:.6g}): these "
                        f"slots cannot make {what} zero over the samples"

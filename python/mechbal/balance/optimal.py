@@ -19,7 +19,7 @@ designs with that least residual, the objective: every least-residual design has
 ``R y`` (the squared norm is strictly convex in it), so the set is ``y_1 + Z z`` with Z the null
 space of the rows; the objective is minimised over z. With a ``residual_target`` above the least
 residual, (2) is ``min objective`` subject to ``RMS residual <= target`` instead (the
-epsilon-constraint, `mechbal.balance.front`); with a ``mass_budget``, (1) is the least residual
+epsilon-constraint, `mechbal.balance.fronts`); with a ``mass_budget``, (1) is the least residual
 within that budget.
 
 **Certificate.** Each stage is solved by Clarabel (an interior-point conic solver, the
@@ -198,10 +198,11 @@ class ConvexSolution:
 def solve(dsg, Ay: np.ndarray, by: np.ndarray, Z: np.ndarray, mscale: float, *,
           objective: Objective | None = None, residual_target: float | None = None,
           P: np.ndarray | None = None, xc: np.ndarray | None = None,
-          y0: np.ndarray | None = None) -> ConvexSolution:
+          y0: np.ndarray | None = None, rows: int | None = None, rest: float = 0.0) -> ConvexSolution:
     """The lexicographic program of the module docstring over the free variables y of ``dsg``
     (`mechbal.balance.common._Design`): residual rows ``Ay y + by`` (RMS over the rows), null space
-    ``Z`` of Ay, ``y0`` its least-squares solution (tried first). ``P``, ``xc``: x = P y + xc, (m, h_user) per group root (for the inertia and
+    ``Z`` of Ay, ``y0`` its least-squares solution (tried first); ``rows``, ``rest``: the rows are
+    a compressed form, RMS ``sqrt((|Ay y + by|^2 + rest) / rows)``. ``P``, ``xc``: x = P y + xc, (m, h_user) per group root (for the inertia and
     torque objectives; default dsg's). ValueError when ``residual_target`` is below the least
     residual the bounds allow (naming both)."""
     obj = objective or Objective()
@@ -209,20 +210,23 @@ def solve(dsg, Ay: np.ndarray, by: np.ndarray, Z: np.ndarray, mscale: float, *,
         raise ValueError(f"objective: must be one of {', '.join(OBJECTIVES)} (got {obj.kind!r})")
     P = dsg.P if P is None else P
     xc = dsg.xc if xc is None else xc
-    N = Ay.shape[0]
+    N = Ay.shape[0] if rows is None else int(rows)
     ny = Ay.shape[1]
     ys = mscale * dsg.L                      # y = ys u: u is O(1)
     Qf, Rf = np.linalg.qr(Ay)
     cf = Qf.T @ by
-    const0 = max(float(by @ by) - float(cf @ cf), 0.0)
+    const0 = max(float(by @ by) - float(cf @ cf), 0.0) + rest
     rscale = max(float(np.linalg.norm(by)), 1e-300)
-    rms = lambda y: float(np.sqrt(np.mean((Ay @ y + by) ** 2))) if N else 0.0  # noqa: E731
+    rms = lambda y: float(np.sqrt((np.sum((Ay @ y + by) ** 2) + rest) / N)) if N else 0.0  # noqa: E731
 
     def stage2(base, off, tau=None):
         """The objective over y = off + base z (within |R y + c| <= tau when given)."""
         extra = _extra_vars(obj, dsg)
         nz = base.shape[1]
         n = nz + extra
+        if nz == 0:
+            v0 = _value(obj, dsg, P, xc, off)
+            return off.copy(), Stage(f"least {obj.kind}", "Solved", v0, v0, 0, obj.unit())
         pr = _Conic(n)
         to_y = np.hstack([base, np.zeros((ny, extra))])
         _cone_cons(pr, dsg, to_y, off, mscale)
@@ -267,6 +271,12 @@ def solve(dsg, Ay: np.ndarray, by: np.ndarray, Z: np.ndarray, mscale: float, *,
         return y2, st2
 
     stages: list[Stage] = []
+    if (dsg.budget is not None and dsg.budget <= 0.0
+            and all(s.mass_min == 0.0 and (math.isfinite(s.max_radius) or s.fixed_position) for s in dsg.slots)):
+        # no mass to add: the only design is no counterweight at all (a point, no interior)
+        y = np.zeros(ny)
+        return ConvexSolution(y, rms(y), rms(y), _value(obj, dsg, P, xc, y),
+                              [Stage("no added mass", "Solved", 0.0, 0.0, 0, obj.unit())])
     if residual_target is None and y0 is not None:
         # the least-squares set y0 + Z z (exact, from the SVD): when a design on it meets the
         # bounds, the least residual is the least squares' and stage 1 is not needed
