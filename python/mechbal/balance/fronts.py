@@ -34,8 +34,8 @@ from mechbal.balance import common
 from mechbal.balance.result import BalanceResult, CounterweightSlot
 from mechbal.mechanism import Mechanism
 
-__all__ = ["Front", "FrontPoint", "front", "problem", "knee", "default_motion", "write", "json_schema",
-           "CSV_COLUMNS"]
+__all__ = ["Front", "FrontPoint", "front", "problem", "knee", "default_motion", "write", "mechanism_toml",
+           "json_schema", "CSV_COLUMNS"]
 
 #: the columns of front.csv, in order
 CSV_COLUMNS = ("added_mass_kg", "residual", "shaking_force_peak", "shaking_moment_peak", "torque_peak",
@@ -256,10 +256,25 @@ def json_schema() -> dict[str, Any]:
     }
 
 
-def write(fr: Front, out: Path, balanced_toml: Callable[[BalanceResult], str], *, case: str = "",
-          title: str = "") -> list[str]:
-    """front.csv, front.json, front.png and front/<k>/balanced.toml into ``out``; the names."""
+def mechanism_toml(result: BalanceResult) -> str:
+    """A case file of the balanced mechanism alone (``[case]`` and ``[mechanism]``: readable by
+    `mechbal.Mechanism.from_toml`): what `write` writes per point when no case is given."""
+    from mechbal.balance.writers import mechanism_table, toml_text
+
+    m = result.balanced
+    added = ", ".join(f"{k} {d.mass:.6g} kg" for k, d in result.design.items())
+    return toml_text({"case": {"name": m.name, "kind": "mechanism"}, "mechanism": mechanism_table(m)},
+                     f"A point of a front ({result.method}): {added or 'nothing added'}.\n"
+                     f"Residual {result.residual:.6g} {result.residual_units}.")
+
+
+def write(fr: Front, out: Path, balanced_toml: Callable[[BalanceResult], str] | None = None, *,
+          case: str = "", title: str = "") -> list[str]:
+    """front.csv, front.json, front.png and front/<k>/balanced.toml into ``out`` (an existing
+    folder); the names. ``balanced_toml(result)``: the text of a point's file (default
+    `mechanism_toml`)."""
     out = Path(out)
+    balanced_toml = balanced_toml or mechanism_toml
     for k, p in enumerate(fr.points):
         d = out / "front" / str(k)
         d.mkdir(parents=True, exist_ok=True)
@@ -297,7 +312,7 @@ def _plot(fr: Front, path: Path, title: str) -> None:
     r = [p.residual for p in fr.points]
     t = [p.torque_peak for p in fr.points]
     fig, ax = plt.subplots(figsize=(7, 4.2))
-    ax.plot(m, r, "o-", color="C0", label=f"residual [{fr.residual_units.split(' ')[0]}]")
+    ax.plot(m, r, "o-", color="C0", label=f"residual [{fr.residual_units.split(' (')[0]}]")
     ax.plot([m[fr.knee]], [r[fr.knee]], "s", ms=12, mfc="none", mec="C3", mew=2, label="knee")
     ax.set_xlabel("added mass [kg]")
     ax.set_ylabel(f"residual ({fr.residual_units})", color="C0")

@@ -13,11 +13,16 @@ matrix (f a convex quadratic: the squared norm of the point's Jacobian), ``= w^T
 w = (m, h), a quadratic over linear (a rotated cone). The peak static torque ``max |A x + b|``
 over the samples is linear with an epigraph.
 
-**Lexicographic.** (1) The least residual over the bounds (``min t``, ``|R y + c| <= t``, R
-the triangular factor of the rows): the balance is as good as the slots allow. (2) Among the
-designs with that least residual, the objective: every least-residual design has the same
-``R y`` (the squared norm is strictly convex in it), so the set is ``y_1 + Z z`` with Z the null
-space of the rows; the objective is minimised over z. With a ``residual_target`` above the least
+**Lexicographic.** (1) The least residual: the balance is as good as the slots allow. (2) Among
+the designs of that residual, the least objective. When a least-squares solution meets the
+bounds, the designs of the least residual are the least-squares set ``y_0 + Z z`` (the SVD's
+minimum-norm solution and null space, exact) and the objective is minimised over z. When the
+bounds exclude every least-squares solution, (1) is the conic program ``min t``,
+``|R y + c| <= t`` over the bounds (R the triangular factor of the rows), and (2) minimises the
+objective over the designs whose RMS residual is within ``RESIDUAL_RTOL`` (1e-6, relative) of
+that least residual: the exact set of least-residual designs has no interior where a bound is
+active, and its lightest design moves like the square root of any error in (1)'s solution, so no
+finite-precision solver pins it; within 1e-6 the program is well posed and certified. With a ``residual_target`` above the least
 residual, (2) is ``min objective`` subject to ``RMS residual <= target`` instead (the
 epsilon-constraint, `mechbal.balance.fronts`); with a ``mass_budget``, (1) is the least residual
 within that budget.
@@ -40,6 +45,11 @@ import numpy as np
 
 #: the objectives of stage 2
 OBJECTIVES = ("mass", "inertia", "torque")
+#: when the bounds exclude the least squares, stage 2 takes the designs whose RMS residual is within
+#: this fraction of the least one (the "same residual" of the lexicographic order)
+RESIDUAL_RTOL = 1e-6
+#: a free mass below this fraction of the mass scale is taken for zero in the polish of `solve`
+APEX_RTOL = 1e-8
 #: the solver's tolerances (relative duality gap, feasibility)
 TOL_GAP = 1e-11
 TOL_FEAS = 1e-11
@@ -231,8 +241,28 @@ def solve(dsg, Ay: np.ndarray, by: np.ndarray, Z: np.ndarray, mscale: float, *,
         to_y = np.hstack([base, np.zeros((ny, extra))])
         _cone_cons(pr, dsg, to_y, off, mscale)
         if tau is not None:
-            a = np.vstack([np.zeros(n), (Rf @ to_y) / rscale])
-            pr.soc(a, np.r_[tau / rscale, (Rf @ off + cf) / rscale])
+            r1 = Rf @ y1 + cf if y1 is not None else None
+            T = float(np.linalg.norm(r1)) if r1 is not None else 0.0
+            if T > 0 and tau > T:
+                # |r| <= tau written about the stage-1 residual r1 (unit u, length T): with
+                # u.r = T (1 + e a), the rest of r = T sqrt(2 e) v, e = tau / T - 1, it is
+                # |v|^2 + (e / 2) a^2 <= 1 + e / 2 - a: the same set, but a cone of order one where
+                # |r| <= tau is a band of relative width e (which an interior-point solve resolves
+                # badly)
+                e = tau / T - 1.0
+                u = r1 / T
+                Up = np.linalg.svd(np.eye(len(u)) - np.outer(u, u))[0][:, :len(u) - 1]
+                Ar, br = Rf @ to_y, Rf @ off + cf
+                a_a, a_b = (u @ Ar) / (T * e), (u @ br - T) / (T * e)            # a = a_a v + a_b
+                v_a, v_b = (Up.T @ Ar) / (T * math.sqrt(2 * e)), (Up.T @ br) / (T * math.sqrt(2 * e))
+                k = math.sqrt(e / 2)
+                s_a, s_b = -a_a, 1.0 + e / 2 - a_b                                # s = 1 + e/2 - a
+                rows_a = np.vstack([s_a, 2 * v_a, 2 * k * a_a, s_a])
+                rows_b = np.r_[s_b + 1.0, 2 * v_b, 2 * k * a_b, s_b - 1.0]
+                pr.soc(rows_a, rows_b)
+            else:
+                a = np.vstack([np.zeros(n), (Rf @ to_y) / rscale])
+                pr.soc(a, np.r_[tau / rscale, (Rf @ off + cf) / rscale])
         cost, unit_scale = _stage2(pr, obj, dsg, P, xc, to_y, off, nz, mscale)
         v, st = pr.solve(cost, f"least {obj.kind}", obj.unit(), unit_scale)
         if obj.kind == "mass":   # the cost counts the free masses' change from ``off``: add the rest
@@ -249,7 +279,7 @@ def solve(dsg, Ay: np.ndarray, by: np.ndarray, Z: np.ndarray, mscale: float, *,
         if y is None:
             return y, st
         apex = [k for k in dsg.cones if dsg.mass_var[k] is not None and dsg.slots[k].mass_min == 0.0
-                and y[dsg.mass_var[k]] / dsg.L < 1e-6 * mscale]
+                and y[dsg.mass_var[k]] / dsg.L < APEX_RTOL * mscale]
         if not apex:
             return y, st
         from scipy.linalg import null_space
@@ -270,6 +300,7 @@ def solve(dsg, Ay: np.ndarray, by: np.ndarray, Z: np.ndarray, mscale: float, *,
         st2.name += " (vanishing slots fixed at zero)"
         return y2, st2
 
+    y1 = None
     stages: list[Stage] = []
     if (dsg.budget is not None and dsg.budget <= 0.0
             and all(s.mass_min == 0.0 and (math.isfinite(s.max_radius) or s.fixed_position) for s in dsg.slots)):
@@ -310,23 +341,48 @@ def solve(dsg, Ay: np.ndarray, by: np.ndarray, Z: np.ndarray, mscale: float, *,
                              f"and bounds allow ({least:.6g})")
         tau = math.sqrt(max(N * residual_target ** 2 - const0, 0.0))
         y, st2 = polished(np.eye(ny) * ys, np.zeros(ny), tau)
-    elif Z.shape[1] == 0:
-        return ConvexSolution(y1, rms(y1), least, _value(obj, dsg, P, xc, y1), stages)
     else:
-        # every least-residual design has R y = R y1: y1 + Z z (no interior when a bound is active,
-        # so an interior-point solve may stall; then the designs within a residual 1e-9 above it)
-        y, st2 = polished(Z * ys, y1)
-        if y is None or dsg.violation(y, mscale) > 1e-7 or st2.status not in ("Solved", "AlmostSolved"):
-            tau = math.sqrt(max(N * (least * (1 + 1e-9)) ** 2 - const0, 0.0))
-            y2, st3 = polished(np.eye(ny) * ys, np.zeros(ny), tau)
-            if y2 is not None and (y is None or dsg.violation(y2, mscale) <= dsg.violation(y, mscale)
-                                   or st3.status == "Solved"):
-                y, st2 = y2, st3
-                st2.name += " within 1e-9 of the least residual"
+        # the bounds exclude the least squares: the designs whose residual is within RESIDUAL_RTOL
+        # of the least (the exact set, R y = R y1, has no interior where a bound is active, and its
+        # lightest design moves like the square root of any error in y1: no solver pins it)
+        tau = math.sqrt(max(N * (least * (1 + RESIDUAL_RTOL)) ** 2 - const0, 0.0))
+        y, st2 = polished(np.eye(ny) * ys, np.zeros(ny), tau)
+        st2.name += f" within {RESIDUAL_RTOL:g} (relative) of the least residual"
+        if y is not None and obj.kind == "mass":
+            # the band is thin (1e-6): an interior-point solve may stop short of its tolerance there;
+            # a local polish from its point (SLSQP on the same convex program) is kept when it is
+            # feasible and lighter
+            yp = _polish_band(dsg, Rf, cf, tau, y, mscale)
+            if yp is not None and float(dsg.mass_row @ yp) < float(dsg.mass_row @ y):
+                y = yp
+                st2.name += ", polished by SLSQP"
     if y is None:
         raise RuntimeError(f"the convex solve failed at the objective (Clarabel status {st2.status})")
     stages.append(st2)
     return ConvexSolution(y, rms(y), least, _value(obj, dsg, P, xc, y), stages)
+
+
+def _polish_band(dsg, Rf, cf, tau, y, mscale):
+    """SLSQP from ``y``: min added mass over the bounds and ``|Rf y + cf| <= tau``; None unless it
+    is feasible (bounds to 1e-10 of the mass scale, the band to 1e-12)."""
+    from scipy.optimize import minimize
+
+    c = dsg.mass_row / mscale
+    t2 = max(tau * tau, 1e-300)
+    cons = dsg.scipy(lambda yy: yy, np.eye(len(y)))
+    cons.append({"type": "ineq", "fun": lambda yy: np.array([1.0 - float(np.sum((Rf @ yy + cf) ** 2)) / t2]),
+                 "jac": lambda yy: (-2.0 * (Rf.T @ (Rf @ yy + cf)) / t2)[None, :]})
+    try:
+        r = minimize(lambda yy: (float(c @ yy), c), y, jac=True, method="SLSQP", constraints=cons,
+                     options=dict(ftol=1e-15, maxiter=500))
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    yp = r.x
+    if not np.all(np.isfinite(yp)) or dsg.violation(yp, mscale) > 1e-10:
+        return None
+    if float(np.sum((Rf @ yp + cf) ** 2)) > t2 * (1 + 1e-12):
+        return None
+    return yp
 
 
 def _extra_vars(obj: Objective, dsg) -> int:
