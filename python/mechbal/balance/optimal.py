@@ -348,8 +348,8 @@ def solve(dsg, Ay: np.ndarray, by: np.ndarray, Z: np.ndarray, mscale: float, *,
         tau = math.sqrt(max(N * (least * (1 + RESIDUAL_RTOL)) ** 2 - const0, 0.0))
         y, st2 = polished(np.eye(ny) * ys, np.zeros(ny), tau)
         st2.name += f" within {RESIDUAL_RTOL:g} (relative) of the least residual"
-        if y is not None and obj.kind == "mass":
-            # the band is thin (1e-6): an interior-point solve may stop short of its tolerance there;
+        if y is not None and obj.kind == "mass" and st2.status != "Solved":
+            # the band is thin (1e-6): where an interior-point solve stops short of its tolerance there,
             # a local polish from its point (SLSQP on the same convex program) is kept when it is
             # feasible and lighter
             yp = _polish_band(dsg, Rf, cf, tau, y, mscale)
