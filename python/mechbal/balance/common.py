@@ -452,7 +452,8 @@ class LinearProblem:
         if self.A.shape[0] > self.A.shape[1]:
             Q, R = np.linalg.qr(self.A)
             c = Q.T @ self.b
-            self._compressed = (R, c, max(float(self.b @ self.b) - float(c @ c), 0.0))
+            e = self.b - Q @ c        # the rows' part no design reaches (not |b|^2 - |c|^2: cancellation)
+            self._compressed = (R, c, float(e @ e))
         else:
             self._compressed = (self.A, self.b, 0.0)
 

@@ -225,7 +225,8 @@ def solve(dsg, Ay: np.ndarray, by: np.ndarray, Z: np.ndarray, mscale: float, *,
     ys = mscale * dsg.L                      # y = ys u: u is O(1)
     Qf, Rf = np.linalg.qr(Ay)
     cf = Qf.T @ by
-    const0 = max(float(by @ by) - float(cf @ cf), 0.0) + rest
+    e0 = by - Qf @ cf
+    const0 = float(e0 @ e0) + rest
     rscale = max(float(np.linalg.norm(by)), 1e-300)
     rms = lambda y: float(np.sqrt((np.sum((Ay @ y + by) ** 2) + rest) / N)) if N else 0.0  # noqa: E731
 
