@@ -870,6 +870,7 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
     if certified is None:
         certified = optimal.available() or objective is not None or residual_target is not None
     certificate = None
+    y_limits = None
     d = Z.shape[1]
     y = y0
     lower_bound = None
@@ -889,6 +890,7 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
         # tolerance (``bound_violation``, relative to the mass scale), as the cuts below meet them to
         # CONE_RTOL, rather than projected onto them at the cost of the residual
         y = conv.y
+        y_limits = conv.y_least
         certificate = conv.certificate(obj.kind)
         certificate["least_residual"] = conv.least_residual
         certificate["objective_value"] = conv.objective
@@ -933,7 +935,9 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
         stage = "constrained least squares (the bounds exclude every least-squares solution)"
     x = E @ dsg.x(y)
     residual = rms(y)
-    active = dsg.active(y, mscale)
+    # the bounds that limit the balance: those active at the least-residual design (where a band
+    # design stands in for it, it may sit ~1e-6 inside them)
+    active = dsg.active(y if y_limits is None else y_limits, mscale)
     limited = []
     scale = max(before, 1e-300)
     x0 = E @ dsg.x(y0)

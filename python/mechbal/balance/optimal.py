@@ -197,6 +197,9 @@ class ConvexSolution:
     least_residual: float
     objective: float
     stages: list[Stage] = field(default_factory=list)
+    #: the least-residual design of stage 1 where the bounds exclude the least squares: the bounds
+    #: active there are what limits the balance (the design within the band may leave them by ~1e-6)
+    y_least: np.ndarray | None = None
 
     def certificate(self, objective: str) -> dict[str, Any]:
         return {"solver": "clarabel", "objective": objective, "lexicographic": "least residual first, "
@@ -360,7 +363,8 @@ def solve(dsg, Ay: np.ndarray, by: np.ndarray, Z: np.ndarray, mscale: float, *,
     if y is None:
         raise RuntimeError(f"the convex solve failed at the objective (Clarabel status {st2.status})")
     stages.append(st2)
-    return ConvexSolution(y, rms(y), least, _value(obj, dsg, P, xc, y), stages)
+    return ConvexSolution(y, rms(y), least, _value(obj, dsg, P, xc, y), stages,
+                          y_least=y1 if residual_target is None else None)
 
 
 def _polish_band(dsg, Rf, cf, tau, y, mscale):
