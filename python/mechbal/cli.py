@@ -130,7 +130,7 @@ def _cmd_balance(args) -> int:
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer), staged_output(out) as tmp, \
             progress.run_bar(f"balance {Path(args.case).stem}", 5):
-        summary = run_balance(args.case, args.method, tmp, design=args.design)
+        summary = run_balance(args.case, args.method, tmp, design=args.design, **_optimal_options(args))
         progress.finish()
     if not args.quiet:
         sys.stdout.write(buffer.getvalue())
@@ -152,6 +152,13 @@ def _cmd_balance(args) -> int:
               f"--allow-partial accepts them): {_one_line(why)}", file=sys.stderr)
         return EXIT_PARTIAL_BALANCE
     return EXIT_OK
+
+
+def _optimal_options(args) -> dict:
+    """--objective, --residual-target, --front of `mechbal balance` (only those given)."""
+    opts = {"objective": getattr(args, "objective", None), "residual_target": getattr(args, "residual_target", None),
+            "front": getattr(args, "front", None)}
+    return {k: v for k, v in opts.items() if v is not None}
 
 
 def _cmd_demo(args) -> int:
@@ -372,6 +379,19 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--allow-partial", action="store_true",
                    help=f"exit 0 when the requested balance is not reached (default: exit "
                         f"{EXIT_PARTIAL_BALANCE}; the results are written either way)")
+    # the convex design of the counterweight methods (static, force): mechbal.balance.optimal, .front
+    s.add_argument("--objective", choices=("mass", "inertia", "torque"), default=None,
+                   help="static/force: among the designs of the least residual (or within "
+                        "--residual-target), the least added mass (default), added inertia (mean trace "
+                        "of the joint-space inertia added) or peak static torque; certified by a conic "
+                        "solver (the 'optimal' extra)")
+    s.add_argument("--residual-target", type=float, default=None, metavar="R",
+                   help="static/force: accept this RMS residual (the method's units) and minimise "
+                        "--objective within it")
+    s.add_argument("--front", type=int, default=None, metavar="N",
+                   help="static/force: also write the trade-off front of N designs from zero added "
+                        "mass to the best residual: DIR/front.csv, front.json, front.png, "
+                        "front/<k>/balanced.toml")
     _last_flags(s, _cmd_balance, force=True, urdf=True)
     s = sub.add_parser("export", help="write a case's mechanism as MJCF (MuJoCo) or URDF",
                        description="Write the mechanism of a case (built-in name, TOML or URDF file) "

@@ -288,6 +288,26 @@ BALANCE: dict[str, Schema] = {
     "total_mass": number_map("kg", "Total mass, unbalanced and balanced."),
     "urdf": string("Why no balanced.urdf was written (loops or springs), or its name."),
     "case_notes": detail("What the case's loader says (default motion, paper values)."),
+    "optimality": {"type": "object", "description": "The certificate of the convex design (static and "
+                   "force methods with the 'optimal' extra, mechbal.balance.optimal): the solver, the "
+                   "objective, the lexicographic order, each stage's primal and dual objectives and "
+                   "duality gap, the least residual, the objective's value, the residual target and the "
+                   "largest bound violation (relative to the mass scale).",
+                   "additionalProperties": False, "properties": {
+                       "solver": string(), "objective": {"enum": ["mass", "inertia", "torque"]},
+                       "lexicographic": string(),
+                       "stages": {"type": "array", "items": detail("stage, status, primal_objective, "
+                                                                   "dual_objective, duality_gap, relative_gap, "
+                                                                   "iterations, unit")},
+                       "duality_gap": number("the objective's unit", "Duality gap of the last stage."),
+                       "least_residual": number("the residual's unit"),
+                       "objective_value": number("kg, kg m^2 or N m"),
+                       "residual_target": {"type": ["number", "null"]},
+                       "bound_violation": number("", "Largest bound violation / mass scale.")}},
+    "front": {"type": "object", "description": "--front N: the trade-off front (front.csv, front.json, "
+              "front.png, front/<k>/balanced.toml; mechbal.balance.fronts).", "additionalProperties": False,
+              "properties": {"points": integer(), "knee": integer(), "files": strings(),
+                             "added_mass_kg": numbers("kg"), "residual": numbers("the residual's unit")}},
     "assembly": detail("Loop assembly: the branch (open or crossed), how it was chosen (branch, "
                        "initial_guess or default) and the branch at the end."),
 }

@@ -91,7 +91,9 @@ def test_static_bound_is_reported_never_success(arm):
                                Slot("cw2", "elbow", 0.0, 5.0, max_radius=0.1, direction=MINUS_X)], q)
     assert not res.exact
     assert "bound: cw1.mass_max" in res.limited_by and "bound: cw1.max_radius" in res.limited_by
-    assert res.design["cw1"].mass == pytest.approx(3.0, rel=1e-9)
+    # the lightest design within 1e-6 of the least residual (mechbal.balance.optimal) may sit
+    # ~1e-6 inside the bound that limits it
+    assert res.design["cw1"].mass == pytest.approx(3.0, rel=1e-5)
     G = res.balanced.gravity_torque(q)
     assert res.residual == pytest.approx(float(np.sqrt(np.mean(G ** 2))), rel=1e-12)
     assert 0 < res.residual < res.residual_before
@@ -99,7 +101,7 @@ def test_static_bound_is_reported_never_success(arm):
     res = static.balance(arm, [Slot("cw1", "shoulder", max_radius=0.2, direction=MINUS_X),
                                Slot("cw2", "elbow", max_radius=0.1, direction=MINUS_X)], q, mass_budget=10.0)
     assert "bound: mass_budget" in res.limited_by
-    assert res.metrics["added_mass"] == pytest.approx(10.0, rel=1e-7)
+    assert res.metrics["added_mass"] == pytest.approx(10.0, rel=1e-5)
 
 
 def test_static_impossible_reports_the_least_squares_residual(arm):

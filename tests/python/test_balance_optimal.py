@@ -239,7 +239,7 @@ def test_cone_cuts_stop_when_the_lp_optimum_stops_moving(monkeypatch):
         return res
 
     monkeypatch.setattr(scipy.optimize, "linprog", recording)
-    r = static.balance(mech, slots, 500)
+    r = static.balance(mech, slots, 500, certified=False)   # the cuts: the path without the optimal extra
     assert r.exact and r.residual < 1e-9 * r.residual_before
     for d in r.design.values():
         assert 0.0 <= d.mass <= 50.0 and d.radius <= 0.4 * (1 + 1e-7)

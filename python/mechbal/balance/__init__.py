@@ -30,10 +30,11 @@ from mechbal.balance.result import (
 
 if TYPE_CHECKING:
     from mechbal.balance import force, moment, rms, springs, static
+    from mechbal.balance.fronts import Front
 
 __all__ = ["METHODS", "BalanceResult", "CounterweightSlot", "DiscSlot", "InertiaSlot", "SpringSlot",
            "CounterweightDesign", "SpringDesign", "DiscDesign", "InertiaDesign",
-           "BalancingMethod", "method", "static", "force", "moment", "springs", "rms"]
+           "BalancingMethod", "method", "static", "force", "moment", "springs", "rms", "front"]
 
 #: method name -> module path; each module has ``balance(mechanism, design, samples, **options)``
 METHODS = {
@@ -60,6 +61,13 @@ def method(name: str) -> BalancingMethod:
         raise ValueError(f"method: unknown balancing method '{name}'{did_you_mean(name, list(METHODS))} "
                          f"(known: {', '.join(METHODS)})")
     return cast(BalancingMethod, importlib.import_module(METHODS[name]))
+
+
+def front(mechanism: Any, design: Any, points: int = 20, **options: Any) -> "Front":
+    """The trade-off front between added mass and residual (`mechbal.balance.fronts.front`)."""
+    from mechbal.balance.fronts import front as _front
+
+    return _front(mechanism, design, points, **options)
 
 
 def __getattr__(name: str) -> Any:

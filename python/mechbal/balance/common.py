@@ -281,6 +281,30 @@ def length_scale(mech) -> float:
     return L if L > 1e-6 else 1.0
 
 
+def objective_data(kind: str, mech, slots: Sequence[Slot], probe, col, q, C=None):
+    """The `mechbal.balance.optimal.Objective` of ``kind`` over the poses ``q`` (closed: C the
+    coupling matrices, the actuated coordinates' inertia and torques): "mass" (None: the default),
+    "inertia" (per slot W: the mean trace of the joint-space inertia a point mass adds, plus the
+    slots' own central inertias as a constant), "torque" (the static torque rows over the
+    poses)."""
+    from mechbal.balance import optimal
+
+    if kind not in optimal.OBJECTIVES:
+        raise ValueError(f"objective: must be one of {', '.join(optimal.OBJECTIVES)} (got {kind!r})")
+    if kind == "mass":
+        return None
+    if kind == "inertia":
+        W = optimal.inertia_weights(mech, slots, q, C)
+        return optimal.Objective("inertia", W=W)
+    Y = probe.gravity_regressor(q)
+    A = user_columns(Y, slots, col)
+    b = mech.gravity_torque(q)
+    if C is not None:
+        A = np.einsum("nij,nik->njk", C, A)
+        b = np.einsum("nij,ni->nj", C, b)
+    return optimal.Objective("torque", rows=(A.reshape(-1, A.shape[-1]), b.reshape(-1)))
+
+
 # ---- samples ----------------------------------------------------------------------------------------
 
 def sample_box(mech, lower=None, upper=None, coordinates: str = "independent"):
@@ -382,6 +406,9 @@ class LinearSolution:
     #: a lower bound of the lightest design's added mass [kg] (the last relaxation's optimum);
     #: None when no least-squares solution meets the bounds
     lower_bound: float | None = None
+    #: the conic solver's certificate (`mechbal.balance.optimal`): stages, duality gaps; None when
+    #: solved without it
+    certificate: dict | None = None
 
     def result(self, method: str, slots: Sequence[Slot], design: dict[str, CounterweightDesign],
                residual: float, units: str, metrics: dict[str, Any],
@@ -394,6 +421,68 @@ class LinearSolution:
                              metrics=metrics, balanced=balanced, active_bounds=self.active_bounds,
                              undetermined=self.undetermined, tied=tied_groups(slots),
                              unconstrained=self.unconstrained)
+
+
+@dataclass
+class LinearProblem:
+    """A counterweight balance that is linear in the slots' (m, h): ``A x + b`` over the rows of
+    the samples (``static.problem``, ``force.problem``), the objective data of stage 2 and
+    ``after(balanced) -> (residual, metrics)``, the residual recomputed from a balanced model.
+    `solve` runs `solve_mass_moments` (any budget or residual target), `result` makes the
+    `BalanceResult` of a solution."""
+
+    method: str
+    mechanism: Any
+    slots: list
+    A: np.ndarray
+    b: np.ndarray
+    L: float
+    what: str
+    components: list
+    objective: Any
+    units: str
+    after: Any
+    q: np.ndarray | None = None
+    C: np.ndarray | None = None
+    v: np.ndarray | None = None
+
+    def __post_init__(self):
+        # the rows once reduced to their triangular factor (|A x + b|^2 = |R x + c|^2 + rest): the
+        # solves of a front then never touch the N rows again
+        if self.A.shape[0] > self.A.shape[1]:
+            Q, R = np.linalg.qr(self.A)
+            c = Q.T @ self.b
+            e = self.b - Q @ c        # the rows' part no design reaches (not |b|^2 - |c|^2: cancellation)
+            self._compressed = (R, c, float(e @ e))
+        else:
+            self._compressed = (self.A, self.b, 0.0)
+
+    def solve(self, *, mass_budget: float | None = None, residual_target: float | None = None,
+              certified: bool | None = None) -> LinearSolution:
+        """The design of `solve_mass_moments` for this budget and residual target."""
+        R, c, rest = self._compressed
+        return solve_mass_moments(R, c, self.slots, mass_budget=mass_budget, L=self.L, what=self.what,
+                                  components=self.components, objective=self.objective,
+                                  residual_target=residual_target, certified=certified,
+                                  rows=self.A.shape[0], rest=rest, full=(self.A, self.b))
+
+    def result(self, sol: LinearSolution) -> BalanceResult[CounterweightDesign]:
+        design_out, placed = design_from_solution(sol.x, self.slots, sol.active_bounds)
+        balanced = balanced_mechanism(self.mechanism, placed)
+        residual, metrics = self.after(balanced)
+        metrics.update({
+            "least_squares_residual": sol.least_squares_residual,
+            # conditioning of the design (smallest / largest singular value of the least squares
+            # over the free variables, masses scaled by the mechanism's length): how well the
+            # samples separate the slots' effects
+            "singular_value_ratio": (float(sol.singular_values[-1] / sol.singular_values[0])
+                                     if len(sol.singular_values) and sol.singular_values[0] > 0 else None),
+            "solve": sol.stage,
+            "added_mass": float(sum(m for _, m, _ in placed)),
+        })
+        if sol.certificate is not None:
+            metrics["optimality"] = sol.certificate
+        return sol.result(self.method, self.slots, design_out, residual, self.units, metrics, balanced)
 
 
 def _rref(M: np.ndarray, tol: float = 1e-9) -> np.ndarray:
@@ -520,6 +609,34 @@ class _Design:
 
     def x(self, y):
         return self.P @ y + self.xc
+
+    def project(self, y):
+        """``y`` with the slots' bounds met exactly where an interior-point solve left them met to
+        its tolerance: masses into their ranges, each offset moment scaled into its radius (a
+        change of the order of the solver's feasibility tolerance)."""
+        y = np.array(y, float)
+        for k, s in enumerate(self.slots):
+            j = self.mass_var[k]
+            if j is not None:
+                y[j] = min(max(y[j], s.mass_min * self.L), s.mass_max * self.L)
+            m = y[j] / self.L if j is not None else s.mass_min
+            if math.isfinite(s.max_radius) and not s.fixed_position and self.d_vars[k]:
+                d = y[self.d_vars[k]]
+                nd = float(np.linalg.norm(d))
+                if nd > s.max_radius * m:
+                    y[self.d_vars[k]] = d * (s.max_radius * max(m, 0.0) / nd)
+        if self.budget is not None:
+            total = float(self.mass_row @ y) + sum(self.count[k] * s.mass_min for k, s in enumerate(self.slots)
+                                                   if self.mass_var[k] is None)
+            if total > self.budget and total > 0:
+                # a budget met to the tolerance: scale the free masses and moments down together
+                f = max(self.budget - (total - float(self.mass_row @ y)), 0.0) / max(float(self.mass_row @ y), 1e-300)
+                if f < 1.0:
+                    for k in range(len(self.slots)):
+                        if self.mass_var[k] is not None:
+                            y[self.mass_var[k]] *= f
+                            y[self.d_vars[k]] *= f
+        return y
 
     def _mass(self, k, y):
         j = self.mass_var[k]
@@ -703,12 +820,25 @@ def lightest_within_bounds(dsg: "_Design", y0: np.ndarray, Z: np.ndarray, mscale
 def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
                        mass_budget: float | None = None, L: float = 1.0,
                        what: str = "the balancing condition",
-                       components: Sequence[str] | None = None) -> LinearSolution:
+                       components: Sequence[str] | None = None, objective: Any = None,
+                       residual_target: float | None = None,
+                       certified: bool | None = None, rows: int | None = None, rest: float = 0.0,
+                       full: tuple[np.ndarray, np.ndarray] | None = None) -> LinearSolution:
     """The two stages of the module docstring for ``A x + b = 0`` (rows: every sample and
     component; x: (m, h_user) per slot). The least squares is over the design's free variables
     (a fixed mass is not an unknown; a slot with a direction has one moment along it).
     ``components``: the names of the components of one sample (the rows are sample-major), e.g.
-    "gravity torque of joint 'elbow'": ``limited_by`` names those the slots cannot cancel."""
+    "gravity torque of joint 'elbow'": ``limited_by`` names those the slots cannot cancel.
+
+    ``objective`` (`mechbal.balance.optimal.Objective`, per slot: default the added mass) and
+    ``residual_target`` (RMS over the rows): the lexicographic convex program of
+    `mechbal.balance.optimal` (least residual, then the least objective among the designs of that
+    residual, or within the target). ``certified``: solve it with the conic solver (the
+    ``optimal`` extra) and keep its certificate in ``certificate``; None: when the extra is
+    installed (otherwise the mass objective by polyhedral cuts and SLSQP, without certificate;
+    another objective or a target then needs the extra). ``rows``, ``rest``, ``full``: ``A``, ``b``
+    are a compressed form of the ``full`` rows (their triangular factor: `LinearProblem`), whose RMS
+    is ``sqrt((|A x + b|^2 + rest) / rows)``."""
     A = np.asarray(A, float)
     b = np.asarray(b, float).reshape(-1)
     if A.shape[0] == 0:
@@ -719,8 +849,9 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
     Ay = A @ dsg.P
     by = A @ dsg.xc + b
     ny = Ay.shape[1]
-    before = float(np.sqrt(np.mean(b ** 2)))
-    rms = lambda y: float(np.sqrt(np.mean((Ay @ y + by) ** 2)))  # noqa: E731
+    nrows = A.shape[0] if rows is None else int(rows)
+    before = float(np.sqrt((b @ b + rest) / nrows))
+    rms = lambda y: float(np.sqrt((np.sum((Ay @ y + by) ** 2) + rest) / nrows))  # noqa: E731
     if ny:
         U, sv, Vt = np.linalg.svd(Ay, full_matrices=False)
         rank = int(np.sum(sv > RANK_RTOL * sv[0])) if sv[0] > 0 else 0
@@ -734,22 +865,55 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
     mscale = max([1.0] + [abs(s.mass_min) for s in roots] + [abs(v) / L for v in y0])
     tol = 1e-9
 
-    # stage 2a: the lightest least-squares solution within the bounds: a convex program (linear
-    # objective, linear bounds, second-order cones), solved by HiGHS on polyhedral outer
-    # approximations of the cones (`lightest_within_bounds`)
+    from mechbal.balance import optimal
+
+    if certified is None:
+        certified = optimal.available() or objective is not None or residual_target is not None
+    certificate = None
+    y_limits = None
     d = Z.shape[1]
     y = y0
     lower_bound = None
-    if d:
+    if certified:
+        obj = optimal.Objective() if objective is None else objective
+        if obj.kind == "inertia" and obj.W is not None:     # per slot -> per tied group (x_k = x_root)
+            Wg = [np.zeros((4, 4)) for _ in roots]
+            for k in range(len(slots)):
+                g = int(np.argmax(E[4 * k]))
+                Wg[g // 4] += obj.W[k]
+            obj = optimal.Objective("inertia", W=Wg, constant=obj.constant)
+        if obj.kind == "torque" and obj.rows is not None:
+            obj = optimal.Objective("torque", rows=(obj.rows[0] @ E, obj.rows[1]))
+        conv = optimal.solve(dsg, Ay, by, Z, mscale, objective=obj, residual_target=residual_target, y0=y0,
+                             rows=nrows, rest=rest)
+        # y as solved, on the least-residual set: the bounds are met to the solver's feasibility
+        # tolerance (``bound_violation``, relative to the mass scale), as the cuts below meet them to
+        # CONE_RTOL, rather than projected onto them at the cost of the residual
+        y = conv.y
+        y_limits = conv.y_least
+        certificate = conv.certificate(obj.kind)
+        certificate["least_residual"] = conv.least_residual
+        certificate["objective_value"] = conv.objective
+        certificate["residual_target"] = residual_target
+        certificate["bound_violation"] = dsg.violation(y, mscale)
+        stage = ("least residual within the bounds, then the least " + obj.kind +
+                 (f" within the residual target {residual_target:.6g}" if residual_target is not None else
+                  " among its designs") + " (convex program, certified)")
+        d = 0   # skip the uncertified stages below
+    if d and not certified:
+        # stage 2a: the lightest least-squares solution within the bounds: a convex program (linear
+        # objective, linear bounds, second-order cones), solved by HiGHS on polyhedral outer
+        # approximations of the cones (`lightest_within_bounds`)
         found = lightest_within_bounds(dsg, y0, Z, mscale)
         if found is not None:
             y, lower_bound = found
         else:
             y = y0
-    elif dsg.violation(y0, mscale) <= tol:
+    elif not certified and dsg.violation(y0, mscale) <= tol:
         lower_bound = float(dsg.mass_row @ y0)
-    stage = "least squares within the bounds"
-    if dsg.violation(y, mscale) > tol:
+    if not certified:
+        stage = "least squares within the bounds"
+    if not certified and dsg.violation(y, mscale) > tol:
         # stage 2b: no least-squares solution meets the bounds: constrained least squares, on the
         # triangular factor (|A y + b|^2 = |R y + Q^T b|^2 + const: ny x ny, whatever the rows)
         Qf, Rf = np.linalg.qr(Ay)
@@ -763,27 +927,37 @@ def solve_mass_moments(A: np.ndarray, b: np.ndarray, slots: Sequence[Slot], *,
         starts = [y, np.zeros(ny)]
         y = _slsqp(g, starts, dsg.scipy(lambda yy: yy, np.eye(ny)), lambda yy: dsg.violation(yy, mscale), tol,
                    ftol=1e-13)
+        if Z.shape[1]:
+            # lexicographic: the lightest of the designs with this residual (same A y: y + Z z)
+            found = lightest_within_bounds(dsg, y, Z, mscale)
+            if found is not None:
+                y = found[0]
         stage = "constrained least squares (the bounds exclude every least-squares solution)"
     x = E @ dsg.x(y)
     residual = rms(y)
-    active = dsg.active(y, mscale)
+    # the bounds that limit the balance: those active at the least-residual design (where a band
+    # design stands in for it, it may sit ~1e-6 inside them)
+    active = dsg.active(y if y_limits is None else y_limits, mscale)
     limited = []
     scale = max(before, 1e-300)
     x0 = E @ dsg.x(y0)
     unconstrained = unconstrained_design(x0, slots)
     if ls > EXACT_RTOL * scale:
-        left = uncancelled(Ay @ y0 + by, components, EXACT_RTOL * scale)
+        left = uncancelled((Ay @ y0 + by) if full is None else (full[0] @ E @ dsg.x(y0) + full[1]),
+                           components, EXACT_RTOL * scale)
         limited.append(f"impossible: rank {rank} of {ny} unknowns and a least-squares residual of "
                        f"{ls:.6g} (RMS; {100 * ls / scale:.3g} % of the unbalanced {before:.6g}): these "
                        f"slots cannot make {what} zero over the samples"
                        + (f"; not cancelled: {left}" if left else ""))
-    if residual > max(ls * (1 + 1e-6), EXACT_RTOL * scale):
+    if residual_target is not None and residual <= residual_target * (1 + 1e-6) + EXACT_RTOL * scale:
+        limited = []     # the target was asked for and is met
+    elif residual > max(ls * (1 + 1e-6), EXACT_RTOL * scale):
         limited += [f"bound: {a}" for a in active] or ["bound: the solver could not meet the bounds "
                                                       f"(violation {dsg.violation(y, mscale):.3g})"]
         limited.append(f"unconstrained: without the bounds the least squares (residual {ls:.6g}) asks "
                        f"for {describe_unconstrained(unconstrained)}")
     return LinearSolution(x, residual, before, ls, rank, ny, undetermined, active, limited, stage, sv,
-                          unconstrained=unconstrained, lower_bound=lower_bound)
+                          unconstrained=unconstrained, lower_bound=lower_bound, certificate=certificate)
 
 
 def uncancelled(r: np.ndarray, components: Sequence[str] | None, floor: float) -> str:

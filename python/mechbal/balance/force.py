@@ -65,7 +65,9 @@ def motion_sample(mech, samples, *, seed: int = 0, lower=None, upper=None, q_gue
 def balance(mechanism: Mechanism, design: Sequence[CounterweightSlot] | CounterweightSlot,
             samples: int | npt.ArrayLike = 200, *, mass_budget: float | None = None, seed: int = 0,
             lower: npt.ArrayLike | None = None, upper: npt.ArrayLike | None = None,
-            q_guess: npt.ArrayLike | None = None) -> BalanceResult[CounterweightDesign]:
+            q_guess: npt.ArrayLike | None = None, objective: str = "mass",
+            residual_target: float | None = None,
+            certified: bool | None = None) -> BalanceResult[CounterweightDesign]:
     """Counterweights that make the linear momentum zero (least squares) over sampled motions:
     complete shaking-force balance where the residual is zero.
 
@@ -73,6 +75,18 @@ def balance(mechanism: Mechanism, design: Sequence[CounterweightSlot] | Counterw
     (q, v), or a tuple of arrays (`motion_sample`); ``mass_budget``: bound on the total
     counterweight mass. ``residual``: the RMS linear momentum of the balanced mechanism over the
     samples [kg m/s], recomputed from the balanced model."""
+    prob = problem(mechanism, design, samples, seed=seed, lower=lower, upper=upper, q_guess=q_guess,
+                   objective=objective)
+    return prob.result(prob.solve(mass_budget=mass_budget, residual_target=residual_target, certified=certified))
+
+
+def problem(mechanism: Mechanism, design: Sequence[CounterweightSlot] | CounterweightSlot,
+            samples: int | npt.ArrayLike = 200, *, seed: int = 0, lower: npt.ArrayLike | None = None,
+            upper: npt.ArrayLike | None = None, q_guess: npt.ArrayLike | None = None,
+            objective: str = "mass") -> common.LinearProblem:
+    """The force balance of `balance` as a `mechbal.balance.common.LinearProblem` (built once,
+    solved for several budgets or residual targets: `mechbal.balance.front`; a partial force
+    balance under a mass budget is ``problem(...).solve(mass_budget=B)``)."""
     mech = mechanism
     slots = common.normalise_slots(mech, design)
     q, v, dropped = motion_sample(mech, samples, seed=seed, lower=lower, upper=upper, q_guess=q_guess)
@@ -80,27 +94,23 @@ def balance(mechanism: Mechanism, design: Sequence[CounterweightSlot] | Counterw
     Y = probe.momentum_regressor(q, v)[:, :3, :]                         # (N, 3, 10 L)
     A = common.user_columns(Y, slots, col)                               # (N, 3, 4K)
     b = mech.momentum(q, v).linear_momentum
-    sol = common.solve_mass_moments(A.reshape(-1, A.shape[-1]), b.reshape(-1), slots,
-                                    mass_budget=mass_budget, L=common.length_scale(mech),
-                                    what="the linear momentum (shaking force)",
-                                    components=[f"linear momentum {a}" for a in "xyz"])
-    design_out, placed = common.design_from_solution(sol.x, slots, sol.active_bounds)
-    balanced = common.balanced_mechanism(mech, placed)
-    after = balanced.momentum(q, v).linear_momentum
-    residual = float(np.sqrt(np.mean(after ** 2)))
-    metrics = {
-        "samples": int(len(q)), "dropped_samples": int(dropped),
-        "linear_momentum_rms_before": np.sqrt(np.mean(b ** 2, axis=0)),
-        "linear_momentum_rms_after": np.sqrt(np.mean(after ** 2, axis=0)),
-        "least_squares_residual": sol.least_squares_residual,
-        # conditioning of the design (smallest / largest singular value of the least squares over
-        # the free variables, masses scaled by the mechanism's length): how well the samples
-        # separate the slots' effects
-        "singular_value_ratio": (float(sol.singular_values[-1] / sol.singular_values[0])
-                                 if len(sol.singular_values) and sol.singular_values[0] > 0 else None),
-        "solve": sol.stage,
-        "added_mass": float(sum(m for _, m, _ in placed)),
-        "total_mass_after": balanced.total_mass,
-    }
-    return sol.result("force", slots, design_out, residual,
-                      "kg m/s (RMS linear momentum over the sampled motions)", metrics, balanced)
+    if objective == "torque" and mech.is_closed:
+        raise ValueError("objective: 'torque' (the peak static torque) is the static method's for a closed "
+                         "mechanism (the force method samples no coupling matrices)")
+
+    def after(balanced):
+        p = balanced.momentum(q, v).linear_momentum
+        metrics = {
+            "samples": int(len(q)), "dropped_samples": int(dropped),
+            "linear_momentum_rms_before": np.sqrt(np.mean(b ** 2, axis=0)),
+            "linear_momentum_rms_after": np.sqrt(np.mean(p ** 2, axis=0)),
+            "total_mass_after": balanced.total_mass,
+        }
+        return float(np.sqrt(np.mean(p ** 2))), metrics
+
+    # the inertia of a closed mechanism: the trace over all its coordinates
+    return common.LinearProblem(
+        "force", mech, slots, A.reshape(-1, A.shape[-1]), b.reshape(-1), common.length_scale(mech),
+        "the linear momentum (shaking force)", [f"linear momentum {a}" for a in "xyz"],
+        common.objective_data(objective, mech, slots, probe, col, q),
+        "kg m/s (RMS linear momentum over the sampled motions)", after, q=q, v=v)

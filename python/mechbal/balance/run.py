@@ -300,8 +300,26 @@ def _comparison(before: dict, after: dict) -> dict:
 
 # ---- the run -------------------------------------------------------------------------------------
 
-def run_method(bc: BalanceCase, name: str) -> BalanceResult:
-    """Run balancing method ``name`` on the case (slots from ``[balance]``, else the case's own)."""
+#: the methods of --objective, --residual-target and --front (linear in the counterweights)
+OPTIMAL_METHODS = ("static", "force")
+
+
+def run_method(bc: BalanceCase, name: str, *, objective: str | None = None,
+               residual_target: float | None = None) -> BalanceResult:
+    """Run balancing method ``name`` on the case (slots from ``[balance]``, else the case's own);
+    ``objective`` and ``residual_target``: the convex stage 2 of the static and force methods
+    (`mechbal.balance.optimal`)."""
+    optimal_opts = {}
+    for flag, v in (("--objective", objective), ("--residual-target", residual_target)):
+        if v is not None and name not in OPTIMAL_METHODS:
+            raise ConfigError(flag, f"is for the methods linear in the counterweights ({', '.join(OPTIMAL_METHODS)}), "
+                                    f"not {name!r}", v)
+    if residual_target is not None and not (math.isfinite(residual_target) and residual_target >= 0):
+        raise ConfigError("--residual-target", "must be a finite number >= 0", residual_target)
+    if objective is not None:
+        optimal_opts["objective"] = objective
+    if residual_target is not None:
+        optimal_opts["residual_target"] = residual_target
     if name not in METHODS:
         raise ConfigError("--method", f"unknown balancing method (known: {', '.join(METHODS)})", name)
     try:
@@ -351,8 +369,55 @@ def run_method(bc: BalanceCase, name: str) -> BalanceResult:
     for key, v in (("lower", lower), ("upper", upper)):
         if v is not None and len(v) != width:
             raise ConfigError(f"balance.{key}", f"must have {width} values", list(v))
-    return module.balance(mech, slots, int(n), mass_budget=budget, seed=table.seed if table is not None else 0,
-                          lower=lower, upper=upper, q_guess=bc.q_guess)
+    kwargs = dict(mass_budget=budget, seed=table.seed if table is not None else 0, lower=lower, upper=upper,
+                  q_guess=bc.q_guess)
+    if optimal_opts:
+        from mechbal.balance.optimal import MissingExtra
+
+        try:
+            return module.balance(mech, slots, int(n), **kwargs, **optimal_opts)
+        except MissingExtra as exc:
+            raise ConfigError("--objective" if objective is not None else "--residual-target", str(exc),
+                              has_value=False) from None
+        except ValueError as exc:
+            raise ConfigError("", str(exc), has_value=False) from None
+    return module.balance(mech, slots, int(n), **kwargs)
+
+
+def run_front(bc: BalanceCase, name: str, points: int, out: Path) -> dict:
+    """The trade-off front (`mechbal.balance.fronts`) of the case's counterweight design into
+    ``out``: front.csv, front.json, front.png, front/<k>/balanced.toml. Returns what summary.json
+    says of it."""
+    from mechbal.balance import fronts as fr
+    from mechbal.balance.optimal import MissingExtra
+
+    if name not in OPTIMAL_METHODS:
+        raise ConfigError("--front", f"is for the methods linear in the counterweights ({', '.join(OPTIMAL_METHODS)}), "
+                                     f"not {name!r}", points)
+    if points < 2:
+        raise ConfigError("--front", "must be an integer >= 2 (the number of designs)", points)
+    table = bc.table
+    slots = slots_from_table(table) or list(bc.default_slots)
+    n = table.samples if table is not None and table.samples is not None else DEFAULT_SAMPLES[name]
+    lower = table.lower if table is not None else None
+    upper = table.upper if table is not None else None
+    if bc.mechanism.is_closed and lower is None and upper is None:
+        lower, upper = np.min(bc.motion[0], axis=0), np.max(bc.motion[0], axis=0)
+    ev = lambda m: (lambda e: {"torque": e["torque"], "shaking_force": e["shaking_force"],  # noqa: E731
+                               "shaking_moment": e["shaking_moment"]})(evaluate(bc, m))
+    try:
+        front = fr.front(bc.mechanism, slots, points, method=name, samples=int(n),
+                         mass_budget=table.mass_budget if table is not None else None,
+                         seed=table.seed if table is not None else 0, lower=lower, upper=upper,
+                         q_guess=bc.q_guess, evaluate=ev)
+    except MissingExtra as exc:
+        raise ConfigError("--front", str(exc), has_value=False) from None
+    front.motion = "the case's [trajectory]"
+    files = fr.write(front, out, lambda r: _balanced_toml(bc, r, name), case=bc.name,
+                     title=f"{bc.title}: {name} balance, least residual per added-mass budget")
+    return {"points": len(front.points), "knee": front.knee, "files": files,
+            "added_mass_kg": [p.added_mass for p in front.points],
+            "residual": [p.residual for p in front.points]}
 
 
 def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
@@ -421,8 +486,12 @@ def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
     return toml_text(data, header)
 
 
-def run_balance(case: str, method: str | None, out: Path, design: str | None = None) -> dict:
-    """The whole run into ``out`` (a fresh folder: the caller stages it). Returns the summary."""
+def run_balance(case: str, method: str | None, out: Path, design: str | None = None, *,
+                objective: str | None = None, residual_target: float | None = None,
+                front: int | None = None) -> dict:
+    """The whole run into ``out`` (a fresh folder: the caller stages it). Returns the summary.
+    ``objective``, ``residual_target``: `run_method`'s; ``front``: also the trade-off front of
+    that many designs (`run_front`)."""
     progress.stage("reading the case")
     bc = load_case(case, design)
     name = method or (bc.table.method if bc.table is not None else None)
@@ -430,7 +499,7 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
         raise ConfigError("--method", "give --method static|force|moment|springs|rms (or balance.method "
                                       "in the case)", has_value=False)
     progress.stage(f"balancing ({name})")
-    result = run_method(bc, name)
+    result = run_method(bc, name, objective=objective, residual_target=residual_target)
     progress.stage("evaluating the trajectory")
     before = evaluate(bc, bc.mechanism)
     after = evaluate(bc, result.balanced)
@@ -490,6 +559,12 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
                "total_mass": {"unbalanced": bc.mechanism.total_mass, "balanced": result.balanced.total_mass},
                "files": files}
     summary.update(export_notes)
+    if "optimality" in result.metrics:
+        summary["optimality"] = result.metrics["optimality"]
+    if front is not None:
+        progress.stage("front")
+        summary["front"] = run_front(bc, name, int(front), out)
+        files += ["front.csv", "front.json", "front.png"]
     if bc.assembly is not None:
         summary["assembly"] = bc.assembly
     if bc.notes:

@@ -64,7 +64,9 @@ def gravity_rows(mech, q, C=None) -> np.ndarray:
 def balance(mechanism: Mechanism, design: Sequence[CounterweightSlot] | CounterweightSlot,
             samples: int | npt.ArrayLike = 1000, *, mass_budget: float | None = None, seed: int = 0,
             lower: npt.ArrayLike | None = None, upper: npt.ArrayLike | None = None,
-            q_guess: npt.ArrayLike | None = None) -> BalanceResult[CounterweightDesign]:
+            q_guess: npt.ArrayLike | None = None, objective: str = "mass",
+            residual_target: float | None = None,
+            certified: bool | None = None) -> BalanceResult[CounterweightDesign]:
     """Counterweights that make the gravity torque zero (least squares) over a workspace sample.
 
     ``design``: the counterweight slots (`CounterweightSlot`: link, mass range, distance
@@ -77,6 +79,17 @@ def balance(mechanism: Mechanism, design: Sequence[CounterweightSlot] | Counterw
     least-squares solution meets them, the constrained least squares, with the active bounds in
     ``limited_by``. ``residual`` is the RMS gravity torque of the balanced mechanism over the
     sample [N m], recomputed from the balanced model."""
+    prob = problem(mechanism, design, samples, seed=seed, lower=lower, upper=upper, q_guess=q_guess,
+                   objective=objective)
+    return prob.result(prob.solve(mass_budget=mass_budget, residual_target=residual_target, certified=certified))
+
+
+def problem(mechanism: Mechanism, design: Sequence[CounterweightSlot] | CounterweightSlot,
+            samples: int | npt.ArrayLike = 1000, *, seed: int = 0, lower: npt.ArrayLike | None = None,
+            upper: npt.ArrayLike | None = None, q_guess: npt.ArrayLike | None = None,
+            objective: str = "mass") -> common.LinearProblem:
+    """The static balance of `balance` as a `mechbal.balance.common.LinearProblem` (built once,
+    solved for several budgets or residual targets: `mechbal.balance.front`)."""
     mech = mechanism
     slots = common.normalise_slots(mech, design)
     q, C, qa, dropped = workspace_sample(mech, samples, seed=seed, lower=lower, upper=upper, q_guess=q_guess)
@@ -87,24 +100,21 @@ def balance(mechanism: Mechanism, design: Sequence[CounterweightSlot] | Counterw
     if C is not None:
         A = np.einsum("nij,nik->njk", C, A)
         b = np.einsum("nij,ni->nj", C, b)
-    sol = common.solve_mass_moments(A.reshape(-1, A.shape[-1]), b.reshape(-1), slots,
-                                    mass_budget=mass_budget, L=common.length_scale(mech),
-                                    what="the gravity torque",
-                                    components=[f"gravity torque of joint '{n}'" for n in
-                                                (mech.joint_names if C is None else mech.actuated_names)])
-    design_out, placed = common.design_from_solution(sol.x, slots, sol.active_bounds)
-    balanced = common.balanced_mechanism(mech, placed)
-    after = gravity_rows(balanced, q, C)
-    residual = float(np.sqrt(np.mean(after ** 2)))
-    metrics = {
-        "samples": int(len(q)), "dropped_samples": int(dropped),
-        "gravity_torque_rms_before": np.sqrt(np.mean(b ** 2, axis=0)),
-        "gravity_torque_rms_after": np.sqrt(np.mean(after ** 2, axis=0)),
-        "gravity_torque_peak_before": np.max(np.abs(b), axis=0),
-        "gravity_torque_peak_after": np.max(np.abs(after), axis=0),
-        "least_squares_residual": sol.least_squares_residual,
-        "solve": sol.stage,
-        "added_mass": float(sum(m for _, m, _ in placed)),
-    }
-    return sol.result("static", slots, design_out, residual, "N m (RMS gravity torque over the sample)",
-                      metrics, balanced)
+
+    def after(balanced):
+        g = gravity_rows(balanced, q, C)
+        metrics = {
+            "samples": int(len(q)), "dropped_samples": int(dropped),
+            "gravity_torque_rms_before": np.sqrt(np.mean(b ** 2, axis=0)),
+            "gravity_torque_rms_after": np.sqrt(np.mean(g ** 2, axis=0)),
+            "gravity_torque_peak_before": np.max(np.abs(b), axis=0),
+            "gravity_torque_peak_after": np.max(np.abs(g), axis=0),
+        }
+        return float(np.sqrt(np.mean(g ** 2))), metrics
+
+    return common.LinearProblem(
+        "static", mech, slots, A.reshape(-1, A.shape[-1]), b.reshape(-1), common.length_scale(mech),
+        "the gravity torque", [f"gravity torque of joint '{n}'" for n in
+                               (mech.joint_names if C is None else mech.actuated_names)],
+        common.objective_data(objective, mech, slots, probe, col, q, C),
+        "N m (RMS gravity torque over the sample)", after, q=q, C=C)
