@@ -9,8 +9,8 @@ the C++ loader.
 
 Modules: `mechbal.identify.logs` (reading and checking logs), `mechbal.identify.signal`
 (uniform grid, filtering, derivatives), `mechbal.identify.model` (segments and parameters),
-`mechbal.identify.base` (base parameters), `mechbal.identify.consistent` (log-Cholesky),
-`mechbal.identify.fit`, `mechbal.identify.excite`, `mechbal.identify.synthetic` (logs of a known
+`mechbal.identify.base` (base parameters), `mechbal.identify.consistent` (the LMI fit),
+`mechbal.identify.fitting`, `mechbal.identify.excite`, `mechbal.identify.synthetic` (logs of a known
 model), `mechbal.identify.report` (files and plots).
 
 Layer: methods (docs/architecture.md).
@@ -18,7 +18,7 @@ Layer: methods (docs/architecture.md).
 from __future__ import annotations
 
 from mechbal.identify.excite import Excitation, excite, fourier_motion
-from mechbal.identify.fit import (MODELS, Friction, IdentificationResult, IdentifyError, Validation,
+from mechbal.identify.fitting import (MODELS, Friction, IdentificationResult, IdentifyError, Validation,
                                   fit)
 from mechbal.identify.logs import Log, LogError, read_log
 from mechbal.identify.synthetic import simulate_log

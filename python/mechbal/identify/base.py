@@ -10,7 +10,7 @@ are the base parameters' leading columns, and the dependent ones regroup onto th
 ``beta = pi_b + K pi_d`` with ``R_b K = R_d``. Columns that are zero at every state (a
 parameter no joint torque depends on) regroup onto nothing. Which parameters are identifiable is
 a property of the mechanism's structure, not of a log; whether a given log determines them is
-checked on its own regressor (`mechbal.identify.fit`).
+checked on its own regressor (`mechbal.identify.fitting`).
 
 Layer: methods (docs/architecture.md).
 """

@@ -1,4 +1,4 @@
-"""Physically consistent inertial parameters: the log-Cholesky parameterisation.
+"""Physically consistent inertial parameters: a convex fit under linear matrix inequalities.
 
 A body's 10 parameters are physically consistent (a non-negative mass density over some region
 can have them) exactly when its pseudo-inertia matrix
@@ -6,14 +6,20 @@ can have them) exactly when its pseudo-inertia matrix
     J = [[Sigma, h], [h^T, m]],  Sigma = tr(I)/2 * 1 - I  (second moment, I about the origin)
 
 is positive semi-definite (Wensing, Kim & Slotine 2017): positive mass, inertia positive
-semi-definite and the triangle inequality of its principal moments all follow. Writing
-``J = U U^T`` with ``U = e^alpha [[e^d1, s12, s13, t1], [0, e^d2, s23, t2], [0, 0, e^d3, t3],
-[0, 0, 0, 1]]`` (Rucker & Wensing 2022, the log-Cholesky parameterisation) makes every real
-theta = (alpha, d1, d2, d3, s12, s23, s13, t1, t2, t3) a consistent body, and every consistent
-body with J positive definite one theta: the constrained fit becomes an unconstrained nonlinear
-least squares, solved by `scipy.optimize.least_squares` (trust region; the friction
-coefficients bounded at zero: viscous and Coulomb friction dissipate). ``mass_bounds`` (relative
-to the CAD mass) bound alpha, which bounds each mass around its CAD value.
+semi-definite and the triangle inequality of its principal moments all follow. J is linear in
+the parameters, so the fit
+
+    minimise |R x - z|^2 + sum_k d_k (pi_k - pi_cad_k)^2
+    subject to J_b(pi) >= 0 for every body b, viscous >= 0, Coulomb >= 0
+               (and, if asked, each mass within bounds around its CAD value)
+
+is a convex semi-definite least squares (an LMI problem). It is solved here without an extra
+dependency by ADMM (Boyd et al. 2011, the splitting of the OSQP / SCS conic solvers: a linear
+solve with a factorised matrix, then a projection onto the cone -- eigenvalues of each 4 x 4 J
+clipped at zero --, variables scaled to a unit diagonal, the penalty adapted to balance the
+primal and dual residuals). The parameters returned are those of the projected J's: consistent
+to rounding. d_k is ``regularisation`` times the squared norm of column k of R (plus a floor), a
+pull towards the CAD values that decides only what the data leave free.
 
 Layer: methods (docs/architecture.md).
 """
@@ -22,9 +28,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 
-__all__ = ["theta_to_parameters", "parameters_to_theta", "pseudo_inertia", "consistency",
-           "BodyConsistency", "consistent_fit"]
+__all__ = ["pseudo_inertia", "consistency", "BodyConsistency", "consistent_fit"]
 
 
 def pseudo_inertia(pi) -> np.ndarray:
@@ -40,50 +46,9 @@ def pseudo_inertia(pi) -> np.ndarray:
     return J
 
 
-def theta_to_parameters(theta):
-    """pi (..., 10) of theta (..., 10) (real or complex: the complex step differentiates it)."""
-    th = np.asarray(theta)
-    e = np.exp
-    a, d1, d2, d3, s12, s23, s13, t1, t2, t3 = np.moveaxis(th, -1, 0)
-    z = np.zeros_like(a)
-    one = np.ones_like(a)
-    U = np.stack([np.stack([e(d1), s12, s13, t1], -1), np.stack([z, e(d2), s23, t2], -1),
-                  np.stack([z, z, e(d3), t3], -1), np.stack([z, z, z, one], -1)], -2)
-    U = U * e(a)[..., None, None]
-    J = U @ np.swapaxes(U, -1, -2)
-    m = J[..., 3, 3]
-    h = J[..., :3, 3]
-    Sigma = J[..., :3, :3]
-    tr = np.trace(Sigma, axis1=-2, axis2=-1)
-    Io = tr[..., None, None] * np.eye(3) - Sigma
-    return np.stack([m, h[..., 0], h[..., 1], h[..., 2], Io[..., 0, 0], Io[..., 0, 1], Io[..., 1, 1],
-                     Io[..., 0, 2], Io[..., 1, 2], Io[..., 2, 2]], -1)
-
-
-def parameters_to_theta(pi, *, floor: float = 1e-9) -> np.ndarray:
-    """theta of 10 parameters; a J that is not positive definite is first moved to the nearest
-    one with eigenvalues at least ``floor`` times its largest (a CAD body with zero mass or a
-    point mass, say)."""
-    J = pseudo_inertia(pi)
-    w, V = np.linalg.eigh(J)
-    lo = floor * max(float(w.max()), 1e-12)
-    if w.min() < lo:
-        J = (V * np.maximum(w, lo)) @ V.T
-    P = np.eye(4)[::-1]
-    L = np.linalg.cholesky(P @ J @ P)
-    U = P @ L @ P
-    alpha = np.log(U[3, 3])
-    U = U / U[3, 3]
-    return np.array([alpha, np.log(U[0, 0]), np.log(U[1, 1]), np.log(U[2, 2]), U[0, 1], U[1, 2], U[0, 2],
-                     U[0, 3], U[1, 3], U[2, 3]])
-
-
-def parameters_jacobian(theta: np.ndarray, h: float = 1e-30) -> np.ndarray:
-    """d pi / d theta (S, 10, 10) of theta (S, 10), by the complex step (exact to rounding)."""
-    S = theta.shape[0]
-    th = np.repeat(theta[:, None, :].astype(complex), 10, axis=1)
-    th[:, np.arange(10), np.arange(10)] += 1j * h
-    return np.swapaxes(theta_to_parameters(th).imag / h, 1, 2).reshape(S, 10, 10)
+def _pseudo_inertia_map() -> np.ndarray:
+    """E (16, 10): vec(J) = E pi."""
+    return np.column_stack([pseudo_inertia(np.eye(10)[k]).reshape(-1) for k in range(10)])
 
 
 @dataclass(frozen=True)
@@ -112,57 +77,111 @@ def consistency(name: str, pi) -> BodyConsistency:
                            min_pseudo_inertia_eigenvalue=jmin, consistent=ok)
 
 
+@dataclass(frozen=True)
+class SolverReport:
+    """How the ADMM iterations ended: ``converged`` (primal and dual residuals below
+    ``tolerance``), ``iterations``, the final relative residuals."""
+
+    converged: bool
+    iterations: int
+    primal_residual: float
+    dual_residual: float
+    tolerance: float
+
+
 def consistent_fit(R: np.ndarray, z: np.ndarray, n_segments: int, n_friction: int, cad: np.ndarray, *,
                    regularisation: float = 1e-6, mass_bounds: tuple[float, float] | None = None,
-                   x0_friction: np.ndarray | None = None, max_nfev: int = 2000):
-    """Minimise ``|R x - z|^2 + regularisation * sum_k c_k^2 (pi_k - pi_cad_k)^2`` over consistent
-    inertial parameters pi (S bodies) and friction x_f (viscous, Coulomb >= 0, offset free), x =
-    [pi, x_f]. ``R`` (P, P), ``z`` (P,): the compressed weighted least squares (R of the QR
-    decomposition of the weighted regressor); c_k: the norm of column k of R (so that the pull
-    towards the CAD values only decides what the data leave free). Returns (x, scipy's result)."""
-    from scipy.optimize import least_squares
-
-    S = n_segments
+                   tolerance: float = 1e-7, max_iterations: int = 30000) -> tuple[np.ndarray, SolverReport]:
+    """The fit of the module docstring: ``R`` (P, P), ``z`` (P,) the compressed weighted least
+    squares (R of the QR decomposition of the weighted regressor), x = [pi (10 S), friction
+    (viscous, Coulomb, offset per joint)]; ``mass_bounds`` (low, high): factors of each body's CAD
+    mass (bodies with a CAD mass only). Returns (x, `SolverReport`)."""
+    S = int(n_segments)
     Pi = 10 * S
+    P = R.shape[1]
     c2 = np.sum(R[:, :Pi] ** 2, axis=0)
     c2 = c2 + 1e-6 * max(float(np.mean(c2)), 1e-300)
-    reg = np.sqrt(regularisation * c2)
-    theta0 = np.concatenate([parameters_to_theta(cad[10 * i:10 * i + 10]) for i in range(S)])
-    f0 = np.zeros(n_friction) if x0_friction is None else np.asarray(x0_friction, float).copy()
-    lo = np.full(Pi + n_friction, -np.inf)
-    hi = np.full(Pi + n_friction, np.inf)
-    lo[Pi::3] = 0.0          # viscous
-    lo[Pi + 1::3] = 0.0      # Coulomb
-    f0[0::3] = np.maximum(f0[0::3], 0.0)
-    f0[1::3] = np.maximum(f0[1::3], 0.0)
+    d = np.zeros(P)
+    d[:Pi] = regularisation * c2
+    x_ref = np.zeros(P)
+    x_ref[:Pi] = cad
+    # constraint rows: vec(J) of every body (cone), then boxes (friction >= 0, masses)
+    E = _pseudo_inertia_map()
+    box_rows, lo, hi = [], [], []
+    for k in range(n_friction // 3):
+        for c in (0, 1):
+            row = np.zeros(P)
+            row[Pi + 3 * k + c] = 1.0
+            box_rows.append(row)
+            lo.append(0.0)
+            hi.append(np.inf)
     if mass_bounds is not None:
-        for i in range(S):
-            m = cad[10 * i]
+        for b in range(S):
+            m = cad[10 * b]
             if m > 0:
-                lo[10 * i] = 0.5 * np.log(m * mass_bounds[0]) if mass_bounds[0] > 0 else -np.inf
-                hi[10 * i] = 0.5 * np.log(m * mass_bounds[1])
-                theta0[10 * i] = np.clip(theta0[10 * i], lo[10 * i] + 1e-12, hi[10 * i] - 1e-12)
-    y0 = np.concatenate([theta0, f0])
-    y0 = np.clip(y0, np.where(np.isfinite(lo), lo + 1e-12, lo), hi)
+                row = np.zeros(P)
+                row[10 * b] = 1.0
+                box_rows.append(row)
+                lo.append(m * mass_bounds[0])
+                hi.append(m * mass_bounds[1])
+    M = np.zeros((16 * S + len(box_rows), P))
+    M[:16 * S, :Pi] = np.kron(np.eye(S), E)
+    if box_rows:
+        M[16 * S:] = np.array(box_rows)
+    lo_a, hi_a = np.array(lo), np.array(hi)
+    H0 = R.T @ R + np.diag(d)
+    sc = 1.0 / np.sqrt(np.maximum(np.diag(H0), 1e-300))   # x = sc * y: H with a unit diagonal
+    H = H0 * np.outer(sc, sc)
+    g = sc * (R.T @ z + d * x_ref)
+    Ms = M * sc[None, :]
+    MtM = Ms.T @ Ms
+    rho = 1.0
 
-    def unpack(y):
-        th = y[:Pi].reshape(S, 10)
-        return th, np.concatenate([theta_to_parameters(th).reshape(-1), y[Pi:]])
+    def project(v):
+        out = v.copy()
+        J = v[:16 * S].reshape(S, 4, 4)
+        J = 0.5 * (J + np.swapaxes(J, 1, 2))
+        w, V = np.linalg.eigh(J)
+        out[:16 * S] = ((V * np.maximum(w, 0.0)[:, None, :]) @ np.swapaxes(V, 1, 2)).reshape(-1)
+        out[16 * S:] = np.clip(v[16 * S:], lo_a, hi_a)
+        return out
 
-    def fun(y):
-        _, x = unpack(y)
-        return np.concatenate([R @ x - z, reg * (x[:Pi] - cad)])
-
-    def jac(y):
-        th, _ = unpack(y)
-        D = parameters_jacobian(th)          # (S, 10 pi, 10 theta)
-        dx = np.zeros((Pi + n_friction, Pi + n_friction))
-        for i in range(S):
-            dx[10 * i:10 * i + 10, 10 * i:10 * i + 10] = D[i]
-        dx[Pi:, Pi:] = np.eye(n_friction)
-        return np.vstack([R @ dx, reg[:, None] * dx[:Pi]])
-
-    sol = least_squares(fun, y0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac",
-                        max_nfev=max_nfev, xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    _, x = unpack(sol.x)
-    return x, sol
+    F = scipy.linalg.cho_factor(H + rho * MtM)
+    y = scipy.linalg.cho_solve(F, g)
+    Zc = project(Ms @ y)
+    U = np.zeros_like(Zc)
+    r_rel = s_rel = np.inf
+    it = 0
+    for it in range(1, int(max_iterations) + 1):
+        y = scipy.linalg.cho_solve(F, g + rho * Ms.T @ (Zc - U))
+        My = Ms @ y
+        Z_old = Zc
+        Zc = project(My + U)
+        U += My - Zc
+        r = float(np.linalg.norm(My - Zc))
+        s = float(rho * np.linalg.norm(Ms.T @ (Zc - Z_old)))
+        r_rel = r / max(float(np.linalg.norm(My)), float(np.linalg.norm(Zc)), 1e-300)
+        s_rel = s / max(float(rho * np.linalg.norm(Ms.T @ U)), 1e-300)
+        if r_rel < tolerance and s_rel < tolerance:
+            break
+        if it % 50 == 0:      # residual balancing (Boyd et al. 2011, section 3.4.1)
+            if r > 10.0 * s:
+                rho, U = 2.0 * rho, U / 2.0
+            elif s > 10.0 * r:
+                rho, U = rho / 2.0, U * 2.0
+            else:
+                continue
+            F = scipy.linalg.cho_factor(H + rho * MtM)
+    x = sc * y
+    # the consistent parameters: those of the projected J's (E is injective), the boxes clipped
+    pi = np.linalg.lstsq(np.kron(np.eye(S), E), Zc[:16 * S], rcond=None)[0]
+    xf = x[Pi:].copy()
+    xf[0::3] = np.maximum(xf[0::3], 0.0)
+    xf[1::3] = np.maximum(xf[1::3], 0.0)
+    if mass_bounds is not None:
+        for b in range(S):
+            if cad[10 * b] > 0:
+                pi[10 * b] = np.clip(pi[10 * b], cad[10 * b] * mass_bounds[0], cad[10 * b] * mass_bounds[1])
+    report = SolverReport(converged=bool(r_rel < tolerance and s_rel < tolerance), iterations=it,
+                          primal_residual=float(r_rel), dual_residual=float(s_rel), tolerance=float(tolerance))
+    return np.concatenate([pi, xf]), report

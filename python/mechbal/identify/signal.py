@@ -9,15 +9,17 @@ The defaults (each a keyword of `prepare`):
    uniform grid of the nominal step (linear interpolation), the largest deviation reported.
 3. **Filtering**: a zero-phase Butterworth low-pass of order 4 (``scipy.signal.sosfiltfilt``) on
    q, v and tau alike (the same filter on both sides of tau = Y pi). The cut-off ``cutoff_hz``
-   defaults to 5 times the frequency below which 99 % of the velocity's power lies (from the
+   defaults to 8 times the frequency below which 99 % of the velocity's power lies (from the
    data's spectrum), at most 0.4 times the sampling rate.
 4. **Derivatives**: v from the filtered positions when the log has none (central differences),
    the accelerations from the filtered velocities (central differences).
 5. **Edges**: the filter runs over the segment extended at both ends by three periods of the
    cut-off (odd extension: value and slope continue), then ``trim`` samples at each end are
-   dropped (default: two periods of the cut-off, what is left of the filter's start-up).
+   dropped (default: three periods of the cut-off, what is left of the filter's start-up).
 6. **Decimation**: after filtering, every ``decimate``-th sample is kept (default: down to about
    20 times the cut-off), which keeps the information and makes the regressor smaller.
+7. **Parallel filtering**: the regressor's columns pass through the same filter as the torque
+   (`Segment.filtered`), so that the fit compares like with like.
 
 Layer: methods (docs/architecture.md).
 """
@@ -37,9 +39,12 @@ FILTER_ORDER = 4
 
 @dataclass(frozen=True)
 class Segment:
-    """A uniform, filtered stretch of a log: time (N,), filtered q, v, a, tau (N, dof) and the
-    measured (unfiltered, resampled) tau, and sign(v) passed through the same filter (the Coulomb
-    friction's regressor column: filtered like the torque it explains)."""
+    """A uniform stretch of a log at the log's own rate: time (N,), filtered q, v, a and tau
+    (N, dof), the measured (unfiltered, resampled) tau, the filter (second-order sections ``sos``
+    and its edge extension ``pad``) and ``keep``: the samples used (edges trimmed, decimated).
+    `regressor_rows` filters the regressor's columns with the same filter as the torque
+    (Gautier's parallel filtering: then ``Y(q, v, a) pi`` filtered equals ``tau`` filtered, exactly,
+    whatever the frequencies of the nonlinear terms)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -47,7 +52,19 @@ class Segment:
     a: np.ndarray
     tau: np.ndarray
     tau_measured: np.ndarray
-    sign_v: np.ndarray
+    sos: np.ndarray
+    pad: int
+    keep: slice
+
+    @property
+    def samples(self) -> int:
+        return len(range(*self.keep.indices(self.t.size)))
+
+    def filtered(self, columns: np.ndarray) -> np.ndarray:
+        """``columns`` (N, ...) through the segment's filter, at the kept samples."""
+        shape = columns.shape
+        out = lowpass(columns.reshape(shape[0], -1), self.sos, self.pad)
+        return out.reshape(shape)[self.keep]
 
 
 @dataclass(frozen=True)
@@ -62,7 +79,7 @@ class PreparedLog:
 
     @property
     def samples(self) -> int:
-        return int(sum(s.t.size for s in self.segments))
+        return int(sum(s.samples for s in self.segments))
 
 
 def lowpass(x: np.ndarray, sos: np.ndarray, pad: int = 0) -> np.ndarray:
@@ -81,7 +98,7 @@ def _butter(cutoff_hz: float, fs: float) -> np.ndarray:
     return butter(FILTER_ORDER, cutoff_hz, btype="low", fs=fs, output="sos")
 
 
-def cutoff_from_spectrum(v: np.ndarray, fs: float, *, energy: float = 0.99, factor: float = 5.0) -> float:
+def cutoff_from_spectrum(v: np.ndarray, fs: float, *, energy: float = 0.99, factor: float = 8.0) -> float:
     """``factor`` times the frequency below which ``energy`` of the power of v (N, k) lies
     (means removed), at most 0.4 fs."""
     x = np.asarray(v, float) - np.mean(v, axis=0)
@@ -158,13 +175,13 @@ def prepare(log: Log, *, cutoff_hz: float | None = None, gap_factor: float = 3.0
         longest = max(pieces, key=lambda p: p[0].size)
         vel = longest[1][2] if has_v else np.gradient(longest[1][0], dt, axis=0)
         cutoff_hz = cutoff_from_spectrum(vel, fs)
-        notes.append(f"cut-off {cutoff_hz:.4g} Hz from the spectrum (5 x the 99 % power frequency of v)")
+        notes.append(f"cut-off {cutoff_hz:.4g} Hz from the spectrum (8 x the 99 % power frequency of v)")
     cutoff_hz = float(cutoff_hz)
     if not (0.0 < cutoff_hz < 0.5 * fs):
         raise LogError(f"log '{log.source}': cut-off {cutoff_hz!r} Hz must lie in (0, {0.5 * fs:.6g}) Hz "
                        f"(half the sampling rate {fs:.6g} Hz)")
     sos = _butter(cutoff_hz, fs)
-    n_trim = int(np.ceil(2.0 * fs / cutoff_hz)) if trim is None else int(trim)
+    n_trim = int(np.ceil(3.0 * fs / cutoff_hz)) if trim is None else int(trim)
     step = max(1, int(fs // (20.0 * cutoff_hz))) if decimate is None else max(1, int(decimate))
     segments = []
     dropped = 0
@@ -178,8 +195,8 @@ def prepare(log: Log, *, cutoff_hz: float | None = None, gap_factor: float = 3.0
         vf = lowpass(cc[2], sos, pad) if has_v else np.gradient(qf, dt, axis=0)
         af = np.gradient(vf, dt, axis=0)
         keep = slice(n_trim, tt.size - n_trim, step)
-        segments.append(Segment(t=tt[keep], q=qf[keep], v=vf[keep], a=af[keep], tau=tau_f[keep],
-                                tau_measured=cc[1][keep], sign_v=lowpass(np.sign(vf), sos, pad)[keep]))
+        segments.append(Segment(t=tt, q=qf, v=vf, a=af, tau=tau_f, tau_measured=cc[1], sos=sos, pad=pad,
+                                keep=keep))
     if dropped:
         notes.append(f"{dropped} segment(s) shorter than {2 * n_trim + min_samples} samples dropped")
     if not segments:

@@ -13,7 +13,7 @@ from typing import Mapping
 import numpy as np
 
 from mechbal.identify.excite import Excitation
-from mechbal.identify.fit import Friction
+from mechbal.identify.fitting import Friction
 from mechbal.identify.logs import Log
 from mechbal.mechanism import Mechanism
 

@@ -6,7 +6,8 @@ regressor of the segments' inertial parameters and the joints' friction
 (`mechbal.identify.model`), reduce it to the base parameters (`mechbal.identify.base`), estimate
 them by least squares and by weighted least squares (each joint's rows weighted by the inverse
 of its residual's standard deviation, Gautier & Poignet 2001), with their standard deviations,
-then fit the full parameters under physical consistency (`mechbal.identify.consistent`), and
+then fit the full parameters under physical consistency (`mechbal.identify.consistent`: an LMI
+problem solved by ADMM), and
 compare the identified model, the least-squares estimate, the CAD model and the CAD model with
 fitted friction on the validation logs.
 
@@ -165,16 +166,25 @@ def _as_log(item, joint_names: Sequence[str]) -> Log:
     return log
 
 
-def _stack(structure: Structure, prepared: Sequence[PreparedLog], friction: bool, filtered_sign: bool = True):
-    """Regressor, filtered torque and measured torque stacked over every segment. The Coulomb
-    column: sign(v) through the same filter as the torque it is fitted to (``filtered_sign``), or
-    sign(v) itself (what the measured, unfiltered torque holds)."""
+def _stack(structure: Structure, prepared: Sequence[PreparedLog], friction: bool, filtered: bool = True):
+    """Regressor, torque and measured torque stacked over every segment's kept samples. With
+    ``filtered``: the regressor's columns and the torque through the segment's filter (what the fit
+    uses); otherwise the regressor of the filtered states against the measured, unfiltered torque
+    (what a validation compares)."""
     Ws, ys, ms = [], [], []
+    n = structure.dof
     for p in prepared:
         for s in p.segments:
-            Ws.append(structure.regressor(s.q, s.v, s.a, s.sign_v if filtered_sign else None, friction=friction))
-            ys.append(s.tau.reshape(-1))
-            ms.append(s.tau_measured.reshape(-1))
+            if filtered:
+                W = structure.regressor(s.q, s.v, s.a, friction=friction)
+                N = s.t.size
+                Ws.append(s.filtered(W.reshape(N, n, -1)).reshape(-1, W.shape[1]))
+                ys.append(s.tau[s.keep].reshape(-1))
+            else:
+                k = s.keep
+                Ws.append(structure.regressor(s.q[k], s.v[k], s.a[k], friction=friction))
+                ys.append(s.tau[k].reshape(-1))
+            ms.append(s.tau_measured[s.keep].reshape(-1))
     return np.vstack(Ws), np.concatenate(ys), np.concatenate(ms)
 
 
@@ -273,16 +283,12 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
     R, z = Raug[:P, :P], Raug[:P, P]
     solver: dict[str, Any] = {}
     if consistent:
-        f0 = None
-        if friction:
-            # start the friction from the least squares' friction where it is a base parameter
-            x_ls = np.zeros(P)
-            x_ls[bs.independent] = beta
-            f0 = x_ls[Pi:]
-        x, sol = consistent_fit(R, z, len(structure.segment_links), P - Pi, structure.cad,
-                                regularisation=regularisation, mass_bounds=mass_bounds, x0_friction=f0)
-        solver = {"method": "log-Cholesky, scipy.optimize.least_squares (trf)", "status": int(sol.status),
-                  "message": str(sol.message), "evaluations": int(sol.nfev), "regularisation": regularisation}
+        x, report = consistent_fit(R, z, len(structure.segment_links), P - Pi, structure.cad,
+                                   regularisation=regularisation, mass_bounds=mass_bounds)
+        solver = {"method": "LMI (pseudo-inertia >= 0) by ADMM", "converged": report.converged,
+                  "iterations": report.iterations, "primal_residual": report.primal_residual,
+                  "dual_residual": report.dual_residual, "tolerance": report.tolerance,
+                  "regularisation": regularisation}
     else:
         x = np.concatenate([structure.cad, np.zeros(P - Pi)])
     pi = x[:Pi]
@@ -304,7 +310,7 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
     held_out = bool(val_logs)
     vprep = [prepare(log, cutoff_hz=cutoff_hz, decimate=decimate, gap_factor=gap_factor, trim=trim)
              for log in val_logs] if held_out else prepared
-    Wv, _, yv = _stack(structure, vprep, True, filtered_sign=False)
+    Wv, _, yv = _stack(structure, vprep, True, filtered=False)
     # CAD with friction: friction fitted to what the CAD inertias leave, on the identification logs
     Wf = W[:, Pi:] if friction else np.zeros((W.shape[0], 0))
     if friction:
@@ -321,8 +327,8 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
     rms = {k: _rms_per_joint(yv - p, names) for k, p in predictions.items()}
     rms_all = {k: _rms_all(yv - p) for k, p in predictions.items()}
     first = vprep[0].segments[0]
-    m0 = first.t.size * n
-    trace = {"t": first.t, "measured": first.tau_measured,
+    m0 = first.samples * n
+    trace = {"t": first.t[first.keep], "measured": first.tau_measured[first.keep],
              **{k: p[:m0].reshape(-1, n) for k, p in predictions.items()}}
     validation = Validation(logs=[p.source for p in vprep], held_out=held_out, joint_names=list(names),
                             rms_torque_error=rms, rms_torque_error_all=rms_all, trace=trace)
