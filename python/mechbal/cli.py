@@ -504,7 +504,7 @@ def _identify_parsers(sub) -> None:
                    help="keep every identified mass within this fraction of its CAD value (e.g. 0.3)")
     s.add_argument("--tolerance", type=float, default=1.2,
                    help="the consistent model's RMS torque error may be at most this times least "
-                        "squares' on the identification logs (default 1.2)")
+                        "squares' on the validation logs (default 1.2)")
     s.add_argument("--allow-degraded", action="store_true",
                    help=f"exit 0 when the goal is missed (default: exit {EXIT_IDENTIFY_DEGRADED})")
     _last_flags(s, _cmd_identify, urdf=True)

@@ -90,8 +90,8 @@ class SolverReport:
 
 
 def consistent_fit(R: np.ndarray, z: np.ndarray, n_segments: int, n_friction: int, cad: np.ndarray, *,
-                   regularisation: float = 1e-6, mass_bounds: tuple[float, float] | None = None,
-                   tolerance: float = 1e-7, max_iterations: int = 30000) -> tuple[np.ndarray, SolverReport]:
+                   regularisation: float = 1e-4, mass_bounds: tuple[float, float] | None = None,
+                   tolerance: float = 1e-6, max_iterations: int = 20000) -> tuple[np.ndarray, SolverReport]:
     """The fit of the module docstring: ``R`` (P, P), ``z`` (P,) the compressed weighted least
     squares (R of the QR decomposition of the weighted regressor), x = [pi (10 S), friction
     (viscous, Coulomb, offset per joint)]; ``mass_bounds`` (low, high): factors of each body's CAD
