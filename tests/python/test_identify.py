@@ -383,3 +383,31 @@ def test_log_errors_name_the_file(tmp_path):
     (tmp_path / "bad.csv").write_text("t,q_a,tau_a,speed_a\n0,0,0,0\n")
     with pytest.raises(LogError, match="unknown column 'speed_a'"):
         read_log(tmp_path / "bad.csv")
+
+
+def test_ros2_bag_joint_states_are_read(tmp_path):
+    pytest.importorskip("rosbags")
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    JointState = ts.types["sensor_msgs/msg/JointState"]
+    Header = ts.types["std_msgs/msg/Header"]
+    Time = ts.types["builtin_interfaces/msg/Time"]
+    bag = tmp_path / "bag"
+    with Writer(bag, version=9) as w:
+        conn = w.add_connection("/joint_states", JointState.__msgtype__, typestore=ts)
+        for k in range(5):
+            ns = 1_000_000_000 + 10_000_000 * k
+            msg = JointState(header=Header(stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id=""),
+                             name=["b", "a"] if k % 2 else ["a", "b"],     # the order may change
+                             position=np.array([k, -k], float) if k % 2 else np.array([-k, k], float),
+                             velocity=np.array([1.0, -1.0]) if k % 2 else np.array([-1.0, 1.0]),
+                             effort=np.array([0.5, 0.25]) if k % 2 else np.array([0.25, 0.5]))
+            w.write(conn, ns, ts.serialize_cdr(msg, JointState.__msgtype__))
+    log = read_log(bag).for_model(["a", "b"])
+    assert np.allclose(log.t, 1.0 + 0.01 * np.arange(5))
+    assert np.allclose(log.q[:, 0], -np.arange(5)) and np.allclose(log.q[:, 1], np.arange(5))
+    assert np.allclose(log.tau, [[0.25, 0.5]] * 5) and np.allclose(log.v, [[-1.0, 1.0]] * 5)
+    with pytest.raises(LogError, match="no sensor_msgs/msg/JointState messages on topic '/other'"):
+        read_log(bag, topic="/other")

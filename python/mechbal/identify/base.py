@@ -98,7 +98,7 @@ def base_structure(structure: Structure, *, friction: bool = True, samples: int 
     key = [(i // 10, rank_in_body[i % 10]) if i < structure.n_inertial else (10 ** 6, i) for i in cols]
     cols = cols[sorted(range(cols.size), key=lambda k: key[k])]
     Wn = W[:, cols] / norms[cols]
-    R = np.linalg.qr(Wn, mode="r")
+    R = np.asarray(np.linalg.qr(Wn, mode="r"))
     d = np.abs(np.diag(R))
     lead = d > tolerance ** 0.5 * max(float(d.max()), 1e-300)
     ind_n, dep_n = np.flatnonzero(lead), np.flatnonzero(~lead)

@@ -19,7 +19,9 @@ solve with a factorised matrix, then a projection onto the cone -- eigenvalues o
 clipped at zero --, variables scaled to a unit diagonal, the penalty adapted to balance the
 primal and dual residuals). The parameters returned are those of the projected J's: consistent
 to rounding. d_k is ``regularisation`` times the squared norm of column k of R (plus a floor), a
-pull towards the CAD values that decides only what the data leave free.
+pull towards the CAD values that decides only what the data leave free: `mechbal.identify.fit`
+scales it by the weakest direction the logs determine (the smallest squared singular value of
+the column-scaled base regressor), so that it never competes with the data.
 
 Layer: methods (docs/architecture.md).
 """
@@ -90,7 +92,7 @@ class SolverReport:
 
 
 def consistent_fit(R: np.ndarray, z: np.ndarray, n_segments: int, n_friction: int, cad: np.ndarray, *,
-                   regularisation: float = 1e-4, mass_bounds: tuple[float, float] | None = None,
+                   regularisation: float = 1e-6, mass_bounds: tuple[float, float] | None = None,
                    tolerance: float = 1e-6, max_iterations: int = 20000) -> tuple[np.ndarray, SolverReport]:
     """The fit of the module docstring: ``R`` (P, P), ``z`` (P,) the compressed weighted least
     squares (R of the QR decomposition of the weighted regressor), x = [pi (10 S), friction
@@ -173,15 +175,18 @@ def consistent_fit(R: np.ndarray, z: np.ndarray, n_segments: int, n_friction: in
                 continue
             F = scipy.linalg.cho_factor(H + rho * MtM)
     x = sc * y
-    # the consistent parameters: those of the projected J's (E is injective), the boxes clipped
-    pi = np.linalg.lstsq(np.kron(np.eye(S), E), Zc[:16 * S], rcond=None)[0]
+    # the consistent parameters: those of the projected J's (E is injective), each J's eigenvalues
+    # at least 1e-12 of its largest (so that rounding cannot make a body inconsistent), and the
+    # friction boxes clipped. (Mass bounds are met to the solver's tolerance: changing a mass
+    # alone would break its body's consistency.)
+    J = Zc[:16 * S].reshape(S, 4, 4)
+    w, V = np.linalg.eigh(0.5 * (J + np.swapaxes(J, 1, 2)))
+    w = np.maximum(w, 1e-12 * np.max(np.abs(w), axis=1, keepdims=True))
+    J = (V * w[:, None, :]) @ np.swapaxes(V, 1, 2)
+    pi = np.linalg.lstsq(np.kron(np.eye(S), E), J.reshape(-1), rcond=None)[0]
     xf = x[Pi:].copy()
     xf[0::3] = np.maximum(xf[0::3], 0.0)
     xf[1::3] = np.maximum(xf[1::3], 0.0)
-    if mass_bounds is not None:
-        for b in range(S):
-            if cad[10 * b] > 0:
-                pi[10 * b] = np.clip(pi[10 * b], cad[10 * b] * mass_bounds[0], cad[10 * b] * mass_bounds[1])
     report = SolverReport(converged=bool(r_rel < tolerance and s_rel < tolerance), iterations=it,
                           primal_residual=float(r_rel), dual_residual=float(s_rel), tolerance=float(tolerance))
     return np.concatenate([pi, xf]), report

@@ -203,7 +203,7 @@ def _check_data_rank(Rb: np.ndarray, names: Sequence[str]) -> float:
     (or any matrix with the same column space geometry, R^T R = W^T W) of the base regressor.
     Returns its condition number."""
     norms = np.linalg.norm(Rb, axis=0)
-    dead = [names[i] for i in np.flatnonzero(norms <= 1e-300)]
+    dead = [names[int(i)] for i in np.flatnonzero(norms <= 1e-300)]
     if dead:
         raise IdentifyError(f"the logs do not determine {len(dead)} base parameter(s): {', '.join(dead)} "
                             "(their regressor columns are zero on these logs: the joints they belong to do not "
@@ -212,7 +212,7 @@ def _check_data_rank(Rb: np.ndarray, names: Sequence[str]) -> float:
     d = np.abs(np.diag(R))
     weak = np.flatnonzero(d < DATA_RANK_TOLERANCE * d[0])
     if weak.size:
-        bad = [names[piv[i]] for i in weak]
+        bad = [names[int(piv[i])] for i in weak]
         raise IdentifyError(f"the logs do not determine {len(bad)} base parameter(s): {', '.join(bad)} "
                             f"(rank-deficient regressor: their columns depend on the others to within "
                             f"{DATA_RANK_TOLERANCE:g}; excite the joints they belong to more, or add logs)")
@@ -234,7 +234,8 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
     ``cutoff_hz``, ``decimate``, ``gap_factor``, ``trim``: the signal processing
     (`mechbal.identify.signal.prepare`; the cut-off of the first log applies to all).
     ``mass_bounds``: (low, high) factors bounding each segment's mass around its CAD value.
-    ``regularisation``: weight of the pull towards the CAD values of what the logs leave free.
+    ``regularisation``: weight of the pull towards the CAD values of what the logs leave free,
+    relative to the weakest direction the logs determine.
     ``consistent=False`` skips the consistent fit (the identified mechanism then carries the CAD
     inertias, and ``parameters`` is NaN). Raises `LogError` / `IdentifyError` (ValueErrors) with one
     line naming the log or the parameters."""
@@ -261,7 +262,11 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
         raise LogError(f"fewer samples than parameters after filtering: {W.shape[0]} equations for {r} base "
                        "parameters (longer logs, or a smaller trim / decimation)")
     Wb = W[:, bs.independent]
-    condition = _check_data_rank(np.linalg.qr(Wb, mode="r"), bs.names)
+    Rb = np.asarray(np.linalg.qr(Wb, mode="r"))
+    condition = _check_data_rank(Rb, bs.names)
+    # the weakest direction the logs determine (column-scaled): the pull towards the CAD values is
+    # ``regularisation`` times it, so that it only decides what the logs leave free
+    weakest = float(np.linalg.svd(Rb / np.linalg.norm(Rb, axis=0), compute_uv=False)[-1] ** 2)
     n = structure.dof
     N = W.shape[0] // n
     # ordinary least squares, then weights per joint from its residual
@@ -282,12 +287,12 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
     P = W.shape[1]
     Pi = structure.n_inertial
     Aug = np.hstack([W * w[:, None], (y * w)[:, None]])
-    Raug = np.linalg.qr(Aug, mode="r")
+    Raug = np.asarray(np.linalg.qr(Aug, mode="r"))
     R, z = Raug[:P, :P], Raug[:P, P]
     solver: dict[str, Any] = {}
     if consistent:
         x, report = consistent_fit(R, z, len(structure.segment_links), P - Pi, structure.cad,
-                                   regularisation=regularisation, mass_bounds=mass_bounds)
+                                   regularisation=regularisation * weakest, mass_bounds=mass_bounds)
         solver = {"method": "LMI (pseudo-inertia >= 0) by ADMM", "converged": report.converged,
                   "iterations": report.iterations, "primal_residual": report.primal_residual,
                   "dual_residual": report.dual_residual, "tolerance": report.tolerance,

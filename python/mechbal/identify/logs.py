@@ -142,10 +142,10 @@ def _read_csv(path: Path) -> Log:
     if "t" not in header:
         raise LogError(f"log '{path}': no column 't' (the time in s) in the header")
     q_names, v_names, tau_names = [], [], []
-    for col in header:
-        if col == "t":
+    for name in header:
+        if name == "t":
             continue
-        kind, _, joint = col.partition("_")
+        kind, _, joint = name.partition("_")
         if kind == "q" and joint:
             q_names.append(joint)
         elif kind == "v" and joint:
@@ -153,7 +153,7 @@ def _read_csv(path: Path) -> Log:
         elif kind == "tau" and joint:
             tau_names.append(joint)
         else:
-            raise LogError(f"log '{path}': unknown column '{col}' (t, q_<joint>, v_<joint>, tau_<joint>)")
+            raise LogError(f"log '{path}': unknown column '{name}' (t, q_<joint>, v_<joint>, tau_<joint>)")
     if len(set(header)) != len(header):
         dup = sorted({c for c in header if header.count(c) > 1})
         raise LogError(f"log '{path}': column '{dup[0]}' appears twice")
@@ -175,7 +175,8 @@ def _read_csv(path: Path) -> Log:
         raise LogError(f"log '{path}': no data rows")
     if data.shape[1] != len(header):
         raise LogError(f"log '{path}': {data.shape[1]} values per row, {len(header)} columns in the header")
-    col = {c: i for i, c in enumerate(header)}
+    index = {c: i for i, c in enumerate(header)}
+    col = index
     return Log(t=data[:, col["t"]], q=data[:, [col[f"q_{j}"] for j in joints]],
                tau=data[:, [col[f"tau_{j}"] for j in joints]],
                v=data[:, [col[f"v_{j}"] for j in joints]] if v_names else None,
