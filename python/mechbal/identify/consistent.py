@@ -30,7 +30,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 __all__ = ["pseudo_inertia", "consistency", "BodyConsistency", "consistent_fit"]
 
@@ -148,14 +147,16 @@ def consistent_fit(R: np.ndarray, z: np.ndarray, n_segments: int, n_friction: in
         out[16 * S:] = np.clip(v[16 * S:], lo_a, hi_a)
         return out
 
-    F = scipy.linalg.cho_factor(H + rho * MtM)
-    y = scipy.linalg.cho_solve(F, g)
+    # the system is small (P x P): its inverse, refreshed when the penalty changes
+    Kinv = np.linalg.inv(H + rho * MtM)
+    y = Kinv @ g
+    g_norm = float(np.linalg.norm(g))
     Zc = project(Ms @ y)
     U = np.zeros_like(Zc)
     r_rel = s_rel = np.inf
     it = 0
     for it in range(1, int(max_iterations) + 1):
-        y = scipy.linalg.cho_solve(F, g + rho * Ms.T @ (Zc - U))
+        y = Kinv @ (g + rho * Ms.T @ (Zc - U))
         My = Ms @ y
         Z_old = Zc
         Zc = project(My + U)
@@ -163,7 +164,7 @@ def consistent_fit(R: np.ndarray, z: np.ndarray, n_segments: int, n_friction: in
         r = float(np.linalg.norm(My - Zc))
         s = float(rho * np.linalg.norm(Ms.T @ (Zc - Z_old)))
         r_rel = r / max(float(np.linalg.norm(My)), float(np.linalg.norm(Zc)), 1e-300)
-        s_rel = s / max(float(rho * np.linalg.norm(Ms.T @ U)), 1e-300)
+        s_rel = s / max(float(rho * np.linalg.norm(Ms.T @ U)), g_norm, 1e-300)
         if r_rel < tolerance and s_rel < tolerance:
             break
         if it % 50 == 0:      # residual balancing (Boyd et al. 2011, section 3.4.1)
@@ -173,7 +174,7 @@ def consistent_fit(R: np.ndarray, z: np.ndarray, n_segments: int, n_friction: in
                 rho, U = rho / 2.0, U * 2.0
             else:
                 continue
-            F = scipy.linalg.cho_factor(H + rho * MtM)
+            Kinv = np.linalg.inv(H + rho * MtM)
     x = sc * y
     # the consistent parameters: those of the projected J's (E is injective), each J's eigenvalues
     # at least 1e-12 of its largest (so that rounding cannot make a body inconsistent), and the
