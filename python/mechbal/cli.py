@@ -8,7 +8,8 @@ request to report it (set ``MECHBAL_DEBUG=1`` for the traceback); 4 another run 
 ``--out`` finished at the same moment (this run's results were discarded, the other run's folder
 is whole); 5 (``mechbal balance`` only) the requested balance was not reached: the balance is not
 exact within mechbal's tolerance (``limited_by`` of summary.json is not empty); the results are
-written all the same, and ``--allow-partial`` makes this exit 0; 130 interrupted. No traceback is
+written all the same, and ``--allow-partial`` makes this exit 0; 6 (``mechbal identify`` only) the
+identified model missed its goal (``--allow-degraded`` makes this exit 0); 130 interrupted. No traceback is
 ever shown otherwise.
 
 Layer: command line (docs/architecture.md).
@@ -36,6 +37,9 @@ EXIT_USER_ERROR = 2
 EXIT_INTERNAL_ERROR = 3
 EXIT_OUTPUT_RACE = 4
 EXIT_PARTIAL_BALANCE = 5
+#: `mechbal identify`: the identified model misses its goal (a body not consistent, or not within
+#: --tolerance of least squares); --allow-degraded accepts it
+EXIT_IDENTIFY_DEGRADED = 6
 EXIT_INTERRUPTED = 130
 
 
@@ -266,11 +270,6 @@ def _cmd_excite(args) -> int:
     return EXIT_OK
 
 
-#: exit code of `mechbal identify` when the identified model misses its goal (not consistent, or
-#: not within --tolerance of least squares); --allow-degraded accepts it
-EXIT_IDENTIFY_DEGRADED = 6
-
-
 def _cmd_identify(args) -> int:
     from mechbal.identify import fit
     from mechbal.identify.report import write_identified
@@ -360,7 +359,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Exit codes: 0 ok, 2 a mistake in the input (one line names the field or path), "
                "3 an internal error (please report it), 4 another run into the same --out finished "
                "at the same moment (this run's results were discarded), 5 balance: the requested "
-               "balance was not reached (results written; --allow-partial: 0), 130 interrupted.")
+               "balance was not reached (results written; --allow-partial: 0), 6 identify: the identified "
+               "model missed its goal (results written; --allow-degraded: 0), 130 interrupted.")
     p.add_argument("--version", action="version", version=f"mechbal {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     s = sub.add_parser("cases", help="list the built-in case studies")

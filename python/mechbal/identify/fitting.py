@@ -236,8 +236,8 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
     ``mass_bounds``: (low, high) factors bounding each segment's mass around its CAD value.
     ``regularisation``: weight of the pull towards the CAD values of what the logs leave free,
     relative to the weakest direction the logs determine.
-    ``consistent=False`` skips the consistent fit (the identified mechanism then carries the CAD
-    inertias, and ``parameters`` is NaN). Raises `LogError` / `IdentifyError` (ValueErrors) with one
+    ``consistent=False`` skips the consistent fit (the identified mechanism and ``parameters``
+    then carry the CAD inertias and no friction). Raises `LogError` / `IdentifyError` (ValueErrors) with one
     line naming the log or the parameters."""
     structure = structure_of(mechanism)
     names = structure.joint_names
