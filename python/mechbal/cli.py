@@ -8,7 +8,8 @@ request to report it (set ``MECHBAL_DEBUG=1`` for the traceback); 4 another run 
 ``--out`` finished at the same moment (this run's results were discarded, the other run's folder
 is whole); 5 (``mechbal balance`` only) the requested balance was not reached: the balance is not
 exact within mechbal's tolerance (``limited_by`` of summary.json is not empty); the results are
-written all the same, and ``--allow-partial`` makes this exit 0; 130 interrupted. No traceback is
+written all the same, and ``--allow-partial`` makes this exit 0; 6 (``mechbal identify`` only) the
+identified model missed its goal (``--allow-degraded`` makes this exit 0); 130 interrupted. No traceback is
 ever shown otherwise.
 
 Layer: command line (docs/architecture.md).
@@ -36,6 +37,9 @@ EXIT_USER_ERROR = 2
 EXIT_INTERNAL_ERROR = 3
 EXIT_OUTPUT_RACE = 4
 EXIT_PARTIAL_BALANCE = 5
+#: `mechbal identify`: the identified model misses its goal (a body not consistent, or not within
+#: --tolerance of least squares); --allow-degraded accepts it
+EXIT_IDENTIFY_DEGRADED = 6
 EXIT_INTERRUPTED = 130
 
 
@@ -280,6 +284,73 @@ def _cmd_verify(args) -> int:
                       "summary.json and the plots beside it")
 
 
+def _load_model(path: str):
+    """A URDF or TOML model file for identify / excite."""
+    from mechbal.mechanism import Mechanism
+
+    if str(path).lower().endswith(".urdf"):
+        return Mechanism.from_urdf(path)
+    return Mechanism.from_toml(path)
+
+
+def _cmd_excite(args) -> int:
+    from mechbal.identify import excite
+
+    mech = _load_model(args.model)
+    out = Path(args.out)
+    if out.exists() and out.is_dir():
+        raise UserError(f"--out: '{out}' is a folder (give the CSV file to write)")
+    ex = excite(mech, args.duration, args.harmonics, max_velocity=args.max_velocity,
+                max_acceleration=args.max_acceleration, margin=args.margin, seed=args.seed,
+                max_iterations=args.iterations)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    ex.to_csv(out, rate_hz=args.rate)
+    if not args.quiet:
+        print(f"excitation of {mech.name}: {ex.harmonics} harmonics over {ex.duration:g} s, condition "
+              f"number of the base regressor {ex.condition_number:.4g} (initial guess "
+              f"{ex.initial_condition_number:.4g}); starts and ends at rest")
+        print(f"wrote {out} (t, q_<joint>, v_<joint>, a_<joint> at {args.rate:g} Hz)")
+    return EXIT_OK
+
+
+def _cmd_identify(args) -> int:
+    from mechbal.identify import fit
+    from mechbal.identify.report import write_identified
+    from mechbal.output import check_output_dir, staged_output
+
+    out = Path(args.out)
+    check_output_dir(out)
+    mech = _load_model(args.model)
+    bounds = None
+    if args.mass_bounds is not None:
+        bounds = (1.0 - args.mass_bounds, 1.0 + args.mass_bounds)
+    result = fit(mech, args.logs, validate=args.validate or (), cutoff_hz=args.cutoff,
+                 friction=not args.no_friction, weighted=not args.unweighted, mass_bounds=bounds,
+                 tolerance=args.tolerance)
+    with staged_output(out) as tmp:
+        write_identified(result, tmp)
+    if not args.quiet:
+        v = result.validation
+        where = "held-out" if v.held_out else "identification (no --validate log)"
+        print(f"identified {len(result.structure.segment_names)} bodies and the friction of "
+              f"{len(result.friction)} joints from {result.samples} samples; {result.base.count} base "
+              f"parameters, condition number {result.condition_number:.4g}")
+        print(f"RMS torque error on the {where} logs [N m]:")
+        for key in ("identified", "least_squares", "cad", "cad_friction"):
+            print(f"  {key:<14} {v.rms_torque_error_all[key]:.4g}")
+        print(f"wrote {out}/identified.urdf, identified.toml, summary.json and plots")
+    if not result.ok:
+        why = "; ".join(result.limited_by)
+        if args.allow_degraded:
+            print(f"mechbal: warning: identification goal missed (--allow-degraded): {_one_line(Exception(why))}",
+                  file=sys.stderr)
+            return EXIT_OK
+        print(f"mechbal: identification goal missed (exit {EXIT_IDENTIFY_DEGRADED}; results written to {out}; "
+              f"--allow-degraded accepts them): {_one_line(Exception(why))}", file=sys.stderr)
+        return EXIT_IDENTIFY_DEGRADED
+    return EXIT_OK
+
+
 # ---- parser and main --------------------------------------------------------------------------
 
 class _Parser(argparse.ArgumentParser):
@@ -331,7 +402,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Exit codes: 0 ok, 2 a mistake in the input (one line names the field or path), "
                "3 an internal error (please report it), 4 another run into the same --out finished "
                "at the same moment (this run's results were discarded), 5 balance: the requested "
-               "balance was not reached (results written; --allow-partial: 0), 130 interrupted.")
+               "balance was not reached (results written; --allow-partial: 0), 6 identify: the identified "
+               "model missed its goal (results written; --allow-degraded: 0), 130 interrupted.")
     p.add_argument("--version", action="version", version=f"mechbal {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     s = sub.add_parser("cases", help="list the built-in case studies")
@@ -470,7 +542,56 @@ def build_parser() -> argparse.ArgumentParser:
                         "loop (four-bar with a counterweight); reactionless: an arm with a "
                         "reaction wheel under the reactionless controller ([control] table)")
     s.set_defaults(func=_cmd_init)
+    _identify_parsers(sub)
     return p
+
+
+def _identify_parsers(sub) -> None:
+    s = sub.add_parser("excite", help="design an excitation trajectory for identification (Fourier series)",
+                       description="Write a finite Fourier series trajectory that starts and ends at rest "
+                                   "and minimises the condition number of the base regressor within the "
+                                   "joints' position and velocity limits and --max-acceleration: a CSV "
+                                   "(t, q_<joint>, v_<joint>, a_<joint>) for the robot's controller to play "
+                                   "while logging.")
+    s.add_argument("model", help="the robot: URDF or TOML file")
+    s.add_argument("--duration", type=float, required=True, metavar="T", help="period of the trajectory [s]")
+    s.add_argument("--harmonics", type=int, default=5, metavar="K", help="harmonics (default 5, at least 2)")
+    s.add_argument("--max-velocity", type=float, metavar="V",
+                   help="velocity limit of every joint [rad/s or m/s] (default: the model's; a lower one wins)")
+    s.add_argument("--max-acceleration", type=float, metavar="A",
+                   help="acceleration limit of every joint [rad/s^2 or m/s^2] (required: a URDF declares none)")
+    s.add_argument("--margin", type=float, default=0.05, metavar="M",
+                   help="distance kept from the position limits [rad or m] (default 0.05)")
+    s.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="rate of the CSV (default 1000 Hz)")
+    s.add_argument("--seed", type=int, default=0, help="seed of the initial guess (default 0)")
+    s.add_argument("--iterations", type=int, default=100, metavar="N",
+                   help="iterations of the optimiser (default 100)")
+    s.add_argument("--out", required=True, metavar="FILE", help="the CSV file to write")
+    _last_flags(s, _cmd_excite, urdf=True)
+    s = sub.add_parser("identify", help="identify inertial parameters and friction from logs",
+                       description="Identify the base parameters (QR), the friction of every joint and a "
+                                   "physically consistent model (an LMI fit) from logs (CSV: t, q_<joint>, "
+                                   "[v_<joint>,] tau_<joint>; npz; ROS 2 bags with the 'ros' extra), validate "
+                                   "it on held-out logs against the CAD model, and write DIR/identified.urdf, "
+                                   "identified.toml, summary.json and plots. Exit "
+                                   f"{EXIT_IDENTIFY_DEGRADED} when the model misses its goal "
+                                   "(--allow-degraded: 0).")
+    s.add_argument("model", help="the robot's CAD model: URDF or TOML file")
+    s.add_argument("logs", nargs="+", metavar="LOG", help="identification logs")
+    s.add_argument("--validate", nargs="+", metavar="LOG", help="held-out logs for the validation")
+    _out_folder(s, "out/identify")
+    s.add_argument("--cutoff", type=float, metavar="HZ",
+                   help="low-pass cut-off [Hz] (default: 8 x the 99 %% power frequency of the velocities)")
+    s.add_argument("--no-friction", action="store_true", help="identify no friction")
+    s.add_argument("--unweighted", action="store_true", help="ordinary instead of weighted least squares")
+    s.add_argument("--mass-bounds", type=float, metavar="FRACTION",
+                   help="keep every identified mass within this fraction of its CAD value (e.g. 0.3)")
+    s.add_argument("--tolerance", type=float, default=1.2,
+                   help="the consistent model's RMS torque error may be at most this times least "
+                        "squares' on the validation logs (default 1.2)")
+    s.add_argument("--allow-degraded", action="store_true",
+                   help=f"exit 0 when the goal is missed (default: exit {EXIT_IDENTIFY_DEGRADED})")
+    _last_flags(s, _cmd_identify, urdf=True)
 
 
 def _with_urdf_reading(args) -> int:

@@ -365,6 +365,42 @@ SWEEP: dict[str, Schema] = {
                 "additionalProperties": {"type": "object", "properties": {"nominal": NUMBER}}},
 }
 
+_RMS_BY_JOINT = number_map("N m or N", "RMS torque error per joint against the measured torques.")
+IDENTIFY: dict[str, Schema] = {
+    "kind": {"const": "identify", "description": "mechbal identify: inertial parameters and friction "
+             "identified from logs (mechbal.identify)."},
+    "goal": string("What ok means: a physically consistent model within the tolerance of least squares."),
+    "ok": boolean("The goal was met."),
+    "limited_by": strings("Why the goal was not met (empty when ok)."),
+    "joint_names": strings(), "segments": strings("The identified bodies: one per moving link."),
+    "samples": integer("Instants used (after trimming and decimation)."),
+    "cutoff_hz": number("Hz", "Cut-off of the zero-phase low-pass filter."),
+    "condition_number": number(None, "Condition number of the base regressor on the identification logs."),
+    "base_parameters": {"type": "object", "description": "Per base parameter (named after its leading "
+                        "standard parameter, SI): value (weighted least squares), std, relative_std_pct, "
+                        "least_squares (ordinary).", "additionalProperties": number_map()},
+    "regrouping": {"type": "object", "additionalProperties": {"type": "string"},
+                   "description": "The standard parameters each base parameter regroups."},
+    "unidentifiable": strings("Standard parameters no joint torque depends on."),
+    "full_parameters": detail("Per identified body: mass [kg], com [m], inertia [kg m^2] about the com "
+                              "(ixx, iyy, izz, ixy, ixz, iyz) in the link frame, and its 10 parameters."),
+    "friction": {"type": "object", "description": "Per joint: viscous [N m s/rad], coulomb [N m], offset "
+                 "[N m] (N s/m, N, N for a prismatic joint).", "additionalProperties": number_map()},
+    "consistency": detail("Per identified body: mass, principal_moments, min_pseudo_inertia_eigenvalue, "
+                          "consistent."),
+    "residual_rms": _RMS_BY_JOINT,
+    "residual_rms_least_squares": _RMS_BY_JOINT,
+    "validation": {"type": "object", "additionalProperties": False, "description": "RMS torque error "
+                   "[N m or N] on the validation logs (held_out false: the identification logs).",
+                   "properties": {"logs": strings(), "held_out": boolean(),
+                                  "rms_torque_error": _RMS_BY_JOINT,
+                                  "rms_torque_error_all": number("N m or N"),
+                                  "models": detail("identified, least_squares, cad, cad_friction: each "
+                                                   "rms_torque_error and rms_torque_error_all.")}},
+    "data": detail("Per log: what the signal processing did (gaps, resampling, cut-off, trimming)."),
+    "solver": detail("The consistent fit's solver and how it ended."),
+}
+
 #: (command, kind or None) -> top-level properties; kind None: every kind of that command
 _SUMMARIES: dict[tuple[str, str | None], dict[str, Schema]] = {
     ("run", "serial_chain"): RUN_MECHANISM,
@@ -374,6 +410,7 @@ _SUMMARIES: dict[tuple[str, str | None], dict[str, Schema]] = {
     ("balance", None): BALANCE,
     ("verify", None): VERIFY,
     ("sweep", None): SWEEP,
+    ("identify", None): IDENTIFY,
 }
 _MUJOCO_KEY = ("run", "engine:mujoco")
 _SUMMARIES[_MUJOCO_KEY] = RUN_MUJOCO

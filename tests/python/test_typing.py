@@ -16,7 +16,8 @@ import stubgen  # noqa: E402
 
 PUBLIC_MODULES = ["__init__.py", "mechanism.py", "control.py", "trajectory.py", "simulate.py",
                   "papers/__init__.py", "_deprecation.py", "balance/__init__.py", "balance/result.py",
-                  "sweep/__init__.py"]
+                  "sweep/__init__.py", "identify/__init__.py", "identify/fitting.py", "identify/logs.py",
+                  "identify/excite.py"]
 
 
 def need(module: str) -> None:

@@ -126,7 +126,7 @@ def to_json(summary: Mapping[str, Any]) -> tuple[str, list[dict]]:
 #: the version of summary.json's schema (``mechbal/cases/summary.schema.json``): every file
 #: starts with ``schema_version`` and ``command``
 SUMMARY_SCHEMA_VERSION = 1
-SUMMARY_COMMANDS = ("run", "balance", "verify", "sweep")
+SUMMARY_COMMANDS = ("run", "balance", "verify", "sweep", "identify")
 
 
 def write_summary(path: str | Path, summary: Mapping[str, Any], command: str = "run") -> Path:
