@@ -68,6 +68,9 @@ MINIMUM = 1e-13
 #: they are nearly hard (MuJoCo's default 0.9 0.95 lets a loaded linkage accelerate off its
 #: closure: 6 % of a four-bar's unbalanced shaking force at the start of a motion, 5e-5 with this)
 SOLIMP = (0.9999, 0.9999, 0.001)
+#: margin kept on MuJoCo's triangle inequality of the principal moments, A + B >= C + margin x
+#: trace (`principal_moments`): far below what any comparison resolves (1e-9), far above rounding
+TRIANGLE_MARGIN = 1e-12
 #: density of the counterweight spheres drawn [kg/m^3] (steel)
 DENSITY = 7850.0
 
@@ -111,16 +114,34 @@ class _Unique:
         return out
 
 
-def _inertial(mass: float, com, inertia) -> str:
-    """``<inertial>`` with the principal moments (``diaginertia``) and axes (``quat``): MuJoCo
-    accepts a point mass's zero inertia there, not in ``fullinertia``."""
+def principal_moments(inertia) -> tuple[np.ndarray, np.ndarray, float]:
+    """(principal moments ascending, axes (columns, a rotation), raise) of an inertia as MuJoCo
+    gets it: the moments within 1e-15 of the largest are zero, and the smallest one is raised so
+    that the triangle inequality A + B >= C holds with `TRIANGLE_MARGIN` of the trace to spare
+    (``raise``: by how much [kg m^2], 0 when it already did). A physical inertia on the boundary
+    (a thin rod, a flat plate, a URDF repair's nearest physical inertia) would otherwise fall on
+    either side of MuJoCo's check with the last bit of rounding."""
     I = np.asarray(inertia, float)
     w, V = np.linalg.eigh(0.5 * (I + I.T))
     w = np.where(np.abs(w) <= 1e-15 * max(float(np.max(np.abs(w))), 1e-300), 0.0, w)
+    w = np.maximum(w, 0.0)
     if np.linalg.det(V) < 0.0:
         V[:, 2] = -V[:, 2]
+    deficit = w[2] + TRIANGLE_MARGIN * float(np.sum(w)) - (w[0] + w[1])
+    lift = float(deficit) if deficit > 0.0 and np.sum(w) > 0.0 else 0.0
+    w[0] += lift
+    return w, V, lift
+
+
+def _inertial(mass: float, com, inertia) -> str:
+    """``<inertial>`` with the principal moments (``diaginertia``) and axes (``quat``): MuJoCo
+    accepts a point mass's zero inertia there, not in ``fullinertia``; moments kept off the
+    triangle boundary (`principal_moments`), a comment saying so where that moved one."""
+    w, V, lift = principal_moments(inertia)
+    note = (f" <!-- smallest principal moment raised by {lift:.3g} kg m^2: A + B >= C with "
+            f"{TRIANGLE_MARGIN:g} of the trace to spare (MuJoCo refuses the boundary's rounding) -->" if lift else "")
     return (f'<inertial pos="{_v(com)}" quat="{_v(quat_of(V))}" mass="{_f(mass)}" '
-            f'diaginertia="{_v(np.maximum(w, 0.0))}"/>')
+            f'diaginertia="{_v(w)}"/>{note}')
 
 
 def _needs_minimum(bodies) -> bool:
