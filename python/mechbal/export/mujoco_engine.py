@@ -77,13 +77,15 @@ def _cross_force(v: np.ndarray, f: np.ndarray) -> np.ndarray:
 
 class MujocoMechanism:
     """``mech`` exported to MJCF and loaded in MuJoCo (module docstring). ``q`` / ``q_guess``:
-    the assembled pose of the keyframe (closed mechanisms); ``timestep`` [s]; ``minimum_mass``:
+    the assembled pose of the keyframe (closed mechanisms); ``timestep`` [s] (default: the
+    file's, `mechbal.export.mjcf.default_timestep`); ``minimum_mass`` (default `MINIMUM`: the
+    mechanism itself, for inverse dynamics; the file's own is `mechbal.export.mjcf.default_minimum_mass`):
     of the bodies added to the links MuJoCo would refuse (`mechbal.export.mjcf.minimum_bodies`;
     ``exported`` is ``mech`` with them: the mechanism MuJoCo integrates); ``constraint_weight``:
     factor on MuJoCo's inverse weights of bodies, dofs and tendons, which set how much its soft
     constraints give under load (1: MuJoCo's own)."""
 
-    def __init__(self, mech, *, q=None, q_guess=None, timestep: float = 1e-3, minimum_mass: float = MINIMUM,
+    def __init__(self, mech, *, q=None, q_guess=None, timestep: float | None = None, minimum_mass: float = MINIMUM,
                  constraint_weight: float = 1.0):
         mj = require_mujoco()
         self.mj = mj
