@@ -396,6 +396,9 @@ class CoSimulation(DeprecatedAttributes):
     q_full: np.ndarray | None = None
     v_full: np.ndarray | None = None
     a_full: np.ndarray | None = None
+    #: MuJoCo's settings of the run: integrator, timestep [s] (dt / substeps), substeps, solref of
+    #: the loops and gears, constraint_weight, minimum_mass [kg] (`mujoco_options`)
+    options: dict | None = None
 
     _renamed: ClassVar[dict[str, str]] = {"qd": "v", "qd_des": "v_des"}
 
@@ -554,7 +557,17 @@ def co_simulate(mech, controller, trajectory, q0=None, v0=None, *, dt: float = 1
                         predicted_base_reaction_force=np.asarray(br.base_reaction_force),
                         predicted_base_reaction_moment=np.asarray(br.base_reaction_moment),
                         gravity=g, mass=mass, mass_moment=mc, predicted_mass_moment=mc_pred,
-                        constraint_violation=viol, q_full=full["q"], v_full=full["v"], a_full=full["a"])
+                        constraint_violation=viol, q_full=full["q"], v_full=full["v"], a_full=full["a"],
+                        options={"integrator": _integrator_name(mj, m), "timestep": float(m.opt.timestep),
+                                 "substeps": int(substeps), "solref": [float(x) for x in m.eq_solref[0]] if m.neq
+                                 else [float(x) for x in COSIM_SOLREF], "constraint_weight": float(constraint_weight),
+                                 "minimum_mass": float(minimum_mass)})
+
+
+def mujoco_options(cs: "CoSimulation") -> dict:
+    """The ``mujoco_options`` of a summary.json: MuJoCo's integrator and time step [s] of the
+    co-simulation ``cs`` and its constraint settings."""
+    return dict(cs.options or {})
 
 
 def _still_bodies(mech) -> set[str]:
