@@ -90,8 +90,12 @@ def check_variant(bc, mech, *, simulate: bool = True, reference: dict | None = N
         Gk = sim.static_torque(q[k])
         tau[k] = P[k].T @ inv.joint_torque if closed else inv.joint_torque
         G[k] = P[k].T @ Gk if closed else Gk
+    from mechbal.export.mjcf import mjcf_text
+
+    # the file written is the export as `mechbal export` writes it (a closed mechanism's with the
+    # minimum bodies that make its loops hold); the inverse dynamics above are of `mech` itself
     out: dict = {"q0": q[0], "mechanism": repr(mech), "mujoco": repr(sim), "light_bodies": sim.light_bodies,
-                 "minimum_bodies": sim.names.minimum, "xml": sim.xml, "t": bc.t,
+                 "minimum_bodies": sim.names.minimum, "xml": mjcf_text(mech, q=q[0], q_guess=bc.q_guess), "t": bc.t,
                  "mechbal": {"shaking_force": ev["shaking_force"], "shaking_moment": ev["shaking_moment"],
                              "actuator_force": ev["torque"], "gravity_torque": ev["gravity_torque"]},
                  "mujoco_inverse": {"shaking_force": F, "shaking_moment": M, "actuator_force": tau,
