@@ -435,6 +435,10 @@ def test_verify_four_bar(tmp_path):
         for key in ("shaking_force", "shaking_moment", "gravity_torque", "actuator_force"):
             assert s["variants"][variant][key]["relative_difference"] < RTOL
     assert s["variants"]["balanced"]["shaking_force"]["simulated_peak_fraction_of_unbalanced"] < 1e-6
+    assert s["mujoco_options"]["integrator"] == "RK4" and s["mujoco_options"]["timestep"] == pytest.approx(1e-3)
+    # the files written are the export as `mechbal export` writes it: they hold, and say how
+    xml = (out / "balanced.xml").read_text()
+    assert 'integrator="RK4"' in xml and 'timestep="0.00025"' in xml
     assert (out / "shaking_wrench.png").stat().st_size > 10_000
     assert math.isfinite(s["variants"]["unbalanced"]["simulation"]["max_constraint_violation"])
 
@@ -446,6 +450,9 @@ def test_run_with_the_mujoco_engine(tmp_path):
     assert main(["run", "four-bar", "--engine", "mujoco", "--out", str(out), "-q"]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["ok"] and s["engine"] == "mujoco"
+    # MuJoCo's integrator and step of the run (issue 39), as MuJoCo had them
+    assert s["mujoco_options"]["integrator"] == "RK4" and s["mujoco_options"]["timestep"] == pytest.approx(1e-3)
+    assert s["mujoco_options"]["solref"] == [0.02, 1.0]
     br = s["base_reaction"]
     # MuJoCo's simulated base reaction is mechbal's prediction up to the tracking error
     assert br["max_force_difference"] < 0.02 * br["peak_force_mechbal"]
