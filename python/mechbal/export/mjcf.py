@@ -78,7 +78,7 @@ MINIMUM = 1e-13
 #: the bodies and dofs they join (``body_invweight0``, ``dof_invweight0``), so a loop through a
 #: link of `MINIMUM` kg gives way under any load (PAMINSA fell 3.9 rad in 0.5 s); with 1e-4 of
 #: the total mass at the mechanism's length scale (`length_scale`) every built-in linkage holds its
-#: keyframe to 2.5e-4 or better for 1 s (docs/guide.md, MuJoCo chapter). mechbal's prediction of
+#: keyframe to 5e-5 or better for 1 s (docs/guide.md, MuJoCo chapter). mechbal's prediction of
 #: the file is of ``mech.with_bodies(minimum_bodies(mech))``.
 CLOSED_MINIMUM_FRACTION = 1e-4
 #: closed mechanisms: MuJoCo's time step [s]; the loops' ``solref`` time constant is twice it
@@ -86,8 +86,9 @@ CLOSED_MINIMUM_FRACTION = 1e-4
 CLOSED_TIMESTEP = 2.5e-4
 #: trees: MuJoCo's time step [s]
 TREE_TIMESTEP = 1e-3
-#: the integrator written in ``<option>``: the one of the documented figures (RK4: 4th order, the
-#: reaction-wheel arm's controlled residual 20 times smaller than with MuJoCo's default Euler)
+#: the integrator written in ``<option>``: the one of the documented figures (RK4: 4th order; a
+#: free swing of 0.5 s at the file's step is 1e-4 to 1e-7 times closer than implicitfast's or
+#: Euler's, docs/guide.md)
 INTEGRATOR = "RK4"
 INTEGRATORS = ("RK4", "implicitfast", "implicit", "Euler")
 #: impedance of the loop and gear constraints (MuJoCo's solimp d0, d_width, width): near 1 so that
@@ -142,9 +143,9 @@ class _Unique:
 
 def principal_moments(inertia) -> tuple[np.ndarray, np.ndarray, float]:
     """(principal moments ascending, axes (columns, a rotation), raise) of an inertia as MuJoCo
-    gets it: the moments within 1e-15 of the largest are zero, and the smallest one is raised so
-    that the triangle inequality A + B >= C holds with `TRIANGLE_MARGIN` of the trace to spare
-    (``raise``: by how much [kg m^2], 0 when it already did). A physical inertia on the boundary
+    gets it: the moments within 1e-15 of the largest are zero, and the smallest ones are raised
+    so that the triangle inequality A + B >= C holds with `TRIANGLE_MARGIN` of the trace to spare
+    (``raise``: by how much in all [kg m^2], 0 when it already did). A physical inertia on the boundary
     (a thin rod, a flat plate, a URDF repair's nearest physical inertia) would otherwise fall on
     either side of MuJoCo's check with the last bit of rounding."""
     I = np.asarray(inertia, float)
@@ -153,9 +154,14 @@ def principal_moments(inertia) -> tuple[np.ndarray, np.ndarray, float]:
     w = np.maximum(w, 0.0)
     if np.linalg.det(V) < 0.0:
         V[:, 2] = -V[:, 2]
-    deficit = w[2] + TRIANGLE_MARGIN * float(np.sum(w)) - (w[0] + w[1])
-    lift = float(deficit) if deficit > 0.0 and np.sum(w) > 0.0 else 0.0
-    w[0] += lift
+    margin = TRIANGLE_MARGIN * float(np.sum(w))
+    before = w.copy()
+    if margin > 0.0 and w[0] + w[1] < w[2] + margin:
+        # ascending a <= b <= c: b >= margin and a >= c - b + margin give every slack >= margin
+        # (a + b - c = margin at least, a + c - b >= a, b + c - a >= 2 b - margin)
+        w[1] = max(w[1], margin)
+        w[0] = max(w[0], w[2] - w[1] + margin)
+    lift = float(np.sum(w - before))
     return w, V, lift
 
 
@@ -164,7 +170,7 @@ def _inertial(mass: float, com, inertia) -> str:
     accepts a point mass's zero inertia there, not in ``fullinertia``; moments kept off the
     triangle boundary (`principal_moments`), a comment saying so where that moved one."""
     w, V, lift = principal_moments(inertia)
-    note = (f" <!-- smallest principal moment raised by {lift:.3g} kg m^2: A + B >= C with "
+    note = (f" <!-- smallest principal moments raised by {lift:.3g} kg m^2: A + B >= C with "
             f"{TRIANGLE_MARGIN:g} of the trace to spare (MuJoCo refuses the boundary's rounding) -->" if lift else "")
     return (f'<inertial pos="{_v(com)}" quat="{_v(quat_of(V))}" mass="{_f(mass)}" '
             f'diaginertia="{_v(w)}"/>{note}')
