@@ -142,6 +142,9 @@ def _cmd_balance(args) -> int:
     if notes:
         print(f"mechbal: warning: {len(notes)} non-finite value(s) written as null in "
               f"{out}/summary.json (listed under non_finite_values)", file=sys.stderr)
+    mjcf_note = summary.get("mjcf_validation", {}).get("note") if isinstance(summary, dict) else None
+    if mjcf_note:
+        print(f"mechbal: note: {mjcf_note}", file=sys.stderr)
     if not args.quiet:
         print(f"wrote {out}/summary.json, the balanced mechanism (balanced.toml"
               f"{', balanced.urdf' if 'balanced.urdf' in summary.get('files', []) else ''}), plots and "
@@ -230,10 +233,13 @@ def _cmd_export(args) -> int:
     out = Path(args.out)
     if out.is_dir():
         raise UserError(f"--out: '{out}' is a folder: give a file name")
+    checked = _validated_mjcf(text) if fmt == "mjcf" else None
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text)
     if not args.quiet:
         print(f"wrote {out} ({fmt.upper()}, {mech!r})")
+    if checked is not None and not checked["validated"]:
+        print(f"mechbal: note: {checked['note']}", file=sys.stderr)
     return 0
 
 
@@ -271,6 +277,16 @@ def _cmd_view(args) -> int:
         print(f"wrote {path} ({size:.1f} MB; {len(variants)} variant(s), {len(variants[0].t)} instants): "
               f"open it in a browser (no network needed)")
     return 0
+def _validated_mjcf(text: str) -> dict:
+    """`mechbal.export.mujoco_engine.validate_mjcf` of an MJCF about to be written: a failure is a
+    UserError (exit 2) naming the body and the reason, before anything is written."""
+    from mechbal.export.common import ExportError
+    from mechbal.export.mujoco_engine import validate_mjcf
+
+    try:
+        return validate_mjcf(text)
+    except ExportError as exc:
+        raise UserError(str(exc)) from None
 
 
 def _cmd_verify(args) -> int:

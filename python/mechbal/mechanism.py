@@ -396,11 +396,13 @@ class Mechanism:
     # ---- export --------------------------------------------------------------------------------
     def to_mjcf(self, path: str | Path | None = None, *, q: npt.ArrayLike | None = None,
                 q_guess: npt.ArrayLike | None = None, name: str | None = None,
-                timestep: float = 1e-3) -> str:
+                timestep: float | None = None) -> str:
         """MuJoCo model (MJCF) of this mechanism: tree, gears, loops, springs, every body with its
         own inertia, names kept (`mechbal.export.mjcf`); ``q``: the keyframe's pose (a closed
-        mechanism is assembled from ``q`` or ``q_guess``). Writes ``path`` when given; returns the
-        text. Raises `mechbal.export.ExportError` (a ValueError) for what MJCF cannot hold."""
+        mechanism is assembled from ``q`` or ``q_guess``); ``timestep`` [s]: MuJoCo's (default
+        1 ms for a tree, 0.25 ms for a closed mechanism: `mechbal.export.mjcf.default_timestep`).
+        Writes ``path`` when given; returns the text. Raises `mechbal.export.ExportError` (a
+        ValueError) for what MJCF cannot hold."""
         from mechbal.export.mjcf import mjcf_text
 
         text = mjcf_text(self, name, q=q, q_guess=q_guess, timestep=timestep)

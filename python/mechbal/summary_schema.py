@@ -233,10 +233,22 @@ _BASE_REACTION_PEAKS = {"type": "object", "additionalProperties": False, "proper
     "max_force_difference": number("N"), "peak_moment_mujoco": number("N m"),
     "peak_moment_mechbal": number("N m"), "max_moment_difference": number("N m")}}
 
+MUJOCO_OPTIONS: Schema = {
+    "type": "object", "additionalProperties": False,
+    "description": "MuJoCo's settings of the co-simulation: integrator, time step, substeps per "
+                   "controller tick, solref of the loops and gears, the factor on its inverse weights "
+                   "and the mass given to each massless moving link.",
+    "properties": {"integrator": string("MuJoCo's integrator (RK4, implicitfast, implicit, Euler)."),
+                   "timestep": number("s", "MuJoCo's time step (the tick over substeps)."),
+                   "substeps": integer(), "solref": numbers("s, 1", "Time constant and damping ratio."),
+                   "constraint_weight": number(None, "Factor on MuJoCo's inverse weights."),
+                   "minimum_mass": number("kg", "Mass of the body added to a massless moving link.")}}
+
 RUN_MUJOCO: dict[str, Schema] = {
     "engine": {"const": "mujoco", "description": "mechbal run --engine mujoco: co-simulation."},
     "mechanism": string("The mechanism (its repr)."),
     "dt": number("s", "Controller and integration step."),
+    "mujoco_options": MUJOCO_OPTIONS,
     "controller": string(),
     "ok": boolean("Every step ok."), "steps_completed": integer(),
     "peak_tracking_error": number("rad or m"),
@@ -287,6 +299,10 @@ BALANCE: dict[str, Schema] = {
                                                               "gravity_torque")}},
     "total_mass": number_map("kg", "Total mass, unbalanced and balanced."),
     "urdf": string("Why no balanced.urdf was written (loops or springs), or its name."),
+    "mjcf": string("Why no balanced.xml was written (a part MJCF cannot hold)."),
+    "mjcf_validation": detail("balanced.xml loaded in MuJoCo: validated (false without MuJoCo, with a "
+                              "note), mujoco (version), max_equality_violation [m or rad] at the keyframe, "
+                              "integrator, timestep [s]."),
     "case_notes": detail("What the case's loader says (default motion, paper values)."),
     "optimality": {"type": "object", "description": "The certificate of the convex design (static and "
                    "force methods with the 'optimal' extra, mechbal.balance.optimal): the solver, the "
@@ -330,6 +346,7 @@ VERIFY: dict[str, Schema] = {
                          **{k: _VERIFY_QUANTITY for k in ("shaking_force", "shaking_moment",
                                                           "gravity_torque", "actuator_force")}}}},
     "checks": string("What was compared, and how."),
+    "mujoco_options": MUJOCO_OPTIONS,
     "kind": string("reactionless: a case checked under its reactionless controller."),
     "mechanism": string("The mechanism (its repr)."), "mujoco": anything("MuJoCo model size"),
     "dt": number("s", "Controller tick and MuJoCo step (reactionless cases)."),

@@ -90,8 +90,12 @@ def check_variant(bc, mech, *, simulate: bool = True, reference: dict | None = N
         Gk = sim.static_torque(q[k])
         tau[k] = P[k].T @ inv.joint_torque if closed else inv.joint_torque
         G[k] = P[k].T @ Gk if closed else Gk
+    from mechbal.export.mjcf import mjcf_text
+
+    # the file written is the export as `mechbal export` writes it (a closed mechanism's with the
+    # minimum bodies that make its loops hold); the inverse dynamics above are of `mech` itself
     out: dict = {"q0": q[0], "mechanism": repr(mech), "mujoco": repr(sim), "light_bodies": sim.light_bodies,
-                 "minimum_bodies": sim.names.minimum, "xml": sim.xml, "t": bc.t,
+                 "minimum_bodies": sim.names.minimum, "xml": mjcf_text(mech, q=q[0], q_guess=bc.q_guess), "t": bc.t,
                  "mechbal": {"shaking_force": ev["shaking_force"], "shaking_moment": ev["shaking_moment"],
                              "actuator_force": ev["torque"], "gravity_torque": ev["gravity_torque"]},
                  "mujoco_inverse": {"shaking_force": F, "shaking_moment": M, "actuator_force": tau,
@@ -107,7 +111,7 @@ def check_variant(bc, mech, *, simulate: bool = True, reference: dict | None = N
                                    "predicted_shaking_moment": cs.predicted_shaking_moment,
                                    "constraint_violation": cs.constraint_violation,
                                    "tracking_error": cs.tracking_error, "ok": bool(np.all(cs.status == 0)),
-                                   "steps_completed": cs.steps_completed}
+                                   "steps_completed": cs.steps_completed, "options": cs.options}
     return out
 
 
@@ -213,6 +217,8 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
                           "the moment, the actuator forces' peak for the gravity torque); simulated: 1 kHz computed torque in MuJoCo"),
                "files": ["summary.json", "unbalanced.xml"] + (["balanced.xml"] if "balanced" in variants else [])
                + (["shaking_wrench.png"] if simulate else [])}
+    if simulate:   # MuJoCo's integrator and time step of the simulated check
+        summary["mujoco_options"] = results["unbalanced"]["mujoco_simulated"]["options"]
     if notes:
         summary["notes"] = notes
     write_summary(out / "summary.json", summary, command="verify")
@@ -269,7 +275,7 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
                        title=f"{bc.title}: tracking in MuJoCo")
     diff_F = _peak(cs.base_reaction_force - cs.predicted_base_reaction_force)
     diff_M = _peak(cs.base_reaction_moment - cs.predicted_base_reaction_moment)
-    summary = {"case": bc.name, "engine": "mujoco", "mechanism": repr(mech), "dt": dt,
+    summary = {"case": bc.name, "engine": "mujoco", "mechanism": repr(mech), "dt": dt, "mujoco_options": cs.options,
                "controller": f"computed torque, Kp {KP:g} 1/s^2, Kd {KD:g} 1/s (mechbal's model)",
                "ok": bool(np.all(cs.status == 0)), "steps_completed": cs.steps_completed,
                "peak_tracking_error": _peak(cs.tracking_error),
@@ -776,6 +782,8 @@ def run_verify_reactionless(case, out: Path, *, simulate: bool = True, dt: float
         summary["balancing_joints"] = list(plan.ctl.balancing_joints)
     if time_step:
         summary["time_step"] = time_step
+    if simulate:   # MuJoCo's integrator and time step of the simulated check
+        summary["mujoco_options"] = simulated["controlled"].cosimulation.options
     if simulate:
         curves = {}
         for label in ("uncontrolled", "controlled"):
@@ -920,6 +928,7 @@ def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration
             "reduction_pct": 100.0 * (1.0 - peak_c / peak_u) if peak_u > 0 else None},
         "control": ctl_summary,
         "cosimulation": by_variant,
+        "mujoco_options": sims["controlled"].cosimulation.options,
         "total_mass": mech.total_mass,
         "files": ["bodies_uncontrolled.npz", "bodies_controlled.npz", "shaking_wrench.png", "balancing_joints.png",
                   "base_reaction.png", "cosimulation.npz", "mechanism.xml"],

@@ -3,6 +3,8 @@
 // nothing. Physics against Pinocchio on the same files is in tests/python/test_urdf.py.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -169,4 +171,31 @@ TEST(Urdf, ErrorsNameTheElement) {
     EXPECT_NE(std::string(ex.what()).find("URDF file '/nonexistent/robot.urdf': cannot be read"), std::string::npos)
         << ex.what();
   }
+}
+
+// icub's feet: a zero tensor with 1e-20 products of inertia passes the absolute tolerance (1e-12
+// kg m^2) but breaks the triangle inequality by 100 % of its own size, which MuJoCo refuses: the
+// strict reading refuses it, naming the link; the lenient one repairs it with one warning and
+// keeps the repaired moments off the triangle's boundary (1e-12 of the trace to spare).
+TEST(Urdf, RoundingThatBreaksTheTriangleIsJudgedToTheInertiasOwnScale) {
+  const std::string tiny = replaced(kTree, "ixx=\"0.005\" ixy=\"0\" ixz=\"0\" iyy=\"0.005\" iyz=\"0\" izz=\"0.005\"",
+                                    "ixx=\"0\" ixy=\"0\" ixz=\"1.35525e-20\" iyy=\"0\" iyz=\"0\" izz=\"0\"");
+  ASSERT_NE(tiny, std::string(kTree));
+  const std::string e = urdf_error_of(tiny);
+  EXPECT_NE(e.find("URDF link 'l3' inertial.inertia is not physical to its own scale"), std::string::npos) << e;
+  UrdfOptions lenient;
+  lenient.strict = false;
+  const UrdfReading r = read_urdf_string(tiny, lenient);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("URDF link 'l3' <inertial>"), std::string::npos) << r.warnings[0];
+  bool found = false;
+  for (const Body& b : r.description.bodies) {
+    if (b.name != "l3") continue;
+    found = true;
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(b.inertia, Eigen::EigenvaluesOnly);
+    const Vec3 p = eig.eigenvalues();
+    EXPECT_GT(p.sum(), 0.0);
+    EXPECT_GE(p(0) + p(1) - p(2), 0.5e-12 * p.sum());
+  }
+  EXPECT_TRUE(found);
 }

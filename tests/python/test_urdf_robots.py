@@ -195,3 +195,19 @@ def test_default_motions_respect_velocity_and_effort_limits(tmp_path):
     dm = json.loads((out / "summary.json").read_text())["default_motion"]
     assert dm["respected"] and dm["duration"] > 0.2
     assert max(dm["peak_velocity"]) <= 0.5 * (1 + 1e-6) and max(dm["peak_torque"]) <= 12.0
+
+
+def test_rounding_that_breaks_the_triangle_inequality_is_judged_to_the_inertia_s_own_scale(tmp_path):
+    """icub's feet: products of inertia of 1e-20 on a zero tensor, within the absolute tolerance
+    (1e-12 kg m^2) but a triangle broken by 100 % of the tensor's size, which MuJoCo refuses.
+    The lenient reading repairs it with a warning, keeping 1e-12 of the trace off the boundary;
+    strict refuses it."""
+    text = _urdf().replace('<inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/>',
+                           '<inertia ixx="0" ixy="0" ixz="1.35525e-20" iyy="0" iyz="0" izz="0"/>')
+    assert "1.35525e-20" in text
+    mech, warned = _load(tmp_path, text)
+    assert len(warned) == 1 and "URDF link 'antenna' <inertial>" in warned[0] and "nearest physical" in warned[0]
+    lam = np.linalg.eigvalsh(next(b for b in mech.bodies if b.name == "antenna").inertia)
+    assert lam[0] + lam[1] - lam[2] >= 0.5e-12 * np.sum(lam) > 0.0      # off the boundary
+    with pytest.raises(ConfigError, match="URDF link 'antenna' inertial.*own scale"):
+        _load(tmp_path, text, strict=True)

@@ -388,6 +388,22 @@ Joint to_joint(const urdf::Joint& uj, const std::string& parent) {
   return j;
 }
 
+/// validate_rigid_body's tolerances are absolute below 1 kg m^2 (1e-12), so a tiny inertia whose
+/// rounding breaks the triangle inequality by 100 % of itself passes them (icub's 1e-20 products of
+/// inertia, which MuJoCo refuses). A URDF inertia is also checked against its own size: principal
+/// moments >= -1e-12 |I| and A + B >= C - 1e-12 |I|, |I| its largest moment in magnitude.
+void check_inertia_to_its_own_scale(const Mat3& I, const std::string& field) {
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(0.5 * (I + I.transpose()), Eigen::EigenvaluesOnly);
+  const Vec3 p = eig.eigenvalues();  // ascending
+  const double tol = 1e-12 * p.cwiseAbs().maxCoeff();
+  if (p(0) < -tol || p(2) > p(0) + p(1) + tol) {
+    std::ostringstream msg;
+    msg << field << ".inertia is not physical to its own scale (principal moments " << p(0) << ", " << p(1)
+        << ", " << p(2) << ": negative, or A + B < C beyond rounding)";
+    throw std::invalid_argument(msg.str());
+  }
+}
+
 Body to_body(const urdf::Link& link, const std::string& carrier) {
   const urdf::Inertial& in = *link.inertial;
   const Eigen::Isometry3d T = to_isometry(in.origin);
@@ -398,6 +414,7 @@ Body to_body(const urdf::Link& link, const std::string& carrier) {
   const std::string field = "URDF link '" + link.name + "' inertial";
   // checked in the inertial frame, as written (the rotation cannot make a bad tensor good)
   validate_rigid_body(RigidBody{in.mass, I}, field.c_str());
+  check_inertia_to_its_own_scale(I, field);
   if (!T.translation().allFinite()) {
     throw std::invalid_argument(field + " origin must be finite");
   }
@@ -414,12 +431,15 @@ Body to_body(const urdf::Link& link, const std::string& carrier) {
 
 // ---- lenient reading (issue 23): the repairs of UrdfOptions, each with its warning ----------
 
-/// The nearest physical inertia (see UrdfOptions): S = tr(I)/2 1 - I clipped to S >= 0.
+/// The nearest physical inertia (see UrdfOptions): S = tr(I)/2 1 - I clipped to S >= 1e-12 tr(S)
+/// (not to 0: the triangle inequality then holds with 1e-12 of the trace to spare, not on its
+/// boundary, where rounding would put it on either side of another engine's check).
 Mat3 nearest_physical_inertia(const Mat3& I_in) {
   const Mat3 I = 0.5 * (I_in + I_in.transpose());
   const Mat3 S = 0.5 * I.trace() * Mat3::Identity() - I;
   Eigen::SelfAdjointEigenSolver<Mat3> eig(S);
-  const Vec3 lam = eig.eigenvalues().cwiseMax(0.0);
+  const Vec3 clipped = eig.eigenvalues().cwiseMax(0.0);
+  const Vec3 lam = clipped.cwiseMax(1e-12 * clipped.sum());
   const Mat3 Sp = eig.eigenvectors() * lam.asDiagonal() * eig.eigenvectors().transpose();
   Mat3 out = Sp.trace() * Mat3::Identity() - Sp;
   return 0.5 * (out + out.transpose());

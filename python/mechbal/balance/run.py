@@ -537,13 +537,20 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
     from mechbal.export.common import ExportError
     from mechbal.export.urdf import urdf_refusal, urdf_text
 
-    export_notes = {}
+    from mechbal.export.mujoco_engine import validate_mjcf
+
+    export_notes, mjcf_validation = {}, None
     try:   # MJCF: any mechanism, assembled at the trajectory's start
-        (out / "balanced.xml").write_text(result.balanced.to_mjcf(q=after["q"][0], q_guess=bc.q_guess,
-                                                                  name=f"{bc.name}-balanced"))
-        files.append("balanced.xml")
+        mjcf = result.balanced.to_mjcf(q=after["q"][0], q_guess=bc.q_guess, name=f"{bc.name}-balanced")
     except ExportError as exc:
         export_notes["mjcf"] = f"no balanced.xml: {exc}"
+    else:
+        try:   # loaded in MuJoCo (when installed): a file MuJoCo refuses is an error, not a note
+            mjcf_validation = validate_mjcf(mjcf)
+        except ExportError as exc:
+            raise ExportError(f"balanced.xml: {exc}") from None
+        (out / "balanced.xml").write_text(mjcf)
+        files.append("balanced.xml")
     why = urdf_refusal(result.balanced)   # no URDF that silently drops loops or springs
     if why:
         export_notes["urdf"] = f"no balanced.urdf: {why}; balanced.toml and balanced.xml carry them"
@@ -565,6 +572,8 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
         progress.stage("front")
         summary["front"] = run_front(bc, name, int(front), out)
         files += ["front.csv", "front.json", "front.png"]
+    if mjcf_validation is not None:
+        summary["mjcf_validation"] = mjcf_validation
     if bc.assembly is not None:
         summary["assembly"] = bc.assembly
     if bc.notes:

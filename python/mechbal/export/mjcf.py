@@ -22,7 +22,10 @@ What is written, for a `mechbal.Mechanism`:
   the point of B's link at A's origin in the assembled pose: exact when the loop moves in the
   plane normal to z_A, which is what the closure describes (MuJoCo has no point-on-line equality).
 * **Constraint softness.** Loops and gears get ``solimp`` `SOLIMP` (nearly hard; MuJoCo's
-  constraints are soft, which shows as a residual shaking force of a balanced linkage).
+  constraints are soft, which shows as a residual shaking force of a balanced linkage) and
+  ``solref`` twice the time step (the stiffest MuJoCo allows). A closed mechanism's file has a
+  time step of `CLOSED_TIMESTEP` and heavier minimum bodies (`CLOSED_MINIMUM_FRACTION`): together
+  they hold every built-in linkage at its keyframe under its static actuator forces.
 * **Springs.** A spatial ``<tendon>`` between two sites at the anchors, ``stiffness`` = the
   equivalent rate count rate / pulley_ratio^2, ``springlength`` = free_length - preload tension /
   stiffness (MuJoCo's spring force is -stiffness (length - springlength): the same tension as
@@ -32,14 +35,20 @@ What is written, for a `mechbal.Mechanism`:
   after it; its torque limit as ``forcerange`` when the joint has one.
 * **MuJoCo's minimum.** MuJoCo refuses a moving body (with the bodies welded to it) of no mass or
   of a zero principal moment of inertia (a point-mass link, a massless rotor's own link); such a
-  link gets a body ``<link>_minimum`` of `MINIMUM` kg and kg m^2 at its origin (listed in
-  `MjcfNames.minimum`).
+  link gets a body ``<link>_minimum`` at its origin (listed in `MjcfNames.minimum`): `MINIMUM`
+  kg and kg m^2 in a tree, `CLOSED_MINIMUM_FRACTION` of the total mass at the mechanism's
+  `length_scale` in a closed mechanism (`default_minimum_mass`; a massless link makes MuJoCo's
+  loop constraints give way).
+* **Inertias.** Principal moments and axes; MuJoCo refuses a triangle inequality A + B >= C
+  broken by rounding, so the smallest moment keeps `TRIANGLE_MARGIN` of the trace to spare
+  (`principal_moments`; a comment says where that moved a moment).
 * **Pose.** A keyframe ``assembled`` with the joint values of the assembled pose (the loops
   closed; mechbal's q = 0 for a tree unless a pose is given).
 * **Geometry** (to look at; no contacts, no mass): capsules from each link's origin to its child
   joints' origins, spheres for counterweights (steel density), cylinders for discs (about their
   largest principal axis), small spheres for motors and payloads.
-* **Gravity** in ``<option>``; ``timestep`` 1 ms unless given.
+* **Options.** Gravity, the integrator (`INTEGRATOR`: RK4) and the time step (`default_timestep`)
+  in ``<option>``, and a comment saying why.
 
 Names are kept (links, joints, frames as sites, springs as tendons, loops as equalities); where
 two MuJoCo objects of one kind would share a name, the later one gets a suffix.
@@ -64,10 +73,31 @@ AXIS_LENGTH = 0.1
 #: would refuse (no mass, or a zero principal moment: a point mass, a massless rotor's link), at
 #: the link origin: 100 times MuJoCo's mjMINVAL, far below what the comparisons resolve
 MINIMUM = 1e-13
+#: closed mechanisms (loops): the mass of the body added to each massless moving link, as a fraction
+#: of the total mass. MuJoCo's loop constraints are soft in proportion to the inverse inertia of
+#: the bodies and dofs they join (``body_invweight0``, ``dof_invweight0``), so a loop through a
+#: link of `MINIMUM` kg gives way under any load (PAMINSA fell 3.9 rad in 0.5 s); with 1e-4 of
+#: the total mass at the mechanism's length scale (`length_scale`) every built-in linkage holds its
+#: keyframe to 5e-5 or better for 1 s (docs/guide.md, MuJoCo chapter). mechbal's prediction of
+#: the file is of ``mech.with_bodies(minimum_bodies(mech))``.
+CLOSED_MINIMUM_FRACTION = 1e-4
+#: closed mechanisms: MuJoCo's time step [s]; the loops' ``solref`` time constant is twice it
+#: (MuJoCo's smallest safe one), so the closure's stiffness grows as 1 / timestep^2
+CLOSED_TIMESTEP = 2.5e-4
+#: trees: MuJoCo's time step [s]
+TREE_TIMESTEP = 1e-3
+#: the integrator written in ``<option>``: the one of the documented figures (RK4: 4th order; a
+#: free swing of 0.5 s at the file's step is 1e-4 to 1e-7 times closer than implicitfast's or
+#: Euler's, docs/guide.md)
+INTEGRATOR = "RK4"
+INTEGRATORS = ("RK4", "implicitfast", "implicit", "Euler")
 #: impedance of the loop and gear constraints (MuJoCo's solimp d0, d_width, width): near 1 so that
 #: they are nearly hard (MuJoCo's default 0.9 0.95 lets a loaded linkage accelerate off its
 #: closure: 6 % of a four-bar's unbalanced shaking force at the start of a motion, 5e-5 with this)
 SOLIMP = (0.9999, 0.9999, 0.001)
+#: margin kept on MuJoCo's triangle inequality of the principal moments, A + B >= C + margin x
+#: trace (`principal_moments`): far below what any comparison resolves (1e-9), far above rounding
+TRIANGLE_MARGIN = 1e-12
 #: density of the counterweight spheres drawn [kg/m^3] (steel)
 DENSITY = 7850.0
 
@@ -111,16 +141,39 @@ class _Unique:
         return out
 
 
-def _inertial(mass: float, com, inertia) -> str:
-    """``<inertial>`` with the principal moments (``diaginertia``) and axes (``quat``): MuJoCo
-    accepts a point mass's zero inertia there, not in ``fullinertia``."""
+def principal_moments(inertia) -> tuple[np.ndarray, np.ndarray, float]:
+    """(principal moments ascending, axes (columns, a rotation), raise) of an inertia as MuJoCo
+    gets it: the moments within 1e-15 of the largest are zero, and the smallest ones are raised
+    so that the triangle inequality A + B >= C holds with `TRIANGLE_MARGIN` of the trace to spare
+    (``raise``: by how much in all [kg m^2], 0 when it already did). A physical inertia on the boundary
+    (a thin rod, a flat plate, a URDF repair's nearest physical inertia) would otherwise fall on
+    either side of MuJoCo's check with the last bit of rounding."""
     I = np.asarray(inertia, float)
     w, V = np.linalg.eigh(0.5 * (I + I.T))
     w = np.where(np.abs(w) <= 1e-15 * max(float(np.max(np.abs(w))), 1e-300), 0.0, w)
+    w = np.maximum(w, 0.0)
     if np.linalg.det(V) < 0.0:
         V[:, 2] = -V[:, 2]
+    margin = TRIANGLE_MARGIN * float(np.sum(w))
+    before = w.copy()
+    if margin > 0.0 and w[0] + w[1] < w[2] + margin:
+        # ascending a <= b <= c: b >= margin and a >= c - b + margin give every slack >= margin
+        # (a + b - c = margin at least, a + c - b >= a, b + c - a >= 2 b - margin)
+        w[1] = max(w[1], margin)
+        w[0] = max(w[0], w[2] - w[1] + margin)
+    lift = float(np.sum(w - before))
+    return w, V, lift
+
+
+def _inertial(mass: float, com, inertia) -> str:
+    """``<inertial>`` with the principal moments (``diaginertia``) and axes (``quat``): MuJoCo
+    accepts a point mass's zero inertia there, not in ``fullinertia``; moments kept off the
+    triangle boundary (`principal_moments`), a comment saying so where that moved one."""
+    w, V, lift = principal_moments(inertia)
+    note = (f" <!-- smallest principal moments raised by {lift:.3g} kg m^2: A + B >= C with "
+            f"{TRIANGLE_MARGIN:g} of the trace to spare (MuJoCo refuses the boundary's rounding) -->" if lift else "")
     return (f'<inertial pos="{_v(com)}" quat="{_v(quat_of(V))}" mass="{_f(mass)}" '
-            f'diaginertia="{_v(np.maximum(w, 0.0))}"/>')
+            f'diaginertia="{_v(w)}"/>{note}')
 
 
 def _needs_minimum(bodies) -> bool:
@@ -149,27 +202,66 @@ def mjcf_names(mech) -> MjcfNames:
     return _build(mech, None, None, 1e-3, names_only=True)[1]
 
 
-def minimum_bodies(mech, minimum_mass: float = MINIMUM) -> list:
+def length_scale(mech) -> float:
+    """The mechanism's length scale [m]: its largest joint offset, at least 5 cm."""
+    d = mech.model.description
+    return max([float(np.linalg.norm(np.asarray(j.placement)[:3, 3])) for j in d.joints] + [0.05])
+
+
+def default_minimum_mass(mech) -> float:
+    """Mass [kg] of the body added to each massless moving link: `MINIMUM` for a tree (far below
+    what any comparison resolves), `CLOSED_MINIMUM_FRACTION` of the total mass for a closed
+    mechanism (so that MuJoCo's loop constraints hold)."""
+    return max(CLOSED_MINIMUM_FRACTION * float(mech.total_mass), MINIMUM) if mech.is_closed else MINIMUM
+
+
+def default_timestep(mech) -> float:
+    """MuJoCo's time step [s] written: `CLOSED_TIMESTEP` for a closed mechanism, else
+    `TREE_TIMESTEP`."""
+    return CLOSED_TIMESTEP if mech.is_closed else TREE_TIMESTEP
+
+
+def minimum_inertia(mech, minimum_mass: float) -> float:
+    """Principal moment [kg m^2] of the body of ``minimum_mass`` added to a link MuJoCo would
+    refuse: `MINIMUM` at `MINIMUM`, else the mass at the mechanism's `length_scale` (a rotation
+    of the link is then as stiff in MuJoCo's loop constraints as a translation)."""
+    return MINIMUM if minimum_mass == MINIMUM else minimum_mass * length_scale(mech) ** 2
+
+
+def minimum_bodies(mech, minimum_mass: float | None = None) -> list:
     """The bodies (``mechbal.Body``) the export adds so that MuJoCo accepts every moving link
-    (`MjcfNames.minimum`): ``minimum_mass`` kg at each such link's origin, principal
-    moments ``minimum_mass`` x (0.1 m)^2 (``MINIMUM`` kg m^2 at the default). ``mech.with_bodies``
-    of them is the mechanism MuJoCo integrates."""
+    (`MjcfNames.minimum`): ``minimum_mass`` kg (default `default_minimum_mass`) at each such
+    link's origin, principal moments `minimum_inertia`. ``mech.with_bodies`` of them is the
+    mechanism MuJoCo integrates."""
+    if minimum_mass is None:
+        minimum_mass = default_minimum_mass(mech)
     names = mjcf_names(mech)
-    inertia = MINIMUM if minimum_mass == MINIMUM else minimum_mass * 0.01
+    inertia = minimum_inertia(mech, minimum_mass)
     return [_core.Body(n, link, float(minimum_mass), np.zeros(3), inertia * np.eye(3), "other")
             for link, n in names.minimum_links.items()]
 
 
-def mjcf_text(mech, name: str | None = None, *, q=None, q_guess=None, timestep: float = 1e-3,
-              minimum_mass: float = MINIMUM) -> str:
+def mjcf_text(mech, name: str | None = None, *, q=None, q_guess=None, timestep: float | None = None,
+              minimum_mass: float | None = None, integrator: str = INTEGRATOR) -> str:
     """MJCF of ``mech`` (module docstring). ``q``: the pose of the keyframe (dof,); a closed
     mechanism is assembled from ``q`` or ``q_guess`` (`mechbal.export.common.assembled_pose`).
-    ``minimum_mass``: of the body added to a link MuJoCo would refuse (`minimum_bodies`).
+    ``timestep`` [s]: MuJoCo's (default `default_timestep`); ``minimum_mass``: of the body added
+    to a link MuJoCo would refuse (`minimum_bodies`; default `default_minimum_mass`);
+    ``integrator``: MuJoCo's (``RK4``, ``implicitfast``, ``implicit``, ``Euler``).
     ExportError (a ValueError, one line) when a part has no MuJoCo equivalent."""
-    return _build(mech, q, q_guess, timestep, name=name, minimum_mass=minimum_mass)[0]
+    return _build(mech, q, q_guess, timestep, name=name, minimum_mass=minimum_mass, integrator=integrator)[0]
 
 
-def _build(mech, q, q_guess, timestep, *, name=None, names_only=False, minimum_mass: float = MINIMUM):
+def _build(mech, q, q_guess, timestep, *, name=None, names_only=False, minimum_mass: float | None = None,
+           integrator: str = INTEGRATOR):
+    if minimum_mass is None:
+        minimum_mass = default_minimum_mass(mech)
+    if timestep is None:
+        timestep = default_timestep(mech)
+    if not (math.isfinite(timestep) and timestep > 0.0):
+        raise ExportError(f"timestep must be a number > 0 [s], got {timestep}")
+    if integrator not in INTEGRATORS:
+        raise ExportError(f"integrator must be one of {', '.join(INTEGRATORS)}, got {integrator!r}")
     d = mech.model.description
     labels = link_labels(mech)
     still = fixed_to_root(mech)
@@ -239,9 +331,9 @@ def _build(mech, q, q_guess, timestep, *, name=None, names_only=False, minimum_m
     extra_sites: dict[str, list[str]] = {}   # link -> site lines
     equality: list[str] = []
     eq_name = _Unique()
-    scale = max([float(np.linalg.norm(np.asarray(j.placement)[:3, 3])) for j in d.joints] + [0.05])
+    scale = length_scale(mech)
 
-    imp = f' solimp="{_v(SOLIMP)}"'
+    imp = f' solref="{_f(2.0 * timestep)} 1" solimp="{_v(SOLIMP)}"'
 
     def add_site(link: str, nm: str, p) -> str:
         s = site_name(nm)
@@ -292,7 +384,16 @@ def _build(mech, q, q_guess, timestep, *, name=None, names_only=False, minimum_m
     out = ['<mujoco model=' + quoteattr(name or mech.name) + '>',
            '  <!-- written by mechbal: every body with its own inertia; geometry for looking only -->',
            '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
-           f'  <option timestep="{_f(timestep)}" gravity="{_v(d.gravity)}"/>',
+           f'  <!-- MuJoCo options: integrator {integrator} '
+           + ('(4th order: the one of mechbal\'s documented MuJoCo figures)' if integrator == "RK4" else '(as asked)')
+           + f', time step {_f(timestep)} s'
+           + (f'; the loops and gears are equality constraints with solref {_f(2.0 * timestep)} s (twice the '
+              f'step: as stiff as MuJoCo allows) and solimp {_v(SOLIMP)}' if d.loops or any(j.mimic_joint for j in d.joints) else '')
+           + (f'; each massless moving link carries {minimum_mass:.6g} kg ({minimum_mass / max(mech.total_mass, 1e-300):.3g} '
+              'of the total mass: the *_minimum bodies) so that the loops hold under load'
+              if d.loops and minimum_mass > MINIMUM and names.minimum else '')
+           + ' -->',
+           f'  <option timestep="{_f(timestep)}" integrator="{integrator}" gravity="{_v(d.gravity)}"/>',
            '  <default>',
            '    <geom contype="0" conaffinity="0" group="1"/>',
            '  </default>',
@@ -359,7 +460,7 @@ def _build(mech, q, q_guess, timestep, *, name=None, names_only=False, minimum_m
         if link in minimum_of:
             lines.append(f"{ind}<!-- MuJoCo refuses a moving body without mass or with a zero principal moment -->")
             lines.append(f'{ind}<body name={quoteattr(minimum_of[link])}>')
-            inertia = MINIMUM if minimum_mass == MINIMUM else minimum_mass * 0.01
+            inertia = minimum_inertia(mech, minimum_mass)
             lines.append(f'{ind}  {_inertial(minimum_mass, np.zeros(3), inertia * np.eye(3))}')
             lines.append(f'{ind}</body>')
         return lines

@@ -33,7 +33,7 @@ from mechbal import _core
 from mechbal._deprecation import DeprecatedAttributes, renamed_kwargs
 from mechbal.export.mjcf import MINIMUM, _build, minimum_bodies
 
-__all__ = ["MujocoMechanism", "MujocoInverse", "require_mujoco"]
+__all__ = ["MujocoMechanism", "MujocoInverse", "require_mujoco", "validate_mjcf"]
 
 
 def require_mujoco():
@@ -43,6 +43,101 @@ def require_mujoco():
     except ImportError:
         raise ImportError("MuJoCo is not installed: pip install 'mechbal[mujoco]' (or pip install mujoco)") from None
     return mujoco
+
+
+#: largest loop or gear violation [m or rad] of a valid MJCF at its keyframe
+VALIDATION_TOLERANCE = 1e-9
+#: the one-line note of a file written without MuJoCo to check it
+NOT_VALIDATED = "MuJoCo is not installed: the MJCF was not validated (pip install 'mechbal[mujoco]')"
+
+
+def _body_at_line(xml: str, line: int) -> str | None:
+    """Name of the innermost ``<body>`` open at ``line`` (1-based) of ``xml``: the body an
+    element of that line belongs to."""
+    import re
+
+    stack: list[str] = []
+    for k, text in enumerate(xml.splitlines()[:max(line, 0)], start=1):
+        for tag in re.finditer(r"<(/?)body\b([^>]*?)(/?)>", text):
+            if tag.group(1):
+                if stack:
+                    stack.pop()
+            elif not tag.group(3):
+                m = re.search(r'name="([^"]*)"', tag.group(2))
+                stack.append(m.group(1) if m else "?")
+        if k == line:
+            m = re.search(r'<body\b[^>]*name="([^"]*)"', text)
+            if m:
+                return m.group(1)
+    return stack[-1] if stack else None
+
+
+def validate_mjcf(xml: str, *, tolerance: float = VALIDATION_TOLERANCE) -> dict:
+    """Load ``xml`` in MuJoCo and run ``mj_forward`` at its keyframe (``assembled``, else the
+    model's reference pose), at rest and without control: MuJoCo must accept the file, raise
+    none of its warnings, and find every equality (loop, gear) satisfied to ``tolerance``
+    [m or rad]. Returns ``{"validated": True, "mujoco": version, "max_equality_violation": ...}``,
+    or ``{"validated": False, "note": NOT_VALIDATED}`` when MuJoCo is not installed; raises
+    ExportError (one line naming the body, or the equality and its bodies, and the reason)
+    when the file fails."""
+    from mechbal.export.common import ExportError
+
+    try:
+        mj = require_mujoco()
+    except ImportError:
+        return {"validated": False, "note": NOT_VALIDATED}
+    import re
+
+    try:
+        m = mj.MjModel.from_xml_string(xml)
+    except ValueError as exc:
+        text = str(exc)
+        reason = text.splitlines()[0].removeprefix("Error:").strip() if text else "refused"
+        where = re.search(r"line (\d+)", text)
+        body = _body_at_line(xml, int(where.group(1))) if where else None
+        element = re.search(r"Element name '([^']*)'", text)
+        what = f"body '{body}'" if body else (f"element '{element.group(1)}'" if element else "the file")
+        raise ExportError(f"MuJoCo refuses the MJCF: {what}: {reason}") from None
+    d = mj.MjData(m)
+    key = mj.mj_name2id(m, mj.mjtObj.mjOBJ_KEY, "assembled")
+    if key >= 0:
+        mj.mj_resetDataKeyframe(m, d, key)
+    mj.mj_forward(m, d)
+    body_name = lambda b: mj.mj_id2name(m, mj.mjtObj.mjOBJ_BODY, int(b)) or f"body {int(b)}"  # noqa: E731
+    for w in mj.mjtWarning.__members__.values():
+        if int(w) < len(d.warning) and d.warning[int(w)].number:
+            info = int(d.warning[int(w)].lastinfo)
+            name = w.name.removeprefix("mjWARN_")
+            where = ""
+            if name.startswith("BADQ") and 0 <= info < m.nv:
+                where = f" at body '{body_name(m.dof_bodyid[info])}'"
+            raise ExportError(f"MuJoCo warns at the MJCF's keyframe ({name}{where}): the file does not hold")
+    worst, row = 0.0, -1
+    for i in range(int(d.ne)):
+        if abs(float(d.efc_pos[i])) > worst:
+            worst, row = abs(float(d.efc_pos[i])), i
+    if worst > tolerance:
+        eq = int(d.efc_id[row])
+        name = mj.mj_id2name(m, mj.mjtObj.mjOBJ_EQUALITY, eq) or f"equality {eq}"
+        bodies = []
+        for obj in (m.eq_obj1id[eq], m.eq_obj2id[eq]):
+            if int(m.eq_objtype[eq]) == int(mj.mjtObj.mjOBJ_SITE):
+                bodies.append(body_name(m.site_bodyid[obj]))
+            elif int(m.eq_objtype[eq]) == int(mj.mjtObj.mjOBJ_BODY):
+                bodies.append(body_name(obj))
+            elif int(m.eq_objtype[eq]) == int(mj.mjtObj.mjOBJ_JOINT) and obj >= 0:
+                bodies.append(body_name(m.jnt_bodyid[obj]))
+        between = f" (bodies {', '.join(repr(b) for b in bodies)})" if bodies else ""
+        raise ExportError(f"MuJoCo finds equality '{name}'{between} violated by {worst:.3g} (> {tolerance:g}) at the "
+                          "MJCF's keyframe: the loops are not closed there")
+    return {"validated": True, "mujoco": str(mj.__version__), "max_equality_violation": worst,
+            "integrator": _integrator_name(mj, m), "timestep": float(m.opt.timestep)}
+
+
+def _integrator_name(mj, m) -> str:
+    return {int(v): k.removeprefix("mjINT_") for k, v in mj.mjtIntegrator.__members__.items()}.get(
+        int(m.opt.integrator), str(int(m.opt.integrator))).replace("IMPLICITFAST", "implicitfast").replace(
+        "IMPLICIT", "implicit").replace("EULER", "Euler")
 
 
 @dataclass(frozen=True)
@@ -77,13 +172,15 @@ def _cross_force(v: np.ndarray, f: np.ndarray) -> np.ndarray:
 
 class MujocoMechanism:
     """``mech`` exported to MJCF and loaded in MuJoCo (module docstring). ``q`` / ``q_guess``:
-    the assembled pose of the keyframe (closed mechanisms); ``timestep`` [s]; ``minimum_mass``:
+    the assembled pose of the keyframe (closed mechanisms); ``timestep`` [s] (default: the
+    file's, `mechbal.export.mjcf.default_timestep`); ``minimum_mass`` (default `MINIMUM`: the
+    mechanism itself, for inverse dynamics; the file's own is `mechbal.export.mjcf.default_minimum_mass`):
     of the bodies added to the links MuJoCo would refuse (`mechbal.export.mjcf.minimum_bodies`;
     ``exported`` is ``mech`` with them: the mechanism MuJoCo integrates); ``constraint_weight``:
     factor on MuJoCo's inverse weights of bodies, dofs and tendons, which set how much its soft
     constraints give under load (1: MuJoCo's own)."""
 
-    def __init__(self, mech, *, q=None, q_guess=None, timestep: float = 1e-3, minimum_mass: float = MINIMUM,
+    def __init__(self, mech, *, q=None, q_guess=None, timestep: float | None = None, minimum_mass: float = MINIMUM,
                  constraint_weight: float = 1.0):
         mj = require_mujoco()
         self.mj = mj
@@ -245,6 +342,9 @@ def load(mech, **kw: Any) -> MujocoMechanism:
 MINIMUM_FRACTION = 1e-6
 #: co-simulation: factor on MuJoCo's inverse weights (its constraints' give under load)
 CONSTRAINT_WEIGHT = 1e-4
+#: co-simulation: solref of the loop and gear constraints (MuJoCo's default time constant and
+#: damping ratio), whatever the file says
+COSIM_SOLREF = (0.02, 1.0)
 
 
 def cosimulated_mechanism(mech, minimum_mass: float | None = None):
@@ -296,6 +396,9 @@ class CoSimulation(DeprecatedAttributes):
     q_full: np.ndarray | None = None
     v_full: np.ndarray | None = None
     a_full: np.ndarray | None = None
+    #: MuJoCo's settings of the run: integrator, timestep [s] (dt / substeps), substeps, solref of
+    #: the loops and gears, constraint_weight, minimum_mass [kg] (`mujoco_options`)
+    options: dict | None = None
 
     _renamed: ClassVar[dict[str, str]] = {"qd": "v", "qd_des": "v_des"}
 
@@ -332,8 +435,9 @@ def co_simulate(mech, controller, trajectory, q0=None, v0=None, *, dt: float = 1
     mechanism) every ``dt`` against MuJoCo integrating ``mech``'s MJCF export, ``substeps``
     MuJoCo steps of dt / substeps per tick, torque held over the tick (zero-order hold).
     ``integrator``: MuJoCo's (``RK4``, ``Euler``, ``implicitfast``, ``implicit``); ``solref``:
-    (time constant [s], damping ratio) of the loop and gear constraints (MuJoCo's default
-    (0.02, 1) when None); ``solimp``: their impedance (d0, d_width, width[, mid, power]), MuJoCo's
+    (time constant [s], damping ratio) of the loop and gear constraints (`COSIM_SOLREF`, MuJoCo's
+    default (0.02, 1), when None; the file's own, twice its step, holds a pose stiffer but
+    tracks a motion with a larger spurious shaking force); ``solimp``: their impedance (d0, d_width, width[, mid, power]), MuJoCo's
     default (0.9, 0.95, 0.001) when None: the closer d to 1, the harder the constraint (MuJoCo
     caps d at 0.9999). ``minimum_mass`` [kg]: of the bodies added to massless moving links
     (default `MINIMUM_FRACTION` of the total mass: MuJoCo's solver fails on a link of 1e-13
@@ -370,8 +474,9 @@ def co_simulate(mech, controller, trajectory, q0=None, v0=None, *, dt: float = 1
     br = model.base_reaction(Q, V, A)
     mj, m, d = sim.mj, sim.model, sim.data
     m.opt.integrator = int(getattr(mj.mjtIntegrator, f"mjINT_{integrator.upper()}"))
-    if solref is not None:
-        m.eq_solref[:] = np.asarray(solref, float)
+    # the co-simulation's constraint settings, not the file's (which are chosen to hold a pose):
+    # MuJoCo's default time constant tracks a motion with the smallest spurious shaking force
+    m.eq_solref[:] = np.asarray(COSIM_SOLREF if solref is None else solref, float)
     if solimp is not None:
         imp = np.asarray(solimp, float)
         m.eq_solimp[:, :imp.size] = imp
@@ -452,7 +557,17 @@ def co_simulate(mech, controller, trajectory, q0=None, v0=None, *, dt: float = 1
                         predicted_base_reaction_force=np.asarray(br.base_reaction_force),
                         predicted_base_reaction_moment=np.asarray(br.base_reaction_moment),
                         gravity=g, mass=mass, mass_moment=mc, predicted_mass_moment=mc_pred,
-                        constraint_violation=viol, q_full=full["q"], v_full=full["v"], a_full=full["a"])
+                        constraint_violation=viol, q_full=full["q"], v_full=full["v"], a_full=full["a"],
+                        options={"integrator": _integrator_name(mj, m), "timestep": float(m.opt.timestep),
+                                 "substeps": int(substeps), "solref": [float(x) for x in m.eq_solref[0]] if m.neq
+                                 else [float(x) for x in COSIM_SOLREF], "constraint_weight": float(constraint_weight),
+                                 "minimum_mass": float(minimum_mass)})
+
+
+def mujoco_options(cs: "CoSimulation") -> dict:
+    """The ``mujoco_options`` of a summary.json: MuJoCo's integrator and time step [s] of the
+    co-simulation ``cs`` and its constraint settings."""
+    return dict(cs.options or {})
 
 
 def _still_bodies(mech) -> set[str]:

@@ -49,9 +49,12 @@ inline constexpr std::size_t kMaxUrdfDepth = 64;
 ///    * a <mimic> of a joint that does not exist is ignored (Pinocchio reads an independent joint);
 ///    * a body whose inertia is not physical (not positive semi-definite, or breaking the triangle
 ///      inequality; Pinocchio loads it) gets the nearest physical one: the second moment of mass
-///      S = tr(I)/2 1 - I has its negative eigenvalues set to zero (S >= 0 is exactly
-///      "physical"), and I = tr(S) 1 - S. The warning says whether the body is negligible (mass
-///      <= kNegligibleMassFraction of the URDF's total mass) or not (then the dynamics differ from
+///      S = tr(I)/2 1 - I has its eigenvalues raised to at least 1e-12 tr(S) (S >= 0 is exactly
+///      "physical"; the margin keeps the triangle inequality off its boundary), and
+///      I = tr(S) 1 - S. "Not physical" is judged to the inertia's own scale too: a tiny inertia
+///      whose rounding breaks the triangle inequality (relative 1e-12) is repaired (or refused by
+///      strict), not passed on to engines that refuse it. The warning says whether the body is
+///      negligible (mass <= kNegligibleMassFraction of the URDF's total mass) or not (then the dynamics differ from
 ///      the file's, and the warning asks for the file to be corrected);
 ///    * a negligible, non-physical <inertial> on the root link (a placeholder on the fixed base,
 ///      which never moves) is dropped.
