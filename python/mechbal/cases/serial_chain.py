@@ -569,7 +569,9 @@ def run_passive(mech: Mechanism, case, traj, out: Path, q_guess=None, assembly=N
             "initial_energy": e0, "max_energy_drift": r.energy_drift,
             "kinetic_energy_swing": swing,
             "relative_energy_drift": r.energy_drift / swing if swing > 0 else 0.0,
-            "energy": "kinetic 1/2 v^T M v + gravity (zero at O) + springs; conserved by the exact motion",
+            "energy": "kinetic 1/2 v^T M v + gravity (zero at O) + springs; conserved by the exact motion "
+                      "until a joint hits a limit (an inelastic end stop: the drift is measured before it)",
+            "stop_steps": r.stop_steps,
             "final_q": r.q[-1], "final_v": r.v[-1],
         },
         "total_mass": mech.total_mass,
