@@ -73,6 +73,32 @@ def _cmd_sweeps(args) -> int:
     return 0
 
 
+def _is_urdf(case) -> bool:
+    return str(case).lower().endswith(".urdf")
+
+
+def _with_design(args, command) -> int | None:
+    """A URDF with ``--design FILE`` (or, for ``verify`` and ``run --engine mujoco``, without):
+    ``command`` run on the URDF's whole case with the design's tables (`mechbal.case.urdf_with_design`);
+    None when the case is not a URDF to compose. ``--design`` on a TOML case: UserError."""
+    design = getattr(args, "design", None)
+    if not _is_urdf(args.case):
+        if design is not None:
+            raise UserError("--design: is for a URDF file (a case file holds its own [trajectory] and "
+                            "[control])")
+        return None
+    if design is None and getattr(args, "engine", "mujoco") == "mechbal":
+        return None   # the URDF's default run (--duration, --samples)
+    for flag in ("duration", "samples"):
+        if design is not None and getattr(args, flag, None) is not None:
+            raise UserError(f"--{flag}: not with --design (its [trajectory] sets the motion)")
+    from mechbal.case import urdf_with_design
+
+    with urdf_with_design(args.case, design) as path:
+        composed = argparse.Namespace(**{**vars(args), "case": str(path), "design": None})
+        return command(composed)
+
+
 def _cmd_run(args) -> int:
     from mechbal.cases import run_case
     from mechbal.output import check_output_dir
@@ -80,6 +106,9 @@ def _cmd_run(args) -> int:
     out = Path(args.out)
     check_output_dir(out)           # before anything else: a bad --out fails in the first second
     check_case_file(args.case)
+    composed = _with_design(args, _cmd_run)
+    if composed is not None:
+        return composed
     if getattr(args, "engine", "mechbal") == "mujoco":
         return _run_mujoco(args, out)
     buffer = io.StringIO()
@@ -180,6 +209,19 @@ def _cmd_demo(args) -> int:
 def _cmd_init(args) -> int:
     from mechbal import templates
 
+    source = getattr(args, "source", None)
+    if source is not None:
+        if args.kind is not None:
+            raise UserError(f"--from: a case from a URDF has no kind to choose (got '{args.kind}' as well)")
+        if not _is_urdf(source):
+            raise UserError(f"--from: must be a URDF file (.urdf), got '{source}'")
+        from mechbal.mechanism import Mechanism
+
+        check_case_file(source)
+        sys.stdout.write(Mechanism.from_urdf(source).to_toml(name=Path(source).stem))
+        return 0
+    if args.kind is None:
+        raise UserError("init: give a kind (serial, linkage, reactionless) or --from robot.urdf")
     text = {"linkage": templates.LINKAGE, "reactionless": templates.REACTIONLESS}
     sys.stdout.write(text.get(args.kind, templates.SERIAL))
     return 0
@@ -295,6 +337,10 @@ def _cmd_verify(args) -> int:
 
     out = Path(args.out)
     check_output_dir(out)
+    check_case_file(args.case)
+    composed = _with_design(args, _cmd_verify)
+    if composed is not None:
+        return composed
     return _in_mujoco(args, out, lambda tmp: run_verify(args.case, tmp, simulate=not args.no_simulation,
                                                         method=args.method),
                       "summary.json and the plots beside it")
@@ -436,6 +482,9 @@ def build_parser() -> argparse.ArgumentParser:
                                    "run.")
     s.add_argument("case", help="built-in case name (see 'mechbal cases') or path to a TOML or URDF file")
     _out_folder(s, "out")
+    s.add_argument("--design", metavar="FILE", default=None,
+                   help="URDF files: a TOML file with [trajectory] and / or [control] (and [balance]) "
+                        "run on the URDF's mechanism, as in a case file")
     s.add_argument("--duration", type=float, metavar="S",
                    help="URDF files: duration of the default trajectory [s] (default: 2)")
     s.add_argument("--samples", type=int, metavar="N",
@@ -525,13 +574,16 @@ def build_parser() -> argparse.ArgumentParser:
                                    "gravity torque with MuJoCo's (inverse dynamics on the trajectory, "
                                    "and a 1 kHz computed-torque simulation): DIR/summary.json, a "
                                    "table and plots. Needs the 'mujoco' extra.")
-    s.add_argument("case", help="built-in case name or path to a TOML case file")
+    s.add_argument("case", help="built-in case name, path to a TOML case file, or a URDF file "
+                                "(with --design, or its default motion)")
+    s.add_argument("--design", metavar="FILE", default=None,
+                   help="URDF files: a TOML file with [trajectory] and / or [control] (and [balance])")
     _out_folder(s, "out/verify")
     s.add_argument("--method", choices=_METHODS, default=None,
                    help="balancing method of the balanced variant (default: balance.method of the case)")
     s.add_argument("--no-simulation", action="store_true",
                    help="only the inverse dynamics on the trajectory (no forward simulation)")
-    _last_flags(s, _cmd_verify)
+    _last_flags(s, _cmd_verify, urdf=True)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")
     _out_folder(s, "out/demo")
@@ -553,10 +605,14 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("init", help="print a commented case template: mechbal init serial > my.toml",
                        description="Print a commented case file to standard output, to edit and "
                                    "run with 'mechbal run my.toml'.")
-    s.add_argument("kind", choices=("serial", "linkage", "reactionless"),
+    s.add_argument("kind", nargs="?", choices=("serial", "linkage", "reactionless"), default=None,
                    help="serial: a serial chain (joints, links, trajectory); linkage: a closed "
                         "loop (four-bar with a counterweight); reactionless: an arm with a "
                         "reaction wheel under the reactionless controller ([control] table)")
+    s.add_argument("--from", dest="source", metavar="URDF", default=None,
+                   help="write the whole case of a URDF file instead (its mechanism exactly, a default "
+                        "trajectory, a commented [control]): mechbal init --from robot.urdf > robot.toml")
+    _urdf_flags(s)
     s.set_defaults(func=_cmd_init)
     _identify_parsers(sub)
     return p

@@ -269,6 +269,10 @@ def trajectory_from_config(table: Any, dof: int, field: str = "trajectory"):
         raise ConfigError(f"{field}.law", "'min_shaking' is a planned motion: `mechbal run` plans it "
                                           "(mechbal.plan.min_shaking); this command needs a fixed law "
                                           "(quintic, cubic, constant_speed)", tr.law)
+    if tr.law == "line":
+        raise ConfigError(f"{field}.law", "'line' is the path of the [control] task_frame (the reactionless "
+                          "controller's operational-space mode), not a motion of the joints: give task_frame, "
+                          "or a joint-space law (quintic, cubic) with end", "line")
     keys = ("start", "speed", "rpm") if tr.law == "constant_speed" else ("start", "end")
     for key in keys:
         v = getattr(tr, key)

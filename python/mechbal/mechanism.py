@@ -28,7 +28,7 @@ import contextvars as _contextvars
 from types import SimpleNamespace as _SimpleNamespace
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -406,6 +406,21 @@ class Mechanism:
         from mechbal.export.mjcf import mjcf_text
 
         text = mjcf_text(self, name, q=q, q_guess=q_guess, timestep=timestep)
+        if path is not None:
+            Path(path).write_text(text)
+        return text
+
+    def to_toml(self, path: str | Path | None = None, *, name: str | None = None,
+                title: str | None = None, trajectory: Mapping[str, Any] | None = None) -> str:
+        """A complete, commented case file of this mechanism (``kind = "mechanism"``, what
+        ``mechbal init --from robot.urdf`` prints; `mechbal.export.toml.case_text`): ``[case]``,
+        ``[mechanism]`` (every joint, body, frame, spring and loop, numbers that round-trip:
+        `from_toml` reads back this model), ``[trajectory]`` (``trajectory``, a table as a case file
+        holds it, or an open mechanism's default motion) and a commented ``[control]``. Writes
+        ``path`` when given; returns the text."""
+        from mechbal.export.toml import case_text
+
+        text = case_text(self, name=name, title=title, trajectory=trajectory, source=self.source)
         if path is not None:
             Path(path).write_text(text)
         return text

@@ -231,6 +231,35 @@ def _closed_loop_mujoco(mech: Any, controller: Any, trajectory: Any, q0: npt.Arr
                             mujoco=r)
 
 
+def _on_stops(plant: Any, q: FloatArray, v: FloatArray, a: FloatArray, lower: FloatArray,
+              upper: FloatArray) -> None:
+    """The accelerations ``a`` (rows of the free motion, changed in place) where a joint rests on
+    a stop: the stops' efforts hold those joints (their acceleration 0) where the free motion
+    would push them through, through the inverse mass matrix (an active set: a stop only pushes)."""
+    n = q.shape[1]
+    zero = np.zeros(n)
+    for k in range(q.shape[0]):
+        side = np.where(q[k] >= upper, 1.0, np.where(q[k] <= lower, -1.0, 0.0))
+        active = [i for i in range(n) if side[i] != 0.0 and side[i] * a[k, i] > 0.0 and side[i] * v[k, i] >= 0.0]
+        if not active:
+            continue
+        a0 = np.asarray(plant.forward_dynamics(q[k], v[k], zero), float)
+        W = np.empty((n, n))
+        for i in range(n):
+            e = np.zeros(n)
+            e[i] = 1.0
+            W[:, i] = np.asarray(plant.forward_dynamics(q[k], v[k], e), float) - a0
+        for _ in range(n):
+            lam = np.linalg.solve(W[np.ix_(active, active)], -a0[active])
+            keep = [i for i, x in zip(active, lam) if side[i] * x <= 0.0]   # a stop pushes back
+            if keep == active:
+                a[k] = a0 + W[:, active] @ lam
+                break
+            active = keep
+            if not active:
+                break
+
+
 @dataclass(frozen=True)
 class PassiveResult:
     """A passive run (`passive`), one row per step k = 0 .. steps (t_k = k dt):
@@ -242,7 +271,10 @@ class PassiveResult:
       and acceleration (forward dynamics at zero effort);
     * ``kinetic_energy``, ``potential_energy`` (N,) [J]: 1/2 v^T M v, and gravity (zero at O) plus
       springs; their sum ``energy`` is conserved by the exact motion (no effort, no friction);
-    * ``status`` (N,): per step (0 = ok); ``steps_completed`` as `ClosedLoopResult`.
+    * ``status`` (N,): per step (0 = ok); ``steps_completed`` as `ClosedLoopResult`;
+    * ``stop_steps``: steps that ended with a joint on one of its limits (an inelastic end stop;
+      `passive`'s ``joint_limits``); ``on_stop`` (N, na): which joint is on a stop at each step.
+      The energy is conserved only up to the first impact.
     """
 
     t: np.ndarray
@@ -255,6 +287,8 @@ class PassiveResult:
     potential_energy: np.ndarray
     status: np.ndarray
     steps_completed: int
+    stop_steps: int = 0
+    on_stop: np.ndarray | None = None
 
     @property
     def energy(self) -> np.ndarray:
@@ -263,8 +297,12 @@ class PassiveResult:
 
     @property
     def energy_drift(self) -> float:
-        """Largest |energy - energy at t = 0| over the run [J] (the integrator's error)."""
-        return float(np.max(np.abs(self.energy - self.energy[0])))
+        """Largest |energy - energy at t = 0| [J] over the run, or up to the first step on a stop
+        (an impact dissipates energy): the integrator's error."""
+        e = self.energy
+        if self.on_stop is not None and np.any(self.on_stop):
+            e = e[:max(1, int(np.argmax(np.any(self.on_stop, axis=1))))]
+        return float(np.max(np.abs(e - e[0])))
 
     @property
     def ok(self) -> bool:
@@ -273,17 +311,25 @@ class PassiveResult:
 
 
 def passive(mech: Any, q0: npt.ArrayLike, v0: npt.ArrayLike | None = None, *, dt: float = 1e-3,
-            duration: float = 1.0, q_guess: npt.ArrayLike | None = None) -> PassiveResult:
+            duration: float = 1.0, q_guess: npt.ArrayLike | None = None,
+            joint_limits: bool = True) -> PassiveResult:
     """Passive simulation: no controller, zero joint effort; ``mech`` (a `mechbal.Mechanism`,
     closed loops included) moves under gravity and its springs from ``q0`` (actuated coordinates,
     every coordinate of an open mechanism) [rad or m] with rates ``v0`` (default at rest), RK4 with
     step ``dt`` [s] for ``duration`` [s] (the closed loop of `closed_loop` with
     `mechbal.control.PassiveController`). ``q_guess``: the full coordinates near the
     assembly of a closed mechanism (its branch). The result carries the energy along the run, the
-    invariant of an unforced motion."""
-    from mechbal.control import PassiveController
+    invariant of an unforced motion while no joint is on a stop.
+
+    ``joint_limits`` (default True): the declared position limits of the actuated joints (URDF
+    ``<limit lower upper>``, case ``limits``) are inelastic end stops (C++
+    ``ClosedLoopOptions::lower_limit / upper_limit``): a joint that reaches one is put back on it
+    and its rate towards it removed by an impulse through the inverse mass matrix (the other joints
+    take the reaction); it rests there while the load pushes it in, and leaves when the load pulls
+    it away. An impact loses energy (no bounce): the result's ``stop_steps`` counts the steps that
+    ended on a stop. False: the joints pass their limits (the unconstrained dynamics). ``q0``
+    must lie within the limits (ValueError naming the joint otherwise)."""
     from mechbal.mechanism import Mechanism
-    from mechbal.trajectory import RestToRest
 
     if not isinstance(mech, Mechanism):
         raise TypeError(f"passive simulates a mechbal.Mechanism, got {type(mech).__name__}")
@@ -297,13 +343,25 @@ def passive(mech: Any, q0: npt.ArrayLike, v0: npt.ArrayLike | None = None, *, dt
         if not np.all(np.isfinite(x)):
             raise ValueError(f"{name} must be finite")
     dt, duration = _check_timing(dt, duration)
-    held = RestToRest(q0, q0, duration)   # the controller ignores it: a placeholder desired motion
-    run = closed_loop(mech, PassiveController(na), held, q0, v0, dt=dt, duration=duration, q_guess=q_guess)
-    q, v = run.q, run.v
+    coords = list(mech.model.actuated_coordinates)
+    lower = np.asarray(mech.model.lower_limits, float)[coords]
+    upper = np.asarray(mech.model.upper_limits, float)[coords]
+    if not joint_limits:
+        lower, upper = np.full(na, -np.inf), np.full(na, np.inf)
+    names = mech.actuated_names
+    for i in range(na):
+        if not lower[i] <= q0[i] <= upper[i]:
+            raise ValueError(f"q0[{i}] = {q0[i]!r} ({names[i]}) is outside the joint's limits "
+                             f"[{lower[i]!r}, {upper[i]!r}] (joint_limits=False lets it pass them)")
     guess = np.zeros(mech.dof) if q_guess is None else np.asarray(q_guess, float)
+    plant = _core.MechanismDynamics(mech.model, guess)
+    log = _core.simulate_passive(plant, q0, v0, dt, duration, lower, upper)
+    q, v = np.asarray(log["q"]), np.asarray(log["v"])
     plant = _core.MechanismDynamics(mech.model, guess)   # accelerations at zero effort
     zero = np.zeros(na)
     aa = np.array([plant.forward_dynamics(qk, vk, zero) for qk, vk in zip(q, v)]).reshape(q.shape)
+    if int(log["stop_ticks"]):
+        _on_stops(plant, q, v, aa, lower, upper)
     if mech.is_closed:
         m = mech.closed_motion(q, v, aa, q_guess=guess)
         qf, vf, af = m.q, m.v, m.a
@@ -312,5 +370,8 @@ def passive(mech: Any, q0: npt.ArrayLike, v0: npt.ArrayLike | None = None, *, dt
     M = mech.mass_matrix(qf)
     kinetic = 0.5 * np.einsum("ni,nij,nj->n", vf, M, vf)
     potential = np.asarray(mech.potential_energy(qf), float)
-    return PassiveResult(t=run.t, q=q, v=v, q_full=qf, v_full=vf, a_full=af, kinetic_energy=kinetic,
-                         potential_energy=potential, status=run.status, steps_completed=run.steps_completed)
+    return PassiveResult(t=np.asarray(log["t"]), q=q, v=v, q_full=qf, v_full=vf, a_full=af,
+                         kinetic_energy=kinetic, potential_energy=potential,
+                         status=np.asarray(log["tick_status"]),
+                         steps_completed=int(log["steps_completed"]), stop_steps=int(log["stop_ticks"]),
+                         on_stop=(q <= lower) | (q >= upper))

@@ -383,8 +383,11 @@ class Mechanism(Table):
 
 
 #: the time laws of ``[trajectory]``: rest-to-rest (quintic, minimum-energy cubic), a steady
-#: rotation at constant speed, or a motion planned to minimise shaking (`mechbal.plan`)
-TrajectoryLaw = Literal["quintic", "cubic", "constant_speed", "min_shaking"]
+#: rotation at constant speed, a motion planned to minimise shaking (`mechbal.plan`), or a line
+#: of the [control] task frame
+TrajectoryLaw = Literal["quintic", "cubic", "constant_speed", "min_shaking", "line"]
+#: a displacement or a rotation vector of the line law: three numbers (O axes)
+Vector3 = Annotated[list[Num], Field(min_length=3, max_length=3)]
 #: what ``law = "min_shaking"`` minimises (`mechbal.plan.OBJECTIVES`)
 PlanObjective = Literal["force_rms", "force_peak", "moment_rms", "moment_peak"]
 #: the keys that only ``law = "min_shaking"`` takes
@@ -445,7 +448,10 @@ class ChainTrajectory(Table):
     mechanism). ``law = "quintic" | "cubic"``: rest-to-rest from ``start`` to ``end`` in
     ``duration``; ``law = "constant_speed"``: from ``start`` at ``speed`` [rad/s or m/s] or ``rpm``
     (exactly one) for ``duration`` seconds or ``revolutions`` turns (exactly one) of the fastest
-    joint."""
+    joint; ``law = "line"`` (the operational-space mode, ``[control] task_frame``): the task
+    frame moves from its pose at ``start`` (joint positions) by ``displacement`` [m] and / or
+    turns by ``rotation`` (a rotation vector [rad]), both in O's axes, on a straight line (and
+    about one fixed axis) along the quintic law in ``duration``."""
     law: TrajectoryLaw = "quintic"
     start: JointValues = Field(description="one value per actuated joint (rad or m)")
     end: Optional[JointValues] = Field(None, description="rest-to-rest laws: one value per actuated joint (rad or m)")
@@ -459,6 +465,10 @@ class ChainTrajectory(Table):
     revolutions: Optional[Annotated[float, Field(gt=0, le=1e6, **_NUM)]] = Field(
         None, description="constant_speed: turns of the fastest joint (duration = revolutions 2 pi / "
                           "max |speed|); or duration")
+    displacement: Optional[Vector3] = Field(
+        None, description="law = 'line': the task frame's displacement [dx, dy, dz] (m, O axes)")
+    rotation: Optional[Vector3] = Field(
+        None, description="law = 'line': the task frame's rotation vector theta k (rad, O axes)")
     samples: Samples = 501
     initial_guess: Optional[JointValues] = Field(
         None, description="closed mechanisms: every joint coordinate near the assembly at start, or "
@@ -500,7 +510,21 @@ class ChainTrajectory(Table):
                                   getattr(self, key))
         elif self.objective is not None and self.weights is not None:
             raise _custom("give objective or weights, not both", ".weights", self.weights.model_dump())
-        if self.law == "constant_speed":
+        if self.law != "line":
+            for key in ("displacement", "rotation"):
+                if getattr(self, key) is not None:
+                    raise _custom(f"is for law = 'line' (law is '{self.law}')", f".{key}", getattr(self, key))
+        if self.law == "line":
+            for key in ("end", "speed", "rpm", "revolutions"):
+                if getattr(self, key) is not None:
+                    raise _custom("is not for law = 'line' (the task frame's path: start, displacement "
+                                  "and / or rotation, duration)", f".{key}", getattr(self, key))
+            if self.displacement is None and self.rotation is None:
+                raise _custom("law = 'line' needs displacement [dx, dy, dz] (m) and / or rotation "
+                              "(rad)", ".displacement", None, has_value=False)
+            if self.duration is None:
+                raise _custom("law = 'line' needs duration", ".duration", None, has_value=False)
+        elif self.law == "constant_speed":
             for key in ("end",):
                 if getattr(self, key) is not None:
                     raise _custom("is for the rest-to-rest laws (quintic, cubic); a constant-speed "

@@ -506,3 +506,25 @@ def quintic_within_limits(mech: Any, start: ArrayLike, end: ArrayLike, duration:
                           and np.all(np.max(np.abs(v), axis=0) <= vmax * (1 + 1e-9))),
     }
     return T, report
+
+
+#: largest default motion of one joint (`default_motion`): revolute [rad], prismatic [m]
+DEFAULT_MAX_STEP = {_core.JointType.revolute: 0.5, _core.JointType.prismatic: 0.1}
+
+
+def default_motion(mech: Any) -> tuple[np.ndarray, np.ndarray]:
+    """(start, end) of the default motion of an open mechanism (``mechbal run robot.urdf``,
+    `mechbal.Mechanism.to_toml`): every joint starts at 0 (clipped into its limits) and moves
+    towards its upper limit by half the room left, at most 0.5 rad (revolute) or 0.1 m
+    (prismatic); a joint with no room above moves towards its lower limit the same way; an
+    unlimited (continuous) joint moves by 0.5 rad."""
+    lower = np.asarray(mech.model.lower_limits, float)
+    upper = np.asarray(mech.model.upper_limits, float)
+    types = {j.name: j.type for j in mech.model.description.joints}
+    step = np.array([DEFAULT_MAX_STEP[types[n]] for n in mech.joint_names])
+    start = np.clip(np.zeros(mech.dof), lower, upper)
+    room_up, room_down = upper - start, start - lower
+    up = np.minimum(step, 0.5 * room_up)
+    down = np.minimum(step, 0.5 * room_down)
+    end = np.where(room_up >= room_down, start + up, start - down)
+    return start, end

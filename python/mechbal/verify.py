@@ -384,7 +384,10 @@ def reactionless_plan(case, *, dt: float = 1e-3, duration: float | None = None) 
                   ctl=ctl, trajectory=tr, dt=float(dt), horizon=horizon, t=th[::2], th=th)
     if ctl.task_frame is not None:
         check_task_space(mech, cfg)
-        _, _, twist, rate = frame_path(mech, ctl.task_frame, tr.start, tr.end, total, tr.law, th)
+        from mechbal.case import task_end_pose
+
+        _, _, twist, rate = frame_path(mech, ctl.task_frame, tr.start, tr.end, total, tr.law, th,
+                                       end_pose=task_end_pose(mech, ctl.task_frame, tr))
         return ReactionlessPlan(**common, q_guess=None, mode="task", start=np.array(tr.start, float), twist=twist,
                                 twist_rate=rate)
     traj, balancing, task = held_trajectory(mech, cfg)

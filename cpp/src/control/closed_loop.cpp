@@ -25,6 +25,106 @@ void desired_on_piece(const RestToRestTrajectory& traj, double t, double t_piece
   traj.evaluate(te, q, qd, qdd);
 }
 
+// Inelastic stops (ClosedLoopOptions::lower_limit / upper_limit), the state at the end of a step.
+// Buffers allocated once before the loop; apply() allocates nothing.
+class Stops {
+ public:
+  Stops(const ClosedLoopOptions& options, int n, const Eigen::VectorXd& q0) {
+    const auto& lo = options.lower_limit;
+    const auto& hi = options.upper_limit;
+    enabled_ = lo.size() != 0 || hi.size() != 0;
+    if (!enabled_) return;
+    std::ostringstream msg;
+    if (lo.size() != n || hi.size() != n) {
+      msg << "closed_loop.lower_limit and upper_limit must have " << n << " values each (got "
+          << lo.size() << " and " << hi.size() << ")";
+      throw std::invalid_argument(msg.str());
+    }
+    for (int i = 0; i < n; ++i) {
+      if (std::isnan(lo(i)) || std::isnan(hi(i)) || lo(i) > hi(i)) {
+        msg << "closed_loop: the stops of coordinate " << i << " must satisfy lower_limit <= "
+            << "upper_limit (got [" << lo(i) << ", " << hi(i) << "])";
+        throw std::invalid_argument(msg.str());
+      }
+      if (q0(i) < lo(i) || q0(i) > hi(i)) {
+        msg << "closed_loop.q0[" << i << "] = " << q0(i) << " is outside its stops [" << lo(i)
+            << ", " << hi(i) << "]";
+        throw std::invalid_argument(msg.str());
+      }
+    }
+    if (options.stop_sweeps < 1) throw std::invalid_argument("closed_loop.stop_sweeps must be >= 1");
+    lower_ = lo;
+    upper_ = hi;
+    sweeps_ = options.stop_sweeps;
+    W_.setZero(n, n);
+    impulse_.setZero(n);
+    side_.setZero(n);
+    a0_.setZero(n);
+    a1_.setZero(n);
+    unit_.setZero(n);
+  }
+
+  // Puts the coordinates beyond a stop back on it and removes their rates towards it; true when a
+  // coordinate is on a stop. A plant that fails here leaves those rates zeroed alone.
+  bool apply(ForwardDynamics& plant, Eigen::VectorXd& q, Eigen::VectorXd& qd) noexcept {
+    if (!enabled_) return false;
+    const Eigen::Index n = q.size();
+    bool any = false;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      side_(i) = 0;
+      if (q(i) >= upper_(i)) side_(i) = 1;
+      else if (q(i) <= lower_(i)) side_(i) = -1;
+      if (side_(i) == 0) continue;
+      any = true;
+      q(i) = side_(i) > 0 ? upper_(i) : lower_(i);
+    }
+    if (!any) return false;
+    // columns of M^-1 of the coordinates on a stop: a(tau = e_i) - a(tau = 0), exact (linear in tau)
+    unit_.setZero();
+    bool solved = plant.forward_dynamics(q, qd, unit_, a0_) == Status::ok;
+    for (Eigen::Index i = 0; solved && i < n; ++i) {
+      if (side_(i) == 0) continue;
+      unit_(i) = 1.0;
+      solved = plant.forward_dynamics(q, qd, unit_, a1_) == Status::ok;
+      unit_(i) = 0.0;
+      W_.col(i) = a1_ - a0_;
+      if (!(W_(i, i) > 0.0) || !W_.col(i).allFinite()) solved = false;
+    }
+    if (!solved) {  // no inverse mass matrix: stop the coordinates themselves
+      for (Eigen::Index i = 0; i < n; ++i)
+        if (side_(i) * qd(i) > 0.0) qd(i) = 0.0;
+      return true;
+    }
+    // projected Gauss-Seidel: impulse p_i pushes away from its stop (side_i p_i <= 0), and after it
+    // the rate towards the stop is zero where p_i != 0 (inelastic), never positive
+    impulse_.setZero();
+    for (int sweep = 0; sweep < sweeps_; ++sweep) {
+      double change = 0.0;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        if (side_(i) == 0) continue;
+        double p = impulse_(i) - qd(i) / W_(i, i);
+        if (side_(i) * p > 0.0) p = 0.0;
+        const double dp = p - impulse_(i);
+        if (dp == 0.0) continue;
+        qd += W_.col(i) * dp;
+        impulse_(i) = p;
+        change = std::max(change, std::abs(dp) * std::sqrt(W_(i, i)));
+      }
+      if (change <= 1e-15 * (1.0 + qd.cwiseAbs().maxCoeff())) break;
+    }
+    for (Eigen::Index i = 0; i < n; ++i)  // the round-off of the last sweep: where a stop pushed,
+      if (impulse_(i) != 0.0 || side_(i) * qd(i) > 0.0) qd(i) = 0.0;  // the rate is exactly zero
+    return true;
+  }
+
+ private:
+  bool enabled_ = false;
+  int sweeps_ = 0;
+  Eigen::VectorXd lower_, upper_, impulse_, a0_, a1_, unit_;
+  Eigen::VectorXi side_;
+  Eigen::MatrixXd W_;
+};
+
 // The loop shared by both desired-motion kinds: `desired(t, t_piece, q, qd, qdd)` writes the
 // desired motion at stage time t (t_piece: the midpoint of the step the stage belongs to).
 template <typename Desired>
@@ -53,6 +153,7 @@ ClosedLoopLog run_closed_loop(ForwardDynamics& plant, JointController& controlle
         << ")";
     throw std::invalid_argument(msg.str());
   }
+  Stops stops(options, n, q0);
   const double dt = options.dt;
   const int steps = static_cast<int>(std::lround(options.duration / dt));
   const bool zoh = options.sampling == ControlSampling::zero_order_hold;
@@ -134,6 +235,7 @@ ClosedLoopLog run_closed_loop(ForwardDynamics& plant, JointController& controlle
       continue;
     }
     log.tick_status(k) = static_cast<std::uint32_t>(tick);
+    if (stops.apply(plant, qs, qds)) ++log.stop_ticks;
     q = qs;
     qd = qds;
   }

@@ -13,6 +13,7 @@ import numpy as np
 from mechbal import control
 import mechbal
 from mechbal import progress, report
+from mechbal.case import task_end_pose
 from mechbal.cases.runners import register
 from mechbal.config import ConfigError, law_name, trajectory_from_config
 from mechbal.export import write_bodies, write_summary
@@ -69,6 +70,12 @@ def run(config, out: Path) -> dict:
     mech = Mechanism.from_spec(case.spec, name=case.case.name)
     if case.trajectory.law == "min_shaking":
         return run_min_shaking(mech, case, out)
+    if case.trajectory.law == "line":   # the task frame's path: the controller finds the joints' motion
+        if case.control is None or case.control.task_frame is None:
+            raise ConfigError("trajectory.law", "'line' moves the [control] task_frame along a line (the "
+                              "reactionless controller's operational-space mode): give [control] task_frame, "
+                              "or a joint-space law (quintic, cubic) with end", "line")
+        return run_controlled(mech, case, out)
     traj, t = trajectory_from_config(case.trajectory, len(mech.actuated_names))
     assembly = start_assembly(mech, case.trajectory, traj)
     q_guess = None if assembly is None else assembly.q
@@ -358,17 +365,21 @@ def _rotation_vector(R: np.ndarray) -> np.ndarray:
     return Rotation.from_matrix(R).as_rotvec()
 
 
-def frame_path(mech: Mechanism, frame: str, start, end, duration: float, law: str, t):
+def frame_path(mech: Mechanism, frame: str, start, end, duration: float, law: str, t, *, end_pose=None):
     """The operational-space mode's path of ``frame`` at times ``t``: from its pose at the joint
-    positions ``start`` to its pose at ``end`` along the time law s(t) (0 to 1), the origin on the
-    straight line and the orientation about the fixed axis of the relative rotation
-    (R(t) = exp(s theta [k]x) R0). Returns (position (N, 3), rotation (N, 3, 3), twist (N, 6),
-    twist_rate (N, 6)), twists [v; w] of the origin in O axes."""
+    positions ``start`` to its pose at ``end`` (or to ``end_pose``, 4 x 4 in O, when given:
+    `mechbal.case.task_end_pose`, the line law's) along the time law s(t) (0 to 1; ``law =
+    "line"``: quintic), the origin on the straight line and the orientation about the fixed axis
+    of the relative rotation (R(t) = exp(s theta [k]x) R0). Returns (position (N, 3), rotation
+    (N, 3, 3), twist (N, 6), twist_rate (N, 6)), twists [v; w] of the origin in O axes."""
     from scipy.spatial.transform import Rotation
 
     from mechbal.trajectory import RestToRest
 
-    T0, T1 = (np.asarray(mech.frame_placement(np.asarray(x, float), frame)) for x in (start, end))
+    law = "quintic" if law == "line" else law
+    T0 = np.asarray(mech.frame_placement(np.asarray(start, float), frame))
+    T1 = np.asarray(end_pose if end_pose is not None else mech.frame_placement(np.asarray(end, float), frame),
+                    float)
     dp = T1[:3, 3] - T0[:3, 3]
     rv = _rotation_vector(T1[:3, :3] @ T0[:3, :3].T)
     s, sd, sdd = (np.asarray(x)[:, 0] for x in RestToRest([0.0], [1.0], duration, law).evaluate(t))
@@ -412,10 +423,11 @@ def check_task_space(mech: Mechanism, case) -> None:
                           "controller moves every joint: list them all (missing: " + ", ".join(missing) + ")",
                           list(ctl.balancing_joints))
     tr = case.trajectory
-    if tr.law not in ("quintic", "cubic"):
+    if tr.law not in ("quintic", "cubic", "line"):
         raise ConfigError("trajectory.law", "the operational-space mode's path is rest-to-rest between the "
-                          "frame's poses at start and end: quintic or cubic", tr.law)
-    for key in ("start", "end"):
+                          "frame's poses at start and end (quintic or cubic), or a line from start "
+                          "(line, with displacement and / or rotation)", tr.law)
+    for key in ("start",) if tr.law == "line" else ("start", "end"):
         if getattr(tr, key) is None or len(getattr(tr, key)) != len(names):
             raise ConfigError(f"trajectory.{key}", f"must have {len(names)} values (joint positions: the "
                               "task frame's path runs from its pose at start to its pose at end)",
@@ -443,7 +455,7 @@ def run_task_space(mech: Mechanism, case, out: Path) -> dict:
     th = np.arange(2 * steps + 1) * (0.5 * dt)
     t = th[::2]
     position, rotation, twist, twist_rate = frame_path(mech, ctl.task_frame, tr.start, tr.end, tr.duration,
-                                                       tr.law, th)
+                                                       tr.law, th, end_pose=task_end_pose(mech, ctl.task_frame, tr))
     rows = list(ctl.task_rows) if ctl.task_rows is not None else ["all"]
 
     progress.stage("operational space: pseudo-inverse alone and in the reaction null space")
@@ -594,7 +606,9 @@ def run_passive(mech: Mechanism, case, traj, out: Path, q_guess=None, assembly=N
             "initial_energy": e0, "max_energy_drift": r.energy_drift,
             "kinetic_energy_swing": swing,
             "relative_energy_drift": r.energy_drift / swing if swing > 0 else 0.0,
-            "energy": "kinetic 1/2 v^T M v + gravity (zero at O) + springs; conserved by the exact motion",
+            "energy": "kinetic 1/2 v^T M v + gravity (zero at O) + springs; conserved by the exact motion "
+                      "until a joint hits a limit (an inelastic end stop: the drift is measured before it)",
+            "stop_steps": r.stop_steps,
             "final_q": r.q[-1], "final_v": r.v[-1],
         },
         "total_mass": mech.total_mass,

@@ -20,7 +20,6 @@ from pathlib import Path
 
 import numpy as np
 
-import mechbal
 from mechbal import trajectory
 from mechbal.cases.runners import register
 from mechbal.config import ConfigError, integer, number, require
@@ -29,8 +28,9 @@ from mechbal.mechanism import Mechanism
 KIND = "urdf"
 DEFAULT_DURATION = 2.0
 DEFAULT_SAMPLES = 501
-#: largest default motion of one joint: revolute [rad], prismatic [m]
-MAX_STEP = {mechbal.JointType.revolute: 0.5, mechbal.JointType.prismatic: 0.1}
+#: largest default motion of one joint (`mechbal.trajectory.default_motion`)
+MAX_STEP = trajectory.DEFAULT_MAX_STEP
+default_motion = trajectory.default_motion
 
 
 def urdf_case(path: str | Path, duration: float | None = None, samples: int | None = None) -> dict:
@@ -42,20 +42,6 @@ def urdf_case(path: str | Path, duration: float | None = None, samples: int | No
                   "samples": DEFAULT_SAMPLES if samples is None else samples}
     return {"case": {"name": path.stem, "kind": KIND, "title": f"{path.name} (URDF)"},
             "urdf": {"path": str(path)}, "trajectory": trajectory}
-
-
-def default_motion(mech: Mechanism) -> tuple[np.ndarray, np.ndarray]:
-    """(start, end) of the default trajectory (see the module docstring)."""
-    lower = np.asarray(mech.model.lower_limits, float)
-    upper = np.asarray(mech.model.upper_limits, float)
-    types = {j.name: j.type for j in mech.model.description.joints}
-    step = np.array([MAX_STEP[types[n]] for n in mech.joint_names])
-    start = np.clip(np.zeros(mech.dof), lower, upper)
-    room_up, room_down = upper - start, start - lower
-    up = np.minimum(step, 0.5 * room_up)
-    down = np.minimum(step, 0.5 * room_down)
-    end = np.where(room_up >= room_down, start + up, start - down)
-    return start, end
 
 
 @register(KIND, stages=3)

@@ -6,7 +6,10 @@ What is written, for a `mechbal.Mechanism`:
   URDF's link names kept), placed by its joint's placement at q = 0 (so MuJoCo's ``qpos`` is
   mechbal's joint value, ``qpos0`` = 0); the joint as a ``hinge`` / ``slide`` of the same name and
   axis at the body origin (a fixed joint: none, the body is welded to its parent); position limits
-  as ``range``. The links joined to the root by fixed joints are static bodies of the world.
+  as ``range`` (an end stop: ``solreflimit`` `LIMIT_SOLREF`, ``solimplimit`` `LIMIT_SOLIMP`,
+  stiff and overdamped like the inelastic stops of `mechbal.simulate.passive`; a one-sided
+  limit's other side at `ONE_SIDED`). The links joined to the root by fixed joints are static
+  bodies of the world.
 * **Bodies.** Every mechbal body (link inertia, counterweight, disc, motor, payload) keeps its
   own mass and inertia: the link's own body (named after the link) is the link body's
   ``<inertial>``, every other one a child ``<body>`` of that name without a joint (welded), with
@@ -98,6 +101,16 @@ SOLIMP = (0.9999, 0.9999, 0.001)
 #: margin kept on MuJoCo's triangle inequality of the principal moments, A + B >= C + margin x
 #: trace (`principal_moments`): far below what any comparison resolves (1e-9), far above rounding
 TRIANGLE_MARGIN = 1e-12
+#: a joint limit as an end stop (``solreflimit``: time constant [s], damping ratio;
+#: ``solimplimit``): stiff and overdamped, the inelastic stop of mechbal's passive simulation
+#: (`mechbal.simulate.passive`): a penetration of about 1e-3 s times the impact rate and no
+#: bounce (MuJoCo's default (0.02, 1) lets a pendulum sink 0.05 rad into its limit; a damping
+#: ratio of 1 still throws it back off the limit at 14 % of its impact rate, 2 or more does not).
+#: MuJoCo raises a time constant below twice the timestep to that (its refsafe flag).
+LIMIT_SOLREF = (0.002, 3.0)
+LIMIT_SOLIMP = (0.99, 0.999, 0.001)
+#: the far side of a one-sided limit in ``range`` [rad or m] (MJCF ranges have two sides)
+ONE_SIDED = 1e6
 #: density of the counterweight spheres drawn [kg/m^3] (steel)
 DENSITY = 7850.0
 
@@ -472,8 +485,11 @@ def _build(mech, q, q_guess, timestep, *, name=None, names_only=False, minimum_m
         if j.type != _core.JointType.fixed:
             typ = "hinge" if j.type == _core.JointType.revolute else "slide"
             attrs = f'name={quoteattr(j.name)} type="{typ}" axis="{_v(j.axis)}"'
-            if math.isfinite(j.lower) and math.isfinite(j.upper):
-                attrs += f' range="{_f(j.lower)} {_f(j.upper)}"'
+            if math.isfinite(j.lower) or math.isfinite(j.upper):   # an end stop (one side: the other far)
+                lower = j.lower if math.isfinite(j.lower) else -ONE_SIDED
+                upper = j.upper if math.isfinite(j.upper) else ONE_SIDED
+                attrs += (f' range="{_f(lower)} {_f(upper)}" solreflimit="{_v(LIMIT_SOLREF)}"'
+                          f' solimplimit="{_v(LIMIT_SOLIMP)}"')
             out.append(f"{inner}<joint {attrs}/>")
             tree_order.append(j.name)
         b = own.get(j.name)

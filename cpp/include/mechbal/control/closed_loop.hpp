@@ -32,6 +32,15 @@ struct ClosedLoopOptions {
   double dt = 1e-3;        ///< controller period = RK4 step [s]
   double duration = 1.0;   ///< simulated time [s]; steps = round(duration / dt)
   ControlSampling sampling = ControlSampling::zero_order_hold;
+  /// Joint stops: the position limits of the plant's coordinates [rad or m], dof() values each
+  /// (-inf / +inf: no stop on that side), or both empty (no stops, the default). A stop is
+  /// inelastic: a coordinate found beyond it at the end of a step is put back on it, and its rate
+  /// towards the stop is removed by an impulse through the plant's inverse mass matrix (the other
+  /// coordinates take the reaction, as at a real end stop; projected Gauss-Seidel over the
+  /// coordinates on a stop, at most `stop_sweeps` sweeps). A coordinate resting on its stop stays
+  /// there to O(dt^2) per step; the energy an impact removes is not returned (no bounce).
+  Eigen::VectorXd lower_limit, upper_limit;
+  int stop_sweeps = 50;
 };
 
 /// One row per tick k = 0..steps (t_k = k dt). tau(k) is the command applied from t_k on (in
@@ -44,6 +53,7 @@ struct ClosedLoopLog {
   Eigen::Matrix<std::uint32_t, Eigen::Dynamic, 1> tick_status;
   Status status = Status::ok;  ///< OR of every controller and plant status
   int saturated_ticks = 0;     ///< ticks on which the controller clipped the torque
+  int stop_ticks = 0;          ///< steps that ended with a coordinate on a stop (options' limits)
   int steps_completed = 0;     ///< < steps when the plant failed (then later rows repeat the last state)
 };
 
@@ -51,7 +61,8 @@ struct ClosedLoopLog {
 /// closed loops included) driven by `controller` (any JointController: ComputedTorque over any
 /// model, which may differ from the plant, or DecoupledJointController) tracking `desired`, from
 /// the initial state (q0, qd0). Throws std::invalid_argument naming the field on bad sizes or
-/// options.
+/// options (stops: lower_limit / upper_limit of dof() values, not NaN, lower <= upper, q0 within
+/// them).
 ClosedLoopLog simulate_closed_loop(ForwardDynamics& plant, JointController& controller,
                                    const RestToRestTrajectory& desired, const Eigen::VectorXd& q0,
                                    const Eigen::VectorXd& qd0, const ClosedLoopOptions& options);

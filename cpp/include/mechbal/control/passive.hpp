@@ -5,8 +5,14 @@
 /// spring-balanced arm let go). It is the JointController of a passive simulation (`[control]
 /// kind = "passive"`, mechbal.simulate.passive): the closed-loop simulator then integrates the
 /// unforced forward dynamics. Real-time: step() is noexcept, allocation-free and O(n).
+///
+/// simulate_passive runs that simulation; the model's joint limits are inelastic stops there
+/// (ClosedLoopOptions::lower_limit / upper_limit, closed_loop.hpp), as MuJoCo's limits are in
+/// mechbal's MJCF export.
 #include <Eigen/Core>
 
+#include "mechbal/control/closed_loop.hpp"
+#include "mechbal/control/dynamics.hpp"
 #include "mechbal/control/joint_controller.hpp"
 
 namespace mechbal {
@@ -29,5 +35,13 @@ class PassiveController : public JointController {
   int dof_;
   Eigen::VectorXd zero_;
 };
+
+/// The passive motion of `plant` from (q0, qd0): simulate_closed_loop with a PassiveController
+/// (zero effort; `options.sampling` is irrelevant), stops from `options.lower_limit` /
+/// `upper_limit` (e.g. the actuated entries of MechanismModel::lower_limits() / upper_limits()).
+/// q_des and qd_des of the log hold q0 and zeros. Throws std::invalid_argument as
+/// simulate_closed_loop.
+ClosedLoopLog simulate_passive(ForwardDynamics& plant, const Eigen::VectorXd& q0,
+                               const Eigen::VectorXd& qd0, const ClosedLoopOptions& options);
 
 }  // namespace mechbal
