@@ -26,7 +26,7 @@ import csv
 import difflib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -231,7 +231,7 @@ def _read_bag(path: Path, topic: str | None) -> Log:
                 raise LogError(f"log '{path}': no sensor_msgs/msg/JointState messages"
                                + (f" on topic '{topic}'" if topic else ""))
             for conn, stamp_ns, raw in reader.messages(connections=states):
-                msg = reader.deserialize(raw, conn.msgtype)
+                msg: Any = reader.deserialize(raw, conn.msgtype)
                 st = msg.header.stamp
                 t = float(st.sec) + 1e-9 * float(st.nanosec)
                 if t == 0.0:
