@@ -84,7 +84,7 @@ TEST(PassiveStops, TheImpactGoesThroughTheInverseMassMatrix) {
   MechanismDynamics plant(model);
   Eigen::VectorXd q0(2), v0(2);
   q0 << 0.2, 0.3;
-  v0 << 0.0, -4.0;
+  v0 << 0.0, -8.0;
   const ClosedLoopLog log = simulate_passive(plant, q0, v0, options(2, -0.4, 2.0, 0.3));
   ASSERT_EQ(log.status, Status::ok);
   ASSERT_GT(log.stop_ticks, 0);
