@@ -756,6 +756,7 @@ class LimitDemand:
 
     @property
     def exceeded(self) -> bool:
+        """True when the demand is above the limit (or not a number)."""
         return not self.peak_demand <= self.limit
 
 
@@ -796,6 +797,7 @@ class FeasibilityReport:
                 + f": {fit}")
 
     def summary(self) -> dict:
+        """The report as summary.json's ``feasibility`` (durations [s], demands and limits in SI)."""
         return {"feasible": self.feasible, "duration": self.duration,
                 "min_duration": self.min_duration if np.isfinite(self.min_duration) else None,
                 "limits": [dict(joint=x.joint, quantity=x.quantity, peak_demand=x.peak_demand, limit=x.limit,

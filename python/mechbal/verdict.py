@@ -1,7 +1,7 @@
 """The verdict of a controlled run: its goal, whether every criterion held, and what limited it.
 
 A run that pursues a goal (cancel momentum components, follow a task, track a command in closed
-loop) states the goal and its tolerances (`Goal`), measures each criterion and says so
+loop) states the goal and its tolerances (`goal`), measures each criterion and says so
 (`Verdict`): ``ok`` is true only if every criterion held, and ``limited_by`` lists each one that
 did not, with numbers (the joint, the first tick, how many ticks, the peak demand against the
 limit). ``summary.json`` of every controlled run carries ``goal``, ``ok`` and ``limited_by``; the
@@ -111,7 +111,7 @@ def limits_in_force(mech: Any, ctl: Any = None, balancing: list[str] | None = No
 
 class ControlInfeasible(Exception):
     """A controlled run refused before it ran: the commanded motion needs more than a declared
-    limit allows (`mechbal.control.feasibility`); ``report`` is the `FeasibilityReport`. The
+    limit allows (`mechbal.control.feasibility`); ``report`` is the `mechbal.control.FeasibilityReport`. The
     command line exits with `EXIT_GOAL_NOT_MET` and writes nothing."""
 
     def __init__(self, report: Any):
@@ -137,6 +137,7 @@ class Verdict:
 
     @property
     def ok(self) -> bool:
+        """True when no criterion failed."""
         return not self.limited_by
 
     def summary(self) -> dict[str, Any]:
@@ -153,6 +154,7 @@ class Verdict:
     # ---- the criteria -------------------------------------------------------------------------
 
     def add(self, criterion: str, message: str, **numbers: Any) -> None:
+        """Record a failed ``criterion`` with its one-line ``message`` and its numbers."""
         self.limited_by.append({"criterion": criterion, "message": message, **numbers})
 
     def statuses(self, status: Any, t: Any, *, who: str = "controller",
@@ -233,6 +235,7 @@ class Verdict:
         return peak
 
     def steps(self, completed: int, total: int, t: Any) -> None:
+        """A closed loop that stopped before its last step (``completed`` of ``total``)."""
         if completed < total:
             tt = np.asarray(t, float).reshape(-1)
             self.add("steps", f"the simulation stopped at t = {tt[min(completed, len(tt) - 1)]:.4g} s "

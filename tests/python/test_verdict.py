@@ -388,3 +388,17 @@ def test_verify_and_mujoco_run_of_the_limited_wheel(tmp_path, capsys):
     assert code == 0 and "control goal not met" in err
     s = summary_of(out)
     assert s["ok"] is False and s["shaking_moment_reduction"]["per_axis"]["z"]["cancelled"]
+
+
+def test_a_closed_loop_beyond_its_tracking_tolerance_exits_6_with_dir_written(tmp_path, capsys):
+    """run --engine mujoco of the (feasible) wheel arm with a joint tolerance no zero-order-hold
+    loop meets: the loop runs, DIR is written, the verdict is the simulation's (tracking), exit 6."""
+    pytest.importorskip("mujoco")
+    case = wheel_case(tmp_path, None, "", duration=0.3)
+    case.write_text(case.read_text().replace("damping = 1e-3", "damping = 1e-3\ntolerance = { joint = 1e-12 }"))
+    out = tmp_path / "m"
+    code, text, err = run_cli(["run", case, "--engine", "mujoco", "--out", out], capsys)
+    assert code == EXIT_GOAL_NOT_MET and "(tolerance.joint)" in err
+    s = summary_of(out)
+    assert s["ok"] is False and [x["criterion"] for x in s["limited_by"]] == ["tracking"]
+    assert s["limited_by"][0]["tolerance"] == 1e-12 and "NOT MET" in text

@@ -369,7 +369,9 @@ def _run_joint_mode(mech: Mechanism, case, out: Path, q_guess, summary_extra: di
     print(report.table(
         [["uncontrolled", *report.peak_abs(Mu)], ["controlled", *report.peak_abs(Mc)]],
         ["peak shaking moment about O [N m]", "x", "y", "z"]))
+    out_of_range = int(np.sum((r.status & np.uint32(int(control.Status.out_of_range))) != 0))
     print(report.table(verdict.goal_rows(v, [["saturated ticks", f"{int(np.sum(saturated))} of {len(t)}"],
+                                             ["out-of-range ticks", f"{out_of_range} of {len(t)}"],
                                              ["singular ticks", f"{int(np.sum(singular))} of {len(t)}"]]),
                        ["reactionless control", "value"]))
     return summary
@@ -591,6 +593,7 @@ def run_task_space(mech: Mechanism, case, out: Path, summary_extra: dict | None 
         ["peak shaking moment about O [N m]", "x", "y", "z", "|M| (whole moment)"]))
     print(report.table(verdict.goal_rows(v, [
         ["saturated ticks", f"{int(np.sum(saturated))} of {len(t)}"],
+        ["out-of-range ticks", f"{int(np.sum((rc.status & np.uint32(int(control.Status.out_of_range))) != 0))} of {len(t)}"],
         ["singular ticks", f"{int(np.sum(singular))} of {len(t)}"],
         *[[f"task error: {k}", f"{x:.3g} {'m' if k == 'position' else 'rad'}"]
           for k, x in frame_error["controlled"].items()]]), ["reactionless control (operational space)", "value"]))
