@@ -38,9 +38,9 @@ void bind_discs(py::module_& m) {
            }),
            py::arg("k"), py::arg("kp"), py::arg("kd"), py::arg("torque_limit") = py::none(),
            MECHBAL_JOINT_RANGE_ARGS,
-           "k, kp, kd: one value per joint; torque_limit: one per joint (default and +inf: mechbal "
-           "default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range "
-           "of a tick (beyond it: the held command and Status.out_of_range)");
+           "k, kp, kd: one value per joint; torque_limit: one per joint (default and +inf: no "
+           "limit); max_position, max_speed, max_acceleration: the input range of a tick (default "
+           "+inf: no limit; beyond it: the held command and Status.out_of_range)");
   dc.def_property_readonly("torque_limit", [](const DecoupledJointController& c) {
         return Eigen::VectorXd(c.torque_limit());
       })

@@ -40,7 +40,7 @@ ReactionlessIntegrator integrator_of(const std::string& name) {
 
 ReactionlessConfig make_config(const std::vector<std::string>& balancing, const std::vector<std::string>& cancel,
                                const std::string& integrator, double rate_hz, double damping, double max_condition,
-                               double max_rate, double max_acceleration, bool position_limits, double home_gain,
+                               double max_rate, double max_acceleration, bool position_limits, bool velocity_limits, double home_gain,
                                double limit_gain, const py::object& home, double max_position, double max_speed,
                                double max_task_acceleration) {
   ReactionlessConfig c;
@@ -53,6 +53,7 @@ ReactionlessConfig make_config(const std::vector<std::string>& balancing, const 
   c.max_rate = max_rate;
   c.max_acceleration = max_acceleration;
   c.position_limits = position_limits;
+  c.velocity_limits = velocity_limits;
   c.home_gain = home_gain;
   c.limit_gain = limit_gain;
   if (!home.is_none()) c.home = vector_arg(to_real_array(home), "home", -1, true);
@@ -81,7 +82,8 @@ std::vector<std::string> names_of(const ReactionlessController& c, const std::ve
       py::arg("max_condition") = ReactionlessConfig{}.max_condition,                                \
       py::arg("max_rate") = ReactionlessConfig{}.max_rate,                                          \
       py::arg("max_acceleration") = ReactionlessConfig{}.max_acceleration,                          \
-      py::arg("position_limits") = true, py::arg("home_gain") = 0.0, py::arg("limit_gain") = 0.0,   \
+      py::arg("position_limits") = true, py::arg("velocity_limits") = true, py::arg("home_gain") = 0.0, \
+      py::arg("limit_gain") = 0.0,                                                                  \
       py::arg("home") = py::none(), py::arg("max_position") = JointInputRange{}.max_position,        \
       py::arg("max_speed") = JointInputRange{}.max_speed,                                           \
       py::arg("max_task_acceleration") = JointInputRange{}.max_acceleration
@@ -146,9 +148,10 @@ void bind_task_controller(py::module_& m) {
       .def(py::init([](const MechanismModel& model, const std::string& frame, const std::vector<std::string>& task_rows,
                        const std::vector<std::string>& cancel, const std::string& integrator, double rate_hz,
                        double damping, double max_condition, double max_rate, bool null_space,
-                       const py::object& q0, const py::object& v0) {
+                       const py::object& q0, const py::object& v0, bool velocity_limits) {
              TaskSpaceConfig c;
              c.null_space = null_space;
+             c.velocity_limits = velocity_limits;
              c.frame = frame;
              c.task_rows = task_rows_mask(task_rows, "task_rows");  // the factory's table and messages
              c.cancel = cancel_of(cancel);
@@ -169,7 +172,8 @@ void bind_task_controller(py::module_& m) {
            py::arg("rate_hz") = TaskSpaceConfig{}.rate_hz, py::arg("damping") = TaskSpaceConfig{}.damping,
            py::arg("max_condition") = TaskSpaceConfig{}.max_condition,
            py::arg("max_rate") = TaskSpaceConfig{}.max_rate, py::arg("null_space") = TaskSpaceConfig{}.null_space,
-           py::arg("q0") = py::none(), py::arg("v0") = py::none())
+           py::arg("q0") = py::none(), py::arg("v0") = py::none(),
+           py::arg("velocity_limits") = TaskSpaceConfig{}.velocity_limits)
       .def_property_readonly("dof", &ReactionlessTaskController::dof)
       .def_property_readonly("dt", &ReactionlessTaskController::dt)
       .def_property_readonly("target", &ReactionlessTaskController::target)
@@ -283,12 +287,12 @@ void bind_reactionless(py::module_& m) {
       .def(py::init([](const MechanismModel& model, const std::vector<std::string>& balancing, const py::object& q0,
                        const std::vector<std::string>& cancel, const std::string& integrator, double rate_hz,
                        double damping, double max_condition, double max_rate, double max_acceleration,
-                       bool position_limits, double home_gain, double limit_gain, const py::object& home,
+                       bool position_limits, bool velocity_limits, double home_gain, double limit_gain, const py::object& home,
                        double max_position, double max_speed, double max_task_acceleration,
                        const py::object& v0, const py::object& q_guess) {
              const ReactionlessConfig c =
                  make_config(balancing, cancel, integrator, rate_hz, damping, max_condition, max_rate, max_acceleration,
-                             position_limits, home_gain, limit_gain, home, max_position, max_speed,
+                             position_limits, velocity_limits, home_gain, limit_gain, home, max_position, max_speed,
                              max_task_acceleration);
              const Eigen::VectorXd q0_ =
                  q0.is_none() ? Eigen::VectorXd(Eigen::VectorXd::Zero(model.num_actuated()))
@@ -385,19 +389,19 @@ void bind_reactionless(py::module_& m) {
   jc.def(py::init([](const MechanismModel& model, const std::vector<std::string>& balancing, const Array& q0,
                      const Array& kp, const Array& kd, const std::vector<std::string>& cancel,
                      const std::string& integrator, double rate_hz, double damping, double max_condition,
-                     double max_rate, double max_acceleration, bool position_limits, double home_gain,
+                     double max_rate, double max_acceleration, bool position_limits, bool velocity_limits, double home_gain,
                      double limit_gain, const py::object& home, double max_position, double max_speed,
                      double max_task_acceleration, const py::object& torque_limit, const py::object& q_guess) {
            const ReactionlessConfig c =
                make_config(balancing, cancel, integrator, rate_hz, damping, max_condition, max_rate, max_acceleration,
-                           position_limits, home_gain, limit_gain, home, max_position, max_speed, max_task_acceleration);
+                           position_limits, velocity_limits, home_gain, limit_gain, home, max_position, max_speed, max_task_acceleration);
            const Eigen::VectorXd q0_ = vector_arg(q0, "q0", model.num_actuated(), true);
            const Eigen::VectorXd limit = optional_vector(torque_limit, "torque_limit", -1);
            const Eigen::VectorXd guess = optional_vector(q_guess, "q_guess", model.dof());
            const Eigen::VectorXd kp_ = vector_arg(kp, "kp", -1), kd_ = vector_arg(kd, "kd", -1);
            return value_errors([&] {
              return new ReactionlessJointController(std::make_shared<const MechanismModel>(model), c, q0_, kp_, kd_,
-                                                    limit, JointInputRange{}, guess);
+                                                    limit, c.task_range, guess);  // one input range, both stages
            });
          }),
          py::arg("model"), py::arg("balancing_joints"), py::arg("q0"), py::arg("kp"), py::arg("kd"),

@@ -1232,12 +1232,12 @@ class ComputedTorque(JointController):
     Computed-torque control, Arakelian et al. 2011 eqs 2-6, over any inverse-dynamics back end (keeps the model alive)
     """
     @typing.overload
-    def __init__(self, model: InverseDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
+    def __init__(self, model: InverseDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = ..., max_speed: typing.SupportsFloat | typing.SupportsIndex = ..., max_acceleration: typing.SupportsFloat | typing.SupportsIndex = ...) -> None:
         """
-        model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, MechanismDynamics). torque_limit: one value per joint (default and +inf: mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range of a tick (beyond it: the held command and Status.out_of_range)
+        model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, MechanismDynamics). torque_limit: one value per joint (default and +inf: no limit); max_position, max_speed, max_acceleration: the input range of a tick (default +inf: no limit; beyond it: the held command and Status.out_of_range)
         """
     @typing.overload
-    def __init__(self, model: FiveBarDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
+    def __init__(self, model: FiveBarDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = ..., max_speed: typing.SupportsFloat | typing.SupportsIndex = ..., max_acceleration: typing.SupportsFloat | typing.SupportsIndex = ...) -> None:
         ...
     def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """
@@ -1290,9 +1290,9 @@ class DecoupledJointController(JointController):
     """
     tau_i = k_i (a_des + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho eqs 15, 26, 36)
     """
-    def __init__(self, k: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
+    def __init__(self, k: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = ..., max_speed: typing.SupportsFloat | typing.SupportsIndex = ..., max_acceleration: typing.SupportsFloat | typing.SupportsIndex = ...) -> None:
         """
-        k, kp, kd: one value per joint; torque_limit: one per joint (default and +inf: mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range of a tick (beyond it: the held command and Status.out_of_range)
+        k, kp, kd: one value per joint; torque_limit: one per joint (default and +inf: no limit); max_position, max_speed, max_acceleration: the input range of a tick (default +inf: no limit; beyond it: the held command and Status.out_of_range)
         """
     def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """
@@ -1544,7 +1544,7 @@ class ReactionlessTaskController:
     """
     Operational-space reactionless control: a redundant open mechanism follows a desired twist of a frame, v = J^+ x' + N z, with z minimising the selected momentum components in the null space
     """
-    def __init__(self, model: MechanismModel, task_frame: str, task_rows: collections.abc.Sequence[str] = ['all'], cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, null_space: bool = True, q0: typing.Any = None, v0: typing.Any = None) -> None:
+    def __init__(self, model: MechanismModel, task_frame: str, task_rows: collections.abc.Sequence[str] = ['all'], cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = ..., null_space: bool = True, q0: typing.Any = None, v0: typing.Any = None, velocity_limits: bool = True) -> None:
         ...
     def run(self, twist: numpy.typing.ArrayLike, twist_rate: typing.Any = None) -> dict:
         """
@@ -1647,7 +1647,7 @@ class ReactionlessController:
     """
     Reactionless control of any MechanismModel (C++ mechbal::ReactionlessController): balancing joints keep the selected momentum components at their target
     """
-    def __init__(self, model: MechanismModel, balancing_joints: collections.abc.Sequence[str], q0: typing.Any = None, cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, position_limits: bool = True, home_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, limit_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, home: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_task_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, v0: typing.Any = None, q_guess: typing.Any = None) -> None:
+    def __init__(self, model: MechanismModel, balancing_joints: collections.abc.Sequence[str], q0: typing.Any = None, cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = ..., max_acceleration: typing.SupportsFloat | typing.SupportsIndex = ..., position_limits: bool = True, velocity_limits: bool = True, home_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, limit_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, home: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = ..., max_speed: typing.SupportsFloat | typing.SupportsIndex = ..., max_task_acceleration: typing.SupportsFloat | typing.SupportsIndex = ..., v0: typing.Any = None, q_guess: typing.Any = None) -> None:
         """
         q0: the actuated coordinates at the start (default zeros); v0: their rates (default rest)
         """
@@ -1707,7 +1707,7 @@ class ReactionlessJointController(JointController):
     """
     The reactionless controller followed by computed torque over the model: a JointController over the actuated coordinates (the balancing joints' desired entries are ignored)
     """
-    def __init__(self, model: MechanismModel, balancing_joints: collections.abc.Sequence[str], q0: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, position_limits: bool = True, home_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, limit_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, home: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_task_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, torque_limit: typing.Any = None, q_guess: typing.Any = None) -> None:
+    def __init__(self, model: MechanismModel, balancing_joints: collections.abc.Sequence[str], q0: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = ..., max_acceleration: typing.SupportsFloat | typing.SupportsIndex = ..., position_limits: bool = True, velocity_limits: bool = True, home_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, limit_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, home: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = ..., max_speed: typing.SupportsFloat | typing.SupportsIndex = ..., max_task_acceleration: typing.SupportsFloat | typing.SupportsIndex = ..., torque_limit: typing.Any = None, q_guess: typing.Any = None) -> None:
         ...
     def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """

@@ -8,9 +8,13 @@ request to report it (set ``MECHBAL_DEBUG=1`` for the traceback); 4 another run 
 ``--out`` finished at the same moment (this run's results were discarded, the other run's folder
 is whole); 5 (``mechbal balance`` only) the requested balance was not reached: the balance is not
 exact within mechbal's tolerance (``limited_by`` of summary.json is not empty); the results are
-written all the same, and ``--allow-partial`` makes this exit 0; 6 (``mechbal identify`` only) the
-identified model missed its goal (``--allow-degraded`` makes this exit 0); 130 interrupted. No traceback is
-ever shown otherwise.
+written all the same, and ``--allow-partial`` makes this exit 0; 6 the goal was not met: a
+controlled run (``mechbal run`` and ``mechbal verify`` of a case with ``[control]``, ``run --engine
+mujoco``: ``ok`` of summary.json is false: a saturated or out-of-range tick, a cancelled component
+or the task beyond its tolerance, a declared limit exceeded, or, before the run, a motion the
+declared limits cannot follow), or ``mechbal identify`` (the identified model missed its goal);
+DIR is written all the same (except for a refusal before the run), and ``--allow-degraded`` makes
+this exit 0 with a warning; 130 interrupted. No traceback is ever shown otherwise.
 
 Layer: command line (docs/architecture.md).
 """
@@ -37,9 +41,10 @@ EXIT_USER_ERROR = 2
 EXIT_INTERNAL_ERROR = 3
 EXIT_OUTPUT_RACE = 4
 EXIT_PARTIAL_BALANCE = 5
-#: `mechbal identify`: the identified model misses its goal (a body not consistent, or not within
-#: --tolerance of least squares); --allow-degraded accepts it
-EXIT_IDENTIFY_DEGRADED = 6
+#: the goal was not met: a controlled run (run, verify, --engine mujoco) or `mechbal identify` (the
+#: identified model: a body not consistent, or not within --tolerance of least squares);
+#: --allow-degraded accepts it
+EXIT_GOAL_NOT_MET = 6
 EXIT_INTERRUPTED = 130
 
 
@@ -114,7 +119,8 @@ def _cmd_run(args) -> int:
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer):  # the runner's tables, printed after its bar closes
         summary = run_case(args.case, out, animate=getattr(args, "animate", False),
-                           duration=getattr(args, "duration", None), samples=getattr(args, "samples", None))
+                           duration=getattr(args, "duration", None), samples=getattr(args, "samples", None),
+                           **_control_options(args))
     if not args.quiet:
         sys.stdout.write(buffer.getvalue())
     notes = summary.get("non_finite_values") if isinstance(summary, dict) else None
@@ -126,7 +132,31 @@ def _cmd_run(args) -> int:
               f"{out}/summary.json (listed under non_finite_values)", file=sys.stderr)
     if not args.quiet:
         print(f"wrote {out}/summary.json and the plots and bodies files beside it")
-    return 0
+    return _goal_exit(args, summary, out)
+
+
+def _control_options(args) -> dict:
+    """The options of a controlled run given on the command line (only those given, so that
+    runners without them are called as before)."""
+    return {k: True for k in ("fit_duration", "allow_degraded") if getattr(args, k, False)}
+
+
+def _goal_exit(args, summary, out: Path) -> int:
+    """A controlled run's verdict (``ok`` and ``limited_by`` of its summary): 0 when the goal was
+    met (or the run has no control goal), else one line on stderr and exit 6, or exit 0 with a
+    warning under ``--allow-degraded``."""
+    if not isinstance(summary, dict) or "goal" not in summary or summary.get("ok", True):
+        return EXIT_OK
+    reasons = summary.get("limited_by") or []
+    first = reasons[0]["message"] if reasons and isinstance(reasons[0], dict) else "see summary.json limited_by"
+    more = f" (and {len(reasons) - 1} more)" if len(reasons) > 1 else ""
+    if getattr(args, "allow_degraded", False):
+        print(f"mechbal: warning: control goal not met: {first}{more}; results written to {out} "
+              "(--allow-degraded)", file=sys.stderr)
+        return EXIT_OK
+    print(f"mechbal: control goal not met (exit {EXIT_GOAL_NOT_MET}; results written to {out}; "
+          f"--allow-degraded exits 0): {first}{more}", file=sys.stderr)
+    return EXIT_GOAL_NOT_MET
 
 
 def _in_mujoco(args, out: Path, run, wrote: str) -> int:
@@ -137,19 +167,19 @@ def _in_mujoco(args, out: Path, run, wrote: str) -> int:
     buffer = io.StringIO()
     try:
         with contextlib.redirect_stdout(buffer), staged_output(out) as tmp:
-            run(tmp)
+            summary = run(tmp)
     except ImportError as exc:  # the optional 'mujoco' extra is missing: the message names it
         raise UserError(str(exc)) from None
     if not args.quiet:
         sys.stdout.write(buffer.getvalue())
         print(f"wrote {out}/{wrote}")
-    return 0
+    return _goal_exit(args, summary, out)
 
 
 def _run_mujoco(args, out: Path) -> int:
     from mechbal.verify import run_cosimulation
 
-    return _in_mujoco(args, out, lambda tmp: run_cosimulation(args.case, tmp),
+    return _in_mujoco(args, out, lambda tmp: run_cosimulation(args.case, tmp, **_control_options(args)),
                       "summary.json, base_reaction.png (MuJoCo beside mechbal) and the files beside them")
 
 
@@ -342,7 +372,7 @@ def _cmd_verify(args) -> int:
     if composed is not None:
         return composed
     return _in_mujoco(args, out, lambda tmp: run_verify(args.case, tmp, simulate=not args.no_simulation,
-                                                        method=args.method),
+                                                        method=args.method, **_control_options(args)),
                       "summary.json and the plots beside it")
 
 
@@ -407,9 +437,9 @@ def _cmd_identify(args) -> int:
             print(f"mechbal: warning: identification goal missed (--allow-degraded): {_one_line(Exception(why))}",
                   file=sys.stderr)
             return EXIT_OK
-        print(f"mechbal: identification goal missed (exit {EXIT_IDENTIFY_DEGRADED}; results written to {out}; "
+        print(f"mechbal: identification goal missed (exit {EXIT_GOAL_NOT_MET}; results written to {out}; "
               f"--allow-degraded accepts them): {_one_line(Exception(why))}", file=sys.stderr)
-        return EXIT_IDENTIFY_DEGRADED
+        return EXIT_GOAL_NOT_MET
     return EXIT_OK
 
 
@@ -464,8 +494,9 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Exit codes: 0 ok, 2 a mistake in the input (one line names the field or path), "
                "3 an internal error (please report it), 4 another run into the same --out finished "
                "at the same moment (this run's results were discarded), 5 balance: the requested "
-               "balance was not reached (results written; --allow-partial: 0), 6 identify: the identified "
-               "model missed its goal (results written; --allow-degraded: 0), 130 interrupted.")
+               "balance was not reached (results written; --allow-partial: 0), 6 run/verify: the "
+               "control goal was not met, identify: the identified model missed its goal (results "
+               "written; --allow-degraded: 0), 130 interrupted.")
     p.add_argument("--version", action="version", version=f"mechbal {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     s = sub.add_parser("cases", help="list the built-in case studies")
@@ -497,6 +528,13 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--animate", action="store_true",
                    help="also write DIR/animation_<variant>.gif: the mechanism moving, with the "
                         "shaking force and moment drawn at its base")
+    s.add_argument("--allow-degraded", action="store_true",
+                   help=f"a case with [control]: exit 0 (with a warning) when the control goal is not met "
+                        f"(default: exit {EXIT_GOAL_NOT_MET}; the results are written either way), and run a "
+                        "motion the declared limits cannot follow instead of refusing it")
+    s.add_argument("--fit-duration", action="store_true",
+                   help="a reactionless case whose motion needs more than a declared limit allows: run the same "
+                        "motion at the shortest duration that keeps every limit (instead of refusing it)")
     _last_flags(s, _cmd_run, force=True, urdf=True)
     s = sub.add_parser("balance", help="balance a mechanism by a method (static, force, moment, springs, rms)",
                        description="Size counterweights (static: gravity torque zero over the "
@@ -583,6 +621,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="balancing method of the balanced variant (default: balance.method of the case)")
     s.add_argument("--no-simulation", action="store_true",
                    help="only the inverse dynamics on the trajectory (no forward simulation)")
+    s.add_argument("--allow-degraded", action="store_true",
+                   help=f"a case with [control]: exit 0 (with a warning) when the control goal is not met "
+                        f"(default: exit {EXIT_GOAL_NOT_MET}; the results are written either way), and run a "
+                        "motion the declared limits cannot follow instead of refusing it")
+    s.add_argument("--fit-duration", action="store_true",
+                   help="a reactionless case whose motion needs more than a declared limit allows: check the same "
+                        "motion at the shortest duration that keeps every limit (instead of refusing it)")
     _last_flags(s, _cmd_verify, urdf=True)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")
@@ -646,7 +691,7 @@ def _identify_parsers(sub) -> None:
                                    "[v_<joint>,] tau_<joint>; npz; ROS 2 bags with the 'ros' extra), validate "
                                    "it on held-out logs against the CAD model, and write DIR/identified.urdf, "
                                    "identified.toml, summary.json and plots. Exit "
-                                   f"{EXIT_IDENTIFY_DEGRADED} when the model misses its goal "
+                                   f"{EXIT_GOAL_NOT_MET} when the model misses its goal "
                                    "(--allow-degraded: 0).")
     s.add_argument("model", help="the robot's CAD model: URDF or TOML file")
     s.add_argument("logs", nargs="+", metavar="LOG", help="identification logs")
@@ -662,7 +707,7 @@ def _identify_parsers(sub) -> None:
                    help="the consistent model's RMS torque error may be at most this times least "
                         "squares' on the validation logs (default 1.2)")
     s.add_argument("--allow-degraded", action="store_true",
-                   help=f"exit 0 when the goal is missed (default: exit {EXIT_IDENTIFY_DEGRADED})")
+                   help=f"exit 0 when the goal is missed (default: exit {EXIT_GOAL_NOT_MET})")
     _last_flags(s, _cmd_identify, urdf=True)
 
 
@@ -695,6 +740,7 @@ def main(argv: list[str] | None = None) -> int:
     from mechbal import progress
     from mechbal.errors import PlausibilityWarning
     from mechbal.output import OutputError, OutputRaceError
+    from mechbal.verdict import ControlInfeasible
 
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -718,6 +764,12 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"mechbal: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_OUTPUT_RACE
+    except ControlInfeasible as exc:
+        if debug:
+            raise
+        print(f"mechbal: control goal not met (exit {EXIT_GOAL_NOT_MET}; refused before the run, nothing "
+              f"written; --fit-duration runs the shortest feasible duration): {_one_line(exc)}", file=sys.stderr)
+        return EXIT_GOAL_NOT_MET
     except (ConfigError, OutputError, UserError) as exc:
         if debug:
             raise

@@ -62,7 +62,8 @@ __all__ = [
     "ControlRun", "WristRun", "PaminsaRun", "InverseDynamics", "ForwardDynamics",
     "MechanismDynamics", "KdlChainDynamics", "InverseDynamicsResult", "Status", "status_text",
     "ReactionlessController", "ReactionlessCommand", "ReactionlessRun", "ReactionlessJointController",
-    "ReactionlessTaskController", "TaskSpaceRun",
+    "ReactionlessTaskController", "TaskSpaceRun", "declared_options", "declared_torque_limit",
+    "feasibility", "FeasibilityReport", "LimitDemand", "FrameMotion",
 ]
 
 Status = _core.Status
@@ -331,6 +332,33 @@ class _JointTicks:
         return _control_run(super().run(q, v, q_des, v_des, a_des))  # type: ignore[misc]
 
 
+def declared_torque_limit(model: Any, torque_limit: npt.ArrayLike | None = None) -> FloatArray | None:
+    """The |tau| limit in force per actuated joint [N m or N]: the smaller of ``torque_limit``
+    (when given) and the model's declared effort limits (a `mechbal.Mechanism` or a
+    ``MechanismModel``; +inf where neither declares one). Another dynamics back end: the
+    ``torque_limit`` given (None: no limit). No hidden limit is added."""
+    m = getattr(model, "model", model)
+    if not isinstance(m, _core.MechanismModel):
+        return None if torque_limit is None else np.asarray(torque_limit, float)
+    declared = np.asarray(m.effort_limits, float)[list(m.actuated_coordinates)]
+    if torque_limit is None:
+        return declared if np.any(np.isfinite(declared)) else None
+    given = np.asarray(torque_limit, float).reshape(-1)
+    if given.shape != declared.shape:
+        return given  # the controller names the size mistake
+    return np.minimum(given, declared)
+
+
+def declared_options(ctl: Any) -> dict[str, float]:
+    """The reactionless controllers' limits of a validated ``[control]`` table: ``max_rate``
+    (balancing joints) and ``max_speed`` (the task joints' input range), +inf where the table
+    declares none (the model's declared velocity limits apply in the controller either way)."""
+    out = {"max_rate": float(getattr(ctl, "max_rate", None) or np.inf)}
+    if getattr(ctl, "max_speed", None) is not None:
+        out["max_speed"] = float(ctl.max_speed)
+    return out
+
+
 class ComputedTorque(_JointTicks, _core.ComputedTorque):  # type: ignore[misc]
     """Computed-torque control (Arakelian, Le Baron & Mottu 2011, eqs 2-6):
     ``tau = M(q) (a_des + Kp (q_des - q) + Kd (v_des - v)) + C(q, v) v + G(q)``, clipped
@@ -343,10 +371,12 @@ class ComputedTorque(_JointTicks, _core.ComputedTorque):  # type: ignore[misc]
             ``FiveBarDynamics`` (`mechbal.papers`). The model may differ from the plant.
         kp: proportional gains [1/s^2], one per joint.
         kd: derivative gains [1/s], one per joint.
-        torque_limit: |tau| limit per joint [N m or N] (default and +inf: 1e4).
+        torque_limit: |tau| limit per joint [N m or N]; with a `mechbal.Mechanism` the joints'
+            declared effort limits when smaller; default and +inf: no limit beyond the declared
+            ones.
         **input_range: ``max_position``, ``max_speed``, ``max_acceleration``: the input range of a
-            tick (|q| [rad or m], |v|, |a_des|); beyond it the tick holds the last command
-            with ``Status.out_of_range``.
+            tick (|q| [rad or m], |v|, |a_des|; default +inf: no limit); beyond it the tick holds
+            the last command with ``Status.out_of_range``.
         q_guess: with a closed-loop Mechanism, every joint coordinate near the assembly [rad or
             m] (picks the assembly mode the loop solve follows; default zeros).
 
@@ -357,7 +387,8 @@ class ComputedTorque(_JointTicks, _core.ComputedTorque):  # type: ignore[misc]
     def __init__(self, model: Any, kp: npt.ArrayLike, kd: npt.ArrayLike,
                  torque_limit: npt.ArrayLike | None = None, *, q_guess: npt.ArrayLike | None = None,
                  **input_range: float):
-        super().__init__(_dynamics(model, q_guess), kp, kd, torque_limit, **input_range)
+        super().__init__(_dynamics(model, q_guess), kp, kd, declared_torque_limit(model, torque_limit),
+                         **input_range)
 
 
 class DecoupledJointController(_JointTicks, _core.DecoupledJointController):  # type: ignore[misc]
@@ -532,10 +563,14 @@ class ReactionlessController(_core.ReactionlessController):
             `joint_controller` is a joint controller for `mechbal.simulate.closed_loop`
             (which accepts this object directly).
         kd: derivative gains [1/s] of the computed-torque stage.
-        torque_limit: |tau| limit per joint of the computed-torque stage [N m or N].
-        **options: ``max_condition``, ``max_rate`` [rad/s], ``max_acceleration``,
-            ``position_limits`` (bool), ``home_gain``, ``limit_gain``, ``home``, ``max_position``,
-            ``max_speed``, ``max_task_acceleration`` (the task input range).
+        torque_limit: |tau| limit per joint of the computed-torque stage [N m or N] (the joints'
+            declared effort limits when smaller; default: only those).
+        **options: ``max_condition``, ``max_rate`` [rad/s] (the balancing joints' declared
+            velocity limits when smaller), ``max_acceleration``, ``position_limits`` (bool),
+            ``home_gain``, ``limit_gain``, ``home``, ``max_position``, ``max_speed``,
+            ``max_task_acceleration`` (the task input range; ``max_speed`` also the
+            computed-torque stage's). Every limit defaults to +inf: no limit beyond the declared
+            ones.
 
     Ticks: ``step(q_task, v_task, a_task[, q_half, v_half, q_next, v_next])`` ->
     `ReactionlessCommand`; ``step_into(now (3, nt), half (2, nt), next (2, nt), out (3,
@@ -563,7 +598,8 @@ class ReactionlessController(_core.ReactionlessController):
             if kp is None or kd is None:
                 raise ValueError("the computed-torque stage needs both kp and kd")
             self.joint_controller = ReactionlessJointController(
-                model, q0=q0, kp=kp, kd=kd, torque_limit=torque_limit, q_guess=q_guess, **kwargs)
+                model, q0=q0, kp=kp, kd=kd, torque_limit=declared_torque_limit(model, torque_limit),
+                q_guess=q_guess, **kwargs)
 
     def step(self, q_task: npt.ArrayLike, v_task: npt.ArrayLike,  # type: ignore[override]
              a_task: npt.ArrayLike, q_half: npt.ArrayLike | None = None,
@@ -687,3 +723,210 @@ class ReactionlessTaskController(_core.ReactionlessTaskController):
         r = super().run(twist, twist_rate)
         N = np.asarray(r["q"]).shape[0]
         return TaskSpaceRun(t=np.arange(N) * self.dt, **{k: np.asarray(v) for k, v in r.items()})
+
+
+# ---- feasibility of a reactionless motion before the run ---------------------------------------
+
+class FrameMotion(NamedTuple):
+    """The operational-space mode's commanded motion: every joint's ``start`` [rad or m], the
+    frame's desired ``twist`` [v (m/s); w (rad/s)] and ``twist_rate`` on the half-step grid
+    t_j = j dt / 2 ((2 steps + 1, 6) each, O axes) and the motion's ``duration`` [s]."""
+
+    start: Any
+    twist: Any
+    twist_rate: Any
+    duration: float
+
+
+@dataclass(frozen=True)
+class LimitDemand:
+    """One declared limit against what the motion needs: the ``joint``, the ``quantity``
+    (``"velocity"`` [rad/s or m/s], ``"effort"`` [N m or N], ``"position"`` [rad or m]), the
+    ``peak_demand`` (|value|; for a position the largest q against the upper limit, or the
+    largest -q against minus the lower limit), the ``limit``, the time of the peak ``peak_time`` [s], and ``min_duration`` [s]: the
+    shortest duration of the same motion (time scaling) that keeps this limit (+inf when none
+    does: a position limit, or a static torque above the effort limit)."""
+
+    joint: str
+    quantity: str
+    peak_demand: float
+    limit: float
+    peak_time: float
+    min_duration: float
+
+    @property
+    def exceeded(self) -> bool:
+        """True when the demand is above the limit (or not a number)."""
+        return not self.peak_demand <= self.limit
+
+
+@dataclass(frozen=True)
+class FeasibilityReport:
+    """`feasibility`'s answer: ``feasible`` (every declared limit kept at ``duration``),
+    ``duration`` [s], ``min_duration`` [s] (the shortest duration of the same motion that keeps
+    every limit; +inf when none does; it may be shorter than ``duration``), every checked limit
+    (``limits``, `LimitDemand`), and the motion's peak demand per actuated joint:
+    ``peak_velocity`` [rad/s or m/s], ``peak_acceleration`` [rad/s^2 or m/s^2], ``peak_torque``
+    [N m or N] (dicts by joint name)."""
+
+    feasible: bool
+    duration: float
+    min_duration: float
+    limits: tuple
+    peak_velocity: dict
+    peak_acceleration: dict
+    peak_torque: dict
+
+    @property
+    def exceeded(self) -> list:
+        """The limits the motion exceeds at ``duration``, worst first (by min_duration)."""
+        return sorted((x for x in self.limits if x.exceeded), key=lambda x: -x.min_duration)
+
+    def line(self) -> str:
+        """One line: the worst exceeded limit (joint, peak demand, limit) and the shortest
+        feasible duration; "feasible" otherwise."""
+        if self.feasible:
+            return f"feasible at {self.duration:g} s (the shortest duration keeping every limit: {self.min_duration:.4g} s)"
+        w = self.exceeded[0]
+        unit = {"velocity": "rad/s or m/s", "effort": "N m or N", "position": "rad or m"}[w.quantity]
+        more = len(self.exceeded) - 1
+        fit = (f"the same motion keeps every limit in {self.min_duration:.4g} s or longer (--fit-duration runs it so)"
+               if np.isfinite(self.min_duration) else "no duration of the same motion keeps it")
+        return (f"{w.joint} needs {w.quantity} {w.peak_demand:.4g} (at t = {w.peak_time:.4g} s) against its declared "
+                f"limit {w.limit:.4g} {unit} in {self.duration:g} s" + (f" (and {more} more limits)" if more else "")
+                + f": {fit}")
+
+    def summary(self) -> dict:
+        """The report as summary.json's ``feasibility`` (durations [s], demands and limits in SI)."""
+        return {"feasible": self.feasible, "duration": self.duration,
+                "min_duration": self.min_duration if np.isfinite(self.min_duration) else None,
+                "limits": [dict(joint=x.joint, quantity=x.quantity, peak_demand=x.peak_demand, limit=x.limit,
+                                peak_time=x.peak_time, exceeded=x.exceeded,
+                                min_duration=x.min_duration if np.isfinite(x.min_duration) else None)
+                           for x in self.limits],
+                "peak_velocity": self.peak_velocity, "peak_acceleration": self.peak_acceleration,
+                "peak_torque": self.peak_torque}
+
+
+def _ctl(control: Any, key: str, default: Any = None) -> Any:
+    if isinstance(control, dict):
+        return control.get(key, default)
+    value = getattr(control, key, default)
+    return default if value is None else value
+
+
+def feasibility(mechanism: Any, control: Any, motion: Any, *, q_guess: npt.ArrayLike | None = None) -> FeasibilityReport:
+    """What a reactionless motion needs, computed open loop before any simulation, against the
+    declared limits (the joints' velocity and effort limits, ``[control]`` ``max_rate``,
+    ``max_speed``, ``torque_limit``; the balancing joints' position limits).
+
+    The reactionless controller is run without any limit over the commanded motion (the momentum
+    equation, joint or operational-space mode): the rates and accelerations of every actuated
+    joint, and their torques (inverse dynamics of the commanded motion, gravity and springs
+    included). Time scaling: started at rest, the same motion run in a duration T' follows the
+    same path (the momentum equation is homogeneous in the rates), so its rates scale by T / T'
+    and the torques' inertial part by (T / T')^2 (the static part stays): each limit's shortest
+    duration follows exactly (not exact with ``home_gain`` or ``limit_gain``, which are not
+    homogeneous).
+
+    Args:
+        mechanism: a `mechbal.Mechanism`.
+        control: the ``[control]`` table (validated, or a dict): ``balancing_joints`` (joint
+            mode) or ``task_frame`` (and ``task_rows``), ``cancel``, ``integrator``,
+            ``rate_hz``, ``damping``, ``max_rate``, ``max_speed``, ``torque_limit``,
+            ``home_gain``, ``limit_gain``.
+        motion: joint mode: a `mechbal.trajectory` of every actuated joint (the balancing joints'
+            entries are ignored; they start at its start); operational-space mode: a
+            `FrameMotion`.
+        q_guess: closed mechanisms: every coordinate near the assembly.
+
+    Returns:
+        `FeasibilityReport`.
+    """
+    from mechbal import verdict as vd
+    from mechbal.trajectory import as_trajectory
+
+    mech = mechanism
+    names = list(mech.actuated_names)
+    rate_hz = float(_ctl(control, "rate_hz", 1000.0))
+    dt = 1.0 / rate_hz
+    cancel = _cancel_list(_ctl(control, "cancel", ["moment"]))
+    integrator = _ctl(control, "integrator", "rk4")
+    damping = float(_ctl(control, "damping", 1e-2))
+    frame = _ctl(control, "task_frame")
+    if frame is not None:
+        if not isinstance(motion, FrameMotion):
+            raise TypeError("the operational-space mode (task_frame) takes a mechbal.control.FrameMotion")
+        duration = float(motion.duration)
+        steps = int(round(duration / dt))
+        rows = _ctl(control, "task_rows", ["all"])
+        ctrl = ReactionlessTaskController(mech, frame, rows, cancel, integrator, rate_hz, damping,
+                                          q0=np.asarray(motion.start, float), max_rate=np.inf, velocity_limits=False)
+        r = ctrl.run(motion.twist, motion.twist_rate)
+        q, v, a = r.q, r.v, r.a
+        q_full, v_full, a_full = q, v, a
+        balancing = names
+    else:
+        traj = as_trajectory(motion)
+        duration = float(getattr(traj, "duration"))
+        steps = int(round(duration / dt))
+        th = np.arange(2 * steps + 1) * (0.5 * dt)
+        qa, va, aa = (np.atleast_2d(x) for x in traj.evaluate(th))
+        balancing = list(_ctl(control, "balancing_joints", []))
+        task = [i for i, n in enumerate(names) if n not in balancing]
+        ctrl = ReactionlessController(mech, balancing, cancel, integrator, rate_hz, damping, q0=qa[0], v0=va[0],
+                                      q_guess=q_guess, max_rate=np.inf, velocity_limits=False,
+                                      position_limits=False, home_gain=float(_ctl(control, "home_gain", 0.0)),
+                                      limit_gain=float(_ctl(control, "limit_gain", 0.0)))
+        r = ctrl.run(np.ascontiguousarray(qa[:, task]), np.ascontiguousarray(va[:, task]),
+                     np.ascontiguousarray(aa[:, task]))
+        q, v, a = r.q, r.v, r.a
+        q_full, v_full, a_full = r.q_full, r.v_full, r.a_full
+    t = np.arange(len(q)) * dt
+    # torques of the commanded motion: the whole, and its static part (gravity, springs)
+    if mech.is_closed:
+        m = mech.closed_motion(q, v, a, q_guess=q_guess, with_forces=True)
+        tau = np.asarray(m.actuated_force)
+        static = np.einsum("ndk,nd->nk", np.asarray(m.projection), np.asarray(mech.static_torque(m.q)))
+    else:
+        tau = np.asarray(mech.inverse_dynamics(q_full, v_full, a_full))
+        static = np.asarray(mech.static_torque(q_full))
+    inertial = tau - static
+    limits = vd.limits_in_force(mech, control, balancing=balancing)
+    checks = []
+    model = mech.model
+    coords = list(model.actuated_coordinates)
+    for j, name in enumerate(names):
+        lim = limits.get(name, {})
+        if "velocity" in lim:
+            x = np.abs(v[:, j])
+            k = int(np.argmax(x))
+            checks.append(LimitDemand(name, "velocity", float(x[k]), lim["velocity"], float(t[k]),
+                                      duration * float(x[k]) / lim["velocity"]))
+        if "effort" in lim:
+            L = lim["effort"]
+            x = np.abs(tau[:, j])
+            k = int(np.argmax(x))
+            # |c i + s| <= L for every sample, c = (T / T')^2: c <= (L - sign(i) s) / |i|
+            i_, s_ = inertial[:, j], static[:, j]
+            if np.any(np.abs(s_) > L):
+                shortest = np.inf
+            else:
+                moving = np.abs(i_) > 0
+                c = np.min((L - np.sign(i_[moving]) * s_[moving]) / np.abs(i_[moving])) if np.any(moving) else np.inf
+                shortest = duration / np.sqrt(c) if c > 0 else np.inf
+            checks.append(LimitDemand(name, "effort", float(x[k]), L, float(t[k]), float(shortest)))
+        if name in balancing:   # the path does not depend on the duration: no duration fixes it
+            lo, hi = float(model.lower_limits[coords[j]]), float(model.upper_limits[coords[j]])
+            for bound, sign in ((hi, 1.0), (lo, -1.0)):
+                if np.isfinite(bound):
+                    x = sign * q[:, j]
+                    k = int(np.argmax(x))
+                    checks.append(LimitDemand(name, "position", float(x[k]), sign * bound, float(t[k]),
+                                              np.inf if x[k] > sign * bound else 0.0))
+    feasible = all(not x.exceeded for x in checks)
+    shortest = max((x.min_duration for x in checks), default=0.0)
+    peak = lambda x: {n: float(np.max(np.abs(x[:, j]))) for j, n in enumerate(names)}  # noqa: E731
+    return FeasibilityReport(feasible=feasible, duration=duration, min_duration=float(shortest),
+                             limits=tuple(checks), peak_velocity=peak(v), peak_acceleration=peak(a),
+                             peak_torque=peak(tau))

@@ -252,6 +252,19 @@ _CONTROL_ONLY = {"k": "decoupled", **{k: "reactionless" for k in (
 PerJoint = Annotated[list[Pos], Field(min_length=1, max_length=MAX_JOINTS)]
 
 
+class ControlTolerance(Table):
+    """``[control] tolerance``: the goal of a controlled run (`mechbal.verdict`). Defaults in
+    `mechbal.verdict.DEFAULT_TOLERANCE`."""
+    residual: Optional[Pos] = Field(None, description="each cancelled component's peak over its uncontrolled "
+                                                      "peak (default 1e-6)")
+    floor: Optional[Pos] = Field(None, description="absolute floor of a cancelled component's residual, N or N m "
+                                                   "(default 1e-9)")
+    position: Optional[Pos] = Field(None, description="task frame's path error, m (default 1e-6)")
+    orientation: Optional[Pos] = Field(None, description="task frame's orientation error, rad (default 1e-6)")
+    joint: Optional[Pos] = Field(None, description="closed loop: the plant's departure from the command, rad or m "
+                                                   "(default 1e-2)")
+
+
 class Control(Table):
     """``[control]``: a real-time controller run along the case's trajectory. ``kind =
     "reactionless"``: the balancing joints keep the cancelled momentum components at their
@@ -273,7 +286,9 @@ class Control(Table):
     damping: Annotated[float, Field(gt=0, lt=1, **_NUM)] = Field(
         1e-2, description="damped least squares near singularity, relative to the largest "
                           "singular value")
-    max_rate: Pos = Field(100.0, description="balancing joints' rate limit (rad/s or m/s)")
+    max_rate: Optional[Pos] = Field(
+        None, description="balancing joints' rate limit (rad/s or m/s); the joint's declared velocity limit "
+                          "when smaller; default: none beyond the declared limits")
     home_gain: NonNeg = Field(0.0, description="redundant balancing joints: pull towards the start pose (1/s)")
     limit_gain: NonNeg = Field(0.0, description="redundant balancing joints: push away from the joint limits")
     task_frame: Optional[Name] = Field(
@@ -287,10 +302,16 @@ class Control(Table):
                           "computed_torque and decoupled; reactionless: its computed-torque stage, with kd")
     kd: Optional[PerJoint] = Field(None, description="derivative gains (1/s), one per actuated joint")
     torque_limit: Optional[PerJoint] = Field(
-        None, description="|tau| limit per actuated joint (N m or N); default: the controller's own")
+        None, description="|tau| limit per actuated joint (N m or N); the joint's declared effort limit when "
+                          "smaller; default: none beyond the declared limits")
     k: Optional[PerJoint] = Field(
         None, description="decoupled: the constant diagonal of the balanced mass matrix (default: "
                           "taken from the mechanism at q = 0)")
+    max_speed: Optional[Pos] = Field(
+        None, description="input range of every controller stage's joint speeds, measured and desired (rad/s "
+                          "or m/s): beyond it a tick holds its command (out of range); default: none")
+    tolerance: Optional[ControlTolerance] = Field(
+        None, description="what counts as the goal met (the verdict of a run: ok, limited_by, exit code 6)")
 
     @model_validator(mode="after")
     def _rules(self):

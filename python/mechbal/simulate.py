@@ -30,7 +30,7 @@ from mechbal.control import MechanismDynamics
 simulate_closed_loop = _core.simulate_closed_loop
 simulate_computed_torque = _core.simulate_computed_torque
 
-__all__ = ["closed_loop", "ClosedLoopResult", "passive", "PassiveResult", "ForwardDynamics", "MechanismDynamics",
+__all__ = ["closed_loop", "ClosedLoopResult", "judge_closed_loop", "passive", "PassiveResult", "ForwardDynamics", "MechanismDynamics",
            "simulate_closed_loop", "simulate_computed_torque"]
 
 ForwardDynamics = _core.ForwardDynamics
@@ -50,7 +50,10 @@ class ClosedLoopResult(DeprecatedAttributes):
     * ``saturated_ticks``: ticks on which the controller clipped the torque;
     * ``steps_completed``: ``steps`` unless the plant failed (later rows repeat the last state);
     * ``mujoco``: with ``engine="mujoco"``, the co-simulation's record (MuJoCo's base reaction
-      beside mechbal's prediction), else None.
+      beside mechbal's prediction), else None;
+    * ``verdict``: the run's goal and whether it was met (`mechbal.verdict.Verdict`: every tick
+      ok, every step completed, the plant within ``tolerance["joint"]`` of the desired motion,
+      the declared velocity limits kept); None for a passive run (no goal). ``ok`` is its ``ok``.
 
     ``qd`` and ``qd_des``, the names of earlier releases, still read ``v`` and ``v_des`` for one
     release (with a DeprecationWarning).
@@ -68,6 +71,7 @@ class ClosedLoopResult(DeprecatedAttributes):
     #: ``engine="mujoco"``: the `mechbal.export.mujoco_engine.CoSimulation` (MuJoCo's base
     #: reaction at every tick beside mechbal's prediction, the loops' constraint violation)
     mujoco: Any = None
+    verdict: Any = None
 
     _renamed: ClassVar[dict[str, str]] = {"qd": "v", "qd_des": "v_des"}
 
@@ -78,8 +82,53 @@ class ClosedLoopResult(DeprecatedAttributes):
 
     @property
     def ok(self) -> bool:
-        """True when every tick's status is 0 (ok)."""
+        """True when the run met its goal (`verdict`); without one (a passive run), when every
+        tick's status is 0 (ok)."""
+        if self.verdict is not None:
+            return bool(self.verdict.ok)
         return bool(np.all(self.status == 0))
+
+    @property
+    def limited_by(self) -> list:
+        """What kept the run from its goal (empty when ``ok``): `mechbal.verdict.Verdict`'s."""
+        return list(self.verdict.limited_by) if self.verdict is not None else []
+
+
+def judge_closed_loop(result: ClosedLoopResult, controller: Any, mechanism_or_plant: Any = None,
+                      tolerance: Any = None) -> Any:
+    """The `mechbal.verdict.Verdict` of a closed-loop run: every tick's status ok, every step
+    completed, the largest |q_des - q| of the tracked joints (a reactionless controller's task
+    joints: its balancing joints follow the reactionless command, not q_des) within
+    ``tolerance["joint"]`` beyond the error the run started with (default `mechbal.verdict.DEFAULT_TOLERANCE`), and, for a
+    `mechbal.Mechanism` plant, its declared velocity limits kept by the simulated motion. None
+    for a passive run (no goal)."""
+    from mechbal import verdict as vd
+    from mechbal.control import PassiveController
+    from mechbal.mechanism import Mechanism
+
+    if isinstance(controller, PassiveController):
+        return None
+    tol = vd.tolerance(tolerance)
+    n = result.q.shape[1]
+    tracked = list(range(n))
+    if isinstance(controller, _core.ReactionlessJointController):
+        tracked = list(controller.reactionless.task_indices)
+    mech = mechanism_or_plant if isinstance(mechanism_or_plant, Mechanism) else None
+    limits = vd.limits_in_force(mech) if mech is not None else {}
+    v = vd.Verdict(vd.goal(kind=type(controller).__name__, tol=tol, limits=limits, closed_loop=True,
+                           tracking={"joint": "largest |q_des - q| of the tracked joints [rad or m] beyond "
+                                              "the error the run started with"}))
+    v.statuses(result.status, result.t)
+    v.steps(result.steps_completed, len(result.t) - 1, result.t)
+    if tracked:
+        err = np.max(np.abs(result.q_des[:, tracked] - result.q[:, tracked]), axis=1)
+        # a start off the desired motion is the caller's: the loop must not depart from it by
+        # more than the tolerance beyond the error it started with
+        v.tracking(np.maximum(err - err[0], 0.0), result.t, tol["joint"],
+                   what="closed-loop tracking (beyond the initial error)", unit="rad or m", key="joint")
+    if mech is not None:
+        v.limit(result.v, result.t, list(mech.actuated_names), "velocity", limits, who="simulated motion")
+    return v
 
 
 def _plant(mechanism_or_plant: Any, q_guess: npt.ArrayLike | None) -> Any:
@@ -130,7 +179,7 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
                 dt: float = 1e-3, duration: float | None = None,
                 sampling: str = "zero_order_hold",
                 q_guess: npt.ArrayLike | None = None, engine: str = "mechbal",
-                **engine_options: Any) -> ClosedLoopResult:
+                tolerance: dict | None = None, **engine_options: Any) -> ClosedLoopResult:
     """Simulate ``controller`` driving ``mechanism_or_plant`` along ``trajectory`` (one C++ call).
 
     Args:
@@ -158,14 +207,28 @@ def closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any,
             `mechbal.Mechanism` only; zero-order hold; needs ``mechbal[mujoco]``). The
             result's ``mujoco`` holds MuJoCo's base reaction at every tick beside mechbal's
             prediction.
+        tolerance: the goal's tolerances (`mechbal.verdict.DEFAULT_TOLERANCE`; ``joint``: the
+            largest |q_des - q| that counts as tracking [rad or m]).
         **engine_options: with ``engine="mujoco"``, the options of
             `mechbal.export.mujoco_engine.co_simulate` (``substeps``, ``integrator``,
             ``solref``, ``solimp``, ``minimum_mass``, ``constraint_weight``).
 
     Returns:
-        `ClosedLoopResult`. A plant failure (an unassemblable pose, a non-finite state)
-        stops the integration and shows in ``status`` and ``steps_completed``; it does not raise.
+        `ClosedLoopResult`, with its ``verdict`` (`judge_closed_loop`). A plant failure (an
+        unassemblable pose, a non-finite state) stops the integration and shows in ``status``,
+        ``steps_completed`` and ``ok``; it does not raise.
     """
+    import dataclasses
+
+    result = _closed_loop(mechanism_or_plant, controller, trajectory, q0, v0, dt=dt, duration=duration,
+                          sampling=sampling, q_guess=q_guess, engine=engine, **engine_options)
+    inner = getattr(controller, "joint_controller", None) or controller
+    return dataclasses.replace(result, verdict=judge_closed_loop(result, inner, mechanism_or_plant, tolerance))
+
+
+def _closed_loop(mechanism_or_plant: Any, controller: Any, trajectory: Any, q0: Any, v0: Any, *, dt: float,
+                 duration: float | None, sampling: str, q_guess: Any, engine: str,
+                 **engine_options: Any) -> ClosedLoopResult:
     from mechbal.trajectory import RestToRest, as_trajectory
 
     if hasattr(controller, "joint_controller"):  # a ReactionlessController with its CT stage

@@ -184,6 +184,26 @@ _CONTROL = {"type": "object", "additionalProperties": False, "description": "The
                 "feed_forward": detail("The acceleration feed-forward against the stored motion's "
                                        "acceleration [rad/s^2] and its predicted moment [N m].")}}
 
+#: the verdict of a controlled run (`mechbal.verdict`): run, run --engine mujoco, verify
+VERDICT: dict[str, Schema] = {
+    "goal": detail("What the controlled run was asked (mechbal.verdict.goal): kind, statuses, the cancelled "
+                   "components with their tolerance (residual, floor), the tracking criteria with theirs, the "
+                   "declared limits in force per joint (velocity [rad/s or m/s], effort [N m or N]) and the "
+                   "tolerance table in force."),
+    "ok": boolean("True only if every criterion of the goal held (every tick ok, no declared limit exceeded, "
+                  "each cancelled component and the tracking within tolerance)."),
+    "limited_by": {"type": "array", "description": "Each criterion that failed, with its numbers: "
+                   "criterion (status, limit, residual, tracking, steps), message, and joint, first_tick, "
+                   "ticks, peak_demand, limit, ... as they apply (empty when ok).",
+                   "items": {"type": "object"}},
+    "feasibility": detail("Reactionless cases, before the run (mechbal.control.feasibility): feasible, duration "
+                          "[s], min_duration [s] (the shortest duration of the same motion keeping every declared "
+                          "limit), each limit's peak demand against it, the peak velocity, acceleration and torque "
+                          "per joint; fitted_duration [s] with --fit-duration."),
+    "cancelled_residual": detail("Per cancelled component (force_x ... moment_z): its uncontrolled and controlled "
+                                 "peaks [N or N m], their fraction, the reduction [%] and the allowed residual."),
+}
+
 RUN_MECHANISM: dict[str, Schema] = {
     "kind": string("[case] kind: serial_chain, mechanism or urdf (a URDF file)."),
     "dof": integer("Degrees of freedom (moving joints, gears and loops not counted out)."),
@@ -217,9 +237,10 @@ RUN_MECHANISM: dict[str, Schema] = {
     "passive": detail("[control] kind = passive: rate_hz, integrator, q0, v0, initial_energy [J], "
                       "max_energy_drift [J], kinetic_energy_swing [J], relative_energy_drift, "
                       "energy (definition), final_q, final_v."),
-    "shaking_moment_reduction": detail("Operational-space mode: peak |shaking moment| [N m] without "
-                                       "(pseudo-inverse) and with the null-space term, their ratio "
-                                       "and the reduction [%]."),
+    "shaking_moment_reduction": detail("Reactionless cases: per_axis (x, y, z: the peak |M_i| [N m] of both "
+                                       "variants, their ratio, the reduction [%], whether the axis is cancelled) "
+                                       "and whole_moment (peak |M| over all three axes, cancelled or not)."),
+    **VERDICT,
     "urdf": string("The URDF file (kind urdf)."),
     "joint_names": strings(), "body_names": strings(),
     "start": numbers("rad or m", "Start pose of the default motion (kind urdf)."),
@@ -250,7 +271,7 @@ RUN_MUJOCO: dict[str, Schema] = {
     "dt": number("s", "Controller and integration step."),
     "mujoco_options": MUJOCO_OPTIONS,
     "controller": string(),
-    "ok": boolean("Every step ok."), "steps_completed": integer(),
+    **VERDICT, "steps_completed": integer(),
     "peak_tracking_error": number("rad or m"),
     "max_constraint_violation": number("m", "Largest loop-closure violation in MuJoCo."),
     "base_reaction": _BASE_REACTION_PEAKS,
@@ -259,8 +280,9 @@ RUN_MUJOCO: dict[str, Schema] = {
     **{k: RUN_MECHANISM[k] for k in ("kind", "dof", "actuated", "closed", "duration", "samples", "law",
                                      "variants", "peak_shaking_force", "peak_shaking_moment", "control",
                                      "total_mass")},
-    "shaking_moment_reduction": detail("Reactionless cases: peak |shaking moment| [N m] of MuJoCo's motion, "
-                                       "uncontrolled and controlled, their ratio and the reduction [%]."),
+    "shaking_moment_reduction": detail("Reactionless cases, of MuJoCo's motion: per_axis (x, y, z: the peak "
+                                       "|M_i| [N m] of both variants, their ratio, the reduction [%], whether "
+                                       "the axis is cancelled) and whole_moment (peak |M| over all three axes)."),
     "cosimulation": {"type": "object", "description": "Reactionless cases, per variant: MuJoCo's realised "
                      "base reaction and shaking wrench beside mechbal's prediction for the controller's "
                      "command, the tracking and the stored poses' wrench against MuJoCo's.",
@@ -362,7 +384,9 @@ VERIFY: dict[str, Schema] = {
     "time_step": detail("The controlled variant co-simulated at dt and dt / 2: the largest cancelled "
                         "component's residual (fraction of its uncontrolled peak) and the largest tracking "
                         "error [rad or m] at each, and their ratios."),
-    "limited_by": string("What limits the simulated residual (measured: time_step)."),
+    "residual_limited_by": string("What limits the simulated residual (measured: time_step); for a failed "
+                                  "loop, that no residual is reported."),
+    **VERDICT,
 }
 
 SWEEP: dict[str, Schema] = {

@@ -219,7 +219,8 @@ cancel = ["moment_z"]         # any of "moment", "force", "both", "moment_x|y|z"
 integrator = "rk4"            # or "euler"
 rate_hz = 1000                # controller rate [Hz]
 damping = 1e-3                # damped least squares near singularities (relative)
-# max_rate = 100.0            # balancing joints' rate limit [rad/s]
+# max_rate = 20.0             # balancing joints' rate limit [rad/s] (default: none beyond the
+#                             #   joints' declared limits = { velocity = ... })
 # home_gain = 0.0             # with more balancing joints than cancelled components: pull
 # limit_gain = 0.0            #   towards the start pose / away from the joint limits [1/s]
 # task_frame = "tool"         # operational-space mode (a redundant arm, every joint listed in

@@ -155,7 +155,8 @@ def _rows(label: str, res: dict, scale: dict, unbalanced: dict) -> tuple[list, d
     return rows, summary
 
 
-def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | None = None) -> dict:
+def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | None = None,
+               fit_duration: bool = False, allow_degraded: bool = False) -> dict:
     """The whole check into ``out`` (module docstring); ``method``: the balancing method of the
     balanced variant (default: the case's ``balance.method``, or its default design's); returns
     the summary."""
@@ -163,7 +164,8 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
 
     out = Path(out)
     if reactionless_control(case) is not None:
-        return run_verify_reactionless(case, out, simulate=simulate)
+        return run_verify_reactionless(case, out, simulate=simulate, fit_duration=fit_duration,
+                                       allow_degraded=allow_degraded)
     progress.stage("reading the case")
     bc = load_case(case)
     variants = {"unbalanced": bc.mechanism}
@@ -227,7 +229,8 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
     return summary
 
 
-def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float | None = None) -> dict:
+def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float | None = None,
+                     fit_duration: bool = False, allow_degraded: bool = False) -> dict:
     """``mechbal run CASE --engine mujoco``: the case's mechanism driven along its trajectory by
     mechbal's computed-torque controller (Kp 400 / s^2, Kd 40 / s) ticked every ``dt`` against
     MuJoCo integrating its MJCF export. DIR receives ``summary.json``, ``base_reaction.png`` (MuJoCo's
@@ -241,7 +244,8 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
 
     out = Path(out)
     if reactionless_control(case) is not None:   # the case's own controller, not computed torque
-        return run_cosimulation_reactionless(case, out, dt=dt, duration=duration)
+        return run_cosimulation_reactionless(case, out, dt=dt, duration=duration, fit_duration=fit_duration,
+                                             allow_degraded=allow_degraded)
     progress.stage("reading the case")
     bc = load_case(case)
     mech = bc.mechanism
@@ -275,9 +279,20 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
                        title=f"{bc.title}: tracking in MuJoCo")
     diff_F = _peak(cs.base_reaction_force - cs.predicted_base_reaction_force)
     diff_M = _peak(cs.base_reaction_moment - cs.predicted_base_reaction_moment)
+    from mechbal import verdict as vd
+
+    tol = vd.tolerance(getattr(getattr(bc, "case", None), "control", None))
+    limits = vd.limits_in_force(mech)
+    judged = vd.Verdict(vd.goal(kind="computed_torque", tol=tol, limits=limits, closed_loop=True,
+                                tracking={"joint": "largest |q_des - q| of MuJoCo's motion [rad or m]"}))
+    judged.statuses(cs.status, cs.t, who="closed loop in MuJoCo")
+    judged.steps(int(cs.steps_completed), len(cs.t) - 1, cs.t)
+    judged.tracking(np.max(np.abs(cs.tracking_error), axis=1), cs.t, tol["joint"], what="MuJoCo's motion",
+                    unit="rad or m", key="joint")
+    judged.limit(cs.v, cs.t, list(mech.actuated_names), "velocity", limits, who="motion in MuJoCo")
     summary = {"case": bc.name, "engine": "mujoco", "mechanism": repr(mech), "dt": dt, "mujoco_options": cs.options,
                "controller": f"computed torque, Kp {KP:g} 1/s^2, Kd {KD:g} 1/s (mechbal's model)",
-               "ok": bool(np.all(cs.status == 0)), "steps_completed": cs.steps_completed,
+               **judged.summary(), "steps_completed": cs.steps_completed,
                "peak_tracking_error": _peak(cs.tracking_error),
                "max_constraint_violation": _peak(cs.constraint_violation),
                "base_reaction": {
@@ -299,6 +314,8 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
                         ["moment [N m]", summary["base_reaction"]["peak_moment_mechbal"],
                          summary["base_reaction"]["peak_moment_mujoco"], diff_M]],
                        ["base reaction", "mechbal peak", "MuJoCo peak", "max difference"]))
+    print(report.table(vd.goal_rows(judged, [["tracking error [rad or m]", f"{_peak(cs.tracking_error):.3g}"]]),
+                       ["computed torque in MuJoCo (verdict)", "value"]))
     return summary
 
 
@@ -361,15 +378,16 @@ class ReactionlessPlan:
         return len(self.mech.actuated_names)
 
 
-def reactionless_plan(case, *, dt: float = 1e-3, duration: float | None = None) -> ReactionlessPlan:
+def reactionless_plan(case, *, dt: float = 1e-3, duration: float | None = None, validated: Any = None) -> ReactionlessPlan:
     """The `ReactionlessPlan` of a case file or built-in case with a reactionless ``[control]``
     at tick ``dt`` [s] over ``duration`` [s] (default: the whole trajectory; a shorter horizon
-    runs its beginning). ConfigError naming the field for a case the controller cannot drive."""
+    runs its beginning; ``validated``: the validated case, when already read, e.g. with a fitted
+    duration). ConfigError naming the field for a case the controller cannot drive."""
     from mechbal.cases.serial_chain import check_task_space, frame_path, held_trajectory, start_assembly
     from mechbal.config import ConfigError
     from mechbal.mechanism import Mechanism
 
-    cfg = reactionless_control(case)
+    cfg = validated if validated is not None else reactionless_control(case)
     if cfg is None:
         raise ConfigError("control.kind", "the case has no reactionless [control] table", has_value=False)
     ctl, tr = cfg.control, cfg.trajectory
@@ -399,8 +417,11 @@ def reactionless_plan(case, *, dt: float = 1e-3, duration: float | None = None) 
 
 def _joint_options(plan: ReactionlessPlan) -> dict:
     ctl = plan.ctl
+    from mechbal.control import declared_options
+
     return dict(cancel=list(ctl.cancel), integrator=ctl.integrator, rate_hz=1.0 / plan.dt, damping=ctl.damping,
-                max_rate=ctl.max_rate, home_gain=ctl.home_gain, limit_gain=ctl.limit_gain, q_guess=plan.q_guess)
+                home_gain=ctl.home_gain, limit_gain=ctl.limit_gain, q_guess=plan.q_guess,
+                **declared_options(ctl))
 
 
 def _task_controller(plan: ReactionlessPlan, null_space: bool):
@@ -412,7 +433,7 @@ def _task_controller(plan: ReactionlessPlan, null_space: bool):
     try:
         return control.ReactionlessTaskController(plan.mech, ctl.task_frame, rows, list(ctl.cancel), ctl.integrator,
                                                   1.0 / plan.dt, ctl.damping, null_space=null_space, q0=plan.start,
-                                                  max_rate=ctl.max_rate)
+                                                  max_rate=control.declared_options(ctl)["max_rate"])
     except ValueError as exc:
         raise ConfigError("control", str(exc), has_value=False) from None
 
@@ -638,8 +659,29 @@ def _largest_residual(plan: ReactionlessPlan, sim: ReactionlessCoSimulation, pea
     return worst
 
 
+def feasible_case(case, *, fit_duration: bool = False, allow_degraded: bool = False):
+    """(validated case, feasibility summary): a case with a reactionless ``[control]`` checked
+    against its declared limits before anything runs
+    (`mechbal.cases.serial_chain.check_feasibility`: `mechbal.verdict.ControlInfeasible`, or
+    the fitted duration with ``fit_duration``)."""
+    from mechbal.cases.serial_chain import check_feasibility, start_assembly
+    from mechbal.config import trajectory_from_config
+    from mechbal.mechanism import Mechanism
+
+    cfg = reactionless_control(case)
+    mech = Mechanism.from_spec(cfg.spec, name=cfg.case.name)
+    q_guess = None
+    if mech.is_closed:
+        traj, _ = trajectory_from_config(cfg.trajectory, len(mech.actuated_names))
+        q_guess = start_assembly(mech, cfg.trajectory, traj).q
+    cfg, report, fitted = check_feasibility(mech, cfg, q_guess, fit_duration=fit_duration,
+                                            allow_degraded=allow_degraded)
+    return cfg, {**report.summary(), **({"fitted_duration": fitted} if fitted else {})}
+
+
 def run_verify_reactionless(case, out: Path, *, simulate: bool = True, dt: float = 1e-3,
-                            duration: float | None = None, time_step_study: bool = True) -> dict:
+                            duration: float | None = None, time_step_study: bool = True,
+                            fit_duration: bool = False, allow_degraded: bool = False) -> dict:
     """``mechbal verify`` of a case with a reactionless ``[control]`` table, in the joint mode
     (balancing joints: the reaction-wheel arm, PAMINSA) or the operational-space mode
     (``task_frame``: the Panda). For each variant, **uncontrolled** and **controlled**
@@ -663,7 +705,8 @@ def run_verify_reactionless(case, out: Path, *, simulate: bool = True, dt: float
 
     out = Path(out)
     progress.stage("reading the case")
-    plan = reactionless_plan(case, dt=dt, duration=duration)
+    validated, feasible = feasible_case(case, fit_duration=fit_duration, allow_degraded=allow_degraded)
+    plan = reactionless_plan(case, dt=dt, duration=duration, validated=validated)
     mech = plan.mech
     rows = sorted({r for c in plan.ctl.cancel for r in _component_rows(c)})
 
@@ -692,9 +735,12 @@ def run_verify_reactionless(case, out: Path, *, simulate: bool = True, dt: float
 
     progress.stage("summary")
     peak_u = {key: _peak_axes(predicted["uncontrolled"][key]) for key in ("shaking_force", "shaking_moment")}
-    if simulate and time_step_study:
+    judged = control_verdict(plan, motions, simulated.get("controlled"))
+    loop_failed = simulate and not judged.ok
+    if simulate and time_step_study and not loop_failed:
         progress.stage(f"MuJoCo: the controlled variant at {2 / dt:g} Hz (time step)")
-        half = cosimulate_reactionless(reactionless_plan(case, dt=dt / 2, duration=duration), "controlled")
+        half = cosimulate_reactionless(reactionless_plan(case, dt=dt / 2, duration=duration, validated=validated),
+                                       "controlled")
         r1, r2 = _largest_residual(plan, simulated["controlled"], peak_u), _largest_residual(plan, half, peak_u)
         e1, e2 = _peak(simulated["controlled"].tracking_error), _peak(half.tracking_error)
         time_step = {"dt": [dt, dt / 2], "residual": [r1, r2], "tracking_error": [e1, e2],
@@ -746,13 +792,17 @@ def run_verify_reactionless(case, out: Path, *, simulate: bool = True, dt: float
                 "mechbal_controlled_fraction": variants["controlled"][key]["mechbal_peak"][axis] / ref,
                 "mujoco_inverse_controlled_fraction": variants["controlled"][key]["mujoco_inverse_peak"][axis] / ref}
         for label in simulated:
+            if label == "controlled" and loop_failed:   # a failed loop is never printed as a residual
+                continue
             item[f"mujoco_simulated_{label}_fraction"] = variants[label][key]["mujoco_simulated_peak"][axis] / ref
         residual[comp] = item
     closed = ""
     if mech.is_closed and simulated:
         violation = max(_peak(s.cosimulation.constraint_violation) for s in simulated.values())
         closed = f"; MuJoCo's soft loop constraints add their violation (at most {violation:.2g} m)"
-    if time_step:
+    if loop_failed:
+        limited_by = "the controlled loop failed its goal (limited_by): no residual is reported for it"
+    elif time_step:
         limited_by = (f"the computed-torque stage's torque is held over each {dt * 1e3:g} ms tick (zero-order hold): "
                       "MuJoCo's motion leaves the command by the tracking error; halving the tick scales the "
                       f"residual by {time_step['residual_ratio']:.2f} ({time_step['residual'][0]:.2g} -> "
@@ -776,7 +826,9 @@ def run_verify_reactionless(case, out: Path, *, simulate: bool = True, dt: float
                    "integrating the export. residual: each cancelled component's peak as a fraction of its "
                    "uncontrolled peak (mechbal's). relative_difference: max |mechbal - MuJoCo inverse| over the "
                    "uncontrolled peak (the force: at least the weight; the torques: the actuator forces' peak)."),
-        "limited_by": limited_by,
+        "residual_limited_by": limited_by,
+        "feasibility": feasible,
+        **judged.summary(),
         "files": ["summary.json", "mechanism.xml"] + (["shaking_wrench.png"] if simulate else []),
     }
     if plan.mode == "task":
@@ -800,12 +852,61 @@ def run_verify_reactionless(case, out: Path, *, simulate: bool = True, dt: float
                                    f"{VARIANTS[plan.mode]['uncontrolled']}; controlled: "
                                    f"{VARIANTS[plan.mode]['controlled']}.")
     write_summary(out / "summary.json", summary, command="verify")
+    if loop_failed:   # the failed loop's realised peaks are not a residual: not printed as one
+        table = [row[:-1] + ["failed"] if row[0] == "controlled" else row for row in table]
     print(report.table(table, ["variant", "quantity", "mechbal peak", "MuJoCo peak (inverse)",
                                "relative difference", "MuJoCo peak (simulated)"]))
+    print(report.table(_verdict_rows(judged, simulated.get("controlled"), plan.t),
+                       ["reactionless control (verdict)", "value"]))
     return summary
 
 
-def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration: float | None = None) -> dict:
+def control_verdict(plan: ReactionlessPlan, motions: dict, sim: "ReactionlessCoSimulation | None" = None):
+    """The `mechbal.verdict.Verdict` of a reactionless case's controlled variant: mechbal's
+    command (its statuses, its predicted wrench's cancelled components against the uncontrolled
+    ones, the declared velocity limits) and, when ``sim`` (the controlled variant co-simulated in
+    MuJoCo) is given, the simulation that ran: every tick ok, every step completed, MuJoCo's motion
+    within ``tolerance.joint`` of the command and within the declared velocity limits."""
+    from mechbal import verdict as vd
+
+    mech, ctl = plan.mech, plan.ctl
+    names = list(mech.actuated_names)
+    tol = vd.tolerance(ctl)
+    limits = vd.limits_in_force(mech, ctl, balancing=names if plan.mode == "task" else None)
+    tracking = {"joint": "largest |q - command| of MuJoCo's motion [rad or m]"} if sim is not None else None
+    v = vd.Verdict(vd.goal(kind=f"reactionless ({plan.mode} mode)", tol=tol, limits=limits, cancel=list(ctl.cancel),
+                           tracking=tracking, closed_loop=sim is not None))
+    c = motions["controlled"]
+    act = [mech.joint_names.index(x) for x in names]
+    v.statuses(c["status"], plan.t, who="reactionless controller (mechbal's command)")
+    v.limit(np.asarray(c["v"])[:, act], plan.t, names, "velocity", limits, who="commanded motion")
+    u = motions["uncontrolled"]
+    v.residual(np.hstack([c["shaking_force"], c["shaking_moment"]]), np.hstack([u["shaking_force"], u["shaking_moment"]]),
+               vd.cancelled_components(list(ctl.cancel)), tol, what="controller's predicted wrench")
+    if sim is not None:
+        cs = sim.cosimulation
+        v.statuses(sim.status, plan.t, who="closed loop in MuJoCo")
+        v.steps(int(cs.steps_completed), len(plan.t) - 1, plan.t)
+        v.tracking(sim.tracking_error, plan.t, tol["joint"], what="MuJoCo's motion against the command",
+                   unit="rad or m", key="joint")
+        v.limit(np.asarray(cs.v_full)[:, act], plan.t, names, "velocity", limits, who="motion in MuJoCo")
+    return v
+
+
+def _verdict_rows(v, sim, t) -> list:
+    from mechbal import verdict as vd
+
+    extra = []
+    if sim is not None:
+        s = np.asarray(sim.status, np.uint32)
+        extra = [["saturated ticks", f"{int(np.sum((s & np.uint32(4)) != 0))} of {len(s)}"],
+                 ["out-of-range ticks", f"{int(np.sum((s & np.uint32(32)) != 0))} of {len(s)}"],
+                 ["tracking error [rad or m]", f"{_peak(sim.tracking_error):.3g}"]]
+    return vd.goal_rows(v, extra)
+
+
+def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration: float | None = None,
+                                  fit_duration: bool = False, allow_degraded: bool = False) -> dict:
     """``mechbal run CASE --engine mujoco`` of a case with a reactionless ``[control]`` (joint or
     operational-space mode): both variants (`VARIANTS`) co-simulated in MuJoCo, each ticking its
     controller every ``dt`` (`cosimulate_reactionless`: the controlled variant ticks the
@@ -823,9 +924,10 @@ def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration
 
     out = Path(out)
     progress.stage("reading the case")
-    plan = reactionless_plan(case, dt=dt, duration=duration)
+    validated, feasible = feasible_case(case, fit_duration=fit_duration, allow_degraded=allow_degraded)
+    plan = reactionless_plan(case, dt=dt, duration=duration, validated=validated)
     mech, ctl, t = plan.mech, plan.ctl, plan.t
-    motions = reactionless_motions(plan) if plan.mode == "joint" else None
+    motions = reactionless_motions(plan)
     sims = {}
     for label in ("uncontrolled", "controlled"):
         progress.stage(f"co-simulation (MuJoCo, {1 / dt:g} Hz): {label}")
@@ -901,7 +1003,9 @@ def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration
                 "force": _peak(sw_F - cs.shaking_force), "moment": _peak(sw_M - cs.shaking_moment),
                 "meaning": "mechbal's shaking wrench of the stored poses (MuJoCo's states and accelerations) "
                            "against MuJoCo's realised one [N, N m]"}}
-    peak_u, peak_c = float(np.max(np.linalg.norm(Mu, axis=1))), float(np.max(np.linalg.norm(Mc, axis=1)))
+    from mechbal import verdict as verdict_
+
+    judged = control_verdict(plan, motions, sims["controlled"])
     rc = sims["controlled"]
     singular = (rc.status & np.uint32(int(control.Status.singular))) != 0
     saturated = (rc.status & np.uint32(int(control.Status.saturated))) != 0
@@ -921,15 +1025,13 @@ def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration
         "samples": int(len(t)), "law": plan.trajectory.law,
         "controller": (f"the reactionless controller ({plan.mode} mode) followed by computed torque, Kp {KP:g} "
                        f"1/s^2, Kd {KD:g} 1/s (mechbal's model), torque held over each {dt * 1e3:g} ms tick"),
-        "ok": all(s.ok for s in sims.values()),
         "variants": ["uncontrolled", "controlled"],
         "peak_shaking_force": {"uncontrolled": report.peak_abs(Fu), "controlled": report.peak_abs(Fc)},
         "peak_shaking_moment": {"uncontrolled": report.peak_abs(Mu), "controlled": report.peak_abs(Mc)},
-        "shaking_moment_reduction": {
-            "peak_norm_uncontrolled": peak_u, "peak_norm_controlled": peak_c,
-            "ratio": peak_c / peak_u if peak_u > 0 else None,
-            "reduction_pct": 100.0 * (1.0 - peak_c / peak_u) if peak_u > 0 else None},
+        "shaking_moment_reduction": verdict_.moment_reduction(Mu, Mc, list(ctl.cancel)),
         "control": ctl_summary,
+        "feasibility": feasible,
+        **judged.summary(),
         "cosimulation": by_variant,
         "mujoco_options": sims["controlled"].cosimulation.options,
         "total_mass": mech.total_mass,
@@ -942,6 +1044,7 @@ def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration
          for who, M in (("mechbal prediction", s.predicted_shaking_moment),
                         ("MuJoCo", s.cosimulation.shaking_moment))],
         ["peak shaking moment about O [N m]", "x", "y", "z"]))
+    print(report.table(_verdict_rows(judged, rc, t), ["reactionless control in MuJoCo (verdict)", "value"]))
     return summary
 
 

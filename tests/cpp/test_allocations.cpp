@@ -74,8 +74,10 @@ TEST(Allocations, RejectionAndSingularPathsAllocateNothing) {
   KdlChainDynamics kdl(model);
   MechanismDynamics rne(model);
   Arm2DofDynamics arm(Arm2DofParameters{});
-  ComputedTorque ct(arm, Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20));
-  DecoupledJointController dc(Eigen::Vector2d(1, 2), Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20));
+  const JointInputRange declared{1e3, 1e2, 1e4};  // no limit unless declared: declare one to reject
+  ComputedTorque ct(arm, Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20), Eigen::VectorXd(), declared);
+  DecoupledJointController dc(Eigen::Vector2d(1, 2), Eigen::Vector2d(100, 100), Eigen::Vector2d(20, 20),
+                              Eigen::VectorXd(), declared);
   const PaminsaModel paminsa(PaminsaParameters{});
   ReactionlessWristConfig rk4;
   rk4.integrator = WristIntegrator::rk4;

@@ -160,14 +160,21 @@ TEST(CaseReader, ControlTable) {
             std::string::npos);
   // every field of the reactionless table, and the defaults of the Python reader's schema.Control
   EXPECT_EQ(r.control.damping, 1e-2);
-  EXPECT_EQ(r.control.max_rate, 100.0);
+  EXPECT_TRUE(std::isinf(r.control.max_rate));  // no hidden limit: none unless declared
+  EXPECT_TRUE(std::isinf(r.control.max_speed));
+  EXPECT_EQ(r.control.tolerance.residual, 1e-6);
+  EXPECT_EQ(r.control.tolerance.joint, 1e-2);
   EXPECT_EQ(r.control.home_gain, 0.0);
   EXPECT_TRUE(r.control.kp.empty() && r.control.task_frame.empty());
   const LoadedCase full = case_from_string(
       base + "[[mechanism.frames]]\nname = \"tip\"\nlink = \"b\"\n[control]\nkind = \"reactionless\"\n"
              "balancing_joints = [\"a\"]\ncancel = [\"both\", \"moment_x\"]\nintegrator = \"rk4\"\nrate_hz = 500\n"
              "damping = 0.25\nmax_rate = 7\nhome_gain = 0.5\nlimit_gain = 2\ntask_frame = \"tip\"\nkp = [1, 2]\n"
-             "kd = [3, 4]\ntorque_limit = [5, 6]\n");
+             "kd = [3, 4]\ntorque_limit = [5, 6]\nmax_speed = 9\ntolerance = { residual = 1e-3, joint = 0.5 }\n");
+  EXPECT_EQ(full.control.max_speed, 9.0);
+  EXPECT_EQ(full.control.tolerance.residual, 1e-3);
+  EXPECT_EQ(full.control.tolerance.joint, 0.5);
+  EXPECT_EQ(full.control.tolerance.floor, 1e-9);
   EXPECT_EQ(full.control.cancel, (std::vector<std::string>{"both", "moment_x"}));
   EXPECT_EQ(full.control.rate_hz, 500.0);
   EXPECT_EQ(full.control.damping, 0.25);
@@ -182,6 +189,9 @@ TEST(CaseReader, ControlTable) {
       {"damping = 1", "control.damping: must be < 1 (got 1)"},
       {"damping = 0", "control.damping: must be > 0 (got 0)"},
       {"max_rate = -1.0", "control.max_rate: must be > 0 (got -1.0)"},
+      {"max_speed = 0", "control.max_speed: must be > 0 (got 0)"},
+      {"tolerance = { residual = 0 }", "control.tolerance.residual: must be > 0 (got 0)"},
+      {"tolerance = { resid = 1 }", "control.tolerance.resid"},
       {"home_gain = nan", "control.home_gain: must be finite"},
       {"limit_gain = \"1\"", "control.limit_gain: must be a number"},
       {"cancel = []", "control.cancel: must have at least 1 values"},

@@ -218,6 +218,8 @@ TEST(Reactionless, BadInputHoldsTheCommand) {
   c.balancing_joints = {"wheel"};
   c.cancel = moment_z;
   c.max_rate = 1000.0;
+  c.task_range = JointInputRange{1e3, 1e2, 1e4};  // declared ranges (none by default)
+  c.max_momentum = 1e4;
   ReactionlessController ctrl(wheel_arm(), c, Eigen::Vector3d(0.2, 0.4, 0.0));
   const Eigen::Vector2d q(0.2, 0.4), v(1.0, -1.0), a(0.0, 0.0);
   ASSERT_EQ(ctrl.step(q, v, a, q, v, q, v), Status::ok);
@@ -648,4 +650,28 @@ TEST(Reactionless, OperationalSpaceMoreCancelledRowsThanNullSpace) {
   J << check.frame_jacobian.topRows<4>();
   const Eigen::Vector4d v_ref = J.partialPivLu().solve(Eigen::Vector4d(x.head<4>()));
   EXPECT_LT((ctrl.v() - v_ref).cwiseAbs().maxCoeff(), 1e-10 * std::max(1.0, v_ref.cwiseAbs().maxCoeff()));
+}
+
+// Issue 37: no hidden limits. Undeclared, a limit is none: the wheel spins beyond 100 rad/s
+// without saturating, a fast task joint is no out-of-range input; a declared velocity limit (the
+// model's) or max_rate is met exactly and reported (saturated); overflow alone is guarded.
+TEST(Reactionless, NoHiddenLimits) {
+  ReactionlessConfig c;
+  c.balancing_joints = {"wheel"};
+  c.cancel = moment_z;
+  EXPECT_TRUE(std::isinf(c.max_rate) && std::isinf(c.max_acceleration) && std::isinf(c.max_momentum) &&
+              std::isinf(c.max_moment) && std::isinf(c.task_range.max_speed));
+  ReactionlessController ctrl(wheel_arm(), c, Eigen::Vector3d(0.0, 0.0, 0.0));
+  const Eigen::Vector2d q(0.2, 0.4), v(150.0, -150.0), a(0.0, 0.0);  // beyond the old 100 rad/s
+  EXPECT_EQ(ctrl.step(q, v, a, q, v, q, v), Status::ok);
+  EXPECT_GT(std::abs(ctrl.command().v(2)), 100.0);
+  c.max_rate = 100.0;  // declared: met exactly, and said
+  ReactionlessController limited(wheel_arm(), c, Eigen::Vector3d(0.0, 0.0, 0.0));
+  EXPECT_TRUE(has(limited.step(q, v, a, q, v, q, v), Status::saturated));
+  EXPECT_NEAR(std::abs(limited.command().v(2)), 100.0, 1e-9);
+  const Eigen::Vector2d overflow(1e200, 0.0);
+  EXPECT_EQ(ctrl.step(q, overflow, a, q, overflow, q, overflow), Status::out_of_range);
+  EXPECT_TRUE(ctrl.command().v.allFinite());
+  c.max_rate = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(validate_reactionless_config(c), std::invalid_argument);
 }

@@ -32,12 +32,13 @@ def test_exit_codes_documented_in_readme_and_help():
     table = readme.split("### Exit codes", 1)[1].split("\n## ", 1)[0]
     codes = {int(c) for c in re.findall(r"^\|\s*(\d+)\s*\|", table, re.M)}
     assert codes == {cli.EXIT_OK, cli.EXIT_USER_ERROR, cli.EXIT_INTERNAL_ERROR, cli.EXIT_OUTPUT_RACE,
-                     cli.EXIT_PARTIAL_BALANCE, cli.EXIT_IDENTIFY_DEGRADED, cli.EXIT_INTERRUPTED}
+                     cli.EXIT_PARTIAL_BALANCE, cli.EXIT_GOAL_NOT_MET, cli.EXIT_INTERRUPTED}
     # its own code: not 0, 2, 3, the lost race's 4 or 130
-    assert len({0, 2, 3, cli.EXIT_OUTPUT_RACE, cli.EXIT_PARTIAL_BALANCE, cli.EXIT_IDENTIFY_DEGRADED, 130}) == 7
+    assert len({0, 2, 3, cli.EXIT_OUTPUT_RACE, cli.EXIT_PARTIAL_BALANCE, cli.EXIT_GOAL_NOT_MET, 130}) == 7
     epilog = " ".join(cli.build_parser().epilog.split())
     assert f"{cli.EXIT_PARTIAL_BALANCE} balance" in epilog and f"{cli.EXIT_OUTPUT_RACE} another run" in epilog
-    assert f"{cli.EXIT_IDENTIFY_DEGRADED} identify" in epilog
+    assert f"{cli.EXIT_GOAL_NOT_MET} run/verify: the control goal was not met" in epilog
+    assert "identify: the identified model missed its goal" in epilog
 
 
 def test_exit_0_balance_reached(tmp_path, capsys):

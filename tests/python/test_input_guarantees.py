@@ -242,10 +242,14 @@ def test_construction_refuses_what_would_give_infinite_or_zero_results(chain):
     with pytest.raises(ValueError, match="duration"):
         _core.RestToRestTrajectory([0.0], [1.0], 5e-324)
     with pytest.raises(ValueError, match="max_speed"):
-        _core.DecoupledJointController([1.0], [1.0], [1.0], max_speed=np.inf)
+        _core.DecoupledJointController([1.0], [1.0], [1.0], max_speed=np.nan)
+    with pytest.raises(ValueError, match="max_speed"):
+        _core.DecoupledJointController([1.0], [1.0], [1.0], max_speed=0.0)
+    # no hidden limit (issue 37): undeclared (and +inf) means none
+    _core.DecoupledJointController([1.0], [1.0], [1.0], max_speed=np.inf)
     arm = _core.Arm2DofDynamics(_core.Arm2DofParameters())
-    assert np.all(_core.ComputedTorque(arm, [1, 1], [1, 1]).torque_limit == 1e4)
-    assert np.all(_core.ComputedTorque(arm, [1, 1], [1, 1], [np.inf, 3.0]).torque_limit == [1e4, 3.0])
+    assert np.all(_core.ComputedTorque(arm, [1, 1], [1, 1]).torque_limit == np.inf)
+    assert np.all(_core.ComputedTorque(arm, [1, 1], [1, 1], [np.inf, 3.0]).torque_limit == [np.inf, 3.0])
     # an axis of 1e300 is normalised (its norm overflowed to inf, and the axis to zero)
     specs = random_chain_specs(np.random.default_rng(11), "RR")
     big = [dict(s, axis=s["axis"] * 1e300) for s in specs]
@@ -322,6 +326,10 @@ def test_property_reactionless_wrist_tick(wrist_J, D, Dd, Dh, Dn, q0, rk4):
         assert np.array_equal(w.angles, q0) and np.all(c.rates == 0.0)  # held
 
 
+#: a declared input range of the joint controllers (none is the default: issue 37)
+DECLARED = dict(max_position=1e3, max_speed=1e2, max_acceleration=1e4)
+
+
 def _joint_property(ctl, k_or_none, q, qd, q_des, qd_des, qdd_des, held):
     tau, s = ctl.step(q, qd, q_des, qd_des, qdd_des)
     event(f"status {_core.status_name(s)}")
@@ -342,7 +350,7 @@ def _joint_property(ctl, k_or_none, q, qd, q_des, qd_des, qdd_des, held):
 def test_property_computed_torque_tick(q, qd, q_des, qd_des, qdd_des):
     arm = _core.Arm2DofDynamics(_core.Arm2DofParameters())
     kp, kd = np.array([100.0, 80.0]), np.array([20.0, 15.0])
-    ct = _core.ComputedTorque(arm, kp, kd)  # default torque limit: finite (1e4)
+    ct = _core.ComputedTorque(arm, kp, kd, [1e4, 1e4], **DECLARED)  # declared limits (none by default)
     held, s0 = ct.step([0.1, 0.2], [0.0, 0.0], [0.3, 0.1], [0.0, 0.0], [0.0, 0.0])
     assert s0 == S.ok
     tau, s = _joint_property(ct, None, q, qd, q_des, qd_des, qdd_des, held)
@@ -358,7 +366,7 @@ def test_property_computed_torque_tick(q, qd, q_des, qd_des, qdd_des):
 @given(q=VEC3, qd=VEC3, q_des=VEC3, qd_des=VEC3, qdd_des=VEC3)
 def test_property_decoupled_joint_controller_tick(q, qd, q_des, qd_des, qdd_des):
     k, kp, kd = np.array([1.0, 2.0, 0.5]), np.array([100.0, 120.0, 150.0]), np.array([20.0, 22.0, 25.0])
-    dc = _core.DecoupledJointController(k, kp, kd, [50.0, np.inf, 80.0])
+    dc = _core.DecoupledJointController(k, kp, kd, [50.0, np.inf, 80.0], **DECLARED)
     held, s0 = dc.step([0.1, 0.2, 0.3], np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3))
     assert s0 == S.ok
     tau, s = _joint_property(dc, k, q, qd, q_des, qd_des, qdd_des, held)

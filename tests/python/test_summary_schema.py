@@ -72,9 +72,9 @@ def test_every_builtin_case_run_follows_the_schema(runs):
     kinds = set()
     for name, (path, returned) in runs.items():
         data = assert_valid(path)
-        assert data["schema_version"] == 1 and data["command"] == "run", name
+        assert data["schema_version"] == 2 and data["command"] == "run", name
         assert list(data)[:2] == ["schema_version", "command"], name
-        assert json.loads(json.dumps(returned, default=str))["schema_version"] == 1
+        assert json.loads(json.dumps(returned, default=str))["schema_version"] == 2
         kinds.add(data["kind"])
     assert kinds >= {"serial_chain", "mechanism", "arm2dof", "discs", "orthoglide", "paminsa", "rpsp"}
 

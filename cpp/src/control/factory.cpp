@@ -1,5 +1,6 @@
 #include "mechbal/control/factory.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -31,11 +32,33 @@ Eigen::VectorXd vec(const std::vector<double>& v) {
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 
+/// The torque limit in force per actuated coordinate: the smaller of `[control] torque_limit`
+/// (when given) and the model's declared effort limit; +infinity where neither is declared.
+/// Empty when the table's vector has the wrong size (check_size reports it).
+Eigen::VectorXd torque_limit_in_force(const MechanismModel& model, const ControlConfig& c) {
+  const int n = model.num_actuated();
+  if (!c.torque_limit.empty() && static_cast<int>(c.torque_limit.size()) != n) return vec(c.torque_limit);
+  Eigen::VectorXd limit(n);
+  for (int i = 0; i < n; ++i) {
+    const double declared = model.effort_limits()(model.actuated_coordinates()[static_cast<std::size_t>(i)]);
+    limit(i) = c.torque_limit.empty() ? declared : std::min(c.torque_limit[static_cast<std::size_t>(i)], declared);
+  }
+  return limit;
+}
+
+/// The joint controllers' input range of a `[control]` table: its max_speed (no other bound).
+JointInputRange input_range(const ControlConfig& c) {
+  JointInputRange r;
+  r.max_speed = c.max_speed;
+  return r;
+}
+
 /// ComputedTorque over its own MechanismDynamics (the controller holds a reference to it).
 class OwnedComputedTorque : public JointController {
  public:
   OwnedComputedTorque(const MechanismModel& model, const ControlConfig& c, const Eigen::VectorXd& q_guess)
-      : dynamics_(model, q_guess), controller_(dynamics_, vec(c.kp), vec(c.kd), vec(c.torque_limit)) {}
+      : dynamics_(model, q_guess),
+        controller_(dynamics_, vec(c.kp), vec(c.kd), torque_limit_in_force(model, c), input_range(c)) {}
   int dof() const noexcept override { return controller_.dof(); }
   Status step(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& qd,
               const Eigen::Ref<const Eigen::VectorXd>& q_des, const Eigen::Ref<const Eigen::VectorXd>& qd_des,
@@ -154,6 +177,7 @@ ReactionlessConfig reactionless_config(const ControlConfig& control) {
   c.rate_hz = control.rate_hz;
   c.damping = control.damping;
   c.max_rate = control.max_rate;
+  c.task_range.max_speed = control.max_speed;
   c.home_gain = control.home_gain;
   c.limit_gain = control.limit_gain;
   rename_errors<int>([&] {
@@ -222,7 +246,8 @@ std::unique_ptr<JointController> make_controller(const MechanismModel& model, co
       check_size(control.k, n, "k", true);
       const std::vector<double> k = control.k.empty() ? balanced_diagonal(model, q_guess) : control.k;
       return std::make_unique<DecoupledJointController>(vec(k), vec(control.kp), vec(control.kd),
-                                                        vec(control.torque_limit));
+                                                        torque_limit_in_force(model, control),
+                                                        input_range(control));
     }
     case ControlKind::reactionless: {
       const ReactionlessConfig config = reactionless_config(control);
@@ -242,7 +267,8 @@ std::unique_ptr<JointController> make_controller(const MechanismModel& model, co
       return rename_errors<std::unique_ptr<JointController>>([&]() -> std::unique_ptr<JointController> {
         return std::make_unique<ReactionlessJointController>(std::make_shared<const MechanismModel>(model), config,
                                                              start, vec(control.kp), vec(control.kd),
-                                                             vec(control.torque_limit), JointInputRange{}, q_guess);
+                                                             torque_limit_in_force(model, control),
+                                                             input_range(control), q_guess);
       });
     }
     case ControlKind::passive:

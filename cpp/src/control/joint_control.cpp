@@ -9,14 +9,12 @@ namespace mechbal::detail {
 
 void check_torque_limit(const Eigen::VectorXd& limit, const char* field, Eigen::Index n,
                         Eigen::VectorXd& out) {
-  if (limit.size() == 0) {
-    out = Eigen::VectorXd::Constant(n, default_torque_limit);
+  if (limit.size() == 0) {  // undeclared: no limit
+    out = Eigen::VectorXd::Constant(n, no_limit);
     return;
   }
   check_positive_vector(limit, field, n, true);
   out = limit;
-  for (Eigen::Index i = 0; i < n; ++i)
-    if (std::isinf(out(i))) out(i) = default_torque_limit;
 }
 
 void check_positive_vector(const Eigen::VectorXd& v, const char* field, Eigen::Index n,
@@ -46,9 +44,9 @@ void validate_joint_input_range(const JointInputRange& r, const char* field) {
                                                   {"max_speed", r.max_speed},
                                                   {"max_acceleration", r.max_acceleration}};
   for (const auto& b : bounds) {
-    if (!std::isfinite(b.second) || b.second <= 0.0) {
+    if (std::isnan(b.second) || b.second <= 0.0) {
       std::ostringstream msg;
-      msg << field << "." << b.first << " must be finite and > 0 (got " << b.second << ")";
+      msg << field << "." << b.first << " must be > 0 (+inf: no limit) (got " << b.second << ")";
       throw std::invalid_argument(msg.str());
     }
   }

@@ -50,7 +50,7 @@ void validate_shared_fields(std::uint32_t cancel, double rate_hz, double damping
   if (!(damping > 0.0 && damping < 1.0)) fail("reactionless.damping", "must be in (0, 1)", damping);
   if (!(std::isfinite(max_condition) && max_condition > 1.0))
     fail("reactionless.max_condition", "must be finite and > 1", max_condition);
-  if (!(std::isfinite(max_rate) && max_rate > 0.0)) fail("reactionless.max_rate", "must be finite and > 0", max_rate);
+  if (!(max_rate > 0.0)) fail("reactionless.max_rate", "must be > 0 (+inf: no limit)", max_rate);
 }
 
 /// The smallest and largest eigenvalues of a small symmetric positive semi-definite matrix (at most
@@ -326,17 +326,15 @@ void validate_reactionless_config(const ReactionlessConfig& c) {
   if (c.integrator != ReactionlessIntegrator::euler && c.integrator != ReactionlessIntegrator::rk4)
     fail("reactionless.integrator", "must be euler or rk4", static_cast<double>(c.integrator));
   validate_shared_fields(c.cancel, c.rate_hz, c.damping, c.max_condition, c.max_rate);
-  if (!(std::isfinite(c.max_acceleration) && c.max_acceleration > 0.0))
-    fail("reactionless.max_acceleration", "must be finite and > 0", c.max_acceleration);
+  if (!(c.max_acceleration > 0.0))
+    fail("reactionless.max_acceleration", "must be > 0 (+inf: no limit)", c.max_acceleration);
   if (!(std::isfinite(c.home_gain) && c.home_gain >= 0.0))
     fail("reactionless.home_gain", "must be finite and >= 0", c.home_gain);
   if (!(std::isfinite(c.limit_gain) && c.limit_gain >= 0.0))
     fail("reactionless.limit_gain", "must be finite and >= 0", c.limit_gain);
   if (c.home.size() != 0 && !c.home.allFinite()) fail("reactionless.home must be finite");
-  if (!(std::isfinite(c.max_momentum) && c.max_momentum > 0.0))
-    fail("reactionless.max_momentum", "must be finite and > 0", c.max_momentum);
-  if (!(std::isfinite(c.max_moment) && c.max_moment > 0.0))
-    fail("reactionless.max_moment", "must be finite and > 0", c.max_moment);
+  if (!(c.max_momentum > 0.0)) fail("reactionless.max_momentum", "must be > 0 (+inf: no limit)", c.max_momentum);
+  if (!(c.max_moment > 0.0)) fail("reactionless.max_moment", "must be > 0 (+inf: no limit)", c.max_moment);
   validate_joint_input_range(c.task_range, "reactionless.task_range");
 }
 
@@ -435,7 +433,7 @@ void ReactionlessController::build(const Eigen::VectorXd& q0, const Eigen::Vecto
   upper_.resize(nb_);
   for (int j = 0; j < nb_; ++j) {
     const int c = balancing_coord_[static_cast<std::size_t>(j)];
-    rate_limit_(j) = std::min(config_.max_rate, m.velocity_limits()(c));
+    rate_limit_(j) = config_.velocity_limits ? std::min(config_.max_rate, m.velocity_limits()(c)) : config_.max_rate;
     lower_(j) = m.lower_limits()(c);
     upper_(j) = m.upper_limits()(c);
   }
@@ -1084,10 +1082,9 @@ ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const Mec
     fail("task_rows", "must select at least one of the six twist components (bit mask 1..63)",
          static_cast<double>(config_.task_rows));
   validate_shared_fields(config_.cancel, config_.rate_hz, config_.damping, config_.max_condition, config_.max_rate);
-  if (!(std::isfinite(config_.max_twist) && config_.max_twist > 0.0))
-    fail("max_twist", "must be finite and > 0", config_.max_twist);
-  if (!(std::isfinite(config_.max_twist_rate) && config_.max_twist_rate > 0.0))
-    fail("max_twist_rate", "must be finite and > 0", config_.max_twist_rate);
+  if (!(config_.max_twist > 0.0)) fail("max_twist", "must be > 0 (+inf: no limit)", config_.max_twist);
+  if (!(config_.max_twist_rate > 0.0))
+    fail("max_twist_rate", "must be > 0 (+inf: no limit)", config_.max_twist_rate);
   n_ = m.dof();
   dt_ = 1.0 / config_.rate_hz;
   for (int r = 0; r < 6; ++r) {
@@ -1101,7 +1098,8 @@ ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const Mec
   const int nt = static_cast<int>(task_rows_.size()), k = static_cast<int>(rows_.size());
   for (Eigen::VectorXd* v : {&q_, &q_cmd_, &v_cmd_, &a_cmd_, &zero_, &a0_, &k1_, &k2_, &k3_, &k4_, &q_stage_, &v0_, &z_, &w_})
     *v = Eigen::VectorXd::Zero(n_);
-  rate_limit_ = m.velocity_limits().cwiseMin(config_.max_rate);
+  rate_limit_ = config_.velocity_limits ? Eigen::VectorXd(m.velocity_limits().cwiseMin(config_.max_rate))
+                                        : Eigen::VectorXd(Eigen::VectorXd::Constant(n_, config_.max_rate));
   J_ = Eigen::MatrixXd::Zero(nt, n_);
   Jt_ = Eigen::MatrixXd::Zero(n_, 6);
   JpJ_ = Eigen::MatrixXd::Zero(n_, n_);

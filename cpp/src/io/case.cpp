@@ -1430,7 +1430,8 @@ ControlConfig read_control(const toml::node& n, const MechanismModel& model) {
   const std::vector<std::string> reactionless{"balancing_joints", "cancel", "integrator", "damping",
                                               "max_rate", "home_gain", "limit_gain", "task_frame", "task_rows"};
   const std::vector<std::string> all{"kind", "balancing_joints", "cancel", "integrator", "rate_hz", "damping", "max_rate",
-                               "home_gain", "limit_gain", "task_frame", "task_rows", "kp", "kd", "torque_limit", "k"};
+                               "home_gain", "limit_gain", "task_frame", "task_rows", "kp", "kd", "torque_limit", "k",
+                                     "max_speed", "tolerance"};
   allow_keys(t, f, all);
   ControlConfig c;
   // the table's own fields (types, ranges), in the Python model's order
@@ -1473,6 +1474,17 @@ ControlConfig read_control(const toml::node& n, const MechanismModel& model) {
   const char* per_joint_keys[] = {"kp", "kd", "torque_limit", "k"};
   for (std::size_t i = 0; i < per_joint.size(); ++i) {
     if (auto x = get(t, per_joint_keys[i])) *per_joint[i] = numbers(*x, join(f, per_joint_keys[i]), kMaxJoints, 0.0, Lo::gt);
+  }
+  if (auto x = get(t, "max_speed")) c.max_speed = number(*x, join(f, "max_speed"), 0.0, kMaxAbs, Lo::gt);
+  if (auto x = get(t, "tolerance")) {
+    const std::string ft = join(f, "tolerance");
+    const auto& tt = table_of(*x, ft);
+    allow_keys(tt, ft, {"residual", "floor", "position", "orientation", "joint"});
+    const std::pair<const char*, double*> keys[] = {
+        {"residual", &c.tolerance.residual}, {"floor", &c.tolerance.floor}, {"position", &c.tolerance.position},
+        {"orientation", &c.tolerance.orientation}, {"joint", &c.tolerance.joint}};
+    for (const auto& k : keys)
+      if (auto y = get(tt, k.first)) *k.second = number(*y, join(ft, k.first), 0.0, kMaxAbs, Lo::gt);
   }
   // the table's own rules across its fields (schema.Control._rules)
   if (c.kind == ControlKind::passive) {  // no controller: only the tick rate of the log

@@ -56,11 +56,16 @@ def available() -> list[tuple[str, str, str]]:
     return out
 
 
-def run_case(name_or_path: str | Path, out: str | Path, *, animate: bool = False, **trajectory) -> dict:
+def run_case(name_or_path: str | Path, out: str | Path, *, animate: bool = False, fit_duration: bool = False,
+             allow_degraded: bool = False, **trajectory) -> dict:
     """Run a built-in case (by name), a TOML case file or a URDF file into the folder ``out``;
     returns the summary. ``trajectory``: ``duration`` and ``samples`` of a URDF file's default
     trajectory (see `mechbal.cases.urdf_robot`). ``animate``: also write
     ``animation_<variant>.gif`` beside every ``bodies_<variant>.npz`` (`mechbal.animation`).
+    A case with a reactionless ``[control]`` is checked for feasibility first: a motion the
+    declared limits cannot follow raises `mechbal.verdict.ControlInfeasible` before anything
+    runs, unless ``fit_duration`` (run it at the shortest feasible duration) or
+    ``allow_degraded`` (run it anyway; its verdict says why it failed).
 
     Raises `mechbal.output.OutputError` (bad ``out``) and `ConfigError` before any
     computation; whatever a runner raises leaves ``out`` as it was."""
@@ -93,12 +98,18 @@ def run_case(name_or_path: str | Path, out: str | Path, *, animate: bool = False
     if kind not in _RUNNERS:
         raise ConfigError("case.kind", f"unknown kind (known: {', '.join(sorted(_RUNNERS))})", kind)
     stages = _STAGES.get(kind)
-    with staged_output(out) as tmp, progress.run_bar(name, None if stages is None else stages + animate):
-        summary = _RUNNERS[kind](config, tmp)
-        if animate:
-            progress.stage("animation")
-            _animate_run(Path(tmp), name)
-        progress.finish()
+    from mechbal.cases.runners import RUN_OPTIONS
+
+    token = RUN_OPTIONS.set({"fit_duration": fit_duration, "allow_degraded": allow_degraded})
+    try:
+        with staged_output(out) as tmp, progress.run_bar(name, None if stages is None else stages + animate):
+            summary = _RUNNERS[kind](config, tmp)
+            if animate:
+                progress.stage("animation")
+                _animate_run(Path(tmp), name)
+            progress.finish()
+    finally:
+        RUN_OPTIONS.reset(token)
     return summary
 
 

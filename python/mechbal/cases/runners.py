@@ -6,6 +6,7 @@ Layer: methods (docs/architecture.md).
 from __future__ import annotations
 
 from pathlib import Path
+from contextvars import ContextVar
 from typing import Callable
 
 Runner = Callable[[dict, Path], dict]
@@ -23,3 +24,9 @@ def register(kind: str, stages: int | None = None) -> Callable[[Runner], Runner]
         return fn
 
     return deco
+
+
+#: options of the current run that are not in the case file (the command line's): ``fit_duration``
+#: (run a reactionless motion the declared limits cannot follow at its shortest feasible
+#: duration) and ``allow_degraded`` (run it anyway); set by `mechbal.cases.run_case`
+RUN_OPTIONS: ContextVar[dict] = ContextVar("mechbal_run_options", default={})

@@ -12,7 +12,7 @@ import numpy as np
 
 from mechbal import control
 import mechbal
-from mechbal import progress, report
+from mechbal import progress, report, verdict
 from mechbal.case import task_end_pose
 from mechbal.cases.runners import register
 from mechbal.config import ConfigError, law_name, trajectory_from_config
@@ -285,8 +285,58 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None
     if ctl.kind != "reactionless":
         raise ConfigError("control.kind", "mechbal run simulates kind 'reactionless' (computed_torque "
                           "and decoupled controllers: mechbal.simulate.closed_loop)", ctl.kind)
+    from mechbal.cases.runners import RUN_OPTIONS
+
+    options = RUN_OPTIONS.get()
+    case, report, fitted = check_feasibility(mech, case, q_guess, fit_duration=options.get("fit_duration", False),
+                                             allow_degraded=options.get("allow_degraded", False))
+    extra = {"feasibility": {**report.summary(), **({"fitted_duration": fitted} if fitted else {})}}
     if ctl.task_frame is not None:
-        return run_task_space(mech, case, out)
+        return run_task_space(mech, case, out, summary_extra=extra)
+    return _run_joint_mode(mech, case, out, q_guess, extra)
+
+
+def feasibility_of(mech: Mechanism, case, q_guess=None):
+    """`mechbal.control.feasibility` of a validated case with a reactionless ``[control]``: its
+    commanded motion (joint mode: the held trajectory; operational-space mode: the frame's path)."""
+    ctl = case.control
+    if ctl.task_frame is not None:
+        check_task_space(mech, case)
+        tr = case.trajectory
+        dt = 1.0 / ctl.rate_hz
+        th = np.arange(2 * int(round(tr.duration / dt)) + 1) * (0.5 * dt)
+        _, _, twist, twist_rate = frame_path(mech, ctl.task_frame, tr.start, tr.end, tr.duration, tr.law, th)
+        motion = control.FrameMotion(np.array(tr.start, float), twist, twist_rate, float(tr.duration))
+        return control.feasibility(mech, ctl, motion)
+    traj, _, _ = held_trajectory(mech, case)
+    return control.feasibility(mech, ctl, traj, q_guess=q_guess)
+
+
+def check_feasibility(mech: Mechanism, case, q_guess=None, *, fit_duration: bool = False,
+                      allow_degraded: bool = False):
+    """(case, report, fitted duration or None): the case's motion checked against the declared
+    limits before the run (`feasibility_of`). Infeasible: with ``fit_duration`` the case with its
+    ``[trajectory] duration`` set to the shortest feasible one (`mechbal.verdict.fitted_duration`;
+    rest-to-rest laws); with ``allow_degraded`` the case as it is (the run's verdict will say why
+    it failed); otherwise `mechbal.verdict.ControlInfeasible`."""
+    report = feasibility_of(mech, case, q_guess)
+    if report.feasible:
+        return case, report, None
+    if fit_duration and np.isfinite(report.min_duration) and case.trajectory.law != "constant_speed":
+        fitted = verdict.fitted_duration(report.min_duration, 1.0 / case.control.rate_hz)
+        refit = case.model_copy(update={"trajectory": case.trajectory.model_copy(update={"duration": fitted})})
+        again = feasibility_of(mech, refit, q_guess)
+        if again.feasible:
+            return refit, again, fitted
+        report = again
+    if allow_degraded:
+        return case, report, None
+    raise verdict.ControlInfeasible(report)
+
+
+def _run_joint_mode(mech: Mechanism, case, out: Path, q_guess, summary_extra: dict) -> dict:
+    ctl = case.control
+    name, title = case.case.name, case.case.title or case.case.name
     names = mech.actuated_names
     traj, balancing, task = held_trajectory(mech, case)
     dt = 1.0 / ctl.rate_hz
@@ -299,16 +349,10 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None
     qu, vu, au, _, _ = mechanism_motion(mech, traj, t, q_guess)
     ctrl = control.ReactionlessController(
         mech, ctl.balancing_joints, cancel=list(ctl.cancel), integrator=ctl.integrator,
-        rate_hz=ctl.rate_hz, damping=ctl.damping, max_rate=ctl.max_rate, home_gain=ctl.home_gain,
-        limit_gain=ctl.limit_gain, q0=qa[0], v0=va[0], q_guess=q_guess)
+        rate_hz=ctl.rate_hz, damping=ctl.damping, home_gain=ctl.home_gain,
+        limit_gain=ctl.limit_gain, q0=qa[0], v0=va[0], q_guess=q_guess, **control.declared_options(ctl))
     r = ctrl.run(np.ascontiguousarray(qa[:, task]), np.ascontiguousarray(va[:, task]),
                  np.ascontiguousarray(aa[:, task]))
-    held = (r.status & np.uint32(int(control.Status.non_finite_input) | int(control.Status.out_of_range)
-                                      | int(control.Status.solver_error))) != 0
-    if np.any(held):
-        k = int(np.argmax(held))
-        raise ConfigError("control", f"the reactionless controller held its command at t = {t[k]:.4g} s "
-                          f"(status {control.status_text(int(r.status[k]))})", has_value=False)
 
     progress.stage("bodies files and plots")
     Fu, Mu = _write_variant(mech, out, "uncontrolled", t, qu, vu, au)
@@ -328,6 +372,16 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None
     progress.stage("summary")
     singular = (r.status & np.uint32(int(control.Status.singular))) != 0
     saturated = (r.status & np.uint32(int(control.Status.saturated))) != 0
+    tol = verdict.tolerance(ctl)
+    limits = verdict.limits_in_force(mech, ctl)
+    v = verdict.Verdict(verdict.goal(kind="reactionless (joint mode)", tol=tol, limits=limits, cancel=list(ctl.cancel)))
+    at_limit = _joint_at_limit(r.v[:, balancing], bnames, limits)
+    v.statuses(r.status, t, who="reactionless controller", joints={"saturated": at_limit} if at_limit else None)
+    demand = summary_extra.get("feasibility", {}).get("peak_velocity")   # unclipped, before the run
+    v.limit(r.v, t, names, "velocity", limits, who="commanded motion", demand=demand)
+    components = verdict.cancelled_components(list(ctl.cancel))
+    residual = v.residual(np.hstack([Fc, Mc]), np.hstack([Fu, Mu]), components, tol,
+                          what="controlled motion (the wrench of the stored poses)")
     summary = {
         "case": name,
         "kind": case.case.kind,
@@ -347,6 +401,10 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None
             "saturated_ticks": int(np.sum(saturated)), "max_condition": float(np.max(r.condition)),
             "peak_balancing_rate": report.peak_abs(r.v[:, balancing]),
         },
+        "cancelled_residual": residual,
+        "shaking_moment_reduction": verdict.moment_reduction(Mu, Mc, list(ctl.cancel)),
+        **summary_extra,
+        **v.summary(),
         "total_mass": mech.total_mass,
         "files": ["bodies_uncontrolled.npz", "bodies_controlled.npz", "shaking_wrench.png",
                   "balancing_joints.png"],
@@ -355,7 +413,24 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None
     print(report.table(
         [["uncontrolled", *report.peak_abs(Mu)], ["controlled", *report.peak_abs(Mc)]],
         ["peak shaking moment about O [N m]", "x", "y", "z"]))
+    out_of_range = int(np.sum((r.status & np.uint32(int(control.Status.out_of_range))) != 0))
+    print(report.table(verdict.goal_rows(v, [["saturated ticks", f"{int(np.sum(saturated))} of {len(t)}"],
+                                             ["out-of-range ticks", f"{out_of_range} of {len(t)}"],
+                                             ["singular ticks", f"{int(np.sum(singular))} of {len(t)}"]]),
+                       ["reactionless control", "value"]))
     return summary
+
+
+def _joint_at_limit(rates, names: list[str], limits: dict) -> str | None:
+    """The joint whose |rate| comes closest to (or reaches) its declared velocity limit."""
+    best, name = -1.0, None
+    for j, n in enumerate(names):
+        lim = limits.get(n, {}).get("velocity")
+        if lim:
+            x = float(np.max(np.abs(rates[:, j]))) / lim
+            if x > best:
+                best, name = x, n
+    return name
 
 
 def _rotation_vector(R: np.ndarray) -> np.ndarray:
@@ -434,7 +509,7 @@ def check_task_space(mech: Mechanism, case) -> None:
                               getattr(tr, key))
 
 
-def run_task_space(mech: Mechanism, case, out: Path) -> dict:
+def run_task_space(mech: Mechanism, case, out: Path, summary_extra: dict | None = None) -> dict:
     """A case whose ``[control]`` names a ``task_frame`` (the operational-space mode,
     `mechbal.control.ReactionlessTaskController`): ``[trajectory]`` is the frame's path,
     from its pose at ``start`` to its pose at ``end`` (joint positions; `frame_path`), and
@@ -464,28 +539,23 @@ def run_task_space(mech: Mechanism, case, out: Path) -> dict:
         try:
             ctrl = control.ReactionlessTaskController(
                 mech, ctl.task_frame, rows, list(ctl.cancel), ctl.integrator, ctl.rate_hz, ctl.damping,
-                null_space=null_space, q0=start, max_rate=ctl.max_rate)
+                null_space=null_space, q0=start, max_rate=control.declared_options(ctl)["max_rate"])
         except ValueError as exc:
             raise ConfigError("control", str(exc), has_value=False) from None
-        r = ctrl.run(twist, twist_rate)
-        held = (r.status & np.uint32(int(control.Status.non_finite_input) | int(control.Status.out_of_range)
-                                          | int(control.Status.solver_error))) != 0
-        if np.any(held):
-            k = int(np.argmax(held))
-            raise ConfigError("control", f"the operational-space controller ({variant}) held its command at "
-                              f"t = {t[k]:.4g} s (status {control.status_text(int(r.status[k]))})",
-                              has_value=False)
-        runs[variant] = r
+        runs[variant] = ctrl.run(twist, twist_rate)
 
     progress.stage("bodies files and plots")
-    wrench, frame_error = {}, {}
+    wrench, frame_error, frame_errors = {}, {}, {}
     for variant, r in runs.items():
         a = _motion_acceleration(t, r.v)
         wrench[variant] = _write_variant(mech, out, variant, t, r.q, r.v, a)
         T = np.asarray(mech.frame_placement(r.q, ctl.task_frame))
         dR = np.einsum("nij,nkj->nik", T[:, :3, :3], rotation[::2])
         angle = np.arccos(np.clip((np.trace(dR, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
-        frame_error[variant] = {"position": float(np.max(np.linalg.norm(T[:, :3, 3] - position[::2], axis=1)))}
+        axes = [i for i, a_ in enumerate("xyz") if any(r_ in ("all", "linear", f"v_{a_}") for r_ in rows)]
+        position_error = np.linalg.norm((T[:, :3, 3] - position[::2])[:, axes], axis=1)
+        frame_errors[variant] = {"position": position_error, "orientation": angle}
+        frame_error[variant] = {"position": float(np.max(position_error)) if axes else 0.0}
         if any(r_ in ("all", "angular") or r_.startswith("w_") for r_ in rows):
             frame_error[variant]["orientation"] = float(np.max(angle))
     (Fu, Mu), (Fc, Mc) = wrench["uncontrolled"], wrench["controlled"]
@@ -510,6 +580,24 @@ def run_task_space(mech: Mechanism, case, out: Path) -> dict:
     # predicted moment
     a_motion = _motion_acceleration(t, rc.v)
     inner = slice(3, -3)
+    tol = verdict.tolerance(ctl)
+    limits = verdict.limits_in_force(mech, ctl, balancing=names)
+    tracked = {"position": f"largest distance of {ctl.task_frame} from its path [m], tracked axes"}
+    if "orientation" in frame_error["controlled"]:
+        tracked["orientation"] = f"largest angle of {ctl.task_frame} from its path [rad]"
+    v = verdict.Verdict(verdict.goal(kind="reactionless (operational-space mode)", tol=tol, limits=limits,
+                                     cancel=list(ctl.cancel), tracking=tracked))
+    at_limit = _joint_at_limit(rc.v, names, limits)
+    v.statuses(rc.status, t, who="operational-space controller",
+               joints={"saturated": at_limit} if at_limit else None)
+    v.limit(rc.v, t, names, "velocity", limits, who="commanded motion",
+            demand=(summary_extra or {}).get("feasibility", {}).get("peak_velocity"))
+    for key, unit in (("position", "m"), ("orientation", "rad")):
+        if key in tracked:
+            v.tracking(frame_errors["controlled"][key], t, tol[key], what=f"{ctl.task_frame} {key}", unit=unit,
+                       key=key)
+    residual = v.residual(np.hstack([Fc, Mc]), np.hstack([Fu, Mu]), verdict.cancelled_components(list(ctl.cancel)),
+                          tol, what="controlled motion (the wrench of the stored poses)")
     summary = {
         "case": name,
         "kind": case.case.kind,
@@ -522,10 +610,10 @@ def run_task_space(mech: Mechanism, case, out: Path) -> dict:
         "variants": ["uncontrolled", "controlled"],
         "peak_shaking_force": {"uncontrolled": report.peak_abs(Fu), "controlled": report.peak_abs(Fc)},
         "peak_shaking_moment": {"uncontrolled": report.peak_abs(Mu), "controlled": report.peak_abs(Mc)},
-        "shaking_moment_reduction": {
-            "peak_norm_without_null_space": peak_u, "peak_norm_with_null_space": peak_c,
-            "ratio": peak_c / peak_u if peak_u > 0 else None,
-            "reduction_pct": 100.0 * (1.0 - peak_c / peak_u) if peak_u > 0 else None},
+        "shaking_moment_reduction": verdict.moment_reduction(Mu, Mc, list(ctl.cancel),
+                                                             ("without_null_space", "with_null_space")),
+        "cancelled_residual": residual,
+        **(summary_extra or {}),
         "control": {
             "kind": ctl.kind, "mode": "operational space (reaction null space)", "task_frame": ctl.task_frame,
             "task_rows": rows, "cancel": list(ctl.cancel), "integrator": ctl.integrator,
@@ -542,6 +630,7 @@ def run_task_space(mech: Mechanism, case, out: Path) -> dict:
                 "meaning": "commanded acceleration feed-forward and its predicted shaking moment against "
                            "the stored motion's (derivative of the integrated rates), away from the ends"},
         },
+        **v.summary(),
         "total_mass": mech.total_mass,
         "files": ["bodies_uncontrolled.npz", "bodies_controlled.npz", "shaking_wrench.png",
                   "balancing_joints.png"],
@@ -550,7 +639,13 @@ def run_task_space(mech: Mechanism, case, out: Path) -> dict:
     print(report.table(
         [["uncontrolled (J^+ x')", *report.peak_abs(Mu), peak_u],
          ["controlled (J^+ x' + N z)", *report.peak_abs(Mc), peak_c]],
-        ["peak shaking moment about O [N m]", "x", "y", "z", "|M|"]))
+        ["peak shaking moment about O [N m]", "x", "y", "z", "|M| (whole moment)"]))
+    print(report.table(verdict.goal_rows(v, [
+        ["saturated ticks", f"{int(np.sum(saturated))} of {len(t)}"],
+        ["out-of-range ticks", f"{int(np.sum((rc.status & np.uint32(int(control.Status.out_of_range))) != 0))} of {len(t)}"],
+        ["singular ticks", f"{int(np.sum(singular))} of {len(t)}"],
+        *[[f"task error: {k}", f"{x:.3g} {'m' if k == 'position' else 'rad'}"]
+          for k, x in frame_error["controlled"].items()]]), ["reactionless control (operational space)", "value"]))
     return summary
 
 

@@ -125,7 +125,7 @@ def to_json(summary: Mapping[str, Any]) -> tuple[str, list[dict]]:
 
 #: the version of summary.json's schema (``mechbal/cases/summary.schema.json``): every file
 #: starts with ``schema_version`` and ``command``
-SUMMARY_SCHEMA_VERSION = 1
+SUMMARY_SCHEMA_VERSION = 2
 SUMMARY_COMMANDS = ("run", "balance", "verify", "sweep", "identify")
 
 

@@ -18,8 +18,8 @@ namespace mechbal {
 
 class ComputedTorque : public JointController {
  public:
-  /// kp, kd: diagonal gains (dof() values each, finite and > 0). torque_limit: empty (every joint
-  /// at default_torque_limit) or dof() values > 0 (+infinity means default_torque_limit): the
+  /// kp, kd: diagonal gains (dof() values each, finite and > 0). torque_limit: empty (no limit)
+  /// or dof() values > 0 (+infinity: no limit on that joint): the
   /// command is clipped to [-limit, limit] and the step returns Status::saturated. range: the
   /// input range of a tick. Throws std::invalid_argument naming the field on bad values. The model
   /// must outlive the controller.

@@ -21,8 +21,8 @@ class DecoupledJointController : public JointController {
   using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_dof, 1>;
 
   /// k: the constant diagonal of the balanced mass matrix (finite, > 0); kp, kd: gains (finite,
-  /// > 0); torque_limit: empty (every joint at default_torque_limit) or one value > 0 per joint
-  /// (+infinity means default_torque_limit), the command is clipped and step() returns
+  /// > 0); torque_limit: empty (no limit) or one value > 0 per joint
+  /// (+infinity: no limit on that joint), the command is clipped and step() returns
   /// Status::saturated; range: the input range of a tick. Sizes 1..max_dof, all equal.
   /// Throws std::invalid_argument naming the field and value.
   DecoupledJointController(const Eigen::VectorXd& k, const Eigen::VectorXd& kp,

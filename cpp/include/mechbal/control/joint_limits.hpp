@@ -1,30 +1,33 @@
 #pragma once
 /// \file joint_limits.hpp
 /// Input ranges and torque limits of the joint controllers (ComputedTorque,
-/// DecoupledJointController). Every limit is finite (issue 14: nothing absurd passes as ok): a
-/// tick whose input is outside its range holds the last safe command and returns
-/// Status::out_of_range; a command beyond its torque limit is clipped (Status::saturated).
+/// DecoupledJointController). No hidden limits: every limit is what the user declared (the
+/// model's joint limits, the `[control]` table, a constructor argument); an undeclared limit is
+/// +infinity, i.e. no limit. A tick whose input is outside a declared range holds the last safe
+/// command and returns Status::out_of_range; a command beyond its declared torque limit is
+/// clipped (Status::saturated); without limits only overflow is guarded (non-finite input or
+/// results: the held command and a status).
 #include <Eigen/Core>
+#include <limits>
 
 #include "mechbal/status.hpp"
 
 namespace mechbal {
 
-/// Torque (or force) limit used for every joint when none is configured, and in place of a
-/// configured +infinity [N m or N]: above the peak torque of any joint of an industrial arm.
-constexpr double default_torque_limit = 1e4;
+/// An undeclared limit: no limit.
+constexpr double no_limit = std::numeric_limits<double>::infinity();
 
 /// Input range of a joint controller tick, per component: q and q_des within +-max_position
 /// [rad or m], qd and qd_des within +-max_speed [rad/s or m/s], qdd_des within +-max_acceleration
-/// [rad/s^2 or m/s^2]. Finite and > 0 (checked at construction).
+/// [rad/s^2 or m/s^2]. Each > 0, +infinity (the default) meaning no limit.
 struct JointInputRange {
-  double max_position = 1e3;
-  double max_speed = 1e2;
-  double max_acceleration = 1e4;
+  double max_position = no_limit;
+  double max_speed = no_limit;
+  double max_acceleration = no_limit;
 };
 
 /// Construction time: throws std::invalid_argument naming `field` (e.g. "computed_torque") and
-/// the member when a bound is not finite and > 0.
+/// the member when a bound is NaN or not > 0 (+infinity is allowed: no limit).
 void validate_joint_input_range(const JointInputRange& range, const char* field);
 
 /// Real time: every component of q, q_des within max_position, of qd, qd_des within max_speed, of

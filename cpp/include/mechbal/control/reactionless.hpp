@@ -107,24 +107,29 @@ struct ReactionlessConfig {
   double rate_hz = 1000.0;      ///< tick rate [Hz], in [1, 1e6]
   double damping = 1e-2;        ///< DLS damping relative to sigma_max(S K_b), in (0, 1)
   double max_condition = 1e4;   ///< cond(S K_b) above which the solve is damped (Status::singular)
-  /// |v_b| limit per balancing joint [rad/s or m/s] (finite; the model's velocity limit when
-  /// smaller): the rate vector is scaled down, direction kept, Status::saturated
-  double max_rate = 100.0;
-  /// |a_b| limit of the feed-forward per balancing joint [rad/s^2 or m/s^2] (finite): scaled down,
-  /// Status::saturated; zero when the rates saturated
-  double max_acceleration = 1e4;
+  /// |v_b| limit per balancing joint [rad/s or m/s] (> 0; the model's velocity limit when
+  /// smaller; +infinity, the default: only the model's): the rate vector is scaled down,
+  /// direction kept, Status::saturated
+  double max_rate = no_limit;
+  /// |a_b| limit of the feed-forward per balancing joint [rad/s^2 or m/s^2] (> 0, default
+  /// +infinity: no limit): scaled down, Status::saturated; zero when the rates saturated
+  double max_acceleration = no_limit;
   /// hold the balancing joints (zero rates, Status::saturated) when a tick would take one beyond
   /// the model's position limits
   bool position_limits = true;
+  /// false: the model's declared velocity limits are not applied (only max_rate): the demand
+  /// study of a motion (the rates it needs, mechbal.control.feasibility), not a controller
+  bool velocity_limits = true;
   /// null-space objective (n_b > k): z = -home_gain (q_b - home) - limit_gain * (q_b - mid) / half_range^2
   /// (the second term for joints with finite limits) [1/s]
   double home_gain = 0.0;
   double limit_gain = 0.0;
   Eigen::VectorXd home;  ///< balancing joints' home [rad or m]; empty: their initial positions
-  /// input range of the task joints' q, v, a (every component)
+  /// input range of the task joints' q, v, a (every component; default no limit)
   JointInputRange task_range;
-  double max_momentum = 1e4;  ///< |h*| and |h| input range per component [kg m/s, kg m^2/s]
-  double max_moment = 1e5;    ///< |dh*/dt| per component [N, N m]
+  /// |h*| and |h| input range per component [kg m/s, kg m^2/s] (default +infinity: no limit)
+  double max_momentum = no_limit;
+  double max_moment = no_limit;  ///< |dh*/dt| per component [N, N m] (default no limit)
   LoopSolveOptions loop_options;
 };
 
@@ -373,11 +378,15 @@ struct TaskSpaceConfig {
   double rate_hz = 1000.0;
   double damping = 1e-2;       ///< relative to sigma_max, used when cond exceeds max_condition
   double max_condition = 1e4;
-  double max_rate = 100.0;     ///< per joint [rad/s or m/s]: scaled down, Status::saturated
-  double max_twist = 1e2;      ///< input range of the desired twist (per component)
-  double max_twist_rate = 1e4; ///< input range of the desired twist's rate (per component)
+  /// per joint [rad/s or m/s] (the model's velocity limit when smaller; default +infinity: only
+  /// the model's): scaled down, Status::saturated
+  double max_rate = no_limit;
+  double max_twist = no_limit;       ///< input range of the desired twist (per component)
+  double max_twist_rate = no_limit;  ///< input range of the desired twist's rate (per component)
   /// false: v = J^+ x' only (no null-space term): the reference without the reaction null space
   bool null_space = true;
+  /// false: the model's declared velocity limits are not applied (only max_rate): a demand study
+  bool velocity_limits = true;
 };
 
 class ReactionlessTaskController {

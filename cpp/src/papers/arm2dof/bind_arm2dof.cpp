@@ -216,8 +216,8 @@ void bind_arm2dof(py::module_& m) {
            py::keep_alive<1, 2>(),
            "model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, "
            "MechanismDynamics). torque_limit: one value per joint (default and +inf: "
-           "mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the "
-           "input range of a tick (beyond it: the held command and Status.out_of_range)")
+           "no limit); max_position, max_speed, max_acceleration: the input range of a tick "
+           "(default +inf: no limit; beyond it: the held command and Status.out_of_range)")
       .def_property_readonly("torque_limit", &ComputedTorque::torque_limit)
       .def_property_readonly("dof", &ComputedTorque::dof)
       .def_property_readonly("last_command", &ComputedTorque::last_command);

@@ -14,9 +14,8 @@ namespace mechbal::detail {
 void check_positive_vector(const Eigen::VectorXd& v, const char* field, Eigen::Index n,
                            bool allow_inf);
 
-/// Construction time (throws): the torque limit of n joints into `out`: empty gives
-/// default_torque_limit for every joint, +infinity entries are replaced by it, other entries must
-/// be finite and > 0.
+/// Construction time (throws): the torque limit of n joints into `out`: empty gives +infinity (no
+/// limit) for every joint; otherwise n entries > 0, +infinity meaning no limit.
 void check_torque_limit(const Eigen::VectorXd& limit, const char* field, Eigen::Index n,
                         Eigen::VectorXd& out);
 
