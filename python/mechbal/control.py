@@ -860,10 +860,11 @@ def feasibility(mechanism: Any, control: Any, motion: Any, *, q_guess: npt.Array
         duration = float(motion.duration)
         steps = int(round(duration / dt))
         rows = _ctl(control, "task_rows", ["all"])
-        ctrl = ReactionlessTaskController(mech, frame, rows, cancel, integrator, rate_hz, damping,
-                                          q0=np.asarray(motion.start, float), max_rate=np.inf, velocity_limits=False)
-        r = ctrl.run(motion.twist, motion.twist_rate)
-        q, v, a = r.q, r.v, r.a
+        task_ctrl = ReactionlessTaskController(mech, frame, rows, cancel, integrator, rate_hz, damping,
+                                               q0=np.asarray(motion.start, float), max_rate=np.inf,
+                                               velocity_limits=False)
+        tr = task_ctrl.run(motion.twist, motion.twist_rate)
+        q, v, a = tr.q, tr.v, tr.a
         q_full, v_full, a_full = q, v, a
         balancing = names
     else:
