@@ -233,7 +233,7 @@ def check_case_file(name_or_path: str) -> Path:
     """Path of the case after the checks that the TOML reader does not do: a regular file, not a
     folder, of reasonable size, UTF-8 text, valid TOML of reasonable nesting (raises
     `ConfigError` naming the path)."""
-    from mechbal import _core
+    import mechbal._core as _core
 
     path = case_path(name_or_path)  # ConfigError for an unknown built-in name or a missing file
     if path.suffix.lower() == ".urdf":

@@ -53,7 +53,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from mechbal import _core
+import mechbal._core as _core
 from mechbal._deprecation import DeprecatedAttributes, renamed_kwargs, renamed_method_kwargs
 
 __all__ = [

@@ -33,13 +33,17 @@ from typing import Any, Sequence
 import numpy as np
 import numpy.typing as npt
 
-from mechbal import _core
+import mechbal._core as _core
+from mechbal._core import (  # the description objects of Mechanism.from_description
+    Body, Frame, Joint, JointType, LoopConstraint, LoopType, MechanismDescription, MechanismModel, Spring)
 
 #: what the public methods return: float64 arrays
 FloatArray = npt.NDArray[np.float64]
 
 __all__ = ["Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion",
-           "BatchArray", "UrdfRepairWarning", "urdf_reading", "INERTIAL_PARAMETER_NAMES"]
+           "BatchArray", "UrdfRepairWarning", "urdf_reading", "INERTIAL_PARAMETER_NAMES",
+           "Body", "Frame", "Joint", "JointType", "LoopConstraint", "LoopType", "MechanismDescription",
+           "MechanismModel", "Spring"]
 
 #: The order of a body's 10 inertial parameters in the regressors and
 #: `Mechanism.inertial_parameters` (Pinocchio's): mass, first moments m c, then the inertia about

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-import mechbal
 from mechbal import trajectory
+from mechbal.mechanism import JointType
 from mechbal.cases.runners import register
 from mechbal.config import ConfigError, integer, number, require
 from mechbal.mechanism import Mechanism
@@ -30,7 +30,7 @@ KIND = "urdf"
 DEFAULT_DURATION = 2.0
 DEFAULT_SAMPLES = 501
 #: largest default motion of one joint: revolute [rad], prismatic [m]
-MAX_STEP = {mechbal.JointType.revolute: 0.5, mechbal.JointType.prismatic: 0.1}
+MAX_STEP = {JointType.revolute: 0.5, JointType.prismatic: 0.1}
 
 
 def urdf_case(path: str | Path, duration: float | None = None, samples: int | None = None) -> dict:
