@@ -74,11 +74,16 @@ paminsa_reactionless_run = _core.paminsa_reactionless_run
 wrist_momentum_matrix = _core.wrist_momentum_matrix
 wrist_momentum_bias = _core.wrist_momentum_bias
 
+from mechbal.papers.paminsa.controller import (  # noqa: E402 (the closed-form controllers)
+    PaminsaController, PaminsaRun, ReactionlessWrist, ReactionlessWristConfig, WristCommand, WristIntegrator,
+    WristRun)
+
 __all__ = ["PaminsaParameters", "parameters_from_config", "PaminsaCounterweights", "PaminsaModel", "paminsa_kinematics", "paminsa_reactionless_run", "wrist_momentum_matrix", "wrist_momentum_bias",
            "paminsa_mechanism", "paminsa_layout", "paminsa_initial_guess", "paminsa_actuated_motion",
            "paminsa_case_toml", "ACTUATED", "body_names", "CounterweightSet", "closed_form_counterweights",
            "printed_counterweights", "reported_counterweights", "counterweights_from_design",
-           "REPORTED_COUNTERWEIGHTS_KG", "copy_parameters"]
+           "REPORTED_COUNTERWEIGHTS_KG", "copy_parameters", "ReactionlessWrist", "ReactionlessWristConfig",
+           "WristIntegrator", "WristCommand", "WristRun", "PaminsaController", "PaminsaRun"]
 
 #: the paper's actuators: M_1, M_3 (revolute, in-plane), M_v (linear, vertical), then the wrist
 ACTUATED = ("leg1_guide", "leg3_guide", "leg1_slider", "wrist_phi", "wrist_theta", "wrist_psi")
