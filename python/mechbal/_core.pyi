@@ -712,6 +712,61 @@ class TrajectoryConfig:
     @property
     def start(self) -> list[float]:
         ...
+class ComputedTorque(JointController):
+    """
+    Computed-torque control, Arakelian et al. 2011 eqs 2-6, over any inverse-dynamics back end (keeps the model alive)
+    """
+    def __init__(self, model: InverseDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
+        """
+        model: any InverseDynamics back end (MechanismDynamics, KdlChainDynamics, a paper's closed form such as Arm2DofDynamics or FiveBarDynamics). torque_limit: one value per joint (default and +inf: mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range of a tick (beyond it: the held command and Status.out_of_range)
+        """
+    def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
+        """
+        step() with the status as an int (what the Python classes' step wraps in a JointCommand)
+        """
+    def reset(self) -> None:
+        """
+        Forget the held command (zero torque).
+        """
+    @typing.overload
+    def run(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> dict:
+        """
+        N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
+        """
+    @typing.overload
+    def run(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
+        """
+        One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
+        """
+    @typing.overload
+    def step(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step_into(self, q: numpy.typing.NDArray[numpy.float64], v: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], v_des: numpy.typing.NDArray[numpy.float64], a_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+        """
+        The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
+        """
+    @typing.overload
+    def step_into(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @property
+    def dof(self) -> int:
+        ...
+    @property
+    def last_command(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def torque_limit(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
 class PaminsaCounterweights:
     """
     Counterweight masses [kg] of PAMINSA (Briot & Arakelian 2009, eqs 11, 14-16): at_A (CP1), at_F (CP2), at_L (CP3), vertical
@@ -1227,65 +1282,6 @@ class Arm2DofDynamics(InverseDynamics, ForwardDynamics):
     @property
     def lumped(self) -> dict:
         ...
-class ComputedTorque(JointController):
-    """
-    Computed-torque control, Arakelian et al. 2011 eqs 2-6, over any inverse-dynamics back end (keeps the model alive)
-    """
-    @typing.overload
-    def __init__(self, model: InverseDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
-        """
-        model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, MechanismDynamics). torque_limit: one value per joint (default and +inf: mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range of a tick (beyond it: the held command and Status.out_of_range)
-        """
-    @typing.overload
-    def __init__(self, model: FiveBarDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
-        ...
-    def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
-        """
-        step() with the status as an int (what the Python classes' step wraps in a JointCommand)
-        """
-    def reset(self) -> None:
-        """
-        Forget the held command (zero torque).
-        """
-    @typing.overload
-    def run(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> dict:
-        """
-        N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
-        """
-    @typing.overload
-    def run(self, *args, **kwargs) -> typing.Any:
-        """
-        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
-        """
-    @typing.overload
-    def step(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
-        """
-        One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
-        """
-    @typing.overload
-    def step(self, *args, **kwargs) -> typing.Any:
-        """
-        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
-        """
-    @typing.overload
-    def step_into(self, q: numpy.typing.NDArray[numpy.float64], v: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], v_des: numpy.typing.NDArray[numpy.float64], a_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
-        """
-        The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
-        """
-    @typing.overload
-    def step_into(self, *args, **kwargs) -> typing.Any:
-        """
-        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
-        """
-    @property
-    def dof(self) -> int:
-        ...
-    @property
-    def last_command(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
-    @property
-    def torque_limit(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
 class DecoupledJointController(JointController):
     """
     tau_i = k_i (a_des + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho eqs 15, 26, 36)
@@ -1513,7 +1509,7 @@ class FiveBarParameters:
     @mp2.setter
     def mp2(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
-class FiveBarDynamics:
+class FiveBarDynamics(InverseDynamics):
     """
     Planar 5R by the coupling-matrix method (4x4 A°), evaluated per tick: M'(q), v'(q, qd), g'(q); Status.singular at type-2 singularities
     """
