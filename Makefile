@@ -166,7 +166,6 @@ test-sanitize: $(SAN_BUILD)/build.ninja
 # builds the core and the module only, and runs the Python tests).
 NOPAPERS := build/without-papers
 NOPAPERS_CPP_TESTS ?= ON
-# (the import-linter tests are left out: pyproject.toml's papers-independent contract names the papers)
 NOPAPERS_PYTESTS := tests/python/test_mechanism.py tests/python/test_spec.py tests/python/test_config.py \
                     tests/python/test_simulate.py tests/python/test_loops.py tests/python/test_passive.py \
                     tests/python/test_rnea.py tests/python/test_layers.py
@@ -184,7 +183,7 @@ test-without-papers: | $(VENV)/.stamp-install-test
 	if [ "$(NOPAPERS_CPP_TESTS)" = ON ]; then $(VENV)/bin/ctest --test-dir $(NOPAPERS)/build --output-on-failure -j $(JOBS); fi
 	cp $(NOPAPERS)/build/_core*.so $(NOPAPERS)/src/python/mechbal/
 	cd $(NOPAPERS)/src && PYTHONPATH=$$PWD/python MPLBACKEND=Agg $(abspath $(PY)) -m pytest -q -p no:cacheprovider \
-	  $(NOPAPERS_PYTESTS) -k "not import_linter and not contracts_catch"
+	  $(NOPAPERS_PYTESTS)
 	@echo "    test-without-papers took $$(( $$(date +%s) - $$(cat $(NOPAPERS)/start) )) s"
 
 # ---- embedded: the minimal core (no KDL, no urdfdom: Eigen + toml++ only) and examples/embedded,

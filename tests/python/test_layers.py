@@ -201,6 +201,8 @@ def test_the_contracts_catch_an_upward_import(tmp_path):
         pytest.skip("import-linter is a test dependency: make test installs it")
     import mechbal
 
+    if not (Path(mechbal.__file__).parent / "papers" / "paminsa").is_dir():
+        pytest.skip("the planted import names PAMINSA's package")
     pkg = tmp_path / "mechbal"
     shutil.copytree(Path(mechbal.__file__).parent, pkg, ignore=shutil.ignore_patterns("__pycache__", "*.so"))
     with (pkg / "trajectory.py").open("a") as f:
@@ -209,6 +211,21 @@ def test_the_contracts_catch_an_upward_import(tmp_path):
                        env={**__import__("os").environ, "PYTHONPATH": str(tmp_path)}, timeout=300)
     assert r.returncode != 0
     assert "mechbal.trajectory is not allowed to import mechbal.papers" in r.stdout
+
+
+def test_the_contracts_catch_a_paper_importing_another(tmp_path):
+    exe = shutil.which("lint-imports", path=str(Path(sys.executable).parent)) or shutil.which("lint-imports")
+    if exe is None:
+        pytest.skip("import-linter is a test dependency: make test installs it")
+    if not (ROOT / "python" / "mechbal" / "papers" / "rpsp").is_dir():
+        pytest.skip("the planted import goes into the RPSP paper")
+    shutil.copytree(ROOT / "python" / "mechbal", tmp_path / "mechbal", ignore=shutil.ignore_patterns("__pycache__", "*.so"))
+    with (tmp_path / "mechbal" / "papers" / "rpsp" / "runner.py").open("a") as f:
+        f.write("\n\ndef _planted():\n    from mechbal.papers.discs import coupling  # noqa\n")
+    r = subprocess.run([exe, "--no-cache", str(ROOT / "pyproject.toml")], capture_output=True, text=True, cwd=tmp_path,
+                       env={**__import__("os").environ, "PYTHONPATH": str(tmp_path)}, timeout=300)
+    assert r.returncode != 0
+    assert "mechbal.papers.rpsp is not allowed to import mechbal.papers.discs" in r.stdout, r.stdout[-3000:]
 
 
 _WITHOUT_PAPERS = r"""
