@@ -446,7 +446,9 @@ def paminsa_case_toml(config="paminsa", balanced: bool = True, samples: int = 50
     qa, _, _ = paminsa_actuated_motion(mech, params, ends, np.zeros((2, 3)), np.zeros((2, 3)), still)
     pb = _balanced(params) if balanced else params
     traj = {"law": tr.get("law", "quintic"), "start": qa[0], "end": qa[1], "duration": tr["duration"],
-            "samples": samples, "initial_guess": paminsa_initial_guess(mech, pb, ends[0], wrist)}
+            # a guess the loop solve refines: rounded to 1e-12, so that the last bits of the trigonometry
+            # (which vary with the platform's libm and memory alignment) leave the written file the same
+            "samples": samples, "initial_guess": np.round(paminsa_initial_guess(mech, pb, ends[0], wrist), 12)}
     variant = "balanced: closed-form counterweights and vertical counter-mass" if balanced else "unbalanced"
     name = "paminsa-reactionless" if reactionless else "paminsa-linkage"
     generator = (f'mechbal.papers.paminsa.paminsa_case_toml("{cfg["case"]["name"]}"'
