@@ -26,7 +26,7 @@ print('\n'.join(p['dependencies'] if sys.argv[1] == 'runtime' else p['optional-d
 endef
 say = @printf '\n==> %s\n' $(1)
 
-.PHONY: demo test test-cpp test-python test-sanitize test-embedded bench docs stubs apt apt-test venv install install-test install-docs clean help
+.PHONY: demo test test-cpp test-python test-sanitize test-embedded test-without-papers bench docs stubs apt apt-test venv install install-test install-docs clean help
 
 help:
 	@echo "make demo   - install what is missing, then run 'mechbal demo' (output in out/demo)"
@@ -35,6 +35,8 @@ help:
 	@echo "make test-embedded - cross-build the minimal core + examples/embedded for aarch64, run it under"
 	@echo "             qemu-user on the PAMINSA case and the reaction-wheel arm and compare with the"
 	@echo "             native build (1e-12)"
+	@echo "make test-without-papers - delete every paper (Python, C++, bindings) in a copy of the sources,"
+	@echo "             build the core, its C++ tests and the Python module there, run the general tests"
 	@echo "make bench  - build and run the benchmarks"
 	@echo "make docs   - build the user guide and API reference into build/site (MkDocs, offline)"
 	@echo "make stubs  - regenerate python/mechbal/_core.pyi from the bindings (pybind11-stubgen)"
@@ -155,6 +157,34 @@ test-sanitize: $(SAN_BUILD)/build.ninja
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  $(VENV)/bin/ctest --test-dir $(SAN_BUILD) --output-on-failure -j $(JOBS) \
 	  -E "install_and_consume|embedded_example"
+
+# ---- without papers: a paper is deleted by deleting its folders (python/mechbal/papers/<paper>,
+# cpp/include/mechbal/papers, cpp/src/papers, bindings/papers). A copy of the sources (tracked and
+# new files) with every paper deleted is built (core, C++ tests and the Python module, in one CMake
+# build: MECHBAL_WITH_PAPERS defaults to OFF there), then its general C++ tests and the general
+# Python tests run on it. A full build of its own: not part of `make test` (NOPAPERS_CPP_TESTS=OFF
+# builds the core and the module only, and runs the Python tests).
+NOPAPERS := build/without-papers
+NOPAPERS_CPP_TESTS ?= ON
+NOPAPERS_PYTESTS := tests/python/test_mechanism.py tests/python/test_spec.py tests/python/test_config.py \
+                    tests/python/test_simulate.py tests/python/test_loops.py tests/python/test_passive.py \
+                    tests/python/test_rnea.py tests/python/test_layers.py
+test-without-papers: | $(VENV)/.stamp-install-test
+	@start=$$(date +%s); rm -rf $(NOPAPERS)/src && mkdir -p $(NOPAPERS)/src && \
+	git ls-files --cached --others --exclude-standard | grep -vE '^(cpp/include/mechbal/papers|cpp/src/papers|bindings/papers|python/mechbal/papers/[^_/][^/]*)/' \
+	  | while IFS= read -r f; do [ -e "$$f" ] && printf '%s\n' "$$f"; done | tar -cf - -T - | tar -xf - -C $(NOPAPERS)/src && \
+	echo "$$start" > $(NOPAPERS)/start
+	$(call say,"Building the sources without any paper ($(NOPAPERS)/src) with $(JOBS) jobs")
+	$(VENV)/bin/cmake -S $(NOPAPERS)/src -B $(NOPAPERS)/build -G Ninja -DCMAKE_BUILD_TYPE=Release \
+	  -DCMAKE_MAKE_PROGRAM=$(abspath $(VENV)/bin/ninja) -DMECHBAL_BUILD_TESTS=$(NOPAPERS_CPP_TESTS) \
+	  -DMECHBAL_BUILD_PYTHON=ON -DPython_EXECUTABLE=$(abspath $(PY)) >/dev/null
+	@grep -q "MECHBAL_WITH_PAPERS:BOOL=OFF" $(NOPAPERS)/build/CMakeCache.txt || { echo "papers still found"; exit 1; }
+	$(VENV)/bin/cmake --build $(NOPAPERS)/build -j $(JOBS)
+	if [ "$(NOPAPERS_CPP_TESTS)" = ON ]; then $(VENV)/bin/ctest --test-dir $(NOPAPERS)/build --output-on-failure -j $(JOBS); fi
+	cp $(NOPAPERS)/build/_core*.so $(NOPAPERS)/src/python/mechbal/
+	cd $(NOPAPERS)/src && PYTHONPATH=$$PWD/python MPLBACKEND=Agg $(abspath $(PY)) -m pytest -q -p no:cacheprovider \
+	  $(NOPAPERS_PYTESTS)
+	@echo "    test-without-papers took $$(( $$(date +%s) - $$(cat $(NOPAPERS)/start) )) s"
 
 # ---- embedded: the minimal core (no KDL, no urdfdom: Eigen + toml++ only) and examples/embedded,
 # built natively and cross-built for aarch64 (Debian's g++-aarch64-linux-gnu), installed, then the

@@ -1,8 +1,10 @@
 #pragma once
 // PAMINSA on the general model, built in C++ for the benchmarks: the same tree, bodies, frames,
 // gear couplings and loop closures as mechbal.papers.paminsa.paminsa_mechanism (its docstring
-// explains every joint). C++ cannot read the TOML (the Python layer does), so this is a second,
-// direct transcription of that generator from the PaminsaModel's parameters and derived layout;
+// explains every joint). The C++ case reader (mechbal/io/case.hpp) reads the paper's
+// paminsa-linkage.toml as well; this header is a direct transcription of the generator instead, so
+// that the closed form and the general model of a benchmark come from one PaminsaModel's
+// parameters and derived layout (balanced or not, as its counterweights are) with no file to find;
 // bench_loops.cpp checks at setup that it moves exactly as the closed form (every body's momentum
 // and the shaking wrench to 1e-9 relative along the bench trajectory) and aborts otherwise, so the
 // bench cannot time a model that drifted from the Python one.

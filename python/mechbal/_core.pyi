@@ -8,7 +8,7 @@ import collections.abc
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ComputedTorque', 'ControlConfig', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MAX_URDF_BYTES', 'MAX_URDF_DEPTH', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'PassiveController', 'ReactionlessCommand', 'ReactionlessController', 'ReactionlessJointController', 'ReactionlessTaskController', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'Spring', 'Status', 'TimeLaw', 'TrajectoryConfig', 'WristCommand', 'WristIntegrator', 'arm2dof_description', 'case_from_toml', 'load_case_file', 'load_case_trajectory', 'load_mechanism_file', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_toml', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_single_sample', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'read_urdf', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'simulate_passive', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
+__all__: list[str] = ['Arm2DofCounterweights', 'Arm2DofDynamics', 'Arm2DofParameters', 'Body', 'ComputedTorque', 'ControlConfig', 'DecoupledJointController', 'FiveBarDynamics', 'FiveBarParameters', 'ForwardDynamics', 'Frame', 'InverseDynamics', 'Joint', 'JointController', 'JointType', 'KdlChainDynamics', 'LoopConstraint', 'LoopType', 'MAX_URDF_BYTES', 'MAX_URDF_DEPTH', 'MechanismDescription', 'MechanismDynamics', 'MechanismModel', 'PaminsaController', 'PaminsaCounterweights', 'PaminsaModel', 'PaminsaParameters', 'PassiveController', 'ReactionlessCommand', 'ReactionlessController', 'ReactionlessJointController', 'ReactionlessTaskController', 'ReactionlessWrist', 'ReactionlessWristConfig', 'RestToRestTrajectory', 'Spring', 'Status', 'TimeLaw', 'TrajectoryConfig', 'WristCommand', 'WristIntegrator', 'arm2dof_description', 'case_from_toml', 'load_case_file', 'load_case_trajectory', 'load_mechanism_file', 'mechanism_bias_torque', 'mechanism_center_of_mass', 'mechanism_closed_forward_dynamics', 'mechanism_closed_mass_matrix', 'mechanism_closed_motion', 'mechanism_frame_jacobian', 'mechanism_from_toml', 'mechanism_from_urdf', 'mechanism_from_urdf_string', 'mechanism_gravity_regressor', 'mechanism_gravity_torque', 'mechanism_inverse_dynamics', 'mechanism_kinematics', 'mechanism_mass_matrix', 'mechanism_momentum', 'mechanism_momentum_matrix', 'mechanism_momentum_regressor', 'mechanism_shaking_wrench', 'mechanism_single_sample', 'mechanism_springs', 'mechanism_static_torque', 'mechanism_torque_regressor', 'paminsa_kinematics', 'paminsa_reactionless_run', 'pd_error_analytic', 'read_urdf', 'simulate_closed_loop', 'simulate_closed_loop_sampled', 'simulate_computed_torque', 'status_name', 'urdf_description', 'validate_rigid_body', 'wrist_momentum_bias', 'wrist_momentum_matrix']
 class Status:
     """
     Bit flags returned by real-time algorithms
@@ -712,6 +712,61 @@ class TrajectoryConfig:
     @property
     def start(self) -> list[float]:
         ...
+class ComputedTorque(JointController):
+    """
+    Computed-torque control, Arakelian et al. 2011 eqs 2-6, over any inverse-dynamics back end (keeps the model alive)
+    """
+    def __init__(self, model: InverseDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
+        """
+        model: any InverseDynamics back end (MechanismDynamics, KdlChainDynamics, a paper's closed form such as Arm2DofDynamics or FiveBarDynamics). torque_limit: one value per joint (default and +inf: mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range of a tick (beyond it: the held command and Status.out_of_range)
+        """
+    def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
+        """
+        step() with the status as an int (what the Python classes' step wraps in a JointCommand)
+        """
+    def reset(self) -> None:
+        """
+        Forget the held command (zero torque).
+        """
+    @typing.overload
+    def run(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> dict:
+        """
+        N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
+        """
+    @typing.overload
+    def run(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
+        """
+        One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
+        """
+    @typing.overload
+    def step(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @typing.overload
+    def step_into(self, q: numpy.typing.NDArray[numpy.float64], v: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], v_des: numpy.typing.NDArray[numpy.float64], a_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
+        """
+        The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
+        """
+    @typing.overload
+    def step_into(self, *args, **kwargs) -> typing.Any:
+        """
+        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
+        """
+    @property
+    def dof(self) -> int:
+        ...
+    @property
+    def last_command(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def torque_limit(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
 class PaminsaCounterweights:
     """
     Counterweight masses [kg] of PAMINSA (Briot & Arakelian 2009, eqs 11, 14-16): at_A (CP1), at_F (CP2), at_L (CP3), vertical
@@ -1227,72 +1282,13 @@ class Arm2DofDynamics(InverseDynamics, ForwardDynamics):
     @property
     def lumped(self) -> dict:
         ...
-class ComputedTorque(JointController):
-    """
-    Computed-torque control, Arakelian et al. 2011 eqs 2-6, over any inverse-dynamics back end (keeps the model alive)
-    """
-    @typing.overload
-    def __init__(self, model: InverseDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = ..., max_speed: typing.SupportsFloat | typing.SupportsIndex = ..., max_acceleration: typing.SupportsFloat | typing.SupportsIndex = ...) -> None:
-        """
-        model: any InverseDynamics back end (Arm2DofDynamics, KdlChainDynamics, MechanismDynamics). torque_limit: one value per joint (default and +inf: no limit); max_position, max_speed, max_acceleration: the input range of a tick (default +inf: no limit; beyond it: the held command and Status.out_of_range)
-        """
-    @typing.overload
-    def __init__(self, model: FiveBarDynamics, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = ..., max_speed: typing.SupportsFloat | typing.SupportsIndex = ..., max_acceleration: typing.SupportsFloat | typing.SupportsIndex = ...) -> None:
-        ...
-    def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
-        """
-        step() with the status as an int (what the Python classes' step wraps in a JointCommand)
-        """
-    def reset(self) -> None:
-        """
-        Forget the held command (zero torque).
-        """
-    @typing.overload
-    def run(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> dict:
-        """
-        N consecutive ticks in one call: q, v [rad or m, rad/s or m/s], q_des, v_des, a_des, each (N, n) -> {'joint_torque': (N, n) [N m or N], 'status': (N,) per tick}
-        """
-    @typing.overload
-    def run(self, *args, **kwargs) -> typing.Any:
-        """
-        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
-        """
-    @typing.overload
-    def step(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
-        """
-        One tick: (tau, status), tau [N m or N] (n,). Any real array-like input; non-finite or out-of-range input returns the held command and a non-ok status.
-        """
-    @typing.overload
-    def step(self, *args, **kwargs) -> typing.Any:
-        """
-        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
-        """
-    @typing.overload
-    def step_into(self, q: numpy.typing.NDArray[numpy.float64], v: numpy.typing.NDArray[numpy.float64], q_des: numpy.typing.NDArray[numpy.float64], v_des: numpy.typing.NDArray[numpy.float64], a_des: numpy.typing.NDArray[numpy.float64], out: numpy.typing.NDArray[numpy.float64]) -> int:
-        """
-        The fast tick: writes tau [N m or N] into `out` (a preallocated float64 array of n values) and returns the status as an int (0 = ok, bit flags of mechbal.Status). Every argument must be a C-contiguous float64 numpy array of n values; nothing is copied or allocated.
-        """
-    @typing.overload
-    def step_into(self, *args, **kwargs) -> typing.Any:
-        """
-        Deprecated keyword names (qd, qd_des, qdd_des: use v, v_des, a_des), for one release
-        """
-    @property
-    def dof(self) -> int:
-        ...
-    @property
-    def last_command(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
-    @property
-    def torque_limit(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
 class DecoupledJointController(JointController):
     """
     tau_i = k_i (a_des + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho eqs 15, 26, 36)
     """
-    def __init__(self, k: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = ..., max_speed: typing.SupportsFloat | typing.SupportsIndex = ..., max_acceleration: typing.SupportsFloat | typing.SupportsIndex = ...) -> None:
+    def __init__(self, k: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, torque_limit: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0) -> None:
         """
-        k, kp, kd: one value per joint; torque_limit: one per joint (default and +inf: no limit); max_position, max_speed, max_acceleration: the input range of a tick (default +inf: no limit; beyond it: the held command and Status.out_of_range)
+        k, kp, kd: one value per joint; torque_limit: one per joint (default and +inf: mechbal default_torque_limit, 1e4); max_position, max_speed, max_acceleration: the input range of a tick (beyond it: the held command and Status.out_of_range)
         """
     def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """
@@ -1513,7 +1509,7 @@ class FiveBarParameters:
     @mp2.setter
     def mp2(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
-class FiveBarDynamics:
+class FiveBarDynamics(InverseDynamics):
     """
     Planar 5R by the coupling-matrix method (4x4 A°), evaluated per tick: M'(q), v'(q, qd), g'(q); Status.singular at type-2 singularities
     """
@@ -1544,7 +1540,7 @@ class ReactionlessTaskController:
     """
     Operational-space reactionless control: a redundant open mechanism follows a desired twist of a frame, v = J^+ x' + N z, with z minimising the selected momentum components in the null space
     """
-    def __init__(self, model: MechanismModel, task_frame: str, task_rows: collections.abc.Sequence[str] = ['all'], cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = ..., null_space: bool = True, q0: typing.Any = None, v0: typing.Any = None, velocity_limits: bool = True) -> None:
+    def __init__(self, model: MechanismModel, task_frame: str, task_rows: collections.abc.Sequence[str] = ['all'], cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, null_space: bool = True, q0: typing.Any = None, v0: typing.Any = None) -> None:
         ...
     def run(self, twist: numpy.typing.ArrayLike, twist_rate: typing.Any = None) -> dict:
         """
@@ -1647,7 +1643,7 @@ class ReactionlessController:
     """
     Reactionless control of any MechanismModel (C++ mechbal::ReactionlessController): balancing joints keep the selected momentum components at their target
     """
-    def __init__(self, model: MechanismModel, balancing_joints: collections.abc.Sequence[str], q0: typing.Any = None, cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = ..., max_acceleration: typing.SupportsFloat | typing.SupportsIndex = ..., position_limits: bool = True, velocity_limits: bool = True, home_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, limit_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, home: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = ..., max_speed: typing.SupportsFloat | typing.SupportsIndex = ..., max_task_acceleration: typing.SupportsFloat | typing.SupportsIndex = ..., v0: typing.Any = None, q_guess: typing.Any = None) -> None:
+    def __init__(self, model: MechanismModel, balancing_joints: collections.abc.Sequence[str], q0: typing.Any = None, cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, position_limits: bool = True, home_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, limit_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, home: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_task_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, v0: typing.Any = None, q_guess: typing.Any = None) -> None:
         """
         q0: the actuated coordinates at the start (default zeros); v0: their rates (default rest)
         """
@@ -1707,7 +1703,7 @@ class ReactionlessJointController(JointController):
     """
     The reactionless controller followed by computed torque over the model: a JointController over the actuated coordinates (the balancing joints' desired entries are ignored)
     """
-    def __init__(self, model: MechanismModel, balancing_joints: collections.abc.Sequence[str], q0: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = ..., max_acceleration: typing.SupportsFloat | typing.SupportsIndex = ..., position_limits: bool = True, velocity_limits: bool = True, home_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, limit_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, home: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = ..., max_speed: typing.SupportsFloat | typing.SupportsIndex = ..., max_task_acceleration: typing.SupportsFloat | typing.SupportsIndex = ..., torque_limit: typing.Any = None, q_guess: typing.Any = None) -> None:
+    def __init__(self, model: MechanismModel, balancing_joints: collections.abc.Sequence[str], q0: numpy.typing.ArrayLike, kp: numpy.typing.ArrayLike, kd: numpy.typing.ArrayLike, cancel: collections.abc.Sequence[str] = ['moment'], integrator: str = 'euler', rate_hz: typing.SupportsFloat | typing.SupportsIndex = 1000.0, damping: typing.SupportsFloat | typing.SupportsIndex = 0.01, max_condition: typing.SupportsFloat | typing.SupportsIndex = 10000.0, max_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, position_limits: bool = True, home_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, limit_gain: typing.SupportsFloat | typing.SupportsIndex = 0.0, home: typing.Any = None, max_position: typing.SupportsFloat | typing.SupportsIndex = 1000.0, max_speed: typing.SupportsFloat | typing.SupportsIndex = 100.0, max_task_acceleration: typing.SupportsFloat | typing.SupportsIndex = 10000.0, torque_limit: typing.Any = None, q_guess: typing.Any = None) -> None:
         ...
     def _tick(self, q: numpy.typing.ArrayLike, v: numpy.typing.ArrayLike, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike) -> tuple:
         """
@@ -1859,10 +1855,6 @@ def simulate_closed_loop(plant: ForwardDynamics, controller: JointController, de
 def simulate_closed_loop_sampled(plant: ForwardDynamics, controller: JointController, q_des: numpy.typing.ArrayLike, v_des: numpy.typing.ArrayLike, a_des: numpy.typing.ArrayLike, q0: numpy.typing.ArrayLike, v0: numpy.typing.ArrayLike, dt: typing.SupportsFloat | typing.SupportsIndex = 0.001, duration: typing.SupportsFloat | typing.SupportsIndex = 1.0, sampling: str = 'zero_order_hold') -> dict:
     """
     simulate_closed_loop tracking a sampled desired motion: q_des, qd_des, qdd_des each (2 steps + 1, dof), sampled every dt/2 from t = 0 (steps = round(duration / dt)).
-    """
-def simulate_passive(plant: ForwardDynamics, q0: numpy.typing.ArrayLike, v0: numpy.typing.ArrayLike, dt: typing.SupportsFloat | typing.SupportsIndex, duration: typing.SupportsFloat | typing.SupportsIndex, lower_limit: numpy.typing.ArrayLike, upper_limit: numpy.typing.ArrayLike) -> dict:
-    """
-    Passive RK4 run of `plant` (any ForwardDynamics) from (q0, v0) with zero effort; lower_limit / upper_limit (dof values each; -inf / inf: no stop on that side) are inelastic stops. Returns a dict: t (N+1,), q, v (N+1, dof), tick_status, steps_completed, stop_ticks (steps that ended on a stop).
     """
 def status_name(status: typing.SupportsInt | typing.SupportsIndex) -> str:
     """

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechbal import _core
+import mechbal._core as _core
 from mechbal.errors import ConfigError
 
 __all__ = ["FourBarLoop", "four_bar_loops", "loop_branches", "assemble", "Assembly", "BRANCHES"]

@@ -485,7 +485,7 @@ def _last_flags(s, func, *, force: bool = False, urdf: bool = False) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from mechbal import __version__
+    from mechbal._core import __version__
 
     p = _Parser(
         prog="mechbal",

@@ -28,7 +28,6 @@ from mechbal.registry import GENERAL_CASES_DIR as CASES_DIR, case_dirs  # noqa: 
 
 
 from mechbal.errors import ConfigError, ConfigWarning, short_repr  # noqa: F401 (re-exported)
-from mechbal.spec import rotation_rpy  # noqa: F401 (re-exported)
 
 _MISSING = object()
 
@@ -77,15 +76,6 @@ def string(value: Any, field: str, choices: tuple[str, ...] | None = None) -> st
     return value
 
 
-def vector(value: Any, field: str, size: int | None = None) -> np.ndarray:
-    """A list of finite numbers, of length ``size`` when given."""
-    if not isinstance(value, (list, tuple)):
-        raise ConfigError(field, "must be a list of numbers", value)
-    if size is not None and len(value) != size:
-        raise ConfigError(field, f"must have {size} values", value)
-    return np.array([number(v, f"{field}[{i}]") for i, v in enumerate(value)], dtype=float)
-
-
 def inertia(value: Any, field: str) -> np.ndarray:
     """An inertia tensor about the centre of mass [kg m^2]: a 3x3 list, three principal moments
     [Ixx, Iyy, Izz], or six values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]. Must be symmetric positive
@@ -102,19 +92,6 @@ def inertia(value: Any, field: str) -> np.ndarray:
         v = ctx.get("value")
         raise ConfigError(field + ctx.get("sub", ""), ctx.get("message", exc.message()),
                           value if v is None else v) from None
-
-
-def transform(value: Any, field: str) -> np.ndarray:
-    """A 4x4 homogeneous transform from ``{xyz = [...], rpy = [...]}`` (both optional)."""
-    if not isinstance(value, Mapping):
-        raise ConfigError(field, "must be a table {xyz = [x, y, z], rpy = [r, p, y]}", value)
-    unknown = set(value) - {"xyz", "rpy"}
-    if unknown:
-        raise ConfigError(field, f"unknown keys {sorted(unknown)}", value)
-    T = np.eye(4)
-    T[:3, 3] = vector(value.get("xyz", [0.0, 0.0, 0.0]), f"{field}.xyz", 3)
-    T[:3, :3] = rotation_rpy(vector(value.get("rpy", [0.0, 0.0, 0.0]), f"{field}.rpy", 3))
-    return T
 
 
 #: refuse case files larger than this (a case is a few kB; anything huge is a mistake)
@@ -233,7 +210,7 @@ def check_case_file(name_or_path: str) -> Path:
     """Path of the case after the checks that the TOML reader does not do: a regular file, not a
     folder, of reasonable size, UTF-8 text, valid TOML of reasonable nesting (raises
     `ConfigError` naming the path)."""
-    from mechbal import _core
+    import mechbal._core as _core
 
     path = case_path(name_or_path)  # ConfigError for an unknown built-in name or a missing file
     if path.suffix.lower() == ".urdf":

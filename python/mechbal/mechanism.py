@@ -28,18 +28,32 @@ import contextvars as _contextvars
 from types import SimpleNamespace as _SimpleNamespace
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Mapping, Sequence, Union, overload
 
 import numpy as np
 import numpy.typing as npt
 
-from mechbal import _core
+import mechbal._core as _core
+from mechbal._core import (  # the description objects of Mechanism.from_description
+    Body, Frame, Joint, JointType, LoopConstraint, LoopType, MechanismDescription, MechanismModel, Spring)
 
 #: what the public methods return: float64 arrays
 FloatArray = npt.NDArray[np.float64]
+#: per-instant statuses of a batch (bit flags of `mechbal.Status`, 0 = ok) and its good rows
+StatusArray = npt.NDArray[np.uint32]
+BoolArray = npt.NDArray[np.bool_]
+
+if TYPE_CHECKING:
+    #: what the overloads call one sample (q of shape (dof,)) and a batch (N, dof): lists, or numpy
+    #: arrays whose shape the type checker knows (np.zeros(n) is 1-D, np.zeros((N, n)) 2-D); an
+    #: array of unknown shape matches both and the result is typed as either
+    Sample = Union[Sequence[float], np.ndarray[tuple[int], np.dtype[Any]]]
+    Samples = Union[Sequence[Sequence[float]], np.ndarray[tuple[int, int], np.dtype[Any]]]
 
 __all__ = ["Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion",
-           "BatchArray", "UrdfRepairWarning", "urdf_reading", "INERTIAL_PARAMETER_NAMES"]
+           "BatchArray", "StatusArray", "BoolArray", "UrdfRepairWarning", "urdf_reading", "INERTIAL_PARAMETER_NAMES",
+           "Body", "Frame", "Joint", "JointType", "LoopConstraint", "LoopType", "MechanismDescription",
+           "MechanismModel", "Spring"]
 
 #: The order of a body's 10 inertial parameters in the regressors and
 #: `Mechanism.inertial_parameters` (Pinocchio's): mass, first moments m c, then the inertia about
@@ -53,9 +67,9 @@ class BatchArray(np.ndarray):
     `mechbal.Status`, 0 = ok); rows whose status is not 0 hold NaN. ``ok`` is the boolean
     mask of the good rows. Slicing or arithmetic gives plain results: read ``status`` first."""
 
-    status: np.ndarray
+    status: StatusArray
 
-    def __new__(cls, values, status):
+    def __new__(cls, values: npt.ArrayLike, status: npt.ArrayLike) -> BatchArray:
         obj = np.asarray(values).view(cls)
         obj.status = np.asarray(status)
         return obj
@@ -72,7 +86,7 @@ class BatchArray(np.ndarray):
         return out[()] if return_scalar else out
 
     @property
-    def ok(self) -> np.ndarray:
+    def ok(self) -> BoolArray:
         """Boolean mask (N,) of the instants whose status is ok."""
         return np.asarray(self.status) == 0
 
@@ -548,6 +562,13 @@ class Mechanism:
         return [BatchArray(result[k], status) for k in keys], status
 
     # ---- algorithms --------------------------------------------------------------------------
+    @overload
+    def inverse_dynamics(self, q: Sample, v: Sample, a: Sample) -> FloatArray: ...
+    @overload
+    def inverse_dynamics(self, q: Samples, v: Samples, a: Samples) -> BatchArray: ...
+    @overload
+    def inverse_dynamics(self, q: npt.ArrayLike, v: npt.ArrayLike, a: npt.ArrayLike) -> FloatArray: ...
+
     def inverse_dynamics(self, q: npt.ArrayLike, v: npt.ArrayLike, a: npt.ArrayLike) -> FloatArray:
         """Joint forces tau = M(q) a + C(q, v) v + G(q) + K(q) [N m or N] (K: the springs' joint
         forces, `spring_torque`), gear couplings projected.
@@ -569,6 +590,13 @@ class Mechanism:
         single, (q,) = self._args(("q",), (q,))
         (M,), _ = self._finish(single, _core.mechanism_mass_matrix(self.model, q), ["mass_matrix"])
         return M
+
+    @overload
+    def gravity_torque(self, q: Sample) -> FloatArray: ...
+    @overload
+    def gravity_torque(self, q: Samples) -> BatchArray: ...
+    @overload
+    def gravity_torque(self, q: npt.ArrayLike) -> FloatArray: ...
 
     def gravity_torque(self, q: npt.ArrayLike) -> FloatArray:
         """Gravity torques G(q): the joint forces that hold the weights still [N m or N]; with
@@ -606,12 +634,26 @@ class Mechanism:
         """Tension at each spring's anchors, count preload / k + K_eq (d - free_length) [N]."""
         return self._springs(q, "spring_tension")
 
-    def spring_energy(self, q: npt.ArrayLike) -> float | FloatArray:
+    @overload
+    def spring_energy(self, q: Sample) -> float: ...
+    @overload
+    def spring_energy(self, q: Samples) -> BatchArray: ...
+    @overload
+    def spring_energy(self, q: npt.ArrayLike) -> float | BatchArray: ...
+
+    def spring_energy(self, q: npt.ArrayLike) -> float | BatchArray:
         """Elastic energy of all springs [J] (zero when each is at its free length): a float, or (N,)."""
         e = self._springs(q, "spring_energy")
         return float(e) if np.ndim(e) == 0 else e
 
-    def potential_energy(self, q: npt.ArrayLike) -> float | FloatArray:
+    @overload
+    def potential_energy(self, q: Sample) -> float: ...
+    @overload
+    def potential_energy(self, q: Samples) -> BatchArray: ...
+    @overload
+    def potential_energy(self, q: npt.ArrayLike) -> float | BatchArray: ...
+
+    def potential_energy(self, q: npt.ArrayLike) -> float | BatchArray:
         """Gravity (-sum m g . c, zero at O) plus springs' energy [J]: constant over the workspace
         exactly when the mechanism is statically balanced. A float, or (N,)."""
         e = self._springs(q, "potential_energy")

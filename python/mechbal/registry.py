@@ -1,9 +1,11 @@
 """Where the papers register what the general code finds by name (core layer).
 
 The general layers (configuration, ``mechbal.cases``, ``mechbal.balance``, ``mechbal.sweep``, the
-command line) never import a paper. Each paper is one package ``mechbal/papers/<paper>/``; this
-module finds those packages by looking in the ``mechbal/papers`` folder (deleting a paper's folder
-removes it, nothing else to edit) and imports each once, on first use. A paper package may hold:
+command line) never import a paper, and neither does this module: the top layer (the root
+package ``mechbal``, a lazy facade above every layer) hands it a *paper source* with
+`set_paper_source`, a function that returns the ``mechbal.papers`` package (which finds its paper
+packages by looking in its own folder, `mechbal.papers.discover`). Deleting a paper's folder removes
+the paper, nothing else to edit. A paper package ``mechbal/papers/<paper>/`` may hold:
 
 * ``cases/*.toml``: its built-in case files (found by name like those of ``mechbal/cases/``);
 * ``sweeps/*.toml``: its built-in sweep files;
@@ -18,13 +20,12 @@ Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
-import importlib
-import importlib.util
 from pathlib import Path
 from types import ModuleType
+from typing import Callable, Protocol
 
 __all__ = ["PAPERS_DIR", "GENERAL_CASES_DIR", "GENERAL_SWEEPS_DIR", "papers", "case_dirs", "sweep_dirs",
-           "paper_modules"]
+           "paper_modules", "set_paper_source", "PaperSource"]
 
 _PACKAGE = Path(__file__).resolve().parent
 #: the folder of the paper packages
@@ -33,7 +34,41 @@ PAPERS_DIR = _PACKAGE / "papers"
 GENERAL_CASES_DIR = _PACKAGE / "cases"
 GENERAL_SWEEPS_DIR = GENERAL_CASES_DIR / "sweeps"
 
+
+class PaperSource(Protocol):
+    """What the top layer registers: the papers, imported, and a submodule of each."""
+
+    def discover(self) -> dict[str, ModuleType]: ...
+
+    def submodules(self, submodule: str) -> list[ModuleType]: ...
+
+
+_source: Callable[[], PaperSource] | None = None
 _papers: dict[str, ModuleType] | None = None
+
+
+def set_paper_source(source: Callable[[], PaperSource] | None) -> None:
+    """Register (or, with None, remove) the function that gives the paper source; called once by
+    the root package. Forgets the papers already found."""
+    global _source, _papers
+    _source, _papers = source, None
+
+
+def papers() -> dict[str, ModuleType]:
+    """Every paper package, imported (and so registered) once: ``{name: module}``; empty when no
+    paper source is registered."""
+    global _papers
+    if _papers is None:
+        _papers = {}  # set first: a paper that asks for the registry while loading sees it
+        if _source is not None:
+            _papers.update(_source().discover())
+    return _papers
+
+
+def paper_modules(submodule: str) -> list[ModuleType]:
+    """The module ``submodule`` (``runner``, ``balance``) of every paper that has one, imported."""
+    papers()
+    return [] if _source is None else _source().submodules(submodule)
 
 
 def _paper_names() -> list[str]:
@@ -41,26 +76,6 @@ def _paper_names() -> list[str]:
         return []
     return sorted(p.name for p in PAPERS_DIR.iterdir()
                   if p.is_dir() and not p.name.startswith(("_", ".")) and (p / "__init__.py").is_file())
-
-
-def papers() -> dict[str, ModuleType]:
-    """Every paper package, imported (and so registered) once: ``{name: module}``."""
-    global _papers
-    if _papers is None:
-        _papers = {}  # set first: a paper that asks for the registry while loading sees it
-        for name in _paper_names():
-            _papers[name] = importlib.import_module(f"mechbal.papers.{name}")
-    return _papers
-
-
-def paper_modules(submodule: str) -> list[ModuleType]:
-    """The module ``submodule`` (``runner``, ``balance``) of every paper that has one, imported."""
-    out = []
-    for name in papers():
-        full = f"mechbal.papers.{name}.{submodule}"
-        if importlib.util.find_spec(full) is not None:
-            out.append(importlib.import_module(full))
-    return out
 
 
 def _dirs(general: Path, sub: str) -> list[Path]:

@@ -139,7 +139,7 @@ def _plant(mechanism_or_plant: Any, q_guess: npt.ArrayLike | None) -> Any:
         guess = np.zeros(model.dof) if q_guess is None else np.asarray(q_guess, dtype=float)
         return MechanismDynamics(model, guess)
     if isinstance(mechanism_or_plant, _core.MechanismModel):
-        return _plant(__import__("mechbal").Mechanism(mechanism_or_plant), q_guess)
+        return _plant(Mechanism(mechanism_or_plant), q_guess)
     if not isinstance(mechanism_or_plant, _core.ForwardDynamics):
         raise TypeError("plant must be a mechbal.Mechanism, a MechanismModel or a forward-dynamics "
                         "plant (MechanismDynamics, Arm2DofDynamics), got "

@@ -33,7 +33,7 @@ from typing import Any, NamedTuple, Protocol, Union, runtime_checkable
 import numpy as np
 import numpy.typing as npt
 
-from mechbal import _core
+import mechbal._core as _core
 from mechbal._deprecation import warn_renamed
 
 __all__ = ["Trajectory", "Motion", "RestToRest", "quintic", "minimum_energy_cubic", "ConstantSpeed", "ViaPoints",

@@ -208,7 +208,9 @@ std::vector<std::string> first_joint_names(const std::vector<std::string>& seeds
 
 TEST(CaseFuzz, TheSeedsAreTheBuiltInCases) {
   const auto seeds = seed_documents();
-  EXPECT_GE(seeds.size(), 8u);
+  // the general built-in cases (six), and the papers' while their folders are there
+  const bool papers = std::filesystem::exists(MECHBAL_SOURCE_DIR "/python/mechbal/papers/paminsa/cases");
+  EXPECT_GE(seeds.size(), papers ? 8u : 6u);
   std::vector<int> actuated;
   const auto names = first_joint_names(seeds, actuated);
   // each seed with each kind of [control] loads

@@ -10,6 +10,7 @@ import pytest
 
 import mechbal
 from mechbal import control, papers, simulate, trajectory
+from mechbal.papers import paminsa
 
 PUBLIC = ["mechbal", "mechbal.mechanism", "mechbal.control", "mechbal.trajectory",
           "mechbal.simulate", "mechbal.assembly", "mechbal.papers", "mechbal.balance"]
@@ -79,8 +80,7 @@ def test_runners_need_nothing_outside_the_public_modules():
     superseded = {"RestToRestTrajectory": trajectory.RestToRest,
                   "simulate_computed_torque": simulate.closed_loop,
                   "simulate_closed_loop": simulate.closed_loop}
-    for cls in (control.ComputedTorque, control.DecoupledJointController, control.ReactionlessWrist,
-                control.PaminsaController):
+    for cls in (control.ComputedTorque, control.DecoupledJointController):
         superseded[cls.__mro__[1].__name__] = cls
     missing = sorted(n for n in used if id(getattr(_core, n)) not in public and n not in superseded)
     assert not missing, f"runners use _core names no public module exports: {missing}"
@@ -196,12 +196,12 @@ def paminsa_platform(steps, dt):
 def test_reactionless_wrist_run_equals_ticks():
     pam = papers.PaminsaModel(papers.PaminsaParameters())
     J = pam.inertia_body[35:38]
-    cfg = control.ReactionlessWristConfig(integrator=control.WristIntegrator.rk4)
+    cfg = paminsa.ReactionlessWristConfig(integrator=paminsa.WristIntegrator.rk4)
     rng = np.random.default_rng(5)
     D = rng.uniform(-0.05, 0.05, (4, 20, 3))
-    w1 = control.ReactionlessWrist(J[0], J[1], J[2], cfg, np.full(3, np.pi / 2), np.zeros(3))
-    w2 = control.ReactionlessWrist(J[0], J[1], J[2], cfg, np.full(3, np.pi / 2), np.zeros(3))
-    w3 = control.ReactionlessWrist(J[0], J[1], J[2], cfg, np.full(3, np.pi / 2), np.zeros(3))
+    w1 = paminsa.ReactionlessWrist(J[0], J[1], J[2], cfg, np.full(3, np.pi / 2), np.zeros(3))
+    w2 = paminsa.ReactionlessWrist(J[0], J[1], J[2], cfg, np.full(3, np.pi / 2), np.zeros(3))
+    w3 = paminsa.ReactionlessWrist(J[0], J[1], J[2], cfg, np.full(3, np.pi / 2), np.zeros(3))
     run = w1.run(*D)
     out = np.zeros((3, 3))
     for k in range(20):
@@ -220,14 +220,14 @@ def test_reactionless_wrist_run_equals_ticks():
 
 def test_paminsa_controller_ticks_equal_its_batch_run():
     pam = papers.PaminsaModel(papers.PaminsaParameters())
-    cfg = control.ReactionlessWristConfig(integrator=control.WristIntegrator.rk4)
+    cfg = paminsa.ReactionlessWristConfig(integrator=paminsa.WristIntegrator.rk4)
     q0 = np.full(3, np.pi / 2)
     steps, dt = 40, 1e-3
     P, Pd, Pdd = paminsa_platform(steps, dt)
-    ctl = control.PaminsaController(pam, cfg, q0)
+    ctl = paminsa.PaminsaController(pam, cfg, q0)
     run = ctl.run(P, Pd, Pdd)
     assert run.shaking_force.shape == (steps + 1, 3) and run.com.shape == (steps + 1, 38, 3)
-    fast = control.PaminsaController(pam, cfg, q0)
+    fast = paminsa.PaminsaController(pam, cfg, q0)
     assert ctl.reset(P[0], q0) == 0 and fast.reset(P[0], q0) == 0
     motion = np.ascontiguousarray(np.stack([P, Pd, Pdd], axis=1))  # (2 steps + 1, 3, 3)
     out = np.zeros((3, 3))

@@ -537,3 +537,21 @@ def test_bad_configurations_are_refused_naming_the_field():
     cfg["parameters"]["d"] = 0.1
     with pytest.raises(ConfigError, match="parallelogram"):
         _RUNNERS["discs"](cfg, None)
+
+
+def test_the_general_computed_torque_runs_over_the_five_bar_closed_form():
+    """FiveBarDynamics is an InverseDynamics back end (its binding adds no constructor to the
+    general ComputedTorque): with zero tracking error the command is the closed form's inverse
+    dynamics of the desired motion."""
+    from mechbal import control
+
+    fb = dz.FiveBarDynamics(dz.FiveBarParameters(
+        a1=0.3, a2=0.25, b1=0.25, b2=0.3, mp1=1.0, mp2=1.0, md1=0.8, md2=0.8, mP=0.5, cp1=0.1,
+        cp2=0.1, cd1=0.1, cd2=0.1, Jp1=0.01, Jp2=0.01, Jd1=0.01, Jd2=0.01))
+    assert isinstance(fb, _core.InverseDynamics)
+    ct = control.ComputedTorque(fb, kp=[100.0, 100.0], kd=[20.0, 20.0])
+    q, v, a = np.array([0.6, 1.9]), np.array([0.3, -0.2]), np.array([1.0, 0.5])
+    cmd = ct.step(q, v, q, v, a)
+    assert cmd.status == 0
+    np.testing.assert_allclose(cmd.joint_torque, fb.inverse_dynamics(q, v, a), rtol=1e-12, atol=1e-12)
+    assert np.abs(cmd.joint_torque).max() > 0.1

@@ -65,7 +65,7 @@ def _paminsa_closed_form(bodies: dict, case_file: Path, integrator: str):
     params = parameters_from_config(cfg)
     model = paper.PaminsaModel(paper.closed_form_counterweights(params).apply(params))
     wrist0 = np.array([case.trajectory.start[names.index(w)] for w in WRIST])
-    ctrl = control.PaminsaController(model, wrist_config_from_config(cfg, integrator), wrist0)
+    ctrl = paper.PaminsaController(model, wrist_config_from_config(cfg, integrator), wrist0)
     return ctrl.run(P, Pd, Pdd), mech
 
 

@@ -82,3 +82,22 @@ def test_the_typed_user_script_runs():
                        capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     assert "sweep rows" in r.stdout
+
+
+def test_mypy_strict_tells_a_batch_from_a_single_sample(tmp_path):
+    """The overloads of Mechanism (issue 38): a batch result is a BatchArray with a typed status,
+    never a float; the checker rejects a script that treats it as one."""
+    need("mypy")
+    script = tmp_path / "wrong.py"
+    script.write_text(
+        "import numpy as np\nimport mechbal\n"
+        "arm = mechbal.Mechanism.from_toml('arm.toml')\n"
+        "poses = np.zeros((4, arm.dof))\n"
+        "batch: float = arm.potential_energy(poses)\n"
+        "single = arm.potential_energy(np.zeros(arm.dof))\n"
+        "single.status\n")
+    r = subprocess.run([sys.executable, "-m", "mypy", "--config-file", str(ROOT / "pyproject.toml"),
+                        "--strict", str(script)], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 1, r.stdout
+    assert 'wrong.py:5: error: Incompatible types in assignment (expression has type "BatchArray"' in r.stdout
+    assert 'wrong.py:7: error: "float" has no attribute "status"' in r.stdout

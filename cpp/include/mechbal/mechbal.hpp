@@ -36,7 +36,6 @@
 #include "mechbal/control/decoupled_control.hpp"
 #include "mechbal/control/passive.hpp"
 #include "mechbal/control/joint_limits.hpp"
-#include "mechbal/papers/paminsa/reactionless_wrist.hpp"
 #include "mechbal/control/closed_loop.hpp"
 #include "mechbal/control/reactionless.hpp"
 #include "mechbal/control/config.hpp"
@@ -46,8 +45,11 @@
 #if MECHBAL_WITH_URDF
 #include "mechbal/io/urdf.hpp"
 #endif
-/// Fast paths of the papers' mechanisms
+/// Fast paths of the papers' mechanisms (a build with MECHBAL_WITH_PAPERS)
+#if MECHBAL_WITH_PAPERS
 #include "mechbal/papers/arm2dof/arm2dof.hpp"
 #include "mechbal/papers/five_bar/coupled_projection.hpp"
 #include "mechbal/papers/five_bar/five_bar.hpp"
 #include "mechbal/papers/paminsa/paminsa.hpp"
+#include "mechbal/papers/paminsa/reactionless_wrist.hpp"
+#endif

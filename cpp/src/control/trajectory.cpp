@@ -42,7 +42,7 @@ RestToRestTrajectory::RestToRestTrajectory(const Eigen::VectorXd& start, const E
     throw std::invalid_argument(msg.str());
   }
   // the peak acceleration (at most 6 |end - start| / T^2, cubic law) must be finite, so that no
-  // evaluate() can overflow (issue 14: a duration of 5e-324 gave infinite rates)
+  // evaluate() can overflow (a duration of 5e-324 gives infinite rates)
   const double stroke = start.size() ? (end - start).cwiseAbs().maxCoeff() : 0.0;
   if (!std::isfinite(stroke) || !std::isfinite(6.0 * stroke / duration / duration)) {
     msg << "trajectory.duration " << duration << " is too short for a stroke of " << stroke

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from mechbal import control
-import mechbal
+from mechbal.mechanism import JointType
 from mechbal import progress, report, verdict
 from mechbal.case import task_end_pose
 from mechbal.cases.runners import register
@@ -171,7 +171,7 @@ def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, 
                                "about O) against the shaking wrench (inertial only): they differ "
                                "by the weight, -m g and -(m c) x g.")
     types = {j.name: j.type for j in mech.model.description.joints}
-    kinds = ["prismatic" if types[n] == mechbal.JointType.prismatic else "revolute" for n in names]
+    kinds = ["prismatic" if types[n] == JointType.prismatic else "revolute" for n in names]
     report.plot_series(out / "joint_torques.png", t, {"general model": torque},
                        [f"{n} ({k})" for n, k in zip(names, kinds)],
                        ["torque [N m]" if k == "revolute" else "force [N]" for k in kinds],

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from mechbal import trajectory
+from mechbal.mechanism import JointType
 from mechbal.cases.runners import register
 from mechbal.config import ConfigError, integer, number, require
 from mechbal.mechanism import Mechanism

@@ -4,8 +4,10 @@ Each package ``mechbal.papers.<paper>`` holds the paper's mechanism as data on t
 (builders of `mechbal.Mechanism`, TOML cases in its ``cases/`` folder), its closed forms (fast
 paths and regression checks of the general algorithms and methods), its case runner
 (``runner.py``) and its ``mechbal balance`` adapter (``balance.py``). General code finds a paper
-only through `mechbal.registry`, never by import, so deleting a paper's folder deletes the
-paper and nothing else (tests/python/test_layers.py checks it).
+only through `mechbal.registry`, never by import: this package finds its papers in its own
+folder (`discover`, `submodules`) and the root package registers it with the registry, so
+deleting a paper's folder deletes the paper and nothing else (tests/python/test_layers.py checks
+it).
 
 * `mechbal.papers.arm2dof`: Arakelian, Le Baron & Mottu 2011, the 2-DOF arm with
   counterweights, computed torque and the RMS-optimal counterweights.
@@ -29,11 +31,38 @@ Layer: papers (docs/architecture.md).
 """
 from __future__ import annotations
 
+import importlib
+import importlib.util
+from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 from mechbal.papers._body_set import shaking_wrench  # deprecated, one release
 
-__all__ = ["shaking_wrench"]
+__all__ = ["shaking_wrench", "discover", "submodules"]
+
+_HERE = Path(__file__).resolve().parent
+
+
+def _names() -> list[str]:
+    return sorted(p.name for p in _HERE.iterdir()
+                  if p.is_dir() and not p.name.startswith(("_", ".")) and (p / "__init__.py").is_file())
+
+
+def discover() -> dict[str, ModuleType]:
+    """Every paper package of this folder, imported (importing one registers its case kinds):
+    ``{name: module}``."""
+    return {name: importlib.import_module(f"{__name__}.{name}") for name in _names()}
+
+
+def submodules(submodule: str) -> list[ModuleType]:
+    """The module ``submodule`` (``runner``, ``balance``) of every paper that has one, imported."""
+    out = []
+    for name in _names():
+        full = f"{__name__}.{name}.{submodule}"
+        if importlib.util.find_spec(full) is not None:
+            out.append(importlib.import_module(full))
+    return out
 
 
 def __getattr__(name: str) -> Any:

@@ -1,5 +1,5 @@
 """Design sweeps at scale: sensitivity, tolerance Monte Carlo and grids over any mechanism, from one
-core to a Dask cluster (issue 16).
+core to a Dask cluster.
 
 Declare the parameters (a path into the mechanism such as ``bodies.counterweight1.mass``,
 ``joints.elbow.placement.xyz[0]``, ``bodies.link2.com[1]``, or a design variable

@@ -33,6 +33,18 @@ def main() -> None:
     tau: npt.NDArray[np.float64] = arm.inverse_dynamics(q, v, a)
     wrench: mechbal.ShakingWrench = arm.shaking_wrench(motion.q, motion.v, motion.a)
     energy = arm.potential_energy(q)
+    # single samples give plain results, batches carry their per-instant status (issue 38)
+    rest = np.zeros(arm.dof)
+    poses = np.zeros((4, arm.dof))
+    e0: float = arm.potential_energy(rest)
+    e1: float = arm.potential_energy([0.3, -0.2])
+    energies: mechbal.BatchArray = arm.potential_energy(poses)
+    flags: npt.NDArray[np.uint32] = energies.status
+    good: npt.NDArray[np.bool_] = energies.ok
+    torques = arm.inverse_dynamics(poses, poses, poses)
+    gravity: npt.NDArray[np.float64] = arm.gravity_torque(rest)
+    print("energy", e0, e1, energies.shape, int(flags.sum()), bool(good.all()), torques.status.shape,
+          torques.ok.all(), gravity.shape)
     M = arm.mass_matrix(q[0])
     print("peak torque", peak(tau), "peak shaking force", peak(wrench.shaking_force),
           "energy span", peak(energy), "M", M.shape)

@@ -37,7 +37,7 @@ void require_mass(double v, const std::string& field) {
 inline double cross2(const Vec2& a, const Vec2& b) noexcept { return a(0) * b(1) - a(1) * b(0); }
 
 /// An angle by its cosine and sine (no atan2 in the tick: every use of an angle is through its
-/// cosine and sine, which the vector gives directly; issue 6), and its first and second derivative.
+/// cosine and sine, which the vector gives directly), and its first and second derivative.
 struct Angle3 {
   double c = 1.0, s = 0.0, d = 0.0, dd = 0.0;
 };
@@ -380,8 +380,8 @@ Status solve_legs(const PaminsaModel& model, const PlatformMotion& pm,
       return Vec2((ec(1) * r0 - ea(1) * r1) * idet, (-ec(0) * r0 + ea(0) * r1) * idet);
     };
     L.E.v = solve2(ea.dot(L.A.v), ec.dot(L.C.v));
-    // guide direction alpha = angle of M_i -> A_i: undefined with A_i on the pivot M_i (issue 14:
-    // angle_of a zero vector gave NaN with Status::ok)
+    // guide direction alpha = angle of M_i -> A_i: undefined with A_i on the pivot M_i (the
+    // angle of a zero vector would be NaN with Status::ok)
     const Vec2 g = Ah - model.guide_pivot()[i];
     const double g2 = g.squaredNorm();
     if (!(g2 > 1e-18)) return Status::singular;
@@ -555,7 +555,7 @@ Status paminsa_kinematics(const PaminsaModel& model, const PlatformMotion& pm,
 namespace {
 
 /// Momenta of the 35 mechanism bodies straight from the leg solution, without forming any body's
-/// state (issue 6). Each leg's in-plane bodies move in the vertical plane X = O + s u + z e_z that
+/// state. Each leg's in-plane bodies move in the vertical plane X = O + s u + z e_z that
 /// turns about e_z at beta_dot (u = (cos b, sin b, 0), n = e_z x u, du/dt = bd n, dn/dt = -bd u):
 ///   V = sd u + s bd n + zd e_z,  A = (sdd - s bd^2) u + (2 sd bd + s bdd) n + zdd e_z,
 ///   (X - O) x V = s^2 bd e_z + (z sd - s zd) n - s z bd u,
@@ -789,8 +789,8 @@ bool PaminsaController::in_range(const PlatformMotion& m) const noexcept {
 }
 
 Status PaminsaController::reset(const PlatformMotion& initial, const Vec3& wrist_angles) noexcept {
-  // everything is computed aside and committed only when the wrist accepts the reset (issue 14:
-  // the workspace was written before the checks)
+  // everything is computed aside and committed only when the wrist accepts the reset (a
+  // rejected reset leaves the workspace as it was)
   if (!finite(initial) || !wrist_angles.allFinite()) return Status::non_finite_input;
   if (!in_range(initial)) return Status::out_of_range;
   PaminsaWorkspace ws;

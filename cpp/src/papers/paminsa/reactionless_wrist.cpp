@@ -24,7 +24,7 @@ inline void cos_sin(const Vec3& q, Vec3& c, Vec3& s) noexcept {
 inline Vec3 cos_of(const Vec3& q) noexcept { return Vec3(std::cos(q(0)), std::cos(q(1)), std::cos(q(2))); }
 inline Vec3 sin_of(const Vec3& q) noexcept { return Vec3(std::sin(q(0)), std::sin(q(1)), std::sin(q(2))); }
 
-/// The wrist at one set of angles, in the frame of link 2 (issue 6: nothing is formed in the base
+/// The wrist at one set of angles, in the frame of link 2 (nothing is formed in the base
 /// frame). With R2 = Rz(phi) Rx(theta): x1 = R2 e_x, z2 = R2 e_z, R2^T e_z = (0, sin th, cos th),
 /// and the link inertias in frame 2 are I1 = Rx^T J1 Rx, I2 = J2, I3 = Rz(psi) J3 Rz(psi)^T, so
 ///     N = R2 N2,  N2 = [I1 ez + (J2 + I3) ez | (J2 + I3) e_x | I3 e_z]   (ez = R2^T e_z)
@@ -102,7 +102,7 @@ struct WristFrame2 {
 /// cos and sin of q0 + delta from those of q0 (the RK4 stages: |delta| = dt |qdot| / 2 or
 /// dt |qdot|, small): for |delta| <= 1/32 the angle-addition formulas with Taylor polynomials of
 /// sin delta, cos delta whose first omitted terms are below 1e-18 relative (exact to rounding,
-/// without the libm calls, issue 6); otherwise libm at q.
+/// without the libm calls); otherwise libm at q.
 inline void sincos_near(double c0, double s0, double delta, double q, double& c,
                         double& s) noexcept {
   if (std::abs(delta) <= 1.0 / 32.0) {
@@ -180,8 +180,8 @@ Vec3 wrist_momentum_bias(const WristInertias& J, const Vec3& q, const Vec3& qd) 
 }
 
 void validate_wrist_config(const ReactionlessWristConfig& c) {
-  // [1, 1e6] Hz: dt = 1/rate_hz finite and a step that is a control tick (issue 14: 5e-324 Hz gave
-  // an infinite step)
+  // [1, 1e6] Hz: dt = 1/rate_hz finite and a step that is a control tick (5e-324 Hz would
+  // give an infinite step)
   if (!(c.rate_hz >= 1.0 && c.rate_hz <= 1e6)) fail("rate_hz", "must be in [1, 1e6] Hz", c.rate_hz);
   if (!std::isfinite(c.max_rate) || c.max_rate <= 0.0) fail("max_rate", "must be finite and > 0", c.max_rate);
   if (!std::isfinite(c.max_acceleration) || c.max_acceleration <= 0.0)
@@ -236,7 +236,7 @@ Status ReactionlessWrist::reset(const Vec3& angles, const Vec3& target_momentum)
 
 Status ReactionlessWrist::solve(const Mat3& N, const Vec3& rhs, Vec3& x, double& condition,
                                 Mat3* inverse) const noexcept {
-  // Fast path (issue 6: a 3x3 JacobiSVD costs ~0.7 us, the whole tick budget): the singular values
+  // Fast path (a 3x3 JacobiSVD costs ~0.7 us, the whole tick budget): the singular values
   // of N are the square roots of the eigenvalues of N^T N, which Eigen gives in closed form; when
   // N is well conditioned the exact solve is the cofactor inverse. The eigenvalues of N^T N lose
   // about cond^2 eps relative accuracy (1e-8 at cond = 1e4), enough to decide well-conditioned
@@ -271,7 +271,7 @@ Status ReactionlessWrist::solve(const Mat3& N, const Vec3& rhs, Vec3& x, double&
     condition = s3 > s1 / huge ? s1 / s3 : huge;
     if (!std::isfinite(condition)) condition = huge;
   }
-  // Singular (issue 14: the former JacobiSVD fallback cost 4-5 us, ten times the tick budget):
+  // Singular (a JacobiSVD fallback costs 4-5 us, ten times the tick budget):
   // damped least squares, x minimises |N x - rhs|^2 + lambda^2 |x|^2 with lambda = damping
   // sigma_max(N), i.e. the 3x3 normal equations (N^T N + lambda^2 1) x = N^T rhs. Their matrix is
   // symmetric positive definite with cond <= 1 + 1/damping^2 (1e4 + 1 by default) whatever N is,
@@ -329,7 +329,7 @@ Status ReactionlessWrist::limit_rate(Vec3& qd) const noexcept {
 
 Status ReactionlessWrist::stage_rates(const Vec3& delta, const Vec3& cos_n, const Vec3& sin_n,
                                       const Vec3& D, Vec3& qd) const noexcept {
-  // An RK4 stage needs the rates only, not cond(N) (issue 6: the closed-form eigenvalues cost as
+  // An RK4 stage needs the rates only, not cond(N) (the closed-form eigenvalues cost as
   // much as the rest of the stage). The decision "well conditioned" must stay the one solve()
   // makes (cond(N) <= max_condition, else damped least squares + Status::singular), so it is
   // taken on an upper bound: cond_2(N) <= |N|_F |N^-1|_F. When the bound is within the limit,
@@ -397,7 +397,7 @@ Status ReactionlessWrist::tick(const Vec3& D_now, const Vec3& D_dot, const Vec3*
   double cond = 1.0, unused = 1.0;
   // N(q_n) is built once (in link 2's frame) for k1 and the feed-forward; cond(N(q_n)), the
   // reported one, comes from solve()'s closed-form eigenvalues; the operator of k1's solve (N's
-  // inverse, or its damped pseudo-inverse at the singularity) is reused for both (issue 6, 14)
+  // inverse, or its damped pseudo-inverse at the singularity) is reused for both
   Vec3 cos_n, sin_n;
   cos_sin(angles_, cos_n, sin_n);
   const WristFrame2 at(inertia_, cos_n, sin_n, diagonal_inertia_);

@@ -74,11 +74,16 @@ paminsa_reactionless_run = _core.paminsa_reactionless_run
 wrist_momentum_matrix = _core.wrist_momentum_matrix
 wrist_momentum_bias = _core.wrist_momentum_bias
 
+from mechbal.papers.paminsa.controller import (  # noqa: E402 (the closed-form controllers)
+    PaminsaController, PaminsaRun, ReactionlessWrist, ReactionlessWristConfig, WristCommand, WristIntegrator,
+    WristRun)
+
 __all__ = ["PaminsaParameters", "parameters_from_config", "PaminsaCounterweights", "PaminsaModel", "paminsa_kinematics", "paminsa_reactionless_run", "wrist_momentum_matrix", "wrist_momentum_bias",
            "paminsa_mechanism", "paminsa_layout", "paminsa_initial_guess", "paminsa_actuated_motion",
            "paminsa_case_toml", "ACTUATED", "body_names", "CounterweightSet", "closed_form_counterweights",
            "printed_counterweights", "reported_counterweights", "counterweights_from_design",
-           "REPORTED_COUNTERWEIGHTS_KG", "copy_parameters"]
+           "REPORTED_COUNTERWEIGHTS_KG", "copy_parameters", "ReactionlessWrist", "ReactionlessWristConfig",
+           "WristIntegrator", "WristCommand", "WristRun", "PaminsaController", "PaminsaRun"]
 
 #: the paper's actuators: M_1, M_3 (revolute, in-plane), M_v (linear, vertical), then the wrist
 ACTUATED = ("leg1_guide", "leg3_guide", "leg1_slider", "wrist_phi", "wrist_theta", "wrist_psi")
@@ -441,7 +446,9 @@ def paminsa_case_toml(config="paminsa", balanced: bool = True, samples: int = 50
     qa, _, _ = paminsa_actuated_motion(mech, params, ends, np.zeros((2, 3)), np.zeros((2, 3)), still)
     pb = _balanced(params) if balanced else params
     traj = {"law": tr.get("law", "quintic"), "start": qa[0], "end": qa[1], "duration": tr["duration"],
-            "samples": samples, "initial_guess": paminsa_initial_guess(mech, pb, ends[0], wrist)}
+            # a guess the loop solve refines: rounded to 1e-12, so that the last bits of the trigonometry
+            # (which vary with the platform's libm and memory alignment) leave the written file the same
+            "samples": samples, "initial_guess": np.round(paminsa_initial_guess(mech, pb, ends[0], wrist), 12)}
     variant = "balanced: closed-form counterweights and vertical counter-mass" if balanced else "unbalanced"
     name = "paminsa-reactionless" if reactionless else "paminsa-linkage"
     generator = (f'mechbal.papers.paminsa.paminsa_case_toml("{cfg["case"]["name"]}"'

@@ -30,7 +30,7 @@ from mechbal.papers import paminsa as paper
 from mechbal.papers.paminsa import parameters_from_config  # noqa: F401 (re-exported)
 
 def wrist_config_from_config(config, integrator: str | None = None):
-    from mechbal.control import ReactionlessWristConfig, WristIntegrator
+    from mechbal.papers.paminsa.controller import ReactionlessWristConfig, WristIntegrator
 
     w = validate_case(config, warn=False).wrist
     try:

@@ -20,7 +20,7 @@ namespace mechbal::pyb {
 namespace {
 
 
-void bind_discs(py::module_& m) {
+void bind_decoupled_control(py::module_& m) {
   py::class_<DecoupledJointController, JointController> dc(
       m, "DecoupledJointController",
       "tau_i = k_i (a_des + Kp e + Kd e') for a dynamically balanced arm (Coutinho & Hess Coelho "
@@ -56,6 +56,6 @@ void bind_discs(py::module_& m) {
 
 }  // namespace
 
-MECHBAL_REGISTER_BINDINGS(50, discs, bind_discs);
+MECHBAL_REGISTER_BINDINGS(50, decoupled_control, bind_decoupled_control);
 
 }  // namespace mechbal::pyb

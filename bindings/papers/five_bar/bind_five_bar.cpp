@@ -6,8 +6,7 @@
 
 #include "array_checks.hpp"
 #include "bindings.hpp"
-#include "controller_step.hpp"
-#include "mechbal/control/computed_torque.hpp"
+#include "mechbal/control/dynamics.hpp"
 #include "mechbal/papers/five_bar/five_bar.hpp"
 
 namespace py = pybind11;
@@ -55,7 +54,8 @@ void bind_five_bar(py::module_& m) {
       .def_readwrite("Jd2", &FiveBarParameters::Jd2)
       .def_readwrite("gravity", &FiveBarParameters::gravity);
 
-  py::class_<FiveBarDynamics>(m, "FiveBarDynamics",
+  // an InverseDynamics back end: the general ComputedTorque accepts it (bind_computed_torque.cpp)
+  py::class_<FiveBarDynamics, InverseDynamics>(m, "FiveBarDynamics",
                               "Planar 5R by the coupling-matrix method (4x4 A°), evaluated per "
                               "tick: M'(q), v'(q, qd), g'(q); Status.singular at type-2 "
                               "singularities")
@@ -165,11 +165,6 @@ void bind_five_bar(py::module_& m) {
           "Joint angles/rates/accelerations (N, 4) in the order (theta1, theta12, theta2, "
           "theta22) and the end effector (y, z) position/velocity/acceleration (N, 2); "
           "status_per_instant (N,) and their OR, status; failed instants give zeros");
-
-  auto ct = py::reinterpret_borrow<py::class_<ComputedTorque>>(m.attr("ComputedTorque"));
-  ct.def(py::init(&make_computed_torque<FiveBarDynamics>), py::arg("model"), py::arg("kp"),
-         py::arg("kd"), py::arg("torque_limit") = py::none(), MECHBAL_JOINT_RANGE_ARGS,
-         py::keep_alive<1, 2>());
 }
 
 }  // namespace

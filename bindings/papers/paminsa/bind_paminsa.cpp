@@ -324,7 +324,7 @@ void bind_paminsa(py::module_& m) {
              const Status s = paminsa_mechanism_kinematics(mo, pm, ws);
              OutArray a = make_array({3, 6, 3});
              for (int i = 0; i < 3; ++i)
-               for (int n = 0; n < 6; ++n)  // zeros when the pose failed (issue 14: was stack garbage)
+               for (int n = 0; n < 6; ++n)  // zeros when the pose failed (never uninitialised memory)
                  Eigen::Map<Eigen::Vector3d>(a.mutable_data(i, n, 0)) =
                      s == Status::ok ? ws.leg_points[i][n] : Vec3::Zero();
              return py::make_tuple(a, s);
