@@ -109,8 +109,23 @@ def run_paper_case(out: Path) -> Path:
     return _save(fig, out / "example_run_paper_case.png")
 
 
+def min_shaking_paminsa(out: Path) -> Path:
+    g = _run("min_shaking_paminsa")
+    rows = g["rows"]
+    labels = [label for label, _, _ in rows]
+    fig, ax = plt.subplots(figsize=SIZE)
+    y = np.arange(len(rows))
+    ax.barh(y - 0.2, [m[0] for _, _, m in rows], 0.4, label="RMS shaking force [N]")
+    ax.barh(y + 0.2, [m[1] for _, _, m in rows], 0.4, label="peak shaking force [N]")
+    ax.set_yticks(y, labels, fontsize=7)
+    ax.invert_yaxis()
+    ax.set(title="PAMINSA: balancing by motion, by mass and by both")
+    ax.legend(fontsize=7)
+    return _save(fig, out / "example_min_shaking_paminsa.png")
+
+
 FIGURES = {f.__name__: f for f in (shaking_wrench_from_urdf, balance_arm, control_against_simulation,
-                                   run_paper_case)}
+                                   run_paper_case, min_shaking_paminsa)}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -305,7 +305,8 @@ def feasibility_of(mech: Mechanism, case, q_guess=None):
         tr = case.trajectory
         dt = 1.0 / ctl.rate_hz
         th = np.arange(2 * int(round(tr.duration / dt)) + 1) * (0.5 * dt)
-        _, _, twist, twist_rate = frame_path(mech, ctl.task_frame, tr.start, tr.end, tr.duration, tr.law, th)
+        _, _, twist, twist_rate = frame_path(mech, ctl.task_frame, tr.start, tr.end, tr.duration, tr.law, th,
+                                             end_pose=task_end_pose(mech, ctl.task_frame, tr))
         motion = control.FrameMotion(np.array(tr.start, float), twist, twist_rate, float(tr.duration))
         return control.feasibility(mech, ctl, motion)
     traj, _, _ = held_trajectory(mech, case)
