@@ -298,18 +298,13 @@ def _skew_mul_sym(g: Graph, p, h):
     return out
 
 
-def mass_matrix(g: Graph, tree: TreeConstants, q):
-    """M(q) (dof x dof values, symmetric) by composite rigid bodies in link frames."""
-    kin = Kinematics(g, tree, q)
+def _composite_bodies(g: Graph, tree: TreeConstants, kin: Kinematics):
+    """Each link's composite body (its subtree) in its own frame: (mass, first moment, inertia
+    about the link's origin), accumulated leaf to root."""
     n = len(tree.links)
-    mass = [0.0] * n
-    h = [None] * n
-    I = [None] * n
-    for i in range(n):
-        link = tree.links[i]
-        mass[i] = link.mass
-        h[i] = [float(x) for x in link.first_moment]
-        I[i] = [[float(x) for x in row] for row in link.inertia_origin]
+    mass: list[Value] = [link.mass for link in tree.links]
+    h: list = [[float(x) for x in link.first_moment] for link in tree.links]
+    I: list = [[[float(x) for x in row] for row in link.inertia_origin] for link in tree.links]
     for i in range(n - 1, 0, -1):
         par = tree.links[i].parent
         R, p = kin.R_local[i], kin.p_local[i]
@@ -323,16 +318,28 @@ def mass_matrix(g: Graph, tree: TreeConstants, q):
                    for c in range(3)] for r in range(3)]
         h[par] = vadd(g, h[par], vadd(g, hR, vscale(g, mass[i], p)))
         mass[par] = g.add(mass[par], mass[i])
+    return mass, h, I
+
+
+def _unit_momentum(g: Graph, link: Link, mass: Value, h, I):
+    """(H about the link's origin, L) of a composite body moving at unit rate of its joint."""
+    axis = [float(x) for x in link.axis]
+    if link.kind == "revolute":
+        return matvec(g, I, axis), cross(g, axis, h)
+    return cross(g, h, axis), vscale(g, mass, axis)
+
+
+def mass_matrix(g: Graph, tree: TreeConstants, q):
+    """M(q) (dof x dof values, symmetric) by composite rigid bodies in link frames."""
+    kin = Kinematics(g, tree, q)
+    n = len(tree.links)
+    mass, h, I = _composite_bodies(g, tree, kin)
     M_joint: dict[tuple[int, int], Value] = {}
     for i in range(1, n):
         link = tree.links[i]
         if link.coordinate < 0:
             continue
-        axis = [float(x) for x in link.axis]
-        if link.kind == "revolute":
-            H, L = matvec(g, I[i], axis), cross(g, axis, h[i])
-        else:
-            H, L = cross(g, h[i], axis), vscale(g, mass[i], axis)
+        H, L = _unit_momentum(g, link, mass[i], h[i], I[i])
         j = i
         while j > 0:
             lj = tree.links[j]
@@ -380,31 +387,13 @@ def momentum_matrix(g: Graph, tree: TreeConstants, q):
     coordinate's subtree moving alone at unit rate, from the composite bodies."""
     kin = Kinematics(g, tree, q)
     n = len(tree.links)
-    mass = [link.mass for link in tree.links]
-    h = [[float(x) for x in link.first_moment] for link in tree.links]
-    I = [[[float(x) for x in row] for row in link.inertia_origin] for link in tree.links]
-    for i in range(n - 1, 0, -1):
-        par = tree.links[i].parent
-        R, p = kin.R_local[i], kin.p_local[i]
-        hR = matvec(g, R, h[i])
-        IR = matmul(g, matmul(g, R, I[i]), transpose(R))
-        pp = dot(g, p, p)
-        shift_h = _skew_mul_sym(g, p, hR)
-        I[par] = [[g.add(I[par][r][c], g.add(IR[r][c], g.add(
-            g.mul(mass[i], g.sub(pp if r == c else 0.0, g.mul(p[r], p[c]))), shift_h[r][c])))
-            for c in range(3)] for r in range(3)]
-        h[par] = vadd(g, h[par], vadd(g, hR, vscale(g, mass[i], p)))
-        mass[par] = g.add(mass[par], mass[i])
+    mass, h, I = _composite_bodies(g, tree, kin)
     A: list[list[Value]] = [[0.0] * tree.dof for _ in range(6)]
     for i in range(1, n):
         link = tree.links[i]
         if link.coordinate < 0:
             continue
-        axis = [float(x) for x in link.axis]
-        if link.kind == "revolute":
-            H, L = matvec(g, I[i], axis), cross(g, axis, h[i])
-        else:
-            H, L = cross(g, h[i], axis), vscale(g, mass[i], axis)
+        H, L = _unit_momentum(g, link, mass[i], h[i], I[i])
         Rw, pw = kin.world(i)
         Lw = matvec(g, Rw, L)
         Hw = vadd(g, matvec(g, Rw, H), cross(g, pw, Lw))
