@@ -192,11 +192,14 @@ test-without-papers: | $(VENV)/.stamp-install-test
 # reactionless controller (with a computed-torque stage) for EMBEDDED_TICKS ticks natively and
 # under qemu-user; each pair of tick traces must agree to 1e-12 of the scale of the torques and of
 # the shaking wrench (force and moment together: the balanced design's shaking force, and the wheel
-# arm's cancelled moment about z, are rounding noise).
+# arm's cancelled moment about z, are rounding noise). The generated variant (generated.cpp: the
+# balanced PAMINSA's generated header, nothing else) runs its closed ticks on the same motion, both
+# builds, against the library's answer (1e-9) and each other (1e-12).
 EMBEDDED_BUILD := build/embedded
 EMBEDDED_TICKS ?= 300
 EMBEDDED_CASE := python/mechbal/papers/paminsa/cases/paminsa-linkage.toml examples/embedded/paminsa-control.toml
 EMBEDDED_WHEEL_CASE := python/mechbal/cases/reaction-wheel-arm.toml examples/embedded/reaction-wheel-control.toml
+EMBEDDED_GENERATED_CASE := python/mechbal/papers/paminsa/cases/paminsa-linkage.toml
 APT_EMBEDDED_PACKAGES := g++-aarch64-linux-gnu qemu-user
 define embedded_build
 	$(VENV)/bin/cmake -S . -B $(EMBEDDED_BUILD)/$(1)/core -G Ninja -DCMAKE_BUILD_TYPE=Release \
@@ -206,11 +209,12 @@ define embedded_build
 	$(VENV)/bin/cmake --install $(EMBEDDED_BUILD)/$(1)/core --prefix $(abspath $(EMBEDDED_BUILD)/$(1)/prefix) >/dev/null
 	$(VENV)/bin/cmake -S examples/embedded -B $(EMBEDDED_BUILD)/$(1)/example -G Ninja \
 	  -DCMAKE_MAKE_PROGRAM=$(abspath $(VENV)/bin/ninja) $(2) \
+	  -DMECHBAL_GENERATED_CASE=$(abspath $(EMBEDDED_GENERATED_CASE)) -DMECHBAL_PYTHON=$(abspath $(PY)) \
 	  -DCMAKE_PREFIX_PATH=$(abspath $(EMBEDDED_BUILD)/$(1)/prefix) >/dev/null
 	$(VENV)/bin/cmake --build $(EMBEDDED_BUILD)/$(1)/example -j $(JOBS)
 endef
 
-test-embedded: | $(VENV)/.stamp-venv
+test-embedded: | $(VENV)/.stamp-install
 	$(call apt_install,$(APT_EMBEDDED_PACKAGES))
 	@start=$$(date +%s); echo "$$start" > $(EMBEDDED_BUILD).start 2>/dev/null || { mkdir -p build; echo "$$start" > $(EMBEDDED_BUILD).start; }
 	$(call say,"Native minimal core (KDL and URDF off) and examples/embedded")
@@ -231,6 +235,15 @@ test-embedded: | $(VENV)/.stamp-venv
 	qemu-aarch64 -L /usr/aarch64-linux-gnu $(EMBEDDED_BUILD)/aarch64/example/mechbal_embedded $(EMBEDDED_WHEEL_CASE) \
 	  --ticks $(EMBEDDED_TICKS) --no-sleep --trace $(EMBEDDED_BUILD)/aarch64-wheel.trace
 	python3 tools/compare_traces.py $(EMBEDDED_BUILD)/native-wheel.trace $(EMBEDDED_BUILD)/aarch64-wheel.trace 1e-12 3,6
+	$(call say,"The generated variant (examples/embedded/generated.cpp, the header of $(EMBEDDED_GENERATED_CASE)): natively and under qemu-aarch64")
+	$(PY) tools/generated_motion.py $(EMBEDDED_GENERATED_CASE) $(EMBEDDED_BUILD)/generated.motion \
+	  $(EMBEDDED_BUILD)/library.trace --ticks $(EMBEDDED_TICKS)
+	$(EMBEDDED_BUILD)/native/example/mechbal_embedded_generated $(EMBEDDED_BUILD)/generated.motion \
+	  --trace $(EMBEDDED_BUILD)/native-generated.trace
+	qemu-aarch64 -L /usr/aarch64-linux-gnu $(EMBEDDED_BUILD)/aarch64/example/mechbal_embedded_generated \
+	  $(EMBEDDED_BUILD)/generated.motion --trace $(EMBEDDED_BUILD)/aarch64-generated.trace
+	python3 tools/compare_traces.py $(EMBEDDED_BUILD)/native-generated.trace $(EMBEDDED_BUILD)/library.trace 1e-9 6,6
+	python3 tools/compare_traces.py $(EMBEDDED_BUILD)/native-generated.trace $(EMBEDDED_BUILD)/aarch64-generated.trace 1e-12 6,6
 	@echo "    test-embedded took $$(( $$(date +%s) - $$(cat $(EMBEDDED_BUILD).start) )) s"
 
 # ---- benchmarks (never part of `make test`; own build dir so test and bench builds don't fight) --

@@ -8,12 +8,18 @@
 //    shaking wrench), on the trajectory and
 //    model of paminsa_general_wrench (bench_loops.cpp), checked at setup against the closed form:
 //    ratio paminsa_generated_over_closed_form.
+//  - four_bar_generated_tick: the generated closed inverse dynamics tick of four_bar_tick's
+//    four-bar (bench/four_bar.toml; warm start moved from the last tick, position solve, v = C v#,
+//    a = C a# + c, tau# = C^T tau) on four_bar_tick's crank motion, checked at setup against the
+//    library's closed_inverse_dynamics on bench_four_bar(): ratio four_bar_generated_over_general.
 #include <algorithm>
 #include <memory>
 
 #include "bench_registry.hpp"
 #include "bench_support.hpp"
+#include "mechbal/algorithm/loops.hpp"
 #include "mechbal/papers/paminsa/paminsa.hpp"
+#include "mechbal_bench_four_bar.hpp"
 #include "mechbal_bench_paminsa.hpp"
 #include "mechbal_bench_panda.hpp"
 #include "paminsa_general.hpp"
@@ -22,6 +28,7 @@
 #include "mechbal_bench_ur5.hpp"
 
 namespace mechbal::bench {
+MechanismModel bench_four_bar();  // bench_loops.cpp
 namespace {
 
 template <int Dof>
@@ -127,10 +134,56 @@ Tick paminsa_generated_case() {
   };
 }
 
+namespace gf = mechbal_generated::mechbal_bench_four_bar;
+
+struct FourBarGeneratedCase {
+  MechanismModel model{bench_four_bar()};
+  MechanismData data{model};
+  std::vector<ActuatedState> in;
+  gf::ClosedState state;
+  double tau[gf::num_actuated];
+  PingPong<1024> order;
+  int status = 0;
+};
+
+Tick four_bar_generated_case() {
+  auto s = std::make_shared<FourBarGeneratedCase>();
+  if (s->model.dof() != gf::dof || s->model.num_actuated() != gf::num_actuated)
+    fail("generated four-bar: not the model of bench_four_bar (dof)", gf::dof);
+  for (int n = 0; n < 1024; ++n) {  // four_bar_tick's motion: the crank swings 1.0 +- 0.4 rad at 2 rad/s
+    const double t = n * 1e-3;
+    s->in.push_back({Eigen::VectorXd::Constant(1, 1.0 + 0.4 * std::sin(2.0 * t)),
+                     Eigen::VectorXd::Constant(1, 0.8 * std::cos(2.0 * t)),
+                     Eigen::VectorXd::Constant(1, -1.6 * std::sin(2.0 * t))});
+  }
+  const double guess[gf::dof] = {1.0, -0.6, 1.75};
+  Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(guess, gf::dof);
+  std::copy(guess, guess + gf::dof, s->state.q);
+  for (int n = 0; n < 256; ++n) {  // the generated tick drives the crank as the library does (1e-9)
+    const ActuatedState& a = s->in[static_cast<std::size_t>(n)];
+    if (gf::closed_inverse_dynamics_tick(s->state, a.q.data(), a.v.data(), a.a.data(), s->tau) != gf::ok)
+      fail("generated four-bar: the closed tick failed on the bench trajectory", n);
+    if (closed_inverse_dynamics(s->model, s->data, a.q, a.v, a.a, q) != Status::ok)
+      fail("four-bar: closed_inverse_dynamics failed", n);
+    const double rel = std::abs(s->tau[0] - s->data.actuated_force[0]) / std::max(1.0, std::abs(s->data.actuated_force[0]));
+    if (!(rel < 1e-9)) fail("generated four-bar != the library's closed inverse dynamics (relative)", rel);
+  }
+  s->state = gf::ClosedState{};
+  std::copy(guess, guess + gf::dof, s->state.q);
+  return [s] {
+    const ActuatedState& a = s->in[s->order.next()];
+    s->status = gf::closed_inverse_dynamics_tick(s->state, a.q.data(), a.v.data(), a.a.data(), s->tau);
+    benchmark::DoNotOptimize(s->status);
+    benchmark::DoNotOptimize(s->tau);
+    benchmark::ClobberMemory();
+  };
+}
+
 }  // namespace
 }  // namespace mechbal::bench
 
 using namespace mechbal::bench;
+MECHBAL_BENCH_CASE(four_bar_generated_tick) { return four_bar_generated_case(); }
 MECHBAL_BENCH_CASE(paminsa_generated_wrench) { return paminsa_generated_case(); }
 MECHBAL_GENERATED_CASES(ur5, mechbal_bench_ur5)
 MECHBAL_GENERATED_CASES(panda, mechbal_bench_panda)

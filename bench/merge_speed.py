@@ -49,6 +49,12 @@ def speed_results(cases, ratio, median, check, loops_extra, interleaved):
     if value is not None:
         ratios["paminsa_generated_over_closed_form"] = value
         targets["paminsa_generated_over_closed_form <= 1"] = check(value, lambda v: v <= 1.0)
+    # the generated four-bar tick (closed inverse dynamics with the warm start) beside the general one
+    value = ratio(cases, "four_bar_tick", "four_bar_generated_tick")
+    if value is not None:
+        ratios["four_bar_general_over_generated"] = value
+        targets["four_bar_generated_tick_median_ns <= 150"] = check(median("four_bar_generated_tick"),
+                                                                    lambda v: v <= 150)
 
     # issue 21's bench: the general reactionless tick beside the same controller over Pinocchio
     for robot in ("wheel", "panda"):

@@ -15,8 +15,11 @@ and fixed joints, gear couplings, springs):
 * ``frame_placements(q, R, p)``: every named frame in O (R column-major, 9 per frame).
 
 With loop closures it adds the loop solve and the closed mechanism's tick: ``loop_residual``,
-``newton_step``, ``closed_projection`` (v = C v#, a = C a# + c), ``closed_motion`` and
-``closed_shaking_wrench`` (bounded Newton from a warm start, with a status). `build`
+``newton_step``, ``closed_projection`` (v = C v#, a = C a# + c), ``closed_evaluate`` and
+``closed_evaluate_forces`` (the closure, the projection and the shaking wrench or the actuated
+forces tau# = C^T tau in one pass), ``closed_motion``, ``closed_shaking_wrench`` and
+``closed_inverse_dynamics`` (bounded Newton from a warm start, with a status), and the ticks
+``closed_tick`` and ``closed_inverse_dynamics_tick`` (warm start moved from the last tick). `build`
 compiles the header into a small shared library with the installed C++ compiler (cached by the
 hash of the generated code) and returns a `GeneratedModule` whose methods mirror `Mechanism`'s,
 for a Python harness that wants the fast path.
@@ -210,24 +213,50 @@ def generate(mechanism, *, name: str | None = None, frames: list[str] | None = N
             return [(f"phi[{i}]", x) for i, x in enumerate(phi)]
 
         def newton_outputs(g, s):
-            new, _ = _tree.newton_step(g, tc, s["q"])
-            return [(f"q_next[{k}]", x) for k, x in zip(tc.passive, new)]
+            new, phi = _tree.newton_step(g, tc, s["q"])
+            return [(f"q_next[{k}]", x) for k, x in zip(tc.passive, new)] + \
+                [(f"phi[{i}]", x) for i, x in enumerate(phi)]
 
         def projection_outputs(g, s):
-            spare = [g.input(f"w{i}") for i in range(n)]
-            v, a = _tree.closed_projection(g, tc, s["q"], s["v_actuated"], s["a_actuated"], spare)
+            v, a = _tree.closed_projection(g, tc, s["q"], s["v_actuated"], s["a_actuated"])
             return [(f"v[{k}]", v[k]) for k in range(n)] + [(f"a[{k}]", a[k]) for k in range(n)]
 
+        def evaluation_outputs(g, s):
+            phi = _tree.loop_residual(g, tc, s["q"])
+            v, a = _tree.closed_projection(g, tc, s["q"], s["v_actuated"], s["a_actuated"])
+            F, M = _tree.shaking_wrench(g, tc, s["q"], v, a)
+            return ([(f"phi[{i}]", x) for i, x in enumerate(phi)] + [(f"v[{k}]", v[k]) for k in range(n)]
+                    + [(f"a[{k}]", a[k]) for k in range(n)] + [(f"force[{i}]", F[i]) for i in range(3)]
+                    + [(f"moment[{i}]", M[i]) for i in range(3)])
+
+        def forces_outputs(g, s):
+            phi = _tree.loop_residual(g, tc, s["q"])
+            v, a = _tree.closed_projection(g, tc, s["q"], s["v_actuated"], s["a_actuated"])
+            tau = _tree.closed_actuated_forces(g, tc, s["q"], v, a)
+            return ([(f"phi[{i}]", x) for i, x in enumerate(phi)] + [(f"v[{k}]", v[k]) for k in range(n)]
+                    + [(f"a[{k}]", a[k]) for k in range(n)] + [(f"tau[{i}]", x) for i, x in enumerate(tau)])
+
+        actuated_sizes = {"v_actuated": na, "a_actuated": na}
         function("void loop_residual(const double* q, double* phi)",
                  "Phi(q): the loop-closure equations (num_equations values).", residual_outputs)
-        function("void newton_step(const double* q, double* q_next)",
+        function("void newton_step(const double* q, double* q_next, double* phi)",
                  "One Gauss-Newton step of the passive coordinates on Phi(q) = 0 (writes only the passive "
-                 "entries of q_next, which may be q).", newton_outputs)
+                 "entries of q_next, which must not be q) and Phi(q), the residual it started from.",
+                 newton_outputs)
         function("void closed_projection(const double* q, const double* v_actuated, const double* a_actuated, "
                  "double* v, double* a)",
                  "At a closed q: v = C v#, a = C a# + c over every coordinate (the coupling-matrix method).",
-                 projection_outputs, ("q", "v_actuated", "a_actuated"),
-                 {"v_actuated": na, "a_actuated": na})
+                 projection_outputs, ("q", "v_actuated", "a_actuated"), actuated_sizes)
+        function("void closed_evaluate(const double* q, const double* v_actuated, const double* a_actuated, "
+                 "double* phi, double* v, double* a, double* force, double* moment)",
+                 "At q, in one pass sharing the kinematics: Phi(q), v = C v#, a = C a# + c and the shaking "
+                 "wrench of (q, v, a) (meaningful when Phi(q) is within the tolerance).",
+                 evaluation_outputs, ("q", "v_actuated", "a_actuated"), actuated_sizes)
+        function("void closed_evaluate_forces(const double* q, const double* v_actuated, "
+                 "const double* a_actuated, double* phi, double* v, double* a, double* tau)",
+                 "At q, in one pass: Phi(q), v = C v#, a = C a# + c and the actuated forces tau# = C^T "
+                 "tau(q, v, a) (gravity and springs included) that drive that motion.",
+                 forces_outputs, ("q", "v_actuated", "a_actuated"), actuated_sizes)
 
     from mechbal._core import __version__ as library_version
     coordinate_lines = "\n".join(f"//   q[{i}] = {c}" for i, c in enumerate(tc.coordinate_names))
@@ -254,12 +283,92 @@ constexpr int dof = {n};
 constexpr int num_frames = {len(frame_names)};
 
 {chr(10).join(bodies)}
-{_closed_driver(tc) if closed else ""}{eigen}
+{_closed_driver(tc) if closed else _computed_torque()}{eigen}
 }}  // namespace {ident}
 }}  // namespace mechbal_generated
 """
     return GeneratedCode(ident, header, n, list(tc.coordinate_names), frame_names, digest, operations,
                          list(tc.actuated) if closed else [], list(tc.passive) if closed else [])
+
+
+def _computed_torque() -> str:
+    """The computed-torque controller of an open tree over the generated inverse dynamics, with
+    the library's semantics (control/computed_torque.hpp): the same checks in the same order, the
+    same status bits, the held command on bad input."""
+    return """/// Status bits of a controller tick, as the library's mechbal::Status.
+enum ControlStatus : unsigned {{
+  control_ok = 0u,
+  non_finite_input = 1u << 0,  ///< an input was NaN or infinite: the held command is returned
+  saturated = 1u << 2,         ///< the command was clipped to torque_limit
+  out_of_range = 1u << 5,      ///< an input beyond the input range, or a command that overflowed
+}};
+
+/// Computed-torque control (tau = M(q) (a_des + kp (q_des - q) + kd (v_des - v)) + C v + G + K)
+/// over the generated inverse dynamics: the library's ComputedTorque for this mechanism. Set kp,
+/// kd (> 0) and, where wanted, torque_limit (+infinity: none) and the input range (+infinity:
+/// none) before the first tick; step() is noexcept, allocation-free and bounded.
+struct ComputedTorque {{
+  double kp[dof];
+  double kd[dof];
+  double torque_limit[dof];
+  double max_position = HUGE_VAL;
+  double max_speed = HUGE_VAL;
+  double max_acceleration = HUGE_VAL;
+  double last_command[dof] = {{}};            ///< held on bad input (zero before the first good tick)
+  double commanded_acceleration[dof] = {{}};  ///< the outer loop's acceleration of the last good tick
+
+  ComputedTorque() noexcept {{
+    for (int i = 0; i < dof; ++i) {{
+      kp[i] = kd[i] = 0.0;
+      torque_limit[i] = HUGE_VAL;
+    }}
+  }}
+
+  unsigned step(const double* q, const double* v, const double* q_des, const double* v_des, const double* a_des,
+                double* tau) noexcept {{
+    bool finite = true;
+    for (int i = 0; i < dof; ++i)
+      finite = finite && std::isfinite(q[i]) && std::isfinite(v[i]) && std::isfinite(q_des[i]) &&
+               std::isfinite(v_des[i]) && std::isfinite(a_des[i]);
+    if (!finite) return hold(tau, non_finite_input);
+    for (int i = 0; i < dof; ++i) {{
+      if (!(std::fabs(q[i]) <= max_position && std::fabs(q_des[i]) <= max_position &&
+            std::fabs(v[i]) <= max_speed && std::fabs(v_des[i]) <= max_speed &&
+            std::fabs(a_des[i]) <= max_acceleration))
+        return hold(tau, out_of_range);
+    }}
+    double a[dof], raw[dof];
+    for (int i = 0; i < dof; ++i) {{
+      a[i] = a_des[i] + kp[i] * (q_des[i] - q[i]) + kd[i] * (v_des[i] - v[i]);
+      if (!std::isfinite(a[i])) return hold(tau, out_of_range);
+    }}
+    for (int i = 0; i < dof; ++i) commanded_acceleration[i] = a[i];
+    inverse_dynamics(q, v, a, raw);
+    for (int i = 0; i < dof; ++i) {{
+      if (!std::isfinite(raw[i])) return hold(tau, out_of_range);
+    }}
+    unsigned status = control_ok;
+    for (int i = 0; i < dof; ++i) {{
+      if (raw[i] > torque_limit[i]) {{
+        raw[i] = torque_limit[i];
+        status = saturated;
+      }} else if (raw[i] < -torque_limit[i]) {{
+        raw[i] = -torque_limit[i];
+        status = saturated;
+      }}
+      last_command[i] = tau[i] = raw[i];
+    }}
+    return status;
+  }}
+
+ private:
+  unsigned hold(double* tau, unsigned status) const noexcept {{
+    for (int i = 0; i < dof; ++i) tau[i] = last_command[i];
+    return status;
+  }}
+}};
+
+""".format()
 
 
 def _closed_driver(tc) -> str:
@@ -279,34 +388,69 @@ constexpr int passive_index[num_passive] = {{{pas}}};
 /// from the warm start: q, v, a are left unchanged); non_finite (a non-finite input or result).
 enum ClosedStatus : int {{ ok = 0, loops_not_closed = 1, non_finite = 2 }};
 
-/// The closed mechanism's motion from its actuated coordinates: q (in: warm start of the passive
-/// coordinates; out: the solution, actuated entries replaced) closes the loops to `tolerance`
-/// (max |Phi|) by at most `max_iterations` Gauss-Newton steps, then v = C v#, a = C a# + c.
-inline int closed_motion(const double* q_actuated, const double* v_actuated, const double* a_actuated,
-                         double* q, double* v, double* a, int max_iterations = 20,
-                         double tolerance = 1e-13) noexcept {{
-  double work[dof];
-  for (int i = 0; i < dof; ++i) work[i] = q[i];
-  for (int i = 0; i < num_actuated; ++i) work[actuated_index[i]] = q_actuated[i];
-  for (int iteration = 0;; ++iteration) {{
-    double phi[num_equations];
-    loop_residual(work, phi);
-    double largest = 0.0;
-    bool finite = true;
-    for (int i = 0; i < num_equations; ++i) {{
-      finite = finite && std::isfinite(phi[i]);
-      largest = std::fabs(phi[i]) > largest ? std::fabs(phi[i]) : largest;
-    }}
-    if (finite && largest <= tolerance) break;
-    if (!finite && iteration == 0) return non_finite;
-    if (iteration == max_iterations || !finite) return loops_not_closed;
-    newton_step(work, work);
+namespace detail {{
+inline bool closed(const double* phi, double tolerance, bool& finite) noexcept {{
+  double largest = 0.0;
+  finite = true;
+  for (int i = 0; i < num_equations; ++i) {{
+    finite = finite && std::isfinite(phi[i]);
+    largest = std::fabs(phi[i]) > largest ? std::fabs(phi[i]) : largest;
   }}
-  double v_out[dof], a_out[dof];
-  closed_projection(work, v_actuated, a_actuated, v_out, a_out);
+  return finite && largest <= tolerance;
+}}
+
+/// The shaking wrench or the actuated forces, evaluated with the closure (closed_evaluate*).
+struct Wrench {{
+  double force[3], moment[3];
+  void evaluate(const double* q, const double* va, const double* aa, double* phi, double* v, double* a) noexcept {{
+    closed_evaluate(q, va, aa, phi, v, a, force, moment);
+  }}
+  bool finite() const noexcept {{
+    bool out = true;
+    for (int i = 0; i < 3; ++i) out = out && std::isfinite(force[i]) && std::isfinite(moment[i]);
+    return out;
+  }}
+}};
+struct Forces {{
+  double tau[num_actuated];
+  void evaluate(const double* q, const double* va, const double* aa, double* phi, double* v, double* a) noexcept {{
+    closed_evaluate_forces(q, va, aa, phi, v, a, tau);
+  }}
+  bool finite() const noexcept {{
+    bool out = true;
+    for (int i = 0; i < num_actuated; ++i) out = out && std::isfinite(tau[i]);
+    return out;
+  }}
+}};
+
+/// The loop solve from q (actuated entries set) and the evaluation at its solution: at most
+/// max_iterations Gauss-Newton steps, each followed by one fused evaluation, which also checks
+/// the closure; q, v, a and `out` hold the result only when ok is returned.
+template <class Output>
+inline int solve(double* q, const double* v_actuated, const double* a_actuated, double* v, double* a,
+                 Output& out, int max_iterations, double tolerance) noexcept {{
+  double work[dof], next[dof], phi[num_equations], v_out[dof], a_out[dof];
+  for (int i = 0; i < dof; ++i) work[i] = next[i] = q[i];
+  bool finite = true;
+  newton_step(work, next, phi);
+  bool step = !closed(phi, tolerance, finite);
+  if (!finite) return non_finite;
+  for (int steps = 0;;) {{
+    if (step) {{
+      if (steps == max_iterations) return loops_not_closed;
+      for (int i = 0; i < num_passive; ++i) work[passive_index[i]] = next[passive_index[i]];
+      ++steps;
+    }}
+    out.evaluate(work, v_actuated, a_actuated, phi, v_out, a_out);
+    if (closed(phi, tolerance, finite)) break;
+    if (!finite) return loops_not_closed;
+    newton_step(work, next, phi);
+    step = true;
+  }}
   for (int i = 0; i < dof; ++i) {{
     if (!std::isfinite(v_out[i]) || !std::isfinite(a_out[i])) return non_finite;
   }}
+  if (!out.finite()) return non_finite;
   for (int i = 0; i < dof; ++i) {{
     q[i] = work[i];
     v[i] = v_out[i];
@@ -315,13 +459,58 @@ inline int closed_motion(const double* q_actuated, const double* v_actuated, con
   return ok;
 }}
 
+/// solve from q with the actuated entries replaced by q_actuated; q is written only on success.
+template <class Output>
+inline int closed(const double* q_actuated, const double* v_actuated, const double* a_actuated, double* q,
+                  double* v, double* a, Output& out, int max_iterations, double tolerance) noexcept {{
+  double work[dof];
+  for (int i = 0; i < dof; ++i) work[i] = q[i];
+  for (int i = 0; i < num_actuated; ++i) work[actuated_index[i]] = q_actuated[i];
+  const int status = solve(work, v_actuated, a_actuated, v, a, out, max_iterations, tolerance);
+  if (status == ok) {{
+    for (int i = 0; i < dof; ++i) q[i] = work[i];
+  }}
+  return status;
+}}
+}}  // namespace detail
+
+/// The closed mechanism's motion from its actuated coordinates: q (in: warm start of the passive
+/// coordinates; out: the solution, actuated entries replaced) closes the loops to `tolerance`
+/// (max |Phi|) by at most `max_iterations` Gauss-Newton steps, then v = C v#, a = C a# + c.
+/// On failure q, v, a are left unchanged.
+inline int closed_motion(const double* q_actuated, const double* v_actuated, const double* a_actuated,
+                         double* q, double* v, double* a, int max_iterations = 20,
+                         double tolerance = 1e-13) noexcept {{
+  detail::Wrench out;
+  return detail::closed(q_actuated, v_actuated, a_actuated, q, v, a, out, max_iterations, tolerance);
+}}
+
 /// closed_motion, then the shaking wrench of that motion (force dP/dt, moment dH_O/dt about O).
 inline int closed_shaking_wrench(const double* q_actuated, const double* v_actuated, const double* a_actuated,
                                  double* q, double* force, double* moment, int max_iterations = 20,
                                  double tolerance = 1e-13) noexcept {{
   double v[dof], a[dof];
-  const int status = closed_motion(q_actuated, v_actuated, a_actuated, q, v, a, max_iterations, tolerance);
-  if (status == ok) shaking_wrench(q, v, a, force, moment);
+  detail::Wrench out;
+  const int status = detail::closed(q_actuated, v_actuated, a_actuated, q, v, a, out, max_iterations, tolerance);
+  if (status == ok) {{
+    for (int i = 0; i < 3; ++i) {{
+      force[i] = out.force[i];
+      moment[i] = out.moment[i];
+    }}
+  }}
+  return status;
+}}
+
+/// closed_motion, then the actuated forces tau# = C^T tau that drive it (gravity, springs).
+inline int closed_inverse_dynamics(const double* q_actuated, const double* v_actuated, const double* a_actuated,
+                                   double* q, double* tau_actuated, int max_iterations = 20,
+                                   double tolerance = 1e-13) noexcept {{
+  double v[dof], a[dof];
+  detail::Forces out;
+  const int status = detail::closed(q_actuated, v_actuated, a_actuated, q, v, a, out, max_iterations, tolerance);
+  if (status == ok) {{
+    for (int i = 0; i < num_actuated; ++i) tau_actuated[i] = out.tau[i];
+  }}
   return status;
 }}
 
@@ -336,14 +525,12 @@ struct ClosedState {{
   bool valid = false;
 }};
 
-/// A tick along a motion: the loops are closed from the last tick's solution moved to the new
-/// actuated coordinates to second order (q + v s + a s^2 / 2, with s the time step that the
-/// actuated displacement and rates imply, so that a motion run backwards or at another rate
-/// predicts as well), then as closed_motion; `state` is updated on success. Before the first
-/// good tick, `state.q` is the warm start (set it, with state.valid = false).
-inline int closed_tick(ClosedState& state, const double* q_actuated, const double* v_actuated,
-                       const double* a_actuated, double* force, double* moment, int max_iterations = 20,
-                       double tolerance = 1e-13) noexcept {{
+namespace detail {{
+/// One tick from `state`: the passive coordinates predicted from the last solution (see
+/// closed_tick), then solve; `state` is updated on success.
+template <class Output>
+inline int tick(ClosedState& state, const double* q_actuated, const double* v_actuated, const double* a_actuated,
+                Output& out, int max_iterations, double tolerance) noexcept {{
   double q[dof], v[dof], a[dof];
   for (int i = 0; i < dof; ++i) q[i] = state.q[i];
   if (state.valid) {{
@@ -361,9 +548,9 @@ inline int closed_tick(ClosedState& state, const double* q_actuated, const doubl
       }}
     }}
   }}
-  const int status = closed_motion(q_actuated, v_actuated, a_actuated, q, v, a, max_iterations, tolerance);
+  for (int i = 0; i < num_actuated; ++i) q[actuated_index[i]] = q_actuated[i];
+  const int status = solve(q, v_actuated, a_actuated, v, a, out, max_iterations, tolerance);
   if (status != ok) return status;
-  shaking_wrench(q, v, a, force, moment);
   for (int i = 0; i < dof; ++i) {{
     state.q[i] = q[i];
     state.v[i] = v[i];
@@ -375,6 +562,38 @@ inline int closed_tick(ClosedState& state, const double* q_actuated, const doubl
   }}
   state.valid = true;
   return ok;
+}}
+}}  // namespace detail
+
+/// A tick along a motion: the loops are closed from the last tick's solution moved to the new
+/// actuated coordinates to second order (q + v s + a s^2 / 2, with s the time step that the
+/// actuated displacement and rates imply, so that a motion run backwards or at another rate
+/// predicts as well), then as closed_shaking_wrench; `state` is updated on success. Before the
+/// first good tick, `state.q` is the warm start (set it, with state.valid = false).
+inline int closed_tick(ClosedState& state, const double* q_actuated, const double* v_actuated,
+                       const double* a_actuated, double* force, double* moment, int max_iterations = 20,
+                       double tolerance = 1e-13) noexcept {{
+  detail::Wrench out;
+  const int status = detail::tick(state, q_actuated, v_actuated, a_actuated, out, max_iterations, tolerance);
+  if (status == ok) {{
+    for (int i = 0; i < 3; ++i) {{
+      force[i] = out.force[i];
+      moment[i] = out.moment[i];
+    }}
+  }}
+  return status;
+}}
+
+/// closed_tick's warm start, then the actuated forces as closed_inverse_dynamics.
+inline int closed_inverse_dynamics_tick(ClosedState& state, const double* q_actuated, const double* v_actuated,
+                                        const double* a_actuated, double* tau_actuated, int max_iterations = 20,
+                                        double tolerance = 1e-13) noexcept {{
+  detail::Forces out;
+  const int status = detail::tick(state, q_actuated, v_actuated, a_actuated, out, max_iterations, tolerance);
+  if (status == ok) {{
+    for (int i = 0; i < num_actuated; ++i) tau_actuated[i] = out.tau[i];
+  }}
+  return status;
 }}
 
 """
@@ -444,8 +663,20 @@ void mb_frame_placements(const double* q, double* R, double* p) {{ g::frame_plac
 {closed}}}
 """
 
+_SHIM_OPEN = """int mb_ct_size() {{ return static_cast<int>(sizeof(g::ComputedTorque)); }}
+void mb_ct_init(void* c, const double* kp, const double* kd, const double* limit, const double* range) {{
+  auto* ct = new (c) g::ComputedTorque();
+  for (int i = 0; i < g::dof; ++i) {{ ct->kp[i] = kp[i]; ct->kd[i] = kd[i]; ct->torque_limit[i] = limit[i]; }}
+  ct->max_position = range[0]; ct->max_speed = range[1]; ct->max_acceleration = range[2];
+}}
+unsigned mb_ct_step(void* c, const double* q, const double* v, const double* qd, const double* vd, const double* ad, double* tau) {{
+  return static_cast<g::ComputedTorque*>(c)->step(q, v, qd, vd, ad, tau);
+}}
+"""
+
 _SHIM_CLOSED = """int mb_closed_motion(const double* qa, const double* va, const double* aa, double* q, double* v, double* a, int it, double tol) {{ return g::closed_motion(qa, va, aa, q, v, a, it, tol); }}
 int mb_closed_shaking_wrench(const double* qa, const double* va, const double* aa, double* q, double* f, double* m, int it, double tol) {{ return g::closed_shaking_wrench(qa, va, aa, q, f, m, it, tol); }}
+int mb_closed_inverse_dynamics(const double* qa, const double* va, const double* aa, double* q, double* tau, int it, double tol) {{ return g::closed_inverse_dynamics(qa, va, aa, q, tau, it, tol); }}
 int mb_closed_state_size() {{ return static_cast<int>(sizeof(g::ClosedState)); }}
 void mb_closed_state_init(void* state, const double* q) {{ auto* s = new (state) g::ClosedState(); for (int i = 0; i < g::dof; ++i) s->q[i] = q[i]; }}
 int mb_closed_tick(void* state, const double* qa, const double* va, const double* aa, double* f, double* m, double* q_out) {{
@@ -490,10 +721,18 @@ class GeneratedModule:
                 f = getattr(self._lib, f"mb_{fname}")
                 f.argtypes = [d] * 6 + [ctypes.c_int, ctypes.c_double]
                 f.restype = ctypes.c_int
+            f = self._lib.mb_closed_inverse_dynamics
+            f.argtypes = [d] * 5 + [ctypes.c_int, ctypes.c_double]
+            f.restype = ctypes.c_int
             self._lib.mb_closed_state_size.restype = ctypes.c_int
             self._lib.mb_closed_state_init.argtypes = [ctypes.c_void_p, d]
             self._lib.mb_closed_tick.argtypes = [ctypes.c_void_p] + [d] * 6
             self._lib.mb_closed_tick.restype = ctypes.c_int
+        else:
+            self._lib.mb_ct_size.restype = ctypes.c_int
+            self._lib.mb_ct_init.argtypes = [ctypes.c_void_p] + [d] * 4
+            self._lib.mb_ct_step.argtypes = [ctypes.c_void_p] + [d] * 6
+            self._lib.mb_ct_step.restype = ctypes.c_uint
 
     def _vec(self, x, name: str) -> np.ndarray:
         arr = np.ascontiguousarray(x, dtype=float)
@@ -580,6 +819,20 @@ class GeneratedModule:
                                                     self._ptr(f), self._ptr(m), int(max_iterations), float(tolerance))
         return f, m, q, int(status)
 
+    def closed_inverse_dynamics(self, q_actuated, v_actuated, a_actuated, q_guess, *, max_iterations: int = 20,
+                                tolerance: float = 1e-13) -> tuple[np.ndarray, np.ndarray, int]:
+        """(tau_actuated, q, status): the actuated forces that drive the closed mechanism's motion
+        (tau# = C^T tau, gravity and springs included), the loops closed from `q_guess`."""
+        if not self.code.closed:
+            raise ValueError(f"{self.code.name!r} has no loop closures: closed_inverse_dynamics does not apply")
+        qa, va, aa = (self._actuated(x, n) for x, n in ((q_actuated, "q_actuated"), (v_actuated, "v_actuated"),
+                                                          (a_actuated, "a_actuated")))
+        q = np.array(self._vec(q_guess, "q_guess"))
+        tau = np.zeros(len(self.code.actuated))
+        status = self._lib.mb_closed_inverse_dynamics(self._ptr(qa), self._ptr(va), self._ptr(aa), self._ptr(q),
+                                                      self._ptr(tau), int(max_iterations), float(tolerance))
+        return tau, q, int(status)
+
     def closed_ticks(self, q_actuated, v_actuated, a_actuated, q_guess):
         """Run `closed_tick` along a motion ((N, na) arrays, in the order given), its state kept
         from tick to tick: (force (N, 3), moment (N, 3), q (N, dof), status (N,))."""
@@ -600,6 +853,35 @@ class GeneratedModule:
                                                  self._ptr(aa), self._ptr(f), self._ptr(m), self._ptr(q))
             F[k], M[k], Q[k] = f, m, q
         return F, M, Q, status
+
+    def computed_torque_run(self, q, v, q_des, v_des, a_des, *, kp, kd, torque_limit=None,
+                            max_position: float = np.inf, max_speed: float = np.inf,
+                            max_acceleration: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
+        """N ticks ((N, dof) arrays) of one generated `ComputedTorque` (open trees): (tau (N, dof),
+        status (N,), the bits of mechbal.Status), its held command carried from tick to tick."""
+        if self.code.closed:
+            raise ValueError(f"{self.code.name!r} has loop closures: the generated computed torque is "
+                             "for open trees")
+        rows = [np.ascontiguousarray(np.atleast_2d(x), dtype=float) for x in (q, v, q_des, v_des, a_des)]
+        for name, x in zip(("q", "v", "q_des", "v_des", "a_des"), rows):
+            if x.ndim != 2 or x.shape[1] != self.dof or len(x) != len(rows[0]):
+                raise ValueError(f"{name} must have shape (N, {self.dof}) with one N, got {x.shape}")
+        gains = [self._vec(np.broadcast_to(np.asarray(x, float), (self.dof,)), name)
+                 for x, name in ((kp, "kp"), (kd, "kd"))]
+        limit = self._vec(np.full(self.dof, np.inf) if torque_limit is None else
+                          np.broadcast_to(np.asarray(torque_limit, float), (self.dof,)), "torque_limit")
+        bounds = np.array([max_position, max_speed, max_acceleration], dtype=float)
+        state = ctypes.create_string_buffer(int(self._lib.mb_ct_size()) + 64)
+        address = ctypes.c_void_p((ctypes.addressof(state) + 63) // 64 * 64)
+        self._lib.mb_ct_init(address, self._ptr(gains[0]), self._ptr(gains[1]), self._ptr(limit), self._ptr(bounds))
+        n = len(rows[0])
+        tau, status = np.zeros((n, self.dof)), np.zeros(n, dtype=np.int64)
+        out = np.zeros(self.dof)
+        for k in range(n):
+            status[k] = self._lib.mb_ct_step(address, *(self._ptr(np.ascontiguousarray(x[k])) for x in rows),
+                                             self._ptr(out))
+            tau[k] = out
+        return tau, status
 
     def frame_placement(self, q, frame: str) -> np.ndarray:
         """4x4 placement of a generated frame in O."""
@@ -639,7 +921,7 @@ def build(mechanism_or_code, *, cache_dir: str | Path | None = None, **generate_
             header.write_text(code.header)
             shim = Path(tmp) / "shim.cpp"
             shim.write_text(_SHIM.format(header=header.name, ident=code.name,
-                                         closed=_SHIM_CLOSED if code.closed else ""))
+                                         closed=_SHIM_CLOSED if code.closed else _SHIM_OPEN.format()))
             out = Path(tmp) / library.name
             result = subprocess.run([cxx, *BUILD_FLAGS, str(shim), "-o", str(out)],
                                     capture_output=True, text=True)

@@ -471,17 +471,20 @@ def _passive_columns(g: Graph, tree: TreeConstants, q, phi):
 
 def newton_step(g: Graph, tree: TreeConstants, q):
     """One Gauss-Newton step of the passive coordinates on Phi(q) = 0 (the normal equations of
-    A°, as the library): the new passive values and |Phi(q)|^2 before the step."""
+    A°, as the library): the new passive values and Phi(q), the residual before the step."""
     phi = loop_residual(g, tree, q)
     columns, factor = _passive_columns(g, tree, q, phi)
     delta = ldlt_apply(g, factor, [g.neg(dot(g, c, phi)) for c in columns])
-    norm2 = dot(g, phi, phi)
-    return [g.add(q[p], delta[i]) for i, p in enumerate(tree.passive)], norm2
+    return [g.add(q[p], delta[i]) for i, p in enumerate(tree.passive)], phi
 
 
-def closed_projection(g: Graph, tree: TreeConstants, q, v_actuated, a_actuated, w):
-    """At a closed q: v = C v#, a = C a# + c (full dof), from A°, A#, gamma = dA/dt v. `w` are
-    spare inputs (one per coordinate) through which gamma is derived with v held constant."""
+def closed_projection(g: Graph, tree: TreeConstants, q, v_actuated, a_actuated, w=None):
+    """At a closed q: v = C v#, a = C a# + c (full dof), from A°, A#, gamma = dA/dt v.
+
+    gamma is the closures' second time derivative at zero acceleration, from the links' angular
+    velocities and velocity-product accelerations (`loop_velocity_product`). Given `w`, spare
+    inputs (one per coordinate), it is derived instead by forward mode twice with v held constant
+    (about three times the operations; kept as the independent reference of the tests)."""
     phi = loop_residual(g, tree, q)
     columns, factor = _passive_columns(g, tree, q, phi)
     act = tree.actuated
@@ -496,9 +499,12 @@ def closed_projection(g: Graph, tree: TreeConstants, q, v_actuated, a_actuated, 
         v[k] = v_actuated[i]
     for i, k in enumerate(tree.passive):
         v[k] = v_passive[i]
-    seeds = {q[k].id: w[k] for k in range(tree.dof)}
-    gamma_w = directional_derivative(g, directional_derivative(g, phi, seeds), seeds)
-    gamma = substitute(g, gamma_w, {w[k].id: v[k] for k in range(tree.dof)})
+    if w is None:
+        gamma = loop_velocity_product(g, tree, Kinematics(g, tree, q), v)
+    else:  # the same by forward mode twice along spare inputs w, then w = v (the reference)
+        seeds = {q[k].id: w[k] for k in range(tree.dof)}
+        gamma_w = directional_derivative(g, directional_derivative(g, phi, seeds), seeds)
+        gamma = substitute(g, gamma_w, {w[k].id: v[k] for k in range(tree.dof)})
     Aa_a = directional_derivative(g, phi, {q[k].id: a_actuated[i] for i, k in enumerate(act)})
     a_passive = solve([g.add(x, y) for x, y in zip(Aa_a, gamma)])
     a: list[Value] = [0.0] * tree.dof
@@ -507,3 +513,103 @@ def closed_projection(g: Graph, tree: TreeConstants, q, v_actuated, a_actuated, 
     for i, k in enumerate(tree.passive):
         a[k] = a_passive[i]
     return v, a
+
+
+
+def closed_actuated_forces(g: Graph, tree: TreeConstants, q, v, a):
+    """tau# = C^T tau(q, v, a) at a closed q: the tree's inverse dynamics (gravity and springs)
+    projected on the actuated coordinates, C^T tau = tau_act - A#^T A° N^-1 tau° (N = A°^T A°,
+    as v° = -N^-1 A°^T A# v#)."""
+    tau, _ = newton_euler(g, tree, q, v, a, gravity=True, springs=True)
+    phi = loop_residual(g, tree, q)
+    columns, factor = _passive_columns(g, tree, q, phi)
+    y = ldlt_apply(g, factor, [tau[k] for k in tree.passive])
+    z = [0.0] * len(phi)
+    for c, yi in zip(columns, y):
+        z = [g.add(zr, g.mul(cr, yi)) for zr, cr in zip(z, c)]
+    out = []
+    for k in tree.actuated:
+        column = directional_derivative(g, phi, {q[k].id: 1.0})
+        out.append(g.sub(tau[k], dot(g, column, z)))
+    return out
+
+# ---- velocity products of the closures -----------------------------------------------------------
+def _link_rates(g: Graph, tree: TreeConstants, kin: Kinematics, v):
+    """Per link, in O: angular velocity w, origin velocity pv, and at zero joint accelerations the
+    angular acceleration dw and origin acceleration pa (the velocity-product terms)."""
+    n = len(tree.links)
+    zero = [0.0, 0.0, 0.0]
+    w, pv, dw, pa = [zero] * n, [zero] * n, [zero] * n, [zero] * n
+    for i in range(1, n):
+        link = tree.links[i]
+        par = link.parent
+        R, p = kin.world(i)
+        _, p_par = kin.world(par)
+        r = vsub(g, p, p_par)
+        wp, dwp = w[par], dw[par]
+        pv_i = vadd(g, pv[par], cross(g, wp, r))
+        pa_i = vadd(g, pa[par], vadd(g, cross(g, dwp, r), cross(g, wp, cross(g, wp, r))))
+        rate = _joint_rates(g, link, v)
+        w_i, dw_i = wp, dwp
+        if link.kind in ("revolute", "prismatic"):
+            u = vscale(g, rate, matvec(g, R, [float(x) for x in link.axis]))  # joint rate x axis in O
+            if link.kind == "revolute":
+                w_i = vadd(g, wp, u)
+                dw_i = vadd(g, dwp, cross(g, wp, u))
+            else:
+                pv_i = vadd(g, pv_i, u)
+                pa_i = vadd(g, pa_i, vscale(g, 2.0, cross(g, wp, u)))
+        w[i], dw[i], pv[i], pa[i] = w_i, dw_i, pv_i, pa_i
+    return w, pv, dw, pa
+
+
+def loop_velocity_product(g: Graph, tree: TreeConstants, kin: Kinematics, v) -> list:
+    """gamma = d/dt(A(q)) v: the second time derivative of `loop_residual` along the motion of
+    rates v (every coordinate) with zero accelerations, from the frames' velocities and
+    velocity-product accelerations (one pass over the links, 3-vectors: no second derivatives of
+    rotation matrices)."""
+    w, pv, dw, pa = _link_rates(g, tree, kin, v)
+
+    def frame_motion(name: str):
+        """(axes e_k, de_k, dde_k as columns; point x, dx, ddx) of a named frame, in O."""
+        link, _ = tree.frames[name]
+        R, x = _frame(g, kin, tree, name)
+        _, p = kin.world(link)
+        rho = vsub(g, x, p)
+        dx = vadd(g, pv[link], cross(g, w[link], rho))
+        ddx = vadd(g, pa[link], vadd(g, cross(g, dw[link], rho), cross(g, w[link], cross(g, w[link], rho))))
+        axes = [[R[0][k], R[1][k], R[2][k]] for k in range(3)]
+        d_axes = [cross(g, w[link], e) for e in axes]
+        dd_axes = [vadd(g, cross(g, dw[link], e), cross(g, w[link], de)) for e, de in zip(axes, d_axes)]
+        return (axes, d_axes, dd_axes), (x, dx, ddx)
+
+    def second(a, b):
+        """d2/dt2 (a . b) for a = (a, da, dda), b = (b, db, ddb)."""
+        return g.add(g.add(dot(g, a[2], b[0]), g.mul(2.0, dot(g, a[1], b[1]))), dot(g, a[0], b[2]))
+
+    gamma: list = []
+    for kind, frame_a, frame_b in tree.loops:
+        (ea, dea, ddea), xa = frame_motion(frame_a)
+        (eb, deb, ddeb), xb = frame_motion(frame_b)
+        d = [vsub(g, xb[k], xa[k]) for k in range(3)]  # d, its rate and acceleration
+        col = lambda e, de, dde, k: (e[k], de[k], dde[k])  # noqa: E731
+        if kind == "point":
+            gamma += d[2]
+        elif kind == "planar_point":
+            gamma += [second(col(ea, dea, ddea, 0), d), second(col(ea, dea, ddea, 1), d)]
+        elif kind == "axis":
+            za = col(ea, dea, ddea, 2)
+            gamma += d[2] + [second(za, col(eb, deb, ddeb, 0)), second(za, col(eb, deb, ddeb, 1))]
+        elif kind == "weld":
+            # R = R_B R_A^T = sum_k b_k a_k^T: R'' = sum_k b''_k a_k^T + 2 b'_k a'_k^T + b_k a''_k^T
+            def entry(r, c):
+                out = 0.0
+                for k in range(3):
+                    out = g.add(out, g.add(g.add(g.mul(ddeb[k][r], ea[k][c]), g.mul(2.0, g.mul(deb[k][r], dea[k][c]))),
+                                           g.mul(eb[k][r], ddea[k][c])))
+                return out
+            gamma += d[2] + [g.mul(0.5, g.sub(entry(2, 1), entry(1, 2))), g.mul(0.5, g.sub(entry(0, 2), entry(2, 0))),
+                             g.mul(0.5, g.sub(entry(1, 0), entry(0, 1)))]
+        else:  # pragma: no cover - the model knows no other type
+            raise ValueError(f"loop type {kind!r}")
+    return gamma
