@@ -517,11 +517,11 @@ inline int closed_inverse_dynamics(const double* q_actuated, const double* v_act
 /// What a tick keeps of the last one, for the warm start: the solved q, v, a and the actuated
 /// coordinates and rates they were solved for. `valid` is false before the first good tick.
 struct ClosedState {{
-  double q[dof];
-  double v[dof];
-  double a[dof];
-  double q_actuated[num_actuated];
-  double v_actuated[num_actuated];
+  double q[dof] = {{}};
+  double v[dof] = {{}};
+  double a[dof] = {{}};
+  double q_actuated[num_actuated] = {{}};
+  double v_actuated[num_actuated] = {{}};
   bool valid = false;
 }};
 
