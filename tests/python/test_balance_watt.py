@@ -214,7 +214,7 @@ def test_watt_force_front(case, lightest):
     independent kinematics at the knee."""
     slots = slots_from_table(case.table)
     lo, hi = np.min(case.motion[0], axis=0), np.max(case.motion[0], axis=0)
-    fr = fronts.front(case.mechanism, slots, 6, method="force", samples=200, lower=lo, upper=hi,
+    fr = fronts.front(case.mechanism, slots, 4, method="force", samples=200, lower=lo, upper=hi,
                       q_guess=case.q_guess, motion=case.motion)
     r = [p.residual for p in fr.points]
     assert all(b <= a * (1 + 1e-9) for a, b in zip(r, r[1:]))
