@@ -170,3 +170,15 @@ def test_cli_front(tmp_path, capsys):
     assert float(rows[0]["added_mass_kg"]) == 0.0
     assert main(["balance", "arm2link", "--method", "rms", "--front", "3", "--out", str(tmp_path / "x"), "-q"]) == 2
     assert "--front" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("method, reason", [("moment", "second moment"), ("springs", "carries no mass")])
+def test_methods_outside_the_convex_path_are_refused_with_the_reason(tmp_path, capsys, method, reason):
+    """The force-vs-moment front, and a lightest spring or disc design, are not convex programs
+    over what the model designs: the options say why instead of running something else."""
+    from mechbal.cli import main
+
+    for flags in (["--objective", "mass"], ["--residual-target", "1.0"]):
+        code = main(["balance", "arm2link", "--method", method, *flags, "--out", str(tmp_path / method), "-q"])
+        assert code == 2
+        assert reason in capsys.readouterr().err

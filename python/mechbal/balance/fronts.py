@@ -315,14 +315,17 @@ def _plot(fr: Front, path: Path, title: str) -> None:
     ax.plot(m, r, "o-", color="C0", label=f"residual [{fr.residual_units.split(' (')[0]}]")
     ax.plot([m[fr.knee]], [r[fr.knee]], "s", ms=12, mfc="none", mec="C3", mew=2, label="knee")
     ax.set_xlabel("added mass [kg]")
-    ax.set_ylabel(f"residual ({fr.residual_units})", color="C0")
+    ax.set_ylabel(f"residual [{fr.residual_units.split(' (')[0]}]", color="C0")
     ax2 = ax.twinx()
     ax2.plot(m, t, "^--", color="C1", label="peak actuator torque")
     ax2.set_ylabel("peak actuator torque [N m or N]", color="C1")
     lines = ax.get_legend_handles_labels()
     lines2 = ax2.get_legend_handles_labels()
     ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="upper right", fontsize=8)
-    ax.set_title(title or f"{fr.method} balance: least residual per added-mass budget", fontsize=10)
+    import textwrap
+
+    ax.set_title(textwrap.fill(title or f"{fr.method} balance: least residual per added-mass budget", 80),
+                 fontsize=9)
     ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=110)

@@ -302,6 +302,23 @@ def _comparison(before: dict, after: dict) -> dict:
 
 #: the methods of --objective, --residual-target and --front (linear in the counterweights)
 OPTIMAL_METHODS = ("static", "force")
+#: why the other methods have no certified design or front (docs/guide.md, "What the convex path
+#: does not cover")
+NOT_CONVEX = {
+    "moment": "a disc's inertia carries no mass in the model (nothing to make lightest), and a "
+              "counterweight's shaking moment is linear in its second moment m |p|^2, not in (m, m p): "
+              "a force-vs-moment front over point-mass counterweights is not a convex program",
+    "springs": "a spring's rate carries no mass in the model (nothing to make lightest), and anchors the "
+               "method may move enter the torque bilinearly; its rates are a bounded least squares",
+    "rms": "the RMS torque over a motion is quadratic in the counterweights' second moments, not linear "
+           "in their (m, m p)",
+}
+
+
+def _not_optimal(flag: str, name: str, value) -> ConfigError:
+    why = NOT_CONVEX.get(name)
+    return ConfigError(flag, f"is for the methods linear in the counterweights ({', '.join(OPTIMAL_METHODS)}), "
+                             f"not {name!r}" + (f": {why}" if why else ""), value)
 
 
 def run_method(bc: BalanceCase, name: str, *, objective: str | None = None,
@@ -312,8 +329,7 @@ def run_method(bc: BalanceCase, name: str, *, objective: str | None = None,
     optimal_opts = {}
     for flag, v in (("--objective", objective), ("--residual-target", residual_target)):
         if v is not None and name not in OPTIMAL_METHODS:
-            raise ConfigError(flag, f"is for the methods linear in the counterweights ({', '.join(OPTIMAL_METHODS)}), "
-                                    f"not {name!r}", v)
+            raise _not_optimal(flag, name, v)
     if residual_target is not None and not (math.isfinite(residual_target) and residual_target >= 0):
         raise ConfigError("--residual-target", "must be a finite number >= 0", residual_target)
     if objective is not None:
@@ -392,8 +408,7 @@ def run_front(bc: BalanceCase, name: str, points: int, out: Path) -> dict:
     from mechbal.balance.optimal import MissingExtra
 
     if name not in OPTIMAL_METHODS:
-        raise ConfigError("--front", f"is for the methods linear in the counterweights ({', '.join(OPTIMAL_METHODS)}), "
-                                     f"not {name!r}", points)
+        raise _not_optimal("--front", name, points)
     if points < 2:
         raise ConfigError("--front", "must be an integer >= 2 (the number of designs)", points)
     table = bc.table
