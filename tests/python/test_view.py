@@ -28,7 +28,7 @@ def _screenshot(html: Path, t: float, out: Path, size=(900, 600)) -> np.ndarray:
            "--enable-unsafe-swiftshader", "--host-resolver-rules=MAP * ~NOTFOUND",
            f"--window-size={size[0]},{size[1]}", "--virtual-time-budget=5000", f"--screenshot={out}",
            f"file://{html}#t={t}"]
-    subprocess.run(cmd, capture_output=True, timeout=120, check=True)
+    subprocess.run(cmd, capture_output=True, timeout=300, check=True)  # minutes only on a loaded machine
     from matplotlib.image import imread
 
     return imread(str(out))[:, :, :3]
@@ -299,3 +299,25 @@ def test_view_of_a_seven_joint_arm_run_stays_under_5_mb(tmp_path, meshes):
     assert len(data["t"]) == 501
     assert any("visual_panda_link3" in p for p in paths) == meshes
     assert page.stat().st_size < 5e6, page.stat().st_size
+
+
+def test_verify_view_puts_unbalanced_and_balanced_side_by_side(tmp_path):
+    pytest.importorskip("mujoco")
+    from mechbal.cli import main
+
+    out = tmp_path / "v"
+    assert main(["verify", "four-bar", "--no-simulation", "--out", str(out), "--view", "-q"]) == 0
+    paths, data = _objects(out / "view.html")
+    assert any(p.startswith("/mechbal/v1/links/") for p in paths)
+    peak = [max(np.linalg.norm(np.reshape(f, (4, 3))[1]) for f in data["tracks"][f"/mechbal/v{k}/force"])
+            for k in (0, 1)]
+    assert peak[1] < 0.5 * peak[0], peak
+    import json
+
+    assert "view.html" in json.loads((out / "summary.json").read_text())["files"]
+
+
+def test_view_asked_of_the_mujoco_engine_is_refused(tmp_path):
+    from mechbal.cli import main
+
+    assert main(["run", "four-bar", "--engine", "mujoco", "--view", "--out", str(tmp_path / "m")]) == 2
