@@ -115,7 +115,12 @@ def _cmd_run(args) -> int:
     if composed is not None:
         return composed
     if getattr(args, "engine", "mechbal") == "mujoco":
+        if getattr(args, "view", False):
+            raise UserError("--view: not with --engine mujoco (run it with the default engine, or "
+                            "'mechbal verify --view')")
         return _run_mujoco(args, out)
+    if getattr(args, "view", False):
+        _view_available()
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer):  # the runner's tables, printed after its bar closes
         summary = run_case(args.case, out, animate=getattr(args, "animate", False),
@@ -130,9 +135,88 @@ def _cmd_run(args) -> int:
     if notes:
         print(f"mechbal: warning: {len(notes)} non-finite value(s) written as null in "
               f"{out}/summary.json (listed under non_finite_values)", file=sys.stderr)
+    if getattr(args, "view", False):
+        _run_view(args, out)
     if not args.quiet:
-        print(f"wrote {out}/summary.json and the plots and bodies files beside it")
+        print(f"wrote {out}/summary.json and the plots and bodies files beside it"
+              + (", and view.html" if getattr(args, "view", False) else ""))
     return _goal_exit(args, summary, out)
+
+
+def _view_available() -> None:
+    """--view asked without the 'view' extra: exit 2 before anything runs."""
+    from mechbal.view import ViewError, viewer_script
+
+    try:
+        viewer_script()
+    except ViewError as exc:
+        raise UserError(f"--view: {exc}") from None
+
+
+def _case_mechanism(case: str, design: str | None = None):
+    """The case's mechanism, or None when the case has none to read (a paper's runner)."""
+    from mechbal.balance.run import load_case
+    from mechbal.config import ConfigError
+
+    try:
+        return load_case(case, design).mechanism
+    except (ConfigError, ValueError, OSError, KeyError, AttributeError, TypeError):
+        return None
+
+
+def _shown_view(write) -> None:
+    """Write a view, its warnings (a URDF mesh drawn as capsules) as warning lines, a ViewError
+    as a UserError."""
+    from mechbal.view import ViewError, ViewWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ViewWarning)
+        try:
+            write()
+        except ViewError as exc:
+            raise UserError(str(exc)) from None
+    for w in caught:
+        if issubclass(w.category, ViewWarning):
+            print(f"mechbal: warning: {_one_line(Exception(str(w.message)))}", file=sys.stderr)
+        else:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+
+
+def _run_view(args, out: Path) -> None:
+    """run --view: view.html from the run folder's bodies files (`mechbal.view.run_dir_variants`),
+    with the case's links where its mechanism is the one a file holds."""
+    from mechbal.view import run_dir_variants, write_html
+
+    mech = _case_mechanism(args.case)
+    _shown_view(lambda: write_html(out / "view.html", run_dir_variants(out, {"*": mech} if mech else None),
+                                   title=f"mechbal run: {Path(str(args.case)).stem}"))
+    with contextlib.suppress(OSError, ValueError):
+        _list_in_summary(out / "summary.json", "view.html")
+
+
+def _balance_view(args, tmp: Path, summary) -> None:
+    """balance --view: the unbalanced and the balanced mechanism (balanced.toml) side by side."""
+    from mechbal.mechanism import Mechanism
+    from mechbal.view import run_dir_variants, write_html
+
+    mechanisms = {"unbalanced": _case_mechanism(args.case, args.design)}
+    if (tmp / "balanced.toml").is_file():
+        mechanisms["balanced"] = Mechanism.from_toml(tmp / "balanced.toml")
+    _shown_view(lambda: write_html(tmp / "view.html", run_dir_variants(tmp, mechanisms),
+                                   title=f"mechbal balance: {Path(str(args.case)).stem}"))
+    _list_in_summary(tmp / "summary.json", "view.html", summary)
+
+
+def _list_in_summary(path: Path, name: str, summary=None) -> None:
+    """Add a file written after summary.json to its ``files`` (and to the summary in memory)."""
+    from mechbal.export.bodies import to_json
+
+    data = json.loads(path.read_text())
+    if isinstance(data.get("files"), list) and name not in data["files"]:
+        data["files"].append(name)
+        path.write_text(to_json(data)[0])
+    if isinstance(summary, dict) and isinstance(summary.get("files"), list) and name not in summary["files"]:
+        summary["files"].append(name)
 
 
 def _control_options(args) -> dict:
@@ -190,10 +274,14 @@ def _cmd_balance(args) -> int:
 
     out = Path(args.out)
     check_output_dir(out)           # before anything else: a bad --out fails in the first second
+    if getattr(args, "view", False):
+        _view_available()
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer), staged_output(out) as tmp, \
             progress.run_bar(f"balance {Path(args.case).stem}", 5):
         summary = run_balance(args.case, args.method, tmp, design=args.design, **_optimal_options(args))
+        if getattr(args, "view", False):
+            _balance_view(args, tmp, summary)
         progress.finish()
     if not args.quiet:
         sys.stdout.write(buffer.getvalue())
@@ -334,16 +422,43 @@ def _cmd_codegen(args) -> int:
     return 0
 
 
+def _folder_mechanisms(folder: Path) -> dict:
+    """The mechanisms a run folder's bodies files may be drawn with: its case's (summary.json's
+    ``case``, a built-in name) and its balanced.toml's (a balance folder)."""
+    from mechbal.mechanism import Mechanism
+
+    found = {}
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        case = json.loads((folder / "summary.json").read_text()).get("case")
+        mech = _case_mechanism(case) if isinstance(case, str) else None
+        if mech is not None:
+            found["*"] = mech
+    if (folder / "balanced.toml").is_file():
+        with contextlib.suppress(OSError, ValueError, AttributeError, KeyError):
+            found["balanced"] = Mechanism.from_toml(folder / "balanced.toml")
+    return found
+
+
 def _cmd_view(args) -> int:
-    from mechbal.view import ViewError, case_variants, write_html
+    from mechbal.view import case_variants, run_dir_variants, write_html
 
     if args.samples < 2:
         raise UserError(f"--samples: {args.samples}: give at least 2")
-    try:
-        variants = case_variants(args.case, samples=args.samples, compare=args.compare)
-        path = write_html(args.out, variants, title=f"mechbal: {Path(str(args.case)).stem}")
-    except ViewError as exc:
-        raise UserError(str(exc)) from None
+    folder = Path(str(args.case))
+    result = {}
+
+    def write():
+        if folder.is_dir():  # a run folder: its bodies files
+            if args.compare:
+                raise UserError("--compare: not with a run folder (its variants are side by side already)")
+            variants = run_dir_variants(folder, _folder_mechanisms(folder), samples=args.samples)
+        else:
+            variants = case_variants(args.case, samples=args.samples, compare=args.compare)
+        result["variants"] = variants
+        result["path"] = write_html(args.out, variants, title=f"mechbal: {folder.stem or folder.name}")
+
+    _shown_view(write)
+    variants, path = result["variants"], result["path"]
     if not args.quiet:
         size = path.stat().st_size / 1e6
         print(f"wrote {path} ({size:.1f} MB; {len(variants)} variant(s), {len(variants[0].t)} instants): "
@@ -371,8 +486,11 @@ def _cmd_verify(args) -> int:
     composed = _with_design(args, _cmd_verify)
     if composed is not None:
         return composed
+    if getattr(args, "view", False):
+        _view_available()
     return _in_mujoco(args, out, lambda tmp: run_verify(args.case, tmp, simulate=not args.no_simulation,
-                                                        method=args.method, **_control_options(args)),
+                                                        method=args.method, view=getattr(args, "view", False),
+                                                        **_control_options(args)),
                       "summary.json and the plots beside it")
 
 
@@ -473,6 +591,10 @@ def _out_folder(s, default: str) -> None:
     s.add_argument("--out", default=default, metavar="DIR", help=f"output folder (default: {default})")
 
 
+_VIEW_HELP = ("also write DIR/view.html: an interactive 3-D view ({what} side by side, in step; one "
+              "self-contained HTML file, see 'mechbal view'; needs the 'view' extra)")
+
+
 def _last_flags(s, func, *, force: bool = False, urdf: bool = False) -> None:
     """The flags every command ends with (-q; --force and the URDF flags where they apply), then
     the function that runs it."""
@@ -525,6 +647,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "at 1 kHz against MuJoCo integrating the case's MJCF export (computed torque; a "
                         "case with a reactionless [control]: its reactionless controller, uncontrolled and "
                         "controlled), MuJoCo's base reaction beside mechbal's (needs the 'mujoco' extra)")
+    s.add_argument("--view", action="store_true", help=_VIEW_HELP.format(what="every variant of the run"))
     s.add_argument("--animate", action="store_true",
                    help="also write DIR/animation_<variant>.gif: the mechanism moving, with the "
                         "shaking force and moment drawn at its base")
@@ -551,6 +674,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a TOML file with a [balance] table (and optionally a [trajectory]) that "
                         "replaces the case's (required for a URDF)")
     _out_folder(s, "out")
+    s.add_argument("--view", action="store_true", help=_VIEW_HELP.format(what="unbalanced and balanced"))
     s.add_argument("--allow-partial", action="store_true",
                    help=f"exit 0 when the requested balance is not reached (default: exit "
                         f"{EXIT_PARTIAL_BALANCE}; the results are written either way)")
@@ -598,7 +722,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "as inertia ellipsoids (counterweights red, discs blue), springs, "
                                    "the centre of mass path, and the shaking force and moment as arrows "
                                    "at O, with play/pause and a time slider. Needs the 'view' extra.")
-    s.add_argument("case", help="built-in case name or path to a TOML or URDF file")
+    s.add_argument("case", help="built-in case name, path to a TOML or URDF file, or a run folder (written by "
+                                "run, balance or verify: its bodies_<variant>.npz files side by side)")
     s.add_argument("--out", required=True, metavar="FILE", help="the HTML file to write")
     s.add_argument("--samples", type=int, default=201, metavar="N",
                    help="instants of the trajectory shown (default: 201)")
@@ -628,6 +753,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--fit-duration", action="store_true",
                    help="a reactionless case whose motion needs more than a declared limit allows: check the same "
                         "motion at the shortest duration that keeps every limit (instead of refusing it)")
+    s.add_argument("--view", action="store_true",
+                   help=_VIEW_HELP.format(what="unbalanced and balanced, or uncontrolled and controlled, as "
+                                               "mechbal predicts them"))
     _last_flags(s, _cmd_verify, urdf=True)
     s = sub.add_parser("demo", help="run the default case study",
                        description="Run the default case study (see 'mechbal cases').")

@@ -156,16 +156,17 @@ def _rows(label: str, res: dict, scale: dict, unbalanced: dict) -> tuple[list, d
 
 
 def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | None = None,
-               fit_duration: bool = False, allow_degraded: bool = False) -> dict:
+               fit_duration: bool = False, allow_degraded: bool = False, view: bool = False) -> dict:
     """The whole check into ``out`` (module docstring); ``method``: the balancing method of the
     balanced variant (default: the case's ``balance.method``, or its default design's); returns
-    the summary."""
+    the summary. ``view``: also ``out/view.html`` (`mechbal.view`), the variants side by side on
+    the case's trajectory."""
     from mechbal.balance.run import load_case, run_method
 
     out = Path(out)
     if reactionless_control(case) is not None:
         return run_verify_reactionless(case, out, simulate=simulate, fit_duration=fit_duration,
-                                       allow_degraded=allow_degraded)
+                                       allow_degraded=allow_degraded, view=view)
     progress.stage("reading the case")
     bc = load_case(case)
     variants = {"unbalanced": bc.mechanism}
@@ -223,6 +224,11 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
         summary["mujoco_options"] = results["unbalanced"]["mujoco_simulated"]["options"]
     if notes:
         summary["notes"] = notes
+    if view:
+        from mechbal.view import motion_variants, write_html
+
+        write_html(out / "view.html", motion_variants(bc, variants), title=f"mechbal verify: {bc.name}")
+        summary["files"].append("view.html")
     write_summary(out / "summary.json", summary, command="verify")
     print(report.table(rows, ["variant", "quantity", "unit", "mechbal peak", "MuJoCo peak (inverse)",
                               "relative difference", "MuJoCo peak (simulated)"]))
@@ -681,7 +687,7 @@ def feasible_case(case, *, fit_duration: bool = False, allow_degraded: bool = Fa
 
 def run_verify_reactionless(case, out: Path, *, simulate: bool = True, dt: float = 1e-3,
                             duration: float | None = None, time_step_study: bool = True,
-                            fit_duration: bool = False, allow_degraded: bool = False) -> dict:
+                            fit_duration: bool = False, allow_degraded: bool = False, view: bool = False) -> dict:
     """``mechbal verify`` of a case with a reactionless ``[control]`` table, in the joint mode
     (balancing joints: the reaction-wheel arm, PAMINSA) or the operational-space mode
     (``task_frame``: the Panda). For each variant, **uncontrolled** and **controlled**
@@ -851,6 +857,13 @@ def run_verify_reactionless(case, out: Path, *, simulate: bool = True, dt: float
                                    f"wrench under the controller at {1 / dt:g} Hz; uncontrolled: "
                                    f"{VARIANTS[plan.mode]['uncontrolled']}; controlled: "
                                    f"{VARIANTS[plan.mode]['controlled']}.")
+    if view:  # mechbal's motions of both variants (MuJoCo's realised ones are in the bodies files)
+        from mechbal.view import Variant, write_html
+
+        write_html(out / "view.html", [Variant(label, mech, plan.t, m["q"], force=m["shaking_force"],
+                                               moment=m["shaking_moment"]) for label, m in motions.items()],
+                   title=f"mechbal verify: {plan.name}", samples=201)
+        summary["files"].append("view.html")
     write_summary(out / "summary.json", summary, command="verify")
     if loop_failed:   # the failed loop's realised peaks are not a residual: not printed as one
         table = [row[:-1] + ["failed"] if row[0] == "controlled" else row for row in table]
