@@ -127,6 +127,8 @@ def write_file(path: str | Path, text: str) -> Path:
             raise OutputError(given, "is a folder: give a file name")
         if out.exists() and not out.is_file():
             raise OutputError(given, "is not a regular file (a device, pipe or socket)")
+        if out.parent.exists() and not out.parent.is_dir():
+            raise OutputError(given, f"{out.parent} is a file, not a folder")
         out.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.partial-{os.getpid()}-", dir=out.parent)
     except OutputError:
