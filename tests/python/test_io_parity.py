@@ -817,4 +817,6 @@ def test_both_readers_refuse_a_misspelled_table(tmp_path, wrong):
         validate_case(read_toml(path), warn=False)
     with pytest.raises(ValueError) as cpp_exc:
         _core.load_case_file(str(path))
-    assert str(cpp_exc.value) == str(py_exc.value), f"Python: {py_exc.value}\nC++:    {cpp_exc.value}"
+    # the same first problem, whole (Python goes on: "; also trajectory: is required")
+    assert str(cpp_exc.value) == py_exc.value.problems[0][1], f"Python: {py_exc.value}\nC++:    {cpp_exc.value}"
+    assert py_exc.value.field == wrong.split()[0] and "unknown" in str(cpp_exc.value)
