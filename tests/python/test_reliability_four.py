@@ -11,7 +11,6 @@ import os
 import signal
 import subprocess
 import sys
-import textwrap
 import time
 import tomllib
 import xml.etree.ElementTree as ET
