@@ -142,11 +142,18 @@ def _distributed(plan, chunks, scheduler, bar) -> list[dict]:
     if own and scheduler is None:
         raise ValueError("backend dask: give the scheduler's address (--scheduler tcp://host:port) or a Client")
     if own:
+        import logging
+
+        quiet = logging.getLogger("distributed")  # its tracebacks of a failed handshake: the one line says it
+        level = quiet.level
+        quiet.setLevel(logging.CRITICAL)
         try:
             client = distributed.Client(scheduler, set_as_default=False)
         except Exception as exc:  # noqa: BLE001 - a closed port, a peer that is not a scheduler: one line
             raise SweepConnectionError(f"scheduler: cannot connect to a Dask scheduler at {scheduler!r}: "
                                        f"{_reason(exc)}") from None
+        finally:
+            quiet.setLevel(level)
     else:
         client = scheduler
     try:
