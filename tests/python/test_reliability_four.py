@@ -236,7 +236,7 @@ def test_d03_cancel_both_with_one_wheel_is_not_a_success(tmp_path, capsys):
 # ---- 4. every table validation accepts runs (no exit 3) -------------------------------------------
 
 @pytest.mark.parametrize("command", ["run", "verify"])
-def test_d04_every_actuated_joint_balancing_runs(tmp_path, capsys, command):
+def test_d04_every_actuated_joint_balancing_is_refused_at_validation(tmp_path, capsys, command):
     data = wheel_arm()
     data["control"]["balancing_joints"] = ["shoulder", "elbow", "wheel"]
     data["control"]["cancel"] = ["moment_z"]
