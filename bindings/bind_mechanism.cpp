@@ -407,6 +407,11 @@ void bind_mechanism(py::module_& m) {
           [](const MechanismModel& mo) { return py::make_tuple(mo.description()); },
           [](const py::tuple& t) { return MechanismModel(t[0].cast<MechanismDescription>()); }));
 
+  m.def(
+      "name_problem", [](const std::string& name) { return name_problem(name); }, py::arg("name"),
+      "Why `name` (UTF-8 bytes or str) is not a valid name of the model, or '' when it is: the "
+      "character set of names (docs/case_format.md, Names).");
+
   // ---- closed loops: actuated (N, na) in; q0 (dof,) the warm start of the first instant ----
   m.def(
       "mechanism_closed_motion",

@@ -350,6 +350,9 @@ def _cmd_sweep(args) -> int:
     from mechbal.sweep.config import run_file
 
     check_output_dir(Path(args.out))  # before anything else, as for run
+    if args.scheduler is not None and args.backend != "dask":
+        raise UserError(f"--scheduler {args.scheduler}: is for --backend dask (a Dask cluster), not "
+                        f"--backend {args.backend}: give --backend dask with it")
     check_case_file(args.case)
     try:
         result = run_file(args.case, args.spec, args.out, backend=args.backend, workers=args.workers,
@@ -383,6 +386,7 @@ def _export_mechanism(case: str):
 
 def _cmd_export(args) -> int:
     from mechbal.export.common import ExportError
+    from mechbal.output import write_file
 
     mech, q0, guess = _export_mechanism(args.case)
     fmt = args.format or ("urdf" if str(args.out).lower().endswith(".urdf") else "mjcf")
@@ -393,9 +397,10 @@ def _cmd_export(args) -> int:
     out = Path(args.out)
     if out.is_dir():
         raise UserError(f"--out: '{out}' is a folder: give a file name")
+    # MuJoCo reads the MJCF before anything is written; then written beside, flushed and renamed
+    # over --out (a failure keeps a previous file whole: exit 2 naming the path and the reason)
     checked = _validated_mjcf(text) if fmt == "mjcf" else None
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(text)
+    write_file(out, text)
     if not args.quiet:
         print(f"wrote {out} ({fmt.upper()}, {mech!r})")
     if checked is not None and not checked["validated"]:
@@ -773,7 +778,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "in one process, then every local core; serial; processes: every local core; "
                         "dask: a cluster (--scheduler)")
     s.add_argument("--workers", type=int, metavar="N", help="processes: number of local processes (default: all cores)")
-    s.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 (implies --backend dask)")
+    s.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786 (with --backend dask; refused otherwise)")
     _last_flags(s, _cmd_sweep, force=True, urdf=True)
     s = sub.add_parser("init", help="print a commented case template: mechbal init serial > my.toml",
                        description="Print a commented case file to standard output, to edit and "

@@ -516,6 +516,9 @@ class ReactionlessController(_core.ReactionlessController):
         traj = as_trajectory(trajectory)
         if duration is None:
             duration = float(getattr(traj, "end_time", traj.duration))
+        from mechbal.tables import check_run_ticks
+
+        check_run_ticks(duration, 1.0 / self.dt, "duration")  # bounded work before the run
         steps = int(round(duration / self.dt))
         q, v, a = traj.evaluate(np.arange(2 * steps + 1) * (0.5 * self.dt))
         task = list(self.task_indices)
@@ -732,6 +735,8 @@ def feasibility(mechanism: Any, control: Any, motion: Any, *, q_guess: npt.Array
 
     mech = mechanism
     names = list(mech.actuated_names)
+    from mechbal.tables import check_run_ticks
+
     rate_hz = float(_ctl(control, "rate_hz", 1000.0))
     dt = 1.0 / rate_hz
     cancel = _cancel_list(_ctl(control, "cancel", ["moment"]))
@@ -742,6 +747,7 @@ def feasibility(mechanism: Any, control: Any, motion: Any, *, q_guess: npt.Array
         if not isinstance(motion, FrameMotion):
             raise TypeError("the operational-space mode (task_frame) takes a mechbal.control.FrameMotion")
         duration = float(motion.duration)
+        check_run_ticks(duration, rate_hz, "rate_hz")
         steps = int(round(duration / dt))
         rows = _ctl(control, "task_rows", ["all"])
         task_ctrl = ReactionlessTaskController(mech, frame, rows, cancel, integrator, rate_hz, damping,
@@ -754,6 +760,7 @@ def feasibility(mechanism: Any, control: Any, motion: Any, *, q_guess: npt.Array
     else:
         traj = as_trajectory(motion)
         duration = float(getattr(traj, "duration"))
+        check_run_ticks(duration, rate_hz, "rate_hz")
         steps = int(round(duration / dt))
         th = np.arange(2 * steps + 1) * (0.5 * dt)
         qa, va, aa = (np.atleast_2d(x) for x in traj.evaluate(th))

@@ -215,6 +215,11 @@ class Mechanism:
         if not isinstance(model, _core.MechanismModel):
             raise TypeError(f"model must be a mechbal._core.MechanismModel, got {type(model).__name__}")
         self.model = model  # also builds the per-sample workspace (see the ``model`` property)
+        if not isinstance(name, str):
+            raise TypeError(f"name must be a str, got {type(name).__name__}")
+        why = _core.name_problem(name.encode("utf-8", "surrogatepass"))
+        if why:  # the character set of every name (docs/case_format.md, Names): files hold it
+            raise ValueError(f"name {why} (got {name!r})")
         self.name = name
         self.source = source
         #: link -> (4, 4) placement in the link frame of the frame the user described the link in

@@ -96,7 +96,64 @@ def _pid_alive(pid: int) -> bool:
         return False
     except (PermissionError, OverflowError, ValueError):
         return pid > 0  # exists (another user's) / not a pid: leave it alone
-    return True
+    return not _zombie(pid)
+
+
+def _zombie(pid: int) -> bool:
+    """A process that has ended and waits for its parent to reap it (state Z or X in
+    /proc/<pid>/stat): dead, though kill(pid, 0) still finds it (a container without an init that
+    reaps at once keeps a killed run's zombie for seconds)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False  # no /proc (not Linux) or gone meanwhile: kill() said it exists
+    # "pid (comm) S ...": comm may hold spaces and parentheses, the state follows the last ')'
+    state = stat[stat.rfind(")") + 1:].split()[:1]
+    return state in (["Z"], ["X"], ["x"])
+
+
+def write_file(path: str | Path, text: str) -> Path:
+    """Write ``text`` to the file ``path`` atomically: into a temporary file beside it (same file
+    system), flushed to disk (fsync), then renamed over ``path``; a failure leaves ``path`` as it
+    was (a previous file whole) and is an `OutputError` naming the path and the OS reason."""
+    given = str(path)
+    out = Path(path)
+    try:
+        if out.is_symlink():
+            if not out.exists():
+                raise OutputError(given, f"is a broken link (to {os.readlink(out)})")
+            out = Path(os.path.realpath(out))  # the file it links to is the one replaced
+        if out.is_dir():
+            raise OutputError(given, "is a folder: give a file name")
+        if out.exists() and not out.is_file():
+            raise OutputError(given, "is not a regular file (a device, pipe or socket)")
+        if out.parent.exists() and not out.parent.is_dir():
+            raise OutputError(given, f"{out.parent} is a file, not a folder")
+        out.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.partial-{os.getpid()}-", dir=out.parent)
+    except OutputError:
+        raise
+    except (OSError, ValueError) as exc:
+        raise OutputError(given, f"cannot be written: {_reason(exc) if isinstance(exc, OSError) else exc}") \
+            from None
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, out)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise OutputError(given, f"cannot be written: {_reason(exc)}") from None
+    return out
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def recover_stale(out: str | Path) -> list[Path]:
@@ -190,5 +247,5 @@ def _replace(tmp: Path, out: Path) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
-__all__ = ["OutputError", "OutputRaceError", "RUN_MARKER", "check_output_dir", "recover_stale",
+__all__ = ["OutputError", "OutputRaceError", "RUN_MARKER", "check_output_dir", "recover_stale", "write_file",
            "staged_output"]

@@ -19,6 +19,9 @@ def _pyplot():
     import matplotlib
 
     matplotlib.use("Agg")
+    # text is text: a name with '$' (a joint "a$b$") is drawn as written, never parsed as
+    # mathtext (whose parse errors would fail the plot); no mechbal label uses mathtext
+    matplotlib.rcParams["text.parse_math"] = False
     import matplotlib.pyplot as plt
 
     return plt

@@ -33,7 +33,7 @@ from pydantic_core import PydanticCustomError
 
 from mechbal.errors import ConfigError, ConfigWarning, short_repr
 from mechbal.tables import (  # noqa: F401 (the tables and machinery this module builds on, re-exported)
-    MAX_ABS, MAX_SAMPLES, MAX_SAMPLE_BODIES, MAX_JOINTS, MAX_BODIES, MAX_FRAMES, MAX_TICKS,
+    MAX_ABS, MAX_SAMPLES, MAX_SAMPLE_BODIES, MAX_JOINTS, MAX_BODIES, MAX_FRAMES, MAX_TICKS, check_run_ticks,
     MAX_CONFIGURATIONS, WARN_MASS_KG, WARN_REACH_M, WARN_LENGTH_M, WARN_ANGLE_RAD, _NUM, Num,
     NonNeg, Pos, Mass, Length, Angle, Duration, Rate, Samples, Name, Title, _vec, Vec2, Vec3,
     PosVec2, PosVec3, Xyz, Rpy, JointValues, _custom, _is_number, inertia_matrix, _check_inertia,
@@ -357,6 +357,11 @@ def _control_cross_checks(control: Control, spec: Any, actuated: list[str]) -> N
         if b not in actuated:
             raise ConfigError(f"control.balancing_joints[{i}]",
                               f"is not an actuated joint{did_you_mean(b, actuated)}", b)
+    if (control.kind == "reactionless" and control.task_frame is None and control.balancing_joints is not None
+            and len(control.balancing_joints) == len(actuated)):
+        raise ConfigError("control.balancing_joints", "lists every actuated joint: none is left to follow "
+                                                      "[trajectory] (keep one out, or give task_frame: the "
+                                                      "operational-space mode)", control.balancing_joints)
     if control.task_frame is not None:
         frames = [f.name for f in spec.frames]
         if control.task_frame not in frames:
@@ -617,6 +622,8 @@ def _cross_checks(case: Any) -> None:
                                                     f"{MAX_SAMPLE_BODIES})", case.trajectory.samples)
         if case.control is not None:
             _control_cross_checks(case.control, spec, names)
+            check_run_ticks(case.trajectory.motion_duration(), case.control.rate_hz)
+
 
 
 # ---- unit warnings -------------------------------------------------------------------------------

@@ -48,6 +48,17 @@ WARN_REACH_M = 5.0
 WARN_LENGTH_M = 100.0
 WARN_ANGLE_RAD = 2.0 * math.pi
 
+
+def check_run_ticks(duration: float, rate_hz: float, field: str = "control.rate_hz") -> None:
+    """Bounded work before a run starts: ``duration x rate_hz`` controller ticks at most
+    `MAX_TICKS` (the C++ case reader the same), else a ConfigError naming ``field``. Every entry
+    point that runs a controller over a duration calls it (the case readers, `mechbal.simulate`)."""
+    ticks = float(duration) * float(rate_hz)
+    if not ticks <= MAX_TICKS:
+        raise ConfigError(field, f"duration x rate_hz must be <= {MAX_TICKS} ticks (a run of "
+                                 f"{float(duration)!r} s)", ticks)
+
+
 # ---- value types --------------------------------------------------------------------------------
 _NUM = dict(strict=True, allow_inf_nan=False)
 Num = Annotated[float, Field(ge=-MAX_ABS, le=MAX_ABS, **_NUM)]
@@ -60,7 +71,25 @@ Duration = Annotated[float, Field(ge=1e-3, le=1e6, description="s", **_NUM)]
 #: a controller's tick rate: at most one second per tick
 Rate = Annotated[float, Field(ge=1, le=1e6, description="Hz", **_NUM)]
 Samples = Annotated[int, Field(ge=3, le=MAX_SAMPLES, strict=True)]
-Name = Annotated[str, Field(min_length=1, max_length=128, strict=True)]
+
+
+def name_problem(name: str) -> str:
+    """Why ``name`` is not a valid name, or ``""``: the C++ model's rule (`mechbal::name_problem`,
+    docs/case_format.md "Names"): printable text, no control character, surrogate or
+    noncharacter, so that every file mechbal writes can hold it."""
+    from mechbal import _core
+
+    return _core.name_problem(name.encode("utf-8", "surrogatepass"))
+
+
+def _check_name(name: str) -> str:
+    why = name_problem(name)
+    if why:
+        raise _custom(why, value=name)
+    return name
+
+
+Name = Annotated[str, Field(min_length=1, max_length=128, strict=True), AfterValidator(_check_name)]
 Title = Annotated[str, Field(max_length=1000, strict=True)]
 
 

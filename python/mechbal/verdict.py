@@ -92,7 +92,9 @@ def limits_in_force(mech: Any, ctl: Any = None, balancing: list[str] | None = No
     eff = np.asarray(model.effort_limits, float)
     get = ctl.get if isinstance(ctl, dict) else (lambda k: getattr(ctl, k, None))
     max_rate, max_speed, torque = get("max_rate"), get("max_speed"), get("torque_limit")
-    balancing = list(balancing if balancing is not None else (get("balancing_joints") or []))
+    if balancing is None:  # the operational-space mode moves every joint (balancing_joints optional there)
+        balancing = get("balancing_joints") or (names if get("task_frame") is not None else [])
+    balancing = list(balancing)
     out: dict[str, dict[str, float]] = {}
     for i, (name, c) in enumerate(zip(names, coords)):
         v = float(vel[c])

@@ -402,6 +402,9 @@ def reactionless_plan(case, *, dt: float = 1e-3, duration: float | None = None, 
     horizon = total if duration is None else min(float(duration), total)
     if not (np.isfinite(dt) and dt > 0 and horizon >= dt):
         raise ValueError(f"dt must be > 0 and the horizon >= dt, got dt={dt}, duration={duration}")
+    from mechbal.tables import check_run_ticks
+
+    check_run_ticks(horizon, 1.0 / dt, "dt")  # bounded work before the run
     steps = int(round(horizon / dt))
     th = np.arange(2 * steps + 1) * (0.5 * dt)
     common = dict(name=cfg.case.name, title=cfg.case.title or cfg.case.name, kind=cfg.case.kind, mech=mech,
@@ -982,7 +985,7 @@ def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration
                                "mechbal's prediction for the controller's command and MuJoCo's along its "
                                f"simulated motion, both variants ({1 / dt:g} Hz).")
     names = mech.actuated_names
-    shown = [names.index(b) for b in ctl.balancing_joints]
+    shown = [names.index(b) for b in (names if ctl.balancing_joints is None else ctl.balancing_joints)]
     act = [mech.joint_names.index(names[i]) for i in shown]
     report.plot_series(out / "balancing_joints.png", t,
                        {f"{label}, {who}": (s.command_q if who == "command" else s.cosimulation.q_full)[:, act]

@@ -506,3 +506,102 @@ TEST(MakeController, PassiveCommandsZeroWithoutAllocating) {
   EXPECT_NE(message_of(arm("origin") + "[control]\nkind = \"passive\"\nkp = [1, 1]\n").find("control.kp: is not for kind = 'passive'"),
             std::string::npos);
 }
+
+// ---- issue 40: names, bounded work, one verdict for both readers, the task controller's start ----
+
+TEST(Names, TheCharacterSetOfNames) {
+  EXPECT_EQ(name_problem("shoulder_lift"), "");
+  EXPECT_EQ(name_problem("bras épaule --> x <y> & \"z\""), "");  // printable: the writers escape it
+  EXPECT_EQ(name_problem(""), "must not be empty");
+  EXPECT_NE(name_problem(std::string("a\x01", 2)).find("U+0001"), std::string::npos);
+  EXPECT_NE(name_problem(std::string("a\0b", 3)).find("U+0000"), std::string::npos);
+  EXPECT_NE(name_problem("a\x7f").find("U+007F"), std::string::npos);
+  EXPECT_NE(name_problem("a\xc2\x85").find("U+0085"), std::string::npos);      // C1 control
+  EXPECT_NE(name_problem("a\xef\xbf\xbe").find("U+FFFE"), std::string::npos);  // noncharacter
+  EXPECT_NE(name_problem("a\xed\xa0\x80").find("U+D800"), std::string::npos);  // a surrogate
+  EXPECT_EQ(name_problem("a\xff"), "is not valid UTF-8");
+  EXPECT_EQ(name_problem("a\xc0\xaf"), "is not valid UTF-8");  // overlong '/'
+  EXPECT_EQ(name_problem(std::string(256, 'x')), "");
+  EXPECT_NE(name_problem(std::string(257, 'x')).find("at most 256"), std::string::npos);
+  // the model refuses it whoever builds it (URDF reader, Python constructors): the field named
+  MechanismDescription d;
+  Joint j;
+  j.name = std::string("j\n1");
+  j.parent = "base";
+  d.joints.push_back(j);
+  try {
+    MechanismModel m(d);
+    ADD_FAILURE() << "a name with a line feed was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("joints[0].name must not contain the character U+000A"), std::string::npos)
+        << e.what();
+  }
+  // and the case reader at the boundary, naming the field
+  const std::string bad = "[mechanism]\n[[mechanism.joints]]\nname = \"a\\u0001b\"\nlink = {mass = 1.0, com = [0.1, 0, 0]}\n";
+  EXPECT_EQ(field_of(bad), "mechanism.joints[0].name");
+}
+
+TEST(CaseReader, TextEntryPointsHaveTheFileSizeLimit) {
+  // a document past 4 MiB is refused before it is parsed, as the file API refuses the file
+  std::string big = arm("origin") + "# " + std::string(4u * 1024u * 1024u, 'x') + "\n";
+  for (int api = 0; api < 2; ++api) {
+    try {
+      if (api == 0) (void)case_from_string(big, "big.toml");
+      else (void)mechanism_from_string(big, "big.toml");
+      ADD_FAILURE() << "a document of " << big.size() << " bytes was read";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.field(), "big.toml");
+      EXPECT_NE(std::string(e.what()).find("4194304 bytes"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(CaseReader, MisspelledTablesAreErrors) {
+  const std::string base = arm("origin") + "[case]\nname = \"arm\"\nkind = \"mechanism\"\n";
+  EXPECT_EQ(message_of(base + "[contrl]\nkind = \"passive\"\n"), "contrl: unknown table (did you mean 'control'?)");
+  EXPECT_EQ(message_of(base + "[trajectry]\nlaw = \"quintic\"\n"),
+            "trajectry: unknown table (did you mean 'trajectory'?)");
+  EXPECT_NE(message_of(base + "extra = 1\n").find("extra: unknown key"), std::string::npos);
+  EXPECT_EQ(message_of(base + "[control]\nkind = \"passive\"\n"), "(accepted)");
+}
+
+TEST(CaseReader, TheTickLimitIsChecked) {
+  const std::string base = arm("origin") + "[case]\nname = \"arm\"\nkind = \"mechanism\"\n"
+                           "[trajectory]\nlaw = \"quintic\"\nstart = [0.0, 0.0]\nend = [1.0, 1.0]\n";
+  EXPECT_EQ(message_of(base + "duration = 2.0\n[control]\nkind = \"passive\"\nrate_hz = 500000.0\n"), "(accepted)");
+  EXPECT_EQ(message_of(base + "duration = 2.0\n[control]\nkind = \"passive\"\nrate_hz = 1000000.0\n"),
+            "control.rate_hz: duration x rate_hz must be <= 1000000 ticks (a run of 2.0 s) (got 2000000.0)");
+  EXPECT_EQ(message_of(base + "duration = 100000.0\n[control]\nkind = \"computed_torque\"\nkp = [1, 1]\nkd = [1, 1]\n"),
+            "control.rate_hz: duration x rate_hz must be <= 1000000 ticks (a run of 100000.0 s) (got 100000000.0)");
+}
+
+TEST(ReactionlessTask, TheStartIsValidated) {
+  const std::string text =
+      "[mechanism]\ngravity = [0.0, 0.0, -9.81]\n"
+      "[[mechanism.joints]]\nname = \"j1\"\nlimits = {lower = -2.0, upper = 2.0}\n"
+      "link = {mass = 1.0, com = [0.2, 0, 0], inertia = [0.001, 0.01, 0.01]}\n"
+      "[[mechanism.joints]]\nname = \"j2\"\norigin = {xyz = [0.4, 0, 0]}\n"
+      "link = {mass = 0.8, com = [0.15, 0, 0], inertia = [0.001, 0.008, 0.008]}\n"
+      "[[mechanism.joints]]\nname = \"j3\"\norigin = {xyz = [0.3, 0, 0]}\n"
+      "link = {mass = 0.5, com = [0.1, 0, 0], inertia = [0.001, 0.004, 0.004]}\n"
+      "[[mechanism.frames]]\nname = \"tip\"\nlink = \"j3\"\norigin = {xyz = [0.2, 0, 0]}\n";
+  const auto model = std::make_shared<const MechanismModel>(mechanism_from_string(text));
+  TaskSpaceConfig config;
+  config.frame = "tip";
+  config.cancel = moment_z;
+  config.task_rows = 3u;  // v_x, v_y
+  EXPECT_NO_THROW(ReactionlessTaskController(model, config, Eigen::Vector3d(0.3, 0.8, -0.6)));
+  // j3 declares no limit: any finite start is within it
+  EXPECT_NO_THROW(ReactionlessTaskController(model, config, Eigen::Vector3d(0.3, 0.8, 1e300)));
+  for (const Eigen::Vector3d& q0 : {Eigen::Vector3d(2.5, 0.0, 0.0), Eigen::Vector3d(1e300, 0.0, 0.0),
+                                    Eigen::Vector3d(-1e300, 0.0, 0.0)}) {
+    try {
+      ReactionlessTaskController c(model, config, q0);
+      ADD_FAILURE() << "the start " << q0.transpose() << " outside j1's limits was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("q0[0] (j1)"), std::string::npos) << e.what();
+    }
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(ReactionlessTaskController(model, config, Eigen::Vector3d(nan, 0.0, 0.0)), std::invalid_argument);
+}

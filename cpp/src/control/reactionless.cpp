@@ -18,6 +18,22 @@ namespace mechbal {
 
 namespace {
 
+/// Relative residual of a least-squares solve above which the cancelled components were not
+/// cancelled (rounding leaves ~1e-15 of |r| where the equations agree).
+constexpr double kUnmetResidual = 1e-8;
+
+/// Status::singular when M x leaves more than kUnmetResidual |r| of r (no allocation: k <= 6).
+Status unmet(const Eigen::MatrixXd& M, const Eigen::VectorXd& x, const Eigen::Ref<const Eigen::VectorXd>& r) noexcept {
+  double residual = 0.0, scale = 0.0;
+  for (Eigen::Index i = 0; i < M.rows(); ++i) {
+    const double e = M.row(i).dot(x) - r(i);
+    residual += e * e;
+    scale += r(i) * r(i);
+  }
+  return residual > kUnmetResidual * kUnmetResidual * scale ? Status::singular : Status::ok;
+}
+
+
 [[noreturn]] void fail(const std::string& field, const std::string& what, double value) {
   std::ostringstream msg;
   msg << field << " " << what << ", got " << value;
@@ -755,6 +771,12 @@ Status ReactionlessController::rates(const Vec6& h, const Eigen::VectorXd& q_b, 
   }
   Status st = factorise(condition);
   solve(kb_work_, v_b);
+  if (!wide_ && !square_ && !has(st, Status::singular)) {
+    // more cancelled components than balancing joints: the least-squares rates cancel them only
+    // where the equations agree (a planar arm's zero rows); a residual left is a tick that did
+    // not cancel what was asked, flagged as such (issue 40: "cancel both" with one wheel)
+    st |= unmet(Kb_, v_b, kb_work_.head(k_));
+  }
   if (wide_ && (config_.home_gain > 0.0 || config_.limit_gain > 0.0)) {
     for (int j = 0; j < nb_; ++j) {
       double zj = -config_.home_gain * (q_b(j) - home_(j));
@@ -1095,6 +1117,16 @@ ReactionlessTaskController::ReactionlessTaskController(std::shared_ptr<const Mec
     fail("q0 must have " + std::to_string(n_) + " finite values (every coordinate), got " + std::to_string(q0.size()));
   if (v0.size() != 0 && (v0.size() != n_ || !v0.allFinite()))
     fail("v0 must have " + std::to_string(n_) + " finite values, got " + std::to_string(v0.size()));
+  // the start within the joints' declared position limits (an undeclared limit is none)
+  for (Eigen::Index i = 0; i < n_; ++i) {
+    const double lo = m.lower_limits()(i), hi = m.upper_limits()(i);
+    if (q0(i) < lo || q0(i) > hi) {
+      std::ostringstream s;
+      s << "q0[" << i << "] (" << m.coordinate_name(static_cast<int>(i)) << ") = " << q0(i)
+        << " is outside the joint's declared limits [" << lo << ", " << hi << "]";
+      fail(s.str());
+    }
+  }
   const int nt = static_cast<int>(task_rows_.size()), k = static_cast<int>(rows_.size());
   for (Eigen::VectorXd* v : {&q_, &q_cmd_, &v_cmd_, &a_cmd_, &zero_, &a0_, &k1_, &k2_, &k3_, &k4_, &q_stage_, &v0_, &z_, &w_})
     *v = Eigen::VectorXd::Zero(n_);
@@ -1235,6 +1267,9 @@ Status ReactionlessTaskController::rates(const Eigen::VectorXd& q, const Vec6& t
     if (has(sm, Status::out_of_range)) return st | sm;
     st |= sm;
     solve(null_, M_, rm_, z_);
+    // more cancelled components than the null space's dimension: what the least squares leaves
+    // is a tick that did not cancel what was asked (as ReactionlessController::rates)
+    if (rank_M_ < M_.rows() && !has(sm, Status::singular)) st |= unmet(M_, z_, rm_);
     v.noalias() += N_ * z_;
   }
   if (!v.allFinite()) {

@@ -311,6 +311,8 @@ std::string name(const toml::node& n, const std::string& f) {
   const std::string v = s->get();
   if (v.empty()) fail(f, "must not be empty", n);
   if (utf8_length(v) > kMaxName) fail(f, "must have at most 128 characters", n);
+  // the character set of names (model.hpp name_problem; tables.Name): printable, XML-safe
+  if (const std::string why = name_problem(v); !why.empty()) fail(f, why, n);
   return v;
 }
 
@@ -1077,6 +1079,7 @@ MechanismDescription build_description(const MechanismIn& m, const std::string& 
 
 // config.MAX_CASE_BYTES, config.MAX_CASE_DEPTH
 constexpr std::uintmax_t kMaxCaseBytes = 4u * 1024u * 1024u;
+constexpr double kMaxTicks = 1e6;  // schema.MAX_TICKS: controller ticks of one run
 constexpr int kMaxCaseDepth = 32;
 
 [[noreturn]] void too_deep(const std::string& source) {
@@ -1365,6 +1368,15 @@ toml::table parse(const std::string& text, const std::string& source) {
   return doc;
 }
 
+/// A text given as a string: at most kMaxCaseBytes, as a file (read_file), else ConfigError(source).
+void check_text_size(const std::string& text, const std::string& source) {
+  if (text.size() > kMaxCaseBytes) {
+    fail(source.empty() ? "case" : source, "is " + std::to_string(text.size()) +
+                                               " bytes, more than a case file can be (" +
+                                               std::to_string(kMaxCaseBytes) + " bytes)");
+  }
+}
+
 /// config.read_regular_file: a regular file of at most kMaxCaseBytes, else ConfigError("case").
 std::string read_file(const std::string& path) {
   std::error_code ec;
@@ -1541,6 +1553,11 @@ ControlConfig read_control(const toml::node& n, const MechanismModel& model) {
       fail(item(fb, k), "is not an actuated joint" + did_you_mean(nm, actuated), quote(nm));
     }
   }
+  if (c.kind == ControlKind::reactionless && c.task_frame.empty() && !c.balancing_joints.empty() &&
+      c.balancing_joints.size() == actuated.size()) {
+    fail(fb, "lists every actuated joint: none is left to follow [trajectory] (keep one out, or give task_frame: "
+             "the operational-space mode)", *get(t, "balancing_joints"));
+  }
   if (!c.task_frame.empty() && model.frame_index(c.task_frame) < 0) {
     std::vector<std::string> frames;
     for (int k = 0; k < model.num_frames(); ++k) frames.push_back(model.frame(k).name);
@@ -1650,9 +1667,6 @@ TrajectoryConfig read_trajectory(const toml::node& n, const MechanismModel& mode
 }
 
 LoadedCase case_of(const toml::table& doc) {
-  MechanismModel model = model_of(description_of(doc));
-  ControlConfig control;
-  if (const toml::node* c = doc.get("control")) control = read_control(*c, model);
   std::string case_name, kind;
   if (const toml::node* h = doc.get("case")) {
     if (h->is_table()) {
@@ -1660,9 +1674,23 @@ LoadedCase case_of(const toml::table& doc) {
       if (auto k = h->as_table()->get("kind"); k && k->is_string()) kind = k->as_string()->get();
     }
   }
+  const bool chain = kind.empty() || kind == "mechanism" || kind == "serial_chain";
+  // the tables of the format (schema.SerialChainCase): a misspelled one ([contrl]) is an error
+  if (chain) allow_keys(doc, "", {"case", "mechanism", "trajectory", "balance", "control"});
+  MechanismModel model = model_of(description_of(doc));
+  ControlConfig control;
+  if (const toml::node* c = doc.get("control")) control = read_control(*c, model);
   TrajectoryConfig trajectory;
-  if (kind.empty() || kind == "mechanism" || kind == "serial_chain") {
+  if (chain) {
     if (const toml::node* t = doc.get("trajectory")) trajectory = read_trajectory(*t, model);
+    // bounded work before a run starts (schema.MAX_TICKS): duration x rate_hz controller ticks
+    if (doc.get("control") && trajectory.present) {
+      const double ticks = trajectory.duration * control.rate_hz;
+      if (ticks > kMaxTicks) {
+        fail("control.rate_hz", "duration x rate_hz must be <= 1000000 ticks (a run of " +
+                                    float_repr(trajectory.duration) + " s)", float_repr(ticks));
+      }
+    }
   }
   return LoadedCase{std::move(model), std::move(control), std::move(trajectory), std::move(case_name)};
 }
@@ -1670,6 +1698,7 @@ LoadedCase case_of(const toml::table& doc) {
 }  // namespace
 
 MechanismDescription mechanism_description_from_string(const std::string& toml_text, const std::string& source) {
+  check_text_size(toml_text, source);
   return description_of(parse(toml_text, source));
 }
 
@@ -1680,6 +1709,7 @@ MechanismModel mechanism_from_string(const std::string& toml_text, const std::st
 MechanismModel load_mechanism(const std::string& path) { return mechanism_from_string(read_file(path), path); }
 
 LoadedCase case_from_string(const std::string& toml_text, const std::string& source) {
+  check_text_size(toml_text, source);
   return case_of(parse(toml_text, source));
 }
 

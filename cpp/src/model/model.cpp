@@ -1,6 +1,7 @@
 #include "mechbal/model/model.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -14,6 +15,11 @@
 namespace mechbal {
 
 namespace {
+
+void check_name(const std::string& field, const std::string& name) {
+  const std::string why = name_problem(name);
+  if (!why.empty()) throw std::invalid_argument(field + " " + why);
+}
 
 std::string joint_field(std::size_t i, const Joint& j, const char* field) {
   std::ostringstream s;
@@ -107,8 +113,37 @@ std::string nearest(const std::string& name, const std::vector<std::string>& kno
 
 }  // namespace
 
+std::string name_problem(const std::string& name) {
+  if (name.empty()) return "must not be empty";
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < name.size();) {
+    const auto b = static_cast<unsigned char>(name[i]);
+    std::size_t len = b < 0x80 ? 1 : (b >> 5) == 6 ? 2 : (b >> 4) == 14 ? 3 : (b >> 3) == 30 ? 4 : 0;
+    if (len == 0 || i + len > name.size()) return "is not valid UTF-8";
+    char32_t c = len == 1 ? b : len == 2 ? (b & 0x1Fu) : len == 3 ? (b & 0x0Fu) : (b & 0x07u);
+    for (std::size_t k = 1; k < len; ++k) {
+      const auto x = static_cast<unsigned char>(name[i + k]);
+      if ((x & 0xC0) != 0x80) return "is not valid UTF-8";
+      c = (c << 6) | (x & 0x3Fu);
+    }
+    const char32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
+    if (c < least[len] || c > 0x10FFFF) return "is not valid UTF-8";
+    if (c < 0x20 || (c >= 0x7F && c <= 0x9F) || (c >= 0xD800 && c <= 0xDFFF) || (c >= 0xFDD0 && c <= 0xFDEF) ||
+        (c & 0xFFFEu) == 0xFFFEu) {
+      char code[16];
+      std::snprintf(code, sizeof code, "U+%04X", static_cast<unsigned>(c));
+      return std::string("must not contain the character ") + code +
+             " (names are printable: no control character, surrogate or noncharacter)";
+    }
+    ++count;
+    i += len;
+  }
+  if (count > kMaxNameCharacters) return "must have at most " + std::to_string(kMaxNameCharacters) + " characters";
+  return "";
+}
+
 MechanismModel::MechanismModel(MechanismDescription d) {
-  if (d.root_name.empty()) throw std::invalid_argument("root_name must not be empty");
+  check_name("root_name", d.root_name);
   if (!d.gravity.allFinite()) throw std::invalid_argument("gravity must be finite");
   root_name_ = d.root_name;
   gravity_ = d.gravity;
@@ -118,7 +153,7 @@ MechanismModel::MechanismModel(MechanismDescription d) {
   std::vector<std::string> link_names{d.root_name};
   for (std::size_t i = 0; i < d.joints.size(); ++i) {
     Joint& j = d.joints[i];
-    if (j.name.empty()) throw std::invalid_argument(joint_field(i, j, "name") + " must not be empty");
+    check_name("joints[" + std::to_string(i) + "].name", j.name);
     if (j.name == d.root_name) {
       throw std::invalid_argument(joint_field(i, j, "name") + " must differ from the root link's name '" +
                                   d.root_name + "'");
@@ -322,7 +357,7 @@ MechanismModel::MechanismModel(MechanismDescription d) {
   std::map<std::string, std::size_t> body_names;
   for (std::size_t b = 0; b < d.bodies.size(); ++b) {
     const Body& body = d.bodies[b];
-    if (body.name.empty()) throw std::invalid_argument(indexed_field("bodies", b, body.name, "name") + " must not be empty");
+    check_name("bodies[" + std::to_string(b) + "].name", body.name);
     if (!body_names.emplace(body.name, b).second) {
       throw std::invalid_argument(indexed_field("bodies", b, body.name, "name") + " is used by two bodies");
     }
@@ -343,7 +378,7 @@ MechanismModel::MechanismModel(MechanismDescription d) {
   std::map<std::string, std::size_t> frame_names;
   for (std::size_t f = 0; f < d.frames.size(); ++f) {
     const Frame& fr = d.frames[f];
-    if (fr.name.empty()) throw std::invalid_argument(indexed_field("frames", f, fr.name, "name") + " must not be empty");
+    check_name("frames[" + std::to_string(f) + "].name", fr.name);
     if (!frame_names.emplace(fr.name, f).second) {
       throw std::invalid_argument(indexed_field("frames", f, fr.name, "name") + " is used by two frames");
     }
@@ -412,7 +447,7 @@ MechanismModel::MechanismModel(MechanismDescription d) {
       s << x;
       return s.str();
     };
-    if (sp.name.empty()) throw std::invalid_argument(field("name") + " must not be empty");
+    check_name("springs[" + std::to_string(i) + "].name", sp.name);
     if (!spring_names.emplace(sp.name, i).second) throw std::invalid_argument(field("name") + " is used by two springs");
     int links[2];
     for (int side = 0; side < 2; ++side) {
@@ -460,7 +495,7 @@ MechanismModel::MechanismModel(MechanismDescription d) {
   std::map<std::string, std::size_t> loop_names;
   for (std::size_t i = 0; i < d.loops.size(); ++i) {
     const LoopConstraint& lc = d.loops[i];
-    if (lc.name.empty()) throw std::invalid_argument(indexed_field("loops", i, lc.name, "name") + " must not be empty");
+    check_name("loops[" + std::to_string(i) + "].name", lc.name);
     if (!loop_names.emplace(lc.name, i).second) {
       throw std::invalid_argument(indexed_field("loops", i, lc.name, "name") + " is used by two loops");
     }

@@ -303,10 +303,9 @@ def _plain(x):
 
 
 def _plot(fr: Front, path: Path, title: str) -> None:
-    import matplotlib
+    from mechbal.report import _pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = _pyplot()
 
     m = [p.added_mass for p in fr.points]
     r = [p.residual for p in fr.points]

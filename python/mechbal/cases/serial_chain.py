@@ -471,7 +471,13 @@ def _motion_acceleration(t, v):
     the commanded rates (the stored poses' own acceleration, whatever the feed-forward)."""
     from scipy.interpolate import make_interp_spline
 
-    return make_interp_spline(t, v, k=5)(t, 1)
+    t, v = np.asarray(t, float), np.asarray(v, float)
+    if len(t) < 2:
+        return np.zeros_like(v)
+    # quintic where there are ticks enough (6); a run of few ticks (a low rate_hz) the highest odd
+    # degree they carry (cubic: 4, linear: 2), never scipy's refusal
+    k = 5 if len(t) >= 6 else 3 if len(t) >= 4 else 1
+    return make_interp_spline(t, v, k=k)(t, 1)
 
 
 def check_task_space(mech: Mechanism, case) -> None:
@@ -489,15 +495,16 @@ def check_task_space(mech: Mechanism, case) -> None:
     if ctl.task_frame not in mech.frame_names:
         raise ConfigError("control.task_frame", "is not a frame of the mechanism"
                           + did_you_mean(ctl.task_frame, list(mech.frame_names)), ctl.task_frame)
-    missing = [n for n in names if n not in ctl.balancing_joints]
-    for i, b in enumerate(ctl.balancing_joints):
+    listed = list(names if ctl.balancing_joints is None else ctl.balancing_joints)  # absent: every joint
+    missing = [n for n in names if n not in listed]
+    for i, b in enumerate(listed):
         if b not in names:
             raise ConfigError(f"control.balancing_joints[{i}]",
                               f"is not an actuated joint{did_you_mean(b, names)}", b)
     if missing:
         raise ConfigError("control.balancing_joints", "in the operational-space mode (task_frame) the "
                           "controller moves every joint: list them all (missing: " + ", ".join(missing) + ")",
-                          list(ctl.balancing_joints))
+                          listed)
     tr = case.trajectory
     if tr.law not in ("quintic", "cubic", "line"):
         raise ConfigError("trajectory.law", "the operational-space mode's path is rest-to-rest between the "

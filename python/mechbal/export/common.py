@@ -77,22 +77,30 @@ def _identity(T) -> bool:
 
 
 def link_labels(mech) -> dict[str, str]:
-    """mechbal link name -> the name a file gives it (module docstring)."""
+    """mechbal link name -> the name a file gives it (module docstring). A link takes the name of
+    its frame of identity placement (its own name first), whatever other joints are called (a
+    URDF whose link names are other joints' names keeps every frame where it was); a link without
+    one keeps its own name, suffixed where a frame's name took it: the names are unique."""
     d = mech.model.description
     links = [d.root_name] + [j.name for j in d.joints]
     labels = {n: n for n in links}
-    taken = set(links)
     named = {f.link for f in d.frames if f.name == f.link and _identity(f.placement)}
     if d.root_name not in named:   # not read from a URDF (whose every link is a frame, the root's too)
         return labels
+    wanted: dict[str, str] = {n: n for n in named}
     for f in d.frames:
-        if f.link in named or labels[f.link] != f.link or not _identity(f.placement):
+        if f.link not in wanted and _identity(f.placement):
+            wanted[f.link] = f.name
+    taken = set(wanted.values())   # frame names: unique
+    for n in links:
+        if n in wanted:
+            labels[n] = wanted[n]
             continue
-        if f.name in taken:  # another link's name: keep the link's own
-            continue
-        taken.discard(f.link)
-        taken.add(f.name)
-        labels[f.link] = f.name
+        label = n
+        while label in taken:
+            label += "_link"
+        taken.add(label)
+        labels[n] = label
     return labels
 
 

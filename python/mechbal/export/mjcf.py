@@ -458,11 +458,14 @@ def _build(mech, q, q_guess, timestep, *, name=None, names_only=False, minimum_m
         lines += [ind + s for s in extra_sites.get(link, [])]
         return lines
 
+    body_index = {b.name: i for i, b in enumerate(mech.model.description.bodies)}
+
     def extra_bodies(link: str, ind: str) -> list[str]:
         lines = []
         for b in by_link.get(link, []):
             if inertia_is_zero(b):
-                lines.append(f"{ind}<!-- body {b.name}: zero mass and inertia, left out -->")
+                # never a name in a comment (a name may hold "--" or "-->"): its index only
+                lines.append(f"{ind}<!-- bodies[{body_index[b.name]}]: zero mass and inertia, left out -->")
                 continue
             if own.get(link) is b:
                 continue

@@ -453,6 +453,9 @@ def co_simulate(mech, controller, trajectory, q0=None, v0=None, *, dt: float = 1
         raise ValueError(f"dt must be > 0 and duration >= dt, got dt={dt}, duration={duration}")
     if int(substeps) < 1:
         raise ValueError(f"substeps must be >= 1, got {substeps}")
+    from mechbal.tables import check_run_ticks
+
+    check_run_ticks(duration, 1.0 / dt, "dt")  # bounded work before the run
     steps = int(round(duration / dt))
     t = np.arange(steps + 1) * dt
     q_des, v_des, a_des = (np.atleast_2d(np.asarray(x, float)) for x in traj.evaluate(t))

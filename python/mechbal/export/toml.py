@@ -18,7 +18,6 @@ Layer: Python core (docs/architecture.md).
 """
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any, Mapping
@@ -32,8 +31,31 @@ from mechbal.export.urdf import urdf_text  # noqa: F401  (its home: mechbal.expo
 _BARE = set("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-")
 
 
+_ESCAPES = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f", "\r": "\\r"}
+
+
+def _string(s: str) -> str:
+    """A TOML basic string holding ``s`` exactly: the quote, the backslash and every control
+    character (U+0000..U+001F, U+007F) escaped; the one string writer of every TOML mechbal writes
+    (case files, balanced.toml, the papers' generated cases). A lone surrogate, which no TOML
+    string can hold, is a ValueError."""
+    out = ['"']
+    for ch in str(s):
+        c = ord(ch)
+        if ch in _ESCAPES:
+            out.append(_ESCAPES[ch])
+        elif c < 0x20 or c == 0x7F:
+            out.append(f"\\u{c:04X}")
+        elif 0xD800 <= c <= 0xDFFF:
+            raise ValueError(f"TOML: cannot write the lone surrogate U+{c:04X} in a string")
+        else:
+            out.append(ch)
+    out.append('"')
+    return "".join(out)
+
+
 def _key(k: str) -> str:
-    return k if k and set(k) <= _BARE else json.dumps(k)
+    return k if k and set(k) <= _BARE else _string(k)
 
 
 def _value(v: Any) -> str:
@@ -47,7 +69,7 @@ def _value(v: Any) -> str:
             raise ValueError(f"TOML: cannot write the non-finite number {x}")
         return repr(x)
     if isinstance(v, str):
-        return json.dumps(v, ensure_ascii=False)
+        return _string(v)
     if isinstance(v, np.ndarray):
         return _value(v.tolist())
     if isinstance(v, (list, tuple)):

@@ -23,10 +23,9 @@ __all__ = ["write_identified", "plot_validation", "plot_parameters"]
 
 
 def plot_validation(result: IdentificationResult, path: str | Path) -> Path:
-    import matplotlib
+    from mechbal.report import _pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = _pyplot()
 
     v = result.validation
     tr = v.trace
@@ -52,10 +51,9 @@ def plot_validation(result: IdentificationResult, path: str | Path) -> Path:
 
 
 def plot_parameters(result: IdentificationResult, path: str | Path) -> Path:
-    import matplotlib
+    from mechbal.report import _pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = _pyplot()
 
     names = result.base.names
     x = np.arange(len(names))

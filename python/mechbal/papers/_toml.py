@@ -19,6 +19,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from mechbal import _core
+from mechbal.export.toml import _string as _str  # the one TOML string writer
 
 __all__ = ["rpy_of", "case_toml"]
 
@@ -55,9 +56,6 @@ def _num(x: float) -> str:
 def _vec(v) -> str:
     return "[" + ", ".join(_num(x) for x in np.asarray(v, float).ravel()) + "]"
 
-
-def _str(s: str) -> str:
-    return '"' + str(s).replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
 def _origin(T: np.ndarray) -> str:

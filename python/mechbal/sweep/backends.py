@@ -11,7 +11,10 @@ Layer: methods (docs/architecture.md).
 """
 from __future__ import annotations
 
+import contextlib
+import functools
 import os
+import sys
 from typing import Any
 
 from mechbal import progress as _progress
@@ -58,8 +61,9 @@ def run_chunks(plan, chunks: list[tuple[int, Any]], *, backend: str = "serial", 
                scheduler=None, progress: bool = True, callback=None) -> list[dict]:
     """Results of every chunk ``(start, values)``, in chunk order; ``callback(done, total)`` after
     each chunk completes (in this process)."""
-    if scheduler is not None and backend in ("serial", "processes"):
-        backend = "dask"
+    if scheduler is not None and backend != "dask":
+        raise ValueError(f"scheduler: is for backend 'dask' (a Dask cluster), not {backend!r}: give "
+                         f"backend 'dask' (--backend dask) with it, or no scheduler")
     if backend not in BACKENDS:
         from mechbal.schema import did_you_mean
         raise ValueError(f"backend: must be one of {', '.join(BACKENDS)}{did_you_mean(str(backend), list(BACKENDS))}")
@@ -112,7 +116,23 @@ def _processes(plan, chunks, workers, bar) -> list[dict]:
             bar.chunk_done(result)
 
     with Callback(posttask=posttask):
-        return list(dask.compute(*tasks, scheduler="processes", num_workers=workers))
+        # the workers die with this process (a parent-death signal): SIGTERM or SIGKILL to a
+        # sweep leaves no worker (nor, their pipes closed, multiprocessing's resource tracker)
+        return list(dask.compute(*tasks, scheduler="processes", num_workers=workers,
+                                 initializer=functools.partial(_die_with_parent, os.getpid())))
+
+
+def _die_with_parent(parent: int) -> None:
+    """A local worker's initializer: SIGTERM when the process that started it ends (Linux's
+    PR_SET_PDEATHSIG); already orphaned: exit at once."""
+    if sys.platform.startswith("linux"):
+        import ctypes
+        import signal
+
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM), 0, 0, 0)  # PR_SET_PDEATHSIG
+    if os.getppid() != parent:
+        os._exit(1)
 
 
 def _distributed(plan, chunks, scheduler, bar) -> list[dict]:
@@ -121,7 +141,21 @@ def _distributed(plan, chunks, scheduler, bar) -> list[dict]:
     own = not isinstance(scheduler, distributed.Client)
     if own and scheduler is None:
         raise ValueError("backend dask: give the scheduler's address (--scheduler tcp://host:port) or a Client")
-    client = distributed.Client(scheduler, set_as_default=False) if own else scheduler
+    if own:
+        import logging
+
+        quiet = logging.getLogger("distributed")  # its tracebacks of a failed handshake: the one line says it
+        level = quiet.level
+        quiet.setLevel(logging.CRITICAL)
+        try:
+            client = distributed.Client(scheduler, set_as_default=False)
+        except Exception as exc:  # noqa: BLE001 - a closed port, a peer that is not a scheduler: one line
+            raise SweepConnectionError(f"scheduler: cannot connect to a Dask scheduler at {scheduler!r}: "
+                                       f"{_reason(exc)}") from None
+        finally:
+            quiet.setLevel(level)
+    else:
+        client = scheduler
     try:
         # The plan once to every worker (each keeps a copy, so a dead worker loses none). Each task
         # carries its own chunk of values: scattered data would die with the worker that holds it,
@@ -149,6 +183,18 @@ def _distributed(plan, chunks, scheduler, bar) -> list[dict]:
             client.close()
 
 
+class SweepConnectionError(ValueError):
+    """No Dask scheduler answered at the address given (nothing listens there, or the peer is not
+    a Dask scheduler): one line naming the address and the reason."""
+
+
+def _reason(exc: BaseException) -> str:
+    if isinstance(exc, MemoryError):  # a peer that is not a Dask scheduler sends what reads as a huge message
+        return "the peer does not speak Dask's protocol (is it a Dask scheduler?)"
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text[:200]}" if text else type(exc).__name__
+
+
 class SweepIncomplete(RuntimeError):
     """The cluster failed before every chunk was evaluated (every worker lost, the scheduler
     gone): ``finished`` holds the results of the chunks that were done, ``(start, result)`` in
@@ -169,4 +215,4 @@ def _incomplete(chunks, out, cause) -> SweepIncomplete:
                            f"and are kept (SweepIncomplete.finished)", finished, done, total)
 
 
-__all__ = ["AUTO_SERIAL_SECONDS", "BACKENDS", "SweepIncomplete", "require_extra", "run_chunks"]
+__all__ = ["AUTO_SERIAL_SECONDS", "BACKENDS", "SweepConnectionError", "SweepIncomplete", "require_extra", "run_chunks"]

@@ -35,6 +35,16 @@
 
 namespace mechbal {
 
+/// Names (of joints, links, bodies, frames, loops, springs): 1 .. kMaxNameCharacters characters
+/// of valid UTF-8, none of them a control character (U+0000..U+001F, U+007F..U+009F), a
+/// surrogate or a noncharacter (U+FDD0..U+FDEF, U+xFFFE, U+xFFFF): printable text that every file
+/// format mechbal writes (TOML, URDF, MJCF, JSON, CSV) can hold. docs/case_format.md, "Names".
+inline constexpr std::size_t kMaxNameCharacters = 256;
+
+/// Why `name` is not a valid name ("" when it is): "must not be empty", "is not valid UTF-8",
+/// "must not contain the character U+0001 (...)", "must have at most 256 characters".
+std::string name_problem(const std::string& name);
+
 /// One joint of the description. `parent` names the parent link (a joint's name, or the root).
 struct Joint {
   std::string name;
