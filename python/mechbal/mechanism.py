@@ -217,7 +217,9 @@ class Mechanism:
         self.model = model  # also builds the per-sample workspace (see the ``model`` property)
         if not isinstance(name, str):
             raise TypeError(f"name must be a str, got {type(name).__name__}")
-        why = _core.name_problem(name.encode("utf-8", "surrogatepass"))
+        # as bytes (pybind11 passes them to std::string unchanged): a lone surrogate reaches the
+        # check as invalid UTF-8 instead of failing the conversion
+        why = _core.name_problem(name.encode("utf-8", "surrogatepass"))  # type: ignore[arg-type]
         if why:  # the character set of every name (docs/case_format.md, Names): files hold it
             raise ValueError(f"name {why} (got {name!r})")
         self.name = name

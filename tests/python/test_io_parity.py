@@ -615,7 +615,9 @@ def random_control(seed: int) -> dict:
             c["task_frame"] = "tool"
         if "task_frame" not in c or pick():
             joints = ["shoulder", "elbow", "wheel"]
-            c["balancing_joints"] = [str(j) for j in rng.choice(joints, size=int(rng.integers(1, 4)), replace=False)]
+            # the joint mode keeps one actuated joint out to follow [trajectory]; the task mode may list all
+            most = 4 if "task_frame" in c else 3
+            c["balancing_joints"] = [str(j) for j in rng.choice(joints, size=int(rng.integers(1, most)), replace=False)]
         if pick():
             names = ["moment", "force", "both", "moment_x", "moment_y", "moment_z", "force_x", "force_y", "force_z"]
             c["cancel"] = [str(n) for n in rng.choice(names, size=int(rng.integers(1, 10)))]

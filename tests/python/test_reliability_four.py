@@ -6,6 +6,8 @@ workers are handled, both case readers give one verdict.
 Test names carry the defect's number in the issue (``test_d01_...`` .. ``test_d13_...``)."""
 from __future__ import annotations
 
+import re
+
 import json
 import os
 import signal
@@ -90,12 +92,12 @@ def test_d01_control_characters_and_xml_invalid_code_points_are_refused(tmp_path
             assert code in str(exc.value) and exc.value.field.endswith(".name"), exc.value
         # the C++ reader the same
         text = toml_text(named_arm([bad, "j2", "j3", "cw", "tool"]))
-        with pytest.raises(ValueError, match=code if ord(bad[1]) < 0x80 else None):
+        with pytest.raises(ValueError, match=re.escape(code) if ord(bad[1]) < 0x80 else None):
             _core.case_from_toml(text)
         # and every constructor: the model (the URDF reader's and Python's), the Mechanism's name
         j = _core.Joint()
         j.name, j.parent = bad, "base"
-        with pytest.raises((ValueError, TypeError), match=code):
+        with pytest.raises((ValueError, TypeError), match=re.escape(code)):
             Mechanism.from_description([j])
     with pytest.raises(ValueError):  # the XML reader's refusal of &#1; or the name's
         Mechanism.from_urdf_string('<robot name="r"><link name="base"/><link name="a&#1;"/>'
@@ -103,7 +105,7 @@ def test_d01_control_characters_and_xml_invalid_code_points_are_refused(tmp_path
                                    '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
                                    '</robot>')
     mech = _mechanism(tmp_path, named_arm(["j1", "j2", "j3", "cw", "tool"]))
-    with pytest.raises(ValueError, match="U+0007"):
+    with pytest.raises(ValueError, match=re.escape("U+0007")):
         Mechanism(mech.model, name="bell\x07")
 
 
