@@ -94,7 +94,8 @@ def _check_round_trip(result, pi_true, fr):
     # the conic solver converged, and every body is physically consistent: the invariant checked
     # here on the parameters themselves (pseudo-inertia positive semi-definite, positive mass,
     # principal moments non-negative and within the triangle inequality)
-    assert result.solver["converged"] and result.solver["status"] == "Solved"
+    assert result.solver["converged"] and result.solver["status"] in ("Solved", "AlmostSolved")
+    assert max(result.solver["primal_residual"], result.solver["dual_residual"], result.solver["gap"]) <= 1e-7
     assert all(c.consistent for c in result.consistency)
     for i in range(len(S.segment_links)):
         pi = result.parameters[10 * i:10 * i + 10]
@@ -255,7 +256,7 @@ def test_the_lmi_fit_is_the_one_cvxpy_finds_and_keeps_every_constraint():
     A, b, R, z, cad = _lmi_problem(3)
     bounds = (0.5, 1.5)
     x, report = consistent_fit(R, z, 3, 6, cad, regularisation=0.0, mass_bounds=bounds)
-    assert report.converged and report.status == "Solved"
+    assert report.converged and max(report.primal_residual, report.dual_residual, report.gap) <= 1e-7
     X = cp.Variable(36)
     cons = [X[30] >= 0, X[31] >= 0, X[33] >= 0, X[34] >= 0]
     for k in range(3):

@@ -15,7 +15,9 @@ the parameters, so the fit
 
 is a convex semi-definite least squares (an LMI problem). It is solved as a conic program by
 the interior-point solver Clarabel (Goulart & Chen 2024; the ``identify`` extra, imported lazily):
-the objective as a second-order cone (minimise t with |[R; D^1/2] x - [z; D^1/2 pi_cad]| <= t),
+the objective as a second-order cone (minimise t with |[R; D^1/2] x - [z; D^1/2 pi_cad]| <= t,
+the part of the residual no parameter changes included, so that the accuracy is relative to the
+whole residual),
 each body's J in a 4 x 4 positive semi-definite cone, the friction signs and mass bounds in the
 non-negative cone. For the solver's sake the variables are scaled to a unit diagonal of the
 normal matrix and each J by a congruence (J -> T J T, T = diag(a, a, a, b) from the CAD body's
@@ -41,6 +43,14 @@ __all__ = ["pseudo_inertia", "consistency", "BodyConsistency", "consistent_fit",
 
 #: the solver's relative accuracy (Clarabel's ``tol_gap_abs``/``tol_gap_rel``/``tol_feas``)
 ACCURACY = 1e-10
+
+#: the floor of the pull towards the CAD values, relative to the mean squared column norm of R
+#: (what gives the directions the data leave free a curvature the interior point can follow)
+FLOOR = 1e-3
+
+#: a solve Clarabel ends as ``AlmostSolved`` (slow progress near the end) counts as converged
+#: when its relative primal and dual residuals and duality gap, measured here, are all below this
+CERTIFIED = 1e-7
 
 
 class MissingExtra(ImportError):
@@ -117,7 +127,8 @@ def consistency(name: str, pi) -> BodyConsistency:
 
 @dataclass(frozen=True)
 class SolverReport:
-    """How the conic solve ended: Clarabel's ``status`` (``converged``: ``"Solved"``), its
+    """How the conic solve ended: Clarabel's ``status`` (``converged``: ``"Solved"``, or
+    ``"AlmostSolved"`` with the residuals and gap below `CERTIFIED`), its
     ``iterations``, the relative primal and dual residuals and duality gap it reached, the
     ``accuracy`` asked, and ``projection``: the largest change of a parameter made by raising
     the J's eigenvalues to the cone, relative to the largest parameter of its body."""
@@ -144,12 +155,14 @@ def _body_scale(pi_cad: np.ndarray) -> np.ndarray:
 
 def consistent_fit(R: np.ndarray, z: np.ndarray, n_segments: int, n_friction: int, cad: np.ndarray, *,
                    regularisation: float = 1e-6, mass_bounds: tuple[float, float] | None = None,
-                   max_iterations: int = 200) -> tuple[np.ndarray, SolverReport]:
+                   max_iterations: int = 200, rest: float = 0.0) -> tuple[np.ndarray, SolverReport]:
     """The fit of the module docstring: ``R`` (P, P), ``z`` (P,) the compressed weighted least
     squares (R of the QR decomposition of the weighted regressor), x = [pi (10 S), friction
     (viscous, Coulomb, offset per joint)]; ``mass_bounds`` (low, high): factors of each body's CAD
     mass (bodies with a CAD mass only); ``max_iterations``: the solver's (interior-point
-    iterations). Returns (x, `SolverReport`); x is consistent whatever the solver's status, which
+    iterations); ``rest``: the part of the residual's norm no parameter changes (the last diagonal
+    element of the QR of [W, y]), so that the solver's relative accuracy is relative to the whole
+    residual, not to its excess over the unconstrained optimum. Returns (x, `SolverReport`); x is consistent whatever the solver's status, which
     the caller judges (`SolverReport.converged`). Raises `MissingExtra` without Clarabel."""
     import scipy.sparse as sp
 
@@ -160,7 +173,7 @@ def consistent_fit(R: np.ndarray, z: np.ndarray, n_segments: int, n_friction: in
     if mass_bounds is not None and not (0.0 <= mass_bounds[0] <= mass_bounds[1]):
         raise ValueError(f"mass_bounds: {mass_bounds!r} is not (low, high) with 0 <= low <= high")
     c2 = np.sum(R[:, :Pi] ** 2, axis=0)
-    c2 = c2 + 1e-6 * max(float(np.mean(c2)), 1e-300)
+    c2 = c2 + FLOOR * max(float(np.mean(c2)), 1e-300)
     d = np.zeros(P)
     d[:Pi] = regularisation * c2
     x_ref = np.zeros(P)
@@ -169,21 +182,24 @@ def consistent_fit(R: np.ndarray, z: np.ndarray, n_segments: int, n_friction: in
     A_obj = np.vstack([R, np.diag(np.sqrt(d))])
     c_obj = np.concatenate([z, np.sqrt(d) * x_ref])
     Q, A_obj = np.linalg.qr(A_obj)
+    c_full = c_obj
     c_obj = Q.T @ c_obj
+    # what no x changes: the residual orthogonal to A's columns and ``rest`` (the cone's last entry)
+    fixed = float(np.sqrt(max(float(c_full @ c_full - c_obj @ c_obj), 0.0) + float(rest) ** 2))
     # variables scaled to a unit diagonal of A^T A: x = sc * y; the solver's are [y, t]
     sc = 1.0 / np.maximum(np.linalg.norm(A_obj, axis=0), 1e-300)
-    obj_scale = max(float(np.linalg.norm(c_obj)), 1e-300)
+    obj_scale = fixed if fixed > 0.0 else max(float(np.linalg.norm(c_obj)), 1e-300)
     n_var = P + 1
     rows_A: list[np.ndarray] = []
     rows_b: list[np.ndarray] = []
     cones = []
-    # second-order cone: (t, A x - c) (both divided by |c| so that t is of order one)
-    blk = np.zeros((P + 1, n_var))
+    # second-order cone: (t, A x - c, fixed), all divided by the fixed part (t of order one)
+    blk = np.zeros((P + 2, n_var))
     blk[0, P] = -1.0
-    blk[1:, :P] = -(A_obj * sc[None, :]) / obj_scale
+    blk[1:P + 1, :P] = -(A_obj * sc[None, :]) / obj_scale
     rows_A.append(blk)
-    rows_b.append(np.concatenate([[0.0], -c_obj / obj_scale]))
-    cones.append(clarabel.SecondOrderConeT(P + 1))
+    rows_b.append(np.concatenate([[0.0], -c_obj / obj_scale, [fixed / obj_scale]]))
+    cones.append(clarabel.SecondOrderConeT(P + 2))
     # non-negative cone: friction signs and mass bounds
     nn_A, nn_b = [], []
     for k in range(n_friction // 3):
@@ -250,7 +266,10 @@ def consistent_fit(R: np.ndarray, z: np.ndarray, n_segments: int, n_friction: in
     xf[0::3] = np.maximum(xf[0::3], 0.0)
     xf[1::3] = np.maximum(xf[1::3], 0.0)
     status = str(sol.status).split(".")[-1]
-    report = SolverReport(converged=status == "Solved", status=status, iterations=int(sol.iterations),
+    r_p = float(getattr(sol, "r_prim", np.nan))
+    r_d = float(getattr(sol, "r_dual", np.nan))
+    certified = status == "AlmostSolved" and max(r_p, r_d, _gap(sol)) <= CERTIFIED
+    report = SolverReport(converged=status == "Solved" or bool(certified), status=status, iterations=int(sol.iterations),
                           primal_residual=float(getattr(sol, "r_prim", np.nan)),
                           dual_residual=float(getattr(sol, "r_dual", np.nan)),
                           gap=_gap(sol), accuracy=ACCURACY, projection=projection,

@@ -296,7 +296,7 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
     if consistent:
         x, report = consistent_fit(R, z, len(structure.segment_links), P - Pi, structure.cad,
                                    regularisation=regularisation * weakest, mass_bounds=mass_bounds,
-                                   max_iterations=max_iterations)
+                                   max_iterations=max_iterations, rest=float(abs(Raug[P, P])) if Raug.shape[0] > P else 0.0)
         solver = {"method": "LMI (pseudo-inertia >= 0), conic interior point (Clarabel)",
                   "converged": report.converged, "status": report.status, "iterations": report.iterations,
                   "max_iterations": int(max_iterations), "primal_residual": report.primal_residual,
