@@ -690,7 +690,8 @@ def _identify_parsers(sub) -> None:
     _last_flags(s, _cmd_excite, urdf=True)
     s = sub.add_parser("identify", help="identify inertial parameters and friction from logs",
                        description="Identify the base parameters (QR), the friction of every joint and a "
-                                   "physically consistent model (an LMI fit by Clarabel: the 'identify' extra) from logs (CSV: t, q_<joint>, "
+                                   "physically consistent model (an LMI fit by Clarabel: the 'identify' extra) "
+                                   "from logs (CSV: t, q_<joint>, "
                                    "[v_<joint>,] tau_<joint>; npz; ROS 2 bags with the 'ros' extra), validate "
                                    "it on held-out logs against the CAD model, and write DIR/identified.urdf, "
                                    "identified.toml, summary.json and plots. Exit "

@@ -7,8 +7,9 @@ regressor of the segments' inertial parameters and the joints' friction
 them by least squares and by weighted least squares (each joint's rows weighted by the inverse
 of its residual's standard deviation, Gautier & Poignet 2001), with their standard deviations,
 then fit the full parameters under physical consistency (`mechbal.identify.consistent`: an LMI
-problem solved by the conic solver Clarabel), and compare the identified model, the least-squares estimate, the CAD model and the CAD model with
-fitted friction on the validation logs.
+problem solved by the conic solver Clarabel), and compare the identified model, the
+least-squares estimate, the CAD model and the CAD model with fitted friction on the validation
+logs.
 
 The goal the result reports (``ok``, ``limited_by``): the consistent fit solved (the conic
 solver converged to its accuracy), every identified body physically consistent, and the
@@ -296,7 +297,8 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
     if consistent:
         x, report = consistent_fit(R, z, len(structure.segment_links), P - Pi, structure.cad,
                                    regularisation=regularisation * weakest, mass_bounds=mass_bounds,
-                                   max_iterations=max_iterations, rest=float(abs(Raug[P, P])) if Raug.shape[0] > P else 0.0)
+                                   max_iterations=max_iterations,
+                                   rest=float(abs(Raug[P, P])) if Raug.shape[0] > P else 0.0)
         solver = {"method": "LMI (pseudo-inertia >= 0), conic interior point (Clarabel)",
                   "converged": report.converged, "status": report.status, "iterations": report.iterations,
                   "max_iterations": int(max_iterations), "primal_residual": report.primal_residual,
