@@ -73,7 +73,8 @@ def main(argv: list[str] | None = None) -> int:
            "target_s": TARGET_S, "met_wall": median <= TARGET_S,
            "met_cpu": float(np.median(cpu)) <= TARGET_S, "parts_first_run_s": parts,
            "validation_rms_identified": result.validation.rms_torque_error_all["identified"],
-           "noise_tau": 0.05, "ok": result.ok}
+           "noise_tau": 0.05, "ok": result.ok,
+           "solver": {k: result.solver.get(k) for k in ("status", "iterations", "gap", "solve_time_s")}}
     print(json.dumps(out, indent=1))
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)

@@ -539,9 +539,12 @@ def _cmd_identify(args) -> int:
     bounds = None
     if args.mass_bounds is not None:
         bounds = (1.0 - args.mass_bounds, 1.0 + args.mass_bounds)
-    result = fit(mech, args.logs, validate=args.validate or (), cutoff_hz=args.cutoff,
-                 friction=not args.no_friction, weighted=not args.unweighted, mass_bounds=bounds,
-                 tolerance=args.tolerance)
+    try:
+        result = fit(mech, args.logs, validate=args.validate or (), cutoff_hz=args.cutoff,
+                     friction=not args.no_friction, weighted=not args.unweighted, mass_bounds=bounds,
+                     tolerance=args.tolerance)
+    except ImportError as exc:  # the optional 'identify' extra (Clarabel) is missing: the message names it
+        raise UserError(str(exc)) from None
     with staged_output(out) as tmp:
         write_identified(result, tmp)
     if not args.quiet:
@@ -820,7 +823,8 @@ def _identify_parsers(sub) -> None:
     _last_flags(s, _cmd_excite, urdf=True)
     s = sub.add_parser("identify", help="identify inertial parameters and friction from logs",
                        description="Identify the base parameters (QR), the friction of every joint and a "
-                                   "physically consistent model (an LMI fit) from logs (CSV: t, q_<joint>, "
+                                   "physically consistent model (an LMI fit by Clarabel: the 'identify' extra) "
+                                   "from logs (CSV: t, q_<joint>, "
                                    "[v_<joint>,] tau_<joint>; npz; ROS 2 bags with the 'ros' extra), validate "
                                    "it on held-out logs against the CAD model, and write DIR/identified.urdf, "
                                    "identified.toml, summary.json and plots. Exit "

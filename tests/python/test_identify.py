@@ -91,8 +91,24 @@ def _check_round_trip(result, pi_true, fr):
     # the boundary of the cone, along directions the data barely see) they move a little more
     rel_c = np.abs(result.base.project(result.parameters) - beta_true) / np.maximum(np.abs(beta_true), floor)
     assert rel_c.max() < 1e-2
-    # every body physically consistent
+    # the conic solver converged, and every body is physically consistent: the invariant checked
+    # here on the parameters themselves (pseudo-inertia positive semi-definite, positive mass,
+    # principal moments non-negative and within the triangle inequality)
+    assert result.solver["converged"] and result.solver["status"] in ("Solved", "AlmostSolved")
+    assert max(result.solver["primal_residual"], result.solver["dual_residual"], result.solver["gap"]) <= 1e-7
     assert all(c.consistent for c in result.consistency)
+    for i in range(len(S.segment_links)):
+        pi = result.parameters[10 * i:10 * i + 10]
+        J = pseudo_inertia(pi)
+        assert np.linalg.eigvalsh(J).min() >= -1e-12 * np.abs(J).max()
+        lam = consistency("b", pi).principal_moments
+        assert pi[0] > 0 and lam[0] >= 0 and lam[2] <= lam[0] + lam[1] * (1 + 1e-12)
+    # the price of consistency on the identification logs: the consistent model's residual is at
+    # least least squares' (it minimises the same sum under constraints) and, the true model being
+    # consistent, hardly more
+    for j in S.joint_names:
+        ls, c = result.residual_rms_least_squares[j], result.residual_rms[j]
+        assert c <= 1.05 * ls, (j, c, ls)
     assert result.ok and not result.limited_by
     # validation: the identified model approaches the noise level, the CAD model does not
     v = result.validation
@@ -215,6 +231,94 @@ def test_consistency_is_the_pseudo_inertia_test_and_the_fit_keeps_it():
     lam = consistency("b", x).principal_moments
     assert lam[2] == pytest.approx(lam[0] + lam[1], rel=1e-5)
     assert np.linalg.norm(A @ x - z) > 1e-4
+
+
+def _lmi_problem(seed: int):
+    """A least-squares problem over 3 bodies and 2 joints' friction whose data pull towards
+    inconsistent bodies (a broken triangle inequality, a negative mass) and negative friction."""
+    rng = np.random.default_rng(seed)
+    rod = body_parameters(1.0, np.array([0.1, 0.0, 0.0]), np.diag([0.01, 0.01, 0.05]))
+    neg = body_parameters(-0.5, np.zeros(3), np.eye(3) * 0.01)
+    ok = body_parameters(2.0, np.array([0.0, 0.05, 0.1]), np.diag([0.03, 0.02, 0.04]))
+    x_bad = np.concatenate([rod, neg, ok, [-0.2, 0.5, 0.1, 0.3, -0.4, 0.0]])
+    A = rng.normal(size=(300, 36)) * np.concatenate([np.tile([1, .3, .3, .3, .1, .1, .1, .1, .1, .1], 3), np.ones(6)])
+    b = A @ x_bad + 1e-3 * rng.normal(size=300)
+    Raug = np.linalg.qr(np.column_stack([A, b]), mode="r")
+    cad = np.concatenate([body_parameters(1.0, np.zeros(3), np.eye(3) * 0.01),
+                          body_parameters(0.8, np.zeros(3), np.eye(3) * 0.01), ok])
+    return A, b, Raug[:36, :36], Raug[:36, 36], cad
+
+
+def test_the_lmi_fit_is_the_one_cvxpy_finds_and_keeps_every_constraint():
+    # the same problem written independently with cvxpy (its own PSD constraint J >> 0 and its
+    # own canonicalisation) and solved by another solver (SCS): the same minimiser
+    cp = pytest.importorskip("cvxpy")
+    A, b, R, z, cad = _lmi_problem(3)
+    bounds = (0.5, 1.5)
+    x, report = consistent_fit(R, z, 3, 6, cad, regularisation=0.0, mass_bounds=bounds)
+    assert report.converged and max(report.primal_residual, report.dual_residual, report.gap) <= 1e-7
+    X = cp.Variable(36)
+    cons = [X[30] >= 0, X[31] >= 0, X[33] >= 0, X[34] >= 0]
+    for k in range(3):
+        p = X[10 * k:10 * k + 10]
+        Io = cp.bmat([[p[4], p[5], p[7]], [p[5], p[6], p[8]], [p[7], p[8], p[9]]])
+        Sigma = 0.5 * cp.trace(Io) * np.eye(3) - Io
+        h = cp.reshape(p[1:4], (3, 1), order="F")
+        J = cp.bmat([[Sigma, h], [h.T, cp.reshape(p[0], (1, 1), order="F")]])
+        cons += [0.5 * (J + J.T) >> 0, p[0] >= bounds[0] * cad[10 * k], p[0] <= bounds[1] * cad[10 * k]]
+    prob = cp.Problem(cp.Minimize(cp.sum_squares(A @ X - b)), cons)
+    prob.solve(solver=cp.SCS, eps_abs=1e-9, eps_rel=1e-9, max_iters=100000)
+    ref = np.asarray(X.value)
+    cost = float(np.sum((A @ x - b) ** 2))
+    assert cost <= prob.value * (1 + 1e-6) + 1e-12
+    assert cost == pytest.approx(prob.value, rel=1e-5)
+    assert np.max(np.abs(x - ref)) <= 1e-4 * np.max(np.abs(ref))
+    # least squares breaks the constraints; the fit keeps each one (rounding aside) and pays for it
+    x_ls = np.linalg.lstsq(A, b, rcond=None)[0]
+    assert not consistency("rod", x_ls[:10]).consistent and not consistency("neg", x_ls[10:20]).consistent
+    assert cost > 1.5 * float(np.sum((A @ x_ls - b) ** 2))
+    for k in range(3):
+        pi = x[10 * k:10 * k + 10]
+        assert consistency(f"b{k}", pi).consistent
+        assert np.linalg.eigvalsh(pseudo_inertia(pi)).min() >= 0.0
+        assert bounds[0] * cad[10 * k] * (1 - 1e-7) <= pi[0] <= bounds[1] * cad[10 * k] * (1 + 1e-7)
+    assert np.all(x[[30, 31, 33, 34]] >= 0)
+
+
+def _arm(seed: int = 2, n: int = 3):
+    return mechbal.Mechanism.from_urdf_string(random_tree(np.random.default_rng(seed), n, types="R",
+                                                          branching=False).urdf(), name="arm")
+
+
+def test_a_solver_that_does_not_converge_is_a_missed_goal():
+    arm = _arm()
+    log = simulate_log(arm, _motion(arm.dof, 8, duration=6.0), friction=_friction(arm.joint_names),
+                       noise_tau=1e-2, seed=8)
+    good = fit(arm, [log])
+    assert good.ok and good.solver["status"] == "Solved" and good.solver["iterations"] > 2
+    starved = fit(arm, [log], max_iterations=2)
+    assert not starved.ok and starved.solver["converged"] is False
+    assert "conic solver did not converge: status MaxIterations after 2 iterations" in starved.limited_by[0]
+    # what it returns is still a consistent model (the verdict says it is not the fit's optimum)
+    assert all(c.consistent for c in starved.consistency)
+    assert starved.summary()["ok"] is False
+
+
+def test_without_the_extra_the_consistent_fit_names_it(monkeypatch, tmp_path, capsys):
+    from mechbal.identify.consistent import MissingExtra
+
+    arm = _arm()
+    log = simulate_log(arm, _motion(arm.dof, 8, duration=3.0), friction=_friction(arm.joint_names),
+                       noise_tau=1e-2, seed=8)
+    monkeypatch.setitem(sys.modules, "clarabel", None)      # import clarabel raises ImportError
+    with pytest.raises(MissingExtra, match=r"'identify' extra: pip install 'mechbal\[identify\]'"):
+        fit(arm, [log])
+    assert fit(arm, [log], consistent=False).solver == {}
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(random_tree(np.random.default_rng(2), 3, types="R", branching=False).urdf())
+    log.to_csv(tmp_path / "a.csv")
+    err = _cli_error(capsys, ["identify", str(urdf), str(tmp_path / "a.csv"), "--out", str(tmp_path / "o")])
+    assert "mechbal[identify]" in err
 
 
 def _small_log(mech, n=2000, seed=0):

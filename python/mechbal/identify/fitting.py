@@ -7,12 +7,13 @@ regressor of the segments' inertial parameters and the joints' friction
 them by least squares and by weighted least squares (each joint's rows weighted by the inverse
 of its residual's standard deviation, Gautier & Poignet 2001), with their standard deviations,
 then fit the full parameters under physical consistency (`mechbal.identify.consistent`: an LMI
-problem solved by ADMM), and
-compare the identified model, the least-squares estimate, the CAD model and the CAD model with
-fitted friction on the validation logs.
+problem solved by the conic solver Clarabel), and compare the identified model, the
+least-squares estimate, the CAD model and the CAD model with fitted friction on the validation
+logs.
 
-The goal the result reports (``ok``, ``limited_by``): every identified body physically
-consistent, and the consistent model's RMS torque error on the validation logs (the held-out
+The goal the result reports (``ok``, ``limited_by``): the consistent fit solved (the conic
+solver converged to its accuracy), every identified body physically consistent, and the
+consistent model's RMS torque error on the validation logs (the held-out
 ones; without them, the identification logs) within ``tolerance`` (default 1.2) times the
 unconstrained least squares' (the price of consistency is small).
 
@@ -226,7 +227,7 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
         friction: bool = True, weighted: bool = True, consistent: bool = True,
         mass_bounds: tuple[float, float] | None = None, regularisation: float = 1e-4,
         tolerance: float = 1.2, decimate: int | None = None, gap_factor: float = 3.0,
-        trim: int | None = None) -> IdentificationResult:
+        trim: int | None = None, max_iterations: int = 200) -> IdentificationResult:
     """Identify ``mechanism``'s inertial parameters (and ``friction``) from ``logs`` (paths or
     `Log` objects; module docstring), validate on ``validate`` (held-out logs; none: the
     identification logs, flagged ``held_out = False``).
@@ -236,8 +237,11 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
     ``mass_bounds``: (low, high) factors bounding each segment's mass around its CAD value.
     ``regularisation``: weight of the pull towards the CAD values of what the logs leave free,
     relative to the weakest direction the logs determine.
+    ``max_iterations``: the conic solver's limit (interior-point iterations; a fit that does not
+    converge within it is reported, ``ok`` False).
     ``consistent=False`` skips the consistent fit (the identified mechanism and ``parameters``
-    then carry the CAD inertias and no friction). Raises `LogError` / `IdentifyError` (ValueErrors) with one
+    then carry the CAD inertias and no friction); it needs the ``identify`` extra (Clarabel:
+    `mechbal.identify.consistent.MissingExtra`, an ImportError, without it). Raises `LogError` / `IdentifyError` (ValueErrors) with one
     line naming the log or the parameters."""
     structure = structure_of(mechanism)
     names = structure.joint_names
@@ -292,10 +296,14 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
     solver: dict[str, Any] = {}
     if consistent:
         x, report = consistent_fit(R, z, len(structure.segment_links), P - Pi, structure.cad,
-                                   regularisation=regularisation * weakest, mass_bounds=mass_bounds)
-        solver = {"method": "LMI (pseudo-inertia >= 0) by ADMM", "converged": report.converged,
-                  "iterations": report.iterations, "primal_residual": report.primal_residual,
-                  "dual_residual": report.dual_residual, "tolerance": report.tolerance,
+                                   regularisation=regularisation * weakest, mass_bounds=mass_bounds,
+                                   max_iterations=max_iterations,
+                                   rest=float(abs(Raug[P, P])) if Raug.shape[0] > P else 0.0)
+        solver = {"method": "LMI (pseudo-inertia >= 0), conic interior point (Clarabel)",
+                  "converged": report.converged, "status": report.status, "iterations": report.iterations,
+                  "max_iterations": int(max_iterations), "primal_residual": report.primal_residual,
+                  "dual_residual": report.dual_residual, "gap": report.gap, "accuracy": report.accuracy,
+                  "projection": report.projection, "solve_time_s": report.solve_time_s,
                   "regularisation": regularisation}
     else:
         x = np.concatenate([structure.cad, np.zeros(P - Pi)])
@@ -307,6 +315,11 @@ def fit(mechanism: Mechanism, logs: Sequence[str | Path | Log], *,
     identified = _identified_mechanism(structure, pi)
     res_c = y - W @ x
     limited_by = []
+    if consistent and not report.converged:
+        limited_by.append(f"the consistent fit's conic solver did not converge: status {report.status} after "
+                          f"{report.iterations} iterations (max_iterations {int(max_iterations)}; relative primal "
+                          f"residual {report.primal_residual:.3g}, dual {report.dual_residual:.3g}, gap "
+                          f"{report.gap:.3g}, accuracy asked {report.accuracy:g})")
     bad = [c.name for c in checks if not c.consistent]
     if bad:
         limited_by.append(f"not physically consistent: {', '.join(bad)}")
