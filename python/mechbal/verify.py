@@ -63,10 +63,11 @@ def _peak(x) -> float:
     return float(np.max(np.abs(np.asarray(x)))) if np.size(x) else 0.0
 
 
-def check_variant(bc, mech, *, simulate: bool = True, reference: dict | None = None, controller=None) -> dict:
+def check_variant(bc, mech, *, simulate: bool = True, reference: dict | None = None, controller=None,
+                  dt: float = 1e-3) -> dict:
     """The checks of one variant (module docstring) as a dict of plain values and arrays;
     ``controller``: ``mech -> joint controller`` of the simulated check (default: computed torque,
-    `KP`, `KD`)."""
+    `KP`, `KD`), ticked every ``dt`` [s]."""
     from mechbal.balance.run import evaluate
     from mechbal.control import ComputedTorque
     from mechbal.export.mujoco_engine import MujocoMechanism, co_simulate
@@ -107,7 +108,7 @@ def check_variant(bc, mech, *, simulate: bool = True, reference: dict | None = N
         traj = case_trajectory(bc, n)
         ctrl = controller(mech) if controller is not None else ComputedTorque(mech, [KP] * n, [KD] * n,
                                                                                q_guess=bc.q_guess)
-        cs = co_simulate(mech, ctrl, traj, q_guess=bc.q_guess)
+        cs = co_simulate(mech, ctrl, traj, q_guess=bc.q_guess, dt=dt)
         out["mujoco_simulated"] = {"t": cs.t, "status": cs.status, "v": cs.v, "shaking_force": cs.shaking_force,
                                    "shaking_moment": cs.shaking_moment,
                                    "predicted_shaking_force": cs.predicted_shaking_force,
@@ -195,7 +196,8 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
     results, summary_variants, rows, scale, peaks, judged = {}, {}, [], {}, {}, {}
     for label, mech in variants.items():
         progress.stage(f"MuJoCo: {label}")
-        res = check_variant(bc, mech, simulate=simulate, controller=controller)
+        res = check_variant(bc, mech, simulate=simulate, controller=controller,
+                            dt=1.0 / jc.control.rate_hz if jc is not None else 1e-3)
         if jc is not None and simulate:
             judged[label] = judge_cosimulation(mech, res["mujoco_simulated"], jc.control,
                                                who=f"{label}: closed loop in MuJoCo")
@@ -327,10 +329,11 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
     traj = case_trajectory(bc, n)
     jc = joint_control(case)
     ctl = jc.control if jc is not None else None
-    progress.stage(f"co-simulation (MuJoCo, {1 / dt:g} Hz)")
-    if ctl is not None:   # the case's own joint controller
+    progress.stage(f"co-simulation (MuJoCo, {ctl.rate_hz if ctl is not None else 1 / dt:g} Hz)")
+    if ctl is not None:   # the case's own joint controller, at its own tick
         from mechbal.control import joint_controller
 
+        dt = 1.0 / ctl.rate_hz
         ctrl = joint_controller(mech, ctl, q_guess=bc.q_guess)
         described = f"{ctl.kind}, Kp {list(ctl.kp)} 1/s^2, Kd {list(ctl.kd)} 1/s ([control] of the case)"
     else:

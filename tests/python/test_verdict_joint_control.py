@@ -64,7 +64,7 @@ def extra_of(kind: str, what: str) -> str:
     base = f"k = {k}\n" if kind == "decoupled" else ""
     if what == "good":
         # decoupled control of an unbalanced arm is not exact: a tolerance the PD loop keeps
-        return base + ("tolerance = { joint = 0.2 }" if kind == "decoupled" else "")
+        return base + ("tolerance = { joint = 0.5 }" if kind == "decoupled" else "")
     if what == "saturating":
         return base + SATURATING
     assert what == "diverging"
@@ -97,7 +97,7 @@ def test_joint_controller_of_a_table_and_its_closed_loop_verdict(kind):
     traj = RestToRest([0.0, 0.0], [1.2, -0.9], 1.0)
     table = {"kind": kind, "kp": [400.0] * 2, "kd": [40.0] * 2, **({"k": true_k()} if kind == "decoupled" else {})}
     good = simulate.closed_loop(mech, control.joint_controller(mech, table), traj,
-                                tolerance={"joint": 0.2} if kind == "decoupled" else None)
+                                tolerance={"joint": 0.5} if kind == "decoupled" else None)
     assert good.ok, good.limited_by
     sat = simulate.closed_loop(mech, control.joint_controller(mech, {**table, "torque_limit": [2.0, 2.0]}), traj)
     assert not sat.ok and any(x.get("status") == "saturated" for x in sat.limited_by)
