@@ -58,7 +58,7 @@ __all__ = [
     "MechanismDynamics", "KdlChainDynamics", "InverseDynamicsResult", "Status", "status_text",
     "ReactionlessController", "ReactionlessCommand", "ReactionlessRun", "ReactionlessJointController",
     "ReactionlessTaskController", "TaskSpaceRun", "declared_options", "declared_torque_limit",
-    "feasibility", "FeasibilityReport", "LimitDemand", "FrameMotion",
+    "joint_controller", "feasibility", "FeasibilityReport", "LimitDemand", "FrameMotion",
 ]
 
 Status = _core.Status
@@ -358,6 +358,37 @@ class DecoupledJointController(_JointTicks, _core.DecoupledJointController):  # 
     The keywords ``max_position``, ``max_speed`` and ``max_acceleration`` bound the input of a
     tick as for `ComputedTorque`.
     """
+
+
+def joint_controller(mechanism: Any, ctl: Any, *, q_guess: npt.ArrayLike | None = None) -> Any:
+    """The joint controller of a validated ``[control]`` table of kind ``computed_torque`` or
+    ``decoupled`` over ``mechanism`` (a `mechbal.Mechanism`), as the C++ ``make_controller``
+    builds it: `ComputedTorque` over the mechanism's model, or `DecoupledJointController` with
+    ``k`` (default: the diagonal of the mass matrix at q = 0, which must be diagonal: a
+    dynamically balanced design); gains ``kp``, ``kd``; the |tau| limit in force
+    (`declared_torque_limit`: ``torque_limit`` and the declared effort limits) and ``max_speed``
+    (the input range). ValueError naming the ``control.`` field otherwise."""
+    get = ctl.get if isinstance(ctl, dict) else (lambda k: getattr(ctl, k, None))
+    kind = get("kind")
+    speed = {} if get("max_speed") is None else {"max_speed": float(get("max_speed"))}
+    if kind == "computed_torque":
+        return ComputedTorque(mechanism, get("kp"), get("kd"), get("torque_limit"), q_guess=q_guess, **speed)
+    if kind != "decoupled":
+        raise ValueError(f"control.kind: a joint controller is computed_torque or decoupled, got {kind!r}")
+    k = get("k")
+    if k is None:
+        n = len(mechanism.actuated_names)
+        dyn = _dynamics(mechanism, q_guess)
+        M = np.asarray(dyn.mass_matrix(np.zeros(n)), float)
+        off = M - np.diag(np.diag(M))
+        scale = float(np.max(np.abs(np.diag(M))))
+        if not np.all(np.isfinite(M)) or np.max(np.abs(off)) > 1e-9 * scale:
+            i, j = np.unravel_index(int(np.argmax(np.abs(off))), off.shape)
+            raise ValueError(f"control.k: the mass matrix at q = 0 is not diagonal (M[{i}][{j}] = {M[i, j]:.6g}): "
+                             "the decoupled controller needs a dynamically balanced design, or give k")
+        k = np.diag(M)
+    limit = declared_torque_limit(mechanism, get("torque_limit"))
+    return DecoupledJointController(k, get("kp"), get("kd"), limit, **speed)
 
 
 class PassiveController(_JointTicks, _core.PassiveController):  # type: ignore[misc]

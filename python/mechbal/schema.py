@@ -272,9 +272,11 @@ class Control(Table):
     computed-torque stage (``kp``, ``kd``); ``mechbal run`` compares the motion with the balancing
     joints held (uncontrolled) and controlled. ``computed_torque`` and ``decoupled``: joint
     controllers with the gains ``kp``, ``kd`` (the C++ ``mechbal::make_controller`` builds each
-    kind from this table)."""
+    kind from this table; `mechbal.control.joint_controller` in Python), run in closed loop along
+    ``[trajectory]``."""
     kind: Literal["reactionless", "computed_torque", "decoupled", "passive"] = Field(
-        description="which controller (mechbal run supports reactionless, and passive: no controller, "
+        description="which controller (mechbal run simulates each: computed_torque and decoupled in closed "
+                    "loop along [trajectory]; reactionless; passive: no controller, "
                     "zero effort, the mechanism moves under gravity and springs from [trajectory]'s "
                     "start with its initial rates, over its duration)")
     balancing_joints: Optional[Annotated[list[Name], Field(min_length=1, max_length=MAX_JOINTS)]] = Field(

@@ -118,7 +118,7 @@ def judge_closed_loop(result: ClosedLoopResult, controller: Any, mechanism_or_pl
     v = vd.Verdict(vd.goal(kind=type(controller).__name__, tol=tol, limits=limits, closed_loop=True,
                            tracking={"joint": "largest |q_des - q| of the tracked joints [rad or m] beyond "
                                               "the error the run started with"}))
-    v.statuses(result.status, result.t)
+    v.statuses(result.status, result.t, joints=_saturated_joint(result, controller, mech))
     v.steps(result.steps_completed, len(result.t) - 1, result.t)
     if tracked:
         err = np.max(np.abs(result.q_des[:, tracked] - result.q[:, tracked]), axis=1)
@@ -129,6 +129,22 @@ def judge_closed_loop(result: ClosedLoopResult, controller: Any, mechanism_or_pl
     if mech is not None:
         v.limit(result.v, result.t, list(mech.actuated_names), "velocity", limits, who="simulated motion")
     return v
+
+
+def _saturated_joint(result: ClosedLoopResult, controller: Any, mech: Any) -> dict[str, str] | None:
+    """``{"saturated": joint}`` for the verdict: the joint whose torque sat at the controller's
+    |tau| limit first (then on the most ticks), when the controller has one."""
+    limit = np.asarray(getattr(controller, "torque_limit", []), float).reshape(-1)
+    tau = np.abs(np.asarray(result.joint_torque, float))
+    if limit.size != tau.shape[1] or not np.any(np.isfinite(limit)):
+        return None
+    hit = tau >= limit[None, :] * (1.0 - 1e-9)
+    if not np.any(hit):
+        return None
+    first = np.where(np.any(hit, axis=0), np.argmax(hit, axis=0), len(tau))
+    j = min(range(len(limit)), key=lambda i: (first[i], -int(np.sum(hit[:, i]))))
+    names = list(mech.actuated_names) if mech is not None else [f"joint {i}" for i in range(len(limit))]
+    return {"saturated": f"{names[j]} at its |tau| limit {limit[j]:.4g} N m or N"}
 
 
 def _plant(mechanism_or_plant: Any, q_guess: npt.ArrayLike | None) -> Any:

@@ -165,8 +165,9 @@ HEADER: dict[str, Schema] = {
 
 # ---- general summaries --------------------------------------------------------------------------
 
-_CONTROL = {"type": "object", "additionalProperties": False, "description": "The reactionless "
-            "controller of a case with [control] (its settings echo the case file's keys).",
+_CONTROL = {"type": "object", "additionalProperties": False, "description": "The controller of a case "
+            "with [control] (its settings echo the case file's keys): reactionless, or a joint controller "
+            "(computed_torque, decoupled) in closed loop.",
             "properties": {
                 "kind": string(), "balancing_joints": strings(), "cancel": strings(),
                 "integrator": string(), "rate_hz": number("Hz", "controller rate (the case's rate_hz)"),
@@ -182,7 +183,17 @@ _CONTROL = {"type": "object", "additionalProperties": False, "description": "The
                                            "task frame from its path, per variant."),
                 "peak_joint_rate": detail("Peak |rate| of each joint [rad/s or m/s], per variant."),
                 "feed_forward": detail("The acceleration feed-forward against the stored motion's "
-                                       "acceleration [rad/s^2] and its predicted moment [N m].")}}
+                                       "acceleration [rad/s^2] and its predicted moment [N m]."),
+                # computed_torque and decoupled: the closed loop
+                "sampling": string("zero_order_hold: the torque of a tick is held over the RK4 step"),
+                "kp": numbers("1/s^2"), "kd": numbers("1/s"),
+                "k": numbers("kg m^2 or kg", "decoupled: the diagonal of the balanced mass matrix"),
+                "torque_limit_in_force": {"type": ["array", "null"], "items": NUMBER,
+                                          "description": "|tau| limit per joint [N m or N] (declared effort "
+                                                         "limits and torque_limit; null: none)"},
+                "steps_completed": integer(), "out_of_range_ticks": integer(),
+                "peak_tracking_error": numbers("rad or m", "peak |q_des - q| of each actuated joint"),
+                "peak_joint_torque": numbers("N m or N", "peak |tau| the controller commanded, per joint")}}
 
 #: the verdict of a controlled run (`mechbal.verdict`): run, run --engine mujoco, verify
 VERDICT: dict[str, Schema] = {
@@ -386,6 +397,8 @@ VERIFY: dict[str, Schema] = {
                         "error [rad or m] at each, and their ratios."),
     "residual_limited_by": string("What limits the simulated residual (measured: time_step); for a failed "
                                   "loop, that no residual is reported."),
+    "controller": string("A case with a joint [control] (computed_torque, decoupled): the controller of the "
+                         "simulated check."),
     **VERDICT,
 }
 

@@ -63,8 +63,11 @@ def _peak(x) -> float:
     return float(np.max(np.abs(np.asarray(x)))) if np.size(x) else 0.0
 
 
-def check_variant(bc, mech, *, simulate: bool = True, reference: dict | None = None) -> dict:
-    """The checks of one variant (module docstring) as a dict of plain values and arrays."""
+def check_variant(bc, mech, *, simulate: bool = True, reference: dict | None = None, controller=None,
+                  dt: float = 1e-3) -> dict:
+    """The checks of one variant (module docstring) as a dict of plain values and arrays;
+    ``controller``: ``mech -> joint controller`` of the simulated check (default: computed torque,
+    `KP`, `KD`), ticked every ``dt`` [s]."""
     from mechbal.balance.run import evaluate
     from mechbal.control import ComputedTorque
     from mechbal.export.mujoco_engine import MujocoMechanism, co_simulate
@@ -103,9 +106,10 @@ def check_variant(bc, mech, *, simulate: bool = True, reference: dict | None = N
     if simulate:
         n = len(mech.actuated_names) if closed else mech.dof
         traj = case_trajectory(bc, n)
-        ctrl = ComputedTorque(mech, [KP] * n, [KD] * n, q_guess=bc.q_guess)
-        cs = co_simulate(mech, ctrl, traj, q_guess=bc.q_guess)
-        out["mujoco_simulated"] = {"t": cs.t, "shaking_force": cs.shaking_force,
+        ctrl = controller(mech) if controller is not None else ComputedTorque(mech, [KP] * n, [KD] * n,
+                                                                               q_guess=bc.q_guess)
+        cs = co_simulate(mech, ctrl, traj, q_guess=bc.q_guess, dt=dt)
+        out["mujoco_simulated"] = {"t": cs.t, "status": cs.status, "v": cs.v, "shaking_force": cs.shaking_force,
                                    "shaking_moment": cs.shaking_moment,
                                    "predicted_shaking_force": cs.predicted_shaking_force,
                                    "predicted_shaking_moment": cs.predicted_shaking_moment,
@@ -145,6 +149,8 @@ def _rows(label: str, res: dict, scale: dict, unbalanced: dict) -> tuple[list, d
                  "max_difference": _peak(np.asarray(mb) - np.asarray(mi)),
                  "relative_difference": _peak(np.asarray(mb) - np.asarray(mi)) / ref}
         sim = res.get("mujoco_simulated")
+        if sim is not None and res.get("simulation_failed"):
+            sim = None   # a failed closed loop is judged (the verdict), not read as a realised wrench
         if sim is not None and key in ("shaking_force", "shaking_moment"):
             entry["mujoco_simulated_peak"] = _peak(sim[key])
             entry["simulated_minus_predicted"] = _peak(sim[key] - sim[f"predicted_{key}"])
@@ -169,6 +175,13 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
                                        allow_degraded=allow_degraded, view=view)
     progress.stage("reading the case")
     bc = load_case(case)
+    jc = joint_control(case)
+    controller = None
+    if jc is not None:   # the case's own controller drives the simulated check, and is judged
+        from mechbal.control import joint_controller
+
+        def controller(mech):
+            return joint_controller(mech, jc.control, q_guess=bc.q_guess)
     variants = {"unbalanced": bc.mechanism}
     if method is None and bc.table is not None and getattr(bc.table, "method", None):
         method = bc.table.method
@@ -181,10 +194,15 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
             variants["balanced"] = run_method(bc, method).balanced
         except (ValueError, RuntimeError) as exc:
             notes["balanced"] = f"not balanced by {method}: {exc}"
-    results, summary_variants, rows, scale, peaks = {}, {}, [], {}, {}
+    results, summary_variants, rows, scale, peaks, judged = {}, {}, [], {}, {}, {}
     for label, mech in variants.items():
         progress.stage(f"MuJoCo: {label}")
-        res = check_variant(bc, mech, simulate=simulate)
+        res = check_variant(bc, mech, simulate=simulate, controller=controller,
+                            dt=1.0 / jc.control.rate_hz if jc is not None else 1e-3)
+        if jc is not None and simulate:
+            judged[label] = judge_cosimulation(mech, res["mujoco_simulated"], jc.control,
+                                               who=f"{label}: closed loop in MuJoCo")
+            res["simulation_failed"] = not judged[label].ok
         (out / f"{label}.xml").parent.mkdir(parents=True, exist_ok=True)
         (out / f"{label}.xml").write_text(res["xml"])
         if label == "unbalanced":
@@ -229,10 +247,68 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
 
         write_html(out / "view.html", motion_variants(bc, variants), title=f"mechbal verify: {bc.name}")
         summary["files"].append("view.html")
+    v = None
+    if judged:   # the verdict of the simulations that ran: each variant's closed loop
+        from mechbal import verdict as vd
+
+        first = next(iter(judged.values()))
+        v = vd.Verdict(first.goal)
+        for label, j in judged.items():
+            summary_variants[label]["simulation"]["ok"] = j.ok
+            for x in j.limited_by:
+                v.limited_by.append({**x, "variant": label})
+        summary.update(v.summary())
+        summary["controller"] = f"{jc.control.kind} ([control] of the case)"
     write_summary(out / "summary.json", summary, command="verify")
     print(report.table(rows, ["variant", "quantity", "unit", "mechbal peak", "MuJoCo peak (inverse)",
                               "relative difference", "MuJoCo peak (simulated)"]))
+    if v is not None:
+        print(report.table(vd.goal_rows(v, [[f"{label}: closed loop", "ok" if j.ok else "failed: " + j.line()]
+                                            for label, j in judged.items()]),
+                           [f"{jc.control.kind} in MuJoCo (verdict)", "value"]))
     return summary
+
+
+def joint_control(case) -> "object | None":
+    """The validated case of a case file whose ``[control]`` table asks for a joint controller
+    (``computed_torque`` or ``decoupled``), else None (URDF files, cases without one, other kinds)."""
+    from mechbal.config import load_case as read_case
+    from mechbal.errors import ConfigError
+
+    if str(case).lower().endswith(".urdf"):
+        return None
+    try:
+        raw = read_case(case)
+    except ConfigError:
+        return None
+    table = raw.get("control") if isinstance(raw, dict) else None
+    if not isinstance(table, dict) or table.get("kind") not in ("computed_torque", "decoupled"):
+        return None
+    from mechbal.schema import validate_case
+
+    return validate_case(raw, warn=False)
+
+
+def judge_cosimulation(mech, cs, ctl=None, *, who: str = "closed loop in MuJoCo"):
+    """The `mechbal.verdict.Verdict` of a joint controller's co-simulation ``cs`` (a
+    `mechbal.export.mujoco_engine.CoSimulation` or the dict `check_variant` keeps): every tick ok,
+    every step completed, MuJoCo's motion within ``tolerance.joint`` of the command, the declared
+    velocity limits kept (``ctl``: the case's ``[control]``, or None: the defaults)."""
+    from mechbal import verdict as vd
+
+    get = cs.get if isinstance(cs, dict) else (lambda k: getattr(cs, k))
+    t = np.asarray(get("t"), float)
+    tol = vd.tolerance(ctl)
+    limits = vd.limits_in_force(mech, ctl)
+    kind = getattr(ctl, "kind", None) or "computed_torque"
+    judged = vd.Verdict(vd.goal(kind=kind, tol=tol, limits=limits, closed_loop=True,
+                                tracking={"joint": "largest |q_des - q| of MuJoCo's motion [rad or m]"}))
+    judged.statuses(get("status"), t, who=who)
+    judged.steps(int(get("steps_completed")), len(t) - 1, t)
+    judged.tracking(np.max(np.abs(np.asarray(get("tracking_error"))), axis=1), t, tol["joint"], what=who,
+                    unit="rad or m", key="joint")
+    judged.limit(get("v"), t, list(mech.actuated_names), "velocity", limits, who=who)
+    return judged
 
 
 def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float | None = None,
@@ -257,8 +333,18 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
     mech = bc.mechanism
     n = len(mech.actuated_names) if mech.is_closed else mech.dof
     traj = case_trajectory(bc, n)
-    progress.stage("co-simulation (MuJoCo, 1 kHz)")
-    ctrl = ComputedTorque(mech, [KP] * n, [KD] * n, q_guess=bc.q_guess)
+    jc = joint_control(case)
+    ctl = jc.control if jc is not None else None
+    progress.stage(f"co-simulation (MuJoCo, {ctl.rate_hz if ctl is not None else 1 / dt:g} Hz)")
+    if ctl is not None:   # the case's own joint controller, at its own tick
+        from mechbal.control import joint_controller
+
+        dt = 1.0 / ctl.rate_hz
+        ctrl = joint_controller(mech, ctl, q_guess=bc.q_guess)
+        described = f"{ctl.kind}, Kp {list(ctl.kp)} 1/s^2, Kd {list(ctl.kd)} 1/s ([control] of the case)"
+    else:
+        ctrl = ComputedTorque(mech, [KP] * n, [KD] * n, q_guess=bc.q_guess)
+        described = f"computed torque, Kp {KP:g} 1/s^2, Kd {KD:g} 1/s (mechbal's model)"
     cs = co_simulate(mech, ctrl, traj, q_guess=bc.q_guess, dt=dt, duration=duration)
     from mechbal.export.mjcf import mjcf_text
 
@@ -287,17 +373,9 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
     diff_M = _peak(cs.base_reaction_moment - cs.predicted_base_reaction_moment)
     from mechbal import verdict as vd
 
-    tol = vd.tolerance(getattr(getattr(bc, "case", None), "control", None))
-    limits = vd.limits_in_force(mech)
-    judged = vd.Verdict(vd.goal(kind="computed_torque", tol=tol, limits=limits, closed_loop=True,
-                                tracking={"joint": "largest |q_des - q| of MuJoCo's motion [rad or m]"}))
-    judged.statuses(cs.status, cs.t, who="closed loop in MuJoCo")
-    judged.steps(int(cs.steps_completed), len(cs.t) - 1, cs.t)
-    judged.tracking(np.max(np.abs(cs.tracking_error), axis=1), cs.t, tol["joint"], what="MuJoCo's motion",
-                    unit="rad or m", key="joint")
-    judged.limit(cs.v, cs.t, list(mech.actuated_names), "velocity", limits, who="motion in MuJoCo")
+    judged = judge_cosimulation(mech, cs, ctl)
     summary = {"case": bc.name, "engine": "mujoco", "mechanism": repr(mech), "dt": dt, "mujoco_options": cs.options,
-               "controller": f"computed torque, Kp {KP:g} 1/s^2, Kd {KD:g} 1/s (mechbal's model)",
+               "controller": described,
                **judged.summary(), "steps_completed": cs.steps_completed,
                "peak_tracking_error": _peak(cs.tracking_error),
                "max_constraint_violation": _peak(cs.constraint_violation),
@@ -320,8 +398,10 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
                         ["moment [N m]", summary["base_reaction"]["peak_moment_mechbal"],
                          summary["base_reaction"]["peak_moment_mujoco"], diff_M]],
                        ["base reaction", "mechbal peak", "MuJoCo peak", "max difference"]))
-    print(report.table(vd.goal_rows(judged, [["tracking error [rad or m]", f"{_peak(cs.tracking_error):.3g}"]]),
-                       ["computed torque in MuJoCo (verdict)", "value"]))
+    saturated = int(np.sum((np.asarray(cs.status) & np.uint32(4)) != 0))
+    print(report.table(vd.goal_rows(judged, [["saturated ticks", f"{saturated} of {len(cs.t)}"],
+                                             ["tracking error [rad or m]", f"{_peak(cs.tracking_error):.3g}"]]),
+                       [f"{ctl.kind if ctl is not None else 'computed torque'} in MuJoCo (verdict)", "value"]))
     return summary
 
 

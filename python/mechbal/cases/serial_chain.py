@@ -276,15 +276,14 @@ def held_trajectory(mech: Mechanism, case):
 
 
 def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None) -> dict:
-    """A case with ``[control]`` (kind reactionless): the motion with the balancing joints held
+    """A case with ``[control]`` (kinds computed_torque and decoupled: `run_joint_controller`;
+    kind reactionless below): the motion with the balancing joints held
     at their start (``uncontrolled``) and under the reactionless controller (``controlled``), at
     the controller's ticks; bodies_uncontrolled.npz, bodies_controlled.npz (each with the shaking
     wrench of its stored poses), the plots and both variants' peaks in summary.json."""
     ctl = case.control
-    name, title = case.case.name, case.case.title or case.case.name
-    if ctl.kind != "reactionless":
-        raise ConfigError("control.kind", "mechbal run simulates kind 'reactionless' (computed_torque "
-                          "and decoupled controllers: mechbal.simulate.closed_loop)", ctl.kind)
+    if ctl.kind in ("computed_torque", "decoupled"):
+        return run_joint_controller(mech, case, out, q_guess=q_guess, assembly=assembly)
     from mechbal.cases.runners import RUN_OPTIONS
 
     options = RUN_OPTIONS.get()
@@ -294,6 +293,109 @@ def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None
     if ctl.task_frame is not None:
         return run_task_space(mech, case, out, summary_extra=extra)
     return _run_joint_mode(mech, case, out, q_guess, extra)
+
+
+def run_joint_controller(mech: Mechanism, case, out: Path, q_guess=None, assembly=None) -> dict:
+    """A case with ``[control] kind = "computed_torque"`` or ``"decoupled"``: the controller of the
+    table (`mechbal.control.joint_controller`: gains, the declared effort limits and
+    ``torque_limit``, ``max_speed``) drives the mechanism along ``[trajectory]`` in closed loop
+    (`mechbal.simulate.closed_loop`, RK4 at ``rate_hz``, zero-order hold), from the trajectory's
+    start. Writes bodies_desired.npz (the commanded motion) and bodies_controlled.npz (the
+    simulated one, every coordinate; accelerations from the spline of the simulated rates), the
+    wrench and tracking plots, and summary.json with the run's verdict (`mechbal.simulate.judge_closed_loop`:
+    every tick ok, no saturation, the tracking within ``tolerance.joint``, the declared velocity
+    limits kept). A run that misses its goal is written all the same; the command line exits 6."""
+    from mechbal import simulate
+
+    ctl = case.control
+    name, title = case.case.name, case.case.title or case.case.name
+    names = mech.actuated_names
+    traj, _ = trajectory_from_config(case.trajectory, len(names))
+    try:
+        ctrl = control.joint_controller(mech, ctl, q_guess=q_guess)
+    except ValueError as exc:
+        msg = str(exc)
+        field, _, why = msg.partition(": ") if msg.startswith("control.") else ("control", "", msg)
+        raise ConfigError(field, why, has_value=False) from None
+    dt = 1.0 / ctl.rate_hz
+    progress.stage(f"closed loop ({ctl.kind}, {ctl.rate_hz:g} Hz)")
+    r = simulate.closed_loop(mech, ctrl, traj, dt=dt, duration=float(traj.duration), q_guess=q_guess,
+                             tolerance=ctl.tolerance.model_dump() if ctl.tolerance is not None else None)
+    t = r.t
+    progress.stage("bodies files and plots")
+    qd, vd, ad, _, _ = mechanism_motion(mech, traj, t, q_guess)
+    ok_steps = r.steps_completed + 1   # rows of the simulated motion that the plant reached
+    a_sim = _motion_acceleration(t[:ok_steps], r.v[:ok_steps]) if ok_steps > 5 else np.zeros_like(r.v[:ok_steps])
+    if mech.is_closed:
+        m = mech.closed_motion(r.q[:ok_steps], r.v[:ok_steps], a_sim, q_guess=q_guess)
+        qs, vs, as_ = m.q, m.v, m.a
+    else:
+        qs, vs, as_ = r.q[:ok_steps], r.v[:ok_steps], a_sim
+    Fd, Md = _write_variant(mech, out, "desired", t, qd, vd, ad)
+    finite = bool(np.all(np.isfinite(qs)) and np.all(np.isfinite(vs)) and np.all(np.isfinite(as_)))
+    files = ["bodies_desired.npz", "shaking_wrench.png", "tracking.png"]
+    curves = {"desired motion": (Fd, Md)}
+    if finite:   # a diverged loop's motion may overflow in its wrench: then it is not written
+        try:
+            Fc, Mc = _write_variant(mech, out, "controlled", t[:ok_steps], qs, vs, as_)
+        except ConfigError:
+            finite = False
+    if finite:
+        curves["closed loop (simulated)"] = (np.pad(Fc, ((0, len(t) - ok_steps), (0, 0)), mode="edge"),
+                                             np.pad(Mc, ((0, len(t) - ok_steps), (0, 0)), mode="edge"))
+        files.insert(1, "bodies_controlled.npz")
+    report.plot_wrench(out / "shaking_wrench.png", t, curves, title=f"{title}: {ctl.kind} control",
+                       caption="Shaking force dP/dt and moment dH_O/dt about O along the commanded motion and "
+                               f"along the motion the {ctl.kind} controller realised in closed loop.")
+    report.plot_series(out / "tracking.png", t, {"q_des - q": r.tracking_error}, names, "tracking error [rad or m]",
+                       title=f"{name}: {ctl.kind} tracking")
+
+    progress.stage("summary")
+    v = r.verdict
+    v.goal["kind"] = ctl.kind
+    v.goal["limits"] = verdict.limits_in_force(mech, ctl)   # the [control] table's limits too
+    torque = r.joint_torque
+    saturated = int(np.sum((r.status & np.uint32(int(control.Status.saturated))) != 0))
+    out_of_range = int(np.sum((r.status & np.uint32(int(control.Status.out_of_range))) != 0))
+    err = np.abs(r.tracking_error)
+    summary = {
+        "case": name,
+        "kind": case.case.kind,
+        "dof": mech.dof,
+        "actuated": names,
+        "closed": mech.is_closed,
+        "duration": float(traj.duration),
+        "samples": int(len(t)),
+        "law": law_name(traj),
+        "variants": ["desired", "controlled"] if finite else ["desired"],
+        "peak_shaking_force": {"desired": report.peak_abs(Fd), **({"controlled": report.peak_abs(Fc)} if finite else {})},
+        "peak_shaking_moment": {"desired": report.peak_abs(Md), **({"controlled": report.peak_abs(Mc)} if finite else {})},
+        "control": {
+            "kind": ctl.kind, "rate_hz": float(ctl.rate_hz), "sampling": "zero_order_hold", "integrator": "rk4",
+            "kp": list(ctl.kp), "kd": list(ctl.kd),
+            **({"k": list(np.asarray(ctrl.k, float))} if ctl.kind == "decoupled" else {}),
+            "torque_limit_in_force": [float(x) if np.isfinite(x) else None for x in np.asarray(ctrl.torque_limit, float)]
+            if np.any(np.isfinite(np.asarray(ctrl.torque_limit, float))) else None,
+            "ticks": int(len(t)), "steps_completed": int(r.steps_completed),
+            "saturated_ticks": saturated, "out_of_range_ticks": out_of_range,
+            "peak_tracking_error": report.peak_abs(err),
+            "peak_joint_torque": report.peak_abs(torque),
+        },
+        **v.summary(),
+        "total_mass": mech.total_mass,
+        "files": files,
+    }
+    if assembly is not None:
+        summary["loops"] = {"assembly": assembly.summary()}
+    write_summary(out / "summary.json", summary)
+    print(report.table([["peak |q_des - q| [rad or m]", *report.peak_abs(err)],
+                        ["peak torque [N m or N]", *report.peak_abs(torque)]], [f"{ctl.kind} control", *names]))
+    print(report.table(verdict.goal_rows(v, [["saturated ticks", f"{saturated} of {len(t)}"],
+                                             ["out-of-range ticks", f"{out_of_range} of {len(t)}"],
+                                             ["steps completed", f"{r.steps_completed} of {len(t) - 1}"],
+                                             ["tracking error [rad or m]", f"{float(np.max(err)):.3g}"]]),
+                       [f"{ctl.kind} control (closed loop)", "value"]))
+    return summary
 
 
 def feasibility_of(mech: Mechanism, case, q_guess=None):
