@@ -348,10 +348,10 @@ class ReactionlessPlan:
     (``ctl``) and ``[trajectory]`` tables, the assembly guess ``q_guess`` and, by ``mode``:
 
     * ``"joint"`` (balancing joints): ``traj``, the trajectory of every actuated joint with the
-      balancing joints held (`mechbal.cases.serial_chain.held_trajectory`), ``balancing`` and
+      balancing joints held (`mechbal.case.control_plan.held_trajectory`), ``balancing`` and
       ``task`` (indices among the actuated joints);
     * ``"task"`` (operational space, ``task_frame``): ``start`` (every joint) and the frame's
-      desired ``twist`` and ``twist_rate`` on ``th`` (`mechbal.cases.serial_chain.frame_path`).
+      desired ``twist`` and ``twist_rate`` on ``th`` (`mechbal.case.motion.frame_path`).
     """
 
     name: str
@@ -383,7 +383,8 @@ def reactionless_plan(case, *, dt: float = 1e-3, duration: float | None = None, 
     at tick ``dt`` [s] over ``duration`` [s] (default: the whole trajectory; a shorter horizon
     runs its beginning; ``validated``: the validated case, when already read, e.g. with a fitted
     duration). ConfigError naming the field for a case the controller cannot drive."""
-    from mechbal.cases.serial_chain import check_task_space, frame_path, held_trajectory, start_assembly
+    from mechbal.case.control_plan import check_task_space, held_trajectory
+    from mechbal.case.motion import frame_path, start_assembly
     from mechbal.config import ConfigError
     from mechbal.mechanism import Mechanism
 
@@ -453,7 +454,7 @@ def reactionless_motions(plan: ReactionlessPlan) -> dict:
     and its predicted ``shaking_force`` and ``shaking_moment`` (the controller's prediction for
     its command; the uncontrolled joint mode: the wrench of the held motion), and ``status``."""
     from mechbal import control
-    from mechbal.cases.serial_chain import mechanism_motion
+    from mechbal.case.motion import mechanism_motion
 
     mech = plan.mech
     out = {}
@@ -662,9 +663,10 @@ def _largest_residual(plan: ReactionlessPlan, sim: ReactionlessCoSimulation, pea
 def feasible_case(case, *, fit_duration: bool = False, allow_degraded: bool = False):
     """(validated case, feasibility summary): a case with a reactionless ``[control]`` checked
     against its declared limits before anything runs
-    (`mechbal.cases.serial_chain.check_feasibility`: `mechbal.verdict.ControlInfeasible`, or
+    (`mechbal.case.control_plan.check_feasibility`: `mechbal.verdict.ControlInfeasible`, or
     the fitted duration with ``fit_duration``)."""
-    from mechbal.cases.serial_chain import check_feasibility, start_assembly
+    from mechbal.case.control_plan import check_feasibility
+    from mechbal.case.motion import start_assembly
     from mechbal.config import trajectory_from_config
     from mechbal.mechanism import Mechanism
 
@@ -918,7 +920,7 @@ def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration
     prediction for the controller's command: ``base_reaction.png`` (plotted together),
     ``cosimulation.npz`` (every series, keys prefixed by the variant) and ``mechanism.xml``."""
     from mechbal import control
-    from mechbal.cases.serial_chain import _write_variant
+    from mechbal.case.writer import write_variant
     from mechbal.export.mjcf import mjcf_text
     from mechbal.export.mujoco_engine import cosimulated_mechanism
 
@@ -939,7 +941,7 @@ def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration
     stored, series = {}, {}
     for label, s in sims.items():
         cs = s.cosimulation
-        stored[label] = _write_variant(exported, out, label, t, cs.q_full, cs.v_full, cs.a_full)
+        stored[label] = write_variant(exported, out, label, t, cs.q_full, cs.v_full, cs.a_full)
         series.update({f"{label}_{k}": v for k, v in dict(
             t=t, q=cs.q_full, v=cs.v_full, a=cs.a_full, joint_torque=cs.joint_torque, status=s.status,
             command_q=s.command_q, command_v=s.command_v, command_a=s.command_a,

@@ -44,7 +44,7 @@ def test_task_controller_step_is_run():
     """``step`` (one tick, the binding's) gives the commands of ``run`` over the same samples,
     RK4 and Euler: what the co-simulation ticks is the controller the mechbal engine runs."""
     from mechbal.cases.panda import START, TOOL_FRAME
-    from mechbal.cases.serial_chain import frame_path
+    from mechbal.case.motion import frame_path
 
     mech = mechbal.Mechanism.from_toml(CASES_DIR / "panda-reactionless.toml")
     end = load_case("panda-reactionless")["trajectory"]["end"]

@@ -267,7 +267,7 @@ def test_task_space_feed_forward_and_null_space_switch():
     the predicted wrench of the general algorithm, the tool's acceleration J a + J'v is the path's
     (J'v by central differences of J), and null_space=False is the pseudo-inverse path."""
     from mechbal.cases.panda import START, TOOL_FRAME, urdf_path
-    from mechbal.cases.serial_chain import frame_path
+    from mechbal.case.motion import frame_path
 
     mech = mechbal.Mechanism.from_urdf(urdf_path())
     case = tomllib.loads((CASES_DIR / "panda-reactionless.toml").read_text())
