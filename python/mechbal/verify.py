@@ -160,14 +160,14 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
     """The whole check into ``out`` (module docstring); ``method``: the balancing method of the
     balanced variant (default: the case's ``balance.method``, or its default design's); returns
     the summary."""
-    from mechbal.balance.run import load_case, run_method
+    from mechbal.balance.run import balance_case, run_method
 
     out = Path(out)
     if reactionless_control(case) is not None:
         return run_verify_reactionless(case, out, simulate=simulate, fit_duration=fit_duration,
                                        allow_degraded=allow_degraded)
     progress.stage("reading the case")
-    bc = load_case(case)
+    bc = balance_case(case)
     variants = {"unbalanced": bc.mechanism}
     if method is None and bc.table is not None and getattr(bc.table, "method", None):
         method = bc.table.method
@@ -238,7 +238,7 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
     ``cosimulation.npz`` (every series) and ``mechanism.xml``; ``duration``: a horizon shorter
     than the trajectory [s]. A case with a reactionless ``[control]`` ticks its reactionless
     controller instead, both variants (`run_cosimulation_reactionless`)."""
-    from mechbal.balance.run import load_case
+    from mechbal.balance.run import balance_case
     from mechbal.control import ComputedTorque
     from mechbal.export.mujoco_engine import co_simulate
 
@@ -247,7 +247,7 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
         return run_cosimulation_reactionless(case, out, dt=dt, duration=duration, fit_duration=fit_duration,
                                              allow_degraded=allow_degraded)
     progress.stage("reading the case")
-    bc = load_case(case)
+    bc = balance_case(case)
     mech = bc.mechanism
     n = len(mech.actuated_names) if mech.is_closed else mech.dof
     traj = case_trajectory(bc, n)
@@ -324,13 +324,13 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
 def reactionless_control(case) -> "object | None":
     """The validated ``[control]`` table of a case file or built-in case when it asks for the
     reactionless controller, else None (URDF files, cases without one, other kinds)."""
-    from mechbal.config import load_case as read_case
+    from mechbal.case.load import load_case
     from mechbal.errors import ConfigError
 
     if str(case).lower().endswith(".urdf"):
         return None
     try:
-        raw = read_case(case)
+        raw = load_case(case, validate=False).raw
     except ConfigError:
         return None
     table = raw.get("control") if isinstance(raw, dict) else None

@@ -24,7 +24,7 @@ import mechbal
 from mechbal import verdict
 from mechbal import control
 from mechbal.cases import run_case
-from mechbal.config import CASES_DIR, ConfigError, case_path, load_case
+from mechbal.config import CASES_DIR, ConfigError, case_path, read_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from generated_text import text_differences
 
@@ -61,7 +61,7 @@ def _paminsa_closed_form(bodies: dict, case_file: Path, integrator: str):
     m = mech.closed_motion(qa, va, aa, q_guess=np.array(case.trajectory.initial_guess))
     platform = [mech.joint_names.index(n) for n in ("platform_x", "platform_y", "platform_z")]
     P, Pd, Pdd = (np.ascontiguousarray(np.asarray(x)[:, platform]) for x in (m.q, m.v, m.a))
-    cfg = load_case("paminsa")
+    cfg = read_case("paminsa")
     params = parameters_from_config(cfg)
     model = paper.PaminsaModel(paper.closed_form_counterweights(params).apply(params))
     wrist0 = np.array([case.trajectory.start[names.index(w)] for w in WRIST])
