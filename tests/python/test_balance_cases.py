@@ -438,7 +438,7 @@ def test_orthoglide_springs_reproduce_eqs_18_19_and_its_toml_runs(tmp_path):
     small["paths"].update(sample_period=0.05, helix_speeds=[0.8], cube_speeds=[1.0])
     small["machining"]["tasks"] = small["machining"]["tasks"][-1:]
     small["machining"]["holes"] = small["machining"]["holes"][:1]
-    from mechbal.balance.writers import toml_text
+    from mechbal.export.toml import toml_text
 
     (tmp_path / "small.toml").write_text(toml_text(small))
     assert main(["run", str(tmp_path / "small.toml"), "--out", str(tmp_path / "run"), "-q"]) == 0

@@ -10,7 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mechbal.balance.writers import rpy_of, toml_text, urdf_text
+from mechbal.export.common import rpy_of
+from mechbal.export.toml import toml_text
+from mechbal.export.urdf import urdf_text
 from mechbal.cli import main
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from mechbal.mechanism import Mechanism

@@ -421,7 +421,7 @@ def run_front(bc: BalanceCase, name: str, points: int, out: Path) -> dict:
 
 
 def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
-    from mechbal.balance.writers import inertia_table, mechanism_table, toml_text
+    from mechbal.export.toml import inertia_table, mechanism_table, toml_text
 
     cws = {k: v for k, v in result.design.items() if isinstance(v, CounterweightDesign)}
     springs = {k: v for k, v in result.design.items() if isinstance(v, SpringDesign)}
