@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from mechbal.config import load_case
+from mechbal.config import read_case
 from mechbal.mechanism import Mechanism
 from mechbal.plan import min_shaking
 from mechbal.schema import validate_case
@@ -38,7 +38,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", help="write the timings as JSON here")
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args(argv)
-    case = validate_case(load_case("ur5-dh"), warn=False)
+    case = validate_case(read_case("ur5-dh"), warn=False)
     mech = Mechanism.from_spec(case.spec, name="ur5")
     tr = case.trajectory
     free = min_shaking(mech, tr.start, tr.end, 2.0, samples=2001, control_points=12,

@@ -4,9 +4,9 @@ folder given. bench_generated.cpp checks at setup that it moves as the closed fo
 import sys
 
 from mechbal.codegen import generate
-from mechbal.config import load_case
+from mechbal.config import read_case
 from mechbal.papers.paminsa import paminsa_mechanism
 from mechbal.papers.paminsa.runner import parameters_from_config
 
-mechanism = paminsa_mechanism(parameters_from_config(load_case("paminsa")), balanced=False)
+mechanism = paminsa_mechanism(parameters_from_config(read_case("paminsa")), balanced=False)
 generate(mechanism, name="mechbal_bench_paminsa", frames=[]).write(sys.argv[1])

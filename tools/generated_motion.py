@@ -22,9 +22,9 @@ def main(argv: list[str]) -> int:
     parser.add_argument("expected")
     parser.add_argument("--ticks", type=int, default=1000)
     args = parser.parse_args(argv)
-    from mechbal.balance.run import load_case
+    from mechbal.balance.run import balance_case
 
-    bc = load_case(args.case)
+    bc = balance_case(args.case)
     mech = bc.mechanism
     if not mech.is_closed:
         print(f"{args.case}: the generated variant runs a closed mechanism; this one has no loops",

@@ -24,7 +24,7 @@ import numpy as np
 
 import mechbal
 from mechbal.assembly import assemble
-from mechbal.config import load_case
+from mechbal.config import read_case
 from mechbal.papers.paminsa import paminsa_case_toml
 from mechbal.plan import com_law, min_shaking
 from mechbal.plan.model import ActuatedModel
@@ -34,7 +34,7 @@ BUDGET = 10.0   # kg of counterweights (the complete balance needs 23.5 kg)
 
 case = validate_case(tomllib.loads(paminsa_case_toml("paminsa", balanced=False)), warn=False)
 unbalanced = mechbal.Mechanism.from_spec(case.spec, name="paminsa (unbalanced)")
-balanced_case = validate_case(load_case("paminsa-linkage"), warn=False)   # the same, balanced
+balanced_case = validate_case(read_case("paminsa-linkage"), warn=False)   # the same, balanced
 full = mechbal.Mechanism.from_spec(balanced_case.spec, name="paminsa (balanced)")
 full_mass = sum(b.mass for b in full.bodies if b.kind == "counterweight")
 s = BUDGET / full_mass

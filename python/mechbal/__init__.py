@@ -16,6 +16,8 @@ The public API (SI units throughout: m, kg, kg m^2, rad, s, N, N m; base frame z
 * `mechbal.export`: URDF and MJCF files of a mechanism, bodies files, the MuJoCo engine;
 * `mechbal.papers`: what exists only to reproduce a paper (closed forms, per-paper models);
 * `mechbal.cases`: the built-in case studies and `run_case(name, out_dir)`.
+* `load_case`: a case (a built-in case's name, a TOML or URDF file) read into a `LoadedCase`
+  (`mechbal.case`).
 
 Results are dataclasses with named fields (``shaking_force``, ``shaking_moment``,
 ``base_reaction_force``, ``joint_torque``, ...) and, for batches, a per-instant ``status`` array
@@ -37,7 +39,8 @@ from mechbal import registry as _registry
 if TYPE_CHECKING:  # what mypy and readers see; at run time each name loads on first use (__getattr__)
     from mechbal import assembly, balance, cases, control, export, papers, simulate, sweep, trajectory
     from mechbal._core import Status, __version__
-    from mechbal.config import ConfigError, ConfigWarning, load_case
+    from mechbal.case import LoadedCase, load_case
+    from mechbal.config import ConfigError, ConfigWarning
     from mechbal.errors import PlausibilityWarning
     from mechbal.mechanism import (  # with the description objects of Mechanism.from_description
         BaseReaction, BatchArray, Body, BodyMotion, ClosedMotion, Frame, Joint, JointType, LoopConstraint, LoopType,
@@ -47,8 +50,8 @@ __all__ = [
     "Mechanism", "ShakingWrench", "BaseReaction", "Momentum", "BodyMotion", "ClosedMotion", "BatchArray",
     "Joint", "JointType", "Body", "Frame", "LoopConstraint", "LoopType", "MechanismDescription", "Spring",
     "MechanismModel", "Status", "ConfigError", "ConfigWarning", "PlausibilityWarning",
-    "load_case", "balance", "control", "trajectory", "simulate", "assembly", "papers", "cases", "sweep",
-    "export", "__version__",
+    "load_case", "LoadedCase", "balance", "control", "trajectory", "simulate", "assembly", "papers", "cases",
+    "sweep", "export", "__version__",
 ]
 
 #: the public subpackages and modules, each loaded on first use
@@ -57,7 +60,8 @@ _MODULES = {"assembly", "balance", "cases", "control", "export", "papers", "simu
 #: public names and the module that holds each (loaded on first use)
 _NAMES = {
     **dict.fromkeys(("Status", "__version__"), "_core"),
-    **dict.fromkeys(("ConfigError", "ConfigWarning", "load_case"), "config"),
+    **dict.fromkeys(("ConfigError", "ConfigWarning"), "config"),
+    **dict.fromkeys(("LoadedCase", "load_case"), "case"),
     "PlausibilityWarning": "errors",
     **dict.fromkeys(("BaseReaction", "BatchArray", "BodyMotion", "ClosedMotion", "Mechanism", "Momentum",
                      "ShakingWrench", "Body", "Frame", "Joint", "JointType", "LoopConstraint", "LoopType",

@@ -155,11 +155,11 @@ def _view_available() -> None:
 
 def _case_mechanism(case: str, design: str | None = None):
     """The case's mechanism, or None when the case has none to read (a paper's runner)."""
-    from mechbal.balance.run import load_case
+    from mechbal.balance.run import balance_case
     from mechbal.config import ConfigError
 
     try:
-        return load_case(case, design).mechanism
+        return balance_case(case, design).mechanism
     except (ConfigError, ValueError, OSError, KeyError, AttributeError, TypeError):
         return None
 
@@ -376,9 +376,9 @@ def _export_mechanism(case: str):
     if str(case).lower().endswith(".urdf"):
         check_case_file(case)
         return Mechanism.from_urdf(case), None, None
-    from mechbal.balance.run import load_case
+    from mechbal.balance.run import balance_case
 
-    bc = load_case(case)
+    bc = balance_case(case)
     mech, qa = bc.mechanism, np.asarray(bc.motion[0][0], float)
     q0 = np.asarray(mech.closed_motion(qa, q_guess=bc.q_guess).q, float) if mech.is_closed else qa
     return mech, q0, bc.q_guess

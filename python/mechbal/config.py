@@ -220,8 +220,9 @@ def check_case_file(name_or_path: str) -> Path:
     return path
 
 
-def load_case(name_or_path: str | Path) -> dict:
-    """Read a case file and check its ``[case]`` header (``name``, ``kind``)."""
+def read_case(name_or_path: str | Path) -> dict:
+    """The tables of a case file (a built-in case's name or a path) as a dict, its ``[case]``
+    header's ``name`` and ``kind`` checked; the case itself: `mechbal.case.load_case`."""
     data = read_toml(case_path(name_or_path))
     header = require(data, "case", "")
     string(require(header, "name", "case"), "case.name")

@@ -167,14 +167,14 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
     balanced variant (default: the case's ``balance.method``, or its default design's); returns
     the summary. ``view``: also ``out/view.html`` (`mechbal.view`), the variants side by side on
     the case's trajectory."""
-    from mechbal.balance.run import load_case, run_method
+    from mechbal.balance.run import balance_case, run_method
 
     out = Path(out)
     if reactionless_control(case) is not None:
         return run_verify_reactionless(case, out, simulate=simulate, fit_duration=fit_duration,
                                        allow_degraded=allow_degraded, view=view)
     progress.stage("reading the case")
-    bc = load_case(case)
+    bc = balance_case(case)
     jc = joint_control(case)
     controller = None
     if jc is not None:   # the case's own controller drives the simulated check, and is judged
@@ -272,7 +272,7 @@ def run_verify(case: str, out: Path, *, simulate: bool = True, method: str | Non
 def joint_control(case) -> "object | None":
     """The validated case of a case file whose ``[control]`` table asks for a joint controller
     (``computed_torque`` or ``decoupled``), else None (URDF files, cases without one, other kinds)."""
-    from mechbal.config import load_case as read_case
+    from mechbal.config import read_case
     from mechbal.errors import ConfigError
 
     if str(case).lower().endswith(".urdf"):
@@ -320,7 +320,7 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
     ``cosimulation.npz`` (every series) and ``mechanism.xml``; ``duration``: a horizon shorter
     than the trajectory [s]. A case with a reactionless ``[control]`` ticks its reactionless
     controller instead, both variants (`run_cosimulation_reactionless`)."""
-    from mechbal.balance.run import load_case
+    from mechbal.balance.run import balance_case
     from mechbal.control import ComputedTorque
     from mechbal.export.mujoco_engine import co_simulate
 
@@ -329,7 +329,7 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
         return run_cosimulation_reactionless(case, out, dt=dt, duration=duration, fit_duration=fit_duration,
                                              allow_degraded=allow_degraded)
     progress.stage("reading the case")
-    bc = load_case(case)
+    bc = balance_case(case)
     mech = bc.mechanism
     n = len(mech.actuated_names) if mech.is_closed else mech.dof
     traj = case_trajectory(bc, n)
@@ -410,13 +410,13 @@ def run_cosimulation(case: str, out: Path, *, dt: float = 1e-3, duration: float 
 def reactionless_control(case) -> "object | None":
     """The validated ``[control]`` table of a case file or built-in case when it asks for the
     reactionless controller, else None (URDF files, cases without one, other kinds)."""
-    from mechbal.config import load_case as read_case
+    from mechbal.case.load import load_case
     from mechbal.errors import ConfigError
 
     if str(case).lower().endswith(".urdf"):
         return None
     try:
-        raw = read_case(case)
+        raw = load_case(case, validate=False).raw
     except ConfigError:
         return None
     table = raw.get("control") if isinstance(raw, dict) else None
@@ -434,10 +434,10 @@ class ReactionlessPlan:
     (``ctl``) and ``[trajectory]`` tables, the assembly guess ``q_guess`` and, by ``mode``:
 
     * ``"joint"`` (balancing joints): ``traj``, the trajectory of every actuated joint with the
-      balancing joints held (`mechbal.cases.serial_chain.held_trajectory`), ``balancing`` and
+      balancing joints held (`mechbal.case.control_plan.held_trajectory`), ``balancing`` and
       ``task`` (indices among the actuated joints);
     * ``"task"`` (operational space, ``task_frame``): ``start`` (every joint) and the frame's
-      desired ``twist`` and ``twist_rate`` on ``th`` (`mechbal.cases.serial_chain.frame_path`).
+      desired ``twist`` and ``twist_rate`` on ``th`` (`mechbal.case.motion.frame_path`).
     """
 
     name: str
@@ -469,7 +469,8 @@ def reactionless_plan(case, *, dt: float = 1e-3, duration: float | None = None, 
     at tick ``dt`` [s] over ``duration`` [s] (default: the whole trajectory; a shorter horizon
     runs its beginning; ``validated``: the validated case, when already read, e.g. with a fitted
     duration). ConfigError naming the field for a case the controller cannot drive."""
-    from mechbal.cases.serial_chain import check_task_space, frame_path, held_trajectory, start_assembly
+    from mechbal.case.control_plan import check_task_space, held_trajectory
+    from mechbal.case.motion import frame_path, start_assembly
     from mechbal.config import ConfigError
     from mechbal.mechanism import Mechanism
 
@@ -542,7 +543,7 @@ def reactionless_motions(plan: ReactionlessPlan) -> dict:
     and its predicted ``shaking_force`` and ``shaking_moment`` (the controller's prediction for
     its command; the uncontrolled joint mode: the wrench of the held motion), and ``status``."""
     from mechbal import control
-    from mechbal.cases.serial_chain import mechanism_motion
+    from mechbal.case.motion import mechanism_motion
 
     mech = plan.mech
     out = {}
@@ -751,9 +752,10 @@ def _largest_residual(plan: ReactionlessPlan, sim: ReactionlessCoSimulation, pea
 def feasible_case(case, *, fit_duration: bool = False, allow_degraded: bool = False):
     """(validated case, feasibility summary): a case with a reactionless ``[control]`` checked
     against its declared limits before anything runs
-    (`mechbal.cases.serial_chain.check_feasibility`: `mechbal.verdict.ControlInfeasible`, or
+    (`mechbal.case.control_plan.check_feasibility`: `mechbal.verdict.ControlInfeasible`, or
     the fitted duration with ``fit_duration``)."""
-    from mechbal.cases.serial_chain import check_feasibility, start_assembly
+    from mechbal.case.control_plan import check_feasibility
+    from mechbal.case.motion import start_assembly
     from mechbal.config import trajectory_from_config
     from mechbal.mechanism import Mechanism
 
@@ -1014,7 +1016,7 @@ def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration
     prediction for the controller's command: ``base_reaction.png`` (plotted together),
     ``cosimulation.npz`` (every series, keys prefixed by the variant) and ``mechanism.xml``."""
     from mechbal import control
-    from mechbal.cases.serial_chain import _write_variant
+    from mechbal.case.writer import write_variant
     from mechbal.export.mjcf import mjcf_text
     from mechbal.export.mujoco_engine import cosimulated_mechanism
 
@@ -1035,7 +1037,7 @@ def run_cosimulation_reactionless(case, out: Path, *, dt: float = 1e-3, duration
     stored, series = {}, {}
     for label, s in sims.items():
         cs = s.cosimulation
-        stored[label] = _write_variant(exported, out, label, t, cs.q_full, cs.v_full, cs.a_full)
+        stored[label] = write_variant(exported, out, label, t, cs.q_full, cs.v_full, cs.a_full)
         series.update({f"{label}_{k}": v for k, v in dict(
             t=t, q=cs.q_full, v=cs.v_full, a=cs.a_full, joint_torque=cs.joint_torque, status=s.status,
             command_q=s.command_q, command_v=s.command_v, command_a=s.command_a,

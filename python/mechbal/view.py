@@ -512,9 +512,9 @@ def _case_variant(case: str, samples: int) -> list[Variant]:
         s = t / 2.0
         blend = 10 * s**3 - 15 * s**4 + 6 * s**5
         return [Variant(mech.name, mech, t, blend[:, None] * target[None, :])]
-    from mechbal.balance.run import load_case
+    from mechbal.balance.run import balance_case
 
-    bc = load_case(case)
+    bc = balance_case(case)
     return motion_variants(bc, {bc.title or bc.name: bc.mechanism}, samples=samples, case=str(case))
 
 

@@ -17,7 +17,7 @@ from mechbal import _core
 from mechbal.balance import CounterweightSlot as Slot
 from mechbal.balance import force, rms, static
 from mechbal.cli import main
-from mechbal.config import case_path, load_case
+from mechbal.config import case_path, read_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from mechbal.mechanism import Mechanism
 from mechbal.papers import discs as dz
@@ -192,7 +192,7 @@ DISC_CASES = {"planar3r": "discs-3r", "spatial3r": "discs-spatial", "scara": "sc
 def params(kind):
     from mechbal.papers.discs.runner import parameters_from_config
 
-    return parameters_from_config(kind, load_case(DISC_CASES.get(kind, "five-bar")))
+    return parameters_from_config(kind, read_case(DISC_CASES.get(kind, "five-bar")))
 
 
 @pytest.fixture(scope="module")
@@ -266,7 +266,7 @@ def moment_columns_of_case():
     """The angular momentum of a unit rate of theta1 and of theta2 (constant: the leg-wise
     balanced parallelogram) of the five-bar case's balance mechanism."""
     from mechbal.balance import moment
-    from mechbal.balance.run import load_case as load_balance_case
+    from mechbal.balance.run import balance_case as load_balance_case
 
     bc = load_balance_case("five-bar")
     _, H = moment.angular_momentum_columns(bc.mechanism, np.array([[0.5, 2.0], [1.0, 2.4]]), q_guess=bc.q_guess)
@@ -372,7 +372,7 @@ def test_rpsp_force_reproduces_eqs_29_31_and_its_toml_runs(tmp_path):
     s = summary_of(out)
     b = s["balance"]
     assert s["kind"] == "rpsp" and s["closed"] and b["exact"] and b["rank"] == b["unknowns"] == 10
-    c = validate_case(load_case("rpsp"), warn=False)
+    c = validate_case(read_case("rpsp"), warn=False)
     p = c.paper
     eqs = paper.counterweights_eqs_29_31(p.m_E, p.m_Q, p.m_H, p.m_K, p.r_H, p.r_K, p.r_P, p.r_N, p.r_Q, p.r_F)
     for key in ("m_P", "m_N", "m_F"):
@@ -438,7 +438,7 @@ def test_orthoglide_springs_reproduce_eqs_18_19_and_its_toml_runs(tmp_path):
     small["paths"].update(sample_period=0.05, helix_speeds=[0.8], cube_speeds=[1.0])
     small["machining"]["tasks"] = small["machining"]["tasks"][-1:]
     small["machining"]["holes"] = small["machining"]["holes"][:1]
-    from mechbal.balance.writers import toml_text
+    from mechbal.export.toml import toml_text
 
     (tmp_path / "small.toml").write_text(toml_text(small))
     assert main(["run", str(tmp_path / "small.toml"), "--out", str(tmp_path / "run"), "-q"]) == 0

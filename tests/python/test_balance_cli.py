@@ -10,7 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mechbal.balance.writers import rpy_of, toml_text, urdf_text
+from mechbal.export.common import rpy_of
+from mechbal.export.toml import toml_text
+from mechbal.export.urdf import urdf_text
 from mechbal.cli import main
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from mechbal.mechanism import Mechanism
@@ -212,7 +214,7 @@ def test_ur5_urdf_balanced_by_springs(tmp_path):
 
     from mechbal import _core
     from mechbal.balance import springs as sp
-    from mechbal.balance.run import load_case
+    from mechbal.balance.run import balance_case
 
     urdf = _robot_file(*ROBOTS["ur5"])
     design = Path(__file__).parents[2] / "docs" / "examples" / "ur5_springs.toml"
@@ -242,7 +244,7 @@ def test_ur5_urdf_balanced_by_springs(tmp_path):
     q = np.random.default_rng(4).uniform(-math.pi, math.pi, (300, balanced.dof))
     assert np.max(np.abs(balanced.static_torque(q)[:, 1:3])) < 0.2
     # the residual is wrist 3's centre of mass, 0.095 m off the wrist-1 axis: without it, exact
-    bc = load_case(str(urdf), str(design))
+    bc = balance_case(str(urdf), str(design))
     bodies = [x if x.name != "wrist_3_link" else _core.Body(x.name, x.link, 0.0, np.asarray(x.com),
                                                              np.asarray(x.inertia), x.kind)
               for x in bc.mechanism.model.description.bodies]

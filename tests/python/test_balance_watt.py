@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from mechbal.balance import CounterweightSlot, force, fronts
-from mechbal.balance.run import load_case, slots_from_table
+from mechbal.balance.run import balance_case, slots_from_table
 from mechbal.config import case_path
 
 pytest.importorskip("clarabel")
@@ -95,7 +95,7 @@ def shaking_force_independent(masses, omega, n=360):
 
 @pytest.fixture(scope="module")
 def case():
-    return load_case("watt-six-bar")
+    return balance_case("watt-six-bar")
 
 
 @pytest.fixture(scope="module")

@@ -261,9 +261,9 @@ def test_generated_computed_torque_ticks_as_the_library(tmp_path):
 
 # ---- closed loops --------------------------------------------------------------------------------
 def _closed_case(name: str):
-    from mechbal.balance.run import load_case
+    from mechbal.balance.run import balance_case
 
-    bc = load_case(name)
+    bc = balance_case(name)
     guess = np.asarray(bc.q_guess, float) if bc.q_guess is not None else np.zeros(bc.mechanism.dof)
     return bc.mechanism, [np.asarray(x, float) for x in bc.motion[:3]], guess
 

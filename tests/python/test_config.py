@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mechbal.config import ConfigError, load_case, read_toml, trajectory_from_config
+from mechbal.config import ConfigError, read_case, read_toml, trajectory_from_config
 from mechbal.mechanism import Mechanism
 from mechbal.spec import mechanism_spec
 
@@ -128,12 +128,12 @@ def test_trajectory_bad_duration_and_size():
 
 
 def test_unknown_case_and_bad_toml(tmp_path):
-    expect_error(lambda: load_case("no_such_case"), "case", "no_such_case")
+    expect_error(lambda: read_case("no_such_case"), "case", "no_such_case")
     p = tmp_path / "broken.toml"
     p.write_text("[case\nname = ")
-    expect_error(lambda: load_case(p), str(p))
+    expect_error(lambda: read_case(p), str(p))
     p.write_text("[case]\nname = 'x'\n")
-    expect_error(lambda: load_case(p), "case.kind")
+    expect_error(lambda: read_case(p), "case.kind")
 
 
 def test_dh_and_mdh_give_the_same_chain_as_origins():

@@ -11,7 +11,7 @@ import pytest
 from mechbal import _core
 from mechbal.papers.discs import coupling as cp
 from mechbal.papers.discs.runner import parameters_from_config
-from mechbal.config import ConfigError, load_case
+from mechbal.config import ConfigError, read_case
 from mechbal.papers import discs as dz
 
 CASES = {"planar3r": "discs-3r", "spatial3r": "discs-spatial", "scara": "scara",
@@ -20,7 +20,7 @@ CASES = {"planar3r": "discs-3r", "spatial3r": "discs-spatial", "scara": "scara",
 
 @lru_cache(maxsize=None)
 def params(kind):
-    return parameters_from_config(kind, load_case(CASES[kind]))
+    return parameters_from_config(kind, read_case(CASES[kind]))
 
 
 def k_closed_form(kind, p):
@@ -451,7 +451,7 @@ def test_discs_case_runs_and_writes_the_summary(kind, tmp_path):
     from mechbal.cases import _load_runners, _RUNNERS
 
     _load_runners()
-    cfg = load_case(CASES[kind])
+    cfg = read_case(CASES[kind])
     cfg["sampling"]["configurations"] = 40
     cfg["sensitivity"]["errors_pct"] = [5.0]
     cfg["trajectory"]["samples"] = 201
@@ -518,22 +518,22 @@ def test_discs_case_runs_and_writes_the_summary(kind, tmp_path):
 
 
 def test_bad_configurations_are_refused_naming_the_field():
-    cfg = load_case("discs-3r")
+    cfg = read_case("discs-3r")
     cfg["parameters"]["m2"] = -3.0
     with pytest.raises(ConfigError, match=r"parameters\.m2"):
         parameters_from_config("planar3r", cfg)
-    cfg = load_case("discs-3r")
+    cfg = read_case("discs-3r")
     cfg["inertia"]["link1"] = [0.25, 1e-3, 1e-3]  # the reference's non-physical planar inertia
     with pytest.raises(ConfigError, match=r"inertia\.link1"):
         parameters_from_config("planar3r", cfg)
-    cfg = load_case("discs-spatial")
+    cfg = read_case("discs-spatial")
     cfg["inertia"]["link2"] = [0.9, 0.41, 0.08]  # Jx2 > Jy2 + Jz2 after the eq 25 condition
     with pytest.raises(ConfigError, match=r"inertia\.link2"):
         parameters_from_config("spatial3r", cfg)
     from mechbal.cases import _load_runners, _RUNNERS
 
     _load_runners()
-    cfg = load_case("five-bar")
+    cfg = read_case("five-bar")
     cfg["parameters"]["d"] = 0.1
     with pytest.raises(ConfigError, match="parallelogram"):
         _RUNNERS["discs"](cfg, None)

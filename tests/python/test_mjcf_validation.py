@@ -21,9 +21,9 @@ from mechbal.export.mujoco_engine import validate_mjcf  # noqa: E402
 
 
 def _four_bar_mjcf() -> str:
-    from mechbal.balance.run import load_case
+    from mechbal.balance.run import balance_case
 
-    bc = load_case("four-bar")
+    bc = balance_case("four-bar")
     q0 = bc.mechanism.closed_motion(bc.motion[0][0], q_guess=bc.q_guess).q
     return bc.mechanism.to_mjcf(q=q0, q_guess=bc.q_guess)
 

@@ -15,7 +15,7 @@ from mechbal import _core
 from mechbal.balance import DiscSlot, InertiaSlot
 from mechbal.balance import moment
 from mechbal.papers.discs.runner import parameters_from_config
-from mechbal.config import load_case
+from mechbal.config import read_case
 from mechbal.papers import discs as dz
 
 EX, EZ = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
@@ -31,7 +31,7 @@ def _T(y):
 def disc_arm(kind, inertia_from_design=True):
     """The case's arm with the closed form's static balancing (l_g), links only (no discs):
     (mechanism, parameters p, closed-form design d)."""
-    p = parameters_from_config(kind, load_case(CASES[kind]))
+    p = parameters_from_config(kind, read_case(CASES[kind]))
     d = dz.design(kind, p, True)
     R, P = _core.JointType.revolute, _core.JointType.prismatic
     axes, types, coms = {"planar3r": ((EX, EX, EX), (R, R, R), (d["lg1"], d["lg2"], d["lg3"])),
@@ -157,7 +157,7 @@ def test_scara_reproduces_eq35_generalised_and_says_why_the_rest_is_impossible()
 def five_bar(parallelogram=True):
     """The five-bar case's leg-wise statically balanced 5R (y-z plane, axes x) with a point loop
     closure at the end effector; a general (non-parallelogram) variant otherwise."""
-    p = parameters_from_config("fivebar", load_case("five-bar"))
+    p = parameters_from_config("fivebar", read_case("five-bar"))
     if not parallelogram:
         p = dict(p, d=0.12, b1=0.32, b2=0.36)
     d = dz.design("fivebar", p, True)

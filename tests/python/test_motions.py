@@ -15,7 +15,7 @@ import pytest
 import sympy as sp
 
 import mechbal
-from mechbal.balance.writers import toml_text
+from mechbal.export.toml import toml_text
 from mechbal.cases import run_case
 from mechbal.cli import main
 from mechbal.errors import ConfigError

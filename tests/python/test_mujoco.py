@@ -104,9 +104,9 @@ def test_random_trees_with_gears_and_springs_match_mujoco(seed):
 
 
 def _case_motion(name, step=10):
-    from mechbal.balance.run import evaluate, load_case
+    from mechbal.balance.run import evaluate, balance_case
 
-    bc = load_case(name)
+    bc = balance_case(name)
     ev = evaluate(bc, bc.mechanism)
     s = slice(None, None, step)
     return bc, ev["q"][s], ev["v"][s], ev["a"][s]
@@ -226,9 +226,9 @@ def test_every_builtin_case_round_trips_through_urdf_or_says_why(case):
     """from_urdf(to_urdf(m)) is m (mass matrix and gravity torque to 1e-12 relative, joints
     matched by name) for every built-in case URDF can express; the others are refused in one line
     naming what URDF cannot hold."""
-    from mechbal.balance.run import load_case
+    from mechbal.balance.run import balance_case
 
-    mech = load_case(case).mechanism
+    mech = balance_case(case).mechanism
     if mech.is_closed or mech.springs:
         with pytest.raises(ExportError, match="loop closure|spring") as err:
             mech.to_urdf()
@@ -250,9 +250,9 @@ def test_balanced_toml_is_the_balanced_model(case, tmp_path):
     """The balanced.toml that ``mechbal balance`` writes (by the case's method, or its default
     design's) reads back as the balanced mechanism through the case reader (any case kind): the
     same bodies, mass matrix and static torque to 1e-12 relative, joints matched by name."""
-    from mechbal.balance.run import _balanced_toml, load_case, run_method
+    from mechbal.balance.run import _balanced_toml, balance_case, run_method
 
-    bc = load_case(case)
+    bc = balance_case(case)
     method = getattr(bc.table, "method", None) if bc.table is not None else None
     if method is None and bc.default_design:
         method = next(iter(bc.default_design))
@@ -263,7 +263,7 @@ def test_balanced_toml_is_the_balanced_model(case, tmp_path):
     balanced = result.balanced
     path = tmp_path / "balanced.toml"
     path.write_text(_balanced_toml(bc, result, method))
-    back = load_case(str(path)).mechanism
+    back = balance_case(str(path)).mechanism
     assert sorted(back.body_names) == sorted(balanced.body_names)
     perm = [back.joint_names.index(n) for n in balanced.joint_names]
     q = np.random.default_rng(5).normal(size=(10, balanced.dof))
@@ -337,12 +337,12 @@ def test_force_balanced_four_bar_in_mujoco_at_1khz():
     (impedance 0.9-0.95, its own inverse weights): about 6e-2; the export's impedance 0.9999:
     about 5e-5; with the co-simulation's constraint weight 1e-4 as well: about 3e-8; 4 substeps of
     0.25 ms take it lower still; a first-order integrator (Euler) at 1 ms leaves about 3e-4."""
-    from mechbal.balance.run import load_case, run_method
+    from mechbal.balance.run import balance_case, run_method
     from mechbal.config import trajectory_from_config
     from mechbal.control import ComputedTorque
     from mechbal.simulate import closed_loop
 
-    bc = load_case("four-bar")
+    bc = balance_case("four-bar")
     balanced = run_method(bc, "force").balanced
     table = {k: v for k, v in bc.trajectory_table.items() if k != "initial_guess"}
     traj, _ = trajectory_from_config(table, 1)
@@ -372,11 +372,11 @@ def test_paminsa_force_balanced_in_mujoco():
     massless moving links 1e-6 of the total mass; mechbal's prediction is of that mechanism) and
     weights their loops like the others. The force-balanced robot's simulated shaking force is
     then below 1e-4 of the unbalanced peak (MuJoCo's own constraint weights: about 3e-3)."""
-    from mechbal.balance.run import load_case, run_method
+    from mechbal.balance.run import balance_case, run_method
     from mechbal.config import trajectory_from_config
     from mechbal.control import ComputedTorque
 
-    bc = load_case("paminsa")
+    bc = balance_case("paminsa")
     balanced = run_method(bc, "force").balanced
     n = len(bc.mechanism.actuated_names)
     table = {k: v for k, v in bc.trajectory_table.items() if k != "initial_guess"}
@@ -401,10 +401,10 @@ def test_co_simulation_stops_where_mujoco_refuses_the_torque_or_resets(torque, f
     tick (steps_completed 20, Status.out_of_range from the first bad row on) and the later rows
     repeat the last one written, as mechbal's own simulator does; before, it ran to the end with
     every status 0."""
-    from mechbal.balance.run import load_case
+    from mechbal.balance.run import balance_case
     from mechbal.config import trajectory_from_config
 
-    bc = load_case("four-bar")
+    bc = balance_case("four-bar")
     mech = bc.mechanism
     n = len(mech.actuated_names)
     traj, _ = trajectory_from_config({k: v for k, v in bc.trajectory_table.items() if k != "initial_guess"}, n)
@@ -469,12 +469,12 @@ def test_decoupled_control_of_the_disc_balanced_arm_in_mujoco():
     rad both, the zero-order hold); on the arm without the discs (off-diagonal inertia 0.185 kg m^2)
     the same law leaves the path by about 1e-2 rad. MuJoCo integrates the discs as geared joints
     (equality constraints): the independent engine confirms the decoupling."""
-    from mechbal.balance.run import load_case, run_method
+    from mechbal.balance.run import balance_case, run_method
     from mechbal.config import trajectory_from_config
     from mechbal.control import ComputedTorque, DecoupledJointController
     from mechbal.simulate import closed_loop
 
-    bc = load_case("discs-3r")
+    bc = balance_case("discs-3r")
     balanced = run_method(bc, "moment").balanced
     n = bc.mechanism.dof
     table = {k: v for k, v in bc.trajectory_table.items() if k != "initial_guess"}

@@ -15,7 +15,7 @@ import pytest
 
 mujoco = pytest.importorskip("mujoco")
 
-from mechbal.balance.run import load_case, run_method  # noqa: E402
+from mechbal.balance.run import balance_case, run_method  # noqa: E402
 from mechbal.export.mjcf import mjcf_text, minimum_bodies  # noqa: E402
 
 #: every built-in case with loops (`mechbal cases`)
@@ -25,7 +25,7 @@ HOLD = 1e-3
 
 
 def _variants(case: str):
-    bc = load_case(case)
+    bc = balance_case(case)
     out = {"unbalanced": bc.mechanism}
     method = getattr(bc.table, "method", None) if bc.table is not None else None
     if method is None and bc.default_design:
@@ -76,7 +76,7 @@ def test_a_loop_through_a_massless_link_gives_way_without_the_closed_minimum():
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        bc = load_case("paminsa")
+        bc = balance_case("paminsa")
     mech = bc.mechanism
     cm = mech.closed_motion(bc.motion[0][0], q_guess=bc.q_guess, with_forces=True)
     m = mujoco.MjModel.from_xml_string(mjcf_text(mech, q=cm.q, q_guess=bc.q_guess, minimum_mass=MINIMUM))

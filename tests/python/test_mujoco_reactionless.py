@@ -23,7 +23,7 @@ import pytest
 
 import mechbal
 from mechbal import control
-from mechbal.config import CASES_DIR, load_case
+from mechbal.config import CASES_DIR, read_case
 from mechbal.export import read_bodies
 
 pytest.importorskip("mujoco")
@@ -44,10 +44,10 @@ def test_task_controller_step_is_run():
     """``step`` (one tick, the binding's) gives the commands of ``run`` over the same samples,
     RK4 and Euler: what the co-simulation ticks is the controller the mechbal engine runs."""
     from mechbal.cases.panda import START, TOOL_FRAME
-    from mechbal.cases.serial_chain import frame_path
+    from mechbal.case.motion import frame_path
 
     mech = mechbal.Mechanism.from_toml(CASES_DIR / "panda-reactionless.toml")
-    end = load_case("panda-reactionless")["trajectory"]["end"]
+    end = read_case("panda-reactionless")["trajectory"]["end"]
     th = np.arange(401) * 0.5e-3
     _, _, twist, rate = frame_path(mech, TOOL_FRAME, START, end, 2.0, "quintic", th + 0.3)
     for integrator in ("rk4", "euler"):

@@ -11,14 +11,14 @@ import pytest
 
 from mechbal.balance.springs import load_catalogue, select_springs
 from mechbal.papers.orthoglide import runner as og
-from mechbal.config import ConfigError, load_case
+from mechbal.config import ConfigError, read_case
 from mechbal.papers import orthoglide as paper
 from mechbal.schema import validate_case
 
 
 @pytest.fixture(scope="module")
 def raw():
-    return load_case("orthoglide")
+    return read_case("orthoglide")
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ import pytest
 import mechbal
 from mechbal import _core
 from mechbal.cases import DEFAULT_CASE, run_case
-from mechbal.config import ConfigError, load_case
+from mechbal.config import ConfigError, read_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from mechbal.papers import paminsa as paper
 from body_set import body_set_wrench
@@ -118,7 +118,7 @@ def test_summary_schema(paminsa_run):
 def params():
     from mechbal.papers.paminsa.runner import parameters_from_config
 
-    return parameters_from_config(load_case("paminsa"))
+    return parameters_from_config(read_case("paminsa"))
 
 
 def test_runner_sizes_by_the_general_method_and_reports_the_closed_form(paminsa_run):
@@ -142,7 +142,7 @@ def test_runner_refuses_slots_that_disagree_with_the_closed_form():
     design, which the closed form does not check: the runner stops and says why."""
     from mechbal.papers.paminsa.runner import check_against_closed_form, general_counterweights
 
-    cfg = load_case("paminsa")
+    cfg = read_case("paminsa")
     cfg["balance"]["counterweights"][3]["position"] = [0.2, 0.0, 0.0]
     general, result = general_counterweights(cfg)
     closed = paper.closed_form_counterweights(parameters_of(cfg))
@@ -248,11 +248,11 @@ def test_bad_parameters_name_the_field(params):
         _core.PaminsaModel(p)
     from mechbal.papers.paminsa.runner import parameters_from_config
 
-    cfg = load_case("paminsa")
+    cfg = read_case("paminsa")
     cfg["masses"]["links"] = cfg["masses"]["links"][:7]
     with pytest.raises(ConfigError, match=r"masses.links"):
         parameters_from_config(cfg)
-    cfg = load_case("paminsa")
+    cfg = read_case("paminsa")
     cfg["wrist"]["rate_hz"] = -5.0
     from mechbal.papers.paminsa.runner import wrist_config_from_config
 

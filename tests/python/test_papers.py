@@ -14,7 +14,7 @@ from mechbal import _core
 from mechbal.papers.discs import coupling as cp
 from mechbal.papers.arm2dof.runner import arm_from_config
 from mechbal.papers.discs.runner import _disc_bodies, parameters_from_config
-from mechbal.config import load_case
+from mechbal.config import read_case
 from mechbal.papers import arm2dof_mechanism, disc_arm_mechanism, disc_design_mechanism
 from mechbal.papers import discs as dz
 from mechbal.papers import arm2dof as paper_arm2dof
@@ -33,7 +33,7 @@ def rel(a, b, floor=0.0):
 # ---- 2-DOF arm ----------------------------------------------------------------------------------
 @lru_cache(maxsize=None)
 def arm_case():
-    config = load_case("arm2dof")
+    config = read_case("arm2dof")
     arm = arm_from_config(config["arm"])
     tt = config["trajectory"]
     t = np.linspace(0.0, tt["duration"], tt["samples"])
@@ -120,7 +120,7 @@ DISC_CASES = {"planar3r": "discs-3r", "spatial3r": "discs-spatial", "scara": "sc
 
 @lru_cache(maxsize=None)
 def disc_case(kind):
-    config = load_case(DISC_CASES[kind])
+    config = read_case(DISC_CASES[kind])
     p = parameters_from_config(kind, config)
     tt = config["trajectory"]
     t = np.linspace(0.0, tt["duration"], tt["samples"])

@@ -15,7 +15,7 @@ from mechbal.config import case_path
 import pytest
 
 from mechbal import Mechanism, _core
-from mechbal.config import load_case
+from mechbal.config import read_case
 from body_set import body_set_wrench
 from generated_text import text_differences
 
@@ -120,7 +120,7 @@ def _five_bar_run(balanced: bool):
     from mechbal.papers.discs.five_bar import five_bar_design_mechanism, five_bar_initial_guess
     from mechbal.papers import discs as dz
 
-    config = load_case("five-bar")
+    config = read_case("five-bar")
     p = parameters_from_config("fivebar", config)
     d = dz.design("fivebar", p, balanced)
     mech = five_bar_design_mechanism(d)
@@ -201,7 +201,7 @@ def _paminsa_run(balanced: bool, samples: int = 251):
     from mechbal.papers.paminsa.runner import parameters_from_config, trajectory_from_config
     from mechbal.papers import paminsa as pp
 
-    config = load_case("paminsa")
+    config = read_case("paminsa")
     params = parameters_from_config(config)
     built = pp.closed_form_counterweights(params).apply(params) if balanced else params
     model = _core.PaminsaModel(built)
@@ -295,7 +295,7 @@ def test_paminsa_linkage_toml_is_the_generated_mechanism_and_force_balanced(tmp_
     path = case_path("paminsa-linkage")
     assert text_differences(path.read_text(), paminsa_case_toml("paminsa")) == [], \
         "regenerate paminsa-linkage.toml"
-    generated = paminsa_mechanism(parameters_from_config(load_case("paminsa")), balanced=True)
+    generated = paminsa_mechanism(parameters_from_config(read_case("paminsa")), balanced=True)
     assert same_model(Mechanism.from_toml(path), generated) == []
     run_case("paminsa-linkage", tmp_path / "out")
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())

@@ -16,7 +16,7 @@ import pytest
 
 import mechbal
 from mechbal import simulate
-from mechbal.balance.writers import toml_text
+from mechbal.export.toml import toml_text
 from mechbal.cases import run_case
 from mechbal.cli import main
 from mechbal.control import PassiveController

@@ -14,7 +14,7 @@ import pytest
 
 import mechbal.plan as plan
 from mechbal.assembly import assemble
-from mechbal.config import load_case, trajectory_from_config
+from mechbal.config import read_case, trajectory_from_config
 from mechbal.errors import ConfigError
 from mechbal.mechanism import Mechanism
 from mechbal.plan.model import ActuatedModel
@@ -22,7 +22,7 @@ from mechbal.schema import validate_case
 
 
 def _case(name):
-    case = validate_case(load_case(name) if isinstance(name, str) else name, warn=False)
+    case = validate_case(read_case(name) if isinstance(name, str) else name, warn=False)
     return case, Mechanism.from_spec(case.spec, name=case.case.name)
 
 
@@ -255,7 +255,7 @@ def test_mechbal_run_writes_the_plan_and_its_poses_give_its_wrench(tmp_path):
 
 
 def test_the_case_format_takes_min_shaking_only_with_its_keys():
-    raw = load_case("four-bar-min-shaking")
+    raw = read_case("four-bar-min-shaking")
     case = validate_case(raw, warn=False)
     assert case.trajectory.law == "min_shaking" and case.trajectory.objective == "force_rms"
     bad = {**raw, "trajectory": {**raw["trajectory"], "law": "quintic"}}

@@ -14,7 +14,7 @@ import pytest
 
 import mechbal
 from mechbal import _core
-from mechbal.balance.writers import toml_text
+from mechbal.export.toml import toml_text
 from mechbal.errors import ConfigError
 from mechbal.mechanism import Mechanism
 from mechbal.schema import validate_case

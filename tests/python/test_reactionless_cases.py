@@ -24,7 +24,7 @@ import mechbal
 from mechbal import verdict
 from mechbal import control
 from mechbal.cases import run_case
-from mechbal.config import CASES_DIR, ConfigError, case_path, load_case
+from mechbal.config import CASES_DIR, ConfigError, case_path, read_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from generated_text import text_differences
 
@@ -61,7 +61,7 @@ def _paminsa_closed_form(bodies: dict, case_file: Path, integrator: str):
     m = mech.closed_motion(qa, va, aa, q_guess=np.array(case.trajectory.initial_guess))
     platform = [mech.joint_names.index(n) for n in ("platform_x", "platform_y", "platform_z")]
     P, Pd, Pdd = (np.ascontiguousarray(np.asarray(x)[:, platform]) for x in (m.q, m.v, m.a))
-    cfg = load_case("paminsa")
+    cfg = read_case("paminsa")
     params = parameters_from_config(cfg)
     model = paper.PaminsaModel(paper.closed_form_counterweights(params).apply(params))
     wrist0 = np.array([case.trajectory.start[names.index(w)] for w in WRIST])
@@ -267,7 +267,7 @@ def test_task_space_feed_forward_and_null_space_switch():
     the predicted wrench of the general algorithm, the tool's acceleration J a + J'v is the path's
     (J'v by central differences of J), and null_space=False is the pseudo-inverse path."""
     from mechbal.cases.panda import START, TOOL_FRAME, urdf_path
-    from mechbal.cases.serial_chain import frame_path
+    from mechbal.case.motion import frame_path
 
     mech = mechbal.Mechanism.from_urdf(urdf_path())
     case = tomllib.loads((CASES_DIR / "panda-reactionless.toml").read_text())

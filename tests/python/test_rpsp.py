@@ -12,7 +12,7 @@ import pytest
 
 from mechbal import _core
 from mechbal.papers.rpsp import runner as runner
-from mechbal.config import ConfigError, load_case
+from mechbal.config import ConfigError, read_case
 from mechbal.export import read_bodies, shaking_wrench_by_finite_differences
 from mechbal.mechanism import Mechanism
 from mechbal.papers import rpsp as paper
@@ -23,7 +23,7 @@ GEOMETRY = paper.RpspGeometry.paper()
 
 @lru_cache(maxsize=None)
 def case():
-    return validate_case(load_case("rpsp"), warn=False)
+    return validate_case(read_case("rpsp"), warn=False)
 
 
 @lru_cache(maxsize=None)
@@ -250,7 +250,7 @@ def test_platform_counterweight_is_sized_when_the_platform_is_not_balanced():
 
 
 def test_schema_refuses_unknown_names_and_keys():
-    raw = load_case("rpsp")
+    raw = read_case("rpsp")
     bad = copy.deepcopy(raw)
     bad["balancing"]["m_P"][0] = "P_9"
     with pytest.raises(ConfigError, match=r"balancing\.m_P\[0\]: no such body"):
@@ -269,15 +269,16 @@ def test_schema_refuses_unknown_names_and_keys():
 
 @pytest.fixture(scope="module")
 def rpsp_run(tmp_path_factory):
+    from mechbal.case.load import LoadedCase
     from mechbal.cases import run_case
     import mechbal.cases as cases
 
-    raw = load_case("rpsp")
+    raw = read_case("rpsp")
     raw["motion"]["samples"] = 501
     raw["motion"]["survey_samples"] = 801
     out = tmp_path_factory.mktemp("rpsp") / "out"
     original = cases.load_case
-    cases.load_case = lambda _name: copy.deepcopy(raw)
+    cases.load_case = lambda _name, **_: LoadedCase(copy.deepcopy(raw))
     try:
         summary = run_case("rpsp", out)
     finally:

@@ -10,12 +10,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from mechbal.config import CASES_DIR, ConfigError, builtin_cases, load_case
+from mechbal.config import CASES_DIR, ConfigError, builtin_cases, read_case
 from mechbal.errors import ConfigWarning
 from mechbal.schema import KINDS, SCHEMA_FILE, json_schema, schema_text, validate_case
 
 CASE_FILES = sorted(builtin_cases().values())
-CASES = {p.stem: load_case(p) for p in CASE_FILES}
+CASES = {p.stem: read_case(p) for p in CASE_FILES}
 
 
 def test_every_shipped_case_validates_without_warnings():
@@ -199,13 +199,14 @@ def test_the_issue_examples_are_refused():
 def test_no_runner_is_reached_by_a_misspelled_file(monkeypatch, tmp_path):
     """run_case validates the whole file before any runner (or the output folder) is touched."""
     import mechbal.cases as cases
+    from mechbal.case.load import LoadedCase
 
     cases._load_runners()
     called = []
     for kind in list(cases._RUNNERS):
         monkeypatch.setitem(cases._RUNNERS, kind, lambda config, out: called.append(config))
     for name, bad, field, _ in MISSPELLED[::7]:
-        monkeypatch.setattr(cases, "load_case", lambda _name, bad=bad: copy.deepcopy(bad))
+        monkeypatch.setattr(cases, "load_case", lambda _name, bad=bad, **_: LoadedCase(copy.deepcopy(bad)))
         with pytest.raises(ConfigError, match=field.replace(".", r"\.").replace("[", r"\[").replace("]", r"\]")):
             cases.run_case(name, tmp_path / "out")
     assert called == []

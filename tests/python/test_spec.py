@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import mechbal
-from mechbal.config import ConfigError, load_case
+from mechbal.config import ConfigError, read_case
 from mechbal.spec import dh_origin, mechanism_spec, rotation_rpy, transform_xyz_rpy
 
 
@@ -171,7 +171,7 @@ def test_spherical_joint_expands_into_three_revolutes():
 
 def test_merged_bodies_give_the_same_dynamics_as_one_body():
     """A counterweight on a link (extra body) = the link's own inertia merged by hand."""
-    cfg = load_case("arm2link")["mechanism"]
+    cfg = read_case("arm2link")["mechanism"]
     extra = copy.deepcopy(cfg)
     extra["bodies"] = [{"name": "cw", "kind": "counterweight", "link": "shoulder", "mass": 3.0,
                         "com": [-0.2, 0.0, 0.0], "inertia": [0.0, 0.0, 0.0]}]
@@ -233,7 +233,7 @@ def test_mimic_and_cross_reference_errors_name_the_field():
 
 
 def test_the_briefs_message_examples():
-    cfg = load_case("arm2link")["mechanism"]
+    cfg = read_case("arm2link")["mechanism"]
     cfg["joints"].append({"name": "wrist", "origin": {"xyz": [0.4, 0, 0]}, "axis": [0, -1, 0],
                           "link": {"mass": 0.5, "cmo": [0.05, 0, 0], "inertia": [1e-4, 1e-4, 1e-4]}})
     with pytest.raises(ConfigError) as exc:

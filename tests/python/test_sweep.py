@@ -22,7 +22,7 @@ pytest.importorskip("pyarrow")
 distributed = pytest.importorskip("distributed")
 
 from mechbal import Mechanism  # noqa: E402
-from mechbal.config import load_case  # noqa: E402
+from mechbal.config import read_case  # noqa: E402
 from mechbal.errors import ConfigError  # noqa: E402
 from mechbal.spec import mechanism_spec  # noqa: E402
 from mechbal.sweep import Parameter, Sweep  # noqa: E402
@@ -149,7 +149,7 @@ def _check_against_rebuilt(config: dict, params: list[Parameter], evaluations: i
 # ---- batched == rebuilt ------------------------------------------------------------------------------
 
 def test_batched_equals_rebuilt_balanced_arm():
-    config = load_case(ARM)
+    config = read_case(ARM)
     params = [Parameter("bodies.counterweight1.mass", tolerance=0.05),
               Parameter("bodies.shoulder.mass", tolerance=0.05, distribution="normal"),
               Parameter("bodies.counterweight2.com[0]", delta=0.002),
@@ -168,7 +168,7 @@ def test_batched_equals_rebuilt_tree_with_fixed_joint_and_rotated_body():
 
 
 def test_batched_equals_rebuilt_closed_four_bar():
-    config = load_case("four-bar")
+    config = read_case("four-bar")
     config["trajectory"]["samples"] = 41
     params = [Parameter("bodies.crank_counterweight.mass", tolerance=0.1),
               Parameter("bodies.coupler.com[0]", delta=0.01),
@@ -179,7 +179,7 @@ def test_batched_equals_rebuilt_closed_four_bar():
 def test_geometric_parameters_rebuild_the_model():
     """A joint placement changes the regressors: such sets are rebuilt, and equal a model built
     from the changed file."""
-    config = load_case(ARM)
+    config = read_case(ARM)
     sweep = Sweep(ARM, [Parameter("joints.elbow.placement.xyz[0]", delta=0.003),
                         Parameter("bodies.counterweight1.mass", tolerance=0.02)],
                   ["peak_gravity_torque", "rms_joint_torque", "peak_shaking_moment"],
@@ -201,7 +201,7 @@ def test_geometric_parameters_rebuild_the_model():
 
 
 def test_balanced_arm_case_is_statically_balanced():
-    mech = Mechanism.from_toml(load_case.__globals__["case_path"](ARM))
+    mech = Mechanism.from_toml(read_case.__globals__["case_path"](ARM))
     q = np.random.default_rng(0).uniform(-np.pi, np.pi, (200, 2))
     assert np.max(np.abs(mech.gravity_torque(q))) < 1e-12
     assert np.max(np.abs(mech.gravity_torque(q))) < 1e-12 * 9.81 * mech.total_mass

@@ -420,7 +420,7 @@ def test_run_a_urdf_file_writes_the_usual_outputs(tmp_path, capsys):
 
 def test_run_default_trajectory_respects_the_limits(tmp_path):
     from mechbal.cases import run_case
-    from mechbal.cases.urdf_robot import default_motion
+    from mechbal.trajectory import default_motion
 
     mech = mechbal.Mechanism.from_urdf(_robot_file(*ROBOTS["panda"]))
     start, end = default_motion(mech)

@@ -176,11 +176,11 @@ def test_wheel_with_a_declared_velocity_limit_is_refused_before_the_run(tmp_path
     shortest feasible duration; --allow-degraded runs it (exit 0, a warning, ok false, limited_by
     naming the wheel); --fit-duration runs it at that duration and meets the goal."""
     case = wheel_case(tmp_path, "{ velocity = 100.0 }")
-    from mechbal.config import load_case
+    from mechbal.config import read_case
     from mechbal.schema import validate_case
     from mechbal.trajectory import RestToRest
 
-    report = control.feasibility(mechbal.Mechanism.from_toml(case), validate_case(load_case(case), warn=False).control,
+    report = control.feasibility(mechbal.Mechanism.from_toml(case), validate_case(read_case(case), warn=False).control,
                                  RestToRest([0.0, 0.0, 0.0], [1.0, -1.2, 0.0], 0.2))
     out = tmp_path / "out"
     code, _, err = run_cli(["run", case, "--out", out], capsys)

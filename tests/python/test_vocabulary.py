@@ -173,10 +173,10 @@ def five_bar():
     """The balanced five-bar of the shipped case, its typed dynamics and the raw binding (the dict
     of earlier releases), and N states along a quintic, away from the flat poses."""
     from mechbal import _core
-    from mechbal.config import load_case
+    from mechbal.config import read_case
     from mechbal.papers import discs
 
-    d = discs.design("fivebar", discs.parameters_from_config("fivebar", load_case("five-bar")), True)
+    d = discs.design("fivebar", discs.parameters_from_config("fivebar", read_case("five-bar")), True)
     typed = discs.fivebar_dynamics(d)
     raw = _core.FiveBarDynamics(typed.parameters)
     q, v, a = trajectory.quintic([0.6, 1.9], [0.9, 2.3], 1.0).evaluate(np.linspace(0, 1, 7))
@@ -296,10 +296,10 @@ def test_no_deprecation_warning_from_the_new_names(arm):
         traj = trajectory.quintic([0.0, 0.0], [0.3, -0.2], 0.1)
         simulate.closed_loop(arm, ct, traj, dt=1e-3)
         control.MechanismDynamics(arm.model).inverse_dynamics(np.zeros(2), np.zeros(2), np.zeros(2))
-        from mechbal.config import load_case
+        from mechbal.config import read_case
         from mechbal.papers import discs
 
         fb = discs.fivebar_dynamics(discs.design("fivebar", discs.parameters_from_config(
-            "fivebar", load_case("five-bar")), True))
+            "fivebar", read_case("five-bar")), True))
         q = np.array([[0.6, 1.9]])
         fb.inverse_dynamics(q, q, q), fb.evaluate(q, q), fb.motion(q, q, q)

@@ -259,7 +259,7 @@ def json_schema() -> dict[str, Any]:
 def mechanism_toml(result: BalanceResult) -> str:
     """A case file of the balanced mechanism alone (``[case]`` and ``[mechanism]``: readable by
     `mechbal.Mechanism.from_toml`): what `write` writes per point when no case is given."""
-    from mechbal.balance.writers import mechanism_table, toml_text
+    from mechbal.export.toml import mechanism_table, toml_text
 
     m = result.balanced
     added = ", ".join(f"{k} {d.mass:.6g} kg" for k, d in result.design.items())

@@ -162,12 +162,13 @@ def _trajectory_motion(mech, tt, law=None, field="trajectory"):
     return t, traj.evaluate_batch(t), table
 
 
-def load_case(case: str, design: str | None = None) -> BalanceCase:
-    """Read CASE (and ``--design``) into a `BalanceCase`; ConfigError naming the field."""
+def balance_case(case: str, design: str | None = None) -> BalanceCase:
+    """Read CASE (`mechbal.case.load_case`; and ``--design``) into a `BalanceCase`; ConfigError
+    naming the field."""
+    from mechbal.case.load import load_case
     from mechbal.config import check_case_file
-    from mechbal.config import load_case as load_toml_case
     from mechbal.mechanism import Mechanism
-    from mechbal.schema import Balance, ChainTrajectory, Table, validate_case, validate_table
+    from mechbal.schema import Balance, ChainTrajectory, Table, validate_table
 
     design_cfg = None
     if design is not None:
@@ -213,9 +214,8 @@ def load_case(case: str, design: str | None = None) -> BalanceCase:
         if design_cfg.trajectory is None:
             bc.notes = {"default_motion": limits}
         return bc
-    path = check_case_file(case)
-    raw = load_toml_case(path)
-    return case_from_config(validate_case(raw), raw, design_cfg, source=str(path))
+    loaded = load_case(case)
+    return case_from_config(loaded.config, loaded.raw, design_cfg, source=str(loaded.source))
 
 
 def case_from_config(cfg, raw: dict | None = None, design_cfg=None, *, source: str | None = None) -> BalanceCase:
@@ -436,7 +436,7 @@ def run_front(bc: BalanceCase, name: str, points: int, out: Path) -> dict:
 
 
 def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
-    from mechbal.balance.writers import inertia_table, mechanism_table, toml_text
+    from mechbal.export.toml import inertia_table, mechanism_table, toml_text
 
     cws = {k: v for k, v in result.design.items() if isinstance(v, CounterweightDesign)}
     springs = {k: v for k, v in result.design.items() if isinstance(v, SpringDesign)}
@@ -508,7 +508,7 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
     ``objective``, ``residual_target``: `run_method`'s; ``front``: also the trade-off front of
     that many designs (`run_front`)."""
     progress.stage("reading the case")
-    bc = load_case(case, design)
+    bc = balance_case(case, design)
     name = method or (bc.table.method if bc.table is not None else None)
     if name is None:
         raise ConfigError("--method", "give --method static|force|moment|springs|rms (or balance.method "

@@ -17,7 +17,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mechbal.config import ConfigError, builtin_cases, load_case, read_toml
+from mechbal.case.load import load_case
+from mechbal.config import ConfigError, builtin_cases, read_toml
 from mechbal.registry import paper_modules
 from mechbal.schema import validate_case
 
@@ -60,7 +61,7 @@ def run_case(name_or_path: str | Path, out: str | Path, *, animate: bool = False
              allow_degraded: bool = False, **trajectory) -> dict:
     """Run a built-in case (by name), a TOML case file or a URDF file into the folder ``out``;
     returns the summary. ``trajectory``: ``duration`` and ``samples`` of a URDF file's default
-    trajectory (see `mechbal.cases.urdf_robot`). ``animate``: also write
+    trajectory (`mechbal.case.load_case`). ``animate``: also write
     ``animation_<variant>.gif`` beside every ``bodies_<variant>.npz`` (`mechbal.animation`).
     A case with a reactionless ``[control]`` is checked for feasibility first: a motion the
     declared limits cannot follow raises `mechbal.verdict.ControlInfeasible` before anything
@@ -76,17 +77,7 @@ def run_case(name_or_path: str | Path, out: str | Path, *, animate: bool = False
     _load_runners()
     from mechbal.schema import CASE_MODELS
 
-    trajectory = {k: v for k, v in trajectory.items() if v is not None}
-    if str(name_or_path).lower().endswith(".urdf"):
-        from mechbal.cases.urdf_robot import urdf_case
-
-        raw = urdf_case(name_or_path, **trajectory)
-    elif trajectory:
-        raise ConfigError(", ".join(f"--{k}" for k in trajectory),
-                          "only applies to URDF files (a TOML case has its [trajectory] table)",
-                          has_value=False)
-    else:
-        raw = load_case(name_or_path)
+    raw = load_case(name_or_path, validate=False, **trajectory).raw
     header = raw.get("case") if isinstance(raw, dict) else None
     kind = header.get("kind") if isinstance(header, dict) else None
     if isinstance(kind, str) and kind in _RUNNERS and kind not in CASE_MODELS:

@@ -60,7 +60,7 @@ def end_pose(mech, start=START, displacement=DISPLACEMENT) -> np.ndarray:
 
 def panda_case_toml() -> str:
     """The text of ``cases/panda-reactionless.toml`` (regenerate it with this function)."""
-    from mechbal.balance.writers import mechanism_table, toml_text
+    from mechbal.export.toml import mechanism_table, toml_text
     from mechbal.mechanism import Mechanism
 
     mech = Mechanism.from_urdf(urdf_path())

@@ -13,54 +13,14 @@ import numpy as np
 from mechbal import control
 from mechbal.mechanism import JointType
 from mechbal import progress, report, verdict
-from mechbal.case import task_end_pose
+from mechbal.case.control_plan import check_feasibility, check_task_space, held_trajectory
+from mechbal.case.motion import frame_path, mechanism_motion, motion_summary, start_assembly, task_end_pose
+from mechbal.case.writer import drawing, write_variant
 from mechbal.cases.runners import register
 from mechbal.config import ConfigError, law_name, trajectory_from_config
 from mechbal.export import write_bodies, write_summary
 from mechbal.mechanism import Mechanism
 from mechbal.schema import validate_case
-
-
-def mechanism_motion(mech: Mechanism, traj, t, q_guess=None):
-    """(q, v, a, torque, extra) of a mechanism along a trajectory of its actuated joints: for an
-    open mechanism the trajectory drives every coordinate and torque is the inverse dynamics; for a
-    closed one the loops are solved instant by instant and torque is the actuated force C^T tau."""
-    qa, va, aa = traj.evaluate_batch(t)
-    if not mech.is_closed:
-        return qa, va, aa, mech.inverse_dynamics(qa, va, aa), {}
-    m = mech.closed_motion(qa, va, aa, q_guess=q_guess, with_forces=True)
-    bad = (m.status & ~np.uint32(int(control.Status.singular))) != 0
-    if np.any(bad):
-        k = int(np.argmax(bad))
-        raise ConfigError("trajectory", f"the loops cannot be assembled at t = {t[k]:.4g} s (closure "
-                                        f"residual {m.residual[k]:.3g}); check the geometry, the "
-                                        "trajectory and trajectory.initial_guess", has_value=False)
-    singular = (m.status & np.uint32(int(control.Status.singular))) != 0
-    extra = {"min_rcond": float(np.min(m.rcond)), "singular_instants": int(np.sum(singular)),
-             "max_closure_residual": float(np.max(m.residual)),
-             "max_newton_iterations": int(np.max(m.iterations))}
-    return m.q, m.v, m.a, m.actuated_force, extra
-
-
-def start_assembly(mech: Mechanism, tr, traj):
-    """The assembly of a closed mechanism at the trajectory's start (`mechbal.assembly.assemble`
-    with ``[trajectory] branch`` and ``initial_guess``), or None for an open one."""
-    if not mech.is_closed:
-        return None
-    from mechbal.assembly import assemble
-
-    qa0 = np.atleast_2d(traj.evaluate_batch(np.zeros(1))[0])[0]
-    return assemble(mech, qa0, branch=getattr(tr, "branch", None),
-                    initial_guess=getattr(tr, "initial_guess", None))
-
-
-def motion_summary(tr, traj) -> dict:
-    """What summary.json says about a constant-speed motion (empty for the rest-to-rest laws)."""
-    if getattr(tr, "law", None) != "constant_speed":
-        return {}
-    speed = np.asarray(traj.speed, float)
-    return {"speed": speed, "rpm": speed * 60.0 / (2.0 * np.pi),
-            "revolutions": float(np.max(np.abs(speed)) * traj.duration / (2.0 * np.pi))}
 
 
 @register("mechanism", stages=3)
@@ -123,16 +83,6 @@ def run_min_shaking(mech: Mechanism, case, out: Path) -> dict:
     return summary
 
 
-def _drawing(mech: Mechanism, motion) -> dict:
-    """What a picture of the mechanism needs beside the bodies (`mechbal.animation`): every
-    link frame's origin and parent, and every named frame's origin with its link."""
-    links = list(mech.link_names)
-    by_name = {f.name: f.link for f in mech.model.description.frames}
-    frame_link = [links.index(by_name[n]) if by_name.get(n) in links else -1 for n in mech.frame_names]
-    return dict(link_position=motion.link_position, link_parent=np.array(mech.model.link_parents, int),
-                frame_position=motion.frame_placement[..., :3, 3], frame_link=np.array(frame_link, int))
-
-
 def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, title: str,
                   q_guess=None, summary_extra: dict | None = None, assembly=None) -> dict:
     """The run every mechanism gets (TOML case or URDF file): motion along ``traj`` at ``t``
@@ -159,7 +109,7 @@ def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, 
                  inertia_body=np.array([b.inertia for b in bodies], float).reshape(-1, 3, 3),
                  com=motion.com, rotation=motion.rotation, shaking_force=F, shaking_moment=M,
                  q=q, qd=v, qdd=a, torque=torque, base_reaction_force=R_F, base_reaction_moment=R_M,
-                 **_drawing(mech, motion))
+                 **drawing(mech, motion))
     report.plot_wrench(out / "shaking_wrench.png", t, {"nominal": (F, M)}, title=title,
                        caption="Shaking force dP/dt and shaking moment dH_O/dt (about the base origin "
                                "O, inertial part only: no gravity) of all bodies along the trajectory.")
@@ -227,54 +177,6 @@ def run_mechanism(mech: Mechanism, traj, t, out: Path, *, name: str, kind: str, 
     return summary
 
 
-def _write_variant(mech: Mechanism, out: Path, variant: str, t, q, v, a):
-    """bodies_<variant>.npz of the motion (q, v, a) (every coordinate) with the wrench of those
-    poses; returns (F, M)."""
-    sw = mech.shaking_wrench(q, v, a)
-    motion = mech.body_motion(q, v, a)
-    if np.any(sw.status != 0) or np.any(motion.status != 0):
-        raise ConfigError("trajectory", f"the {variant} motion has non-finite results",
-                          has_value=False)
-    bodies = mech.bodies
-    write_bodies(out / f"bodies_{variant}.npz", t=t, names=mech.body_names,
-                 mass=np.array([b.mass for b in bodies], float),
-                 inertia_body=np.array([b.inertia for b in bodies], float).reshape(-1, 3, 3),
-                 com=motion.com, rotation=motion.rotation, shaking_force=sw.shaking_force,
-                 shaking_moment=sw.shaking_moment, q=q, qd=v, qdd=a, **_drawing(mech, motion))
-    return sw.shaking_force, sw.shaking_moment
-
-
-def held_trajectory(mech: Mechanism, case):
-    """(trajectory, balancing, task) of a validated case with a reactionless ``[control]`` in the
-    joint mode: the ``[trajectory]`` of every actuated joint with the balancing joints held at
-    their start (their end or speed is ignored: the controller computes them; the uncontrolled
-    motion), and the indices of the balancing and task joints among the actuated ones.
-    ConfigError naming a balancing joint that is not actuated."""
-    from mechbal.schema import did_you_mean
-
-    ctl = case.control
-    names = mech.actuated_names
-    for i, b in enumerate(ctl.balancing_joints):
-        if b not in names:
-            raise ConfigError(f"control.balancing_joints[{i}]",
-                              f"is not an actuated joint{did_you_mean(b, names)}", b)
-    balancing = [names.index(b) for b in ctl.balancing_joints]
-    task = [i for i in range(len(names)) if i not in balancing]
-    if case.trajectory.law == "constant_speed":   # a balancing joint's speed is ignored: held at its start
-        speed = case.trajectory.speeds(len(names))
-        for i in balancing:
-            speed[i] = 0.0
-        held = {"speed": speed, "rpm": None}
-    else:                                        # a balancing joint's end is ignored: held at its start
-        end = list(case.trajectory.end)
-        if len(end) == len(names):
-            for i in balancing:
-                end[i] = case.trajectory.start[i]
-        held = {"end": end}
-    traj, _ = trajectory_from_config(case.trajectory.model_copy(update=held), len(names))
-    return traj, balancing, task
-
-
 def run_controlled(mech: Mechanism, case, out: Path, q_guess=None, assembly=None) -> dict:
     """A case with ``[control]`` (kinds computed_torque and decoupled: `run_joint_controller`;
     kind reactionless below): the motion with the balancing joints held
@@ -331,13 +233,13 @@ def run_joint_controller(mech: Mechanism, case, out: Path, q_guess=None, assembl
         qs, vs, as_ = m.q, m.v, m.a
     else:
         qs, vs, as_ = r.q[:ok_steps], r.v[:ok_steps], a_sim
-    Fd, Md = _write_variant(mech, out, "desired", t, qd, vd, ad)
+    Fd, Md = write_variant(mech, out, "desired", t, qd, vd, ad)
     finite = bool(np.all(np.isfinite(qs)) and np.all(np.isfinite(vs)) and np.all(np.isfinite(as_)))
     files = ["bodies_desired.npz", "shaking_wrench.png", "tracking.png"]
     curves = {"desired motion": (Fd, Md)}
     if finite:   # a diverged loop's motion may overflow in its wrench: then it is not written
         try:
-            Fc, Mc = _write_variant(mech, out, "controlled", t[:ok_steps], qs, vs, as_)
+            Fc, Mc = write_variant(mech, out, "controlled", t[:ok_steps], qs, vs, as_)
         except ConfigError:
             finite = False
     if finite:
@@ -398,45 +300,6 @@ def run_joint_controller(mech: Mechanism, case, out: Path, q_guess=None, assembl
     return summary
 
 
-def feasibility_of(mech: Mechanism, case, q_guess=None):
-    """`mechbal.control.feasibility` of a validated case with a reactionless ``[control]``: its
-    commanded motion (joint mode: the held trajectory; operational-space mode: the frame's path)."""
-    ctl = case.control
-    if ctl.task_frame is not None:
-        check_task_space(mech, case)
-        tr = case.trajectory
-        dt = 1.0 / ctl.rate_hz
-        th = np.arange(2 * int(round(tr.duration / dt)) + 1) * (0.5 * dt)
-        _, _, twist, twist_rate = frame_path(mech, ctl.task_frame, tr.start, tr.end, tr.duration, tr.law, th,
-                                             end_pose=task_end_pose(mech, ctl.task_frame, tr))
-        motion = control.FrameMotion(np.array(tr.start, float), twist, twist_rate, float(tr.duration))
-        return control.feasibility(mech, ctl, motion)
-    traj, _, _ = held_trajectory(mech, case)
-    return control.feasibility(mech, ctl, traj, q_guess=q_guess)
-
-
-def check_feasibility(mech: Mechanism, case, q_guess=None, *, fit_duration: bool = False,
-                      allow_degraded: bool = False):
-    """(case, report, fitted duration or None): the case's motion checked against the declared
-    limits before the run (`feasibility_of`). Infeasible: with ``fit_duration`` the case with its
-    ``[trajectory] duration`` set to the shortest feasible one (`mechbal.verdict.fitted_duration`;
-    rest-to-rest laws); with ``allow_degraded`` the case as it is (the run's verdict will say why
-    it failed); otherwise `mechbal.verdict.ControlInfeasible`."""
-    report = feasibility_of(mech, case, q_guess)
-    if report.feasible:
-        return case, report, None
-    if fit_duration and np.isfinite(report.min_duration) and case.trajectory.law != "constant_speed":
-        fitted = verdict.fitted_duration(report.min_duration, 1.0 / case.control.rate_hz)
-        refit = case.model_copy(update={"trajectory": case.trajectory.model_copy(update={"duration": fitted})})
-        again = feasibility_of(mech, refit, q_guess)
-        if again.feasible:
-            return refit, again, fitted
-        report = again
-    if allow_degraded:
-        return case, report, None
-    raise verdict.ControlInfeasible(report)
-
-
 def _run_joint_mode(mech: Mechanism, case, out: Path, q_guess, summary_extra: dict) -> dict:
     ctl = case.control
     name, title = case.case.name, case.case.title or case.case.name
@@ -458,8 +321,8 @@ def _run_joint_mode(mech: Mechanism, case, out: Path, q_guess, summary_extra: di
                  np.ascontiguousarray(aa[:, task]))
 
     progress.stage("bodies files and plots")
-    Fu, Mu = _write_variant(mech, out, "uncontrolled", t, qu, vu, au)
-    Fc, Mc = _write_variant(mech, out, "controlled", t, r.q_full, r.v_full, r.a_full)
+    Fu, Mu = write_variant(mech, out, "uncontrolled", t, qu, vu, au)
+    Fc, Mc = write_variant(mech, out, "controlled", t, r.q_full, r.v_full, r.a_full)
     report.plot_wrench(out / "shaking_wrench.png", t, {"uncontrolled": (Fu, Mu), "controlled": (Fc, Mc)},
                        title=f"{title}: reactionless control",
                        caption="Shaking force dP/dt and moment dH_O/dt about O with the balancing joints "
@@ -536,38 +399,6 @@ def _joint_at_limit(rates, names: list[str], limits: dict) -> str | None:
     return name
 
 
-def _rotation_vector(R: np.ndarray) -> np.ndarray:
-    """theta k of a rotation R = exp(theta [k]x), theta in [0, pi]."""
-    from scipy.spatial.transform import Rotation
-
-    return Rotation.from_matrix(R).as_rotvec()
-
-
-def frame_path(mech: Mechanism, frame: str, start, end, duration: float, law: str, t, *, end_pose=None):
-    """The operational-space mode's path of ``frame`` at times ``t``: from its pose at the joint
-    positions ``start`` to its pose at ``end`` (or to ``end_pose``, 4 x 4 in O, when given:
-    `mechbal.case.task_end_pose`, the line law's) along the time law s(t) (0 to 1; ``law =
-    "line"``: quintic), the origin on the straight line and the orientation about the fixed axis
-    of the relative rotation (R(t) = exp(s theta [k]x) R0). Returns (position (N, 3), rotation
-    (N, 3, 3), twist (N, 6), twist_rate (N, 6)), twists [v; w] of the origin in O axes."""
-    from scipy.spatial.transform import Rotation
-
-    from mechbal.trajectory import RestToRest
-
-    law = "quintic" if law == "line" else law
-    T0 = np.asarray(mech.frame_placement(np.asarray(start, float), frame))
-    T1 = np.asarray(end_pose if end_pose is not None else mech.frame_placement(np.asarray(end, float), frame),
-                    float)
-    dp = T1[:3, 3] - T0[:3, 3]
-    rv = _rotation_vector(T1[:3, :3] @ T0[:3, :3].T)
-    s, sd, sdd = (np.asarray(x)[:, 0] for x in RestToRest([0.0], [1.0], duration, law).evaluate(t))
-    position = T0[:3, 3] + s[:, None] * dp
-    rotation = Rotation.from_rotvec(s[:, None] * rv).as_matrix() @ T0[:3, :3]
-    twist = np.concatenate([sd[:, None] * dp, sd[:, None] * rv], axis=1)
-    twist_rate = np.concatenate([sdd[:, None] * dp, sdd[:, None] * rv], axis=1)
-    return position, rotation, twist, twist_rate
-
-
 def _motion_acceleration(t, v):
     """dv/dt of the integrated motion at the ticks: the derivative of the quintic spline through
     the commanded rates (the stored poses' own acceleration, whatever the feed-forward)."""
@@ -580,43 +411,6 @@ def _motion_acceleration(t, v):
     # degree they carry (cubic: 4, linear: 2), never scipy's refusal
     k = 5 if len(t) >= 6 else 3 if len(t) >= 4 else 1
     return make_interp_spline(t, v, k=k)(t, 1)
-
-
-def check_task_space(mech: Mechanism, case) -> None:
-    """ConfigError naming the field unless the validated ``case``'s operational-space mode
-    (``[control] task_frame``) fits ``mech``: an open mechanism with every joint actuated and
-    listed as balancing, a named task frame, a quintic or cubic ``[trajectory]`` whose ``start``
-    and ``end`` are joint positions."""
-    from mechbal.schema import did_you_mean
-
-    ctl = case.control
-    names = mech.actuated_names
-    if mech.is_closed or len(names) != mech.dof:
-        raise ConfigError("control.task_frame", "the operational-space mode drives open mechanisms with "
-                          "every joint actuated", ctl.task_frame)
-    if ctl.task_frame not in mech.frame_names:
-        raise ConfigError("control.task_frame", "is not a frame of the mechanism"
-                          + did_you_mean(ctl.task_frame, list(mech.frame_names)), ctl.task_frame)
-    listed = list(names if ctl.balancing_joints is None else ctl.balancing_joints)  # absent: every joint
-    missing = [n for n in names if n not in listed]
-    for i, b in enumerate(listed):
-        if b not in names:
-            raise ConfigError(f"control.balancing_joints[{i}]",
-                              f"is not an actuated joint{did_you_mean(b, names)}", b)
-    if missing:
-        raise ConfigError("control.balancing_joints", "in the operational-space mode (task_frame) the "
-                          "controller moves every joint: list them all (missing: " + ", ".join(missing) + ")",
-                          listed)
-    tr = case.trajectory
-    if tr.law not in ("quintic", "cubic", "line"):
-        raise ConfigError("trajectory.law", "the operational-space mode's path is rest-to-rest between the "
-                          "frame's poses at start and end (quintic or cubic), or a line from start "
-                          "(line, with displacement and / or rotation)", tr.law)
-    for key in ("start",) if tr.law == "line" else ("start", "end"):
-        if getattr(tr, key) is None or len(getattr(tr, key)) != len(names):
-            raise ConfigError(f"trajectory.{key}", f"must have {len(names)} values (joint positions: the "
-                              "task frame's path runs from its pose at start to its pose at end)",
-                              getattr(tr, key))
 
 
 def run_task_space(mech: Mechanism, case, out: Path, summary_extra: dict | None = None) -> dict:
@@ -658,7 +452,7 @@ def run_task_space(mech: Mechanism, case, out: Path, summary_extra: dict | None 
     wrench, frame_error, frame_errors = {}, {}, {}
     for variant, r in runs.items():
         a = _motion_acceleration(t, r.v)
-        wrench[variant] = _write_variant(mech, out, variant, t, r.q, r.v, a)
+        wrench[variant] = write_variant(mech, out, variant, t, r.q, r.v, a)
         T = np.asarray(mech.frame_placement(r.q, ctl.task_frame))
         dR = np.einsum("nij,nkj->nik", T[:, :3, :3], rotation[::2])
         angle = np.arccos(np.clip((np.trace(dR, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
@@ -781,7 +575,7 @@ def run_passive(mech: Mechanism, case, traj, out: Path, q_guess=None, assembly=N
                           "assembled or its state is not finite there", has_value=False)
     progress.stage("bodies file and plots")
     t = r.t
-    F, M = _write_variant(mech, out, "passive", t, r.q_full, r.v_full, r.a_full)
+    F, M = write_variant(mech, out, "passive", t, r.q_full, r.v_full, r.a_full)
     report.plot_wrench(out / "shaking_wrench.png", t, {"passive": (F, M)}, title=f"{title}: passive motion",
                        caption="Shaking force dP/dt and moment dH_O/dt about O of the mechanism moving "
                                "with zero joint effort under gravity and its springs.")

@@ -3,9 +3,9 @@ reader as a general `mechbal.Mechanism`, moved along a default rest-to-rest traj
 shaking force and moment about O, base reaction and joint torques (inverse dynamics), written as
 every case writes them (summary.json, PNG plots, bodies_nominal.npz).
 
-Default trajectory: a quintic rest-to-rest motion over ``duration`` seconds (2 s) sampled at
-``samples`` instants (501). Every joint starts at 0 (clipped into its limits) and moves towards its
-upper limit by half the room left, at most 0.5 rad (revolute) or 0.1 m (prismatic); a joint with
+Default trajectory (the case of a URDF file: `mechbal.case.load.urdf_run_case`): a quintic
+rest-to-rest motion over ``duration`` seconds (2 s) sampled at ``samples`` instants (501). Every
+joint starts at 0 (clipped into its limits) and moves towards its upper limit by half the room left, at most 0.5 rad (revolute) or 0.1 m (prismatic); a joint with
 no room above moves towards its lower limit the same way; an unlimited (continuous) joint moves
 by 0.5 rad. The duration is lengthened where the URDF's velocity limits (15/8 |step| / limit, the
 quintic's peak) or effort limits (doubled while the inverse-dynamics torque exceeds one) need it:
@@ -21,28 +21,10 @@ from pathlib import Path
 import numpy as np
 
 from mechbal import trajectory
-from mechbal.mechanism import JointType
+from mechbal.case.load import URDF_KIND as KIND
 from mechbal.cases.runners import register
 from mechbal.config import ConfigError, integer, number, require
 from mechbal.mechanism import Mechanism
-
-KIND = "urdf"
-DEFAULT_DURATION = 2.0
-DEFAULT_SAMPLES = 501
-#: largest default motion of one joint (`mechbal.trajectory.default_motion`)
-MAX_STEP = trajectory.DEFAULT_MAX_STEP
-default_motion = trajectory.default_motion
-
-
-def urdf_case(path: str | Path, duration: float | None = None, samples: int | None = None) -> dict:
-    """The case configuration of a URDF file (what a TOML case file would hold)."""
-    path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"URDF file '{path}'", "not found", has_value=False)
-    trajectory = {"duration": DEFAULT_DURATION if duration is None else duration,
-                  "samples": DEFAULT_SAMPLES if samples is None else samples}
-    return {"case": {"name": path.stem, "kind": KIND, "title": f"{path.name} (URDF)"},
-            "urdf": {"path": str(path)}, "trajectory": trajectory}
 
 
 @register(KIND, stages=3)
@@ -58,7 +40,7 @@ def run(config: dict, out: Path) -> dict:
     mech = Mechanism.from_urdf(path)
     if mech.dof == 0:
         raise ConfigError(f"URDF file '{path}'", "has no moving joint to run", has_value=False)
-    start, end = default_motion(mech)
+    start, end = trajectory.default_motion(mech)
     # at least as long as asked, longer where the URDF's velocity or effort limits need it
     duration, limits = trajectory.quintic_within_limits(mech, start, end, duration)
     traj = trajectory.RestToRestTrajectory(start, end, duration, trajectory.TimeLaw.quintic)

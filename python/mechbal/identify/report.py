@@ -77,7 +77,7 @@ def plot_parameters(result: IdentificationResult, path: str | Path) -> Path:
 def write_identified(result: IdentificationResult, out: str | Path, *, plots: bool = True) -> dict:
     """Write the files of the module docstring into the folder ``out`` (created); returns the
     summary written."""
-    from mechbal.balance.writers import mechanism_table, toml_text
+    from mechbal.export.toml import mechanism_table, toml_text
     from mechbal.export.bodies import write_summary
 
     out = Path(out)

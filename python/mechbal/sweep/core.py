@@ -187,9 +187,10 @@ def load_base(case, trajectory_samples: int | None = None) -> Base:
     """The base of a sweep from a built-in case name, a TOML case file (``[mechanism]`` and
     ``[trajectory]``), a URDF file (its default trajectory), a `mechbal.Mechanism` or a
     `mechbal.spec.MechanismSpec`."""
-    from mechbal.config import case_path, read_toml, trajectory_from_config
+    from mechbal.case.load import load_case
+    from mechbal.config import trajectory_from_config
     from mechbal.mechanism import Mechanism
-    from mechbal.schema import SerialChainCase, validate_case
+    from mechbal.schema import SerialChainCase
     from mechbal.spec import MechanismSpec
 
     if isinstance(case, MechanismSpec):
@@ -198,16 +199,15 @@ def load_base(case, trajectory_samples: int | None = None) -> Base:
         return Base(case.name, spec_of_mechanism(case))
     if str(case).lower().endswith(".urdf"):
         from mechbal._core import RestToRestTrajectory, TimeLaw
-        from mechbal.cases.urdf_robot import DEFAULT_DURATION, DEFAULT_SAMPLES, default_motion
+        from mechbal.case.load import DEFAULT_DURATION, DEFAULT_SAMPLES
+        from mechbal.trajectory import default_motion
 
         mech = Mechanism.from_urdf(case)
         start, end = default_motion(mech)
         traj = RestToRestTrajectory(start, end, DEFAULT_DURATION, TimeLaw.quintic)
         t = np.linspace(0.0, DEFAULT_DURATION, trajectory_samples or DEFAULT_SAMPLES)
         return Base(mech.name, spec_of_mechanism(mech), (t, *traj.evaluate_batch(t)))
-    path = case_path(case)
-    config = read_toml(path)
-    validated = validate_case(config, warn=False)
+    validated = load_case(case, warn=False).config
     if not isinstance(validated, SerialChainCase):
         raise ConfigError("case.kind", "a sweep needs a case of kind mechanism or serial_chain "
                                        "(a [mechanism] table)", validated.case.kind)

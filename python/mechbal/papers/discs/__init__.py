@@ -157,9 +157,9 @@ def disc_arm_mechanism(case_config: Mapping[str, Any] | str | Path, balanced: bo
     ratios of eqs 14, 25, 35 and, for the spatial arm, the corrected inertia conditions of eq 25:
     the mass matrix is then diagonal and constant (k_i of eqs 16, 27, 37) and the gravity torque
     zero. ``balanced=False``: the case's ``[unbalanced]`` baseline, no discs."""
-    from mechbal.config import load_case, require, string
+    from mechbal.config import read_case, require, string
 
-    config = load_case(case_config) if isinstance(case_config, (str, Path)) else case_config
+    config = read_case(case_config) if isinstance(case_config, (str, Path)) else case_config
     kind = string(require(require(config, "case", ""), "mechanism", "case"), "case.mechanism",
                   MECHANISMS)
     if kind not in SERIAL_ARMS:

@@ -97,9 +97,9 @@ def five_bar_initial_guess(mech: Mechanism, d: Mapping[str, Any], q_actuated) ->
 
 
 def _case(case_config):
-    from mechbal.config import load_case
+    from mechbal.config import read_case
 
-    return load_case(case_config) if isinstance(case_config, (str, Path)) else case_config
+    return read_case(case_config) if isinstance(case_config, (str, Path)) else case_config
 
 
 def five_bar_mechanism(case_config: Mapping[str, Any] | str | Path = "five-bar",

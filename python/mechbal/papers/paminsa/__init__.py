@@ -434,10 +434,10 @@ def paminsa_case_toml(config="paminsa", balanced: bool = True, samples: int = 50
     ``[control]`` table (kind reactionless, the three wrist joints balancing the moment, the
     case's ``[wrist]`` integrator, rate, damping and rate limit): PAMINSA's reactionless wrist
     through the general controller (``mechbal run paminsa-reactionless``)."""
-    from mechbal.config import load_case
+    from mechbal.config import read_case
     from mechbal.papers._toml import case_toml
 
-    cfg = load_case(config) if isinstance(config, str) else config
+    cfg = read_case(config) if isinstance(config, str) else config
     params = parameters_from_config(cfg)
     mech = paminsa_mechanism(params, balanced)
     tr, wrist = cfg["trajectory"], np.asarray(cfg["wrist"]["initial_angles"], float)
