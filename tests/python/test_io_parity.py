@@ -786,3 +786,21 @@ def test_both_readers_read_the_trajectory(tmp_path, k):
         assert c.speed == pytest.approx(tr.speeds(1), rel=1e-15) and c.end == []
     else:
         assert c.end == tr.end and c.law.name == tr.law
+
+
+@pytest.mark.parametrize("extra", [{}, {"objective": "moment_peak", "control_points": 10}])
+def test_min_shaking_is_planned_in_python_and_refused_by_the_cpp_reader(tmp_path, extra):
+    """law = "min_shaking" is a plan of the Python layer (mechbal.plan): the Python reader takes it,
+    the C++ reader refuses it at trajectory.law (not as an unknown key, not run as another law)."""
+    from mechbal.schema import validate_case
+
+    tr = {"law": "min_shaking", "start": [0.5], "end": [1.0], "duration": 2, **extra}
+    cfg = {"case": {"name": "planar", "kind": "mechanism"}, "mechanism": PLANAR, "trajectory": tr}
+    path = tmp_path / "t.toml"
+    path.write_text(toml_text(cfg))
+    assert validate_case(cfg, warn=False).trajectory.law == "min_shaking"
+    with pytest.raises(ValueError, match=r"^trajectory\.law: 'min_shaking' is a motion planned by the "
+                                         r"Python layer .* \(got 'min_shaking'\)$"):
+        _core.load_case_trajectory(str(path))
+    with pytest.raises(ValueError, match=r"^trajectory\.law: "):
+        _core.load_case_file(str(PKG / "cases" / "four-bar-min-shaking.toml"))
