@@ -10,9 +10,12 @@ value: the rates of the projection with ``v# = e_j``). Rates and accelerations a
 the graph: their derivatives are forward-mode too. Nothing is differenced.
 
 The graph is built once per mechanism and moment point (a few hundred milliseconds for a
-six-joint arm or a four-bar) and compiled into one straight-line numpy function; mechanisms the
-generator does not take (too many joints, or a graph above `MAX_NODES`) have no exact partials
-(`exact_partials` returns None) and `mechbal.plan.model` falls back on central differences.
+six-joint arm or a four-bar) and compiled into one straight-line function: C++ by the installed
+compiler (cached beside `mechbal.codegen.build`'s libraries; then an evaluation costs what the
+central differences cost), else numpy (about three times that). Mechanisms the generator does
+not take (too many joints, more than `MAX_PASSIVE` passive coordinates, a graph above
+`MAX_NODES`) have no exact partials (`exact_partials` returns None) and `mechbal.plan.model`
+falls back on central differences.
 
 Layer: methods (docs/architecture.md).
 """
@@ -23,8 +26,12 @@ from typing import Any, Callable
 
 import numpy as np
 
-#: largest graph compiled (nodes); beyond it the central differences are cheaper
-MAX_NODES = 200_000
+#: largest graph compiled (nodes the outputs need); beyond it compiling costs minutes and the
+#: central differences are as good
+MAX_NODES = 20_000
+#: most passive coordinates of a closed mechanism whose loop projection is unrolled (PAMINSA's
+#: legs, with dozens, stay on differences: their graph alone takes a minute to build)
+MAX_PASSIVE = 12
 
 _CACHE: "weakref.WeakKeyDictionary[Any, dict]" = weakref.WeakKeyDictionary()
 
@@ -96,6 +103,8 @@ def _build(mech, p: np.ndarray, with_rates: bool = False, torque: bool = True) -
 
     if mech.model.num_links - 1 > MAX_JOINTS:
         return None
+    if mech.is_closed and len(mech.model.passive_coordinates) > MAX_PASSIVE:
+        return None
     tc = T.tree_constants(mech)
     g = Graph()
     n = tc.dof
@@ -134,7 +143,7 @@ def _build(mech, p: np.ndarray, with_rates: bool = False, torque: bool = True) -
         for j in range(na):
             derivs += directional_derivative(g, outputs, {aa[j].id: 1.0})
     allout = outputs + derivs
-    if len(g.nodes) > MAX_NODES:
+    if int(np.count_nonzero(_needed(g, allout))) > MAX_NODES:
         return None
     function = _compile_c(g, allout, n, na) or _compile(g, allout, n, na, closed)
     return ExactPartials(function, na, len(g.nodes), with_rates, torque)

@@ -513,7 +513,11 @@ def _plan(am, q0, q1, v0, v1, duration, limits, *, objective, weights, control_p
 def _shortest_duration(am, q0, q1, v0, v1, duration, limits, common) -> float | None:
     """The shortest duration (to 0.5 %) at which the planner finds a motion within the limits
     (bisection over durations, doubling first), or None up to 4096 times ``duration``."""
-    feasible = lambda T: _solve(am, q0, q1, v0, v1, T, limits, feasibility_only=True, **common).ok  # noqa: E731
+    def feasible(T: float) -> bool:
+        try:
+            return _solve(am, q0, q1, v0, v1, T, limits, feasibility_only=True, **common).ok
+        except LoopFailure:   # the search wandered out of the workspace: no motion found at T
+            return False
     lo, hi = float(duration), 2.0 * float(duration)
     for _ in range(12):
         if feasible(hi):
