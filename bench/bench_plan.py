@@ -8,7 +8,10 @@ and, second, within a torque limit on the shoulder that the unconstrained plan e
 constrained path: SLSQP with the torque constraints). Target: <= 10 s each on 2 cores (wall
 time; the CPU time of the process is given beside it, which a loaded machine does not inflate).
 
-Each plan is checked before it is timed: ok, below the quintic, limits held.
+Each plan is checked before it is timed: ok, below the quintic, limits held. Each is timed with
+the exact partial derivatives (forward mode on the model's expression graph, the default) and
+with central differences in the positions (``derivatives="differences"``, the earlier scheme):
+the speed-up is the ratio of their median wall times.
 
 Usage: python bench/bench_plan.py [--out FILE.json] [--repeat N]
 """
@@ -51,23 +54,36 @@ def main(argv: list[str] | None = None) -> int:
             "ur5_2s_1khz_shoulder_torque_active": dict(velocity_limit=UR5_VELOCITY, torque_limit=tight)}
     results = {}
     for name, limits in runs.items():
-        times, cpu, r = [], [], None
-        for _ in range(args.repeat):
-            t0, c0 = time.perf_counter(), time.process_time()
-            r = min_shaking(mech, tr.start, tr.end, 2.0, samples=2001, control_points=12, **limits)
-            times.append(time.perf_counter() - t0)
-            cpu.append(time.process_time() - c0)
-        assert r is not None and r.ok and r.value < r.quintic_value, (name, r and r.message)
+        timed = {}
+        for derivatives in ("exact", "differences"):
+            times, cpu, r = [], [], None
+            for _ in range(args.repeat):
+                t0, c0 = time.perf_counter(), time.process_time()
+                r = min_shaking(mech, tr.start, tr.end, 2.0, samples=2001, control_points=12,
+                                derivatives=derivatives, **limits)
+                times.append(time.perf_counter() - t0)
+                cpu.append(time.process_time() - c0)
+            assert r is not None and r.ok and r.value < r.quintic_value, (name, derivatives, r and r.message)
+            assert r.derivatives == derivatives
+            timed[derivatives] = (times, cpu, r)
+        times, cpu, r = timed["exact"]
+        d_times, d_cpu, d = timed["differences"]
         results[name] = {"median_s": statistics.median(times), "min_s": min(times), "runs": len(times),
                          "median_cpu_s": statistics.median(cpu),
                          "rms_shaking_force": r.value, "quintic_rms_shaking_force": r.quintic_value,
                          "reduction": r.reduction, "iterations": r.iterations,
                          "active_limits": sorted({(a["kind"], a["joint"]) for a in r.active_limits}),
+                         "differences": {"median_s": statistics.median(d_times), "median_cpu_s": statistics.median(d_cpu),
+                                         "iterations": d.iterations, "rms_shaking_force": d.value},
+                         "speed_up_cpu": statistics.median(d_cpu) / statistics.median(cpu),
+                         "speed_up_wall": statistics.median(d_times) / statistics.median(times),
                          "target_s": 10.0, "met": statistics.median(times) <= 10.0}
         print(f"{name}: {results[name]['median_s']:.2f} s median of {len(times)} (target 10 s; CPU "
               f"{results[name]['median_cpu_s']:.2f} s, load average {os.getloadavg()[0]:.1f}), RMS force "
               f"{r.quintic_value:.3f} -> {r.value:.3f} N, {r.iterations} iterations, active limits "
-              f"{results[name]['active_limits']}")
+              f"{results[name]['active_limits']}; central differences: {statistics.median(d_times):.2f} s "
+              f"(CPU {statistics.median(d_cpu):.2f} s, {d.iterations} iterations, {d.value:.3f} N): "
+              f"speed-up x{results[name]['speed_up_cpu']:.2f} (CPU)")
     if args.out:
         meta = {"python": sys.version.split()[0], "machine": platform.machine(), "cpus": os.cpu_count(),
                 "load_average": os.getloadavg()}

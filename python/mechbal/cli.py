@@ -7,8 +7,9 @@ naming the field or path; 3 an internal error (a bug in mechbal), reported as on
 request to report it (set ``MECHBAL_DEBUG=1`` for the traceback); 4 another run into the same
 ``--out`` finished at the same moment (this run's results were discarded, the other run's folder
 is whole); 5 (``mechbal balance`` only) the requested balance was not reached: the balance is not
-exact within mechbal's tolerance (``limited_by`` of summary.json is not empty); the results are
-written all the same, and ``--allow-partial`` makes this exit 0; 6 the goal was not met: a
+exact within mechbal's tolerance (``limited_by`` of summary.json is not empty; with ``--partial``,
+the combined design's verdict: ``partial.ok`` false); the results are written all the same, and
+``--allow-partial`` makes this exit 0; 6 the goal was not met: a
 controlled run (``mechbal run`` and ``mechbal verify`` of a case with ``[control]``, ``run --engine
 mujoco``: ``ok`` of summary.json is false: a saturated or out-of-range tick, a cancelled component
 or the task beyond its tolerance, a declared limit exceeded, or, before the run, a motion the
@@ -279,7 +280,8 @@ def _cmd_balance(args) -> int:
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer), staged_output(out) as tmp, \
             progress.run_bar(f"balance {Path(args.case).stem}", 5):
-        summary = run_balance(args.case, args.method, tmp, design=args.design, **_optimal_options(args))
+        summary = run_balance(args.case, args.method, tmp, design=args.design, partial=args.partial,
+                              shaking_target=args.shaking_target, **_optimal_options(args))
         if getattr(args, "view", False):
             _balance_view(args, tmp, summary)
         progress.finish()
@@ -297,6 +299,9 @@ def _cmd_balance(args) -> int:
               f"{', balanced.urdf' if 'balanced.urdf' in summary.get('files', []) else ''}), plots and "
               "bodies files beside it")
     b = summary.get("balance", {}) if isinstance(summary, dict) else {}
+    if args.partial:   # the combined design's verdict replaces the exact balance's
+        p = summary.get("partial", {})
+        b = {"exact": bool(p.get("ok")), "limited_by": p.get("limited_by")}
     if not b.get("exact", True):
         why = "; ".join(b.get("limited_by") or []) or "not exact"
         if args.allow_partial:
@@ -699,6 +704,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="static/force: also write the trade-off front of N designs from zero added "
                         "mass to the best residual: DIR/front.csv, front.json, front.png, "
                         "front/<k>/balanced.toml")
+    s.add_argument("--partial", action="store_true",
+                   help="force: the combined design: counterweights within balance.mass_budget plus the "
+                        "motion that minimises the RMS shaking force on the partially balanced mechanism "
+                        "(mechbal.plan); the report compares quintic and planned motion, unbalanced and "
+                        "with the counterweights")
+    s.add_argument("--shaking-target", type=float, default=None, metavar="F",
+                   help="--partial: the goal, the combined design's RMS shaking force at most F newtons "
+                        f"(not met: exit {EXIT_PARTIAL_BALANCE}, the reason named)")
     _last_flags(s, _cmd_balance, force=True, urdf=True)
     s = sub.add_parser("export", help="write a case's mechanism as MJCF (MuJoCo) or URDF",
                        description="Write the mechanism of a case (built-in name, TOML or URDF file) "

@@ -359,6 +359,11 @@ BALANCE: dict[str, Schema] = {
                              "added_mass_kg": numbers("kg"), "residual": numbers("the residual's unit")}},
     "assembly": detail("Loop assembly: the branch (open or crossed), how it was chosen (branch, "
                        "initial_guess or default) and the branch at the end."),
+    "partial": detail("--partial (force, mechbal.plan.partial): the combined design of counterweights "
+                      "within balance.mass_budget and the motion that minimises shaking: ok, limited_by, "
+                      "added_mass [kg], mass_budget [kg], shaking_target [N], variants (quintic_unbalanced, "
+                      "min_shaking_unbalanced, quintic_balanced, min_shaking_balanced: RMS and peak shaking "
+                      "force [N], shaking moment [N m], joint torque, added mass [kg]) and the two plans."),
 }
 
 _PEAKS = {"type": ["number", "null", "array"], "items": NUMBER,

@@ -453,6 +453,25 @@ TEST(CaseReader, ConstantSpeedTrajectory) {
   refused("start = [0, 0]\nend = [1, 1]\nduration = 1.0\nbranch = \"open\"\n", "trajectory.branch");  // no loop
 }
 
+TEST(CaseReader, MinShakingIsRefusedByItsLaw) {
+  // a planned motion (Python's mechbal.plan) is not run as another law: refused at trajectory.law,
+  // with or without its own keys (which would otherwise read as unknown ones)
+  const std::string base = arm("origin") + "[case]\nname = \"arm\"\nkind = \"mechanism\"\n[trajectory]\n";
+  for (const std::string extra : {"", "objective = \"force_rms\"\ncontrol_points = 10\n"}) {
+    const std::string msg =
+        message_of(base + "law = \"min_shaking\"\nstart = [0, 0]\nend = [1, 1]\nduration = 1.0\n" + extra);
+    EXPECT_EQ(msg.rfind("trajectory.law: 'min_shaking' is a motion planned by the Python layer", 0), 0u) << msg;
+    EXPECT_NE(msg.find("(got 'min_shaking')"), std::string::npos) << msg;
+  }
+  // the built-in case that plans one
+  try {
+    load_case(cases_dir + "four-bar-min-shaking.toml");
+    ADD_FAILURE() << "four-bar-min-shaking.toml accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.field(), "trajectory.law");
+  }
+}
+
 TEST(CaseReader, PlanarIzzIsALamina) {
   // the 2R arm turns about z: izz alone is accepted and is the lamina diag(izz/2, izz/2, izz)
   const std::string planar = "[mechanism]\n[[mechanism.joints]]\nname = \"a\"\nlink = {mass = 1.0, izz = 0.4}\n"

@@ -822,3 +822,21 @@ def test_both_readers_refuse_a_misspelled_table(tmp_path, wrong):
     # the same first problem, whole (Python goes on: "; also trajectory: is required")
     assert str(cpp_exc.value) == py_exc.value.problems[0][1], f"Python: {py_exc.value}\nC++:    {cpp_exc.value}"
     assert py_exc.value.field == wrong.split()[0] and "unknown" in str(cpp_exc.value)
+
+
+@pytest.mark.parametrize("extra", [{}, {"objective": "moment_peak", "control_points": 10}])
+def test_min_shaking_is_planned_in_python_and_refused_by_the_cpp_reader(tmp_path, extra):
+    """law = "min_shaking" is a plan of the Python layer (mechbal.plan): the Python reader takes it,
+    the C++ reader refuses it at trajectory.law (not as an unknown key, not run as another law)."""
+    from mechbal.schema import validate_case
+
+    tr = {"law": "min_shaking", "start": [0.5], "end": [1.0], "duration": 2, **extra}
+    cfg = {"case": {"name": "planar", "kind": "mechanism"}, "mechanism": PLANAR, "trajectory": tr}
+    path = tmp_path / "t.toml"
+    path.write_text(toml_text(cfg))
+    assert validate_case(cfg, warn=False).trajectory.law == "min_shaking"
+    with pytest.raises(ValueError, match=r"^trajectory\.law: 'min_shaking' is a motion planned by the "
+                                         r"Python layer .* \(got 'min_shaking'\)$"):
+        _core.load_case_trajectory(str(path))
+    with pytest.raises(ValueError, match=r"^trajectory\.law: "):
+        _core.load_case_file(str(PKG / "cases" / "four-bar-min-shaking.toml"))

@@ -272,3 +272,88 @@ def test_the_case_format_takes_min_shaking_only_with_its_keys():
     case = validate_case(short, warn=False)
     with pytest.raises(ConfigError, match=r"trajectory\.start_velocity: must have 1 values"):
         plan_from_table(Mechanism.from_spec(case.spec), case.trajectory)
+
+
+@pytest.mark.parametrize("which", ["four-bar", "ur5-dh"])
+def test_exact_partials_against_finite_differences_of_the_library(which, four_bar):
+    """The forward-mode partials (mechbal.plan.exact) of the shaking wrench (moment about a point
+    off O) and of the actuated torques in the actuated q, v and a, against central differences of
+    the library's own Mechanism.closed_motion / inverse_dynamics and shaking_wrench (an
+    independent path: no expression graph); the graph's values are the library's."""
+    if which == "four-bar":
+        mech, qg = four_bar
+    else:
+        mech, qg = _case("ur5-dh")[1], None
+    p = np.array([0.1, -0.2, 0.3])
+    am = ActuatedModel(mech, q_guess=qg, moment_point=p)
+    assert am.exact is not None and am.exact.nodes > 0
+    rng = np.random.default_rng(7)
+    na = am.na
+    # a closed mechanism's instants in order (each loop solve starts from the one before: one branch)
+    qa = np.linspace(0.3, 2.5, 5)[:, None] if mech.is_closed else rng.uniform(-2, 2, (5, na))
+    va, aa = rng.normal(0, 3, (5, na)), rng.normal(0, 20, (5, na))
+    ev = am.evaluate(qa, va, aa, torque=True, partials=True)
+
+    def library(qa, va, aa):   # [F; M_p] and the actuated torques by the library alone
+        if mech.is_closed:
+            m = mech.closed_motion(qa, va, aa, q_guess=qg, with_forces=True)
+            q, v, a, tau = m.q, m.v, m.a, m.actuated_force
+        else:
+            q, v, a, tau = qa, va, aa, mech.inverse_dynamics(qa, va, aa)
+        sw = mech.shaking_wrench(q, v, a)
+        F, M = np.asarray(sw.shaking_force), np.asarray(sw.shaking_moment)
+        return np.concatenate([F, M - np.cross(p, F), np.asarray(tau)], axis=1)
+
+    base = library(qa, va, aa)
+    graph = am.exact(np.asarray(ev.q), va, aa)
+    np.testing.assert_allclose(graph["wrench"], base[:, :6], rtol=0, atol=1e-10 * np.max(np.abs(base[:, :6])))
+    np.testing.assert_allclose(graph["torque"], base[:, 6:], rtol=0, atol=1e-10 * np.max(np.abs(base[:, 6:])))
+    exact = {"q": np.concatenate([ev.dq, ev.torque_dq], axis=1), "v": np.concatenate([ev.dv, ev.torque_dv], axis=1),
+             "a": np.concatenate([ev.da, ev.torque_da], axis=1)}
+    for name, h in (("q", 1e-6), ("v", 1e-4), ("a", 1e-3)):
+        fd = np.zeros_like(exact[name])
+        for j in range(na):
+            args_p, args_m = [qa.copy(), va.copy(), aa.copy()], [qa.copy(), va.copy(), aa.copy()]
+            k = "qva".index(name)
+            args_p[k][:, j] += h
+            args_m[k][:, j] -= h
+            fd[:, :, j] = (library(*args_p) - library(*args_m)) / (2 * h)
+        # per output: the differences' error (truncation h^2, rounding eps |x| / h) against its scale
+        scale = np.max(np.abs(fd), axis=(0, 2), keepdims=True)
+        err = np.abs(exact[name] - fd)
+        assert np.all(err <= 2e-6 * scale + 1e-12 * np.max(scale)), (name, float(np.max(err / (scale + 1e-300))))
+
+
+def test_exact_and_differenced_partials_plan_the_same_motion(four_bar):
+    """The plan with exact partials and the plan with central differences in the positions reach
+    the same optimum (the objective to 1e-6), and each says which it used."""
+    mech, qg = four_bar
+    exact = plan.min_shaking(mech, [0.0], [np.pi], 0.5, q_guess=qg, control_points=10)
+    diff = plan.min_shaking(mech, [0.0], [np.pi], 0.5, q_guess=qg, control_points=10, derivatives="differences")
+    assert exact.ok and diff.ok
+    assert (exact.derivatives, diff.derivatives) == ("exact", "differences")
+    assert exact.summary(mech.actuated_names)["derivatives"] == "exact"
+    assert exact.value == pytest.approx(diff.value, rel=1e-6)
+    with pytest.raises(ValueError, match="derivatives must be 'exact' or 'differences'"):
+        plan.min_shaking(mech, [0.0], [np.pi], 0.5, q_guess=qg, derivatives="forward")
+
+
+def test_the_compiled_and_the_numpy_partials_agree(four_bar, monkeypatch):
+    """The graph's function compiled (the installed C++ compiler) and interpreted by numpy (no
+    compiler) give the same numbers."""
+    from mechbal.codegen import compiler
+    from mechbal.plan.exact import _build
+
+    mech, qg = four_bar
+    if compiler() is None:
+        pytest.skip("no C++ compiler: only the numpy function")
+    compiled = _build(mech, np.array([0.1, 0.0, 0.2]))
+    monkeypatch.setenv("MECHBAL_PLAN_NO_COMPILE", "1")
+    interpreted = _build(mech, np.array([0.1, 0.0, 0.2]))
+    assert hasattr(compiled._f, "library") and not hasattr(interpreted._f, "library")
+    qa = np.linspace(0.2, 2.8, 7)[:, None]
+    va, aa = np.full((7, 1), 2.0), np.linspace(-30, 30, 7)[:, None]
+    q = ActuatedModel(mech, q_guess=qg).full(qa, va, aa)[0]
+    a, b = compiled(q, va, aa), interpreted(q, va, aa)
+    for k in a:
+        np.testing.assert_allclose(a[k], b[k], rtol=1e-12, atol=1e-12 * np.max(np.abs(b[k])), err_msg=k)

@@ -1586,6 +1586,17 @@ std::vector<double> speeds(const toml::node& n, const std::string& f, bool& scal
 TrajectoryConfig read_trajectory(const toml::node& n, const MechanismModel& model) {
   const std::string f = "trajectory";
   const auto& t = table_of(n, f);
+  // the laws of the Python layer that this reader cannot run: refused by name, before their own
+  // keys would read as unknown ones (a planned motion is an optimisation, not a time law)
+  if (auto x = get(t, "law"); x && x->is_string()) {
+    const std::string law = x->as_string()->get();
+    if (law == "min_shaking") {
+      fail(join(f, "law"),
+           "'min_shaking' is a motion planned by the Python layer (mechbal.plan); this reader runs "
+           "quintic, cubic and constant_speed: plan it with `mechbal run` (motion.npz) or give one of those",
+           *x);
+    }
+  }
   allow_keys(t, f, {"law", "start", "end", "duration", "speed", "rpm", "revolutions", "samples", "initial_guess",
                     "branch"});
   TrajectoryConfig tr;

@@ -503,16 +503,23 @@ def _balanced_toml(bc: BalanceCase, result: BalanceResult, method: str) -> str:
 
 def run_balance(case: str, method: str | None, out: Path, design: str | None = None, *,
                 objective: str | None = None, residual_target: float | None = None,
-                front: int | None = None) -> dict:
+                front: int | None = None, partial: bool = False,
+                shaking_target: float | None = None) -> dict:
     """The whole run into ``out`` (a fresh folder: the caller stages it). Returns the summary.
     ``objective``, ``residual_target``: `run_method`'s; ``front``: also the trade-off front of
-    that many designs (`run_front`)."""
+    that many designs (`run_front`); ``partial``: the combined design of the force method under
+    the case's mass budget plus a minimum-shaking motion (`run_partial`), ``shaking_target`` [N]
+    its goal on the RMS shaking force."""
     progress.stage("reading the case")
     bc = balance_case(case, design)
     name = method or (bc.table.method if bc.table is not None else None)
     if name is None:
         raise ConfigError("--method", "give --method static|force|moment|springs|rms (or balance.method "
                                       "in the case)", has_value=False)
+    if shaking_target is not None and not partial:
+        raise ConfigError("--shaking-target", "is the goal of --partial (the combined design)", shaking_target)
+    if partial:
+        _check_partial(bc, name, shaking_target)
     progress.stage(f"balancing ({name})")
     result = run_method(bc, name, objective=objective, residual_target=residual_target)
     progress.stage("evaluating the trajectory")
@@ -587,6 +594,11 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
         progress.stage("front")
         summary["front"] = run_front(bc, name, int(front), out)
         files += ["front.csv", "front.json", "front.png"]
+    if partial:
+        progress.stage("planning the motion (--partial)")
+        combined = run_partial(bc, result, out, shaking_target)
+        summary["partial"] = combined.summary()
+        files += ["partial_shaking_wrench.png"]
     if mjcf_validation is not None:
         summary["mjcf_validation"] = mjcf_validation
     if bc.assembly is not None:
@@ -611,4 +623,45 @@ def run_balance(case: str, method: str | None, out: Path, design: str | None = N
                        ["peak along the trajectory", "unbalanced", "balanced"]))
     print(f"residual {result.residual:.4g} {result.residual_units} (unbalanced {result.residual_before:.4g})"
           + ("" if result.exact else "; limited by: " + "; ".join(result.limited_by)))
+    if partial:
+        print(report.table(combined.table_rows(), combined.TABLE_HEADER))
+        print(f"combined design (counterweights {combined.added_mass:.4g} kg of {combined.mass_budget:g} kg, "
+              f"min-shaking motion): " + ("ok" if combined.ok else "NOT ok: " + "; ".join(combined.limited_by)))
     return summary
+
+
+def _check_partial(bc: BalanceCase, name: str, shaking_target: float | None) -> None:
+    """--partial's requirements, before the long run: the force method, a mass budget, a
+    rest-to-rest trajectory."""
+    if name != "force":
+        raise ConfigError("--partial", f"is the combined design of the force method (counterweights under a "
+                                       f"mass budget plus a min-shaking motion), not of {name!r}", has_value=False)
+    if bc.table is None or bc.table.mass_budget is None:
+        raise ConfigError("balance.mass_budget", "--partial needs a mass budget (kg, the total counterweight "
+                                                 "mass): add mass_budget to [balance]", has_value=False)
+    tt = bc.trajectory_table
+    if tt.get("law", "quintic") not in ("quintic", "cubic") or "end" not in tt:
+        raise ConfigError("trajectory.law", "--partial plans a rest-to-rest motion between start and end in "
+                                            "duration (law quintic, cubic or min_shaking)", tt.get("law"))
+    if shaking_target is not None and not (np.isfinite(shaking_target) and shaking_target > 0):
+        raise ConfigError("--shaking-target", "must be a finite force > 0 (N)", shaking_target)
+
+
+def run_partial(bc: BalanceCase, result: BalanceResult, out: Path, shaking_target: float | None = None):
+    """The combined design (`mechbal.plan.partial`) of a force balance under the case's mass budget:
+    the four-way comparison, its plot (partial_shaking_wrench.png) and verdict."""
+    from mechbal.plan.partial import LABELS, VARIANTS, combined_design, plan_options_of
+
+    tt = bc.trajectory_table
+    added = float(sum(v.mass for v in result.design.values() if isinstance(v, CounterweightDesign)))
+    raw_tr = (bc.raw or {}).get("trajectory") if isinstance(bc.raw, dict) else None
+    combined = combined_design(bc.mechanism, result.balanced, tt["start"], tt["end"], float(tt["duration"]),
+                               added_mass=added, mass_budget=float(bc.table.mass_budget),
+                               shaking_target=shaking_target, budget_active="mass_budget" in result.active_bounds,
+                               samples=len(bc.t), q_guess=bc.q_guess, plan_options=plan_options_of(raw_tr))
+    report.plot_wrench(out / "partial_shaking_wrench.png", np.linspace(0.0, float(tt["duration"]), len(bc.t)),
+                       {LABELS[k]: combined.series[k] for k in VARIANTS},
+                       title=f"{bc.title}: counterweights within {bc.table.mass_budget:g} kg and the planned motion",
+                       caption="Shaking force and shaking moment about O of the quintic and of the motion that "
+                               "minimises shaking, on the unbalanced mechanism and with the counterweights.")
+    return combined

@@ -9,9 +9,10 @@ the joints' position, velocity, acceleration and torque limits.
 * Parameterisation: a clamped quintic B-spline per actuated joint (`mechbal.plan.spline`), the
   boundary positions and velocities held exactly (and zero accelerations with ``smooth_ends``);
   the quintic law is one point of it, the warm start.
-* Gradients: the shaking wrench and the torques are linear in the accelerations and quadratic in
-  the rates; their partial derivatives come from the model (`mechbal.plan.model`), chained through
-  the spline basis.
+* Gradients: the partial derivatives of the shaking wrench and the torques in the actuated
+  positions, rates and accelerations are exact, forward mode on the model's expression graph
+  (`mechbal.plan.exact`; central differences in the positions where the code generator does not
+  take the mechanism), chained through the spline basis.
 * Solvers (scipy): RMS objectives, integrated by Gauss-Legendre quadrature on each knot span,
   by BFGS without the limits first; where that motion exceeds a limit, SLSQP from there with the
   limits imposed where the motion comes near them (an active set: local maxima within 5 % of a
@@ -126,6 +127,8 @@ class PlanResult:
     iterations: int
     checked_samples: int
     metrics: dict[str, dict[str, float]] = field(default_factory=dict)
+    #: how the position partials were had: "exact" (forward mode) or "differences"
+    derivatives: str = "exact"
 
     def summary(self, names: list[str]) -> dict[str, Any]:
         """What summary.json says about the plan (``plan``)."""
@@ -135,7 +138,8 @@ class PlanResult:
                 "ok": self.ok, "message": self.message, "iterations": self.iterations,
                 "control_points": int(self.trajectory.basis.count),
                 "active_limits": [{**a, "joint": names[a["joint"]]} for a in self.active_limits],
-                "limits_checked_on": self.checked_samples, "metrics": self.metrics}
+                "limits_checked_on": self.checked_samples, "metrics": self.metrics,
+                "derivatives": self.derivatives}
 
 
 def quintic_with_velocities(start, end, duration, v0, v1):
@@ -411,7 +415,7 @@ def min_shaking(mech: Mechanism, start: ArrayLike, end: ArrayLike, duration: flo
                 torque_limit: ArrayLike | None = None, velocity_limit: ArrayLike | None = None,
                 smooth_ends: bool = False, control_points: int = 14, samples: int = 501,
                 q_guess: ArrayLike | None = None, max_iterations: int = 2000,
-                feasibility_search: bool = True) -> PlanResult:
+                feasibility_search: bool = True, derivatives: str = "exact") -> PlanResult:
     """Plan the motion of ``mech``'s actuated joints from ``start`` to ``end`` (rad or m, one per
     actuated joint) in ``duration`` [s] that minimises shaking (module docstring).
 
@@ -434,6 +438,9 @@ def min_shaking(mech: Mechanism, start: ArrayLike, end: ArrayLike, duration: flo
         samples: the output grid (``samples`` instants over ``[0, duration]``); the limits are
             checked on a grid ten times finer.
         q_guess: a closed mechanism's assembly at the start (default: `mechbal.assembly.assemble`).
+        derivatives: ``"exact"`` (forward mode on the model's expression graph where the code
+            generator takes the mechanism, `mechbal.plan.exact`; else differences) or
+            ``"differences"`` (central differences of the model in the positions).
 
     Raises `PlanInfeasible` when no motion within the limits is found, with the shortest duration
     the planner found feasible in its message; ValueError on bad arguments."""
@@ -470,7 +477,7 @@ def min_shaking(mech: Mechanism, start: ArrayLike, end: ArrayLike, duration: flo
         from mechbal.assembly import assemble
 
         q_guess = assemble(mech, q0).q
-    am = ActuatedModel(mech, q_guess=q_guess, moment_point=moment_point)
+    am = ActuatedModel(mech, q_guess=q_guess, moment_point=moment_point, derivatives=derivatives)
     with _single_threaded_blas():
         return _plan(am, q0, q1, v0, v1, float(duration), limits, objective=objective, weights=weights,
                      control_points=control_points, samples=samples, max_iterations=max_iterations,
@@ -506,7 +513,11 @@ def _plan(am, q0, q1, v0, v1, duration, limits, *, objective, weights, control_p
 def _shortest_duration(am, q0, q1, v0, v1, duration, limits, common) -> float | None:
     """The shortest duration (to 0.5 %) at which the planner finds a motion within the limits
     (bisection over durations, doubling first), or None up to 4096 times ``duration``."""
-    feasible = lambda T: _solve(am, q0, q1, v0, v1, T, limits, feasibility_only=True, **common).ok  # noqa: E731
+    def feasible(T: float) -> bool:
+        try:
+            return _solve(am, q0, q1, v0, v1, T, limits, feasibility_only=True, **common).ok
+        except LoopFailure:   # the search wandered out of the workspace: no motion found at T
+            return False
     lo, hi = float(duration), 2.0 * float(duration)
     for _ in range(12):
         if feasible(hi):
@@ -626,7 +637,8 @@ def _solve(am: ActuatedModel, q0, q1, v0, v1, T: float, limits: Limits, *, objec
                       moment_point=am.moment_point, value=value, quintic_value=quintic_value,
                       reduction=1.0 - value / quintic_value if quintic_value > 0 else 0.0,
                       active_limits=active, limits=limits, ok=ok, message=message,
-                      iterations=iterations, checked_samples=len(check_t), metrics=metrics)
+                      iterations=iterations, checked_samples=len(check_t), metrics=metrics,
+                      derivatives="exact" if am.exact_of(prob.need_torque) is not None else "differences")
 
 
 #: a limit is watched (imposed) at the instants where the motion comes within this fraction of it

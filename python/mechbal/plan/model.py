@@ -10,10 +10,14 @@ The shaking wrench ``W = dh/dt`` (momentum rate about O; the moment taken about 
   read exactly as ``W(q, 0, e_j)``; ``dtau/da`` likewise;
 * ``dW/dv``: exact by polarisation of the quadratic term, ``(W(q, v + e_j, 0) - W(q, v - e_j,
   0)) / 2`` (a central difference of a quadratic is its derivative, for any step);
-* ``dW/dq``: the one non-polynomial dependence, by central differences of the model
-  (step `Q_STEP`); the model has no position derivatives of the momentum matrix (yet).
+* ``dW/dq``: the one non-polynomial dependence.
 
-Each is one batched call of the model per actuated joint.
+With ``derivatives = "exact"`` (the default where the code generator takes the mechanism) every
+partial, positions included, is the forward-mode derivative of the model's expression graph
+(`mechbal.plan.exact`), evaluated at the library's solution of the loops; with
+``"differences"`` (and where the generator does not apply) the accelerations and rates as
+above, each one batched call of the model per actuated joint, and the positions by central
+differences of the model (step `Q_STEP`).
 
 Layer: methods (docs/architecture.md).
 """
@@ -57,7 +61,12 @@ class ActuatedModel:
     """``mech`` seen from its actuated joints (see the module docstring); ``q_guess``: the
     assembly at the start of a closed mechanism (`mechbal.assembly`)."""
 
-    def __init__(self, mech: Mechanism, *, q_guess=None, moment_point=(0.0, 0.0, 0.0)):
+    def __init__(self, mech: Mechanism, *, q_guess=None, moment_point=(0.0, 0.0, 0.0),
+                 derivatives: str = "exact"):
+        if derivatives not in ("exact", "differences"):
+            raise ValueError(f"derivatives must be 'exact' or 'differences', got {derivatives!r}")
+        self.derivatives = derivatives
+        self._graphs: dict[bool, Any] = {}
         self.mech = mech
         self.closed = bool(mech.is_closed)
         self.na = len(mech.actuated_names)
@@ -87,16 +96,35 @@ class ActuatedModel:
         q, v, a, tau = self.full(qa, va, aa, torque)
         return self.wrench_of(q, v, a), tau, (q, v, a)
 
+    @property
+    def exact(self):
+        """The compiled exact partials of the wrench and the torques
+        (`mechbal.plan.exact.ExactPartials`), or None (differences)."""
+        return self.exact_of(True)
+
+    def exact_of(self, torque: bool):
+        """The compiled exact partials of the wrench (and with ``torque`` of the torques), or None
+        (differences: asked for, or the generator does not take the mechanism)."""
+        if self.derivatives != "exact":
+            return None
+        if torque not in self._graphs:
+            from mechbal.plan.exact import exact_partials
+
+            self._graphs[torque] = exact_partials(self.mech, self.moment_point, torque=torque)
+        return self._graphs[torque]
+
     def evaluate(self, qa, va, aa, *, torque: bool = False, partials: bool = False) -> Evaluation:
         qa, va, aa = (np.atleast_2d(np.asarray(x, float)) for x in (qa, va, aa))
         if not partials:
             W, tau, (q, v, a) = self._eval(qa, va, aa, torque)
             return Evaluation(W, tau, q, v, a)
         N, na = qa.shape
+        graph = self.exact_of(torque)
+        exact = graph is not None
         # every instant with its 1 + 5 na variants, consecutive (one batched call of the model;
         # a closed mechanism's loop solve warm-starts each row from the one before, all nearby):
         # 0: the motion; 1 + j: (q, 0, e_j); 1 + na + j: (q, v +- e_j, 0); 1 + 3 na + j: (q +- h e_j, v, a)
-        K = 1 + 5 * na
+        K = 1 + (3 if exact else 5) * na
         h = Q_STEP * np.maximum(1.0, np.max(np.abs(qa), axis=0))
         E = np.eye(na)
         Q = np.repeat(qa[:, None, :], K, axis=1)
@@ -106,9 +134,10 @@ class ActuatedModel:
         A[:, 1:1 + na] = E
         V[:, 1 + na:1 + 2 * na] = va[:, None, :] + E
         V[:, 1 + 2 * na:1 + 3 * na] = va[:, None, :] - E
-        Q[:, 1 + 3 * na:1 + 4 * na] += h * E
-        Q[:, 1 + 4 * na:] -= h * E
-        V[:, 1 + 3 * na:], A[:, 1 + 3 * na:] = va[:, None, :], aa[:, None, :]
+        if not exact:
+            Q[:, 1 + 3 * na:1 + 4 * na] += h * E
+            Q[:, 1 + 4 * na:] -= h * E
+            V[:, 1 + 3 * na:], A[:, 1 + 3 * na:] = va[:, None, :], aa[:, None, :]
         W, tau, (q, v, a) = self._eval(Q.reshape(-1, na), V.reshape(-1, na), A.reshape(-1, na), torque)
         W = W.reshape(N, K, 6)
         out = Evaluation(W[:, 0], None, q.reshape(N, K, -1)[:, 0], v.reshape(N, K, -1)[:, 0],
@@ -117,13 +146,31 @@ class ActuatedModel:
         out.da = np.moveaxis(W[:, 1:1 + na], 1, 2)
         # rates: polarisation of the quadratic term
         out.dv = np.moveaxis(0.5 * (W[:, 1 + na:1 + 2 * na] - W[:, 1 + 2 * na:1 + 3 * na]), 1, 2)
-        # positions: central differences of the model
-        out.dq = np.moveaxis((W[:, 1 + 3 * na:1 + 4 * na] - W[:, 1 + 4 * na:]) / (2.0 * h[:, None]), 1, 2)
+        if exact:   # positions: forward mode on the model's graph at the library's q
+            d = self._exact_dq(graph, out.q, va, aa)
+            out.dq = d["dq"]
+        else:       # positions: central differences of the model
+            out.dq = np.moveaxis((W[:, 1 + 3 * na:1 + 4 * na] - W[:, 1 + 4 * na:]) / (2.0 * h[:, None]), 1, 2)
         if torque:
             T = tau.reshape(N, K, na)
             out.torque = T[:, 0]
             gravity = self._eval(qa, np.zeros_like(va), np.zeros_like(aa), True)[1]
             out.torque_da = np.moveaxis(T[:, 1:1 + na] - gravity[:, None, :], 1, 2)
             out.torque_dv = np.moveaxis(0.5 * (T[:, 1 + na:1 + 2 * na] - T[:, 1 + 2 * na:1 + 3 * na]), 1, 2)
-            out.torque_dq = np.moveaxis((T[:, 1 + 3 * na:1 + 4 * na] - T[:, 1 + 4 * na:]) / (2.0 * h[:, None]), 1, 2)
+            if exact:
+                out.torque_dq = d["torque_dq"]
+            else:
+                out.torque_dq = np.moveaxis((T[:, 1 + 3 * na:1 + 4 * na] - T[:, 1 + 4 * na:]) / (2.0 * h[:, None]), 1, 2)
         return out
+
+    #: rows per call of the compiled partials (bounds the memory of its intermediate arrays)
+    EXACT_CHUNK = 256
+
+    def _exact_dq(self, graph, q, va, aa) -> dict[str, np.ndarray]:
+        parts: dict[str, list] = {}
+        q = np.asarray(q)
+        for s in range(0, len(q), self.EXACT_CHUNK):
+            sl = slice(s, s + self.EXACT_CHUNK)
+            for k, x in graph(q[sl], va[sl], aa[sl]).items():
+                parts.setdefault(k, []).append(x)
+        return {k: np.concatenate(x) for k, x in parts.items()}
