@@ -1687,7 +1687,10 @@ LoadedCase case_of(const toml::table& doc) {
   }
   const bool chain = kind.empty() || kind == "mechanism" || kind == "serial_chain";
   // the tables of the format (schema.SerialChainCase): a misspelled one ([contrl]) is an error
-  if (chain) allow_keys(doc, "", {"case", "mechanism", "trajectory", "balance", "control"});
+  if (chain) {
+    allow_keys(doc, "", {"case", "mechanism", "trajectory", "balance", "control"});
+    if (const toml::node* h = doc.get("case"); h && h->is_table()) allow_keys(*h->as_table(), "case", {"name", "kind", "title"});
+  }
   MechanismModel model = model_of(description_of(doc));
   ControlConfig control;
   if (const toml::node* c = doc.get("control")) control = read_control(*c, model);
