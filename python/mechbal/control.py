@@ -44,7 +44,7 @@ Layer: Python core (docs/architecture.md).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
+from typing import TYPE_CHECKING, Any, Callable, ClassVar, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -368,7 +368,7 @@ def joint_controller(mechanism: Any, ctl: Any, *, q_guess: npt.ArrayLike | None 
     dynamically balanced design); gains ``kp``, ``kd``; the |tau| limit in force
     (`declared_torque_limit`: ``torque_limit`` and the declared effort limits) and ``max_speed``
     (the input range). ValueError naming the ``control.`` field otherwise."""
-    get = ctl.get if isinstance(ctl, dict) else (lambda k: getattr(ctl, k, None))
+    get: Callable[[str], Any] = ctl.get if isinstance(ctl, dict) else (lambda k: getattr(ctl, k, None))
     kind = get("kind")
     speed = {} if get("max_speed") is None else {"max_speed": float(get("max_speed"))}
     if kind == "computed_torque":

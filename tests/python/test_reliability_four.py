@@ -95,10 +95,8 @@ def test_d01_control_characters_and_xml_invalid_code_points_are_refused(tmp_path
         with pytest.raises(ValueError, match=re.escape(code) if ord(bad[1]) < 0x80 else None):
             _core.case_from_toml(text)
         # and every constructor: the model (the URDF reader's and Python's), the Mechanism's name
-        j = _core.Joint()
-        j.name, j.parent = bad, "base"
         with pytest.raises((ValueError, TypeError), match=re.escape(code)):
-            Mechanism.from_description([j])
+            Mechanism.from_description([_core.Joint(bad, parent="base")])
     with pytest.raises(ValueError):  # the XML reader's refusal of &#1; or the name's
         Mechanism.from_urdf_string('<robot name="r"><link name="base"/><link name="a&#1;"/>'
                                    '<joint name="j" type="revolute"><parent link="base"/><child link="a&#1;"/>'
